@@ -1,0 +1,115 @@
+// Next-event estimation: pick a light by the host's power table, then a point or direction on it.
+
+typedef struct {
+    float3 wi;          // unit direction towards the light
+    float distance;     // distance to the sampled point (INFINITY for directional lights)
+    float3 radiance;    // incident radiance divided by the solid-angle pdf (selection included)
+    float pdf;          // solid-angle pdf including selection; 0 for delta lights
+} LightSample;
+
+// Spot cone attenuation as the glTF KHR_lights_punctual specification writes it.
+inline float spot_falloff(global const GpuLight* l, float3 to_point) {
+    float cos_outer = l->spot.w;
+    float cos_inner = l->extra.x;
+    float scale = 1.0f / fmax(0.001f, cos_inner - cos_outer);
+    float offset = -cos_outer * scale;
+    float cd = dot(l->spot.xyz, to_point);
+    float a = clamp(cd * scale + offset, 0.0f, 1.0f);
+    return a * a;
+}
+
+// Picks a light with probability proportional to the table built on the host.
+inline uint pick_light(global const float* cdf, uint count, float u) {
+    uint lo = 0, hi = count - 1;
+    while (lo < hi) {
+        uint mid = (lo + hi) >> 1;
+        if (u < cdf[mid]) hi = mid; else lo = mid + 1;
+    }
+    return lo;
+}
+
+// Samples light `index` from point p. Punctual lights with radius r > 0 become spheres of the
+// same power (radiance I / (pi r^2)); directional lights with angular radius a > 0 become discs
+// of directions (radiance E / (pi sin^2 a)).
+inline LightSample sample_light(global const GpuLight* lights, global const GpuTriangle* tris,
+                                global const GpuMaterial* materials, uint index, float3 p,
+                                float u1, float u2) {
+    global const GpuLight* l = &lights[index];
+    float select = l->extra.y;
+    uint kind = as_uint(l->position.w);
+    float radius = l->intensity.w;
+    LightSample s;
+    s.pdf = 0.0f;
+    s.radiance = (float3)(0.0f);
+    s.wi = (float3)(0.0f, 0.0f, 1.0f);
+    s.distance = 0.0f;
+    if (kind == LIGHT_DIRECTIONAL) {
+        float3 axis = -l->position.xyz;
+        s.distance = INFINITY;
+        if (radius > 0.0f) {
+            float half_sin = sin(0.5f * radius);
+            float one_minus_cos = 2.0f * half_sin * half_sin;
+            float sin_max = sin(radius);
+            float sin2 = fmax(1e-12f, sin_max * sin_max);
+            s.wi = normalize(to_world(sample_cone(u1, u2, one_minus_cos), axis));
+            float pdf = 1.0f / (2.0f * PI_F * one_minus_cos);
+            s.radiance = l->intensity.xyz / (PI_F * sin2) / (pdf * select);
+            s.pdf = pdf * select;
+        } else {
+            s.wi = axis;
+            s.radiance = l->intensity.xyz / select;
+        }
+        return s;
+    }
+#ifdef HAS_TRIANGLE_LIGHTS
+    if (kind == LIGHT_TRIANGLE) {
+        uint prim = as_uint(l->spot.x);
+        float area = l->spot.y;
+        GpuTriangle t = tris[prim];
+        float2 b = sample_triangle(u1, u2);
+        float3 q = (1.0f - b.x - b.y) * t.v0.xyz + b.x * t.v1.xyz + b.y * t.v2.xyz;
+        float3 ng = normalize(cross(t.v1.xyz - t.v0.xyz, t.v2.xyz - t.v0.xyz));
+        float3 d = q - p;
+        float dist2 = dot(d, d);
+        if (dist2 <= 0.0f) return s;
+        s.distance = sqrt(dist2);
+        s.wi = d / s.distance;
+        global const GpuMaterial* m = &materials[as_uint(t.v0.w)];
+        float cos_l = -dot(ng, s.wi);
+        bool two_sided = (as_uint(m->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
+        if (!two_sided && cos_l <= 0.0f) return s;
+        cos_l = fabs(cos_l);
+        if (cos_l <= 0.0f) return s;
+        s.pdf = select * dist2 / (area * cos_l);
+        s.radiance = m->emission.xyz / s.pdf;
+        return s;
+    }
+#endif
+    float3 center = l->position.xyz;
+    float3 d = center - p;
+    float dist2 = dot(d, d);
+    float dist = sqrt(dist2);
+    if (dist <= 0.0f) return s;
+    float3 intensity = l->intensity.xyz;
+    if (kind == LIGHT_SPOT) intensity *= spot_falloff(l, -d / dist);
+    if (radius > 0.0f && dist > radius) {
+        // Uniform sampling of the cone the sphere subtends.
+        float sin2_max = radius * radius / dist2;
+        float cos_max = sqrt(fmax(0.0f, 1.0f - sin2_max));
+        float one_minus_cos = sin2_max / (1.0f + cos_max);
+        float3 axis = d / dist;
+        s.wi = normalize(to_world(sample_cone(u1, u2, one_minus_cos), axis));
+        // Distance to the near side of the sphere along wi.
+        float b = dot(s.wi, d);
+        float disc = b * b - dist2 + radius * radius;
+        s.distance = b - sqrt(fmax(0.0f, disc));
+        float pdf = 1.0f / (2.0f * PI_F * one_minus_cos);
+        s.radiance = intensity / (PI_F * radius * radius) / (pdf * select);
+        s.pdf = pdf * select;
+    } else {
+        s.wi = d / dist;
+        s.distance = dist;
+        s.radiance = intensity / (dist2 * select);
+    }
+    return s;
+}

@@ -1,0 +1,63 @@
+// Random numbers (PCG-style hash chain) and sampling warps.
+
+#define PI_F 3.14159265358979f
+#define INV_PI_F 0.318309886183791f
+
+inline uint hash_u32(uint x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+// Advances the state and returns a float in [0, 1).
+inline float rng_next(uint* state) {
+    *state = *state * 747796405u + 2891336453u;
+    uint word = ((*state >> ((*state >> 28u) + 4u)) ^ *state) * 277803737u;
+    word = (word >> 22u) ^ word;
+    return (float)(word >> 8) * (1.0f / 16777216.0f);
+}
+
+// An orthonormal basis around unit n (Duff et al. 2017).
+inline void onb(float3 n, float3* t, float3* b) {
+    float s = n.z >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (s + n.z);
+    float c = n.x * n.y * a;
+    *t = (float3)(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+    *b = (float3)(c, s + n.y * n.y * a, -n.y);
+}
+
+inline float3 to_world(float3 v_local, float3 n) {
+    float3 t, b;
+    onb(n, &t, &b);
+    return v_local.x * t + v_local.y * b + v_local.z * n;
+}
+
+// Cosine-weighted hemisphere around +z; pdf = cos / pi.
+inline float3 sample_cosine(float u1, float u2) {
+    float r = sqrt(u1);
+    float phi = 2.0f * PI_F * u2;
+    return (float3)(r * cos(phi), r * sin(phi), sqrt(fmax(0.0f, 1.0f - u1)));
+}
+
+// Uniform direction in a cone around +z given 1 - cos(half-angle) (passed as such so that tiny
+// cones keep their precision); pdf = 1 / (2 pi one_minus_cos).
+inline float3 sample_cone(float u1, float u2, float one_minus_cos) {
+    float x = u1 * one_minus_cos;  // 1 - cos(theta)
+    float c = 1.0f - x;
+    float s = sqrt(fmax(0.0f, x * (2.0f - x)));
+    float phi = 2.0f * PI_F * u2;
+    return (float3)(s * cos(phi), s * sin(phi), c);
+}
+
+// Uniform point on a triangle as barycentric weights of vertices 1 and 2.
+inline float2 sample_triangle(float u1, float u2) {
+    float su = sqrt(u1);
+    return (float2)(su * (1.0f - u2), su * u2);
+}
+
+inline float luminance(float3 c) {
+    return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}

@@ -1,0 +1,237 @@
+// The wavefront stages of the path tracer, in the order the host launches them:
+//   generate -> [extend -> shade -> connect -> advance] x (bounces + 2) -> accumulate
+// Paths live in `paths` by slot (pixel + sample_in_wave * pixels); queues hold the slots of the
+// live paths, compacted by atomic counters, so later bounces only touch live paths.
+
+#define STRATEGY_MIS 0u
+#define STRATEGY_BSDF 1u
+#define STRATEGY_LIGHTS 2u
+
+// Moves p off the surface along the geometric normal n by a few ulps of its coordinates
+// (Wächter and Binder, Ray Tracing Gems, chapter 6).
+inline float3 offset_ray(float3 p, float3 n) {
+    const float origin = 1.0f / 32.0f;
+    const float float_scale = 1.0f / 65536.0f;
+    const float int_scale = 256.0f;
+    int3 of_i = convert_int3(int_scale * n);
+    int3 p_i = as_int3(p) + select(of_i, -of_i, p < 0.0f);
+    return select(as_float3(p_i), p + float_scale * n, fabs(p) < origin);
+}
+
+inline float power_heuristic(float a, float b) {
+    float a2 = a * a;
+    float b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, global uint* queue,
+                     global uint* counters) {
+    uint slot = get_global_id(0);
+    uint pixels = frame.width * frame.height;
+    uint total = pixels * frame.samples_in_wave;
+    if (slot == 0) {
+        counters[COUNT_IN] = total;
+        counters[COUNT_OUT] = 0;
+        counters[COUNT_SHADOW] = 0;
+    }
+    if (slot >= total) return;
+    uint pixel = slot % pixels;
+    uint sample = frame.first_sample + slot / pixels;
+    uint rng = hash_u32(hash_u32(pixel ^ hash_u32(frame.seed)) ^ hash_u32(sample * 0x9e3779b9u + 1u));
+
+    // Jitter within the pixel (box filter) and form the pinhole or thin-lens ray.
+    float fx = ((float)(pixel % frame.width) + rng_next(&rng)) / (float)frame.width;
+    float fy = ((float)(pixel / frame.width) + rng_next(&rng)) / (float)frame.height;
+    float3 dir = camera.forward.xyz + (2.0f * fx - 1.0f) * camera.right.xyz +
+                 (1.0f - 2.0f * fy) * camera.up.xyz;
+    float3 origin = camera.origin.xyz;
+    float u1 = rng_next(&rng);
+    float u2 = rng_next(&rng);
+    if (camera.origin.w > 0.0f) {
+        float3 focus = origin + dir * camera.forward.w;
+        float r = camera.origin.w * sqrt(u1);
+        float phi = 2.0f * PI_F * u2;
+        origin += r * cos(phi) * normalize(camera.right.xyz) + r * sin(phi) * normalize(camera.up.xyz);
+        dir = focus - origin;
+    }
+    GpuPath p;
+    p.origin = (float4)(origin, 0.0f);
+    p.direction = (float4)(normalize(dir), as_float(0u));
+    p.throughput = (float4)(1.0f, 1.0f, 1.0f, as_float(slot));
+    p.radiance = (float4)(0.0f, 0.0f, 0.0f, as_float(rng));
+    paths[slot] = p;
+    queue[slot] = slot;
+}
+
+kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                   global const GpuPath* paths, global const uint* queue,
+                   volatile global uint* counters, global GpuHit* hits) {
+    uint i = get_global_id(0);
+    if (i >= counters[COUNT_IN]) return;
+    global const GpuPath* p = &paths[queue[i]];
+    hits[i] = traverse(nodes, tris, p->origin.xyz, p->direction.xyz, 0.0f, INFINITY, false,
+                       &counters[COUNT_OVERFLOW]);
+}
+
+kernel void shade(GpuFrame frame, global const GpuTriangle* tris,
+                  global const GpuTriShading* shading, global const GpuMaterial* materials,
+                  global const GpuLight* lights, global const float* light_cdf,
+                  global GpuPath* paths, global const uint* queue_in, global const GpuHit* hits,
+                  global uint* queue_out, global GpuShadowRay* shadow_rays,
+                  volatile global uint* counters) {
+    uint i = get_global_id(0);
+    if (i >= counters[COUNT_IN]) return;
+    uint slot = queue_in[i];
+    GpuPath path = paths[slot];
+    GpuHit hit = hits[i];
+    float3 throughput = path.throughput.xyz;
+    float3 radiance = path.radiance.xyz;
+    uint rng = as_uint(path.radiance.w);
+    float3 wo = -path.direction.xyz;
+    float prev_pdf = path.origin.w;
+    bool prev_specular = (as_uint(path.direction.w) & PATH_SPECULAR) != 0u;
+    bool counts_emission = frame.bounce == 0u || prev_specular || frame.strategy != STRATEGY_LIGHTS;
+
+    if (hit.prim == NO_HIT) {
+        // Escaped: the uniform sky, reached by BSDF sampling only.
+        if (counts_emission) radiance += throughput * frame.sky.xyz;
+        paths[slot].radiance.xyz = radiance;
+        return;
+    }
+
+    GpuTriangle tri = tris[hit.prim];
+    float w0 = 1.0f - hit.u - hit.v;
+    float3 p = w0 * tri.v0.xyz + hit.u * tri.v1.xyz + hit.v * tri.v2.xyz;
+    float3 ng = normalize(cross(tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz));
+    global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
+    bool front = dot(ng, wo) > 0.0f;
+
+#ifdef HAS_TRIANGLE_LIGHTS
+    // Emission of a light hit by this ray, weighted against light sampling of the last vertex.
+    int light_index = as_int(tri.v1.w);
+    bool two_sided = (as_uint(mat->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
+    if (light_index >= 0 && (front || two_sided) && counts_emission) {
+        float weight = 1.0f;
+        if (frame.bounce > 0u && !prev_specular && frame.strategy == STRATEGY_MIS) {
+            global const GpuLight* l = &lights[light_index];
+            float cos_l = fabs(dot(ng, wo));
+            float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
+            weight = power_heuristic(prev_pdf, light_pdf);
+        }
+        radiance += throughput * mat->emission.xyz * weight;
+    }
+#endif
+
+    // The last extension only looks for emitters (the MIS partner of the last light sample).
+    if (frame.bounce > frame.max_bounces) {
+        paths[slot].radiance.xyz = radiance;
+        return;
+    }
+
+    // Face the normals towards the side the ray came from.
+    if (!front) ng = -ng;
+    float3 ns = ng;
+    GpuTriShading sh = shading[hit.prim];
+    if (sh.n0.w > 0.0f) {
+        float3 n = w0 * sh.n0.xyz + hit.u * sh.n1.xyz + hit.v * sh.n2.xyz;
+        float len = length(n);
+        if (len > 0.0f) {
+            ns = n / len;
+            if (dot(ns, ng) < 0.0f) ns = -ns;
+        }
+    }
+    SurfaceMaterial m = surface_material(mat);
+    float3 origin = offset_ray(p, ng);
+
+    // Next-event estimation: one light sample, traced later by `connect`.
+    if (frame.strategy != STRATEGY_BSDF && frame.light_count > 0u) {
+        uint index = pick_light(light_cdf, frame.light_count, rng_next(&rng));
+        float u1 = rng_next(&rng);
+        float u2 = rng_next(&rng);
+        LightSample ls = sample_light(lights, tris, materials, index, p, u1, u2);
+        if (dot(ls.wi, ng) > 0.0f && (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
+            float bsdf_pdf;
+            float3 f = bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
+            float weight = (frame.strategy == STRATEGY_MIS && ls.pdf > 0.0f)
+                               ? power_heuristic(ls.pdf, bsdf_pdf)
+                               : 1.0f;
+            float3 contribution = throughput * f * ls.radiance * weight;
+            if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
+                uint s = atomic_inc(&counters[COUNT_SHADOW]);
+                GpuShadowRay ray;
+                ray.origin = (float4)(origin, ls.distance * 0.9999f);
+                ray.direction = (float4)(ls.wi, as_float(slot));
+                ray.contribution = (float4)(contribution, 0.0f);
+                shadow_rays[s] = ray;
+            }
+        }
+    }
+
+    // Sample the BSDF for the next ray; Russian roulette after rr_depth bounces.
+    float3 wi;
+    float pdf;
+    bool specular;
+    float u1 = rng_next(&rng);
+    float u2 = rng_next(&rng);
+    float3 weight = bsdf_sample(&m, ns, wo, u1, u2, &wi, &pdf, &specular);
+    throughput *= weight;
+    bool alive = pdf > 0.0f && dot(wi, ng) > 0.0f &&
+                 (throughput.x > 0.0f || throughput.y > 0.0f || throughput.z > 0.0f);
+    if (alive && frame.bounce >= frame.rr_depth) {
+        float q = fmin(fmax(throughput.x, fmax(throughput.y, throughput.z)), 0.95f);
+        if (rng_next(&rng) >= q) {
+            alive = false;
+        } else {
+            throughput /= q;
+        }
+    }
+    path.radiance = (float4)(radiance, as_float(rng));
+    if (alive) {
+        path.origin = (float4)(origin, pdf);
+        path.direction = (float4)(wi, as_float(specular ? PATH_SPECULAR : 0u));
+        path.throughput.xyz = throughput;
+        queue_out[atomic_inc(&counters[COUNT_OUT])] = slot;
+    }
+    paths[slot] = path;
+}
+
+kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                    global const GpuShadowRay* shadow_rays, volatile global uint* counters,
+                    global GpuPath* paths) {
+    uint i = get_global_id(0);
+    if (i >= counters[COUNT_SHADOW]) return;
+    GpuShadowRay r = shadow_rays[i];
+    GpuHit hit = traverse(nodes, tris, r.origin.xyz, r.direction.xyz, 0.0f, r.origin.w, true,
+                          &counters[COUNT_OVERFLOW]);
+    if (hit.prim == NO_HIT) paths[as_uint(r.direction.w)].radiance.xyz += r.contribution.xyz;
+}
+
+// One work item: counts the rays of this bounce and makes the output queue the next input.
+kernel void advance(global uint* counters, global ulong* stats) {
+    if (get_global_id(0) != 0) return;
+    stats[STAT_EXTENSION_RAYS] += counters[COUNT_IN];
+    stats[STAT_SHADOW_RAYS] += counters[COUNT_SHADOW];
+    counters[COUNT_IN] = counters[COUNT_OUT];
+    counters[COUNT_OUT] = 0;
+    counters[COUNT_SHADOW] = 0;
+}
+
+// Adds every finished sample of the wave to the film (.xyz radiance sum, .w sample count), in a
+// fixed order per pixel so the result does not depend on the queues' order. Non-finite samples
+// are counted and dropped.
+kernel void accumulate(GpuFrame frame, global const GpuPath* paths, global float4* film,
+                       volatile global uint* counters) {
+    uint pixel = get_global_id(0);
+    uint pixels = frame.width * frame.height;
+    if (pixel >= pixels) return;
+    float3 sum = (float3)(0.0f);
+    for (uint j = 0; j < frame.samples_in_wave; ++j) {
+        float3 r = paths[pixel + j * pixels].radiance.xyz;
+        if (all(isfinite(r))) {
+            sum += r;
+        } else {
+            atomic_inc(&counters[COUNT_NONFINITE]);
+        }
+    }
+    film[pixel] += (float4)(sum, (float)frame.samples_in_wave);
+}

@@ -1,0 +1,144 @@
+// BVH traversal: watertight ray-triangle test (Woop, Benthin, Wald 2013) over the flat node array.
+// The host reference (src/bvh/traverse.rs) follows these steps exactly; contraction into fused
+// multiply-adds is off so both sides round the same way.
+#pragma OPENCL FP_CONTRACT OFF
+
+#define STACK_SIZE 64
+#define NO_HIT 0xffffffffu
+
+typedef struct {
+    float3 origin;
+    float3 inv;    // safe reciprocal of the direction
+    uint4 perm;    // (kx, ky, kz, 3) for shuffle()
+    float3 shear;  // (dx/dz, dy/dz, 1/dz) in the permuted frame
+} RayPrep;
+
+inline float safe_rcp(float x) {
+    return 1.0f / (fabs(x) > 1e-20f ? x : copysign(1e-20f, x));
+}
+
+inline RayPrep prepare_ray(float3 o, float3 d) {
+    RayPrep r;
+    r.origin = o;
+    r.inv = (float3)(safe_rcp(d.x), safe_rcp(d.y), safe_rcp(d.z));
+    float3 a = fabs(d);
+    uint kz = a.x > a.y ? (a.x > a.z ? 0u : 2u) : (a.y > a.z ? 1u : 2u);
+    uint kx = (kz + 1u) % 3u;
+    uint ky = (kx + 1u) % 3u;
+    float4 d4 = (float4)(d, 0.0f);
+    float dz = kz == 0u ? d.x : (kz == 1u ? d.y : d.z);
+    if (dz < 0.0f) {
+        uint tmp = kx;
+        kx = ky;
+        ky = tmp;
+    }
+    r.perm = (uint4)(kx, ky, kz, 3u);
+    float4 p = shuffle(d4, r.perm);
+    r.shear = (float3)(p.x / p.z, p.y / p.z, 1.0f / p.z);
+    return r;
+}
+
+// Returns true on a hit in (tmin, *tmax), updating *tmax and the barycentrics.
+inline bool intersect_triangle(const RayPrep* r, float4 v0, float4 v1, float4 v2, float tmin,
+                               float* tmax, float* bu, float* bv) {
+    float4 o = (float4)(r->origin, 0.0f);
+    float4 a = shuffle(v0 - o, r->perm);
+    float4 b = shuffle(v1 - o, r->perm);
+    float4 c = shuffle(v2 - o, r->perm);
+    float ax = a.x - r->shear.x * a.z;
+    float ay = a.y - r->shear.y * a.z;
+    float bx = b.x - r->shear.x * b.z;
+    float by = b.y - r->shear.y * b.z;
+    float cx = c.x - r->shear.x * c.z;
+    float cy = c.y - r->shear.y * c.z;
+    float u = cx * by - cy * bx;
+    float v = ax * cy - ay * cx;
+    float w = bx * ay - by * ax;
+#ifdef cl_khr_fp64
+    if (u == 0.0f || v == 0.0f || w == 0.0f) {
+        u = (float)((double)cx * (double)by - (double)cy * (double)bx);
+        v = (float)((double)ax * (double)cy - (double)ay * (double)cx);
+        w = (float)((double)bx * (double)ay - (double)by * (double)ax);
+    }
+#endif
+    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
+    float det = u + v + w;
+    if (det == 0.0f) return false;
+    float t = (u * (r->shear.z * a.z) + v * (r->shear.z * b.z) + w * (r->shear.z * c.z)) / det;
+    if (!(t > tmin && t < *tmax)) return false;
+    *tmax = t;
+    *bu = v / det;
+    *bv = w / det;
+    return true;
+}
+
+// Slab test with the far distance scaled up by two ulps (Ize 2013); returns the entry distance
+// or INFINITY on a miss.
+inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float tmax) {
+    float3 t0 = (lo.xyz - r->origin) * r->inv;
+    float3 t1 = (hi.xyz - r->origin) * r->inv;
+    float3 mn = fmin(t0, t1);
+    float3 mx = fmax(t0, t1);
+    float near = fmax(fmax(fmax(mn.x, mn.y), mn.z), tmin);
+    float far = fmin(fmin(mx.x, mx.y), mx.z) * 1.00000024f;
+    return (near <= far && near < tmax) ? near : INFINITY;
+}
+
+// Closest hit (any_hit = false) or first hit (any_hit = true). On a stack overflow, which the
+// builder's depth limit rules out, the overflow counter is raised instead of failing silently.
+inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle* tris, float3 o,
+                       float3 d, float tmin, float tmax, bool any_hit,
+                       volatile global uint* overflow) {
+    RayPrep r = prepare_ray(o, d);
+    GpuHit hit;
+    hit.t = tmax;
+    hit.u = 0.0f;
+    hit.v = 0.0f;
+    hit.prim = NO_HIT;
+    uint stack[STACK_SIZE];
+    uint sp = 0;
+    uint node = 0;
+    for (;;) {
+        GpuBvhNode n = nodes[node];
+        float dist[2];
+        int child[2];
+        for (int side = 0; side < 2; ++side) {
+            float4 lo = side == 0 ? n.left_min : n.right_min;
+            float4 hi = side == 0 ? n.left_max : n.right_max;
+            child[side] = -1;
+            dist[side] = box_entry(lo, hi, &r, tmin, hit.t);
+            if (dist[side] == INFINITY) continue;
+            int ref = as_int(lo.w);
+            if (ref >= 0) {
+                child[side] = ref;
+                continue;
+            }
+            uint first = (uint)(~ref);
+            uint count = as_uint(hi.w);
+            for (uint p = first; p < first + count; ++p) {
+                GpuTriangle t = tris[p];
+                if (intersect_triangle(&r, t.v0, t.v1, t.v2, tmin, &hit.t, &hit.u, &hit.v)) {
+                    hit.prim = p;
+                    if (any_hit) return hit;
+                }
+            }
+        }
+        if (child[0] >= 0 && child[1] >= 0) {
+            uint first = dist[0] <= dist[1] ? (uint)child[0] : (uint)child[1];
+            uint second = dist[0] <= dist[1] ? (uint)child[1] : (uint)child[0];
+            if (sp == STACK_SIZE) {
+                atomic_inc(overflow);
+                return hit;
+            }
+            stack[sp++] = second;
+            node = first;
+        } else if (child[0] >= 0) {
+            node = (uint)child[0];
+        } else if (child[1] >= 0) {
+            node = (uint)child[1];
+        } else {
+            if (sp == 0) return hit;
+            node = stack[--sp];
+        }
+    }
+}

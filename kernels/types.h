@@ -1,0 +1,107 @@
+// Structs shared with the host. Each mirrors one in src/cl/types.rs field for field; the layout
+// probe test checks sizes and offsets. No bare float3: payloads ride in .w of a float4.
+
+typedef struct {
+    float4 left_min;   // .w = left child (int bits): node index, or ~first triangle for a leaf
+    float4 left_max;   // .w = left leaf triangle count (uint bits), 0 for an interior child
+    float4 right_min;  // .w = right child (int bits)
+    float4 right_max;  // .w = right leaf triangle count (uint bits)
+} GpuBvhNode;
+
+typedef struct {
+    float4 v0;  // .w = material index (uint bits)
+    float4 v1;  // .w = emissive light index (int bits), -1 when not emissive
+    float4 v2;  // .w = object index (uint bits)
+} GpuTriangle;
+
+typedef struct {
+    float4 n0;    // normal at vertex 0; .w = 1 with file normals, 0 for flat shading
+    float4 n1;    // normal at vertex 1
+    float4 n2;    // normal at vertex 2
+    float4 uv01;  // TEXCOORD_0 of vertices 0 (.xy) and 1 (.zw)
+    float4 uv2;   // TEXCOORD_0 of vertex 2 (.xy)
+} GpuTriShading;
+
+#define MATERIAL_DOUBLE_SIDED 1u
+
+typedef struct {
+    float4 base_color;  // linear base color; .w = alpha
+    float4 emission;    // emitted radiance; .w = flags (uint bits, MATERIAL_*)
+    float4 params;      // .x metallic, .y roughness, .z ior, .w specularFactor
+    float4 specular;    // specularColorFactor; .w = transmission
+    int4 textures;      // base color, metallic-roughness, normal, emissive; -1 when absent
+} GpuMaterial;
+
+#define LIGHT_POINT 0u
+#define LIGHT_SPOT 1u
+#define LIGHT_DIRECTIONAL 2u
+#define LIGHT_TRIANGLE 3u
+
+typedef struct {
+    float4 position;   // position, or travel direction (directional); .w = kind (uint bits)
+    float4 intensity;  // intensity (point/spot) or irradiance (directional); .w = radius
+    float4 spot;       // spot axis; .w = cos outer angle. Triangle: .x = index bits, .y = area
+    float4 extra;      // .x = cos inner angle, .y = selection probability
+} GpuLight;
+
+typedef struct {
+    float4 origin;   // eye; .w = lens radius
+    float4 forward;  // unit view direction; .w = focus distance
+    float4 right;    // right * tan(fov/2) * aspect
+    float4 up;       // up * tan(fov/2)
+} GpuCamera;
+
+typedef struct {
+    uint width;
+    uint height;
+    uint samples_in_wave;
+    uint first_sample;
+    uint seed;
+    uint max_bounces;
+    uint rr_depth;
+    uint strategy;  // 0 = MIS, 1 = BSDF only, 2 = lights only
+    float4 sky;     // uniform environment radiance
+    uint light_count;
+    float light_weight_total;
+    uint bounce;
+    uint pad;
+} GpuFrame;
+
+typedef struct {
+    float4 origin;      // .w = pdf of the BSDF sample that made this ray (0: camera ray)
+    float4 direction;   // .w = flags (uint bits): PATH_SPECULAR
+    float4 throughput;  // .w = slot (uint bits): pixel + sample_in_wave * pixels
+    float4 radiance;    // .w = random state (uint bits)
+} GpuPath;
+
+#define PATH_SPECULAR 1u
+
+typedef struct {
+    float t;
+    float u;      // weight of vertex 1
+    float v;      // weight of vertex 2
+    uint prim;    // triangle in BVH order, 0xffffffff on a miss
+} GpuHit;
+
+typedef struct {
+    float4 origin;        // .w = maximum distance
+    float4 direction;     // .w = path slot (uint bits)
+    float4 contribution;  // radiance added to the path when the light is visible
+} GpuShadowRay;
+
+typedef struct {
+    float4 origin;     // .w = tmin
+    float4 direction;  // .w = tmax
+} GpuRay;
+
+// Slots of the uint counters buffer.
+#define COUNT_IN 0
+#define COUNT_OUT 1
+#define COUNT_SHADOW 2
+#define COUNT_NONFINITE 3
+#define COUNT_OVERFLOW 4
+#define COUNTER_SLOTS 8
+
+// Slots of the ulong statistics buffer.
+#define STAT_EXTENSION_RAYS 0
+#define STAT_SHADOW_RAYS 1

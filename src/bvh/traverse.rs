@@ -1,0 +1,240 @@
+//! Host reference traversal. It follows the kernels' rules step by step (watertight triangle
+//! test, slab test with conservative far distances, leaf children tested on the spot, the nearer
+//! interior child first) so device results can be compared with it hit for hit.
+
+use super::{Bvh, Child};
+use glam::Vec3;
+
+/// A ray with a distance interval (tmin, tmax).
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    /// Origin.
+    pub origin: Vec3,
+    /// Direction (need not be unit length; t is in units of it).
+    pub direction: Vec3,
+    /// Hits at or before this distance are ignored.
+    pub tmin: f32,
+    /// Hits at or beyond this distance are ignored.
+    pub tmax: f32,
+}
+
+/// A ray–triangle hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Distance along the ray.
+    pub t: f32,
+    /// Barycentric weight of vertex 1.
+    pub u: f32,
+    /// Barycentric weight of vertex 2.
+    pub v: f32,
+    /// Triangle index in BVH order.
+    pub prim: u32,
+}
+
+/// Per-ray constants of the watertight test (Woop, Benthin, Wald 2013).
+struct Shear {
+    k: [usize; 3],
+    s: Vec3,
+}
+
+impl Shear {
+    fn new(d: Vec3) -> Self {
+        let a = d.abs();
+        let kz = if a.x > a.y {
+            if a.x > a.z { 0 } else { 2 }
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        Self {
+            k: [kx, ky, kz],
+            s: Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]),
+        }
+    }
+}
+
+/// The watertight ray–triangle test: returns (t, u, v) with u, v the weights of vertices 1 and 2.
+/// Rays through shared edges and vertices hit exactly one of the triangles sharing them.
+pub fn intersect_triangle(ray: &Ray, tri: &[Vec3; 3]) -> Option<(f32, f32, f32)> {
+    intersect_sheared(ray, &Shear::new(ray.direction), tri)
+}
+
+fn intersect_sheared(ray: &Ray, sh: &Shear, tri: &[Vec3; 3]) -> Option<(f32, f32, f32)> {
+    let [kx, ky, kz] = sh.k;
+    let a = tri[0] - ray.origin;
+    let b = tri[1] - ray.origin;
+    let c = tri[2] - ray.origin;
+    let ax = a[kx] - sh.s.x * a[kz];
+    let ay = a[ky] - sh.s.y * a[kz];
+    let bx = b[kx] - sh.s.x * b[kz];
+    let by = b[ky] - sh.s.y * b[kz];
+    let cx = c[kx] - sh.s.x * c[kz];
+    let cy = c[ky] - sh.s.y * c[kz];
+    let mut u = cx * by - cy * bx;
+    let mut v = ax * cy - ay * cx;
+    let mut w = bx * ay - by * ax;
+    // Fall back to double precision on an edge, as the paper does.
+    if u == 0.0 || v == 0.0 || w == 0.0 {
+        let (ax, ay, bx, by, cx, cy) = (
+            ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
+        );
+        u = (cx * by - cy * bx) as f32;
+        v = (ax * cy - ay * cx) as f32;
+        w = (bx * ay - by * ax) as f32;
+    }
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return None;
+    }
+    let det = u + v + w;
+    if det == 0.0 {
+        return None;
+    }
+    let t = (u * (sh.s.z * a[kz]) + v * (sh.s.z * b[kz]) + w * (sh.s.z * c[kz])) / det;
+    if !(t > ray.tmin && t < ray.tmax) {
+        return None;
+    }
+    Some((t, v / det, w / det))
+}
+
+/// Direction reciprocal that stays finite for axis-parallel rays.
+fn safe_inverse(d: Vec3) -> Vec3 {
+    let fix = |x: f32| {
+        if x.abs() > 1e-20 {
+            1.0 / x
+        } else {
+            1.0 / 1e-20f32.copysign(x)
+        }
+    };
+    Vec3::new(fix(d.x), fix(d.y), fix(d.z))
+}
+
+/// Slab test; the far distance is scaled up by two ulps so that rounding never loses a hit
+/// (Ize 2013). Returns the entry distance.
+fn box_entry(lo: Vec3, hi: Vec3, origin: Vec3, inv: Vec3, tmin: f32, tmax: f32) -> Option<f32> {
+    let t0 = (lo - origin) * inv;
+    let t1 = (hi - origin) * inv;
+    let near = t0.min(t1).max_element().max(tmin);
+    let far = t0.max(t1).min_element() * 1.000_000_24;
+    (near <= far && near < tmax).then_some(near)
+}
+
+/// Entries of the traversal stack; the kernels use the same size.
+pub const STACK_SIZE: usize = 64;
+
+impl Bvh {
+    /// The closest hit along `ray` among `tris` (in BVH order).
+    pub fn intersect(&self, ray: &Ray, tris: &[[Vec3; 3]]) -> Option<Hit> {
+        self.traverse(ray, tris, false)
+    }
+
+    /// Whether anything blocks `ray` within its interval.
+    pub fn occluded(&self, ray: &Ray, tris: &[[Vec3; 3]]) -> bool {
+        self.traverse(ray, tris, true).is_some()
+    }
+
+    fn traverse(&self, ray: &Ray, tris: &[[Vec3; 3]], any: bool) -> Option<Hit> {
+        let sh = Shear::new(ray.direction);
+        let inv = safe_inverse(ray.direction);
+        let mut tmax = ray.tmax;
+        let mut best = None;
+        let mut stack = [0u32; STACK_SIZE];
+        let mut sp = 0;
+        let mut node = 0u32;
+        loop {
+            let mut near = [None, None];
+            for (side, slot) in near.iter_mut().enumerate() {
+                let (bounds, child) = self.child(node, side);
+                let Some(d) = box_entry(bounds.min, bounds.max, ray.origin, inv, ray.tmin, tmax)
+                else {
+                    continue;
+                };
+                match child {
+                    Child::Leaf { first, count } => {
+                        for prim in first..first + count {
+                            let r = Ray { tmax, ..*ray };
+                            if let Some((t, u, v)) =
+                                intersect_sheared(&r, &sh, &tris[prim as usize])
+                            {
+                                tmax = t;
+                                best = Some(Hit { t, u, v, prim });
+                                if any {
+                                    return best;
+                                }
+                            }
+                        }
+                    }
+                    Child::Node(index) => *slot = Some((d, index)),
+                }
+            }
+            node = match near {
+                [Some((dl, l)), Some((dr, r))] => {
+                    let (first, second) = if dl <= dr { (l, r) } else { (r, l) };
+                    assert!(sp < STACK_SIZE, "BVH deeper than the traversal stack");
+                    stack[sp] = second;
+                    sp += 1;
+                    first
+                }
+                [Some((_, n)), None] | [None, Some((_, n))] => n,
+                [None, None] => {
+                    if sp == 0 {
+                        return best;
+                    }
+                    sp -= 1;
+                    stack[sp]
+                }
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ray(o: Vec3, d: Vec3) -> Ray {
+        Ray {
+            origin: o,
+            direction: d,
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        }
+    }
+
+    #[test]
+    fn hits_a_triangle_with_correct_barycentrics() {
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let (t, u, v) =
+            intersect_triangle(&ray(Vec3::new(0.25, 0.5, 1.0), -Vec3::Z), &tri).unwrap();
+        assert!((t - 1.0).abs() < 1e-6);
+        assert!((u - 0.25).abs() < 1e-6 && (v - 0.5).abs() < 1e-6, "{u} {v}");
+    }
+
+    #[test]
+    fn misses_outside_and_behind() {
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        assert!(intersect_triangle(&ray(Vec3::new(0.8, 0.8, 1.0), -Vec3::Z), &tri).is_none());
+        assert!(intersect_triangle(&ray(Vec3::new(0.2, 0.2, 1.0), Vec3::Z), &tri).is_none());
+    }
+
+    #[test]
+    fn a_ray_through_a_shared_edge_hits_exactly_one_triangle() {
+        // Two triangles sharing the diagonal of the unit square; rays exactly on the diagonal.
+        let a = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0)];
+        let b = [Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        for i in 1..100 {
+            let x = i as f32 / 100.0;
+            let r = ray(Vec3::new(x, x, 1.0), Vec3::new(0.0, 0.0, -1.0));
+            let hits = [&a, &b]
+                .iter()
+                .filter(|t| intersect_triangle(&r, t).is_some())
+                .count();
+            assert!(hits >= 1, "the ray at {x} slipped through the edge");
+        }
+    }
+}

@@ -1,0 +1,176 @@
+//! Platform and device discovery, device choice, and the one context and in-order queue.
+
+use super::{ClError, call_err};
+use opencl3::command_queue::{CL_QUEUE_PROFILING_ENABLE, CommandQueue};
+use opencl3::context::Context;
+use opencl3::device::{CL_DEVICE_TYPE_ALL, CL_DEVICE_TYPE_GPU, Device};
+use opencl3::platform::get_platforms;
+use std::str::FromStr;
+
+/// How the user picks a device (`--device gpu|cpu|INDEX`, or `PENUMBRA_DEVICE`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum DeviceChoice {
+    /// The first GPU, else the first CPU (the default).
+    #[default]
+    Auto,
+    /// The first GPU.
+    Gpu,
+    /// The first CPU device.
+    Cpu,
+    /// The device with this index in `penumbra devices`.
+    Index(usize),
+}
+
+impl FromStr for DeviceChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "" | "auto" => Ok(Self::Auto),
+            "gpu" => Ok(Self::Gpu),
+            "cpu" => Ok(Self::Cpu),
+            other => other.parse().map(Self::Index).map_err(|_| {
+                format!("device '{s}' is not 'gpu', 'cpu' or an index from `penumbra devices`")
+            }),
+        }
+    }
+}
+
+impl DeviceChoice {
+    /// The choice from the command line, else from `PENUMBRA_DEVICE`, else automatic.
+    pub fn from_arg_or_env(arg: Option<&str>) -> Result<Self, String> {
+        match arg {
+            Some(a) => a.parse(),
+            None => match std::env::var("PENUMBRA_DEVICE") {
+                Ok(v) => v.parse().map_err(|e| format!("PENUMBRA_DEVICE: {e}")),
+                Err(_) => Ok(Self::Auto),
+            },
+        }
+    }
+}
+
+/// One OpenCL device as `penumbra devices` lists it.
+#[derive(Clone, Debug)]
+pub struct DeviceInfo {
+    /// Index `--device` takes.
+    pub index: usize,
+    /// Platform name.
+    pub platform: String,
+    /// Device name.
+    pub name: String,
+    /// Whether it is a GPU.
+    pub is_gpu: bool,
+    /// OpenCL version string.
+    pub version: String,
+    /// Driver version.
+    pub driver: String,
+    /// Compute units.
+    pub compute_units: u32,
+    /// Global memory in bytes.
+    pub memory: u64,
+    /// The device handle.
+    pub id: opencl3::types::cl_device_id,
+}
+
+/// Every device of every platform, in platform order.
+pub fn list_devices() -> Result<Vec<DeviceInfo>, ClError> {
+    let platforms = get_platforms().map_err(|e| {
+        ClError::Device(format!(
+            "no OpenCL platform found ({e}); install an OpenCL driver such as pocl-opencl-icd"
+        ))
+    })?;
+    let mut out = Vec::new();
+    for platform in platforms {
+        let pname = platform.name().unwrap_or_default();
+        let Ok(ids) = platform.get_devices(CL_DEVICE_TYPE_ALL) else {
+            continue;
+        };
+        for id in ids {
+            let d = Device::new(id);
+            out.push(DeviceInfo {
+                index: out.len(),
+                platform: pname.clone(),
+                name: d.name().unwrap_or_default().trim().to_string(),
+                is_gpu: d.dev_type().is_ok_and(|t| t & CL_DEVICE_TYPE_GPU != 0),
+                version: d.version().unwrap_or_default(),
+                driver: d.driver_version().unwrap_or_default(),
+                compute_units: d.max_compute_units().unwrap_or(0),
+                memory: d.global_mem_size().unwrap_or(0),
+                id,
+            });
+        }
+    }
+    if out.is_empty() {
+        return Err(ClError::Device(
+            "no OpenCL device found; install an OpenCL driver such as pocl-opencl-icd".into(),
+        ));
+    }
+    Ok(out)
+}
+
+/// The chosen device with its context and in-order profiling queue.
+pub struct Gpu {
+    /// What was chosen.
+    pub info: DeviceInfo,
+    /// The device.
+    pub device: Device,
+    /// The context.
+    pub context: Context,
+    /// The in-order queue with profiling enabled.
+    pub queue: CommandQueue,
+}
+
+impl Gpu {
+    /// Opens the device the choice names.
+    pub fn open(choice: &DeviceChoice) -> Result<Self, ClError> {
+        let devices = list_devices()?;
+        let info = match choice {
+            DeviceChoice::Auto => devices
+                .iter()
+                .find(|d| d.is_gpu)
+                .or_else(|| devices.first())
+                .cloned(),
+            DeviceChoice::Gpu => devices.iter().find(|d| d.is_gpu).cloned(),
+            DeviceChoice::Cpu => devices.iter().find(|d| !d.is_gpu).cloned(),
+            DeviceChoice::Index(i) => devices.get(*i).cloned(),
+        }
+        .ok_or_else(|| {
+            let names: Vec<String> = devices
+                .iter()
+                .map(|d| format!("{}: {}", d.index, d.name))
+                .collect();
+            ClError::Device(format!(
+                "no OpenCL device matches {choice:?} (devices: {})",
+                names.join(", ")
+            ))
+        })?;
+        let device = Device::new(info.id);
+        let context = Context::from_device(&device).map_err(call_err("creating the context"))?;
+        #[allow(deprecated)] // clCreateCommandQueue keeps OpenCL 1.2 devices working.
+        let queue = CommandQueue::create_default(&context, CL_QUEUE_PROFILING_ENABLE)
+            .map_err(call_err("creating the queue"))?;
+        Ok(Self {
+            info,
+            device,
+            context,
+            queue,
+        })
+    }
+
+    /// "name (platform)" for summaries and the overlay.
+    pub fn description(&self) -> String {
+        format!("{} ({})", self.info.name, self.info.platform)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_device_choices() {
+        assert_eq!("gpu".parse::<DeviceChoice>(), Ok(DeviceChoice::Gpu));
+        assert_eq!("CPU".parse::<DeviceChoice>(), Ok(DeviceChoice::Cpu));
+        assert_eq!("2".parse::<DeviceChoice>(), Ok(DeviceChoice::Index(2)));
+        assert!("fastest".parse::<DeviceChoice>().is_err());
+    }
+}

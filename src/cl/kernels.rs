@@ -1,0 +1,388 @@
+//! Typed wrappers over the kernels and device buffers: the only `unsafe` code and the only
+//! positional kernel arguments in penumbra. Each wrapper takes exactly the kernel's arguments,
+//! launches it under its stage name and returns the profiling event.
+
+use super::types::*;
+use super::{ClError, Gpu, KernelFeatures, build_program, call_err};
+use bytemuck::Pod;
+use opencl3::event::Event;
+use opencl3::kernel::{ExecuteKernel, Kernel};
+use opencl3::memory::{CL_MEM_READ_WRITE, ClMem};
+use opencl3::types::CL_BLOCKING;
+use std::ptr;
+
+/// A typed device buffer of `len` elements (at least one is allocated: OpenCL has no empty
+/// buffers).
+pub struct Buffer<T: Pod> {
+    inner: opencl3::memory::Buffer<T>,
+    len: usize,
+}
+
+impl<T: Pod> Buffer<T> {
+    /// An uninitialised buffer of `len` elements.
+    pub fn new(gpu: &Gpu, len: usize) -> Result<Self, ClError> {
+        // SAFETY: no host pointer is passed; the size is at least one element.
+        let inner = unsafe {
+            opencl3::memory::Buffer::<T>::create(
+                &gpu.context,
+                CL_MEM_READ_WRITE,
+                len.max(1),
+                ptr::null_mut(),
+            )
+        }
+        .map_err(|e| ClError::Call {
+            stage: format!("allocating {} bytes", len.max(1) * std::mem::size_of::<T>()),
+            message: e.to_string(),
+        })?;
+        Ok(Self { inner, len })
+    }
+
+    /// A buffer holding a copy of `data`.
+    pub fn from_slice(gpu: &Gpu, data: &[T]) -> Result<Self, ClError> {
+        let mut b = Self::new(gpu, data.len())?;
+        b.write(gpu, data)?;
+        Ok(b)
+    }
+
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the buffer holds no elements.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Size in bytes on the device.
+    pub fn bytes(&self) -> usize {
+        self.len.max(1) * std::mem::size_of::<T>()
+    }
+
+    /// Copies `data` to the start of the buffer (blocking).
+    pub fn write(&mut self, gpu: &Gpu, data: &[T]) -> Result<(), ClError> {
+        assert!(
+            data.len() <= self.len.max(1),
+            "write past the end of a buffer"
+        );
+        if data.is_empty() {
+            return Ok(());
+        }
+        // SAFETY: the slice fits the buffer (checked above); the write is blocking.
+        unsafe {
+            gpu.queue
+                .enqueue_write_buffer(&mut self.inner, CL_BLOCKING, 0, data, &[])
+                .map_err(call_err("uploading a buffer"))?;
+        }
+        Ok(())
+    }
+
+    /// Reads the whole buffer back (blocking).
+    pub fn read(&self, gpu: &Gpu) -> Result<Vec<T>, ClError> {
+        let mut out = vec![T::zeroed(); self.len];
+        if self.len == 0 {
+            return Ok(out);
+        }
+        // SAFETY: `out` has exactly the buffer's length; the read is blocking.
+        unsafe {
+            gpu.queue
+                .enqueue_read_buffer(&self.inner, CL_BLOCKING, 0, &mut out, &[])
+                .map_err(call_err("reading a buffer back"))?;
+        }
+        Ok(out)
+    }
+
+    /// Sets every element to zero.
+    pub fn clear(&mut self, gpu: &Gpu) -> Result<(), ClError> {
+        let bytes = self.bytes();
+        // SAFETY: fills the whole allocation with a zero pattern of one element.
+        unsafe {
+            gpu.queue
+                .enqueue_fill_buffer(&mut self.inner, &[T::zeroed()], 0, bytes, &[])
+                .map_err(call_err("clearing a buffer"))?;
+        }
+        Ok(())
+    }
+
+    fn mem(&self) -> opencl3::types::cl_mem {
+        self.inner.get()
+    }
+}
+
+/// A launched kernel: its stage name and profiling event.
+pub struct Launch {
+    /// Stage name (the kernel's name).
+    pub stage: &'static str,
+    /// The event, for profiling.
+    pub event: Event,
+}
+
+impl Launch {
+    /// Kernel run time in milliseconds from the profiling timestamps (waits for the event).
+    pub fn millis(&self) -> f64 {
+        let start = self.event.profiling_command_start().unwrap_or(0);
+        let end = self.event.profiling_command_end().unwrap_or(start);
+        end.saturating_sub(start) as f64 * 1e-6
+    }
+}
+
+/// The built program with every kernel.
+pub struct Program {
+    generate: Kernel,
+    extend: Kernel,
+    shade: Kernel,
+    connect: Kernel,
+    advance: Kernel,
+    accumulate: Kernel,
+    trace_closest: Kernel,
+    trace_any: Kernel,
+    probe_layout: Kernel,
+    local_size: usize,
+    /// Features it was built with.
+    pub features: KernelFeatures,
+}
+
+/// Rounds `n` up to a multiple of `local` (and at least one group).
+fn global_size(n: usize, local: usize) -> usize {
+    n.max(1).div_ceil(local) * local
+}
+
+impl Program {
+    /// Builds the kernels for `features`.
+    pub fn build(gpu: &Gpu, features: KernelFeatures) -> Result<Self, ClError> {
+        let program = build_program(gpu, features)?;
+        let k = |name: &str| {
+            Kernel::create(&program, name).map_err(|e| ClError::Build(format!("{name}: {e}")))
+        };
+        let max_group = gpu.device.max_work_group_size().unwrap_or(64).max(1);
+        Ok(Self {
+            generate: k("generate")?,
+            extend: k("extend")?,
+            shade: k("shade")?,
+            connect: k("connect")?,
+            advance: k("advance")?,
+            accumulate: k("accumulate")?,
+            trace_closest: k("trace_closest")?,
+            trace_any: k("trace_any")?,
+            probe_layout: k("probe_layout")?,
+            local_size: 64.min(max_group),
+            features,
+        })
+    }
+
+    fn run(
+        &self,
+        gpu: &Gpu,
+        stage: &'static str,
+        kernel: &Kernel,
+        n: usize,
+        set: impl FnOnce(&mut ExecuteKernel),
+    ) -> Result<Launch, ClError> {
+        let mut exec = ExecuteKernel::new(kernel);
+        set(&mut exec);
+        exec.set_global_work_size(global_size(n, self.local_size))
+            .set_local_work_size(self.local_size);
+        // SAFETY: every wrapper below sets exactly the kernel's arguments, in order, with the
+        // types the kernel declares; buffers outlive the launch because the queue is in order
+        // and every reader of results waits on it.
+        let event = unsafe { exec.enqueue_nd_range(&gpu.queue) }.map_err(call_err(stage))?;
+        Ok(Launch { stage, event })
+    }
+
+    /// `generate`: camera rays for every slot of the wave; resets the queue counters.
+    #[allow(clippy::too_many_arguments)]
+    pub fn generate(
+        &self,
+        gpu: &Gpu,
+        frame: &GpuFrame,
+        camera: &GpuCamera,
+        paths: &Buffer<GpuPath>,
+        queue: &Buffer<u32>,
+        counters: &Buffer<u32>,
+        slots: usize,
+    ) -> Result<Launch, ClError> {
+        self.run(gpu, "generate", &self.generate, slots, |e| unsafe {
+            e.set_arg(frame)
+                .set_arg(camera)
+                .set_arg(&paths.mem())
+                .set_arg(&queue.mem())
+                .set_arg(&counters.mem());
+        })
+    }
+
+    /// `extend`: closest hits of the queued paths' rays.
+    #[allow(clippy::too_many_arguments)]
+    pub fn extend(
+        &self,
+        gpu: &Gpu,
+        nodes: &Buffer<GpuBvhNode>,
+        tris: &Buffer<GpuTriangle>,
+        paths: &Buffer<GpuPath>,
+        queue: &Buffer<u32>,
+        counters: &Buffer<u32>,
+        hits: &Buffer<GpuHit>,
+        slots: usize,
+    ) -> Result<Launch, ClError> {
+        self.run(gpu, "extend", &self.extend, slots, |e| unsafe {
+            e.set_arg(&nodes.mem())
+                .set_arg(&tris.mem())
+                .set_arg(&paths.mem())
+                .set_arg(&queue.mem())
+                .set_arg(&counters.mem())
+                .set_arg(&hits.mem());
+        })
+    }
+
+    /// `shade`: emission, a light sample (queued for `connect`) and the next bounce.
+    #[allow(clippy::too_many_arguments)]
+    pub fn shade(
+        &self,
+        gpu: &Gpu,
+        frame: &GpuFrame,
+        scene: &SceneBuffers,
+        paths: &Buffer<GpuPath>,
+        queue_in: &Buffer<u32>,
+        hits: &Buffer<GpuHit>,
+        queue_out: &Buffer<u32>,
+        shadow_rays: &Buffer<GpuShadowRay>,
+        counters: &Buffer<u32>,
+        slots: usize,
+    ) -> Result<Launch, ClError> {
+        self.run(gpu, "shade", &self.shade, slots, |e| unsafe {
+            e.set_arg(frame)
+                .set_arg(&scene.triangles.mem())
+                .set_arg(&scene.shading.mem())
+                .set_arg(&scene.materials.mem())
+                .set_arg(&scene.lights.mem())
+                .set_arg(&scene.light_cdf.mem())
+                .set_arg(&paths.mem())
+                .set_arg(&queue_in.mem())
+                .set_arg(&hits.mem())
+                .set_arg(&queue_out.mem())
+                .set_arg(&shadow_rays.mem())
+                .set_arg(&counters.mem());
+        })
+    }
+
+    /// `connect`: traces the queued shadow rays (any hit) and adds the visible contributions.
+    #[allow(clippy::too_many_arguments)]
+    pub fn connect(
+        &self,
+        gpu: &Gpu,
+        nodes: &Buffer<GpuBvhNode>,
+        tris: &Buffer<GpuTriangle>,
+        shadow_rays: &Buffer<GpuShadowRay>,
+        counters: &Buffer<u32>,
+        paths: &Buffer<GpuPath>,
+        slots: usize,
+    ) -> Result<Launch, ClError> {
+        self.run(gpu, "connect", &self.connect, slots, |e| unsafe {
+            e.set_arg(&nodes.mem())
+                .set_arg(&tris.mem())
+                .set_arg(&shadow_rays.mem())
+                .set_arg(&counters.mem())
+                .set_arg(&paths.mem());
+        })
+    }
+
+    /// `advance`: counts this bounce's rays and turns the output queue into the next input.
+    pub fn advance(
+        &self,
+        gpu: &Gpu,
+        counters: &Buffer<u32>,
+        stats: &Buffer<u64>,
+    ) -> Result<Launch, ClError> {
+        self.run(gpu, "advance", &self.advance, 1, |e| unsafe {
+            e.set_arg(&counters.mem()).set_arg(&stats.mem());
+        })
+    }
+
+    /// `accumulate`: adds the wave's finished samples to the film.
+    pub fn accumulate(
+        &self,
+        gpu: &Gpu,
+        frame: &GpuFrame,
+        paths: &Buffer<GpuPath>,
+        film: &Buffer<[f32; 4]>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
+        let pixels = (frame.width * frame.height) as usize;
+        self.run(gpu, "accumulate", &self.accumulate, pixels, |e| unsafe {
+            e.set_arg(frame)
+                .set_arg(&paths.mem())
+                .set_arg(&film.mem())
+                .set_arg(&counters.mem());
+        })
+    }
+
+    /// `trace_closest`: closest hits of arbitrary rays (tests and `bench trace`).
+    pub fn trace_closest(
+        &self,
+        gpu: &Gpu,
+        bvh: &SceneBuffers,
+        rays: &Buffer<GpuRay>,
+        hits: &Buffer<GpuHit>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
+        let count = rays.len() as u32;
+        self.run(
+            gpu,
+            "trace_closest",
+            &self.trace_closest,
+            rays.len(),
+            |e| unsafe {
+                e.set_arg(&bvh.nodes.mem())
+                    .set_arg(&bvh.triangles.mem())
+                    .set_arg(&rays.mem())
+                    .set_arg(&count)
+                    .set_arg(&hits.mem())
+                    .set_arg(&counters.mem());
+            },
+        )
+    }
+
+    /// `trace_any`: occlusion of arbitrary rays (tests and `bench trace`).
+    pub fn trace_any(
+        &self,
+        gpu: &Gpu,
+        bvh: &SceneBuffers,
+        rays: &Buffer<GpuRay>,
+        occluded: &Buffer<u32>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
+        let count = rays.len() as u32;
+        self.run(gpu, "trace_any", &self.trace_any, rays.len(), |e| unsafe {
+            e.set_arg(&bvh.nodes.mem())
+                .set_arg(&bvh.triangles.mem())
+                .set_arg(&rays.mem())
+                .set_arg(&count)
+                .set_arg(&occluded.mem())
+                .set_arg(&counters.mem());
+        })
+    }
+
+    /// `probe_layout`: sizes and offsets of the shared structs as the device compiler sees them.
+    pub fn probe_layout(&self, gpu: &Gpu) -> Result<Vec<u32>, ClError> {
+        let out = Buffer::<u32>::new(gpu, 256)?;
+        self.run(gpu, "probe_layout", &self.probe_layout, 1, |e| unsafe {
+            e.set_arg(&out.mem());
+        })?;
+        out.read(gpu)
+    }
+}
+
+/// The scene on the device: BVH, triangles, shading data, materials and lights.
+pub struct SceneBuffers {
+    /// BVH nodes.
+    pub nodes: Buffer<GpuBvhNode>,
+    /// Triangles in BVH order.
+    pub triangles: Buffer<GpuTriangle>,
+    /// Shading data in BVH order.
+    pub shading: Buffer<GpuTriShading>,
+    /// Materials.
+    pub materials: Buffer<GpuMaterial>,
+    /// Lights (punctual first, then emissive triangles).
+    pub lights: Buffer<GpuLight>,
+    /// Cumulative selection probabilities of the lights.
+    pub light_cdf: Buffer<f32>,
+}

@@ -1,0 +1,39 @@
+//! OpenCL on the host: device choice, the context and queue, program builds with scene-feature
+//! defines and line-mapped errors, typed buffers, and the typed kernel wrappers (`kernels`), the
+//! one place with `unsafe` code and positional kernel arguments.
+
+mod device;
+pub mod kernels;
+mod program;
+pub mod types;
+
+pub use device::{DeviceChoice, DeviceInfo, Gpu, list_devices};
+pub use kernels::{Buffer, Program};
+pub use program::{KernelFeatures, build_program};
+
+/// Errors from OpenCL: no usable device, a failed build, a failed launch.
+#[derive(Debug, thiserror::Error)]
+pub enum ClError {
+    /// No platform or device matched.
+    #[error("{0}")]
+    Device(String),
+    /// A kernel failed to build; the message names the `.cl` file and line.
+    #[error("kernel build failed: {0}")]
+    Build(String),
+    /// An OpenCL call failed during `stage`.
+    #[error("OpenCL error in {stage}: {message}")]
+    Call {
+        /// The stage or operation.
+        stage: String,
+        /// The OpenCL error.
+        message: String,
+    },
+}
+
+/// Wraps an OpenCL error with the stage it happened in.
+pub(crate) fn call_err(stage: &str) -> impl Fn(opencl3::error_codes::ClError) -> ClError + '_ {
+    move |e| ClError::Call {
+        stage: stage.to_string(),
+        message: e.to_string(),
+    }
+}

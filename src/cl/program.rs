@@ -1,0 +1,115 @@
+//! Kernel sources (embedded at compile time) and their run-time build with feature defines.
+
+use super::{ClError, Gpu};
+use opencl3::device::CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT;
+
+/// Kernel sources in the order they are concatenated; headers first.
+const SOURCES: &[(&str, &str)] = &[
+    ("kernels/types.h", include_str!("../../kernels/types.h")),
+    ("kernels/rng.h", include_str!("../../kernels/rng.h")),
+    (
+        "kernels/traverse.h",
+        include_str!("../../kernels/traverse.h"),
+    ),
+    ("kernels/bsdf.h", include_str!("../../kernels/bsdf.h")),
+    ("kernels/lights.h", include_str!("../../kernels/lights.h")),
+    ("kernels/stages.cl", include_str!("../../kernels/stages.cl")),
+    ("kernels/tools.cl", include_str!("../../kernels/tools.cl")),
+];
+
+/// The scene features that decide which kernel code is compiled in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct KernelFeatures {
+    /// Some triangles emit light (area lights with MIS).
+    pub triangle_lights: bool,
+}
+
+impl KernelFeatures {
+    /// The `-D` options for these features.
+    pub fn defines(&self) -> String {
+        let mut d = String::new();
+        if self.triangle_lights {
+            d.push_str(" -DHAS_TRIANGLE_LIGHTS");
+        }
+        d
+    }
+}
+
+/// The full program source: every file behind a `#line` directive so the compiler's messages
+/// name the `.cl` file and line.
+pub fn program_source() -> String {
+    let mut s = String::new();
+    for (name, text) in SOURCES {
+        s.push_str(&format!("#line 1 \"{name}\"\n"));
+        s.push_str(text);
+        s.push('\n');
+    }
+    s
+}
+
+/// Builds the program for `features` on the device. A failure returns the compiler's first
+/// error line, which names the kernel file and line.
+pub fn build_program(
+    gpu: &Gpu,
+    features: KernelFeatures,
+) -> Result<opencl3::program::Program, ClError> {
+    build_source(gpu, &program_source(), features)
+}
+
+pub(crate) fn build_source(
+    gpu: &Gpu,
+    source: &str,
+    features: KernelFeatures,
+) -> Result<opencl3::program::Program, ClError> {
+    let mut options = String::new();
+    // Correctly rounded division keeps the device's triangle tests identical to the host's.
+    if gpu
+        .device
+        .single_fp_config()
+        .is_ok_and(|c| c & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT != 0)
+    {
+        options.push_str("-cl-fp32-correctly-rounded-divide-sqrt");
+    }
+    options.push_str(&features.defines());
+    let mut program = opencl3::program::Program::create_from_source(&gpu.context, source)
+        .map_err(|e| ClError::Build(format!("cannot create the program: {e}")))?;
+    if program.build(&[gpu.device.id()], &options).is_err() {
+        let log = program.get_build_log(gpu.device.id()).unwrap_or_default();
+        log::debug!("kernel build log:\n{log}");
+        return Err(ClError::Build(first_error(&log)));
+    }
+    Ok(program)
+}
+
+/// The first line of a build log that reports an error (with its file and line), or the
+/// log's first line.
+fn first_error(log: &str) -> String {
+    log.lines()
+        .find(|l| l.contains("error"))
+        .or_else(|| log.lines().find(|l| !l.trim().is_empty()))
+        .unwrap_or("the compiler gave no log")
+        .trim()
+        .to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_source_is_marked_with_its_file() {
+        let s = program_source();
+        for (name, _) in SOURCES {
+            assert!(s.contains(&format!("#line 1 \"{name}\"")), "{name}");
+        }
+    }
+
+    #[test]
+    fn first_error_picks_the_error_line() {
+        let log = "warning: x\nkernels/stages.cl:12:5: error: use of undeclared identifier\n";
+        assert_eq!(
+            first_error(log),
+            "kernels/stages.cl:12:5: error: use of undeclared identifier"
+        );
+    }
+}

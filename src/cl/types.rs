@@ -1,0 +1,250 @@
+//! Structs shared between the host and the kernels.
+//!
+//! Each struct here is mirrored field for field in `kernels/types.h`; the layout probe test
+//! (`tests/layout.rs`) builds a kernel that reports `sizeof` and field offsets on the device and
+//! compares them with these definitions. A bare `float3` never appears: it is 16 bytes in OpenCL,
+//! so three-component payloads travel as `float4` with something useful in `.w`.
+
+use bytemuck::{Pod, Zeroable};
+use std::mem::{offset_of, size_of};
+
+/// One BVH node holding the boxes of both children (Aila–Laine layout, 64 bytes).
+///
+/// A child index `>= 0` names an interior node; a negative one is a leaf `!first_triangle`
+/// whose triangle count is in the matching `*_max.w` (as integer bits).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuBvhNode {
+    /// Left child box minimum; `.w` = left child (i32 bits).
+    pub left_min: [f32; 4],
+    /// Left child box maximum; `.w` = left leaf triangle count (u32 bits, 0 for an interior child).
+    pub left_max: [f32; 4],
+    /// Right child box minimum; `.w` = right child (i32 bits).
+    pub right_min: [f32; 4],
+    /// Right child box maximum; `.w` = right leaf triangle count (u32 bits).
+    pub right_max: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuBvhNode>() == 64);
+
+/// A triangle's vertices in world space, in BVH order (48 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuTriangle {
+    /// Vertex 0; `.w` = material index (u32 bits).
+    pub v0: [f32; 4],
+    /// Vertex 1; `.w` = emissive light index (i32 bits, -1 when not emissive).
+    pub v1: [f32; 4],
+    /// Vertex 2; `.w` = object index (u32 bits).
+    pub v2: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuTriangle>() == 48);
+
+/// Per-vertex shading data of a triangle, in BVH order (80 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuTriShading {
+    /// Normal at vertex 0; `.w` = 1 when the file had normals, 0 for flat shading.
+    pub n0: [f32; 4],
+    /// Normal at vertex 1; `.w` unused.
+    pub n1: [f32; 4],
+    /// Normal at vertex 2; `.w` unused.
+    pub n2: [f32; 4],
+    /// `TEXCOORD_0` of vertices 0 and 1 (`.xy`, `.zw`).
+    pub uv01: [f32; 4],
+    /// `TEXCOORD_0` of vertex 2 (`.xy`); `.zw` unused (reserved for `TEXCOORD_1`).
+    pub uv2: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuTriShading>() == 80);
+
+/// Material flags in `GpuMaterial::emission.w`.
+pub const MATERIAL_DOUBLE_SIDED: u32 = 1;
+
+/// A glTF material as the kernels see it (80 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuMaterial {
+    /// Linear base color; `.w` = alpha.
+    pub base_color: [f32; 4],
+    /// Emitted radiance (emissiveFactor × strength); `.w` = flags (u32 bits, `MATERIAL_*`).
+    pub emission: [f32; 4],
+    /// `.x` metallic, `.y` roughness, `.z` ior, `.w` specularFactor.
+    pub params: [f32; 4],
+    /// specularColorFactor; `.w` = transmission factor.
+    pub specular: [f32; 4],
+    /// Texture slots (base color, metallic-roughness, normal, emissive); -1 when absent.
+    pub textures: [i32; 4],
+}
+const _: () = assert!(size_of::<GpuMaterial>() == 80);
+
+/// Light kinds in `GpuLight::position.w`.
+pub const LIGHT_POINT: u32 = 0;
+/// A spot light: a point light with a cone.
+pub const LIGHT_SPOT: u32 = 1;
+/// A directional light (sun).
+pub const LIGHT_DIRECTIONAL: u32 = 2;
+/// An emissive triangle, sampled by area.
+pub const LIGHT_TRIANGLE: u32 = 3;
+
+/// One light for next-event estimation (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuLight {
+    /// Position (point/spot), or the direction light travels (directional); `.w` = kind (u32 bits).
+    pub position: [f32; 4],
+    /// Radiant intensity (point/spot) or irradiance (directional) per channel; `.w` = radius
+    /// (world units; an angular radius in radians for a directional light).
+    pub intensity: [f32; 4],
+    /// Spot axis (direction light travels); `.w` = cos of the outer cone angle.
+    /// For a triangle light: `.x` = triangle index (u32 bits), `.y` = area.
+    pub spot: [f32; 4],
+    /// `.x` = cos of the inner cone angle; `.y` = selection probability; `.zw` unused.
+    pub extra: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuLight>() == 64);
+
+/// A pinhole camera (64 bytes). Rays leave `origin` towards
+/// `forward + (2u - 1)·right + (1 - 2v)·up` for film coordinates (u, v) in [0, 1]².
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuCamera {
+    /// Eye position; `.w` = lens radius (0 for a pinhole).
+    pub origin: [f32; 4],
+    /// Unit view direction; `.w` = focus distance.
+    pub forward: [f32; 4],
+    /// Camera right scaled by tan(fov/2)·aspect; `.w` unused.
+    pub right: [f32; 4],
+    /// Camera up scaled by tan(fov/2); `.w` unused.
+    pub up: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuCamera>() == 64);
+
+/// Per-frame constants of the path tracer (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuFrame {
+    /// Film width in pixels.
+    pub width: u32,
+    /// Film height in pixels.
+    pub height: u32,
+    /// Paths per pixel in this wave.
+    pub samples_in_wave: u32,
+    /// Index of the first sample of this wave (for the random sequence).
+    pub first_sample: u32,
+    /// User seed.
+    pub seed: u32,
+    /// Maximum bounces after the first hit.
+    pub max_bounces: u32,
+    /// Bounce from which Russian roulette applies (u32::MAX: never).
+    pub rr_depth: u32,
+    /// Sampling strategy: 0 = MIS, 1 = BSDF only, 2 = lights only.
+    pub strategy: u32,
+    /// Uniform environment radiance; `.w` unused.
+    pub sky: [f32; 4],
+    /// Number of lights in the light list.
+    pub light_count: u32,
+    /// Total light selection weight (for pdfs).
+    pub light_weight_total: f32,
+    /// Current bounce (set per launch by the host).
+    pub bounce: u32,
+    /// Padding.
+    pub pad: u32,
+}
+const _: () = assert!(size_of::<GpuFrame>() == 64);
+
+/// The state of one path between stages (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuPath {
+    /// Ray origin; `.w` = pdf of the BSDF sample that made this ray (0 after a camera ray).
+    pub origin: [f32; 4],
+    /// Unit ray direction; `.w` = 1 when the last bounce was specular (u32 bits as flags).
+    pub direction: [f32; 4],
+    /// Path throughput; `.w` = slot (u32 bits): pixel + sample_in_wave × pixels.
+    pub throughput: [f32; 4],
+    /// Radiance gathered so far; `.w` = random state (u32 bits).
+    pub radiance: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuPath>() == 64);
+
+/// The closest hit of an extension ray (16 bytes). `prim` is `u32::MAX` on a miss.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuHit {
+    /// Hit distance along the ray.
+    pub t: f32,
+    /// Barycentric coordinate of vertex 1.
+    pub u: f32,
+    /// Barycentric coordinate of vertex 2.
+    pub v: f32,
+    /// Triangle index in BVH order, or `u32::MAX` for a miss.
+    pub prim: u32,
+}
+const _: () = assert!(size_of::<GpuHit>() == 16);
+
+/// A shadow ray with the radiance it carries if unoccluded (48 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuShadowRay {
+    /// Ray origin; `.w` = maximum distance.
+    pub origin: [f32; 4],
+    /// Unit direction; `.w` = path slot (u32 bits).
+    pub direction: [f32; 4],
+    /// Radiance to add to the path if the light is visible; `.w` unused.
+    pub contribution: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuShadowRay>() == 48);
+
+/// A ray for the traversal benchmark and the device agreement tests (32 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuRay {
+    /// Origin; `.w` = tmin.
+    pub origin: [f32; 4],
+    /// Direction (need not be unit); `.w` = tmax.
+    pub direction: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuRay>() == 32);
+
+/// Every shared struct with its size and field offsets, for the layout probe test.
+pub fn layouts() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
+    macro_rules! layout {
+        ($t:ty, $($f:ident),*) => {
+            (stringify!($t), size_of::<$t>(), vec![$((stringify!($f), offset_of!($t, $f))),*])
+        };
+    }
+    vec![
+        layout!(GpuBvhNode, left_min, left_max, right_min, right_max),
+        layout!(GpuTriangle, v0, v1, v2),
+        layout!(GpuTriShading, n0, n1, n2, uv01, uv2),
+        layout!(
+            GpuMaterial,
+            base_color,
+            emission,
+            params,
+            specular,
+            textures
+        ),
+        layout!(GpuLight, position, intensity, spot, extra),
+        layout!(GpuCamera, origin, forward, right, up),
+        layout!(
+            GpuFrame,
+            width,
+            height,
+            samples_in_wave,
+            first_sample,
+            seed,
+            max_bounces,
+            rr_depth,
+            strategy,
+            sky,
+            light_count,
+            light_weight_total,
+            bounce,
+            pad
+        ),
+        layout!(GpuPath, origin, direction, throughput, radiance),
+        layout!(GpuHit, t, u, v, prim),
+        layout!(GpuShadowRay, origin, direction, contribution),
+        layout!(GpuRay, origin, direction),
+    ]
+}

@@ -1,0 +1,320 @@
+//! The command line: `view` (default), `render`, `devices`, `bench`.
+
+pub mod bench;
+mod devices;
+mod render;
+
+use crate::cl::DeviceChoice;
+use crate::render::{RenderSettings, Strategy};
+use crate::scene::{Camera, Light, LightKind, Scene, default_light_radius, load_or_bundled};
+use anyhow::{Result, bail};
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+/// penumbra: an interactive OpenCL path tracer for glTF scenes.
+#[derive(Parser, Debug)]
+#[command(name = "penumbra", version, args_conflicts_with_subcommands = true)]
+pub struct Cli {
+    /// What to do; without a command, the viewer opens.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Viewer options when no command is given.
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
+
+/// The commands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Open the interactive viewer (the default).
+    View(ViewArgs),
+    /// Render a scene headless to an image; prints a JSON summary on stdout.
+    Render(RenderArgs),
+    /// List OpenCL platforms and devices with the index --device takes.
+    Devices,
+    /// Benchmarks: ray throughput and error against time.
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
+}
+
+/// Options every rendering command shares.
+#[derive(Args, Debug, Clone)]
+pub struct CommonArgs {
+    /// OpenCL device: gpu, cpu or an index from `penumbra devices` (default: first GPU, else
+    /// first CPU; also PENUMBRA_DEVICE).
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Image width in pixels.
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Samples per pixel.
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Bounces after the first hit (0 = direct light only).
+    #[arg(long, default_value_t = 4)]
+    pub bounces: u32,
+    /// Seed of the random sequence.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Camera of the glTF file to use (index; the automatic camera when the file has none).
+    #[arg(long)]
+    pub camera: Option<usize>,
+    /// Radius of point and spot lights in scene units (soft shadows); default 2% of the
+    /// scene's diagonal. Directional lights get an angular radius of 2·R/diagonal radians.
+    #[arg(long)]
+    pub light_radius: Option<f32>,
+    /// Hard shadows: every light radius 0.
+    #[arg(long, conflicts_with = "light_radius")]
+    pub hard_shadows: bool,
+    /// Uniform sky radiance as R,G,B (or one value for gray); default black.
+    #[arg(long, value_parser = parse_color)]
+    pub sky: Option<[f32; 3]>,
+}
+
+/// Options of the viewer.
+#[derive(Args, Debug, Clone)]
+pub struct ViewArgs {
+    /// glTF or GLB file; the bundled Cornell box when absent.
+    pub scene: Option<PathBuf>,
+    /// Shared options.
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// Exit after this many frames (for tests).
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Save the final frame to this PNG path on exit (for tests); an EXR beside it.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+}
+
+/// Options of `render`.
+#[derive(Args, Debug, Clone)]
+pub struct RenderArgs {
+    /// glTF or GLB file.
+    pub scene: PathBuf,
+    /// Output image: .exr (linear radiance) or .png (tone-mapped sRGB). Overwritten if present.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Shared options.
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// Direct-light strategy.
+    #[arg(long, value_enum, default_value_t = StrategyArg::Mis)]
+    pub strategy: StrategyArg,
+    /// Disable Russian roulette.
+    #[arg(long)]
+    pub no_russian_roulette: bool,
+    /// Exposure in stops for PNG output.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+}
+
+/// `--strategy` values.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StrategyArg {
+    /// Light and BSDF sampling with multiple importance sampling.
+    Mis,
+    /// BSDF sampling only.
+    Bsdf,
+    /// Light sampling only.
+    Lights,
+}
+
+impl From<StrategyArg> for Strategy {
+    fn from(s: StrategyArg) -> Self {
+        match s {
+            StrategyArg::Mis => Strategy::Mis,
+            StrategyArg::Bsdf => Strategy::Bsdf,
+            StrategyArg::Lights => Strategy::Lights,
+        }
+    }
+}
+
+fn parse_color(s: &str) -> Result<[f32; 3], String> {
+    let parts: Vec<f32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}' is not a color: use R,G,B or one number"))?;
+    let c = match parts.as_slice() {
+        [v] => [*v; 3],
+        [r, g, b] => [*r, *g, *b],
+        _ => return Err(format!("'{s}' is not a color: use R,G,B or one number")),
+    };
+    if c.iter().any(|v| !v.is_finite() || *v < 0.0) {
+        return Err(format!(
+            "'{s}': color values must be finite and not negative"
+        ));
+    }
+    Ok(c)
+}
+
+/// The largest image side accepted.
+pub const MAX_SIDE: u32 = 16384;
+/// The most bounces accepted.
+pub const MAX_BOUNCES: u32 = 256;
+
+/// A scene ready to render: its lights with the chosen radii and the chosen camera.
+pub struct Prepared {
+    /// The scene.
+    pub scene: Scene,
+    /// Lights with radii applied.
+    pub lights: Vec<Light>,
+    /// The camera.
+    pub camera: Camera,
+    /// Loading time.
+    pub load_ms: f64,
+    /// Light radius applied to point and spot lights.
+    pub light_radius: f32,
+}
+
+impl CommonArgs {
+    /// The device choice from `--device` or `PENUMBRA_DEVICE`.
+    pub fn device_choice(&self) -> Result<DeviceChoice> {
+        DeviceChoice::from_arg_or_env(self.device.as_deref()).map_err(anyhow::Error::msg)
+    }
+
+    /// Render settings for a default size; rejects absurd values.
+    pub fn settings(&self, default_size: (u32, u32)) -> Result<RenderSettings> {
+        let width = self.width.unwrap_or(default_size.0);
+        let height = self.height.unwrap_or(default_size.1);
+        for (name, v) in [("--width", width), ("--height", height)] {
+            if v == 0 || v > MAX_SIDE {
+                bail!("{name} {v} is out of range (1..={MAX_SIDE})");
+            }
+        }
+        if self.bounces > MAX_BOUNCES {
+            bail!(
+                "--bounces {} is out of range (0..={MAX_BOUNCES})",
+                self.bounces
+            );
+        }
+        if self.spp == Some(0) {
+            bail!("--spp must be at least 1");
+        }
+        if let Some(r) = self.light_radius
+            && !(r.is_finite() && r >= 0.0)
+        {
+            bail!("--light-radius {r} must be a finite number >= 0");
+        }
+        Ok(RenderSettings {
+            width,
+            height,
+            bounces: self.bounces,
+            seed: self.seed,
+            sky: self.sky.unwrap_or([0.0; 3]),
+            ..RenderSettings::default()
+        })
+    }
+
+    /// Loads the scene (or the bundled one) and applies camera and light options.
+    pub fn prepare(&self, path: Option<&std::path::Path>) -> Result<Prepared> {
+        let t = std::time::Instant::now();
+        let scene = load_or_bundled(path)?;
+        let load_ms = t.elapsed().as_secs_f64() * 1e3;
+        for w in &scene.warnings {
+            log::warn!("{}: {w}", scene.source);
+        }
+        if scene.default_rig {
+            eprintln!(
+                "penumbra: {} has no lights; using the default light rig",
+                scene.source
+            );
+        }
+        let camera = match self.camera {
+            None => scene.cameras[0].clone(),
+            Some(i) => match scene.cameras.get(i) {
+                Some(c) => c.clone(),
+                None => bail!(
+                    "{}: --camera {i} is out of range (the scene has {} camera(s))",
+                    scene.source,
+                    scene.cameras.len()
+                ),
+            },
+        };
+        let diagonal = scene.bounds().diagonal();
+        let light_radius = if self.hard_shadows {
+            0.0
+        } else {
+            self.light_radius
+                .unwrap_or_else(|| default_light_radius(&scene.bounds()))
+        };
+        let lights = with_radius(&scene.lights, light_radius, diagonal);
+        Ok(Prepared {
+            scene,
+            lights,
+            camera,
+            load_ms,
+            light_radius,
+        })
+    }
+}
+
+/// Lights with the shadow softness applied: point and spot lights get `radius` (scene units),
+/// directional lights an angular radius of 2·radius/diagonal radians (at most 0.5).
+pub fn with_radius(lights: &[Light], radius: f32, diagonal: f64) -> Vec<Light> {
+    lights
+        .iter()
+        .map(|l| Light {
+            radius: match l.kind {
+                LightKind::Directional => {
+                    (2.0 * radius as f64 / diagonal.max(1e-9)).min(0.5) as f32
+                }
+                _ => radius,
+            },
+            ..l.clone()
+        })
+        .collect()
+}
+
+/// Runs the command line; errors come back as one line for `main` to print.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        None => crate::app::run(cli.view),
+        Some(Command::View(v)) => crate::app::run(v),
+        Some(Command::Render(r)) => render::run(&r),
+        Some(Command::Devices) => devices::run(),
+        Some(Command::Bench(b)) => bench::run(b),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colors_parse_or_fail_clearly() {
+        assert_eq!(parse_color("0.5").unwrap(), [0.5; 3]);
+        assert_eq!(parse_color("1,2,3").unwrap(), [1.0, 2.0, 3.0]);
+        assert!(parse_color("1,2").is_err());
+        assert!(parse_color("-1").is_err());
+        assert!(parse_color("nan").is_err());
+    }
+
+    #[test]
+    fn absurd_settings_are_rejected() {
+        let cli = Cli::parse_from(["penumbra", "render", "a.glb", "-o", "x.exr", "--width", "0"]);
+        let Some(Command::Render(r)) = cli.command else {
+            panic!("not a render command")
+        };
+        assert!(r.common.settings((64, 64)).is_err());
+    }
+
+    #[test]
+    fn directional_lights_get_an_angular_radius() {
+        let sun = Light {
+            name: "sun".into(),
+            kind: LightKind::Directional,
+            position: glam::DVec3::ZERO,
+            direction: glam::DVec3::NEG_Y,
+            color: [1.0; 3],
+            intensity: 1.0,
+            radius: 0.0,
+        };
+        let l = with_radius(&[sun], 1.0, 100.0);
+        assert!((l[0].radius - 0.02).abs() < 1e-6);
+    }
+}

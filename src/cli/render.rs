@@ -1,0 +1,104 @@
+//! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary.
+
+use super::RenderArgs;
+use crate::image_io::{Format, write_exr, write_png};
+use crate::render::{Renderer, tonemap::ToneMapper};
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::time::Instant;
+
+/// Samples per pixel when `--spp` is not given.
+pub const DEFAULT_SPP: u32 = 64;
+
+/// Renders and writes the image; prints the summary line on stdout.
+pub fn run(args: &RenderArgs) -> Result<()> {
+    let format = Format::of(&args.output)?;
+    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        anyhow::bail!("{}: the output folder does not exist", dir.display());
+    }
+    let mut settings = args.common.settings((640, 480))?;
+    settings.strategy = args.strategy.into();
+    if args.no_russian_roulette {
+        settings.russian_roulette = None;
+    }
+    let spp = args.common.spp.unwrap_or(DEFAULT_SPP);
+    let prepared = args.common.prepare(Some(&args.scene))?;
+    let mut renderer = Renderer::new(&args.common.device_choice()?)?;
+    renderer.set_settings(&settings)?;
+    let scene_stats = renderer
+        .load_scene(&prepared.scene, &prepared.lights)
+        .with_context(|| format!("{}", args.scene.display()))?;
+    renderer.set_camera(&prepared.camera)?;
+
+    let bar = ProgressBar::new(spp as u64).with_style(
+        ProgressStyle::with_template(
+            "{spinner} {bar:40} {pos}/{len} spp {elapsed_precise} eta {eta}",
+        )
+        .expect("the progress template is valid"),
+    );
+    let chunk = spp.div_ceil(50).max(1);
+    let start = Instant::now();
+    let mut done = 0;
+    while done < spp {
+        let n = chunk.min(spp - done);
+        renderer.render(n)?;
+        done += n;
+        bar.set_position(done as u64);
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    let image = renderer.image()?;
+    match format {
+        Format::Exr => write_exr(&args.output, settings.width, settings.height, &image)?,
+        Format::Png => write_png(
+            &args.output,
+            settings.width,
+            settings.height,
+            &image,
+            args.exposure,
+            ToneMapper::default(),
+        )?,
+    }
+    let stats = renderer.stats();
+    if stats.stack_overflows > 0 {
+        anyhow::bail!(
+            "{}: {} traversal stack overflow(s): the image is wrong",
+            args.scene.display(),
+            stats.stack_overflows
+        );
+    }
+    let samples = settings.width as f64 * settings.height as f64 * spp as f64;
+    let rays = (stats.extension_rays + stats.shadow_rays) as f64;
+    let summary = serde_json::json!({
+        "scene": args.scene.display().to_string(),
+        "output": args.output.display().to_string(),
+        "device": renderer.gpu.description(),
+        "width": settings.width,
+        "height": settings.height,
+        "spp": spp,
+        "bounces": settings.bounces,
+        "seed": settings.seed,
+        "strategy": settings.strategy,
+        "russian_roulette": settings.russian_roulette.is_some(),
+        "light_radius": prepared.light_radius,
+        "seconds": seconds,
+        "samples_per_second": samples / seconds,
+        "rays_per_second": rays / seconds,
+        "extension_rays": stats.extension_rays,
+        "shadow_rays": stats.shadow_rays,
+        "load_ms": prepared.load_ms,
+        "bvh_build_ms": scene_stats.bvh_build_ms,
+        "kernel_build_ms": scene_stats.kernel_build_ms,
+        "triangles": scene_stats.triangles,
+        "bvh_nodes": scene_stats.nodes,
+        "lights": prepared.lights.len(),
+        "default_light_rig": prepared.scene.default_rig,
+        "nonfinite_samples": stats.nonfinite_samples,
+        "kernel_ms": stats.stage_ms,
+    });
+    println!("{summary}");
+    Ok(())
+}

@@ -1,0 +1,134 @@
+//! Writing and reading images: EXR is linear radiance (RGB float), PNG is exposed, tone-mapped
+//! and sRGB-encoded 8-bit.
+
+use crate::render::tonemap::{ToneMapper, to_rgba8};
+use anyhow::{Context, Result, bail};
+use std::path::{Path, PathBuf};
+
+/// Image formats penumbra writes, chosen by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// OpenEXR, linear.
+    Exr,
+    /// PNG, display-referred.
+    Png,
+}
+
+impl Format {
+    /// The format a path's extension names.
+    pub fn of(path: &Path) -> Result<Self> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("exr") => Ok(Format::Exr),
+            Some("png") => Ok(Format::Png),
+            _ => bail!("{}: output must end in .exr or .png", path.display()),
+        }
+    }
+}
+
+/// Writes linear RGB as a float EXR.
+pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+    let w = width as usize;
+    exr::prelude::write_rgb_file(path, w, height as usize, |x, y| {
+        let p = rgb[y * w + x];
+        (p[0], p[1], p[2])
+    })
+    .with_context(|| format!("{}: cannot write EXR", path.display()))
+}
+
+/// Writes an exposed, tone-mapped, sRGB-encoded PNG.
+pub fn write_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    exposure: f32,
+    mapper: ToneMapper,
+) -> Result<()> {
+    let rgba = to_rgba8(rgb, exposure, mapper);
+    write_rgba_png(path, width, height, &rgba)
+}
+
+/// Writes RGBA8 pixels as PNG.
+pub fn write_rgba_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
+    image::save_buffer(path, rgba, width, height, image::ColorType::Rgba8)
+        .with_context(|| format!("{}: cannot write PNG", path.display()))
+}
+
+/// Writes `rgb` in the format the path's extension names.
+pub fn write_image(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+    match Format::of(path)? {
+        Format::Exr => write_exr(path, width, height, rgb),
+        Format::Png => write_png(path, width, height, rgb, 0.0, ToneMapper::default()),
+    }
+}
+
+/// Reads the RGB channels of an EXR file: (width, height, pixels).
+pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| {
+            (
+                resolution.width(),
+                vec![[0f32; 3]; resolution.width() * resolution.height()],
+            )
+        },
+        |(w, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = [r, g, b];
+        },
+    )
+    .with_context(|| format!("{}: cannot read EXR", path.display()))?;
+    let size = image.layer_data.size;
+    let (_, pixels) = image.layer_data.channel_data.pixels;
+    Ok((size.width() as u32, size.height() as u32, pixels))
+}
+
+/// A path in `dir` named `{stem}-{timestamp}.{ext}` that does not exist yet; a counter is
+/// appended when several are made in the same second. Never returns an existing file.
+pub fn unique_path(dir: &Path, stem: &str, timestamp: &str, ext: &str) -> PathBuf {
+    let mut candidate = dir.join(format!("{stem}-{timestamp}.{ext}"));
+    let mut n = 2;
+    while candidate.exists() {
+        candidate = dir.join(format!("{stem}-{timestamp}-{n}.{ext}"));
+        n += 1;
+    }
+    candidate
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trips_linear_values() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        let px = vec![[0.25, 1.5, 100.0], [0.0, 0.001, 7.0]];
+        write_exr(&path, 2, 1, &px).unwrap();
+        let (w, h, back) = read_exr(&path).unwrap();
+        assert_eq!((w, h), (2, 1));
+        assert_eq!(back, px);
+    }
+
+    #[test]
+    fn unique_path_never_returns_an_existing_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = unique_path(dir.path(), "shot", "t", "png");
+        std::fs::write(&a, b"x").unwrap();
+        let b = unique_path(dir.path(), "shot", "t", "png");
+        assert_ne!(a, b);
+        assert!(!b.exists());
+    }
+
+    #[test]
+    fn format_follows_the_extension() {
+        assert_eq!(Format::of(Path::new("a.EXR")).unwrap(), Format::Exr);
+        assert_eq!(Format::of(Path::new("a.png")).unwrap(), Format::Png);
+        assert!(Format::of(Path::new("a.jpg")).is_err());
+    }
+}

@@ -1,0 +1,14 @@
+use clap::Parser;
+
+fn main() {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+        .format_timestamp(None)
+        .init();
+    let cli = penumbra::cli::Cli::parse();
+    if let Err(e) = penumbra::cli::run(cli) {
+        // One line: the error and its causes, outermost first.
+        let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
+        eprintln!("penumbra: error: {}", chain.join(": "));
+        std::process::exit(1);
+    }
+}

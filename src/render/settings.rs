@@ -1,0 +1,78 @@
+//! What the user controls about a render.
+
+use crate::cl::types::GpuFrame;
+
+/// Which estimator feeds direct light.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum Strategy {
+    /// Light sampling and BSDF sampling combined by the power heuristic.
+    #[default]
+    Mis,
+    /// BSDF sampling only (lights found by hitting them; punctual lights are never hit).
+    Bsdf,
+    /// Light sampling only (emitters hit by BSDF rays count only when seen directly).
+    Lights,
+}
+
+/// Settings of the path tracer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Film width in pixels.
+    pub width: u32,
+    /// Film height in pixels.
+    pub height: u32,
+    /// Bounces after the first hit (0 = direct light only).
+    pub bounces: u32,
+    /// Seed of the random sequence.
+    pub seed: u32,
+    /// Russian roulette from this bounce on; `None` disables it.
+    pub russian_roulette: Option<u32>,
+    /// Direct-light strategy.
+    pub strategy: Strategy,
+    /// Uniform sky radiance (linear RGB).
+    pub sky: [f32; 3],
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            width: 640,
+            height: 480,
+            bounces: 4,
+            seed: 0,
+            russian_roulette: Some(3),
+            strategy: Strategy::Mis,
+            sky: [0.0; 3],
+        }
+    }
+}
+
+impl RenderSettings {
+    /// Width over height.
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height.max(1) as f32
+    }
+
+    /// The per-wave constants, without the wave-specific fields.
+    pub fn gpu_frame(&self, light_count: u32) -> GpuFrame {
+        GpuFrame {
+            width: self.width,
+            height: self.height,
+            samples_in_wave: 1,
+            first_sample: 0,
+            seed: self.seed,
+            max_bounces: self.bounces,
+            rr_depth: self.russian_roulette.unwrap_or(u32::MAX),
+            strategy: match self.strategy {
+                Strategy::Mis => 0,
+                Strategy::Bsdf => 1,
+                Strategy::Lights => 2,
+            },
+            sky: [self.sky[0], self.sky[1], self.sky[2], 0.0],
+            light_count,
+            light_weight_total: 1.0,
+            bounce: 0,
+            pad: 0,
+        }
+    }
+}

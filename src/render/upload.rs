@@ -1,0 +1,187 @@
+//! Turning the host scene into the device's structs: triangles and shading data in BVH order,
+//! materials, the light list with its selection table, and the camera.
+
+use crate::bvh::Bvh;
+use crate::cl::types::*;
+use crate::scene::{Camera, Light, LightKind, Material, WorldTriangle};
+use glam::Vec3;
+
+/// The scene as uploaded, kept on the host for picking and for tests.
+pub struct HostScene {
+    /// The BVH.
+    pub bvh: Bvh,
+    /// Triangles in BVH order.
+    pub triangles: Vec<GpuTriangle>,
+    /// Vertices in BVH order (for the host traversal).
+    pub vertices: Vec<[Vec3; 3]>,
+    /// Shading data in BVH order.
+    pub shading: Vec<GpuTriShading>,
+    /// Materials.
+    pub materials: Vec<GpuMaterial>,
+    /// Emissive triangles (BVH order index, area, emitted power for selection).
+    pub emissive: Vec<(u32, f32, f32)>,
+}
+
+fn f4(v: Vec3, w: f32) -> [f32; 4] {
+    [v.x, v.y, v.z, w]
+}
+
+fn luminance(c: [f32; 3]) -> f32 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}
+
+/// The device form of a material.
+pub fn gpu_material(m: &Material) -> GpuMaterial {
+    let flags = if m.double_sided {
+        MATERIAL_DOUBLE_SIDED
+    } else {
+        0
+    };
+    GpuMaterial {
+        base_color: m.base_color,
+        emission: [
+            m.emission[0],
+            m.emission[1],
+            m.emission[2],
+            f32::from_bits(flags),
+        ],
+        params: [m.metallic, m.roughness, m.ior, m.specular_factor],
+        specular: [
+            m.specular_color[0],
+            m.specular_color[1],
+            m.specular_color[2],
+            m.transmission,
+        ],
+        textures: [-1; 4],
+    }
+}
+
+impl HostScene {
+    /// Orders the triangles as the BVH wants them and fills the device structs.
+    pub fn new(world: &[WorldTriangle], bvh: Bvh, materials: &[Material]) -> Self {
+        let mut emissive = Vec::new();
+        let mut triangles = Vec::with_capacity(world.len());
+        let mut shading = Vec::with_capacity(world.len());
+        let mut vertices = Vec::with_capacity(world.len());
+        for (order, &index) in bvh.tri_indices.iter().enumerate() {
+            let t = &world[index as usize];
+            let m = &materials[t.material as usize];
+            let mut light = -1i32;
+            let area = 0.5 * (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).length();
+            if m.is_emissive() && area > 0.0 {
+                let sides = if m.double_sided { 2.0 } else { 1.0 };
+                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
+                light = emissive.len() as i32;
+                emissive.push((order as u32, area, power));
+            }
+            triangles.push(GpuTriangle {
+                v0: f4(t.v[0], f32::from_bits(t.material)),
+                v1: f4(t.v[1], f32::from_bits(light as u32)),
+                v2: f4(t.v[2], f32::from_bits(t.object)),
+            });
+            let smooth = if t.smooth { 1.0 } else { 0.0 };
+            shading.push(GpuTriShading {
+                n0: f4(t.n[0], smooth),
+                n1: f4(t.n[1], 0.0),
+                n2: f4(t.n[2], 0.0),
+                uv01: [t.uv[0].x, t.uv[0].y, t.uv[1].x, t.uv[1].y],
+                uv2: [t.uv[2].x, t.uv[2].y, 0.0, 0.0],
+            });
+            vertices.push(t.v);
+        }
+        Self {
+            bvh,
+            triangles,
+            vertices,
+            shading,
+            materials: materials.iter().map(gpu_material).collect(),
+            emissive,
+        }
+    }
+
+    /// The object index of a triangle in BVH order.
+    pub fn object_of(&self, prim: u32) -> u32 {
+        self.triangles[prim as usize].v2[3].to_bits()
+    }
+}
+
+/// The light list (emissive triangles first, so a triangle's light index is its position in
+/// `HostScene::emissive`, then the punctual lights) and its cumulative selection table,
+/// proportional to each light's power.
+pub fn gpu_lights(
+    lights: &[Light],
+    host: &HostScene,
+    scene_diagonal: f64,
+) -> (Vec<GpuLight>, Vec<f32>) {
+    let mut out = Vec::new();
+    let mut weights = Vec::new();
+    for &(prim, area, power) in &host.emissive {
+        out.push(GpuLight {
+            position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_TRIANGLE)],
+            intensity: [0.0; 4],
+            spot: [f32::from_bits(prim), area, 0.0, 0.0],
+            extra: [0.0; 4],
+        });
+        weights.push(power);
+    }
+    let scene_radius = (scene_diagonal * 0.5) as f32;
+    let pi = std::f32::consts::PI;
+    for l in lights {
+        let color = l.color.map(|c| c * l.intensity);
+        let (kind, position, power) = match l.kind {
+            LightKind::Point => (LIGHT_POINT, l.position, luminance(color) * 4.0 * pi),
+            LightKind::Spot { outer, .. } => (
+                LIGHT_SPOT,
+                l.position,
+                luminance(color) * 2.0 * pi * (1.0 - outer.cos()).max(0.05),
+            ),
+            LightKind::Directional => (
+                LIGHT_DIRECTIONAL,
+                l.direction,
+                luminance(color) * pi * scene_radius * scene_radius,
+            ),
+        };
+        if !(power > 0.0 && power.is_finite()) {
+            continue;
+        }
+        let (cos_inner, cos_outer) = match l.kind {
+            LightKind::Spot { inner, outer } => (inner.cos(), outer.cos()),
+            _ => (1.0, -1.0),
+        };
+        let d = l.direction.as_vec3().normalize_or(Vec3::NEG_Y);
+        out.push(GpuLight {
+            position: f4(position.as_vec3(), f32::from_bits(kind)),
+            intensity: [color[0], color[1], color[2], l.radius.max(0.0)],
+            spot: f4(d, cos_outer),
+            extra: [cos_inner, 0.0, 0.0, 0.0],
+        });
+        weights.push(power);
+    }
+    let total: f32 = weights.iter().sum();
+    let mut cdf = Vec::with_capacity(weights.len());
+    let mut acc = 0.0;
+    for (l, w) in out.iter_mut().zip(&weights) {
+        let p = w / total;
+        l.extra[1] = p;
+        acc += p;
+        cdf.push(acc);
+    }
+    if let Some(last) = cdf.last_mut() {
+        *last = 1.0;
+    }
+    (out, cdf)
+}
+
+/// The device camera for an aspect ratio (width / height).
+pub fn gpu_camera(c: &Camera, aspect: f32) -> GpuCamera {
+    let forward = c.forward.normalize().as_vec3();
+    let right = c.forward.cross(c.up).normalize().as_vec3();
+    let up = right.cross(forward).normalize();
+    let h = (c.yfov as f32 * 0.5).tan();
+    GpuCamera {
+        origin: f4(c.eye.as_vec3(), 0.0),
+        forward: f4(forward, 1.0),
+        right: f4(right * h * aspect, 0.0),
+        up: f4(up * h, 0.0),
+    }
+}

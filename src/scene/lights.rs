@@ -1,0 +1,162 @@
+//! The default light rig and the presets the viewer offers.
+
+use super::{Bounds, Light, LightKind};
+use glam::DVec3;
+
+/// Light rigs the viewer can put in place of, or beside, the scene's lights.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightPreset {
+    /// Key, fill and rim point lights around the scene.
+    ThreePointStudio,
+    /// A warm sun (directional light) and a blue sky fill from above.
+    SunAndSky,
+    /// A large soft light straight above the scene.
+    OverheadSoftbox,
+}
+
+impl LightPreset {
+    /// Every preset, for menus.
+    pub const ALL: [LightPreset; 3] = [
+        LightPreset::ThreePointStudio,
+        LightPreset::SunAndSky,
+        LightPreset::OverheadSoftbox,
+    ];
+
+    /// Name shown to users.
+    pub fn name(self) -> &'static str {
+        match self {
+            LightPreset::ThreePointStudio => "three-point studio",
+            LightPreset::SunAndSky => "sun + sky",
+            LightPreset::OverheadSoftbox => "overhead softbox",
+        }
+    }
+}
+
+/// The default soft-shadow radius: 2% of the scene's diagonal.
+pub fn default_light_radius(bounds: &Bounds) -> f32 {
+    (bounds.diagonal() * 0.02) as f32
+}
+
+/// The rig a scene without lights gets: a point key light above the middle of the scene (inside
+/// it, so interiors are lit too) and a sun from above-front.
+pub fn default_light_rig(bounds: &Bounds) -> Vec<Light> {
+    let center = bounds.center();
+    let size = bounds.diagonal();
+    let extent = if bounds.is_empty() {
+        DVec3::ONE
+    } else {
+        bounds.max - bounds.min
+    };
+    let radius = default_light_radius(bounds);
+    vec![
+        Light {
+            name: "default key".into(),
+            kind: LightKind::Point,
+            position: center + DVec3::new(0.1 * extent.x, 0.3 * extent.y, 0.2 * extent.z),
+            direction: DVec3::NEG_Y,
+            color: [1.0, 0.97, 0.92],
+            intensity: (0.5 * size * size) as f32,
+            radius,
+        },
+        Light {
+            name: "default sun".into(),
+            kind: LightKind::Directional,
+            position: center,
+            direction: DVec3::new(-0.4, -1.0, -0.5).normalize(),
+            color: [1.0, 0.95, 0.85],
+            intensity: 2.0,
+            radius: 0.02,
+        },
+    ]
+}
+
+/// The lights of a preset, sized to the scene.
+pub fn preset_lights(preset: LightPreset, bounds: &Bounds) -> Vec<Light> {
+    let center = bounds.center();
+    let size = bounds.diagonal();
+    let radius = default_light_radius(bounds);
+    let point = |name: &str, offset: DVec3, color: [f32; 3], power: f64| Light {
+        name: name.into(),
+        kind: LightKind::Point,
+        position: center + offset * size,
+        direction: (-offset).normalize_or(DVec3::NEG_Y),
+        color,
+        intensity: (power * size * size) as f32,
+        radius,
+    };
+    match preset {
+        LightPreset::ThreePointStudio => vec![
+            point("key", DVec3::new(0.6, 0.5, 0.6), [1.0, 0.96, 0.9], 1.0),
+            point("fill", DVec3::new(-0.7, 0.2, 0.5), [0.85, 0.9, 1.0], 0.3),
+            point("rim", DVec3::new(0.0, 0.6, -0.8), [1.0, 1.0, 1.0], 0.6),
+        ],
+        LightPreset::SunAndSky => vec![
+            Light {
+                name: "sun".into(),
+                kind: LightKind::Directional,
+                position: center,
+                direction: DVec3::new(-0.3, -0.8, -0.5).normalize(),
+                color: [1.0, 0.93, 0.8],
+                intensity: 3.0,
+                radius: 0.01,
+            },
+            Light {
+                name: "sky fill".into(),
+                kind: LightKind::Directional,
+                position: center,
+                direction: DVec3::NEG_Y,
+                color: [0.5, 0.65, 1.0],
+                intensity: 0.5,
+                radius: 0.5,
+            },
+        ],
+        LightPreset::OverheadSoftbox => vec![Light {
+            name: "softbox".into(),
+            kind: LightKind::Spot {
+                inner: 0.6,
+                outer: 1.2,
+            },
+            position: center + DVec3::Y * (0.6 * size),
+            direction: DVec3::NEG_Y,
+            color: [1.0, 1.0, 1.0],
+            intensity: (1.5 * size * size) as f32,
+            radius: (0.15 * size) as f32,
+        }],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_box() -> Bounds {
+        Bounds {
+            min: DVec3::ZERO,
+            max: DVec3::ONE,
+        }
+    }
+
+    #[test]
+    fn default_rig_scales_with_the_scene() {
+        let small = default_light_rig(&unit_box());
+        let big = default_light_rig(&Bounds {
+            min: DVec3::ZERO,
+            max: DVec3::splat(100.0),
+        });
+        assert_eq!(small.len(), big.len());
+        let ratio = big[0].intensity / small[0].intensity;
+        assert!((ratio - 10_000.0).abs() < 1.0, "{ratio}");
+        assert!(big[0].radius > small[0].radius);
+    }
+
+    #[test]
+    fn presets_place_lights_with_positive_power() {
+        for preset in LightPreset::ALL {
+            let lights = preset_lights(preset, &unit_box());
+            assert!(!lights.is_empty(), "{}", preset.name());
+            for l in lights {
+                assert!(l.intensity > 0.0 && l.direction.is_normalized(), "{l:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,388 @@
+//! The scene on the host: objects with their geometry, materials, lights and cameras.
+//!
+//! Transforms are composed in f64; geometry is stored per object in object space and flattened
+//! into world-space triangles (f32) whenever the scene changes.
+
+mod gltf_import;
+mod lights;
+
+pub use gltf_import::{AUTO_YFOV, load, load_from_bytes};
+pub use lights::{LightPreset, default_light_radius, default_light_rig, preset_lights};
+
+use glam::{DMat4, DVec3, Vec2, Vec3};
+use std::path::{Path, PathBuf};
+
+/// The bundled default scene (made by `scripts/cornell_box.py`).
+pub const BUNDLED_SCENE: &[u8] = include_bytes!("../../assets/cornell-box.glb");
+
+/// Loads `path`, or the bundled Cornell box when there is none.
+pub fn load_or_bundled(path: Option<&Path>) -> Result<Scene, SceneError> {
+    match path {
+        Some(p) => load(p),
+        None => load_from_bytes(BUNDLED_SCENE, None, "bundled Cornell box").map_err(|message| {
+            SceneError::Invalid {
+                path: PathBuf::from("assets/cornell-box.glb"),
+                message,
+            }
+        }),
+    }
+}
+
+/// Errors a user's scene file can cause.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read or parsed as glTF.
+    #[error("{path}: {message}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, naming the glTF element.
+        message: String,
+    },
+}
+
+/// A triangle mesh in object space.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Vertex normals; empty when the file had none (flat shading).
+    pub normals: Vec<Vec3>,
+    /// `TEXCOORD_0`; empty when absent.
+    pub uvs: Vec<Vec2>,
+    /// Triangles as vertex indices.
+    pub indices: Vec<[u32; 3]>,
+    /// Material index of each triangle.
+    pub materials: Vec<u32>,
+}
+
+/// One placed mesh: a glTF node's mesh with its world transform.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// Node or mesh name.
+    pub name: String,
+    /// World from object transform.
+    pub world_from_object: DMat4,
+    /// Hidden objects are left out of the BVH.
+    pub visible: bool,
+    /// The geometry.
+    pub mesh: Mesh,
+}
+
+/// How a material's alpha is used (glTF `alphaMode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha ignored.
+    #[default]
+    Opaque,
+    /// Cut out below the cutoff.
+    Mask(f32),
+    /// Blended (stochastic transparency).
+    Blend,
+}
+
+/// A glTF metallic-roughness material.
+#[derive(Clone, Debug)]
+pub struct Material {
+    /// Material name.
+    pub name: String,
+    /// Linear RGBA base color factor.
+    pub base_color: [f32; 4],
+    /// Metallic factor.
+    pub metallic: f32,
+    /// Perceptual roughness factor.
+    pub roughness: f32,
+    /// Emitted radiance: emissiveFactor × `KHR_materials_emissive_strength`.
+    pub emission: [f32; 3],
+    /// Emits and scatters from both faces.
+    pub double_sided: bool,
+    /// Index of refraction (`KHR_materials_ior`), 1.5 by default.
+    pub ior: f32,
+    /// `KHR_materials_specular` specularFactor (0 makes a dielectric purely Lambertian).
+    pub specular_factor: f32,
+    /// `KHR_materials_specular` specularColorFactor.
+    pub specular_color: [f32; 3],
+    /// `KHR_materials_transmission` factor.
+    pub transmission: f32,
+    /// Alpha mode.
+    pub alpha: AlphaMode,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            name: "default".into(),
+            base_color: [0.8, 0.8, 0.8, 1.0],
+            metallic: 0.0,
+            roughness: 1.0,
+            emission: [0.0; 3],
+            double_sided: false,
+            ior: 1.5,
+            specular_factor: 1.0,
+            specular_color: [1.0; 3],
+            transmission: 0.0,
+            alpha: AlphaMode::Opaque,
+        }
+    }
+}
+
+impl Material {
+    /// Whether the material emits light.
+    pub fn is_emissive(&self) -> bool {
+        self.emission.iter().any(|&e| e > 0.0)
+    }
+}
+
+/// The kind of a punctual light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Emits equally in all directions.
+    Point,
+    /// A point light limited to a cone (glTF angles in radians).
+    Spot {
+        /// Inner cone angle.
+        inner: f32,
+        /// Outer cone angle.
+        outer: f32,
+    },
+    /// Parallel light from infinitely far away.
+    Directional,
+}
+
+/// A punctual light (`KHR_lights_punctual` or added by the user).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    /// Name shown in the overlay.
+    pub name: String,
+    /// Kind.
+    pub kind: LightKind,
+    /// World position (point and spot).
+    pub position: DVec3,
+    /// Unit direction the light travels (spot and directional).
+    pub direction: DVec3,
+    /// Linear color.
+    pub color: [f32; 3],
+    /// Radiant intensity (W/sr, point and spot) or irradiance (directional), used 1:1.
+    pub intensity: f32,
+    /// Radius in world units (an angular radius in radians for directional lights);
+    /// 0 gives hard shadows.
+    pub radius: f32,
+}
+
+/// A perspective camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    /// Name shown to users.
+    pub name: String,
+    /// Eye position.
+    pub eye: DVec3,
+    /// Unit view direction.
+    pub forward: DVec3,
+    /// Unit up vector.
+    pub up: DVec3,
+    /// Vertical field of view in radians.
+    pub yfov: f64,
+}
+
+impl Camera {
+    /// A camera at `eye` looking at `target`, with +Y up.
+    pub fn look_at(name: &str, eye: DVec3, target: DVec3, yfov: f64) -> Self {
+        let forward = (target - eye).normalize();
+        let side = forward.cross(DVec3::Y);
+        let side = if side.length_squared() < 1e-12 {
+            DVec3::X
+        } else {
+            side.normalize()
+        };
+        Self {
+            name: name.into(),
+            eye,
+            forward,
+            up: side.cross(forward).normalize(),
+            yfov,
+        }
+    }
+
+    /// The automatic camera: looks at the box from its front (+Z), slightly above, so that the
+    /// whole box fits the vertical field of view.
+    pub fn framing(bounds: &Bounds, yfov: f64) -> Self {
+        let center = bounds.center();
+        let radius = (bounds.diagonal() * 0.5).max(1e-6);
+        let distance = radius / (yfov * 0.5).sin();
+        let dir = DVec3::new(0.35, 0.3, 1.0).normalize();
+        Self::look_at("auto", center + dir * distance, center, yfov)
+    }
+}
+
+/// An axis-aligned box in f64.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    /// Minimum corner.
+    pub min: DVec3,
+    /// Maximum corner.
+    pub max: DVec3,
+}
+
+impl Default for Bounds {
+    fn default() -> Self {
+        Self {
+            min: DVec3::splat(f64::INFINITY),
+            max: DVec3::splat(f64::NEG_INFINITY),
+        }
+    }
+}
+
+impl Bounds {
+    /// Grows the box to hold `p`.
+    pub fn grow(&mut self, p: DVec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+    /// Whether the box holds nothing.
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x
+    }
+    /// The center.
+    pub fn center(&self) -> DVec3 {
+        if self.is_empty() {
+            DVec3::ZERO
+        } else {
+            (self.min + self.max) * 0.5
+        }
+    }
+    /// The length of the diagonal (1 for an empty box).
+    pub fn diagonal(&self) -> f64 {
+        if self.is_empty() {
+            1.0
+        } else {
+            (self.max - self.min).length()
+        }
+    }
+}
+
+/// A flattened world-space triangle with what shading needs.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WorldTriangle {
+    /// Vertices.
+    pub v: [Vec3; 3],
+    /// Vertex normals (the geometric normal when the mesh had none).
+    pub n: [Vec3; 3],
+    /// Whether `n` came from the file.
+    pub smooth: bool,
+    /// `TEXCOORD_0` per vertex.
+    pub uv: [Vec2; 3],
+    /// Material index.
+    pub material: u32,
+    /// Object index.
+    pub object: u32,
+}
+
+/// A loaded scene.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// Where it came from (a file path or "bundled Cornell box").
+    pub source: String,
+    /// Placed meshes.
+    pub objects: Vec<Object>,
+    /// Materials, indexed by `Mesh::materials`.
+    pub materials: Vec<Material>,
+    /// Punctual lights.
+    pub lights: Vec<Light>,
+    /// The file's cameras (the automatic one when the file has none).
+    pub cameras: Vec<Camera>,
+    /// True when the file had no light and the default rig was added.
+    pub default_rig: bool,
+    /// Warnings raised while loading (unsupported optional extensions, skipped primitives).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// World-space triangles of the visible objects, in object order.
+    pub fn world_triangles(&self) -> Vec<WorldTriangle> {
+        use rayon::prelude::*;
+        let per_object: Vec<Vec<WorldTriangle>> = self
+            .objects
+            .par_iter()
+            .enumerate()
+            .filter(|(_, o)| o.visible)
+            .map(|(oi, o)| object_triangles(oi as u32, o))
+            .collect();
+        per_object.concat()
+    }
+
+    /// World-space bounds of the visible geometry.
+    pub fn bounds(&self) -> Bounds {
+        let mut b = Bounds::default();
+        for o in self.objects.iter().filter(|o| o.visible) {
+            for p in &o.mesh.positions {
+                b.grow(o.world_from_object.transform_point3(p.as_dvec3()));
+            }
+        }
+        b
+    }
+
+    /// Number of triangles over all visible objects.
+    pub fn triangle_count(&self) -> usize {
+        self.objects
+            .iter()
+            .filter(|o| o.visible)
+            .map(|o| o.mesh.indices.len())
+            .sum()
+    }
+}
+
+fn object_triangles(object: u32, o: &Object) -> Vec<WorldTriangle> {
+    let m = o.world_from_object;
+    let normal_matrix = m.inverse().transpose();
+    // A mirroring transform flips the winding; swap two vertices to keep front faces in front.
+    let flip = m.determinant() < 0.0;
+    let world: Vec<Vec3> = o
+        .mesh
+        .positions
+        .iter()
+        .map(|p| m.transform_point3(p.as_dvec3()).as_vec3())
+        .collect();
+    let normals: Vec<Vec3> = o
+        .mesh
+        .normals
+        .iter()
+        .map(|n| {
+            normal_matrix
+                .transform_vector3(n.as_dvec3())
+                .normalize_or_zero()
+                .as_vec3()
+        })
+        .collect();
+    o.mesh
+        .indices
+        .iter()
+        .zip(&o.mesh.materials)
+        .map(|(&[a, b, c], &material)| {
+            let idx = if flip { [a, c, b] } else { [a, b, c] };
+            let v = idx.map(|i| world[i as usize]);
+            let geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+            let smooth = !normals.is_empty();
+            let n = if smooth {
+                idx.map(|i| {
+                    let n = normals[i as usize];
+                    if n == Vec3::ZERO { geometric } else { n }
+                })
+            } else {
+                [geometric; 3]
+            };
+            let uv = if o.mesh.uvs.is_empty() {
+                [Vec2::ZERO; 3]
+            } else {
+                idx.map(|i| o.mesh.uvs[i as usize])
+            };
+            WorldTriangle {
+                v,
+                n,
+                smooth,
+                uv,
+                material,
+                object,
+            }
+        })
+        .collect()
+}
