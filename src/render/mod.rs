@@ -85,6 +85,7 @@ pub struct Renderer {
     light_count: u32,
     samples: u32,
     stats: RenderStats,
+    pending: Vec<Launch>,
 }
 
 impl Renderer {
@@ -105,6 +106,7 @@ impl Renderer {
             light_count: 0,
             samples: 0,
             stats: RenderStats::default(),
+            pending: Vec::new(),
         };
         r.reset()?;
         Ok(r)
@@ -200,6 +202,9 @@ impl Renderer {
 
     /// Clears the film and the counters.
     pub fn reset(&mut self) -> Result<(), ClError> {
+        if !self.pending.is_empty() {
+            self.finish()?;
+        }
         self.samples = 0;
         self.stats = RenderStats::default();
         self.counters.clear(&self.gpu)?;
@@ -276,11 +281,28 @@ impl Renderer {
 
     /// Renders `spp` more samples per pixel into the film and waits for them.
     pub fn render(&mut self, spp: u32) -> Result<(), ClError> {
+        self.start(spp)?;
+        self.finish()
+    }
+
+    /// Enqueues `spp` more samples per pixel and returns at once, so the host can do other
+    /// work (display the last frame) while the device renders; [`Renderer::finish`] waits.
+    pub fn start(&mut self, spp: u32) -> Result<(), ClError> {
         let launches = self.enqueue(spp)?;
+        self.pending.extend(launches);
+        self.gpu
+            .queue
+            .flush()
+            .map_err(crate::cl::call_err("submitting the frame"))
+    }
+
+    /// Waits for the work [`Renderer::start`] enqueued and gathers its statistics.
+    pub fn finish(&mut self) -> Result<(), ClError> {
         self.gpu
             .queue
             .finish()
             .map_err(crate::cl::call_err("waiting for the frame"))?;
+        let launches = std::mem::take(&mut self.pending);
         self.collect(launches)
     }
 
@@ -372,7 +394,10 @@ impl Renderer {
     }
 
     /// The film as linear RGB (the mean of the samples), row by row from the top.
-    pub fn image(&self) -> Result<Vec<[f32; 3]>, ClError> {
+    pub fn image(&mut self) -> Result<Vec<[f32; 3]>, ClError> {
+        if !self.pending.is_empty() {
+            self.finish()?;
+        }
         let Some(f) = self.frame.as_ref() else {
             let n = (self.settings.width * self.settings.height) as usize;
             return Ok(vec![[0.0; 3]; n]);
