@@ -253,3 +253,158 @@ fn depth(node: &BuildNode) -> u32 {
         BuildNode::Interior { children, .. } => 1 + depth(&children[0]).max(depth(&children[1])),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Child, Ray};
+    use super::*;
+
+    /// Deterministic pseudo-random numbers in [0, 1).
+    pub(crate) fn lcg(state: &mut u64) -> f32 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*state >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    pub(crate) fn random_triangles(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
+        let mut s = seed;
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 10.0;
+                let mut v = || c + (Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5) * 0.8;
+                [v(), v(), v()]
+            })
+            .collect()
+    }
+
+    /// Walks the tree checking boxes and returning (leaf ranges, max depth).
+    fn check_node(bvh: &Bvh, node: u32, tris: &[[Vec3; 3]], depth: u32, ranges: &mut Vec<(u32, u32)>) {
+        for side in 0..2 {
+            let (b, child) = bvh.child(node, side);
+            match child {
+                Child::Node(n) => {
+                    assert!(n > node, "children come after their parent");
+                    let (cb, _) = bvh.child(n, 0);
+                    let (cb2, _) = bvh.child(n, 1);
+                    assert!(b.contains(cb.min) && b.contains(cb.max));
+                    assert!(b.contains(cb2.min) && b.contains(cb2.max));
+                    check_node(bvh, n, tris, depth + 1, ranges);
+                }
+                Child::Leaf { first, count } => {
+                    for p in first..first + count {
+                        let original = bvh.tri_indices[p as usize] as usize;
+                        for v in tris[original] {
+                            assert!(b.contains(v), "a leaf box must hold its triangles");
+                        }
+                    }
+                    ranges.push((first, count));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn every_triangle_is_in_exactly_one_leaf_inside_its_boxes() {
+        let tris = random_triangles(5000, 7);
+        let bvh = build(&tris);
+        let mut ranges = vec![];
+        check_node(&bvh, 0, &tris, 0, &mut ranges);
+        ranges.sort();
+        let mut next = 0;
+        for (first, count) in ranges {
+            assert_eq!(first, next, "leaf ranges tile the triangle list");
+            assert!(count >= 1);
+            next = first + count;
+        }
+        assert_eq!(next as usize, tris.len());
+        let mut seen = bvh.tri_indices.clone();
+        seen.sort();
+        assert!(seen.iter().enumerate().all(|(i, &t)| i as u32 == t), "a permutation");
+        assert!(bvh.depth <= MAX_DEPTH);
+        assert!(bvh.sah_cost > 0.0 && bvh.sah_cost < tris.len() as f32);
+    }
+
+    #[test]
+    fn two_triangles_give_the_known_tree() {
+        // Two unit triangles far apart on x: the root must split them into two leaves.
+        let a = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let b = [Vec3::new(10.0, 0.0, 0.0), Vec3::new(11.0, 0.0, 0.0), Vec3::new(10.0, 1.0, 0.0)];
+        let bvh = build(&[a, b]);
+        assert_eq!(bvh.nodes.len(), 1);
+        assert_eq!(bvh.tri_indices, vec![0, 1]);
+        let (lb, l) = bvh.child(0, 0);
+        let (rb, r) = bvh.child(0, 1);
+        assert_eq!(l, Child::Leaf { first: 0, count: 1 });
+        assert_eq!(r, Child::Leaf { first: 1, count: 1 });
+        assert_eq!((lb.min, lb.max), (Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
+        assert_eq!((rb.min, rb.max), (Vec3::new(10.0, 0.0, 0.0), Vec3::new(11.0, 1.0, 0.0)));
+    }
+
+    #[test]
+    fn a_single_triangle_gets_a_root_node() {
+        let bvh = build(&[[Vec3::ZERO, Vec3::X, Vec3::Y]]);
+        assert_eq!(bvh.nodes.len(), 1);
+        assert_eq!(bvh.child(0, 0).1, Child::Leaf { first: 0, count: 1 });
+        assert_eq!(bvh.child(0, 1).1, Child::Leaf { first: 0, count: 0 });
+    }
+
+    #[test]
+    fn identical_triangles_still_build_within_the_depth_limit() {
+        let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let bvh = build(&vec![t; 1000]);
+        assert!(bvh.depth <= MAX_DEPTH);
+        let mut ranges = vec![];
+        check_node(&bvh, 0, &vec![t; 1000], 0, &mut ranges);
+        assert_eq!(ranges.iter().map(|r| r.1).sum::<u32>(), 1000);
+    }
+
+    fn brute_force(ray: &Ray, tris: &[[Vec3; 3]]) -> Option<f32> {
+        let mut best: Option<f32> = None;
+        for t in tris {
+            let r = Ray {
+                tmax: best.unwrap_or(ray.tmax),
+                ..*ray
+            };
+            if let Some((d, _, _)) = super::super::intersect_triangle(&r, t) {
+                best = Some(d);
+            }
+        }
+        best
+    }
+
+    /// Random, grazing and axis-parallel rays; the BVH must find the same closest distance as
+    /// testing every triangle, and any-hit must agree on occlusion.
+    #[test]
+    fn host_traversal_equals_brute_force() {
+        let tris = random_triangles(2000, 11);
+        let bvh = build(&tris);
+        let ordered: Vec<[Vec3; 3]> = bvh.tri_indices.iter().map(|&i| tris[i as usize]).collect();
+        let mut s = 99u64;
+        let mut rays = vec![];
+        for _ in 0..3000 {
+            let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 14.0 - 2.0;
+            let d = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5;
+            rays.push(Ray { origin: o, direction: d.normalize(), tmin: 0.0, tmax: f32::INFINITY });
+        }
+        for i in 0..600 {
+            // Axis-parallel rays along each axis in both directions.
+            let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 10.0;
+            let mut d = Vec3::ZERO;
+            d[i % 3] = if i % 2 == 0 { 1.0 } else { -1.0 };
+            rays.push(Ray { origin: o - d * 20.0, direction: d, tmin: 0.0, tmax: f32::INFINITY });
+        }
+        for t in tris.iter().take(600) {
+            // Grazing rays: in the plane of a triangle, through its edge midpoint.
+            let mid = (t[0] + t[1]) * 0.5;
+            let d = (t[1] - t[0]).normalize();
+            rays.push(Ray { origin: mid - d * 5.0, direction: d, tmin: 0.0, tmax: f32::INFINITY });
+        }
+        for ray in &rays {
+            let expect = brute_force(ray, &tris);
+            let got = bvh.intersect(ray, &ordered).map(|h| h.t);
+            assert_eq!(got, expect, "closest hit differs for {ray:?}");
+            assert_eq!(bvh.occluded(ray, &ordered), expect.is_some(), "any hit differs for {ray:?}");
+        }
+    }
+}

@@ -223,7 +223,7 @@ mod tests {
     }
 
     #[test]
-    fn a_ray_through_a_shared_edge_hits_exactly_one_triangle() {
+    fn no_ray_slips_through_a_shared_edge() {
         // Two triangles sharing the diagonal of the unit square; rays exactly on the diagonal.
         let a = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0)];
         let b = [Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];

@@ -1,0 +1,323 @@
+//! Helpers shared by the integration tests: a tiny glTF writer for fixtures, and running the
+//! binary.
+#![allow(dead_code)]
+
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// One mesh primitive of a fixture.
+pub struct Prim {
+    /// Positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Normals (empty for none).
+    pub normals: Vec<[f32; 3]>,
+    /// Triangle indices (empty: non-indexed).
+    pub indices: Vec<u32>,
+    /// Material index.
+    pub material: Option<usize>,
+    /// glTF mode (4 = triangles).
+    pub mode: u32,
+}
+
+impl Prim {
+    /// An indexed triangle list.
+    pub fn triangles(positions: Vec<[f32; 3]>, indices: Vec<u32>, material: usize) -> Self {
+        Self {
+            positions,
+            normals: vec![],
+            indices,
+            material: Some(material),
+            mode: 4,
+        }
+    }
+}
+
+/// A glTF document under construction; `nodes`, `materials` etc. are raw JSON values.
+#[derive(Default)]
+pub struct Gltf {
+    /// Binary buffer contents.
+    pub bin: Vec<u8>,
+    /// Accessors.
+    pub accessors: Vec<Value>,
+    /// Buffer views.
+    pub views: Vec<Value>,
+    /// Meshes.
+    pub meshes: Vec<Value>,
+    /// Nodes.
+    pub nodes: Vec<Value>,
+    /// Materials.
+    pub materials: Vec<Value>,
+    /// KHR_lights_punctual lights.
+    pub lights: Vec<Value>,
+    /// Cameras.
+    pub cameras: Vec<Value>,
+    /// extensionsUsed.
+    pub used: Vec<String>,
+    /// extensionsRequired.
+    pub required: Vec<String>,
+}
+
+impl Gltf {
+    fn push_data(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let offset = self.bin.len();
+        self.bin.extend_from_slice(bytes);
+        let mut view = json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()});
+        if let Some(t) = target {
+            view["target"] = json!(t);
+        }
+        self.views.push(view);
+        self.views.len() - 1
+    }
+
+    fn vec3_accessor(&mut self, data: &[[f32; 3]]) -> usize {
+        let bytes: Vec<u8> = data.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+        let view = self.push_data(&bytes, Some(34962));
+        let mut min = [f32::INFINITY; 3];
+        let mut max = [f32::NEG_INFINITY; 3];
+        for p in data {
+            for i in 0..3 {
+                min[i] = min[i].min(p[i]);
+                max[i] = max[i].max(p[i]);
+            }
+        }
+        let finite = min.iter().chain(&max).all(|v| v.is_finite());
+        let mut acc = json!({"bufferView": view, "componentType": 5126, "count": data.len(), "type": "VEC3"});
+        if finite {
+            acc["min"] = json!(min);
+            acc["max"] = json!(max);
+        }
+        self.accessors.push(acc);
+        self.accessors.len() - 1
+    }
+
+    /// Adds a mesh of primitives; returns its index.
+    pub fn mesh(&mut self, prims: Vec<Prim>) -> usize {
+        let mut out = vec![];
+        for p in prims {
+            let pos = self.vec3_accessor(&p.positions);
+            let mut attributes = json!({"POSITION": pos});
+            if !p.normals.is_empty() {
+                attributes["NORMAL"] = json!(self.vec3_accessor(&p.normals));
+            }
+            let mut prim = json!({"attributes": attributes, "mode": p.mode});
+            if !p.indices.is_empty() {
+                let bytes: Vec<u8> = p.indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+                let view = self.push_data(&bytes, Some(34963));
+                self.accessors.push(json!({"bufferView": view, "componentType": 5125, "count": p.indices.len(), "type": "SCALAR"}));
+                prim["indices"] = json!(self.accessors.len() - 1);
+            }
+            if let Some(m) = p.material {
+                prim["material"] = json!(m);
+            }
+            out.push(prim);
+        }
+        self.meshes.push(json!({"primitives": out}));
+        self.meshes.len() - 1
+    }
+
+    /// Adds a node; returns its index.
+    pub fn node(&mut self, node: Value) -> usize {
+        self.nodes.push(node);
+        self.nodes.len() - 1
+    }
+
+    /// Adds a Lambertian material (specularFactor 0) with an optional emission.
+    pub fn lambert(&mut self, color: [f32; 3], emission: [f32; 3], strength: f32, double_sided: bool) -> usize {
+        self.use_ext("KHR_materials_specular");
+        self.use_ext("KHR_materials_emissive_strength");
+        self.materials.push(json!({
+            "pbrMetallicRoughness": {"baseColorFactor": [color[0], color[1], color[2], 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0},
+            "emissiveFactor": emission,
+            "doubleSided": double_sided,
+            "extensions": {
+                "KHR_materials_specular": {"specularFactor": 0.0},
+                "KHR_materials_emissive_strength": {"emissiveStrength": strength}
+            }
+        }));
+        self.materials.len() - 1
+    }
+
+    /// Declares an extension as used.
+    pub fn use_ext(&mut self, name: &str) {
+        if !self.used.iter().any(|u| u == name) {
+            self.used.push(name.to_string());
+        }
+    }
+
+    /// The JSON document; `uri` is the buffer's URI (None for GLB).
+    pub fn json(&self, uri: Option<String>) -> Value {
+        let roots: Vec<usize> = (0..self.nodes.len())
+            .filter(|i| !self.nodes.iter().any(|n| n["children"].as_array().is_some_and(|c| c.iter().any(|c| c.as_u64() == Some(*i as u64)))))
+            .collect();
+        let mut buffer = json!({"byteLength": self.bin.len()});
+        if let Some(u) = uri {
+            buffer["uri"] = json!(u);
+        }
+        let mut doc = json!({
+            "asset": {"version": "2.0", "generator": "penumbra tests"},
+            "scene": 0,
+            "scenes": [{"nodes": roots}],
+            "nodes": self.nodes,
+            "meshes": self.meshes,
+            "materials": self.materials,
+            "accessors": self.accessors,
+            "bufferViews": self.views,
+            "buffers": [buffer],
+        });
+        if !self.cameras.is_empty() {
+            doc["cameras"] = json!(self.cameras);
+        }
+        let mut used = self.used.clone();
+        if !self.lights.is_empty() {
+            if !used.iter().any(|u| u == "KHR_lights_punctual") {
+                used.push("KHR_lights_punctual".into());
+            }
+            doc["extensions"] = json!({"KHR_lights_punctual": {"lights": self.lights}});
+        }
+        if !used.is_empty() {
+            doc["extensionsUsed"] = json!(used);
+        }
+        if !self.required.is_empty() {
+            doc["extensionsRequired"] = json!(self.required);
+        }
+        doc
+    }
+
+    /// GLB bytes.
+    pub fn glb(&self) -> Vec<u8> {
+        let mut json = serde_json::to_vec(&self.json(None)).unwrap();
+        while json.len() % 4 != 0 {
+            json.push(b' ');
+        }
+        let mut bin = self.bin.clone();
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        let total = 12 + 8 + json.len() + 8 + bin.len();
+        let mut out = Vec::with_capacity(total);
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&(total as u32).to_le_bytes());
+        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&json);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+        out
+    }
+
+    /// Writes `name.glb` into `dir`.
+    pub fn write_glb(&self, dir: &Path, name: &str) -> PathBuf {
+        let p = dir.join(format!("{name}.glb"));
+        std::fs::write(&p, self.glb()).unwrap();
+        p
+    }
+
+    /// Writes `name.gltf` with an external `name.bin` into `dir`.
+    pub fn write_gltf(&self, dir: &Path, name: &str) -> PathBuf {
+        let bin = format!("{name}.bin");
+        std::fs::write(dir.join(&bin), &self.bin).unwrap();
+        let p = dir.join(format!("{name}.gltf"));
+        std::fs::write(&p, serde_json::to_vec_pretty(&self.json(Some(bin))).unwrap()).unwrap();
+        p
+    }
+
+    /// Writes `name.gltf` with the buffer embedded as a base64 data URI.
+    pub fn write_gltf_embedded(&self, dir: &Path, name: &str) -> PathBuf {
+        let uri = format!("data:application/octet-stream;base64,{}", base64(&self.bin));
+        let p = dir.join(format!("{name}.gltf"));
+        std::fs::write(&p, serde_json::to_vec(&self.json(Some(uri))).unwrap()).unwrap();
+        p
+    }
+}
+
+fn base64(data: &[u8]) -> String {
+    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::new();
+    for c in data.chunks(3) {
+        let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
+        let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
+        for i in 0..4 {
+            if i <= c.len() {
+                s.push(T[(n >> (18 - 6 * i)) as usize & 63] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}
+
+/// A UV sphere of `radius` at the origin; `inward` flips the winding and normals.
+pub fn sphere(radius: f32, rings: u32, segments: u32, inward: bool) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u32>) {
+    let mut pos = vec![];
+    let mut nrm = vec![];
+    for r in 0..=rings {
+        let theta = std::f32::consts::PI * r as f32 / rings as f32;
+        for s in 0..=segments {
+            let phi = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
+            let n = [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()];
+            pos.push(n.map(|v| v * radius));
+            nrm.push(if inward { n.map(|v| -v) } else { n });
+        }
+    }
+    let mut idx = vec![];
+    let w = segments + 1;
+    for r in 0..rings {
+        for s in 0..segments {
+            let a = r * w + s;
+            let b = a + w;
+            // Outward-facing (counter-clockwise seen from outside).
+            let tris = [[a, a + 1, b], [a + 1, b + 1, b]];
+            for t in tris {
+                if inward {
+                    idx.extend([t[0], t[2], t[1]]);
+                } else {
+                    idx.extend(t);
+                }
+            }
+        }
+    }
+    (pos, nrm, idx)
+}
+
+/// Runs the penumbra binary with `args`.
+pub fn penumbra(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .args(args)
+        .env("PENUMBRA_DEVICE", "cpu")
+        .output()
+        .expect("the penumbra binary runs")
+}
+
+/// Runs a render and returns (the JSON summary, the linear image).
+pub fn render_exr(scene: &Path, out: &Path, extra: &[&str]) -> (Value, Vec<[f32; 3]>) {
+    let mut args = vec!["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let o = penumbra(&args);
+    assert!(
+        o.status.success(),
+        "render failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let summary: Value = serde_json::from_slice(&o.stdout).expect("one JSON line on stdout");
+    let (_, _, px) = penumbra::image_io::read_exr(out).unwrap();
+    (summary, px)
+}
+
+/// The scenes folder, if set.
+pub fn scenes_dir() -> Option<PathBuf> {
+    std::env::var_os("PENUMBRA_SCENES").map(PathBuf::from).filter(|p| p.is_dir())
+}
+
+/// A folder for test outputs kept after the run (actual and difference images).
+pub fn output_dir(test: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(test);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
