@@ -1,0 +1,431 @@
+//! `penumbra bench converge SCENE --reference REF.exr`: error against run time.
+//!
+//! For each configuration (direct-light strategy × Russian roulette) the film is cleared and
+//! rendered progressively; at every power of two of samples per pixel the wall time of the
+//! renders so far, their kernel time, and the RMSE and relMSE of the image against the
+//! reference are recorded. An unbiased estimator's MSE falls as 1/time: slope −1 on log–log
+//! axes. A curve that flattens is bias (or a reference that does not match the render).
+
+use super::stats::{ImageError, image_error, log_log_slope};
+use super::{device_json, device_line, plot, today};
+use crate::cli::CommonArgs;
+use crate::image_io::read_exr;
+use crate::render::{Renderer, Strategy};
+use crate::scene::{AUTO_YFOV, Camera};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use glam::DVec3;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Options of `bench converge`.
+#[derive(Args, Debug, Clone)]
+pub struct ConvergeArgs {
+    /// glTF or GLB file; the bundled Cornell box when absent.
+    pub scene: Option<PathBuf>,
+    /// Reference image (linear EXR) of the same scene, camera and bounces, e.g. from
+    /// `penumbra render --spp 65536` or scripts/mitsuba_reference.py. Its size is the
+    /// render size unless --width/--height are given (they must then match).
+    #[arg(long)]
+    pub reference: PathBuf,
+    /// Shared options (`--spp` is the most samples per pixel, default 1024).
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// Configurations, comma-separated: mis, bsdf, lights, each optionally with "+rr"
+    /// (Russian roulette from bounce 3); default all six.
+    #[arg(long, value_delimiter = ',', value_parser = parse_config)]
+    pub configs: Vec<Config>,
+    /// Stop a configuration after the step that passes this many seconds of rendering.
+    #[arg(long, default_value_t = 60.0)]
+    pub max_seconds: f64,
+    /// Fit the slopes over the steps with at least this many samples per pixel.
+    #[arg(long, default_value_t = 4)]
+    pub fit_from: u32,
+    /// Leave out the punctual lights (the file's and the default rig), so that all light comes
+    /// from emissive geometry, which every strategy reaches (BSDF sampling never hits a
+    /// punctual light).
+    #[arg(long)]
+    pub no_punctual: bool,
+    /// Camera position X,Y,Z (with --look-at; replaces the file's camera).
+    #[arg(long, value_parser = parse_vec3, requires = "look_at", allow_negative_numbers = true)]
+    pub look_from: Option<DVec3>,
+    /// Point the camera looks at, X,Y,Z.
+    #[arg(long, value_parser = parse_vec3, requires = "look_from", allow_negative_numbers = true)]
+    pub look_at: Option<DVec3>,
+    /// Vertical field of view in degrees of the --look-from camera.
+    #[arg(long)]
+    pub fov: Option<f64>,
+    /// Write the steps as CSV here.
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// Write a log-log plot of relMSE against time here (PNG).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Title line of the plot (default: the scene's file name).
+    #[arg(long)]
+    pub title: Option<String>,
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One sampling configuration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Config {
+    /// Direct-light strategy.
+    pub strategy: Strategy,
+    /// Russian roulette on.
+    pub russian_roulette: bool,
+}
+
+impl Config {
+    /// Every configuration, in the order they are plotted.
+    pub const ALL: [Config; 6] = [
+        Config::new(Strategy::Mis, false),
+        Config::new(Strategy::Mis, true),
+        Config::new(Strategy::Lights, false),
+        Config::new(Strategy::Lights, true),
+        Config::new(Strategy::Bsdf, false),
+        Config::new(Strategy::Bsdf, true),
+    ];
+
+    const fn new(strategy: Strategy, russian_roulette: bool) -> Self {
+        Self {
+            strategy,
+            russian_roulette,
+        }
+    }
+
+    /// "mis", "lights+rr", ...
+    pub fn name(&self) -> String {
+        let s = match self.strategy {
+            Strategy::Mis => "mis",
+            Strategy::Bsdf => "bsdf",
+            Strategy::Lights => "lights",
+        };
+        if self.russian_roulette {
+            format!("{s}+rr")
+        } else {
+            s.to_string()
+        }
+    }
+}
+
+fn parse_config(s: &str) -> Result<Config, String> {
+    Config::ALL
+        .into_iter()
+        .find(|c| c.name() == s.trim())
+        .ok_or_else(|| {
+            format!("'{s}' is not a configuration (mis, bsdf, lights, each optionally +rr)")
+        })
+}
+
+fn parse_vec3(s: &str) -> Result<DVec3, String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}' is not X,Y,Z"))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(DVec3::new(*x, *y, *z)),
+        _ => Err(format!("'{s}' is not X,Y,Z")),
+    }
+}
+
+/// One recorded step.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Step {
+    /// Samples per pixel in the film.
+    pub spp: u32,
+    /// Wall time of the renders so far (blocking calls; read-back and metrics excluded).
+    pub seconds: f64,
+    /// Kernel time of the renders so far, from profiling events.
+    pub kernel_seconds: f64,
+    /// Root mean squared error against the reference.
+    pub rmse: f64,
+    /// Mean of (x − r)² / (r² + 0.01) over pixels and channels.
+    pub relmse: f64,
+}
+
+/// The steps of one configuration and what is fitted to them.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Curve {
+    /// Configuration name.
+    pub config: String,
+    /// Steps, in order.
+    pub steps: Vec<Step>,
+    /// Slope of ln relMSE against ln wall time over the fitted steps (−1: unbiased).
+    pub slope_time: Option<f64>,
+    /// Slope of ln relMSE against ln spp over the fitted steps (not a timing).
+    pub slope_spp: Option<f64>,
+    /// 1 / (relMSE × seconds) at the last step.
+    pub efficiency: f64,
+}
+
+impl Curve {
+    fn fit(config: String, steps: Vec<Step>, fit_from: u32) -> Self {
+        let fitted: Vec<&Step> = steps.iter().filter(|s| s.spp >= fit_from).collect();
+        let slope_time = log_log_slope(
+            &fitted
+                .iter()
+                .map(|s| (s.seconds, s.relmse))
+                .collect::<Vec<_>>(),
+        );
+        let slope_spp = log_log_slope(
+            &fitted
+                .iter()
+                .map(|s| (s.spp as f64, s.relmse))
+                .collect::<Vec<_>>(),
+        );
+        let efficiency = steps
+            .last()
+            .map_or(0.0, |s| 1.0 / (s.relmse * s.seconds).max(1e-300));
+        Self {
+            config,
+            steps,
+            slope_time,
+            slope_spp,
+            efficiency,
+        }
+    }
+}
+
+/// Runs the benchmark.
+pub fn run(args: &ConvergeArgs) -> Result<()> {
+    let (ref_w, ref_h, reference) = read_exr(&args.reference)?;
+    if args.common.width.is_some_and(|w| w != ref_w)
+        || args.common.height.is_some_and(|h| h != ref_h)
+    {
+        bail!(
+            "{}: the reference is {ref_w}×{ref_h}, not the --width/--height given",
+            args.reference.display()
+        );
+    }
+    let mut settings = args.common.settings((ref_w, ref_h))?;
+    let max_spp = args.common.spp.unwrap_or(1024);
+    let configs = if args.configs.is_empty() {
+        Config::ALL.to_vec()
+    } else {
+        args.configs.clone()
+    };
+    let mut prepared = args.common.prepare(args.scene.as_deref())?;
+    let source = prepared.scene.source.clone();
+    if args.no_punctual {
+        prepared.lights.clear();
+    }
+    if let (Some(eye), Some(target)) = (args.look_from, args.look_at) {
+        let yfov = args.fov.map_or(AUTO_YFOV, f64::to_radians);
+        prepared.camera = Camera::look_at("look-from", eye, target, yfov);
+    } else if args.fov.is_some() {
+        bail!("--fov needs --look-from and --look-at");
+    }
+    if !prepared.lights.is_empty() && configs.iter().any(|c| c.strategy == Strategy::Bsdf) {
+        eprintln!(
+            "penumbra: {source} has {} punctual light(s), which BSDF sampling never reaches: \
+             the bsdf curves will flatten (bias); --no-punctual leaves them out",
+            prepared.lights.len()
+        );
+    }
+
+    let mut renderer = Renderer::new(&args.common.device_choice()?)?;
+    renderer.set_settings(&settings)?;
+    let scene_stats = renderer
+        .load_scene(&prepared.scene, &prepared.lights)
+        .with_context(|| source.clone())?;
+    if renderer.host_scene().is_some_and(|h| h.emissive.is_empty()) && prepared.lights.is_empty() {
+        bail!("{source}: no light is left (no emissive triangles and --no-punctual)");
+    }
+    renderer.set_camera(&prepared.camera)?;
+    // Warm up: buffers, kernel caches, device clocks.
+    renderer.render(1)?;
+
+    let base_seed = settings.seed;
+    let mut curves = Vec::new();
+    for (ci, config) in configs.iter().enumerate() {
+        settings.strategy = config.strategy;
+        settings.russian_roulette = config.russian_roulette.then_some(3);
+        settings.seed = base_seed.wrapping_add(ci as u32 + 1);
+        renderer.set_settings(&settings)?;
+        let mut steps = Vec::new();
+        let mut seconds = 0.0;
+        let mut spp = 0;
+        let mut next = 1;
+        while spp < max_spp && seconds <= args.max_seconds {
+            let start = Instant::now();
+            renderer.render(next - spp)?;
+            seconds += start.elapsed().as_secs_f64();
+            spp = next;
+            let ImageError { rmse, relmse } = image_error(&renderer.image()?, &reference);
+            steps.push(Step {
+                spp,
+                seconds,
+                kernel_seconds: renderer.stats().kernel_ms() * 1e-3,
+                rmse,
+                relmse,
+            });
+            next = (spp * 2).min(max_spp);
+        }
+        if renderer.stats().stack_overflows > 0 {
+            bail!("{source}: traversal stack overflow: the images are wrong");
+        }
+        if !args.json {
+            eprintln!(
+                "penumbra: {}: {} spp in {:.2} s",
+                config.name(),
+                spp,
+                seconds
+            );
+        }
+        curves.push(Curve::fit(config.name(), steps, args.fit_from));
+    }
+
+    let date = today();
+    let device = renderer.gpu.description();
+    let scene_name = args
+        .scene
+        .as_ref()
+        .and_then(|p| p.file_name())
+        .map_or_else(|| source.clone(), |n| n.to_string_lossy().into_owned());
+    if let Some(path) = &args.csv {
+        write_csv(path, &curves)?;
+    }
+    if let Some(path) = &args.plot {
+        let title = args.title.clone().unwrap_or_else(|| {
+            format!(
+                "{scene_name}: {}×{}, {} bounces",
+                settings.width, settings.height, settings.bounces
+            )
+        });
+        plot::convergence(path, &title, &format!("{device} — {date}"), &curves)?;
+    }
+    if args.json {
+        let summary = serde_json::json!({
+            "benchmark": "converge",
+            "date": date,
+            "scene": source,
+            "reference": args.reference.display().to_string(),
+            "device": device_json(&renderer.gpu),
+            "width": settings.width,
+            "height": settings.height,
+            "bounces": settings.bounces,
+            "max_spp": max_spp,
+            "max_seconds": args.max_seconds,
+            "fit_from": args.fit_from,
+            "punctual_lights": prepared.lights.len(),
+            "light_radius": if prepared.lights.is_empty() { 0.0 } else { prepared.light_radius },
+            "triangles": scene_stats.triangles,
+            "curves": curves,
+        });
+        println!("{summary}");
+        return Ok(());
+    }
+    println!(
+        "penumbra bench converge — {source} against {} — {date}",
+        args.reference.display()
+    );
+    println!("device   {}", device_line(&renderer.gpu));
+    println!(
+        "render   {}×{}, {} bounces, {} punctual light(s), up to {max_spp} spp or {} s per \
+         configuration; slopes fitted from {} spp",
+        settings.width,
+        settings.height,
+        settings.bounces,
+        prepared.lights.len(),
+        args.max_seconds,
+        args.fit_from
+    );
+    println!();
+    println!(
+        "{:<10} {:>6} {:>10} {:>10} {:>12} {:>12}",
+        "config", "spp", "seconds", "kernel s", "RMSE", "relMSE"
+    );
+    for c in &curves {
+        for s in &c.steps {
+            println!(
+                "{:<10} {:>6} {:>10.4} {:>10.4} {:>12.4e} {:>12.4e}",
+                c.config, s.spp, s.seconds, s.kernel_seconds, s.rmse, s.relmse
+            );
+        }
+    }
+    println!();
+    println!(
+        "{:<10} {:>6} {:>12} {:>12} {:>11} {:>12}",
+        "config", "spp", "relMSE", "slope/time", "slope/spp", "efficiency"
+    );
+    let fmt = |s: Option<f64>| s.map_or_else(|| "-".into(), |v| format!("{v:.3}"));
+    for c in &curves {
+        let last = c.steps.last();
+        println!(
+            "{:<10} {:>6} {:>12.4e} {:>12} {:>11} {:>12.4e}",
+            c.config,
+            last.map_or(0, |s| s.spp),
+            last.map_or(0.0, |s| s.relmse),
+            fmt(c.slope_time),
+            fmt(c.slope_spp),
+            c.efficiency
+        );
+    }
+    println!();
+    println!("efficiency = 1 / (relMSE × seconds) at the last step; slope −1 = unbiased");
+    Ok(())
+}
+
+fn write_csv(path: &std::path::Path, curves: &[Curve]) -> Result<()> {
+    let mut out = String::from("config,spp,seconds,kernel_seconds,rmse,relmse\n");
+    for c in curves {
+        for s in &c.steps {
+            out.push_str(&format!(
+                "{},{},{},{},{},{}\n",
+                c.config, s.spp, s.seconds, s.kernel_seconds, s.rmse, s.relmse
+            ));
+        }
+    }
+    std::fs::write(path, out).with_context(|| format!("{}: cannot write CSV", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn configurations_parse_by_name() {
+        assert_eq!(
+            parse_config("lights+rr"),
+            Ok(Config::new(Strategy::Lights, true))
+        );
+        assert_eq!(parse_config("mis"), Ok(Config::new(Strategy::Mis, false)));
+        assert!(parse_config("path").is_err());
+        for c in Config::ALL {
+            assert_eq!(parse_config(&c.name()), Ok(c));
+        }
+    }
+
+    #[test]
+    fn vectors_parse() {
+        assert_eq!(
+            parse_vec3("-278, 273,800"),
+            Ok(DVec3::new(-278.0, 273.0, 800.0))
+        );
+        assert!(parse_vec3("1,2").is_err());
+    }
+
+    #[test]
+    fn a_one_over_n_curve_fits_slope_minus_one() {
+        let steps = (0..8)
+            .map(|i| {
+                let spp = 1 << i;
+                Step {
+                    spp,
+                    seconds: 0.01 * spp as f64,
+                    kernel_seconds: 0.0,
+                    rmse: 0.0,
+                    relmse: 0.5 / spp as f64,
+                }
+            })
+            .collect();
+        let c = Curve::fit("mis".into(), steps, 4);
+        assert!((c.slope_time.unwrap() + 1.0).abs() < 1e-9);
+        assert!((c.slope_spp.unwrap() + 1.0).abs() < 1e-9);
+        assert!((c.efficiency - 1.0 / (0.5 / 128.0 * 1.28)).abs() < 1e-6);
+    }
+}

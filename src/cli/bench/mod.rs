@@ -1,0 +1,123 @@
+//! `penumbra bench`: ray throughput of the traversal kernels (`trace`), where a frame's time
+//! goes (`frame`), error against run time (`converge`), and a generator of large test scenes
+//! (`generate`). What each measures, and the figures, are in `docs/benchmarks.md`.
+
+mod converge;
+mod frame;
+mod generate;
+mod plot;
+mod rays;
+mod stats;
+mod trace;
+
+pub use converge::ConvergeArgs;
+pub use frame::FrameArgs;
+pub use generate::GenerateArgs;
+pub use trace::TraceArgs;
+
+use crate::cl::Gpu;
+use anyhow::Result;
+use clap::Subcommand;
+
+/// Benchmarks.
+#[derive(Subcommand, Debug)]
+pub enum BenchCommand {
+    /// Rays per second of the traversal kernels alone (primary, diffuse-bounce and shadow
+    /// rays), validated against the host traversal.
+    Trace(TraceArgs),
+    /// Samples per second of the whole path tracer and the kernel time of each stage.
+    Frame(FrameArgs),
+    /// Error (RMSE, relMSE) against run time for several sampling settings, against a
+    /// reference image; table, CSV/JSON and a log-log plot.
+    Converge(ConvergeArgs),
+    /// Writes a large test scene (instanced spheres or copies of a mesh in a closed, lit room).
+    Generate(GenerateArgs),
+}
+
+/// Runs a benchmark.
+pub fn run(cmd: BenchCommand) -> Result<()> {
+    match cmd {
+        BenchCommand::Trace(a) => trace::run(&a),
+        BenchCommand::Frame(a) => frame::run(&a),
+        BenchCommand::Converge(a) => converge::run(&a),
+        BenchCommand::Generate(a) => generate::run(&a),
+    }
+}
+
+/// The device as benchmark outputs describe it.
+fn device_json(gpu: &Gpu) -> serde_json::Value {
+    let i = &gpu.info;
+    serde_json::json!({
+        "name": i.name,
+        "platform": i.platform,
+        "driver": i.driver,
+        "version": i.version,
+        "is_gpu": i.is_gpu,
+        "compute_units": i.compute_units,
+    })
+}
+
+/// One line naming the device, its platform and driver.
+fn device_line(gpu: &Gpu) -> String {
+    let i = &gpu.info;
+    format!(
+        "{} ({}), driver {}, {}, {} compute units",
+        i.name, i.platform, i.driver, i.version, i.compute_units
+    )
+}
+
+/// Today's date (UTC) as YYYY-MM-DD, for benchmark records and figures.
+fn today() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
+    let (y, m, d) = civil_from_days((secs / 86_400) as i64);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// Proleptic Gregorian date of a day count since 1970-01-01 (Howard Hinnant's algorithm).
+fn civil_from_days(z: i64) -> (i64, u32, u32) {
+    let z = z + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    (yoe + era * 400 + i64::from(m <= 2), m, d)
+}
+
+/// `1234567` as `1,234,567`.
+fn thousands(n: u64) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dates_follow_the_calendar() {
+        assert_eq!(civil_from_days(0), (1970, 1, 1));
+        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
+        assert_eq!(civil_from_days(20_417), (2025, 11, 25));
+    }
+
+    #[test]
+    fn thousands_are_grouped() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(1000), "1,000");
+        assert_eq!(thousands(1_234_567), "1,234,567");
+    }
+}

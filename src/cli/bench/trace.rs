@@ -1,0 +1,513 @@
+//! `penumbra bench trace SCENE`: rays per second of the traversal kernels alone.
+//!
+//! Three ray sets of width × height rays each are made on the host (see `rays`): primary,
+//! diffuse first bounce and shadow rays (the secondary rays start from the primary hits, in
+//! pixel order, cycling through them when some primary rays missed). Each is uploaded once, traced `--warmup` times untimed, then `--runs` times; the
+//! reported time is the median kernel time from OpenCL profiling events. Every result is then
+//! checked against the host traversal (`Bvh::intersect` / `occluded`) on a deterministic
+//! subset of at least `--validate` rays (all of them with `--validate 0`).
+
+use super::rays::{self, LightTargets, MISS};
+use super::stats::median;
+use super::{device_json, device_line, thousands, today};
+use crate::bvh::Bvh;
+use crate::cl::kernels::{Launch, SceneBuffers};
+use crate::cl::types::{GpuHit, GpuRay};
+use crate::cl::{Buffer, Gpu, Program, call_err};
+use crate::cli::CommonArgs;
+use crate::render::{Renderer, gpu_camera};
+use crate::scene::LightKind;
+use anyhow::{Context, Result, anyhow};
+use clap::Args;
+use glam::Vec3;
+use rayon::prelude::*;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Options of `bench trace`.
+#[derive(Args, Debug, Clone)]
+pub struct TraceArgs {
+    /// glTF or GLB file; the bundled Cornell box when absent.
+    pub scene: Option<PathBuf>,
+    /// OpenCL device: gpu, cpu or an index from `penumbra devices` (default: first GPU, else
+    /// first CPU; also PENUMBRA_DEVICE).
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Width of the primary ray grid.
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    /// Height of the primary ray grid.
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// Camera of the glTF file to use (index; the automatic camera when the file has none).
+    #[arg(long)]
+    pub camera: Option<usize>,
+    /// Seed of the diffuse and shadow ray directions.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Timed launches per ray set (the median is reported).
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+    /// Untimed launches before the timed ones.
+    #[arg(long, default_value_t = 2)]
+    pub warmup: usize,
+    /// Rays of each set checked against the host traversal (every k-th ray; 0 checks all).
+    #[arg(long, default_value_t = 262_144)]
+    pub validate: usize,
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Agreement of device results with the host traversal.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct Check {
+    /// Rays compared.
+    pub checked: u64,
+    /// Same triangle and distance (or both missed / same occlusion).
+    pub matches: u64,
+    /// Different triangles at the same distance (within 1e-5 relative): exact ties, counted
+    /// as agreement.
+    pub ties: u64,
+    /// Real disagreements: a hit against a miss, or different distances.
+    pub mismatches: u64,
+}
+
+impl Check {
+    fn add(self, o: Check) -> Check {
+        Check {
+            checked: self.checked + o.checked,
+            matches: self.matches + o.matches,
+            ties: self.ties + o.ties,
+            mismatches: self.mismatches + o.mismatches,
+        }
+    }
+}
+
+/// Timing and validation of one ray set.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SetResult {
+    /// primary, diffuse or shadow.
+    pub kind: &'static str,
+    /// closest or any (hit query).
+    pub query: &'static str,
+    /// Rays in the set.
+    pub rays: usize,
+    /// Rays that hit something (closest) or were occluded (any).
+    pub hits: usize,
+    /// Median kernel time of the timed launches.
+    pub median_ms: f64,
+    /// Fastest timed launch.
+    pub min_ms: f64,
+    /// Slowest timed launch.
+    pub max_ms: f64,
+    /// rays / median time.
+    pub rays_per_second: f64,
+    /// Agreement with the host traversal.
+    pub validation: Check,
+    /// Rays per second of the host reference traversal while validating (all threads).
+    pub host_rays_per_second: f64,
+}
+
+/// The indices of the rays to check: every k-th so that at least `want` are checked.
+fn sample_indices(n: usize, want: usize) -> Vec<usize> {
+    let stride = if want == 0 || want >= n { 1 } else { n / want };
+    (0..n).step_by(stride.max(1)).collect()
+}
+
+fn same_t(a: f32, b: f32) -> bool {
+    a == b || (a - b).abs() <= 1e-5 * a.abs().max(b.abs())
+}
+
+/// Compares closest hits with the host traversal.
+fn check_closest(
+    bvh: &Bvh,
+    tris: &[[Vec3; 3]],
+    rays: &[GpuRay],
+    hits: &[GpuHit],
+    want: usize,
+) -> Check {
+    sample_indices(rays.len(), want)
+        .into_par_iter()
+        .map(|i| {
+            let host = bvh.intersect(&rays::to_host(&rays[i]), tris);
+            let dev = hits[i];
+            let mut c = Check {
+                checked: 1,
+                ..Check::default()
+            };
+            match host {
+                None if dev.prim == MISS => c.matches = 1,
+                Some(h) if dev.prim != MISS && same_t(h.t, dev.t) => {
+                    if h.prim == dev.prim {
+                        c.matches = 1;
+                    } else {
+                        c.ties = 1;
+                    }
+                }
+                _ => c.mismatches = 1,
+            }
+            c
+        })
+        .reduce(Check::default, Check::add)
+}
+
+/// Compares occlusion with the host traversal.
+fn check_any(
+    bvh: &Bvh,
+    tris: &[[Vec3; 3]],
+    rays: &[GpuRay],
+    occluded: &[u32],
+    want: usize,
+) -> Check {
+    sample_indices(rays.len(), want)
+        .into_par_iter()
+        .map(|i| {
+            let host = bvh.occluded(&rays::to_host(&rays[i]), tris);
+            let agree = host == (occluded[i] != 0);
+            Check {
+                checked: 1,
+                matches: agree as u64,
+                ties: 0,
+                mismatches: (!agree) as u64,
+            }
+        })
+        .reduce(Check::default, Check::add)
+}
+
+/// Launches `launch` `warmup` times untimed, then `runs` times; returns the kernel times (ms).
+fn time_launches(
+    gpu: &Gpu,
+    warmup: usize,
+    runs: usize,
+    mut launch: impl FnMut() -> Result<Launch>,
+) -> Result<Vec<f64>> {
+    let mut times = Vec::with_capacity(runs);
+    for i in 0..warmup + runs {
+        let l = launch()?;
+        gpu.queue
+            .finish()
+            .map_err(call_err("waiting for a traversal kernel"))?;
+        if i >= warmup {
+            times.push(l.millis());
+        }
+    }
+    Ok(times)
+}
+
+fn set_result(
+    kind: &'static str,
+    query: &'static str,
+    rays: usize,
+    hits: usize,
+    times: &[f64],
+    (validation, host_seconds): (Check, f64),
+) -> SetResult {
+    let median_ms = median(times);
+    SetResult {
+        kind,
+        query,
+        rays,
+        hits,
+        median_ms,
+        min_ms: times.iter().copied().fold(f64::INFINITY, f64::min),
+        max_ms: times.iter().copied().fold(0.0, f64::max),
+        rays_per_second: if median_ms > 0.0 {
+            rays as f64 / (median_ms * 1e-3)
+        } else {
+            0.0
+        },
+        validation,
+        host_rays_per_second: validation.checked as f64 / host_seconds.max(1e-9),
+    }
+}
+
+/// Runs `check` and returns its result with its duration in seconds.
+fn timed(check: impl FnOnce() -> Check) -> (Check, f64) {
+    let start = Instant::now();
+    let c = check();
+    (c, start.elapsed().as_secs_f64())
+}
+
+/// Everything a closest-hit run needs on the device.
+struct Tracer<'a> {
+    gpu: &'a Gpu,
+    program: &'a Program,
+    scene: &'a SceneBuffers,
+    counters: Buffer<u32>,
+    warmup: usize,
+    runs: usize,
+}
+
+impl Tracer<'_> {
+    /// Times closest-hit traversal of `rays`; returns the hits and the times.
+    fn closest(&self, rays: &[GpuRay]) -> Result<(Vec<GpuHit>, Vec<f64>)> {
+        let buf = Buffer::from_slice(self.gpu, rays)?;
+        let hits = Buffer::<GpuHit>::new(self.gpu, rays.len())?;
+        let times = time_launches(self.gpu, self.warmup, self.runs, || {
+            Ok(self
+                .program
+                .trace_closest(self.gpu, self.scene, &buf, &hits, &self.counters)?)
+        })?;
+        let mut out = hits.read(self.gpu)?;
+        out.truncate(rays.len());
+        Ok((out, times))
+    }
+
+    /// Times any-hit traversal of `rays`; returns the occlusion flags and the times.
+    fn any(&self, rays: &[GpuRay]) -> Result<(Vec<u32>, Vec<f64>)> {
+        let buf = Buffer::from_slice(self.gpu, rays)?;
+        let occluded = Buffer::<u32>::new(self.gpu, rays.len())?;
+        let times = time_launches(self.gpu, self.warmup, self.runs, || {
+            Ok(self
+                .program
+                .trace_any(self.gpu, self.scene, &buf, &occluded, &self.counters)?)
+        })?;
+        let mut out = occluded.read(self.gpu)?;
+        out.truncate(rays.len());
+        Ok((out, times))
+    }
+}
+
+/// Runs the benchmark.
+pub fn run(args: &TraceArgs) -> Result<()> {
+    if args.runs == 0 {
+        anyhow::bail!("--runs must be at least 1");
+    }
+    let common = CommonArgs {
+        device: args.device.clone(),
+        width: Some(args.width),
+        height: Some(args.height),
+        spp: None,
+        bounces: 0,
+        seed: 0,
+        camera: args.camera,
+        light_radius: None,
+        hard_shadows: true,
+        sky: None,
+    };
+    let settings = common.settings((args.width, args.height))?;
+    let prepared = common.prepare(args.scene.as_deref())?;
+    let source = prepared.scene.source.clone();
+    let mut renderer = Renderer::new(&common.device_choice()?)?;
+    renderer.set_settings(&settings)?;
+    let stats = renderer
+        .load_scene(&prepared.scene, &prepared.lights)
+        .with_context(|| source.clone())?;
+    let gpu = &renderer.gpu;
+    let (Some(program), Some(scene), Some(host)) = (
+        renderer.program(),
+        renderer.scene_buffers(),
+        renderer.host_scene(),
+    ) else {
+        return Err(anyhow!("{source}: the scene did not load"));
+    };
+    let mut counters = Buffer::<u32>::new(gpu, 8)?;
+    counters.clear(gpu)?;
+    let tracer = Tracer {
+        gpu,
+        program,
+        scene,
+        counters,
+        warmup: args.warmup,
+        runs: args.runs,
+    };
+    let tris = &host.vertices;
+    let bvh = &host.bvh;
+
+    // Primary rays.
+    let camera = gpu_camera(&prepared.camera, settings.aspect());
+    let primary = rays::primary_rays(&camera, args.width, args.height);
+    let (primary_hits, times) = tracer.closest(&primary)?;
+    let check = timed(|| check_closest(bvh, tris, &primary, &primary_hits, args.validate));
+    let hit_count = primary_hits.iter().filter(|h| h.prim != MISS).count();
+    let mut results = vec![set_result(
+        "primary",
+        "closest",
+        primary.len(),
+        hit_count,
+        &times,
+        check,
+    )];
+
+    // Diffuse first-bounce rays from the primary hits.
+    let points = rays::surface_points(&primary, &primary_hits, tris);
+    if points.is_empty() {
+        eprintln!("penumbra: {source}: no primary ray hit anything; only primary rays timed");
+    } else {
+        let diffuse = rays::diffuse_rays(&points, primary.len(), args.seed);
+        let (hits, times) = tracer.closest(&diffuse)?;
+        let check = timed(|| check_closest(bvh, tris, &diffuse, &hits, args.validate));
+        let n = hits.iter().filter(|h| h.prim != MISS).count();
+        results.push(set_result(
+            "diffuse",
+            "closest",
+            diffuse.len(),
+            n,
+            &times,
+            check,
+        ));
+
+        // Shadow rays from the primary hits to the lights.
+        let targets = light_targets(&prepared.lights, host, tris);
+        let shadow = rays::shadow_rays(&points, primary.len(), &targets, args.seed);
+        let (occluded, times) = tracer.any(&shadow)?;
+        let check = timed(|| check_any(bvh, tris, &shadow, &occluded, args.validate));
+        let n = occluded.iter().filter(|&&o| o != 0).count();
+        results.push(set_result("shadow", "any", shadow.len(), n, &times, check));
+    }
+    let overflows = tracer.counters.read(gpu)?.get(4).copied().unwrap_or(0);
+    let total = results
+        .iter()
+        .fold(Check::default(), |a, r| a.add(r.validation));
+
+    if args.json {
+        let summary = serde_json::json!({
+            "benchmark": "trace",
+            "date": today(),
+            "scene": source,
+            "device": device_json(gpu),
+            "width": args.width,
+            "height": args.height,
+            "camera": prepared.camera.name,
+            "triangles": stats.triangles,
+            "bvh_nodes": stats.nodes,
+            "bvh_depth": bvh.depth,
+            "sah_cost": stats.sah_cost,
+            "load_ms": prepared.load_ms,
+            "bvh_build_ms": stats.bvh_build_ms,
+            "kernel_build_ms": stats.kernel_build_ms,
+            "lights": prepared.lights.len(),
+            "emissive_triangles": host.emissive.len(),
+            "warmup": args.warmup,
+            "runs": args.runs,
+            "results": results,
+            "checked": total.checked,
+            "ties": total.ties,
+            "mismatches": total.mismatches,
+            "stack_overflows": overflows,
+        });
+        println!("{summary}");
+    } else {
+        println!("penumbra bench trace — {source} — {}", today());
+        println!("device   {}", device_line(gpu));
+        println!(
+            "scene    {} triangles, {} BVH nodes (depth {}), SAH cost {:.2}; load {:.0} ms, \
+             BVH build {:.0} ms, kernel build {:.0} ms",
+            thousands(stats.triangles as u64),
+            thousands(stats.nodes as u64),
+            bvh.depth,
+            stats.sah_cost,
+            prepared.load_ms,
+            stats.bvh_build_ms,
+            stats.kernel_build_ms
+        );
+        println!(
+            "rays     {}×{} primary from camera '{}'; kernel time from profiling events, median \
+             of {} runs after {} warm-up",
+            args.width, args.height, prepared.camera.name, args.runs, args.warmup
+        );
+        println!();
+        println!(
+            "{:<8} {:<7} {:>10} {:>7} {:>10} {:>10} {:>10} {:>11} {:>9} {:>5} {:>10} {:>12}",
+            "rays",
+            "query",
+            "count",
+            "hit %",
+            "median ms",
+            "min ms",
+            "max ms",
+            "M rays/s",
+            "checked",
+            "ties",
+            "mismatches",
+            "host M/s"
+        );
+        for r in &results {
+            println!(
+                "{:<8} {:<7} {:>10} {:>7.1} {:>10.3} {:>10.3} {:>10.3} {:>11.2} {:>9} {:>5} {:>10} {:>12.2}",
+                r.kind,
+                r.query,
+                r.rays,
+                100.0 * r.hits as f64 / r.rays.max(1) as f64,
+                r.median_ms,
+                r.min_ms,
+                r.max_ms,
+                r.rays_per_second * 1e-6,
+                r.validation.checked,
+                r.validation.ties,
+                r.validation.mismatches,
+                r.host_rays_per_second * 1e-6
+            );
+        }
+        println!();
+        println!(
+            "validation: {} rays checked against the host traversal ({} threads), {} mismatches, \
+             {} ties, {} stack overflows",
+            thousands(total.checked),
+            rayon::current_num_threads(),
+            total.mismatches,
+            total.ties,
+            overflows
+        );
+    }
+    if total.mismatches > 0 || overflows > 0 {
+        anyhow::bail!(
+            "{source}: the device traversal disagrees with the host on {} of {} rays \
+             ({overflows} stack overflows)",
+            total.mismatches,
+            total.checked
+        );
+    }
+    Ok(())
+}
+
+/// Shadow ray targets: the emissive triangles and the punctual lights of the scene.
+fn light_targets(
+    lights: &[crate::scene::Light],
+    host: &crate::render::HostScene,
+    tris: &[[Vec3; 3]],
+) -> LightTargets {
+    let mut t = LightTargets {
+        triangles: host
+            .emissive
+            .iter()
+            .map(|&(prim, _, _)| tris[prim as usize])
+            .collect(),
+        ..LightTargets::default()
+    };
+    for l in lights {
+        match l.kind {
+            LightKind::Directional => t
+                .directions
+                .push((-l.direction.as_vec3()).normalize_or(Vec3::Y)),
+            _ => t.points.push(l.position.as_vec3()),
+        }
+    }
+    let (lo, hi) = tris.iter().flatten().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    t.bounds = (lo, hi);
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn at_least_the_wanted_rays_are_checked() {
+        assert_eq!(sample_indices(10, 0).len(), 10);
+        assert_eq!(sample_indices(10, 100).len(), 10);
+        let s = sample_indices(1_000_000, 65_536);
+        assert!(s.len() >= 65_536 && s.len() < 2 * 65_536);
+    }
+
+    #[test]
+    fn distances_within_a_relative_tolerance_agree() {
+        assert!(same_t(1.0, 1.0));
+        assert!(same_t(100.0, 100.0005));
+        assert!(!same_t(1.0, 1.001));
+    }
+}
