@@ -29,8 +29,15 @@ typedef struct {
     float4 emission;    // emitted radiance; .w = flags (uint bits, MATERIAL_*)
     float4 params;      // .x metallic, .y roughness, .z ior, .w specularFactor
     float4 specular;    // specularColorFactor; .w = transmission
-    int4 textures;      // base color, metallic-roughness, normal, emissive; -1 when absent
+    float4 volume;      // attenuationColor; .w = attenuationDistance (INFINITY: none)
+    float4 alpha;       // .x alphaCutoff, .y mode (uint bits, ALPHA_*), .z thickness, .w normal scale
+    int4 textures;      // texture refs: base color, metallic-roughness, normal, emissive; -1 none
+    int4 textures2;     // texture refs: .x transmission, .y thickness; -1 none
 } GpuMaterial;
+
+#define ALPHA_OPAQUE 0u
+#define ALPHA_MASK 1u
+#define ALPHA_BLEND 2u
 
 #define LIGHT_POINT 0u
 #define LIGHT_SPOT 1u

@@ -59,7 +59,14 @@ const _: () = assert!(size_of::<GpuTriShading>() == 80);
 /// Material flags in `GpuMaterial::emission.w`.
 pub const MATERIAL_DOUBLE_SIDED: u32 = 1;
 
-/// A glTF material as the kernels see it (80 bytes).
+/// Alpha modes in `GpuMaterial::alpha.y`.
+pub const ALPHA_OPAQUE: u32 = 0;
+/// Cut out below the cutoff.
+pub const ALPHA_MASK: u32 = 1;
+/// Stochastic transparency.
+pub const ALPHA_BLEND: u32 = 2;
+
+/// A glTF material as the kernels see it (128 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuMaterial {
@@ -71,10 +78,17 @@ pub struct GpuMaterial {
     pub params: [f32; 4],
     /// specularColorFactor; `.w` = transmission factor.
     pub specular: [f32; 4],
-    /// Texture slots (base color, metallic-roughness, normal, emissive); -1 when absent.
+    /// `KHR_materials_volume` attenuationColor; `.w` = attenuationDistance (INFINITY: none).
+    pub volume: [f32; 4],
+    /// `.x` alphaCutoff, `.y` alpha mode (u32 bits, `ALPHA_*`), `.z` thicknessFactor,
+    /// `.w` normal texture scale.
+    pub alpha: [f32; 4],
+    /// Texture references (base color, metallic-roughness, normal, emissive); -1 when absent.
     pub textures: [i32; 4],
+    /// More texture references (`.x` transmission, `.y` thickness, `.zw` spare); -1 when absent.
+    pub textures2: [i32; 4],
 }
-const _: () = assert!(size_of::<GpuMaterial>() == 80);
+const _: () = assert!(size_of::<GpuMaterial>() == 128);
 
 /// Light kinds in `GpuLight::position.w`.
 pub const LIGHT_POINT: u32 = 0;
@@ -222,7 +236,10 @@ pub fn layouts() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
             emission,
             params,
             specular,
-            textures
+            volume,
+            alpha,
+            textures,
+            textures2
         ),
         layout!(GpuLight, position, intensity, spot, extra),
         layout!(GpuCamera, origin, forward, right, up),

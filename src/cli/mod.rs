@@ -64,7 +64,7 @@ pub struct CommonArgs {
     pub camera: Option<usize>,
     /// Radius of point and spot lights in scene units (soft shadows); default 2% of the
     /// scene's diagonal. Directional lights get an angular radius of 2·R/diagonal radians.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub light_radius: Option<f32>,
     /// Hard shadows: every light radius 0.
     #[arg(long, conflicts_with = "light_radius")]

@@ -3,7 +3,7 @@
 
 use crate::bvh::Bvh;
 use crate::cl::types::*;
-use crate::scene::{Camera, Light, LightKind, Material, WorldTriangle};
+use crate::scene::{AlphaMode, Camera, Light, LightKind, Material, WorldTriangle};
 use glam::Vec3;
 
 /// The scene as uploaded, kept on the host for picking and for tests.
@@ -52,7 +52,27 @@ pub fn gpu_material(m: &Material) -> GpuMaterial {
             m.specular_color[2],
             m.transmission,
         ],
+        volume: [
+            m.attenuation_color[0],
+            m.attenuation_color[1],
+            m.attenuation_color[2],
+            m.attenuation_distance,
+        ],
+        alpha: [
+            match m.alpha {
+                AlphaMode::Mask(c) => c,
+                _ => 0.5,
+            },
+            f32::from_bits(match m.alpha {
+                AlphaMode::Opaque => ALPHA_OPAQUE,
+                AlphaMode::Mask(_) => ALPHA_MASK,
+                AlphaMode::Blend => ALPHA_BLEND,
+            }),
+            m.thickness,
+            1.0,
+        ],
         textures: [-1; 4],
+        textures2: [-1; 4],
     }
 }
 

@@ -64,8 +64,12 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         Some(s) => s.nodes().collect(),
         None => document.nodes().collect(),
     };
-    let mut stack: Vec<(gltf::Node, DMat4, usize)> =
-        roots.into_iter().map(|n| (n, DMat4::IDENTITY, 0)).collect();
+    // Depth first in document order: the stack pops the last entry, so push in reverse.
+    let mut stack: Vec<(gltf::Node, DMat4, usize)> = roots
+        .into_iter()
+        .rev()
+        .map(|n| (n, DMat4::IDENTITY, 0))
+        .collect();
     while let Some((node, parent, depth)) = stack.pop() {
         if depth > 256 {
             return Err(format!(
@@ -114,7 +118,8 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         if let Some(light) = node.light() {
             scene.lights.push(import_light(&light, &world));
         }
-        for child in node.children() {
+        let children: Vec<gltf::Node> = node.children().collect();
+        for child in children.into_iter().rev() {
             stack.push((child, world, depth + 1));
         }
     }
@@ -207,6 +212,11 @@ fn import_material(m: gltf::Material) -> Material {
         specular_factor,
         specular_color,
         transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
+        thickness: m.volume().map_or(0.0, |v| v.thickness_factor()),
+        attenuation_color: m.volume().map_or([1.0; 3], |v| v.attenuation_color()),
+        attenuation_distance: m
+            .volume()
+            .map_or(f32::INFINITY, |v| v.attenuation_distance()),
         alpha: match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),

@@ -104,6 +104,12 @@ pub struct Material {
     pub specular_color: [f32; 3],
     /// `KHR_materials_transmission` factor.
     pub transmission: f32,
+    /// `KHR_materials_volume` thicknessFactor (0: thin-walled).
+    pub thickness: f32,
+    /// `KHR_materials_volume` attenuationColor.
+    pub attenuation_color: [f32; 3],
+    /// `KHR_materials_volume` attenuationDistance (infinite: no absorption).
+    pub attenuation_distance: f32,
     /// Alpha mode.
     pub alpha: AlphaMode,
 }
@@ -121,6 +127,9 @@ impl Default for Material {
             specular_factor: 1.0,
             specular_color: [1.0; 3],
             transmission: 0.0,
+            thickness: 0.0,
+            attenuation_color: [1.0; 3],
+            attenuation_distance: f32::INFINITY,
             alpha: AlphaMode::Opaque,
         }
     }
