@@ -20,14 +20,17 @@ fn renderer() -> Renderer {
 fn random_scene(n: usize) -> Scene {
     let mut s = 5u64;
     let mut r = || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (s >> 40) as f32 / (1u64 << 24) as f32
     };
     let mut mesh = Mesh::default();
     for i in 0..n {
         let c = Vec3::new(r(), r(), r()) * 10.0;
         for _ in 0..3 {
-            mesh.positions.push(c + (Vec3::new(r(), r(), r()) - 0.5) * 0.7);
+            mesh.positions
+                .push(c + (Vec3::new(r(), r(), r()) - 0.5) * 0.7);
         }
         let b = 3 * i as u32;
         mesh.indices.push([b, b + 1, b + 2]);
@@ -65,11 +68,18 @@ fn layout_probe_agrees_with_every_shared_rust_struct() {
         assert_eq!(probed[at] as usize, size, "sizeof({name}) on the device");
         at += 1;
         for (field, offset) in fields {
-            assert_eq!(probed[at] as usize, offset, "offsetof({name}, {field}) on the device");
+            assert_eq!(
+                probed[at] as usize, offset,
+                "offsetof({name}, {field}) on the device"
+            );
             at += 1;
         }
     }
-    assert_eq!(probed[at], u32::MAX, "the probe wrote exactly the fields listed");
+    assert_eq!(
+        probed[at],
+        u32::MAX,
+        "the probe wrote exactly the fields listed"
+    );
 }
 
 #[test]
@@ -79,7 +89,9 @@ fn kernel_traversal_equals_host_traversal() {
     let host = r.host_scene().unwrap();
     let mut s = 17u64;
     let mut rnd = || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (s >> 40) as f32 / (1u64 << 24) as f32
     };
     let mut rays = vec![];
@@ -120,14 +132,23 @@ fn kernel_traversal_equals_host_traversal() {
     counters.clear(&r.gpu).unwrap();
     let program = r.program().unwrap();
     let scene = r.scene_buffers().unwrap();
-    program.trace_closest(&r.gpu, scene, &ray_buf, &hits, &counters).unwrap();
-    program.trace_any(&r.gpu, scene, &ray_buf, &occluded, &counters).unwrap();
+    program
+        .trace_closest(&r.gpu, scene, &ray_buf, &hits, &counters)
+        .unwrap();
+    program
+        .trace_any(&r.gpu, scene, &ray_buf, &occluded, &counters)
+        .unwrap();
     let hits = hits.read(&r.gpu).unwrap();
     let occluded = occluded.read(&r.gpu).unwrap();
     assert_eq!(counters.read(&r.gpu).unwrap()[4], 0, "no stack overflow");
     let mut hit_count = 0;
     for (i, (o, d, tmin, tmax)) in rays.iter().enumerate() {
-        let ray = Ray { origin: *o, direction: *d, tmin: *tmin, tmax: *tmax };
+        let ray = Ray {
+            origin: *o,
+            direction: *d,
+            tmin: *tmin,
+            tmax: *tmax,
+        };
         let expect = host.bvh.intersect(&ray, &host.vertices);
         let got = hits[i];
         match expect {
@@ -135,13 +156,23 @@ fn kernel_traversal_equals_host_traversal() {
                 hit_count += 1;
                 assert_eq!(got.prim, h.prim, "ray {i}: device hit {got:?}, host {h:?}");
                 assert_eq!(got.t, h.t, "ray {i}");
-                assert!((got.u - h.u).abs() < 1e-6 && (got.v - h.v).abs() < 1e-6, "ray {i}");
+                assert!(
+                    (got.u - h.u).abs() < 1e-6 && (got.v - h.v).abs() < 1e-6,
+                    "ray {i}"
+                );
             }
             None => assert_eq!(got.prim, u32::MAX, "ray {i}: device hit, host missed"),
         }
-        assert_eq!(occluded[i] == 1, expect.is_some(), "ray {i}: any-hit disagrees");
+        assert_eq!(
+            occluded[i] == 1,
+            expect.is_some(),
+            "ray {i}: any-hit disagrees"
+        );
     }
-    assert!(hit_count > rays.len() / 10, "the test rays hit something ({hit_count})");
+    assert!(
+        hit_count > rays.len() / 10,
+        "the test rays hit something ({hit_count})"
+    );
 }
 
 /// Builds a closed sphere with a Lambertian, emissive material. Inward-facing single-sided
@@ -150,15 +181,25 @@ fn furnace(dir: &std::path::Path, albedo: f32, le: f32, inward: bool) -> std::pa
     let mut g = Gltf::default();
     let m = g.lambert([albedo; 3], [1.0; 3], le, false);
     let (positions, normals, indices) = sphere(1.0, 24, 48, inward);
-    let mesh = g.mesh(vec![Prim { positions, normals, indices, material: Some(m), mode: 4 }]);
+    let mesh = g.mesh(vec![Prim {
+        positions,
+        normals,
+        indices,
+        material: Some(m),
+        mode: 4,
+    }]);
     g.node(json!({"mesh": mesh}));
-    g.cameras.push(json!({"type": "perspective", "perspective": {"yfov": 1.2, "znear": 0.01}}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 1.2, "znear": 0.01}}));
     g.node(json!({"camera": 0, "translation": [0.0, 0.0, 0.3]}));
     g.write_glb(dir, if inward { "furnace" } else { "furnace-outward" })
 }
 
 fn mean(px: &[[f32; 3]]) -> f64 {
-    px.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / px.len() as f64
+    px.iter()
+        .map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0)
+        .sum::<f64>()
+        / px.len() as f64
 }
 
 #[test]
@@ -167,12 +208,38 @@ fn furnace_sphere_converges_to_le_over_one_minus_albedo() {
     let scene = furnace(dir.path(), 0.5, 1.0, true);
     let out = dir.path().join("f.exr");
     // 0.5^42 is far below the noise, so 40 bounces reach the closed-form answer.
-    let (summary, px) = render_exr(&scene, &out, &["--width", "24", "--height", "24", "--spp", "64", "--bounces", "40"]);
+    let (summary, px) = render_exr(
+        &scene,
+        &out,
+        &[
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--spp",
+            "64",
+            "--bounces",
+            "40",
+        ],
+    );
     let m = mean(&px);
     assert!((m - 2.0).abs() < 0.03, "furnace mean {m}, expected 2.0");
     assert_eq!(summary["nonfinite_samples"], 0);
     // Direct light only: emission seen plus one reflection of it, Le (1 + albedo).
-    let (_, px) = render_exr(&scene, &out, &["--width", "24", "--height", "24", "--spp", "64", "--bounces", "0"]);
+    let (_, px) = render_exr(
+        &scene,
+        &out,
+        &[
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--spp",
+            "64",
+            "--bounces",
+            "0",
+        ],
+    );
     let m = mean(&px);
     assert!((m - 1.5).abs() < 0.02, "direct-only mean {m}, expected 1.5");
 }
@@ -183,7 +250,20 @@ fn single_sided_emitters_do_not_emit_from_their_back() {
     // Facing outwards, the sphere shows its back to the camera inside: nothing is lit.
     let scene = furnace(dir.path(), 0.5, 1.0, false);
     let out = dir.path().join("f.exr");
-    let (_, px) = render_exr(&scene, &out, &["--width", "16", "--height", "16", "--spp", "8", "--bounces", "3"]);
+    let (_, px) = render_exr(
+        &scene,
+        &out,
+        &[
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--spp",
+            "8",
+            "--bounces",
+            "3",
+        ],
+    );
     // Facing inwards the same sphere reads 2.0; sliver triangles at the poles, whose winding
     // rounding can flip, may leak a trace, so allow a millionth of that.
     let m = mean(&px);
@@ -197,10 +277,23 @@ fn same_seed_gives_the_same_image_bit_for_bit() {
     let a = dir.path().join("a.exr");
     let b = dir.path().join("b.exr");
     let c = dir.path().join("c.exr");
-    let args = ["--width", "40", "--height", "40", "--spp", "6", "--bounces", "3"];
+    let args = [
+        "--width",
+        "40",
+        "--height",
+        "40",
+        "--spp",
+        "6",
+        "--bounces",
+        "3",
+    ];
     let (_, pa) = render_exr(&scene, &a, &args);
     let (_, pb) = render_exr(&scene, &b, &args);
-    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "same seed, same file");
+    assert_eq!(
+        std::fs::read(&a).unwrap(),
+        std::fs::read(&b).unwrap(),
+        "same seed, same file"
+    );
     assert_eq!(pa, pb);
     let mut other = args.to_vec();
     other.extend(["--seed", "7"]);

@@ -279,7 +279,13 @@ mod tests {
     }
 
     /// Walks the tree checking boxes and returning (leaf ranges, max depth).
-    fn check_node(bvh: &Bvh, node: u32, tris: &[[Vec3; 3]], depth: u32, ranges: &mut Vec<(u32, u32)>) {
+    fn check_node(
+        bvh: &Bvh,
+        node: u32,
+        tris: &[[Vec3; 3]],
+        depth: u32,
+        ranges: &mut Vec<(u32, u32)>,
+    ) {
         for side in 0..2 {
             let (b, child) = bvh.child(node, side);
             match child {
@@ -320,7 +326,10 @@ mod tests {
         assert_eq!(next as usize, tris.len());
         let mut seen = bvh.tri_indices.clone();
         seen.sort();
-        assert!(seen.iter().enumerate().all(|(i, &t)| i as u32 == t), "a permutation");
+        assert!(
+            seen.iter().enumerate().all(|(i, &t)| i as u32 == t),
+            "a permutation"
+        );
         assert!(bvh.depth <= MAX_DEPTH);
         assert!(bvh.sah_cost > 0.0 && bvh.sah_cost < tris.len() as f32);
     }
@@ -329,7 +338,11 @@ mod tests {
     fn two_triangles_give_the_known_tree() {
         // Two unit triangles far apart on x: the root must split them into two leaves.
         let a = [Vec3::ZERO, Vec3::X, Vec3::Y];
-        let b = [Vec3::new(10.0, 0.0, 0.0), Vec3::new(11.0, 0.0, 0.0), Vec3::new(10.0, 1.0, 0.0)];
+        let b = [
+            Vec3::new(10.0, 0.0, 0.0),
+            Vec3::new(11.0, 0.0, 0.0),
+            Vec3::new(10.0, 1.0, 0.0),
+        ];
         let bvh = build(&[a, b]);
         assert_eq!(bvh.nodes.len(), 1);
         assert_eq!(bvh.tri_indices, vec![0, 1]);
@@ -338,7 +351,10 @@ mod tests {
         assert_eq!(l, Child::Leaf { first: 0, count: 1 });
         assert_eq!(r, Child::Leaf { first: 1, count: 1 });
         assert_eq!((lb.min, lb.max), (Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
-        assert_eq!((rb.min, rb.max), (Vec3::new(10.0, 0.0, 0.0), Vec3::new(11.0, 1.0, 0.0)));
+        assert_eq!(
+            (rb.min, rb.max),
+            (Vec3::new(10.0, 0.0, 0.0), Vec3::new(11.0, 1.0, 0.0))
+        );
     }
 
     #[test]
@@ -385,26 +401,45 @@ mod tests {
         for _ in 0..3000 {
             let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 14.0 - 2.0;
             let d = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5;
-            rays.push(Ray { origin: o, direction: d.normalize(), tmin: 0.0, tmax: f32::INFINITY });
+            rays.push(Ray {
+                origin: o,
+                direction: d.normalize(),
+                tmin: 0.0,
+                tmax: f32::INFINITY,
+            });
         }
         for i in 0..600 {
             // Axis-parallel rays along each axis in both directions.
             let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 10.0;
             let mut d = Vec3::ZERO;
             d[i % 3] = if i % 2 == 0 { 1.0 } else { -1.0 };
-            rays.push(Ray { origin: o - d * 20.0, direction: d, tmin: 0.0, tmax: f32::INFINITY });
+            rays.push(Ray {
+                origin: o - d * 20.0,
+                direction: d,
+                tmin: 0.0,
+                tmax: f32::INFINITY,
+            });
         }
         for t in tris.iter().take(600) {
             // Grazing rays: in the plane of a triangle, through its edge midpoint.
             let mid = (t[0] + t[1]) * 0.5;
             let d = (t[1] - t[0]).normalize();
-            rays.push(Ray { origin: mid - d * 5.0, direction: d, tmin: 0.0, tmax: f32::INFINITY });
+            rays.push(Ray {
+                origin: mid - d * 5.0,
+                direction: d,
+                tmin: 0.0,
+                tmax: f32::INFINITY,
+            });
         }
         for ray in &rays {
             let expect = brute_force(ray, &tris);
             let got = bvh.intersect(ray, &ordered).map(|h| h.t);
             assert_eq!(got, expect, "closest hit differs for {ray:?}");
-            assert_eq!(bvh.occluded(ray, &ordered), expect.is_some(), "any hit differs for {ray:?}");
+            assert_eq!(
+                bvh.occluded(ray, &ordered),
+                expect.is_some(),
+                "any hit differs for {ray:?}"
+            );
         }
     }
 }

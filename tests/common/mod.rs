@@ -74,7 +74,11 @@ impl Gltf {
     }
 
     fn vec3_accessor(&mut self, data: &[[f32; 3]]) -> usize {
-        let bytes: Vec<u8> = data.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
         let view = self.push_data(&bytes, Some(34962));
         let mut min = [f32::INFINITY; 3];
         let mut max = [f32::NEG_INFINITY; 3];
@@ -85,7 +89,8 @@ impl Gltf {
             }
         }
         let finite = min.iter().chain(&max).all(|v| v.is_finite());
-        let mut acc = json!({"bufferView": view, "componentType": 5126, "count": data.len(), "type": "VEC3"});
+        let mut acc =
+            json!({"bufferView": view, "componentType": 5126, "count": data.len(), "type": "VEC3"});
         if finite {
             acc["min"] = json!(min);
             acc["max"] = json!(max);
@@ -126,7 +131,13 @@ impl Gltf {
     }
 
     /// Adds a Lambertian material (specularFactor 0) with an optional emission.
-    pub fn lambert(&mut self, color: [f32; 3], emission: [f32; 3], strength: f32, double_sided: bool) -> usize {
+    pub fn lambert(
+        &mut self,
+        color: [f32; 3],
+        emission: [f32; 3],
+        strength: f32,
+        double_sided: bool,
+    ) -> usize {
         self.use_ext("KHR_materials_specular");
         self.use_ext("KHR_materials_emissive_strength");
         self.materials.push(json!({
@@ -151,7 +162,13 @@ impl Gltf {
     /// The JSON document; `uri` is the buffer's URI (None for GLB).
     pub fn json(&self, uri: Option<String>) -> Value {
         let roots: Vec<usize> = (0..self.nodes.len())
-            .filter(|i| !self.nodes.iter().any(|n| n["children"].as_array().is_some_and(|c| c.iter().any(|c| c.as_u64() == Some(*i as u64)))))
+            .filter(|i| {
+                !self.nodes.iter().any(|n| {
+                    n["children"]
+                        .as_array()
+                        .is_some_and(|c| c.iter().any(|c| c.as_u64() == Some(*i as u64)))
+                })
+            })
             .collect();
         let mut buffer = json!({"byteLength": self.bin.len()});
         if let Some(u) = uri {
@@ -223,7 +240,11 @@ impl Gltf {
         let bin = format!("{name}.bin");
         std::fs::write(dir.join(&bin), &self.bin).unwrap();
         let p = dir.join(format!("{name}.gltf"));
-        std::fs::write(&p, serde_json::to_vec_pretty(&self.json(Some(bin))).unwrap()).unwrap();
+        std::fs::write(
+            &p,
+            serde_json::to_vec_pretty(&self.json(Some(bin))).unwrap(),
+        )
+        .unwrap();
         p
     }
 
@@ -254,14 +275,23 @@ fn base64(data: &[u8]) -> String {
 }
 
 /// A UV sphere of `radius` at the origin; `inward` flips the winding and normals.
-pub fn sphere(radius: f32, rings: u32, segments: u32, inward: bool) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u32>) {
+pub fn sphere(
+    radius: f32,
+    rings: u32,
+    segments: u32,
+    inward: bool,
+) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u32>) {
     let mut pos = vec![];
     let mut nrm = vec![];
     for r in 0..=rings {
         let theta = std::f32::consts::PI * r as f32 / rings as f32;
         for s in 0..=segments {
             let phi = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
-            let n = [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()];
+            let n = [
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            ];
             pos.push(n.map(|v| v * radius));
             nrm.push(if inward { n.map(|v| -v) } else { n });
         }
@@ -297,7 +327,12 @@ pub fn penumbra(args: &[&str]) -> Output {
 
 /// Runs a render and returns (the JSON summary, the linear image).
 pub fn render_exr(scene: &Path, out: &Path, extra: &[&str]) -> (Value, Vec<[f32; 3]>) {
-    let mut args = vec!["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
     args.extend_from_slice(extra);
     let o = penumbra(&args);
     assert!(
@@ -312,7 +347,9 @@ pub fn render_exr(scene: &Path, out: &Path, extra: &[&str]) -> (Value, Vec<[f32;
 
 /// The scenes folder, if set.
 pub fn scenes_dir() -> Option<PathBuf> {
-    std::env::var_os("PENUMBRA_SCENES").map(PathBuf::from).filter(|p| p.is_dir())
+    std::env::var_os("PENUMBRA_SCENES")
+        .map(PathBuf::from)
+        .filter(|p| p.is_dir())
 }
 
 /// A folder for test outputs kept after the run (actual and difference images).
