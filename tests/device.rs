@@ -13,7 +13,8 @@ use penumbra::scene::{Material, Mesh, Object, Scene};
 use serde_json::json;
 
 fn renderer() -> Renderer {
-    Renderer::new(&DeviceChoice::Cpu).expect("an OpenCL CPU device (PoCL) is available")
+    let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
+    Renderer::new(&choice).expect("the test's OpenCL device is available")
 }
 
 /// A scene of random small triangles in a 10-unit cube, plus a large floor.

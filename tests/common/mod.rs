@@ -316,11 +316,19 @@ pub fn sphere(
     (pos, nrm, idx)
 }
 
-/// Runs the penumbra binary with `args`.
+/// The device the tests use: `PENUMBRA_TEST_DEVICE` (e.g. `gpu` on the H100 machine), else
+/// the CPU device (PoCL in CI).
+pub fn test_device() -> String {
+    std::env::var("PENUMBRA_TEST_DEVICE").unwrap_or_else(|_| "cpu".into())
+}
+
+/// Runs the penumbra binary with `args` on the test device.
 pub fn penumbra(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_penumbra"))
+    let exe = std::env::var("PENUMBRA_TEST_BINARY")
+        .unwrap_or_else(|_| env!("CARGO_BIN_EXE_penumbra").to_string());
+    Command::new(exe)
         .args(args)
-        .env("PENUMBRA_DEVICE", "cpu")
+        .env("PENUMBRA_DEVICE", test_device())
         .output()
         .expect("the penumbra binary runs")
 }
