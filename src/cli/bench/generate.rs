@@ -198,7 +198,7 @@ struct GlbWriter {
 
 impl GlbWriter {
     fn view(&mut self, bytes: &[u8], target: u32) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         self.views.push(json!({
@@ -365,7 +365,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     }));
 
     let triangles = copies * per_copy + 14;
-    while w.bin.len() % 4 != 0 {
+    while !w.bin.len().is_multiple_of(4) {
         w.bin.push(0);
     }
     let gltf = json!({
@@ -396,7 +396,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         "buffers": [{"byteLength": w.bin.len()}],
     });
     let mut js = serde_json::to_vec(&gltf)?;
-    while js.len() % 4 != 0 {
+    while !js.len().is_multiple_of(4) {
         js.push(b' ');
     }
     let total = 12 + 8 + js.len() + 8 + w.bin.len();

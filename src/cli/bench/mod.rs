@@ -24,14 +24,14 @@ use clap::Subcommand;
 pub enum BenchCommand {
     /// Rays per second of the traversal kernels alone (primary, diffuse-bounce and shadow
     /// rays), validated against the host traversal.
-    Trace(TraceArgs),
+    Trace(Box<TraceArgs>),
     /// Samples per second of the whole path tracer and the kernel time of each stage.
-    Frame(FrameArgs),
+    Frame(Box<FrameArgs>),
     /// Error (RMSE, relMSE) against run time for several sampling settings, against a
     /// reference image; table, CSV/JSON and a log-log plot.
-    Converge(ConvergeArgs),
+    Converge(Box<ConvergeArgs>),
     /// Writes a large test scene (instanced spheres or copies of a mesh in a closed, lit room).
-    Generate(GenerateArgs),
+    Generate(Box<GenerateArgs>),
 }
 
 /// Runs a benchmark.
@@ -94,7 +94,7 @@ fn thousands(n: u64) -> String {
     let s = n.to_string();
     let mut out = String::new();
     for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i) % 3 == 0 {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
             out.push(',');
         }
         out.push(c);
