@@ -1,9 +1,741 @@
-//! The interactive viewer.
+//! The interactive viewer: a winit window showing the progressive render through `pixels`, with
+//! an egui overlay, fly/orbit camera controls, picking, light and object editing, and
+//! screenshots. See `docs/viewer.md` for the frame loop.
+
+mod budget;
+mod camera;
+mod frame_loop;
+mod framework;
+mod gui;
+mod pick;
+mod screenshot;
+mod state;
 
 use crate::cli::ViewArgs;
-use anyhow::Result;
+use crate::render::Renderer;
+use crate::render::tonemap::{ToneMapper, to_rgba8};
+use crate::scene::{Light, Scene, SceneError};
+use anyhow::{Context, Result, anyhow, bail};
+use camera::{CameraController, Mode, Motion};
+use frame_loop::{Changes, FrameLoop, World};
+use framework::Framework;
+use gui::{Gui, Info, Model};
+use pixels::{Pixels, PixelsBuilder, ScalingMode, SurfaceTexture};
+use state::ViewState;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, TryRecvError};
+use std::time::{Duration, Instant};
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::{Window, WindowId};
 
-/// Opens the viewer.
-pub fn run(_args: ViewArgs) -> Result<()> {
-    anyhow::bail!("the viewer is not built yet")
+/// The window size when `--width`/`--height` are not given.
+const DEFAULT_SIZE: (u32, u32) = (960, 600);
+/// How long after the last camera change the view still counts as moving.
+const MOVING_FOR: Duration = Duration::from_millis(250);
+/// Display frame interval while something happens, and while only waiting for the device.
+const ACTIVE_INTERVAL: Duration = Duration::from_millis(16);
+const IDLE_INTERVAL: Duration = Duration::from_millis(33);
+
+/// The controls, for the overlay and the docs.
+pub const CONTROLS: &[(&str, &str)] = &[
+    ("W A S D", "move forward, left, back, right"),
+    ("Q / E", "move down / up"),
+    ("Shift", "move 4× faster"),
+    ("right drag", "look around (fly) / orbit the pivot (orbit)"),
+    ("middle drag, Shift + right drag", "pan"),
+    ("wheel", "fly speed (fly) / zoom to the pivot (orbit)"),
+    ("+ / −", "fly speed"),
+    ("O", "switch fly / orbit mode"),
+    ("left click", "pick an object (orbit: also sets the pivot)"),
+    ("R", "reset the view"),
+    ("H", "hard / soft shadows"),
+    ("F12", "screenshot (PNG + EXR in screenshots/)"),
+    ("Tab, F1", "hide / show the overlay"),
+    ("Ctrl + Q", "quit (like closing the window)"),
+    ("drop a file", "open a .gltf / .glb scene"),
+];
+
+/// Opens the viewer and runs it until the window closes (or `--frames` are shown).
+pub fn run(args: ViewArgs) -> Result<()> {
+    check_display()?;
+    if let Some(p) = &args.screenshot {
+        check_screenshot_path(p)?;
+    }
+    let settings = args.common.settings(DEFAULT_SIZE)?;
+    let prepared = args.common.prepare(args.scene.as_deref())?;
+    let event_loop = EventLoop::new().map_err(|e| {
+        anyhow!(
+            "cannot open a window ({e}); use `penumbra render SCENE -o OUT.png` without a display"
+        )
+    })?;
+    let renderer = Renderer::new(&args.common.device_choice()?)
+        .context("cannot open the OpenCL device (see `penumbra devices`)")?;
+    let bounds = prepared.scene.bounds();
+    let view = ViewState::from_args(&args.common, &prepared.scene.lights, bounds);
+    let camera = CameraController::new(prepared.camera.clone(), &bounds);
+    let path_text = args
+        .scene
+        .as_ref()
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    let mut app = App {
+        size: (settings.width, settings.height),
+        device: renderer.gpu.description(),
+        frame_loop: FrameLoop::new(renderer),
+        lights: view.lights(),
+        diagonal: bounds.diagonal(),
+        model: Model::new(prepared.scene, view, camera),
+        gui: Gui::new(path_text),
+        load_ms: prepared.load_ms,
+        frames_limit: args.frames,
+        screenshot_on_exit: args.screenshot.clone(),
+        gfx: None,
+        input: Input::default(),
+        overlay: true,
+        last_motion: None,
+        last_redraw: Instant::now(),
+        wake: None,
+        input_at: None,
+        frames: 0,
+        fps: 0.0,
+        display: Vec::new(),
+        display_key: None,
+        loader: None,
+        device_error: None,
+        fatal: None,
+        last_screenshot: None,
+        converged: false,
+        quit: false,
+    };
+    event_loop.run_app(&mut app)?;
+    if let Some(e) = app.fatal.take() {
+        return Err(e);
+    }
+    if let Some(path) = app.screenshot_on_exit.clone() {
+        app.save_final(&path)?;
+    }
+    Ok(())
+}
+
+/// Fails with a pointer to `penumbra render` when there is no display to open a window on.
+fn check_display() -> Result<()> {
+    if cfg!(all(unix, not(target_os = "macos"))) {
+        let set = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty());
+        if !set("DISPLAY") && !set("WAYLAND_DISPLAY") {
+            bail!(
+                "no display (neither DISPLAY nor WAYLAND_DISPLAY is set): the viewer needs a \
+                 window; use `penumbra render SCENE -o OUT.png` to render without one"
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `--screenshot` must name a PNG in an existing folder.
+fn check_screenshot_path(p: &Path) -> Result<()> {
+    let is_png = p
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !is_png {
+        bail!("--screenshot {}: must end in .png", p.display());
+    }
+    if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        bail!("--screenshot {}: the folder does not exist", p.display());
+    }
+    Ok(())
+}
+
+/// The window and what draws into it.
+struct Gfx {
+    window: Arc<Window>,
+    pixels: Pixels<'static>,
+    framework: Framework,
+}
+
+/// Mouse and key state between events.
+#[derive(Default)]
+struct Input {
+    motion: Motion,
+    cursor: Option<(f64, f64)>,
+    look: bool,
+    pan: bool,
+    shift: bool,
+    ctrl: bool,
+}
+
+struct App {
+    /// The window's inner size in physical pixels (the full film size).
+    size: (u32, u32),
+    device: String,
+    frame_loop: FrameLoop,
+    model: Model,
+    gui: Gui,
+    /// The lights as rendered, and the scene's diagonal, kept in step with the model.
+    lights: Vec<Light>,
+    diagonal: f64,
+    load_ms: f64,
+    frames_limit: Option<u64>,
+    screenshot_on_exit: Option<PathBuf>,
+    gfx: Option<Gfx>,
+    input: Input,
+    overlay: bool,
+    last_motion: Option<Instant>,
+    last_redraw: Instant,
+    /// When egui asked to be redrawn.
+    wake: Option<Instant>,
+    /// When input arrived that is not drawn yet.
+    input_at: Option<Instant>,
+    frames: u64,
+    fps: f64,
+    /// The film tone-mapped (RGBA8), as on screen.
+    display: Vec<u8>,
+    /// Exposure, tone mapper and samples of `display`.
+    display_key: Option<(f32, ToneMapper, u32, usize)>,
+    loader: Option<(PathBuf, Receiver<Result<(Scene, f64), SceneError>>)>,
+    device_error: Option<String>,
+    fatal: Option<anyhow::Error>,
+    last_screenshot: Option<PathBuf>,
+    /// Whether the last frame had reached the samples-per-pixel target.
+    converged: bool,
+    /// Ctrl+Q was pressed.
+    quit: bool,
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_some() {
+            return;
+        }
+        match self.open_window(event_loop) {
+            Ok(gfx) => self.gfx = Some(gfx),
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(gfx) = self.gfx.as_mut() else {
+            return;
+        };
+        let ctx = gfx.framework.context().clone();
+        // Keys are the viewer's unless text is being typed; Tab then never reaches egui (where
+        // it would move the keyboard focus instead of hiding the overlay).
+        let typing = self.overlay && ctx.text_edit_focused();
+        let overlay_key = matches!(
+            &event,
+            WindowEvent::KeyboardInput { event: k, .. }
+                if matches!(k.physical_key, PhysicalKey::Code(KeyCode::Tab | KeyCode::F1))
+        );
+        let consumed = if overlay_key && !typing {
+            false
+        } else {
+            gfx.framework.handle_event(&gfx.window, &event)
+        };
+        let egui_wants_pointer = self.overlay && ctx.egui_wants_pointer_input();
+        // Any input may change what is shown: draw soon (about_to_wait keeps the frame rate).
+        if !matches!(event, WindowEvent::RedrawRequested) {
+            self.input_at = Some(self.last_redraw + ACTIVE_INTERVAL);
+        }
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                if size.width > 0 && size.height > 0 {
+                    if let Err(e) = gfx.pixels.resize_surface(size.width, size.height) {
+                        self.fail(event_loop, anyhow!("cannot resize the window surface: {e}"));
+                        return;
+                    }
+                    gfx.framework.resize(size.width, size.height);
+                    self.size = (size.width, size.height);
+                    self.frame_loop.invalidate(Changes {
+                        camera: true,
+                        ..Changes::default()
+                    });
+                }
+            }
+            WindowEvent::ScaleFactorChanged { scale_factor, .. } => {
+                gfx.framework.set_scale_factor(scale_factor);
+            }
+            WindowEvent::DroppedFile(path) => self.open(path),
+            WindowEvent::ModifiersChanged(m) => {
+                self.input.shift = m.state().shift_key();
+                self.input.ctrl = m.state().control_key();
+                self.input.motion.fast = self.input.shift;
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    let pressed = event.state == ElementState::Pressed;
+                    // Releases always count so no key stays stuck.
+                    if !pressed || !typing {
+                        self.key(code, pressed, event.repeat);
+                    }
+                }
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                let pressed = state == ElementState::Pressed;
+                let free = !egui_wants_pointer && !consumed;
+                match button {
+                    MouseButton::Left if pressed && free => self.pick(),
+                    MouseButton::Right if self.input.shift && pressed && free => {
+                        self.input.pan = true
+                    }
+                    MouseButton::Right if pressed && free => self.input.look = true,
+                    MouseButton::Middle if pressed && free => self.input.pan = true,
+                    MouseButton::Right | MouseButton::Middle if !pressed => {
+                        self.input.look = false;
+                        self.input.pan = false;
+                    }
+                    _ => {}
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let now = (position.x, position.y);
+                if let Some(last) = self.input.cursor {
+                    let (dx, dy) = (now.0 - last.0, now.1 - last.1);
+                    let moved = if self.input.pan {
+                        self.model.camera.pan(dx, dy, self.size.1 as f64)
+                    } else if self.input.look {
+                        self.model.camera.look(dx, dy)
+                    } else {
+                        false
+                    };
+                    if moved {
+                        self.camera_moved();
+                    }
+                }
+                self.input.cursor = Some(now);
+            }
+            WindowEvent::CursorLeft { .. } => self.input.cursor = None,
+            WindowEvent::MouseWheel { delta, .. } if !egui_wants_pointer && !consumed => {
+                let notches = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y as f64,
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                if self.model.camera.wheel(notches) {
+                    self.camera_moved();
+                }
+            }
+            WindowEvent::RedrawRequested => self.redraw(event_loop),
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(gfx) = self.gfx.as_ref() else {
+            return;
+        };
+        let now = Instant::now();
+        let active = self.input.motion.any()
+            || self.input.look
+            || self.input.pan
+            || self.moving(now)
+            || self.loader.is_some();
+        let interval = if active {
+            ACTIVE_INTERVAL
+        } else {
+            IDLE_INTERVAL
+        };
+        let rendering = self.device_error.is_none()
+            && !self.frame_loop.converged(self.model.view.spp_target)
+            || self.frame_loop.busy();
+        let mut next = (active || rendering || self.frames_limit.is_some())
+            .then(|| self.last_redraw + interval);
+        for w in [self.wake, self.input_at].into_iter().flatten() {
+            next = Some(next.map_or(w, |n| n.min(w)));
+        }
+        match next {
+            Some(t) if t <= now => {
+                gfx.window.request_redraw();
+                event_loop.set_control_flow(ControlFlow::WaitUntil(now + interval));
+            }
+            Some(t) => event_loop.set_control_flow(ControlFlow::WaitUntil(t)),
+            None => event_loop.set_control_flow(ControlFlow::Wait),
+        }
+    }
+}
+
+impl App {
+    fn open_window(&mut self, event_loop: &ActiveEventLoop) -> Result<Gfx> {
+        let title = format!("penumbra — {}", self.model.scene.source);
+        let attributes = Window::default_attributes()
+            .with_title(title)
+            .with_inner_size(PhysicalSize::new(self.size.0, self.size.1))
+            .with_min_inner_size(PhysicalSize::new(16, 16));
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .context("cannot create the window")?,
+        );
+        let size = window.inner_size();
+        self.size = (size.width.max(1), size.height.max(1));
+        let surface = SurfaceTexture::new(self.size.0, self.size.1, window.clone());
+        let mut pixels = PixelsBuilder::new(self.size.0, self.size.1, surface)
+            .build()
+            .context("cannot draw into the window (no usable Vulkan, Metal or DX12 adapter)")?;
+        // Fill the window whatever the film's size (it is smaller while moving); the scaling
+        // matrix is only recomputed on a resize.
+        pixels.set_scaling_mode(ScalingMode::Fill);
+        pixels
+            .resize_surface(self.size.0, self.size.1)
+            .context("cannot size the window surface")?;
+        let framework = Framework::new(&window, &pixels);
+        window.request_redraw();
+        Ok(Gfx {
+            window,
+            pixels,
+            framework,
+        })
+    }
+
+    /// Stops the viewer with an error that `run` returns.
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        if self.fatal.is_none() {
+            self.fatal = Some(e);
+        }
+        event_loop.exit();
+    }
+
+    fn moving(&self, now: Instant) -> bool {
+        self.input.look
+            || self.input.pan
+            || self.input.motion.any()
+            || self.last_motion.is_some_and(|t| now - t < MOVING_FOR)
+    }
+
+    fn camera_moved(&mut self) {
+        self.last_motion = Some(Instant::now());
+        self.frame_loop.invalidate(Changes {
+            camera: true,
+            ..Changes::default()
+        });
+    }
+
+    fn key(&mut self, code: KeyCode, pressed: bool, repeat: bool) {
+        let ctrl = self.input.ctrl;
+        let m = &mut self.input.motion;
+        match code {
+            KeyCode::KeyW => m.forward = pressed,
+            KeyCode::KeyS => m.back = pressed,
+            KeyCode::KeyA => m.left = pressed,
+            KeyCode::KeyD => m.right = pressed,
+            KeyCode::KeyQ if !ctrl || !pressed => m.down = pressed,
+            KeyCode::KeyE => m.up = pressed,
+            _ if !pressed || repeat && !matches!(code, KeyCode::Equal | KeyCode::Minus) => {}
+            KeyCode::KeyR => {
+                self.model.camera.reset();
+                self.camera_moved();
+            }
+            KeyCode::KeyH => {
+                self.model.view.toggle_hard_shadows();
+                self.lights_changed();
+            }
+            KeyCode::KeyO => {
+                let next = match self.model.camera.mode {
+                    Mode::Fly => Mode::Orbit,
+                    Mode::Orbit => Mode::Fly,
+                };
+                self.model.camera.set_mode(next);
+            }
+            KeyCode::Equal | KeyCode::NumpadAdd => self.model.camera.scale_speed(1.0),
+            KeyCode::Minus | KeyCode::NumpadSubtract => self.model.camera.scale_speed(-1.0),
+            KeyCode::KeyQ if ctrl => self.quit = true,
+            KeyCode::Tab | KeyCode::F1 => self.overlay = !self.overlay,
+            KeyCode::F12 => self.screenshot(),
+            _ => {}
+        }
+    }
+
+    fn lights_changed(&mut self) {
+        self.lights = self.model.view.lights();
+        self.frame_loop.invalidate(Changes {
+            lights: true,
+            ..Changes::default()
+        });
+    }
+
+    /// Picks the object under the cursor (host BVH ray cast).
+    fn pick(&mut self) {
+        let Some((x, y)) = self.input.cursor else {
+            return;
+        };
+        let Some(host) = self.frame_loop.renderer.host_scene() else {
+            return;
+        };
+        let (w, h) = (self.size.0 as f32, self.size.1 as f32);
+        let ray = pick::primary_ray(&self.model.camera.camera, w / h, x as f32 / w, y as f32 / h);
+        match pick::pick(host, &ray) {
+            Some(hit) => {
+                self.model.selected = Some(hit.object);
+                if self.model.camera.mode == Mode::Orbit {
+                    self.model.camera.set_pivot(hit.point);
+                }
+            }
+            None => self.model.selected = None,
+        }
+    }
+
+    /// Loads `path` on a background thread; the current scene stays until it succeeds.
+    fn open(&mut self, path: PathBuf) {
+        self.gui.path_text = path.display().to_string();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let p = path.clone();
+        std::thread::spawn(move || {
+            let t = Instant::now();
+            let result = crate::scene::load(&p).map(|s| (s, t.elapsed().as_secs_f64() * 1e3));
+            // The viewer may have closed meanwhile; nobody to tell then.
+            let _ = tx.send(result);
+        });
+        self.loader = Some((path, rx));
+    }
+
+    /// Takes a finished background load.
+    fn poll_loader(&mut self) {
+        let Some((path, rx)) = self.loader.as_ref() else {
+            return;
+        };
+        let result = match rx.try_recv() {
+            Ok(r) => r,
+            Err(TryRecvError::Empty) => return,
+            Err(TryRecvError::Disconnected) => Err(SceneError::Invalid {
+                path: path.clone(),
+                message: "the loader stopped unexpectedly".into(),
+            }),
+        };
+        self.loader = None;
+        match result {
+            Ok((scene, ms)) => {
+                for w in &scene.warnings {
+                    log::warn!("{}: {w}", scene.source);
+                }
+                let bounds = scene.bounds();
+                self.model.view.replace_scene_lights(&scene.lights, bounds);
+                let camera = CameraController::new(scene.cameras[0].clone(), &bounds);
+                let view = self.model.view.clone();
+                if let Some(gfx) = &self.gfx {
+                    gfx.window
+                        .set_title(&format!("penumbra — {}", scene.source));
+                }
+                self.model = Model::new(scene, view, camera);
+                self.load_ms = ms;
+                self.diagonal = bounds.diagonal();
+                self.lights = self.model.view.lights();
+                self.gui.file_error = None;
+                self.device_error = None;
+                self.frame_loop.invalidate(Changes::ALL);
+            }
+            Err(e) => self.gui.file_error = Some(e.to_string()),
+        }
+    }
+
+    /// Saves the frame on screen (PNG) and the film (EXR) into `screenshots/`.
+    fn screenshot(&mut self) {
+        let film = &self.frame_loop.film;
+        if film.pixels.is_empty() || self.display.len() != film.pixels.len() * 4 {
+            self.gui.file_error = Some("no frame to save yet".into());
+            return;
+        }
+        let shot = screenshot::Shot {
+            width: film.width,
+            height: film.height,
+            rgba: &self.display,
+            linear: &film.pixels,
+        };
+        match screenshot::save_timestamped(Path::new(screenshot::FOLDER), &shot) {
+            Ok(png) => {
+                println!(
+                    "penumbra: saved {} and {}",
+                    png.display(),
+                    png.with_extension("exr").display()
+                );
+                self.last_screenshot = Some(png);
+            }
+            Err(e) => self.gui.file_error = Some(format!("{e:#}")),
+        }
+    }
+
+    /// On exit with `--screenshot`: waits for the running batch and saves the final frame.
+    fn save_final(&mut self, path: &Path) -> Result<()> {
+        if let Err(e) = self.frame_loop.wait() {
+            log::warn!("the last batch failed: {e}");
+        }
+        let film = &self.frame_loop.film;
+        if film.pixels.is_empty() {
+            bail!("--screenshot {}: no frame was rendered", path.display());
+        }
+        let rgba = to_rgba8(
+            &film.pixels,
+            self.model.view.exposure,
+            self.model.view.tone_mapper,
+        );
+        let shot = screenshot::Shot {
+            width: film.width,
+            height: film.height,
+            rgba: &rgba,
+            linear: &film.pixels,
+        };
+        let exr = screenshot::save_at(path, &shot)?;
+        println!(
+            "penumbra: saved {} and {} ({} spp)",
+            path.display(),
+            exr.display(),
+            film.spp
+        );
+        Ok(())
+    }
+
+    /// One display frame: input, overlay, a step of the frame loop, tone mapping, present.
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        let now = Instant::now();
+        let dt = (now - self.last_redraw).as_secs_f64().min(0.1);
+        self.last_redraw = now;
+        self.input_at = None;
+        if dt > 0.0 {
+            self.fps += 0.1 * (1.0 / dt - self.fps);
+        }
+        self.poll_loader();
+        if self.model.camera.fly(&self.input.motion, dt) {
+            self.camera_moved();
+        }
+
+        // The overlay edits the model; what it changed goes to the frame loop.
+        let Some(gfx) = self.gfx.as_mut() else {
+            return;
+        };
+        let info = Info {
+            device: &self.device,
+            progress: &self.frame_loop.progress,
+            film: &self.frame_loop.film,
+            scene_stats: self.frame_loop.scene_stats.as_ref(),
+            load_ms: self.load_ms,
+            fps: self.fps,
+            loading: self.loader.as_ref().map(|(p, _)| p.as_path()),
+            last_screenshot: self.last_screenshot.as_deref(),
+            device_error: self.device_error.as_deref(),
+        };
+        let mut actions = gui::Actions::default();
+        let (overlay, gui, model) = (self.overlay, &mut self.gui, &mut self.model);
+        let repaint = gfx.framework.prepare(&gfx.window, |ui| {
+            if overlay {
+                actions = gui.ui(ui, model, &info);
+            }
+        });
+        self.wake = now.checked_add(repaint);
+        if actions.changes.camera {
+            self.last_motion = Some(now);
+        }
+        if actions.changes.lights || actions.changes.scene {
+            self.lights = self.model.view.lights();
+        }
+        if actions.changes.scene {
+            self.diagonal = self.model.scene.bounds().diagonal();
+        }
+        self.frame_loop.invalidate(actions.changes);
+        if actions.hide_overlay {
+            self.overlay = false;
+        }
+        if let Some(path) = actions.open {
+            self.open(path);
+        }
+
+        // Collect a finished batch and start the next one before showing this image.
+        let mut new_image = false;
+        if self.device_error.is_none() {
+            let world = World {
+                scene: &self.model.scene,
+                lights: &self.lights,
+                diagonal: self.diagonal,
+                camera: &self.model.camera.camera,
+                settings: self.model.view.render_settings(self.size),
+                spp_target: self.model.view.spp_target,
+                moving: self.moving(now),
+            };
+            match self.frame_loop.step(&world) {
+                Ok(new) => new_image = new,
+                Err(e) => {
+                    let message = e.to_string();
+                    eprintln!("penumbra: device error: {message}");
+                    self.device_error = Some(message);
+                }
+            }
+        }
+        self.update_display(new_image);
+        if actions.screenshot {
+            self.screenshot();
+        }
+
+        let Some(gfx) = self.gfx.as_mut() else {
+            return;
+        };
+        let framework = &mut gfx.framework;
+        let result = gfx.pixels.render_with(|encoder, target, context| {
+            context.scaling_renderer.render(encoder, target);
+            framework.render(encoder, target, context);
+            Ok(())
+        });
+        if let Err(e) = result {
+            self.fail(event_loop, anyhow!("cannot draw the window: {e}"));
+            return;
+        }
+        self.frames += 1;
+        let converged = self.frame_loop.converged(self.model.view.spp_target);
+        if converged && !self.converged {
+            // One line per convergence, for scripts (and tests) that wait for a clean frame.
+            println!(
+                "penumbra: reached {} spp in {:.2} s",
+                self.frame_loop.progress.spp, self.frame_loop.progress.seconds
+            );
+        }
+        self.converged = converged;
+        if self.quit {
+            event_loop.exit();
+        }
+        if let Some(limit) = self.frames_limit {
+            let target_reached = self.device_error.is_some()
+                || self.model.view.spp_target.is_none()
+                || self.frame_loop.converged(self.model.view.spp_target);
+            if self.frames >= limit && target_reached {
+                event_loop.exit();
+            }
+        }
+    }
+
+    /// Tone-maps the film into the window's frame when the film, the exposure or the tone
+    /// mapper changed.
+    fn update_display(&mut self, new_image: bool) {
+        let Some(gfx) = self.gfx.as_mut() else {
+            return;
+        };
+        let film = &self.frame_loop.film;
+        if film.pixels.is_empty() {
+            return;
+        }
+        let v = &self.model.view;
+        let key = (v.exposure, v.tone_mapper, film.spp, film.pixels.len());
+        if self.display_key == Some(key) && !new_image {
+            return;
+        }
+        self.display_key = Some(key);
+        self.display = to_rgba8(&film.pixels, v.exposure, v.tone_mapper);
+        let texture = gfx.pixels.texture();
+        if (texture.width(), texture.height()) != (film.width, film.height)
+            && let Err(e) = gfx.pixels.resize_buffer(film.width, film.height)
+        {
+            log::warn!(
+                "cannot resize the frame to {}×{}: {e}",
+                film.width,
+                film.height
+            );
+            return;
+        }
+        let frame = gfx.pixels.frame_mut();
+        if frame.len() == self.display.len() {
+            frame.copy_from_slice(&self.display);
+        }
+    }
 }

@@ -296,6 +296,21 @@ impl Renderer {
             .map_err(crate::cl::call_err("submitting the frame"))
     }
 
+    /// Whether the work [`Renderer::start`] enqueued is done (true when nothing is pending).
+    /// Never waits, so a viewer can keep drawing while the device works; the queue is in
+    /// order, so the last launch finishing means all have.
+    pub fn is_finished(&self) -> Result<bool, ClError> {
+        let Some(last) = self.pending.last() else {
+            return Ok(true);
+        };
+        let status = last
+            .event
+            .command_execution_status()
+            .map_err(crate::cl::call_err("polling the frame"))?;
+        // CL_COMPLETE is 0; negative values are errors, which `finish` reports.
+        Ok(status.0 <= 0)
+    }
+
     /// Waits for the work [`Renderer::start`] enqueued and gathers its statistics.
     pub fn finish(&mut self) -> Result<(), ClError> {
         self.gpu

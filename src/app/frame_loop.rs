@@ -1,0 +1,264 @@
+//! The progressive frame loop between the window and the [`Renderer`]. It never waits for the
+//! device while the window runs: a batch of samples is started, the window keeps drawing (the
+//! overlay, the previous image) and polls; when the batch is done its image is read, the next
+//! batch is started at once (so kernel work overlaps the display of this image), and then the
+//! image is shown. Changes (camera, lights, scene, settings, window size) are collected and
+//! applied together between batches; every one of them resets the accumulation.
+
+use super::budget::{Budget, Plan, pixel_count, scaled};
+use crate::cl::ClError;
+use crate::render::{RenderSettings, RenderStats, Renderer, SceneStats};
+use crate::scene::{Camera, Light, Scene};
+use std::time::Instant;
+
+/// The budget of one batch of kernel work in milliseconds.
+pub const FRAME_BUDGET_MS: f64 = 30.0;
+
+/// What changed since the last batch.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Changes {
+    /// Objects were added, removed, hidden or moved: the BVH is rebuilt.
+    pub scene: bool,
+    /// Lights changed (no BVH rebuild).
+    pub lights: bool,
+    /// The camera moved or its field of view changed.
+    pub camera: bool,
+    /// Bounces, seed or sky changed.
+    pub settings: bool,
+}
+
+impl Changes {
+    /// Everything.
+    pub const ALL: Changes = Changes {
+        scene: true,
+        lights: true,
+        camera: true,
+        settings: true,
+    };
+
+    /// Whether anything changed.
+    pub fn any(&self) -> bool {
+        self.scene || self.lights || self.camera || self.settings
+    }
+
+    /// Adds `other`'s changes.
+    pub fn merge(&mut self, other: Changes) {
+        self.scene |= other.scene;
+        self.lights |= other.lights;
+        self.camera |= other.camera;
+        self.settings |= other.settings;
+    }
+}
+
+/// What the next batch renders.
+pub struct World<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The lights as rendered (radii applied).
+    pub lights: &'a [Light],
+    /// The scene's diagonal (scales directional lights).
+    pub diagonal: f64,
+    /// The camera.
+    pub camera: &'a Camera,
+    /// Full-resolution settings (the window's size).
+    pub settings: RenderSettings,
+    /// Stop at this many samples per pixel.
+    pub spp_target: Option<u32>,
+    /// Whether the camera is moving (a reduced resolution is allowed).
+    pub moving: bool,
+}
+
+/// The latest image read from the film.
+#[derive(Clone, Debug, Default)]
+pub struct Film {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Linear radiance, rows from the top.
+    pub pixels: Vec<[f32; 3]>,
+    /// Samples per pixel in it.
+    pub spp: u32,
+    /// Resolution divisor it was rendered at.
+    pub divisor: u32,
+}
+
+/// Figures for the overlay, as of the latest finished batch.
+#[derive(Clone, Debug, Default)]
+pub struct Progress {
+    /// Samples per pixel so far.
+    pub spp: u32,
+    /// Rendering seconds since the last reset (from each batch's start to its end).
+    pub seconds: f64,
+    /// Pixel samples per second.
+    pub samples_per_second: f64,
+    /// Rays (extension and shadow) per second.
+    pub rays_per_second: f64,
+    /// Counters and per-stage kernel times since the last reset.
+    pub stats: RenderStats,
+    /// The last batch's plan.
+    pub plan: Option<Plan>,
+    /// The last batch's wall time in milliseconds.
+    pub batch_ms: f64,
+}
+
+struct Batch {
+    started: Instant,
+    plan: Plan,
+}
+
+/// The renderer with its batches in flight and changes waiting.
+pub struct FrameLoop {
+    /// The renderer.
+    pub renderer: Renderer,
+    budget: Budget,
+    batch: Option<Batch>,
+    pending: Changes,
+    /// Film size and divisor as applied to the renderer.
+    applied: Option<((u32, u32), u32)>,
+    /// Whether a scene was loaded into the renderer yet.
+    loaded: bool,
+    /// The latest image.
+    pub film: Film,
+    /// Figures for the overlay.
+    pub progress: Progress,
+    /// Figures from the last BVH rebuild.
+    pub scene_stats: Option<SceneStats>,
+}
+
+impl FrameLoop {
+    /// A loop around `renderer` that will load everything on its first step.
+    pub fn new(renderer: Renderer) -> Self {
+        Self {
+            renderer,
+            budget: Budget::new(FRAME_BUDGET_MS),
+            batch: None,
+            pending: Changes::ALL,
+            applied: None,
+            loaded: false,
+            film: Film::default(),
+            progress: Progress::default(),
+            scene_stats: None,
+        }
+    }
+
+    /// Records changes to apply before the next batch.
+    pub fn invalidate(&mut self, changes: Changes) {
+        self.pending.merge(changes);
+    }
+
+    /// Whether a batch is running on the device.
+    pub fn busy(&self) -> bool {
+        self.batch.is_some()
+    }
+
+    /// Whether there is nothing left to do: no batch running, no change waiting, and the
+    /// samples-per-pixel target reached at full resolution.
+    pub fn converged(&self, spp_target: Option<u32>) -> bool {
+        self.batch.is_none()
+            && !self.pending.any()
+            && self.applied.is_some_and(|(_, d)| d == 1)
+            && spp_target.is_some_and(|t| self.renderer.samples() >= t)
+    }
+
+    /// One step, without waiting: collects a finished batch (returns true when a new image is
+    /// in [`FrameLoop::film`]), applies waiting changes and starts the next batch.
+    pub fn step(&mut self, world: &World) -> Result<bool, ClError> {
+        if self.batch.is_some() && !self.renderer.is_finished()? {
+            return Ok(false);
+        }
+        let new_image = self.collect()?;
+        self.apply(world)?;
+        let remaining = world
+            .spp_target
+            .map(|t| t.saturating_sub(self.renderer.samples()));
+        if remaining == Some(0) {
+            return Ok(new_image);
+        }
+        let full = (world.settings.width, world.settings.height);
+        let mut plan = self.budget.plan(full, world.moving, remaining);
+        if let Some((_, divisor)) = self.applied {
+            plan.divisor = divisor;
+        }
+        self.renderer.start(plan.spp)?;
+        self.batch = Some(Batch {
+            started: Instant::now(),
+            plan,
+        });
+        Ok(new_image)
+    }
+
+    /// Waits for the running batch and reads its image (on exit). Returns whether the image
+    /// is new.
+    pub fn wait(&mut self) -> Result<bool, ClError> {
+        self.collect()
+    }
+
+    /// Finishes the running batch, if any, and reads the film.
+    fn collect(&mut self) -> Result<bool, ClError> {
+        let Some(batch) = self.batch.take() else {
+            return Ok(false);
+        };
+        self.renderer.finish()?;
+        let ms = batch.started.elapsed().as_secs_f64() * 1e3;
+        let settings = self.renderer.settings();
+        let size = (settings.width, settings.height);
+        self.budget
+            .record(batch.plan.divisor, pixel_count(size), batch.plan.spp, ms);
+        let spp = self.renderer.samples();
+        self.film = Film {
+            width: size.0,
+            height: size.1,
+            pixels: self.renderer.image()?,
+            spp,
+            divisor: batch.plan.divisor,
+        };
+        let p = &mut self.progress;
+        p.seconds += ms * 1e-3;
+        p.spp = spp;
+        p.stats = self.renderer.stats().clone();
+        p.plan = Some(batch.plan);
+        p.batch_ms = ms;
+        if p.seconds > 0.0 {
+            p.samples_per_second = pixel_count(size) as f64 * spp as f64 / p.seconds;
+            p.rays_per_second = (p.stats.extension_rays + p.stats.shadow_rays) as f64 / p.seconds;
+        }
+        Ok(true)
+    }
+
+    /// Applies waiting changes and the resolution the budget wants; resets the film when
+    /// anything changed.
+    fn apply(&mut self, world: &World) -> Result<(), ClError> {
+        let full = (world.settings.width, world.settings.height);
+        let divisor = self.budget.plan(full, world.moving, None).divisor;
+        let size = scaled(full, divisor);
+        let mut pending = std::mem::take(&mut self.pending);
+        if pending.any() {
+            log::debug!("applying {pending:?} at {}x{} (1/{divisor})", size.0, size.1);
+        }
+        if pending.settings || self.applied != Some((size, divisor)) {
+            let settings = RenderSettings {
+                width: size.0,
+                height: size.1,
+                ..world.settings.clone()
+            };
+            self.renderer.set_settings(&settings)?;
+            self.applied = Some((size, divisor));
+            // The camera's aspect follows the film.
+            pending.camera = true;
+        }
+        if pending.scene || !self.loaded {
+            self.scene_stats = Some(self.renderer.load_scene(world.scene, world.lights)?);
+            self.loaded = true;
+        } else if pending.lights {
+            self.renderer.set_lights(world.lights, world.diagonal)?;
+        }
+        if pending.camera {
+            self.renderer.set_camera(world.camera)?;
+        }
+        if pending.any() {
+            self.progress = Progress::default();
+        }
+        Ok(())
+    }
+}

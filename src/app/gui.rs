@@ -1,0 +1,703 @@
+//! The overlay (egui): a top bar with the screenshot button and the frame's figures, and a
+//! controls window with render, camera, light, scene and statistics sections. It edits the
+//! [`Model`] and reports what changed in [`Actions`]; the window loop applies them.
+
+use super::camera::{CameraController, Mode};
+use super::frame_loop::{Changes, Film, Progress};
+use super::state::{NewLight, RigLight, ViewState};
+use crate::render::SceneStats;
+use crate::render::tonemap::ToneMapper;
+use crate::scene::{LightKind, LightPreset, Scene};
+use egui::{Color32, RichText, Ui};
+use glam::{DMat4, DQuat, DVec3, EulerRot};
+use std::path::PathBuf;
+
+/// What the overlay edits.
+pub struct Model {
+    /// The scene (objects are hidden, shown and moved here).
+    pub scene: Scene,
+    /// Each object's transform as loaded, for "reset transform".
+    pub loaded_transforms: Vec<DMat4>,
+    /// Render settings and lights.
+    pub view: ViewState,
+    /// The camera.
+    pub camera: CameraController,
+    /// The picked object.
+    pub selected: Option<usize>,
+}
+
+impl Model {
+    /// The model of a freshly loaded scene.
+    pub fn new(scene: Scene, view: ViewState, camera: CameraController) -> Self {
+        Self {
+            loaded_transforms: scene.objects.iter().map(|o| o.world_from_object).collect(),
+            scene,
+            view,
+            camera,
+            selected: None,
+        }
+    }
+}
+
+/// Read-only figures the overlay shows.
+pub struct Info<'a> {
+    /// The OpenCL device.
+    pub device: &'a str,
+    /// Progress of the accumulation.
+    pub progress: &'a Progress,
+    /// The image on screen.
+    pub film: &'a Film,
+    /// The last BVH rebuild.
+    pub scene_stats: Option<&'a SceneStats>,
+    /// Scene file loading time.
+    pub load_ms: f64,
+    /// Display frames per second.
+    pub fps: f64,
+    /// The file being loaded in the background.
+    pub loading: Option<&'a std::path::Path>,
+    /// The last screenshot's PNG path.
+    pub last_screenshot: Option<&'a std::path::Path>,
+    /// A device failure; rendering has stopped.
+    pub device_error: Option<&'a str>,
+}
+
+/// What the user asked for this frame.
+#[derive(Debug, Default)]
+pub struct Actions {
+    /// What to re-upload.
+    pub changes: Changes,
+    /// Save a screenshot.
+    pub screenshot: bool,
+    /// Open this file.
+    pub open: Option<PathBuf>,
+    /// Hide the overlay.
+    pub hide_overlay: bool,
+}
+
+/// The selected object's transform as the overlay edits it.
+#[derive(Clone, Debug, PartialEq)]
+struct TransformEdit {
+    object: usize,
+    translation: DVec3,
+    /// XYZ Euler angles in degrees.
+    rotation: DVec3,
+    scale: DVec3,
+}
+
+impl TransformEdit {
+    fn of(object: usize, m: &DMat4) -> Self {
+        let (scale, rotation, translation) = m.to_scale_rotation_translation();
+        let (x, y, z) = rotation.to_euler(EulerRot::XYZ);
+        Self {
+            object,
+            translation,
+            rotation: DVec3::new(x, y, z).map(f64::to_degrees),
+            scale,
+        }
+    }
+
+    fn matrix(&self) -> DMat4 {
+        let r = self.rotation.map(f64::to_radians);
+        DMat4::from_scale_rotation_translation(
+            self.scale,
+            DQuat::from_euler(EulerRot::XYZ, r.x, r.y, r.z),
+            self.translation,
+        )
+    }
+}
+
+/// The overlay's own state (text being typed, the open editors).
+pub struct Gui {
+    /// The file path field.
+    pub path_text: String,
+    preset: LightPreset,
+    edit: Option<TransformEdit>,
+    /// The last error about a file (shown in red until the next file loads).
+    pub file_error: Option<String>,
+}
+
+impl Gui {
+    /// The overlay with `path` in its file field.
+    pub fn new(path: String) -> Self {
+        Self {
+            path_text: path,
+            preset: LightPreset::ThreePointStudio,
+            edit: None,
+            file_error: None,
+        }
+    }
+
+    /// Draws the overlay; returns what the user asked for.
+    pub fn ui(&mut self, ui: &mut Ui, m: &mut Model, info: &Info) -> Actions {
+        let mut actions = Actions::default();
+        egui::Panel::top("penumbra-bar").show(ui, |ui| {
+            self.bar(ui, m, info, &mut actions);
+        });
+        let height = ui.ctx().content_rect().height();
+        egui::Window::new("Controls")
+            .default_pos([8.0, 44.0])
+            .default_width(290.0)
+            .default_height((height - 60.0).max(120.0))
+            .vscroll(true)
+            .show(ui.ctx(), |ui| {
+                self.render_section(ui, m, &mut actions);
+                self.camera_section(ui, m, &mut actions);
+                self.lights_section(ui, m, &mut actions);
+                self.scene_section(ui, m, info, &mut actions);
+                stats_section(ui, m, info);
+                controls_section(ui);
+            });
+        actions
+    }
+
+    fn bar(&mut self, ui: &mut Ui, m: &mut Model, info: &Info, actions: &mut Actions) {
+        ui.horizontal_wrapped(|ui| {
+            if ui.button("📷 Screenshot (F12)").clicked() {
+                actions.screenshot = true;
+            }
+            if ui
+                .checkbox(&mut m.view.hard_shadows, "Hard shadows (H)")
+                .changed()
+            {
+                actions.changes.lights = true;
+            }
+            for mode in [Mode::Fly, Mode::Orbit] {
+                if ui
+                    .selectable_label(m.camera.mode == mode, mode.name())
+                    .clicked()
+                {
+                    m.camera.set_mode(mode);
+                }
+            }
+            if ui.button("Hide (Tab)").clicked() {
+                actions.hide_overlay = true;
+            }
+            let target = m
+                .view
+                .spp_target
+                .map_or_else(|| "∞".to_string(), |t| t.to_string());
+            ui.label(format!(
+                "{} / {target} spp · {:.2} MS/s · {:.0} fps",
+                info.progress.spp,
+                info.progress.samples_per_second * 1e-6,
+                info.fps
+            ));
+            if let Some(e) = info.device_error {
+                ui.label(RichText::new(format!("device error: {e}")).color(Color32::LIGHT_RED));
+            }
+        });
+    }
+
+    fn render_section(&mut self, ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
+        egui::CollapsingHeader::new("Render")
+            .default_open(true)
+            .show(ui, |ui| {
+                let v = &mut m.view;
+                if ui
+                    .add(egui::Slider::new(&mut v.bounces, 0..=32).text("bounces"))
+                    .changed()
+                {
+                    actions.changes.settings = true;
+                }
+                ui.horizontal(|ui| {
+                    let mut endless = v.spp_target.is_none();
+                    if ui.checkbox(&mut endless, "endless").changed() {
+                        v.spp_target = if endless { None } else { Some(256) };
+                    }
+                    if let Some(t) = v.spp_target.as_mut() {
+                        ui.add(
+                            egui::DragValue::new(t)
+                                .range(1..=1_000_000)
+                                .speed(1.0)
+                                .suffix(" spp target"),
+                        );
+                    }
+                });
+                ui.horizontal(|ui| {
+                    ui.label("sky");
+                    if ui.color_edit_button_rgb(&mut v.sky).changed() {
+                        actions.changes.settings = true;
+                    }
+                    let mut level = v.sky.iter().copied().fold(0.0, f32::max);
+                    if ui
+                        .add(
+                            egui::DragValue::new(&mut level)
+                                .range(0.0..=100.0)
+                                .speed(0.01)
+                                .prefix("× "),
+                        )
+                        .changed()
+                    {
+                        let old = v.sky.iter().copied().fold(0.0, f32::max);
+                        v.sky = if old > 0.0 {
+                            v.sky.map(|c| c * level / old)
+                        } else {
+                            [level; 3]
+                        };
+                        actions.changes.settings = true;
+                    }
+                });
+                ui.add(egui::Slider::new(&mut v.exposure, -10.0..=10.0).text("exposure (stops)"));
+                egui::ComboBox::from_label("tone mapper")
+                    .selected_text(v.tone_mapper.name())
+                    .show_ui(ui, |ui| {
+                        for t in ToneMapper::ALL {
+                            ui.selectable_value(&mut v.tone_mapper, t, t.name());
+                        }
+                    });
+            });
+    }
+
+    fn camera_section(&mut self, ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
+        egui::CollapsingHeader::new("Camera")
+            .default_open(true)
+            .show(ui, |ui| {
+                let c: &mut CameraController = &mut m.camera;
+                ui.horizontal(|ui| {
+                    ui.label("mode (O)");
+                    for mode in [Mode::Fly, Mode::Orbit] {
+                        if ui.radio(c.mode == mode, mode.name()).clicked() {
+                            c.set_mode(mode);
+                        }
+                    }
+                });
+                if m.scene.cameras.len() > 1 || m.scene.cameras[0].name != "auto" {
+                    egui::ComboBox::from_label("file camera")
+                        .selected_text(c.camera.name.clone())
+                        .show_ui(ui, |ui| {
+                            for cam in &m.scene.cameras {
+                                if ui.selectable_label(false, &cam.name).clicked() {
+                                    c.set_initial(cam.clone());
+                                    actions.changes.camera = true;
+                                }
+                            }
+                        });
+                }
+                let mut fov = c.camera.yfov.to_degrees();
+                if ui
+                    .add(egui::Slider::new(&mut fov, 5.0..=150.0).text("field of view (°)"))
+                    .changed()
+                {
+                    c.camera.yfov = fov.to_radians();
+                    actions.changes.camera = true;
+                }
+                ui.horizontal(|ui| {
+                    ui.label("fly speed");
+                    let speed = c.speed;
+                    ui.add(
+                        egui::DragValue::new(&mut c.speed)
+                            .speed(speed * 0.01)
+                            .range(1e-6..=1e9)
+                            .suffix(" /s"),
+                    );
+                });
+                if c.mode == Mode::Orbit {
+                    let p = c.pivot;
+                    ui.label(format!("pivot {:.3} {:.3} {:.3}", p.x, p.y, p.z));
+                }
+                if ui.button("Reset view (R)").clicked() {
+                    c.reset();
+                    actions.changes.camera = true;
+                }
+            });
+    }
+
+    fn lights_section(&mut self, ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
+        egui::CollapsingHeader::new("Shadows & lights")
+            .default_open(true)
+            .show(ui, |ui| {
+                let v = &mut m.view;
+                if ui
+                    .checkbox(&mut v.hard_shadows, "hard shadows (H)")
+                    .changed()
+                {
+                    actions.changes.lights = true;
+                }
+                let max = v.max_softness();
+                if ui
+                    .add_enabled(
+                        !v.hard_shadows,
+                        egui::Slider::new(&mut v.softness, 0.0..=max)
+                            .logarithmic(true)
+                            .text("softness (light radius)"),
+                    )
+                    .changed()
+                {
+                    actions.changes.lights = true;
+                }
+                ui.horizontal(|ui| {
+                    egui::ComboBox::from_id_salt("preset")
+                        .selected_text(self.preset.name())
+                        .show_ui(ui, |ui| {
+                            for p in LightPreset::ALL {
+                                ui.selectable_value(&mut self.preset, p, p.name());
+                            }
+                        });
+                    if ui.button("replace").clicked() {
+                        v.apply_preset(self.preset, true);
+                        actions.changes.lights = true;
+                    }
+                    if ui.button("add").clicked() {
+                        v.apply_preset(self.preset, false);
+                        actions.changes.lights = true;
+                    }
+                });
+                ui.horizontal_wrapped(|ui| {
+                    ui.label("add");
+                    for kind in NewLight::ALL {
+                        if ui.button(kind.name()).clicked() {
+                            v.add_light(kind);
+                            actions.changes.lights = true;
+                        }
+                    }
+                });
+                let mut remove = None;
+                let size = v.diagonal();
+                for i in 0..v.rig.len() {
+                    let radius = v.effective_radius(&v.rig[i]);
+                    let hard = v.hard_shadows;
+                    let l = &mut v.rig[i];
+                    let id = ui.make_persistent_id(("light", i));
+                    egui::collapsing_header::CollapsingState::load_with_default_open(
+                        ui.ctx(),
+                        id,
+                        false,
+                    )
+                    .show_header(ui, |ui| {
+                        if ui.checkbox(&mut l.enabled, "").changed() {
+                            actions.changes.lights = true;
+                        }
+                        ui.label(format!("{} ({})", l.light.name, kind_name(l.light.kind)));
+                        if ui.small_button("✖").on_hover_text("remove").clicked() {
+                            remove = Some(i);
+                        }
+                    })
+                    .body(|ui| {
+                        if light_editor(ui, l, radius, hard, size) {
+                            actions.changes.lights = true;
+                        }
+                    });
+                }
+                if let Some(i) = remove {
+                    v.rig.remove(i);
+                    actions.changes.lights = true;
+                }
+            });
+    }
+
+    fn scene_section(&mut self, ui: &mut Ui, m: &mut Model, info: &Info, actions: &mut Actions) {
+        egui::CollapsingHeader::new("Scene")
+            .default_open(true)
+            .show(ui, |ui| {
+                ui.label(format!("{}", m.scene.source));
+                ui.horizontal(|ui| {
+                    let field = ui.add(
+                        egui::TextEdit::singleline(&mut self.path_text)
+                            .hint_text("path/to/scene.glb")
+                            .desired_width(180.0),
+                    );
+                    let entered =
+                        field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                    if ui.button("Open").clicked() || entered {
+                        let path = self.path_text.trim();
+                        if path.is_empty() {
+                            self.file_error = Some("type a .gltf or .glb path first".into());
+                        } else {
+                            actions.open = Some(PathBuf::from(path));
+                        }
+                    }
+                });
+                ui.label(RichText::new("or drop a .gltf / .glb file on the window").weak());
+                if let Some(p) = info.loading {
+                    ui.horizontal(|ui| {
+                        ui.spinner();
+                        ui.label(format!("loading {}", p.display()));
+                    });
+                }
+                if let Some(e) = &self.file_error {
+                    ui.label(RichText::new(e).color(Color32::LIGHT_RED));
+                }
+                if let Some(s) = info.scene_stats {
+                    ui.label(format!(
+                        "{} triangles · load {:.1} ms · BVH rebuild {:.2} ms · kernels {:.0} ms",
+                        s.triangles, info.load_ms, s.bvh_build_ms, s.kernel_build_ms
+                    ));
+                }
+                ui.label("objects (click one in the image to pick it):");
+                egui::ScrollArea::vertical()
+                    .id_salt("objects")
+                    .max_height(140.0)
+                    .show(ui, |ui| {
+                        for (i, o) in m.scene.objects.iter_mut().enumerate() {
+                            ui.horizontal(|ui| {
+                                if ui.checkbox(&mut o.visible, "").changed() {
+                                    actions.changes.scene = true;
+                                }
+                                let name = if o.name.is_empty() {
+                                    format!("object {i}")
+                                } else {
+                                    o.name.clone()
+                                };
+                                if ui.selectable_label(m.selected == Some(i), name).clicked() {
+                                    m.selected = if m.selected == Some(i) { None } else { Some(i) };
+                                }
+                            });
+                        }
+                    });
+                self.transform_editor(ui, m, actions);
+            });
+    }
+
+    fn transform_editor(&mut self, ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
+        let Some(i) = m.selected.filter(|&i| i < m.scene.objects.len()) else {
+            self.edit = None;
+            return;
+        };
+        if self.edit.as_ref().is_none_or(|e| e.object != i) {
+            self.edit = Some(TransformEdit::of(i, &m.scene.objects[i].world_from_object));
+        }
+        let Some(edit) = self.edit.as_mut() else {
+            return;
+        };
+        let size = m.view.diagonal();
+        ui.separator();
+        ui.label(RichText::new(format!("selected: {}", m.scene.objects[i].name)).strong());
+        let mut changed = false;
+        egui::Grid::new("transform").num_columns(4).show(ui, |ui| {
+            let mut row = |ui: &mut Ui, label: &str, v: &mut DVec3, speed: f64| {
+                ui.label(label);
+                for c in [&mut v.x, &mut v.y, &mut v.z] {
+                    changed |= ui.add(egui::DragValue::new(c).speed(speed)).changed();
+                }
+                ui.end_row();
+            };
+            row(ui, "move", &mut edit.translation, 0.002 * size);
+            row(ui, "rotate °", &mut edit.rotation, 0.5);
+            row(ui, "scale", &mut edit.scale, 0.005);
+        });
+        ui.horizontal(|ui| {
+            let mut uniform = (edit.scale.x + edit.scale.y + edit.scale.z) / 3.0;
+            ui.label("uniform scale");
+            if ui
+                .add(egui::DragValue::new(&mut uniform).speed(0.005))
+                .changed()
+                && uniform.abs() > 1e-9
+            {
+                let mean = (edit.scale.x + edit.scale.y + edit.scale.z) / 3.0;
+                edit.scale *= if mean.abs() > 1e-12 {
+                    uniform / mean
+                } else {
+                    1.0
+                };
+                changed = true;
+            }
+        });
+        // A zero scale would flatten the object into nothing; keep it pickable.
+        edit.scale = edit.scale.map(|s| if s.abs() < 1e-6 { 1e-6 } else { s });
+        if changed {
+            m.scene.objects[i].world_from_object = edit.matrix();
+            actions.changes.scene = true;
+        }
+        if ui.button("reset transform").clicked()
+            && let Some(t) = m.loaded_transforms.get(i)
+        {
+            m.scene.objects[i].world_from_object = *t;
+            self.edit = Some(TransformEdit::of(i, t));
+            actions.changes.scene = true;
+        }
+    }
+}
+
+fn kind_name(kind: LightKind) -> &'static str {
+    match kind {
+        LightKind::Point => "point",
+        LightKind::Spot { .. } => "spot",
+        LightKind::Directional => "directional",
+    }
+}
+
+/// The editor of one light; returns whether it changed.
+fn light_editor(ui: &mut Ui, l: &mut RigLight, radius: f32, hard: bool, size: f64) -> bool {
+    let mut changed = false;
+    let light = &mut l.light;
+    if light.kind != LightKind::Directional {
+        ui.horizontal(|ui| {
+            ui.label("position");
+            for c in [
+                &mut light.position.x,
+                &mut light.position.y,
+                &mut light.position.z,
+            ] {
+                changed |= ui
+                    .add(egui::DragValue::new(c).speed(0.002 * size))
+                    .changed();
+            }
+        });
+    }
+    if light.kind != LightKind::Point {
+        // Direction as azimuth and elevation (the direction the light travels).
+        let d = light.direction.normalize_or(DVec3::NEG_Y);
+        let mut elevation = d.y.clamp(-1.0, 1.0).asin().to_degrees();
+        let mut azimuth = d.x.atan2(d.z).to_degrees();
+        ui.horizontal(|ui| {
+            ui.label("direction");
+            let a = ui.add(
+                egui::DragValue::new(&mut azimuth)
+                    .speed(0.5)
+                    .range(-180.0..=180.0)
+                    .prefix("az ")
+                    .suffix("°"),
+            );
+            let e = ui.add(
+                egui::DragValue::new(&mut elevation)
+                    .speed(0.5)
+                    .range(-90.0..=90.0)
+                    .prefix("el ")
+                    .suffix("°"),
+            );
+            if a.changed() || e.changed() {
+                let (az, el) = (azimuth.to_radians(), elevation.to_radians());
+                light.direction = DVec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
+                changed = true;
+            }
+        });
+    }
+    if let LightKind::Spot { inner, outer } = &mut light.kind {
+        let mut deg = [inner.to_degrees(), outer.to_degrees()];
+        ui.horizontal(|ui| {
+            ui.label("cone");
+            let a = ui.add(
+                egui::DragValue::new(&mut deg[0])
+                    .range(0.0..=90.0)
+                    .prefix("inner ")
+                    .suffix("°"),
+            );
+            let b = ui.add(
+                egui::DragValue::new(&mut deg[1])
+                    .range(0.0..=90.0)
+                    .prefix("outer ")
+                    .suffix("°"),
+            );
+            if a.changed() || b.changed() {
+                *outer = deg[1].to_radians().max(1e-3);
+                *inner = deg[0].to_radians().min(*outer);
+                changed = true;
+            }
+        });
+    }
+    ui.horizontal(|ui| {
+        ui.label("color");
+        changed |= ui.color_edit_button_rgb(&mut light.color).changed();
+        let speed = (light.intensity.abs() * 0.01).max(1e-3);
+        changed |= ui
+            .add(
+                egui::DragValue::new(&mut light.intensity)
+                    .speed(speed)
+                    .range(0.0..=f32::MAX)
+                    .prefix("intensity "),
+            )
+            .changed();
+    });
+    ui.horizontal(|ui| {
+        let unit = if light.kind == LightKind::Directional {
+            " rad"
+        } else {
+            ""
+        };
+        let mut r = radius;
+        let edited = ui
+            .add_enabled(
+                !hard,
+                egui::DragValue::new(&mut r)
+                    .speed(0.001 * size)
+                    .range(0.0..=f32::MAX)
+                    .prefix("radius ")
+                    .suffix(unit),
+            )
+            .changed();
+        if edited {
+            light.radius = r;
+            l.follows_softness = false;
+            changed = true;
+        }
+        if !l.follows_softness && ui.small_button("follow softness").clicked() {
+            l.follows_softness = true;
+            changed = true;
+        }
+    });
+    changed
+}
+
+fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
+    egui::CollapsingHeader::new("Statistics")
+        .default_open(true)
+        .show(ui, |ui| {
+            let p = info.progress;
+            ui.label(format!("device: {}", info.device));
+            let moving = if info.film.divisor > 1 {
+                format!(" (1/{} while moving)", info.film.divisor)
+            } else {
+                String::new()
+            };
+            ui.label(format!(
+                "film {}×{}{moving}",
+                info.film.width, info.film.height
+            ));
+            let target = m
+                .view
+                .spp_target
+                .map_or_else(|| "endless".to_string(), |t| format!("target {t}"));
+            ui.label(format!("{} spp ({target}) in {:.2} s", p.spp, p.seconds));
+            ui.label(format!(
+                "{:.3} M samples/s · {:.3} M rays/s",
+                p.samples_per_second * 1e-6,
+                p.rays_per_second * 1e-6
+            ));
+            if let Some(plan) = p.plan {
+                ui.label(format!(
+                    "last batch: {} spp in {:.1} ms (budget {:.0} ms)",
+                    plan.spp,
+                    p.batch_ms,
+                    super::frame_loop::FRAME_BUDGET_MS
+                ));
+            }
+            if p.stats.nonfinite_samples > 0 {
+                ui.label(format!(
+                    "{} non-finite samples dropped",
+                    p.stats.nonfinite_samples
+                ));
+            }
+            if !p.stats.stage_ms.is_empty() {
+                egui::Grid::new("stages").striped(true).show(ui, |ui| {
+                    ui.label("stage");
+                    ui.label("kernel ms");
+                    ui.label("ms / spp");
+                    ui.end_row();
+                    let spp = p.spp.max(1) as f64;
+                    for (stage, ms) in &p.stats.stage_ms {
+                        ui.label(*stage);
+                        ui.label(format!("{ms:.1}"));
+                        ui.label(format!("{:.2}", ms / spp));
+                        ui.end_row();
+                    }
+                });
+            }
+            if let Some(path) = info.last_screenshot {
+                ui.label(format!("saved {}", path.display()));
+            }
+        });
+}
+
+fn controls_section(ui: &mut Ui) {
+    egui::CollapsingHeader::new("Keys and mouse")
+        .default_open(false)
+        .show(ui, |ui| {
+            egui::Grid::new("keys").striped(true).show(ui, |ui| {
+                for (key, what) in super::CONTROLS {
+                    ui.label(*key);
+                    ui.label(*what);
+                    ui.end_row();
+                }
+            });
+        });
+}

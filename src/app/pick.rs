@@ -1,0 +1,106 @@
+//! Picking: the object under the mouse, found by casting the pixel's primary ray through the
+//! host BVH (the same one the device traverses).
+
+use crate::bvh::Ray;
+use crate::render::{HostScene, gpu_camera};
+use crate::scene::Camera;
+use glam::{DVec3, Vec3};
+
+/// What a click hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pick {
+    /// Index into `Scene::objects`.
+    pub object: usize,
+    /// The hit point in world space.
+    pub point: DVec3,
+}
+
+/// The primary ray through the point (fx, fy) of the image, both in [0, 1] from the top left,
+/// as the camera kernel makes it (without jitter and lens).
+pub fn primary_ray(camera: &Camera, aspect: f32, fx: f32, fy: f32) -> Ray {
+    let c = gpu_camera(camera, aspect);
+    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let direction = v(c.forward) + (2.0 * fx - 1.0) * v(c.right) + (1.0 - 2.0 * fy) * v(c.up);
+    Ray {
+        origin: v(c.origin),
+        direction,
+        tmin: 0.0,
+        tmax: f32::INFINITY,
+    }
+}
+
+/// The object the ray hits first, if any.
+pub fn pick(host: &HostScene, ray: &Ray) -> Option<Pick> {
+    let hit = host.bvh.intersect(ray, &host.vertices)?;
+    let point = ray.origin + ray.direction * hit.t;
+    Some(Pick {
+        object: host.object_of(hit.prim) as usize,
+        point: point.as_dvec3(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Material, Mesh, Object, Scene};
+    use glam::{DMat4, Vec2};
+
+    /// Two unit quads facing +Z: object 0 at x = -2, object 1 at x = +2, and a hidden one in
+    /// front of object 1.
+    fn scene() -> Scene {
+        let quad = Mesh {
+            positions: vec![
+                Vec3::new(-0.5, -0.5, 0.0),
+                Vec3::new(0.5, -0.5, 0.0),
+                Vec3::new(0.5, 0.5, 0.0),
+                Vec3::new(-0.5, 0.5, 0.0),
+            ],
+            normals: vec![],
+            uvs: vec![Vec2::ZERO; 0],
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+            materials: vec![0, 0],
+        };
+        let object = |name: &str, x: f64, z: f64, visible: bool| Object {
+            name: name.into(),
+            world_from_object: DMat4::from_translation(DVec3::new(x, 0.0, z)),
+            visible,
+            mesh: quad.clone(),
+        };
+        Scene {
+            objects: vec![
+                object("left", -2.0, 0.0, true),
+                object("right", 2.0, 0.0, true),
+                object("hidden", 2.0, 1.0, false),
+            ],
+            materials: vec![Material::default()],
+            ..Scene::default()
+        }
+    }
+
+    fn host(scene: &Scene) -> HostScene {
+        let world = scene.world_triangles();
+        let verts: Vec<[Vec3; 3]> = world.iter().map(|t| t.v).collect();
+        let bvh = crate::bvh::build(&verts);
+        HostScene::new(&world, bvh, &scene.materials)
+    }
+
+    #[test]
+    fn clicks_find_the_object_under_the_pixel() {
+        let scene = scene();
+        let host = host(&scene);
+        // Looking down -Z from z = 5 with a field of view that spans x in about [-4, 4].
+        let cam = Camera::look_at("c", DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, 1.3);
+        let aspect = 1.0;
+        let half = (cam.yfov * 0.5).tan() as f32 * 5.0;
+        let fx = |x: f32| 0.5 + 0.5 * x / half;
+        let left = pick(&host, &primary_ray(&cam, aspect, fx(-2.0), 0.5)).unwrap();
+        assert_eq!(left.object, 0);
+        assert!((left.point - DVec3::new(-2.0, 0.0, 0.0)).length() < 1e-3);
+        // The hidden quad in front of the right one is not in the BVH.
+        let right = pick(&host, &primary_ray(&cam, aspect, fx(2.0), 0.5)).unwrap();
+        assert_eq!(right.object, 1);
+        assert!(pick(&host, &primary_ray(&cam, aspect, 0.5, 0.5)).is_none());
+        // The top of the image looks up.
+        assert!(pick(&host, &primary_ray(&cam, aspect, fx(2.0), 0.0)).is_none());
+    }
+}

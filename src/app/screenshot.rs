@@ -1,0 +1,125 @@
+//! Screenshots: the displayed frame as PNG (exposure, tone curve and sRGB, without the overlay)
+//! and the film as EXR (linear radiance), side by side with the same name.
+
+use crate::image_io::{unique_path, write_exr, write_rgba_png};
+use anyhow::{Context, Result};
+use std::path::{Path, PathBuf};
+use std::time::{SystemTime, UNIX_EPOCH};
+
+/// The folder F12 saves into, relative to the working directory.
+pub const FOLDER: &str = "screenshots";
+
+/// A frame to save.
+pub struct Shot<'a> {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// What is on screen: RGBA8, sRGB.
+    pub rgba: &'a [u8],
+    /// The film: linear RGB.
+    pub linear: &'a [[f32; 3]],
+}
+
+/// `YYYYMMDD-HHMMSS` in UTC.
+pub fn timestamp(t: SystemTime) -> String {
+    let secs = t.duration_since(UNIX_EPOCH).map_or(0, |d| d.as_secs());
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    let (y, m, d) = civil_from_days(days as i64);
+    format!(
+        "{y:04}{m:02}{d:02}-{:02}{:02}{:02}",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
+/// The calendar date of a day count since 1970-01-01 (Howard Hinnant's algorithm).
+fn civil_from_days(z: i64) -> (i64, u32, u32) {
+    let z = z + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    (y, m, d)
+}
+
+/// A PNG path in `dir` named `penumbra-{timestamp}` whose PNG and EXR both do not exist yet.
+pub fn next_path(dir: &Path, timestamp: &str) -> PathBuf {
+    let mut png = unique_path(dir, "penumbra", timestamp, "png");
+    while png.with_extension("exr").exists() {
+        let stem = png
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        png = unique_path(dir, &stem, "b", "png");
+    }
+    png
+}
+
+/// Saves into `dir` (created if missing) under a new timestamped name; returns the PNG path.
+pub fn save_timestamped(dir: &Path, shot: &Shot) -> Result<PathBuf> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
+    let png = next_path(dir, &timestamp(SystemTime::now()));
+    save_at(&png, shot)?;
+    Ok(png)
+}
+
+/// Saves the PNG at `png` and the EXR beside it (same name, `.exr`); returns the EXR path.
+pub fn save_at(png: &Path, shot: &Shot) -> Result<PathBuf> {
+    write_rgba_png(png, shot.width, shot.height, shot.rgba)?;
+    let exr = png.with_extension("exr");
+    write_exr(&exr, shot.width, shot.height, shot.linear)?;
+    Ok(exr)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    #[test]
+    fn timestamps_are_utc_calendar_times() {
+        assert_eq!(timestamp(UNIX_EPOCH), "19700101-000000");
+        // 2024-02-29 13:45:07 UTC (a leap day).
+        let t = UNIX_EPOCH + Duration::from_secs(1_709_214_307);
+        assert_eq!(timestamp(t), "20240229-134507");
+    }
+
+    #[test]
+    fn screenshots_never_overwrite() {
+        let dir = tempfile::tempdir().unwrap();
+        let folder = dir.path().join(FOLDER);
+        let shot = Shot {
+            width: 2,
+            height: 1,
+            rgba: &[255, 0, 0, 255, 0, 255, 0, 255],
+            linear: &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        };
+        let a = save_timestamped(&folder, &shot).unwrap();
+        let b = save_timestamped(&folder, &shot).unwrap();
+        assert_ne!(a, b);
+        for p in [&a, &b] {
+            assert!(p.exists() && p.with_extension("exr").exists());
+            let name = p.file_name().unwrap().to_string_lossy();
+            assert!(
+                name.starts_with("penumbra-") && name.ends_with(".png"),
+                "{name}"
+            );
+        }
+        // A stray EXR with the next name is not overwritten either.
+        let ts = "20000101-000000";
+        std::fs::write(folder.join(format!("penumbra-{ts}.exr")), b"keep").unwrap();
+        let c = next_path(&folder, ts);
+        assert!(!c.exists() && !c.with_extension("exr").exists());
+        assert_eq!(
+            std::fs::read(folder.join(format!("penumbra-{ts}.exr"))).unwrap(),
+            b"keep"
+        );
+    }
+}

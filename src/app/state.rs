@@ -1,0 +1,349 @@
+//! What the overlay controls, and how it maps onto the renderer: render settings, the light rig
+//! with shadow softness, exposure and tone mapping.
+
+use crate::cli::{CommonArgs, with_radius};
+use crate::render::RenderSettings;
+use crate::render::tonemap::ToneMapper;
+use crate::scene::{Bounds, Light, LightKind, LightPreset, default_light_radius, preset_lights};
+use glam::DVec3;
+
+/// Kinds of light the user can add.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NewLight {
+    /// A point light (follows the shadow softness).
+    Point,
+    /// A spot light pointing down.
+    Spot,
+    /// A directional (sun) light.
+    Directional,
+    /// A sphere (area) light: a point light with its own, larger radius.
+    Sphere,
+}
+
+impl NewLight {
+    /// Every kind, for the overlay's buttons.
+    pub const ALL: [NewLight; 4] = [
+        NewLight::Point,
+        NewLight::Spot,
+        NewLight::Directional,
+        NewLight::Sphere,
+    ];
+
+    /// Name shown to users.
+    pub fn name(self) -> &'static str {
+        match self {
+            NewLight::Point => "point",
+            NewLight::Spot => "spot",
+            NewLight::Directional => "directional",
+            NewLight::Sphere => "sphere / area",
+        }
+    }
+}
+
+/// One light of the rig.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigLight {
+    /// The light; its `radius` is used when `follows_softness` is false.
+    pub light: Light,
+    /// Whether it is rendered.
+    pub enabled: bool,
+    /// Whether its radius is the global shadow softness (true for the scene's lights and
+    /// added point, spot and directional lights, until the user sets its radius by hand).
+    pub follows_softness: bool,
+}
+
+/// The overlay's render state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewState {
+    /// Bounces after the first hit.
+    pub bounces: u32,
+    /// Seed of the random sequence.
+    pub seed: u32,
+    /// Uniform sky radiance.
+    pub sky: [f32; 3],
+    /// Stop accumulating at this many samples per pixel; `None` renders on and on.
+    pub spp_target: Option<u32>,
+    /// Shadow softness: the radius of point and spot lights in scene units (directional
+    /// lights get the matching angular radius).
+    pub softness: f32,
+    /// Hard shadows: every light radius 0. Flipping it back restores the softness.
+    pub hard_shadows: bool,
+    /// Exposure in stops.
+    pub exposure: f32,
+    /// Tone curve.
+    pub tone_mapper: ToneMapper,
+    /// The lights: the scene's, presets' and the user's.
+    pub rig: Vec<RigLight>,
+    /// The scene's bounds, which size new lights and the softness range.
+    pub bounds: Bounds,
+}
+
+impl ViewState {
+    /// The state the command line asks for on a scene with `lights` and `bounds`.
+    pub fn from_args(args: &CommonArgs, lights: &[Light], bounds: Bounds) -> Self {
+        let mut s = Self {
+            bounces: args.bounces,
+            seed: args.seed,
+            sky: args.sky.unwrap_or([0.0; 3]),
+            spp_target: args.spp,
+            softness: args
+                .light_radius
+                .unwrap_or_else(|| default_light_radius(&bounds)),
+            hard_shadows: args.hard_shadows,
+            exposure: 0.0,
+            tone_mapper: ToneMapper::default(),
+            rig: Vec::new(),
+            bounds,
+        };
+        s.replace_scene_lights(lights, bounds);
+        s
+    }
+
+    /// A new scene: its lights replace the rig, the softness goes back to the scene's default.
+    pub fn replace_scene_lights(&mut self, lights: &[Light], bounds: Bounds) {
+        if self.bounds != bounds {
+            self.softness = default_light_radius(&bounds);
+        }
+        self.bounds = bounds;
+        self.rig = lights
+            .iter()
+            .map(|l| RigLight {
+                light: l.clone(),
+                enabled: true,
+                follows_softness: true,
+            })
+            .collect();
+    }
+
+    /// The scene's diagonal.
+    pub fn diagonal(&self) -> f64 {
+        self.bounds.diagonal()
+    }
+
+    /// Render settings for a film of `size` pixels.
+    pub fn render_settings(&self, size: (u32, u32)) -> RenderSettings {
+        RenderSettings {
+            width: size.0.max(1),
+            height: size.1.max(1),
+            bounces: self.bounces,
+            seed: self.seed,
+            sky: self.sky,
+            ..RenderSettings::default()
+        }
+    }
+
+    /// The radius a rig light renders with.
+    pub fn effective_radius(&self, l: &RigLight) -> f32 {
+        if self.hard_shadows {
+            0.0
+        } else if l.follows_softness {
+            with_radius(
+                std::slice::from_ref(&l.light),
+                self.softness,
+                self.diagonal(),
+            )[0]
+            .radius
+        } else {
+            l.light.radius
+        }
+    }
+
+    /// The enabled lights with the radii they render with.
+    pub fn lights(&self) -> Vec<Light> {
+        self.rig
+            .iter()
+            .filter(|l| l.enabled)
+            .map(|l| Light {
+                radius: self.effective_radius(l),
+                ..l.light.clone()
+            })
+            .collect()
+    }
+
+    /// Flips hard shadows (the H key).
+    pub fn toggle_hard_shadows(&mut self) {
+        self.hard_shadows = !self.hard_shadows;
+    }
+
+    /// Adds a light of `kind` sized and placed for the scene.
+    pub fn add_light(&mut self, kind: NewLight) {
+        let center = self.bounds.center();
+        let size = self.diagonal();
+        let count = self.rig.len() + 1;
+        let above = center + DVec3::new(0.0, 0.35 * size, 0.0);
+        let (light_kind, follows, radius, intensity) = match kind {
+            NewLight::Point => (LightKind::Point, true, 0.0, 0.3 * size * size),
+            NewLight::Spot => (
+                LightKind::Spot {
+                    inner: 0.3,
+                    outer: 0.6,
+                },
+                true,
+                0.0,
+                0.6 * size * size,
+            ),
+            NewLight::Directional => (LightKind::Directional, true, 0.0, 2.0),
+            NewLight::Sphere => (LightKind::Point, false, 0.05 * size, 0.3 * size * size),
+        };
+        self.rig.push(RigLight {
+            light: Light {
+                name: format!("{} {count}", kind.name()),
+                kind: light_kind,
+                position: above,
+                direction: if kind == NewLight::Directional {
+                    DVec3::new(-0.3, -1.0, -0.4).normalize()
+                } else {
+                    DVec3::NEG_Y
+                },
+                color: [1.0; 3],
+                intensity: intensity as f32,
+                radius: radius as f32,
+            },
+            enabled: true,
+            follows_softness: follows,
+        });
+    }
+
+    /// Puts a preset's lights in place of (`replace`) or beside the rig's. Preset lights keep
+    /// their own radii (the softbox is meant to be large).
+    pub fn apply_preset(&mut self, preset: LightPreset, replace: bool) {
+        if replace {
+            self.rig.clear();
+        }
+        self.rig.extend(
+            preset_lights(preset, &self.bounds)
+                .into_iter()
+                .map(|light| RigLight {
+                    light,
+                    enabled: true,
+                    follows_softness: false,
+                }),
+        );
+    }
+
+    /// Largest softness the overlay's slider offers.
+    pub fn max_softness(&self) -> f32 {
+        (0.2 * self.diagonal()) as f32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    fn args(extra: &[&str]) -> CommonArgs {
+        let mut argv = vec!["penumbra", "view"];
+        argv.extend_from_slice(extra);
+        match crate::cli::Cli::parse_from(argv).command {
+            Some(crate::cli::Command::View(v)) => v.common,
+            _ => panic!("not a view command"),
+        }
+    }
+
+    fn bounds() -> Bounds {
+        Bounds {
+            min: DVec3::ZERO,
+            max: DVec3::new(1.0, 2.0, 2.0),
+        }
+    }
+
+    fn point() -> Light {
+        Light {
+            name: "p".into(),
+            kind: LightKind::Point,
+            position: DVec3::ONE,
+            direction: DVec3::NEG_Y,
+            color: [1.0; 3],
+            intensity: 5.0,
+            radius: 0.0,
+        }
+    }
+
+    fn sun() -> Light {
+        Light {
+            name: "sun".into(),
+            kind: LightKind::Directional,
+            ..point()
+        }
+    }
+
+    #[test]
+    fn command_line_options_map_to_render_settings() {
+        let s = ViewState::from_args(
+            &args(&[
+                "--bounces",
+                "2",
+                "--seed",
+                "7",
+                "--sky",
+                "0.5",
+                "--spp",
+                "9",
+            ]),
+            &[point()],
+            bounds(),
+        );
+        let r = s.render_settings((160, 120));
+        assert_eq!((r.width, r.height, r.bounces, r.seed), (160, 120, 2, 7));
+        assert_eq!(r.sky, [0.5; 3]);
+        assert_eq!(s.spp_target, Some(9));
+    }
+
+    #[test]
+    fn the_default_softness_is_visibly_soft() {
+        let s = ViewState::from_args(&args(&[]), &[point(), sun()], bounds());
+        assert_eq!(s.softness, default_light_radius(&bounds()));
+        let lights = s.lights();
+        assert_eq!(lights[0].radius, s.softness);
+        // The sun gets the matching angular radius.
+        let angular = 2.0 * s.softness as f64 / bounds().diagonal();
+        assert!((lights[1].radius as f64 - angular).abs() < 1e-6);
+    }
+
+    #[test]
+    fn the_hard_toggle_gives_radius_zero_and_restores_the_softness() {
+        let mut s = ViewState::from_args(&args(&["--light-radius", "0.1"]), &[point()], bounds());
+        s.add_light(NewLight::Sphere);
+        let soft = s.lights();
+        assert_eq!(soft[0].radius, 0.1);
+        assert!(soft[1].radius > 0.0);
+        s.toggle_hard_shadows();
+        assert!(s.lights().iter().all(|l| l.radius == 0.0));
+        s.toggle_hard_shadows();
+        assert_eq!(s.lights(), soft);
+        // --hard-shadows starts hard but keeps the default softness for the toggle.
+        let mut h = ViewState::from_args(&args(&["--hard-shadows"]), &[point()], bounds());
+        assert_eq!(h.lights()[0].radius, 0.0);
+        h.toggle_hard_shadows();
+        assert_eq!(h.lights()[0].radius, default_light_radius(&bounds()));
+    }
+
+    #[test]
+    fn the_softness_follows_the_slider_unless_set_by_hand() {
+        let mut s = ViewState::from_args(&args(&[]), &[point(), point()], bounds());
+        s.rig[1].follows_softness = false;
+        s.rig[1].light.radius = 0.3;
+        s.softness = 0.05;
+        let l = s.lights();
+        assert_eq!((l[0].radius, l[1].radius), (0.05, 0.3));
+    }
+
+    #[test]
+    fn disabled_lights_are_left_out_and_presets_replace_or_extend() {
+        let mut s = ViewState::from_args(&args(&[]), &[point()], bounds());
+        s.apply_preset(LightPreset::ThreePointStudio, false);
+        assert_eq!(s.lights().len(), 4);
+        s.rig[0].enabled = false;
+        assert_eq!(s.lights().len(), 3);
+        s.apply_preset(LightPreset::OverheadSoftbox, true);
+        assert_eq!(s.rig.len(), 1);
+        // The softbox keeps its large radius.
+        assert!(s.lights()[0].radius > s.softness);
+        for kind in NewLight::ALL {
+            s.add_light(kind);
+        }
+        assert_eq!(s.lights().len(), 5);
+        assert!(s.lights().iter().all(|l| l.intensity > 0.0));
+    }
+}
