@@ -234,7 +234,11 @@ impl FrameLoop {
         let size = scaled(full, divisor);
         let mut pending = std::mem::take(&mut self.pending);
         if pending.any() {
-            log::debug!("applying {pending:?} at {}x{} (1/{divisor})", size.0, size.1);
+            log::debug!(
+                "applying {pending:?} at {}x{} (1/{divisor})",
+                size.0,
+                size.1
+            );
         }
         if pending.settings || self.applied != Some((size, divisor)) {
             let settings = RenderSettings {

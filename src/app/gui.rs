@@ -389,7 +389,7 @@ impl Gui {
         egui::CollapsingHeader::new("Scene")
             .default_open(true)
             .show(ui, |ui| {
-                ui.label(format!("{}", m.scene.source));
+                ui.label(m.scene.source.as_str());
                 ui.horizontal(|ui| {
                     let field = ui.add(
                         egui::TextEdit::singleline(&mut self.path_text)

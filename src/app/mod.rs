@@ -153,6 +153,9 @@ fn check_screenshot_path(p: &Path) -> Result<()> {
     Ok(())
 }
 
+/// A scene loaded in the background, with its loading time in milliseconds.
+type Loaded = Result<(Scene, f64), SceneError>;
+
 /// The window and what draws into it.
 struct Gfx {
     window: Arc<Window>,
@@ -199,7 +202,7 @@ struct App {
     display: Vec<u8>,
     /// Exposure, tone mapper and samples of `display`.
     display_key: Option<(f32, ToneMapper, u32, usize)>,
-    loader: Option<(PathBuf, Receiver<Result<(Scene, f64), SceneError>>)>,
+    loader: Option<(PathBuf, Receiver<Loaded>)>,
     device_error: Option<String>,
     fatal: Option<anyhow::Error>,
     last_screenshot: Option<PathBuf>,
@@ -245,19 +248,18 @@ impl ApplicationHandler for App {
         }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
-            WindowEvent::Resized(size) => {
-                if size.width > 0 && size.height > 0 {
-                    if let Err(e) = gfx.pixels.resize_surface(size.width, size.height) {
-                        self.fail(event_loop, anyhow!("cannot resize the window surface: {e}"));
-                        return;
-                    }
-                    gfx.framework.resize(size.width, size.height);
-                    self.size = (size.width, size.height);
-                    self.frame_loop.invalidate(Changes {
-                        camera: true,
-                        ..Changes::default()
-                    });
+            // A minimized window is 0×0: keep the last size.
+            WindowEvent::Resized(size) if size.width > 0 && size.height > 0 => {
+                if let Err(e) = gfx.pixels.resize_surface(size.width, size.height) {
+                    self.fail(event_loop, anyhow!("cannot resize the window surface: {e}"));
+                    return;
                 }
+                gfx.framework.resize(size.width, size.height);
+                self.size = (size.width, size.height);
+                self.frame_loop.invalidate(Changes {
+                    camera: true,
+                    ..Changes::default()
+                });
             }
             WindowEvent::ScaleFactorChanged { scale_factor, .. } => {
                 gfx.framework.set_scale_factor(scale_factor);
