@@ -37,26 +37,24 @@ pub fn default_light_radius(bounds: &Bounds) -> f32 {
     (bounds.diagonal() * 0.02) as f32
 }
 
-/// The rig a scene without lights gets: a point key light above the middle of the scene (inside
-/// it, so interiors are lit too) and a sun from above-front.
+/// The rig a scene without lights gets: a point key light just above the automatic camera,
+/// bright enough for an irradiance of about 1 at the middle of the scene, and a dimmer sun from
+/// above-front for shape.
 pub fn default_light_rig(bounds: &Bounds) -> Vec<Light> {
     let center = bounds.center();
     let size = bounds.diagonal();
-    let extent = if bounds.is_empty() {
-        DVec3::ONE
-    } else {
-        bounds.max - bounds.min
-    };
-    let radius = default_light_radius(bounds);
+    let camera = super::Camera::framing(bounds, super::AUTO_YFOV);
+    let key = camera.eye + camera.up * (0.25 * size);
+    let distance = (key - center).length();
     vec![
         Light {
             name: "default key".into(),
             kind: LightKind::Point,
-            position: center + DVec3::new(0.1 * extent.x, 0.3 * extent.y, 0.2 * extent.z),
-            direction: DVec3::NEG_Y,
+            position: key,
+            direction: (center - key).normalize_or(DVec3::NEG_Y),
             color: [1.0, 0.97, 0.92],
-            intensity: (0.5 * size * size) as f32,
-            radius,
+            intensity: (distance * distance) as f32,
+            radius: default_light_radius(bounds),
         },
         Light {
             name: "default sun".into(),
@@ -64,7 +62,7 @@ pub fn default_light_rig(bounds: &Bounds) -> Vec<Light> {
             position: center,
             direction: DVec3::new(-0.4, -1.0, -0.5).normalize(),
             color: [1.0, 0.95, 0.85],
-            intensity: 2.0,
+            intensity: 0.6,
             radius: 0.02,
         },
     ]
