@@ -1,0 +1,350 @@
+#!/usr/bin/env python3
+"""penumbra against Mitsuba 3's CPU path tracer (llvm_ad_rgb), side by side, in one run on one
+machine: the same scene, resolution, path depth and samples per pixel.
+
+Two scenes, each defined once here as plain data and given to both renderers:
+
+  cornell  the bundled Lambertian Cornell box (assets/cornell-box.glb, built by
+           scripts/cornell_box.py; the Mitsuba side is scripts/mitsuba_reference.py's
+           build_scene): quad area light + point light. Reference:
+           tests/references/cornell-box-mitsuba-128.exr (Mitsuba, 49152 spp) at 128x128.
+  bunny    StanfordBunny ($PENUMBRA_SCENES/StanfordBunny/bunny.glb, 144,046 triangles) on a
+           floor in front of a back wall, all Lambertian, lit by one point light. Written as a
+           GLB for penumbra (flat shading: every triangle its own three vertices, so both
+           renderers shade with the geometric normal) and handed to Mitsuba as the same
+           arrays. Mitsuba's `diffuse` is one-sided; penumbra scatters from both faces, so the
+           Mitsuba BSDFs are wrapped in `twosided`. Reference: Mitsuba at --ref-spp, cached in
+           --work.
+
+Settings on both sides: --size x --size pixels, box pixel filter, penumbra --bounces B =
+Mitsuba max_depth B + 2, Russian roulette off, hard shadows (point light radius 0), MIS.
+
+Measured (wall clock, on this machine, one after the other, nothing else of ours running):
+  * time for the same spp: `penumbra render --spp S` ("seconds": rendering only, kernel build
+    excluded) against mi.render(spp=S) after a warm-up render (the JIT compile is reported
+    separately);
+  * error against the reference as samples double (penumbra: `bench converge --configs mis`,
+    progressive; Mitsuba: an independent render per spp count), and the time each needs to
+    reach the relMSE Mitsuba reaches at S spp (log-log interpolation on each curve).
+
+    python3 scripts/peers/mitsuba_compare.py                      # both scenes, defaults
+    python3 scripts/peers/mitsuba_compare.py --scenes cornell --spp 64 --max-spp 256
+
+Needs: mitsuba 3 (pip install mitsuba; see scripts/README.md), a release build of penumbra
+(cargo build --release), PENUMBRA_SCENES for the bunny. Prints a Markdown table and writes
+the raw figures as JSON (--json).
+"""
+
+import argparse
+import json
+import math
+import os
+import platform
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import cornell_box  # noqa: E402
+import mitsuba_reference  # noqa: E402  (sets the llvm_ad_rgb variant)
+
+import drjit as dr  # noqa: E402
+import mitsuba as mi  # noqa: E402
+
+
+# ---------------------------------------------------------------------------------------
+# The bunny scene, as plain data in cornell_box.scene()'s format
+# ---------------------------------------------------------------------------------------
+
+BUNNY_MATERIALS = [
+    {"name": "Bunny", "color": (0.8, 0.76, 0.7)},
+    {"name": "Floor", "color": (0.5, 0.5, 0.5)},
+    {"name": "Wall", "color": (0.6, 0.62, 0.65)},
+]
+BUNNY_CAMERA = {"name": "Camera", "eye": (-0.15, 0.85, 3.4), "forward": (0.0, 0.0, -1.0),
+                "up": (0.0, 1.0, 0.0), "yfov_deg": 40.0, "aspect": 1.0, "znear": 0.01,
+                "zfar": 100.0}
+BUNNY_LIGHT = {"name": "Key", "position": (1.2, 2.6, 1.8), "color": (1.0, 1.0, 1.0),
+               "intensity": 10.0}
+
+
+def _flat_mesh(name, material, positions, triangles):
+    """A flat-shaded mesh: every triangle gets its own vertices with the face normal."""
+    pos, nrm = [], []
+    for a, b, c in triangles:
+        pa, pb, pc = positions[a], positions[b], positions[c]
+        n = cornell_box._normalize(cornell_box._cross(cornell_box._sub(pb, pa),
+                                                      cornell_box._sub(pc, pa)))
+        pos += [pa, pb, pc]
+        nrm += [n, n, n]
+    return {"name": name, "material": material, "positions": pos, "normals": nrm,
+            "indices": list(range(len(pos)))}
+
+
+def bunny_scene(glb_path):
+    gltf, bin_data = cornell_box.read_glb(glb_path)
+    prim = gltf["meshes"][0]["primitives"][0]
+    positions = cornell_box.read_accessor(gltf, bin_data, prim["attributes"]["POSITION"])
+    idx = cornell_box.read_accessor(gltf, bin_data, prim["indices"])
+    tris = [(idx[i], idx[i + 1], idx[i + 2]) for i in range(0, len(idx), 3)]
+    # Drop zero-area triangles: neither renderer can hit them and a zero normal is invalid.
+    tris = [t for t in tris if any(abs(c) > 0 for c in cornell_box._cross(
+        cornell_box._sub(positions[t[1]], positions[t[0]]),
+        cornell_box._sub(positions[t[2]], positions[t[0]])))]
+    y0 = min(p[1] for p in positions)
+    floor = cornell_box._quad([(-3.0, y0, -1.5), (3.0, y0, -1.5), (3.0, y0, 4.0),
+                               (-3.0, y0, 4.0)], (0, 1, 0))
+    wall = cornell_box._quad([(-3.0, y0, -1.5), (3.0, y0, -1.5), (3.0, 4.0, -1.5),
+                              (-3.0, 4.0, -1.5)], (0, 0, 1))
+    meshes = [_flat_mesh("Bunny", 0, positions, tris)]
+    for name, mat, (p, n, i) in [("Floor", 1, cornell_box._merge([floor])),
+                                 ("Wall", 2, cornell_box._merge([wall]))]:
+        meshes.append({"name": name, "material": mat, "positions": p, "normals": n,
+                       "indices": i})
+    return {"meshes": meshes, "materials": BUNNY_MATERIALS, "camera": BUNNY_CAMERA,
+            "point_lights": [BUNNY_LIGHT]}
+
+
+def mitsuba_scene(sc, width, height, bounces, twosided):
+    """The Mitsuba scene of a cornell_box.scene()-style description."""
+    cam = sc["camera"]
+    eye = cam["eye"]
+    target = tuple(e + f for e, f in zip(eye, cam["forward"]))
+    d = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": bounces + 2, "rr_depth": bounces + 100,
+                       "hide_emitters": False},
+        "sensor": {
+            "type": "perspective", "fov_axis": "y", "fov": cam["yfov_deg"],
+            "near_clip": cam["znear"], "far_clip": cam["zfar"],
+            "to_world": mi.ScalarTransform4f().look_at(origin=list(eye), target=list(target),
+                                                       up=list(cam["up"])),
+            "sampler": {"type": "independent", "sample_count": 1},
+            "film": {"type": "hdrfilm", "width": width, "height": height,
+                     "rfilter": {"type": "box"}, "pixel_format": "rgb",
+                     "component_format": "float32"},
+        },
+    }
+    for obj in sc["meshes"]:
+        m = sc["materials"][obj["material"]]
+        if twosided and "emissive_factor" not in m:
+            d["mesh_" + obj["name"]] = _twosided_mesh(obj, m)
+        else:
+            d["mesh_" + obj["name"]] = mitsuba_reference.make_mesh(obj, m)
+    for i, pl in enumerate(sc["point_lights"]):
+        d[f"point_{i}"] = {"type": "point", "position": list(pl["position"]),
+                           "intensity": mitsuba_reference._rgb(
+                               [c * pl["intensity"] for c in pl["color"]])}
+    return mi.load_dict(d)
+
+
+def _twosided_mesh(obj, material):
+    props = mi.Properties()
+    props["bsdf"] = mi.load_dict({"type": "twosided", "bsdf": {
+        "type": "diffuse", "reflectance": mitsuba_reference._rgb(material["color"])}})
+    nv, nf = len(obj["positions"]), len(obj["indices"]) // 3
+    mesh = mi.Mesh(obj["name"], nv, nf, props, has_vertex_normals=True)
+    params = mi.traverse(mesh)
+    params["vertex_positions"] = mi.Float([c for p in obj["positions"] for c in p])
+    params["vertex_normals"] = mi.Float([c for n in obj["normals"] for c in n])
+    params["faces"] = mi.UInt32(obj["indices"])
+    params.update()
+    return mesh
+
+
+# ---------------------------------------------------------------------------------------
+# Measurements
+# ---------------------------------------------------------------------------------------
+
+def relmse(img, ref):
+    """Mean over pixels and channels of (x - r)^2 / (r^2 + 0.01), as penumbra computes it."""
+    x, r = img.array, ref.array
+    return float(dr.mean(dr.square(x - r) / (dr.square(r) + 0.01))[0])
+
+
+def mitsuba_render(scene, spp, seed):
+    """Renders and waits; returns (image, seconds)."""
+    t = time.perf_counter()
+    img = mi.render(scene, seed=seed, spp=spp)
+    dr.eval(img)
+    dr.sync_thread()
+    return img, time.perf_counter() - t
+
+
+def mitsuba_reference_image(scene, spp, seed0, pass_spp):
+    acc = None
+    passes = max(1, spp // pass_spp)
+    for i in range(passes):
+        img, _ = mitsuba_render(scene, pass_spp, seed0 + i)
+        acc = img if acc is None else acc + img
+        dr.eval(acc)
+    return acc / passes
+
+
+def read_exr_tensor(path):
+    bmp = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32,
+                                  srgb_gamma=False)
+    return mi.TensorXf(bmp)
+
+
+def time_to_reach(curve, target):
+    """Seconds at which a (seconds, relmse) curve, interpolated in log-log, reaches `target`;
+    extrapolated with slope -1 from the last point when it ends above it."""
+    pts = sorted(curve)
+    for (t0, e0), (t1, e1) in zip(pts, pts[1:]):
+        if e0 >= target >= e1 and e0 > e1:
+            a = (math.log(e0) - math.log(target)) / (math.log(e0) - math.log(e1))
+            return math.exp(math.log(t0) + a * (math.log(t1) - math.log(t0))), False
+    if pts and target >= pts[0][1]:
+        return pts[0][0], False
+    t, e = pts[-1]
+    return t * e / target, True
+
+
+def run_penumbra(binary, args):
+    out = subprocess.run([binary] + args, capture_output=True, text=True)
+    if out.returncode != 0:
+        sys.exit(f"penumbra {' '.join(args)} failed:\n{out.stderr}")
+    return json.loads([line for line in out.stdout.splitlines() if line.startswith("{")][-1])
+
+
+def compare(name, glb, msc, reference, args, results):
+    print(f"== {name}: {glb}", file=sys.stderr)
+    size, bounces = str(args.size), str(args.bounces)
+    common = ["--width", size, "--height", size, "--bounces", bounces, "--hard-shadows",
+              "--device", args.device]
+    # penumbra: time for S spp (kernels built before the clock starts), then the error curve.
+    pen_render = run_penumbra(args.penumbra, ["render", glb, "-o",
+                                              os.path.join(args.work, f"{name}-penumbra.exr"),
+                                              "--spp", str(args.spp), "--no-russian-roulette"]
+                              + common)
+    pen_conv = run_penumbra(args.penumbra, ["bench", "converge", glb, "--reference", reference,
+                                            "--configs", "mis", "--spp", str(args.max_spp),
+                                            "--json"] + common)
+    pen_curve = [(s["seconds"], s["relmse"]) for s in pen_conv["curves"][0]["steps"]]
+
+    # Mitsuba: compile (first render), then independent renders at each spp count.
+    ref = read_exr_tensor(reference)
+    _, compile_s = mitsuba_render(msc, 1, 10_000)
+    mit_curve, mit_steps = [], []
+    spp = 1
+    while spp <= args.max_spp:
+        img, secs = mitsuba_render(msc, spp, spp)
+        e = relmse(img, ref)
+        mit_curve.append((secs, e))
+        mit_steps.append({"spp": spp, "seconds": secs, "relmse": e})
+        spp *= 2
+    _, mit_same_spp = mitsuba_render(msc, args.spp, 77)
+    target = next(s["relmse"] for s in mit_steps if s["spp"] == args.spp)
+    mit_t, _ = time_to_reach(mit_curve, target)
+    pen_t, extrapolated = time_to_reach(pen_curve, target)
+    pixels = args.size * args.size
+    r = {
+        "scene": name, "glb": glb, "reference": reference, "size": args.size,
+        "bounces": args.bounces, "spp": args.spp,
+        "triangles": pen_render["triangles"],
+        "penumbra_device": pen_render["device"],
+        "penumbra_seconds": pen_render["seconds"],
+        "penumbra_kernel_build_ms": pen_render["kernel_build_ms"],
+        "penumbra_samples_per_second": pen_render["samples_per_second"],
+        "mitsuba_seconds": mit_same_spp,
+        "mitsuba_compile_seconds": compile_s,
+        "mitsuba_samples_per_second": pixels * args.spp / mit_same_spp,
+        "target_relmse": target,
+        "penumbra_seconds_to_target": pen_t,
+        "penumbra_extrapolated": extrapolated,
+        "mitsuba_seconds_to_target": mit_t,
+        "penumbra_slope_time": pen_conv["curves"][0]["slope_time"],
+        "penumbra_steps": pen_conv["curves"][0]["steps"],
+        "mitsuba_steps": mit_steps,
+    }
+    results.append(r)
+    print(f"   penumbra {r['penumbra_seconds']:.3f} s, Mitsuba {mit_same_spp:.3f} s for "
+          f"{args.spp} spp", file=sys.stderr)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--penumbra", default=os.path.join(ROOT, "target", "release", "penumbra"))
+    ap.add_argument("--device", default="cpu", help="penumbra --device (default cpu: PoCL)")
+    ap.add_argument("--scenes", default="cornell,bunny")
+    ap.add_argument("--size", type=int, default=128)
+    ap.add_argument("--bounces", type=int, default=8)
+    ap.add_argument("--spp", type=int, default=256, help="spp of the same-spp timing")
+    ap.add_argument("--max-spp", type=int, default=1024, help="last spp of the error curves")
+    ap.add_argument("--ref-spp", type=int, default=16384, help="bunny reference spp")
+    ap.add_argument("--work", default=os.path.join(ROOT, "target", "peers"),
+                    help="scratch folder (scenes, cached references)")
+    ap.add_argument("--json", default=None, help="write the raw figures here")
+    args = ap.parse_args(argv)
+    os.makedirs(args.work, exist_ok=True)
+    if not os.path.exists(args.penumbra):
+        sys.exit(f"{args.penumbra}: no penumbra binary (cargo build --release)")
+
+    results = []
+    for name in args.scenes.split(","):
+        if name == "cornell":
+            glb = os.path.join(ROOT, "assets", "cornell-box.glb")
+            reference = os.path.join(ROOT, "tests", "references",
+                                     f"cornell-box-mitsuba-{args.size}.exr")
+            msc = mitsuba_scene(cornell_box.scene(), args.size, args.size, args.bounces,
+                                twosided=False)
+            if not os.path.exists(reference):
+                reference = os.path.join(args.work, f"cornell-mitsuba-{args.size}.exr")
+                if not os.path.exists(reference):
+                    print(f"rendering {reference}", file=sys.stderr)
+                    mi.Bitmap(mitsuba_reference_image(msc, args.ref_spp, 1000, 256)).write(
+                        reference)
+        elif name == "bunny":
+            scenes = os.environ.get("PENUMBRA_SCENES")
+            src = os.path.join(scenes or "", "StanfordBunny", "bunny.glb")
+            if not scenes or not os.path.exists(src):
+                sys.exit("bunny: set PENUMBRA_SCENES to the folder holding StanfordBunny/")
+            sc = bunny_scene(src)
+            glb = os.path.join(args.work, "bunny-lambert.glb")
+            cornell_box.write_glb(glb, *cornell_box.build_gltf(sc))
+            msc = mitsuba_scene(sc, args.size, args.size, args.bounces, twosided=True)
+            reference = os.path.join(args.work,
+                                     f"bunny-mitsuba-{args.size}-{args.bounces}-"
+                                     f"{args.ref_spp}.exr")
+            if not os.path.exists(reference):
+                print(f"rendering {reference} ({args.ref_spp} spp)", file=sys.stderr)
+                t = time.perf_counter()
+                mi.Bitmap(mitsuba_reference_image(msc, args.ref_spp, 1000, 256)).write(
+                    reference)
+                print(f"   {time.perf_counter() - t:.0f} s", file=sys.stderr)
+        else:
+            sys.exit(f"unknown scene '{name}' (cornell, bunny)")
+        compare(name, glb, msc, reference, args, results)
+
+    cpu = platform.processor() or platform.machine()
+    meta = {"date": time.strftime("%Y-%m-%d", time.gmtime()), "host": cpu,
+            "cores": os.cpu_count(), "mitsuba": mi.__version__, "drjit": dr.__version__,
+            "variant": mi.variant()}
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"meta": meta, "results": results}, f, indent=1)
+    print(f"penumbra ({results[0]['penumbra_device'] if results else '?'}) against Mitsuba "
+          f"{mi.__version__} {mi.variant()}, {meta['cores']} cores, {meta['date']}; "
+          f"{args.size}x{args.size}, {args.bounces} bounces (max_depth {args.bounces + 2}), "
+          f"no Russian roulette, hard shadows, MIS")
+    print()
+    print("| scene | triangles | spp | penumbra s | Mitsuba s (compile) | penumbra M samples/s "
+          "| Mitsuba M samples/s | target relMSE | penumbra s to target | Mitsuba s to target "
+          "| penumbra slope |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in results:
+        ext = " (extrapolated)" if r["penumbra_extrapolated"] else ""
+        print(f"| {r['scene']} | {r['triangles']:,} | {r['spp']} | {r['penumbra_seconds']:.3f} "
+              f"| {r['mitsuba_seconds']:.3f} ({r['mitsuba_compile_seconds']:.1f}) "
+              f"| {r['penumbra_samples_per_second'] / 1e6:.2f} "
+              f"| {r['mitsuba_samples_per_second'] / 1e6:.2f} | {r['target_relmse']:.3e} "
+              f"| {r['penumbra_seconds_to_target']:.3f}{ext} "
+              f"| {r['mitsuba_seconds_to_target']:.3f} | {r['penumbra_slope_time']:.2f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
