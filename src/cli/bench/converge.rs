@@ -154,7 +154,8 @@ pub struct Curve {
     pub config: String,
     /// Steps, in order.
     pub steps: Vec<Step>,
-    /// Slope of ln relMSE against ln wall time over the fitted steps (−1: unbiased).
+    /// Slope of ln relMSE against ln wall time over the fitted steps that took at least 1/64
+    /// of the last step's time (−1: unbiased).
     pub slope_time: Option<f64>,
     /// Slope of ln relMSE against ln spp over the fitted steps (not a timing).
     pub slope_spp: Option<f64>,
@@ -165,9 +166,14 @@ pub struct Curve {
 impl Curve {
     fn fit(config: String, steps: Vec<Step>, fit_from: u32) -> Self {
         let fitted: Vec<&Step> = steps.iter().filter(|s| s.spp >= fit_from).collect();
+        // Steps shorter than 1/64 of the last are left out of the time fit: there, fixed costs
+        // per call (launch latency, a wave that does not fill the device) outweigh the
+        // samples and would steepen the slope.
+        let last_seconds = steps.last().map_or(0.0, |s| s.seconds);
         let slope_time = log_log_slope(
             &fitted
                 .iter()
+                .filter(|s| s.seconds >= last_seconds / 64.0)
                 .map(|s| (s.seconds, s.relmse))
                 .collect::<Vec<_>>(),
         );

@@ -98,6 +98,7 @@ fn icosphere(level: u32) -> Mesh {
         positions,
         uvs: Vec::new(),
         indices: faces,
+        ..Mesh::default()
     }
 }
 
