@@ -43,7 +43,7 @@ pub fn pick(host: &HostScene, ray: &Ray) -> Option<Pick> {
 mod tests {
     use super::*;
     use crate::scene::{Material, Mesh, Object, Scene};
-    use glam::{DMat4, Vec2};
+    use glam::DMat4;
 
     /// Two unit quads facing +Z: object 0 at x = -2, object 1 at x = +2, and a hidden one in
     /// front of object 1.
@@ -55,10 +55,9 @@ mod tests {
                 Vec3::new(0.5, 0.5, 0.0),
                 Vec3::new(-0.5, 0.5, 0.0),
             ],
-            normals: vec![],
-            uvs: vec![Vec2::ZERO; 0],
             indices: vec![[0, 1, 2], [0, 2, 3]],
             materials: vec![0, 0],
+            ..Mesh::default()
         };
         let object = |name: &str, x: f64, z: f64, visible: bool| Object {
             name: name.into(),

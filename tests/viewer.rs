@@ -1,0 +1,535 @@
+//! The viewer's real window under Xvfb (with Mesa's lavapipe Vulkan), driven by xdotool:
+//! keys and mouse move the camera, H toggles hard shadows, F12 and the overlay's button save
+//! screenshots, `--frames`/`--screenshot` end a run with the final frame. The saved images are
+//! checked: not blank, changed by camera moves, and sharper shadow edges with hard shadows.
+//!
+//! Each test starts its own `Xvfb :N` and kills it at the end; without Xvfb (or xdotool for
+//! the interactive test) the test prints why and passes. The tests run one at a time (the
+//! machine may have two cores).
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Output, Stdio};
+use std::sync::Mutex;
+use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
+use std::time::{Duration, Instant};
+
+/// How long one step (a convergence, a screenshot) may take on a slow, shared machine.
+const STEP_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// One viewer test at a time.
+static SERIAL: Mutex<()> = Mutex::new(());
+
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn binary() -> String {
+    std::env::var("PENUMBRA_TEST_BINARY")
+        .unwrap_or_else(|_| env!("CARGO_BIN_EXE_penumbra").to_string())
+}
+
+fn test_device() -> String {
+    std::env::var("PENUMBRA_TEST_DEVICE").unwrap_or_else(|_| "cpu".into())
+}
+
+/// Whether `tool` can be run.
+fn have(tool: &str) -> bool {
+    Command::new(tool)
+        .arg("-version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok()
+}
+
+/// A private X server, killed on drop.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    /// Starts Xvfb on a free display number; `None` (with a message) when Xvfb is missing.
+    fn start() -> Option<Xvfb> {
+        if !have("Xvfb") {
+            println!("SKIPPED: Xvfb is not installed (apt-get install xvfb)");
+            return None;
+        }
+        let base = 200 + std::process::id() % 500;
+        for n in base..base + 40 {
+            if Path::new(&format!("/tmp/.X{n}-lock")).exists() {
+                continue;
+            }
+            let mut child = Command::new("Xvfb")
+                .arg(format!(":{n}"))
+                .args(["-screen", "0", "1024x768x24", "-nolisten", "tcp"])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .expect("Xvfb starts");
+            let socket = PathBuf::from(format!("/tmp/.X11-unix/X{n}"));
+            let start = Instant::now();
+            while start.elapsed() < Duration::from_secs(10) {
+                if let Ok(Some(_)) = child.try_wait() {
+                    break; // taken meanwhile: try the next number
+                }
+                if socket.exists() {
+                    return Some(Xvfb {
+                        child,
+                        display: format!(":{n}"),
+                    });
+                }
+                std::thread::sleep(Duration::from_millis(50));
+            }
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+        panic!("no free X display number in {base}..{}", base + 40);
+    }
+
+    /// Runs xdotool on this display; returns its stdout.
+    fn xdotool(&self, args: &[&str]) -> String {
+        let o = Command::new("xdotool")
+            .args(args)
+            .env("DISPLAY", &self.display)
+            .output()
+            .expect("xdotool runs");
+        assert!(
+            o.status.success(),
+            "xdotool {args:?} failed: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    }
+
+    /// The viewer's window id (its title starts with "penumbra").
+    fn find_window(&self) -> String {
+        let start = Instant::now();
+        loop {
+            let o = Command::new("xdotool")
+                .args(["search", "--name", "^penumbra"])
+                .env("DISPLAY", &self.display)
+                .output()
+                .expect("xdotool runs");
+            let out = String::from_utf8_lossy(&o.stdout);
+            if let Some(id) = out.lines().next().filter(|l| !l.trim().is_empty()) {
+                return id.trim().to_string();
+            }
+            assert!(
+                start.elapsed() < STEP_TIMEOUT,
+                "no window titled penumbra appeared"
+            );
+            std::thread::sleep(Duration::from_millis(200));
+        }
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// The viewer's command line on `x`'s display in `dir`.
+fn viewer_command(x: &Xvfb, dir: &Path, args: &[&str]) -> Command {
+    let mut c = Command::new(binary());
+    c.args(args)
+        .current_dir(dir)
+        .env("DISPLAY", &x.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("PENUMBRA_DEVICE", test_device());
+    c
+}
+
+/// A running viewer whose stdout lines arrive on a channel.
+struct Viewer {
+    child: Child,
+    lines: Receiver<String>,
+}
+
+impl Viewer {
+    fn spawn(mut command: Command) -> Viewer {
+        let mut child = command
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("the viewer starts");
+        let stdout = child.stdout.take().expect("stdout is piped");
+        let (tx, lines) = channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Viewer { child, lines }
+    }
+
+    /// The next stdout line containing `what`.
+    fn wait_for(&mut self, what: &str) -> String {
+        let deadline = Instant::now() + STEP_TIMEOUT;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) if line.contains(what) => return line,
+                Ok(_) => {}
+                Err(RecvTimeoutError::Timeout) => panic!("no '{what}' line from the viewer"),
+                Err(RecvTimeoutError::Disconnected) => {
+                    let status = self.child.wait().ok();
+                    panic!("the viewer exited ({status:?}) before printing '{what}'")
+                }
+            }
+        }
+    }
+
+    /// Waits for the screenshot line and returns the PNG path (relative to `dir`).
+    fn screenshot_path(&mut self, dir: &Path) -> PathBuf {
+        let line = self.wait_for("saved ");
+        let png = line
+            .split("saved ")
+            .nth(1)
+            .and_then(|rest| rest.split(" and ").next())
+            .unwrap_or_else(|| panic!("unexpected line: {line}"));
+        let path = dir.join(png);
+        assert!(path.exists(), "{} is missing", path.display());
+        assert!(
+            path.with_extension("exr").exists(),
+            "the EXR beside {} is missing",
+            path.display()
+        );
+        path
+    }
+
+    fn wait_exit(&mut self) -> ExitStatus {
+        let start = Instant::now();
+        loop {
+            if let Some(s) = self.child.try_wait().expect("the viewer can be waited for") {
+                return s;
+            }
+            assert!(start.elapsed() < STEP_TIMEOUT, "the viewer did not exit");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+}
+
+impl Drop for Viewer {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// A PNG as luminance in [0, 1], with its size.
+struct Gray {
+    width: usize,
+    height: usize,
+    pixels: Vec<f32>,
+}
+
+fn load(path: &Path) -> Gray {
+    let img = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb8();
+    let pixels = img
+        .pixels()
+        .map(|p| (0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32) / 255.0)
+        .collect();
+    Gray {
+        width: img.width() as usize,
+        height: img.height() as usize,
+        pixels,
+    }
+}
+
+impl Gray {
+    fn at(&self, x: usize, y: usize) -> f32 {
+        self.pixels[y * self.width + x]
+    }
+
+    /// Asserts the image shows something: neither flat nor black nor white.
+    fn assert_not_blank(&self, what: &str) {
+        let n = self.pixels.len() as f32;
+        let mean = self.pixels.iter().sum::<f32>() / n;
+        let var = self.pixels.iter().map(|p| (p - mean).powi(2)).sum::<f32>() / n;
+        assert!(
+            (0.03..0.97).contains(&mean) && var.sqrt() > 0.05,
+            "{what} looks blank: mean {mean}, deviation {}",
+            var.sqrt()
+        );
+    }
+
+    /// Means over `block`×`block` tiles (averages noise out, keeps the picture).
+    fn blocks(&self, block: usize) -> Vec<f32> {
+        let (bw, bh) = (self.width / block, self.height / block);
+        let mut out = Vec::with_capacity(bw * bh);
+        for by in 0..bh {
+            for bx in 0..bw {
+                let mut sum = 0.0;
+                for y in by * block..(by + 1) * block {
+                    for x in bx * block..(bx + 1) * block {
+                        sum += self.at(x, y);
+                    }
+                }
+                out.push(sum / (block * block) as f32);
+            }
+        }
+        out
+    }
+
+    /// Sharpness of the shadow edge that the bundled Cornell box's tall block casts from the
+    /// point light onto the back wall (a diagonal edge in the region below, given in fractions
+    /// of the image so any size works). The edge is located in each column (largest step of a
+    /// lightly smoothed profile), a line is fitted through those points, and the luminance
+    /// profile across the line is averaged along it (edge-spread function; the averaging
+    /// over ~50 columns quiets the noise). The result is the profile's steepest one-pixel step
+    /// over its whole contrast: about 1/3 for a hard edge, well under that for a penumbra.
+    fn edge_sharpness(&self) -> f32 {
+        let x0 = (0.53 * self.width as f32) as usize;
+        let x1 = (0.68 * self.width as f32) as usize;
+        let y0 = (0.47 * self.height as f32) as usize;
+        let y1 = (0.61 * self.height as f32) as usize;
+        let smooth = |x: usize, y: usize| {
+            let mut s = 0.0;
+            for dx in 0..3 {
+                for dy in 0..2 {
+                    s += self.at(x + dx - 1, y + dy);
+                }
+            }
+            s / 6.0
+        };
+        // Locate the edge in each column and fit y = a + b·x through it.
+        let points: Vec<(f32, f32)> = (x0..x1)
+            .map(|x| {
+                let step = |y: &usize| (smooth(x, y + 2) - smooth(x, *y)).abs();
+                let y = (y0..y1)
+                    .max_by(|a, b| step(a).total_cmp(&step(b)))
+                    .unwrap_or(y0);
+                (x as f32, y as f32 + 1.5)
+            })
+            .collect();
+        let n = points.len() as f32;
+        let (mx, my) = points
+            .iter()
+            .fold((0.0, 0.0), |(sx, sy), (x, y)| (sx + x / n, sy + y / n));
+        let sxy: f32 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+        let sxx: f32 = points.iter().map(|(x, _)| (x - mx).powi(2)).sum();
+        let b = sxy / sxx;
+        let a = my - b * mx;
+        // The profile across the line, averaged along it.
+        let sample = |x: usize, y: f32| {
+            let (yi, f) = (y.floor() as usize, y - y.floor());
+            self.at(x, yi) * (1.0 - f) + self.at(x, yi + 1) * f
+        };
+        let profile: Vec<f32> = (-8..=8)
+            .map(|d| {
+                (x0..x1)
+                    .map(|x| sample(x, a + b * x as f32 + d as f32))
+                    .sum::<f32>()
+                    / n
+            })
+            .collect();
+        let (lo, hi) = profile
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let steepest = profile
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f32::max);
+        steepest / (hi - lo).max(1e-6)
+    }
+}
+
+/// Mean absolute difference of two images' 8×8 block means.
+fn picture_difference(a: &Gray, b: &Gray) -> f32 {
+    assert_eq!((a.width, a.height), (b.width, b.height), "sizes differ");
+    let (a, b) = (a.blocks(8), b.blocks(8));
+    a.iter().zip(&b).map(|(p, q)| (p - q).abs()).sum::<f32>() / a.len() as f32
+}
+
+/// Whether two PNGs hold the same pixels.
+fn same_pixels(a: &Path, b: &Path) -> bool {
+    let load = |p: &Path| image::open(p).expect("a PNG").to_rgba8().into_raw();
+    load(a) == load(b)
+}
+
+fn run_to_exit(command: &mut Command) -> Output {
+    command.output().expect("the viewer runs")
+}
+
+#[test]
+fn without_a_display_the_viewer_points_to_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(binary())
+        .args(["view", "--frames", "1"])
+        .current_dir(dir.path())
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("the binary runs");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "stderr: {stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "one line: {stderr}");
+    assert!(
+        stderr.starts_with("penumbra: error:") && stderr.contains("penumbra render"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn frames_and_screenshot_save_the_final_frame_and_hard_shadows_are_sharper() {
+    let _serial = serial();
+    let Some(x) = Xvfb::start() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let common = [
+        "--width",
+        "320",
+        "--height",
+        "240",
+        "--bounces",
+        "1",
+        "--spp",
+        "48",
+        "--frames",
+        "2",
+    ];
+    let mut shots = Vec::new();
+    for (name, extra) in [("soft", None), ("hard", Some("--hard-shadows"))] {
+        let png = dir.path().join(format!("{name}.png"));
+        let mut args: Vec<&str> = common.to_vec();
+        args.extend(extra);
+        args.extend(["--screenshot", png.to_str().unwrap()]);
+        let t = Instant::now();
+        let o = run_to_exit(&mut viewer_command(&x, dir.path(), &args));
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            o.status.success(),
+            "{name}: {}\n{stdout}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(
+            stdout.contains("(48 spp)"),
+            "{name}: not converged: {stdout}"
+        );
+        println!("{name}: {:.1} s", t.elapsed().as_secs_f64());
+        assert!(png.with_extension("exr").exists());
+        let (w, h, _) = penumbra::image_io::read_exr(&png.with_extension("exr")).unwrap();
+        assert_eq!((w, h), (320, 240));
+        let img = load(&png);
+        img.assert_not_blank(name);
+        shots.push(img);
+    }
+    let (soft, hard) = (shots[0].edge_sharpness(), shots[1].edge_sharpness());
+    println!("edge sharpness: soft {soft:.4}, hard {hard:.4}");
+    assert!(
+        hard > 1.8 * soft,
+        "hard shadows should have sharper edges: soft {soft}, hard {hard}"
+    );
+}
+
+#[test]
+fn keys_and_mouse_drive_the_window() {
+    let _serial = serial();
+    if !have("xdotool") {
+        println!("SKIPPED: xdotool is not installed (apt-get install xdotool)");
+        return;
+    }
+    let Some(x) = Xvfb::start() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let last = dir.path().join("last.png");
+    let args = [
+        "--width",
+        "320",
+        "--height",
+        "240",
+        "--bounces",
+        "1",
+        "--spp",
+        "48",
+        "--screenshot",
+        last.to_str().unwrap(),
+    ];
+    let mut v = Viewer::spawn(viewer_command(&x, dir.path(), &args));
+    let t = Instant::now();
+    let wid = x.find_window();
+    let title = x.xdotool(&["getwindowname", &wid]);
+    assert!(title.starts_with("penumbra"), "title: {title}");
+    // Without a window manager, keys reach the window only once it has the focus.
+    x.xdotool(&["windowfocus", "--sync", &wid]);
+    v.wait_for("reached 48 spp");
+    println!(
+        "first frame converged after {:.1} s",
+        t.elapsed().as_secs_f64()
+    );
+
+    // Hide the overlay so the mouse reaches the image; F12 saves what is on screen.
+    x.xdotool(&["key", "Tab"]);
+    x.xdotool(&["key", "F12"]);
+    let soft = v.screenshot_path(dir.path());
+    load(&soft).assert_not_blank("the first screenshot");
+
+    // H switches to hard shadows: the accumulation restarts and the edges sharpen.
+    x.xdotool(&["key", "h"]);
+    v.wait_for("reached 48 spp");
+    x.xdotool(&["key", "F12"]);
+    let hard = v.screenshot_path(dir.path());
+    assert_ne!(soft, hard, "screenshots must not overwrite each other");
+    let (s, h) = (load(&soft).edge_sharpness(), load(&hard).edge_sharpness());
+    println!("after H: edge sharpness soft {s:.4}, hard {h:.4}");
+    assert!(h > 1.8 * s, "H did not sharpen the shadows: {s} -> {h}");
+
+    // W moves the camera forward: the picture changes.
+    x.xdotool(&["keydown", "w", "sleep", "0.4", "keyup", "w"]);
+    v.wait_for("reached 48 spp");
+    x.xdotool(&["key", "F12"]);
+    let forward = v.screenshot_path(dir.path());
+    let moved = picture_difference(&load(&hard), &load(&forward));
+    println!("after W: picture difference {moved:.4}");
+    assert!(moved > 0.02, "W did not move the camera ({moved})");
+
+    // Dragging with the right button turns the view.
+    x.xdotool(&["mousemove", "--window", &wid, "160", "120"]);
+    x.xdotool(&["mousedown", "3"]);
+    for dx in [20, 40, 60, 80] {
+        x.xdotool(&[
+            "mousemove",
+            "--window",
+            &wid,
+            &(160 + dx).to_string(),
+            "120",
+        ]);
+    }
+    x.xdotool(&["mouseup", "3"]);
+    v.wait_for("reached 48 spp");
+    x.xdotool(&["key", "F12"]);
+    let turned = v.screenshot_path(dir.path());
+    let turn = picture_difference(&load(&forward), &load(&turned));
+    println!("after the drag: picture difference {turn:.4}");
+    assert!(turn > 0.02, "the mouse drag did not turn the view ({turn})");
+    load(&turned).assert_not_blank("the turned view");
+
+    // Show the overlay again and click its Screenshot button (top left of the top bar): the
+    // PNG holds the image without the overlay, so it equals the last one.
+    x.xdotool(&["key", "Tab"]);
+    std::thread::sleep(Duration::from_millis(300));
+    x.xdotool(&["mousemove", "--window", &wid, "40", "11", "click", "1"]);
+    let button = v.screenshot_path(dir.path());
+    assert_ne!(button, turned);
+    assert!(
+        same_pixels(&button, &turned),
+        "the button's screenshot differs from F12's (overlay in the image?)"
+    );
+
+    // Ctrl+Q quits; --screenshot saves the final frame on the way out.
+    x.xdotool(&["key", "ctrl+q"]);
+    let status = v.wait_exit();
+    assert!(status.success(), "exit status {status}");
+    assert!(last.exists() && last.with_extension("exr").exists());
+    assert!(same_pixels(&last, &turned), "the final frame differs");
+    println!("total {:.1} s", t.elapsed().as_secs_f64());
+}
