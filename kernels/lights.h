@@ -32,8 +32,8 @@ inline uint pick_light(global const float* cdf, uint count, float u) {
 // same power (radiance I / (pi r^2)); directional lights with angular radius a > 0 become discs
 // of directions (radiance E / (pi sin^2 a)).
 inline LightSample sample_light(global const GpuLight* lights, global const GpuTriangle* tris,
-                                global const GpuMaterial* materials, uint index, float3 p,
-                                float u1, float u2) {
+                                global const GpuMaterial* materials, const SceneSurfaces* surf,
+                                const EnvMap* env, uint index, float3 p, float u1, float u2) {
     global const GpuLight* l = &lights[index];
     float select = l->extra.y;
     uint kind = as_uint(l->position.w);
@@ -61,6 +61,19 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
         }
         return s;
     }
+#ifdef HAS_ENV_MAP
+    if (kind == LIGHT_ENVIRONMENT) {
+        float3 radiance;
+        float pdf;
+        s.wi = env_sample(env, u1, u2, &radiance, &pdf);
+        s.distance = INFINITY;
+        if (pdf > 0.0f) {
+            s.pdf = pdf * select;
+            s.radiance = radiance / s.pdf;
+        }
+        return s;
+    }
+#endif
 #ifdef HAS_TRIANGLE_LIGHTS
     if (kind == LIGHT_TRIANGLE) {
         uint prim = as_uint(l->spot.x);
@@ -81,7 +94,12 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
         cos_l = fabs(cos_l);
         if (cos_l <= 0.0f) return s;
         s.pdf = select * dist2 / (area * cos_l);
+#ifdef HAS_TEXTURES
+        TexCoords tc = texcoords_at(surf->shading[prim], b.x, b.y);
+        s.radiance = textured_emission(m, surf, &tc) / s.pdf;
+#else
         s.radiance = m->emission.xyz / s.pdf;
+#endif
         return s;
     }
 #endif

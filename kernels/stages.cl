@@ -25,7 +25,7 @@ inline float power_heuristic(float a, float b) {
 }
 
 kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, global uint* queue,
-                     global uint* counters) {
+                     global uint* counters, global float2* cones) {
     uint slot = get_global_id(0);
     uint pixels = frame.width * frame.height;
     uint total = pixels * frame.samples_in_wave;
@@ -61,24 +61,34 @@ kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, gl
     p.radiance = (float4)(0.0f, 0.0f, 0.0f, as_float(rng));
     paths[slot] = p;
     queue[slot] = slot;
+    // The ray cone for texture filtering: no width at the eye, one pixel's angle of spread.
+    cones[slot] = (float2)(0.0f, 2.0f * length(camera.up.xyz) / (float)frame.height);
 }
 
 kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                   global const GpuTriShading* shading, global const GpuTriTangents* tangents,
+                   global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
+                   global const GpuTexture* textures, global const uint* texels,
                    global const GpuPath* paths, global const uint* queue,
                    volatile global uint* counters, global GpuHit* hits) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_IN]) return;
+    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
     global const GpuPath* p = &paths[queue[i]];
-    hits[i] = traverse(nodes, tris, p->origin.xyz, p->direction.xyz, 0.0f, INFINITY, false,
-                       &counters[COUNT_OVERFLOW]);
+    hits[i] = traverse(nodes, tris, &surf, p->origin.xyz, p->direction.xyz, 0.0f, INFINITY,
+                       false, &counters[COUNT_OVERFLOW]);
 }
 
-kernel void shade(GpuFrame frame, global const GpuTriangle* tris,
-                  global const GpuTriShading* shading, global const GpuMaterial* materials,
+kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTriangle* tris,
+                  global const GpuTriShading* shading, global const GpuTriTangents* tangents,
+                  global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
+                  global const GpuTexture* textures, global const uint* texels,
+                  global const float* env_texels, global const float* env_marginal,
+                  global const float* env_conditional,
                   global const GpuLight* lights, global const float* light_cdf,
                   global GpuPath* paths, global const uint* queue_in, global const GpuHit* hits,
                   global uint* queue_out, global GpuShadowRay* shadow_rays,
-                  volatile global uint* counters) {
+                  volatile global uint* counters, global float2* cones) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_IN]) return;
     uint slot = queue_in[i];
@@ -91,10 +101,23 @@ kernel void shade(GpuFrame frame, global const GpuTriangle* tris,
     float prev_pdf = path.origin.w;
     bool prev_specular = (as_uint(path.direction.w) & PATH_SPECULAR) != 0u;
     bool counts_emission = frame.bounce == 0u || prev_specular || frame.strategy != STRATEGY_LIGHTS;
+    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
+    EnvMap env = {environment, env_texels, env_marginal, env_conditional};
 
     if (hit.prim == NO_HIT) {
+#ifdef HAS_ENV_MAP
+        // Escaped into the environment map, weighted against its sampling at the last vertex.
+        float env_pdf;
+        float3 le = env_radiance(&env, -wo, &env_pdf);
+        float weight = 1.0f;
+        if (frame.bounce > 0u && !prev_specular && frame.strategy == STRATEGY_MIS) {
+            weight = power_heuristic(prev_pdf, environment.scale.z * env_pdf);
+        }
+        if (counts_emission) radiance += throughput * le * weight;
+#else
         // Escaped: the uniform sky, reached by BSDF sampling only.
         if (counts_emission) radiance += throughput * frame.sky.xyz;
+#endif
         paths[slot].radiance.xyz = radiance;
         return;
     }
@@ -105,6 +128,16 @@ kernel void shade(GpuFrame frame, global const GpuTriangle* tris,
     float3 ng = normalize(cross(tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz));
     global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
     bool front = dot(ng, wo) > 0.0f;
+    GpuTriShading sh = shading[hit.prim];
+    TexCoords tc = texcoords_at(sh, hit.u, hit.v);
+#ifdef HAS_TEXTURES
+    // The ray cone's footprint picks the mip levels; it widens by the roughness at each bounce.
+    float2 cone = cones[slot];
+    float cone_width = cone.x + cone.y * hit.t;
+    texcoords_footprint(&tc, sh, tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz, cone_width,
+                        fabs(dot(ng, wo)));
+    tc.xi = rng_next(&rng);
+#endif
 
 #ifdef HAS_TRIANGLE_LIGHTS
     // Emission of a light hit by this ray, weighted against light sampling of the last vertex.
@@ -118,7 +151,13 @@ kernel void shade(GpuFrame frame, global const GpuTriangle* tris,
             float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
             weight = power_heuristic(prev_pdf, light_pdf);
         }
+#ifdef HAS_TEXTURES
+        // Past the camera ray, emission is read at the finest level, as light sampling reads it.
+        TexCoords etc = frame.bounce == 0u ? tc : texcoords_at(sh, hit.u, hit.v);
+        radiance += throughput * textured_emission(mat, &surf, &etc) * weight;
+#else
         radiance += throughput * mat->emission.xyz * weight;
+#endif
     }
 #endif
 
@@ -131,7 +170,6 @@ kernel void shade(GpuFrame frame, global const GpuTriangle* tris,
     // Face the normals towards the side the ray came from.
     if (!front) ng = -ng;
     float3 ns = ng;
-    GpuTriShading sh = shading[hit.prim];
     if (sh.n0.w > 0.0f) {
         float3 n = w0 * sh.n0.xyz + hit.u * sh.n1.xyz + hit.v * sh.n2.xyz;
         float len = length(n);
@@ -140,7 +178,15 @@ kernel void shade(GpuFrame frame, global const GpuTriangle* tris,
             if (dot(ns, ng) < 0.0f) ns = -ns;
         }
     }
+#ifdef HAS_NORMAL_MAPS
+    if (mat->textures.z >= 0) ns = normal_map(&surf, mat, &tc, hit.prim, hit.u, hit.v, ns, ng, front);
+#endif
     SurfaceMaterial m = surface_material(mat);
+#ifdef HAS_TEXTURES
+    apply_textures(&m, mat, &surf, &tc);
+    float alpha_r = m.roughness * m.roughness;
+    cones[slot] = (float2)(cone_width, cone.y + alpha_r);
+#endif
     float3 origin = offset_ray(p, ng);
 
     // Next-event estimation: one light sample, traced later by `connect`.
@@ -148,7 +194,7 @@ kernel void shade(GpuFrame frame, global const GpuTriangle* tris,
         uint index = pick_light(light_cdf, frame.light_count, rng_next(&rng));
         float u1 = rng_next(&rng);
         float u2 = rng_next(&rng);
-        LightSample ls = sample_light(lights, tris, materials, index, p, u1, u2);
+        LightSample ls = sample_light(lights, tris, materials, &surf, &env, index, p, u1, u2);
         if (dot(ls.wi, ng) > 0.0f && (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
             float bsdf_pdf;
             float3 f = bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
@@ -196,13 +242,17 @@ kernel void shade(GpuFrame frame, global const GpuTriangle* tris,
 }
 
 kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                    global const GpuTriShading* shading, global const GpuTriTangents* tangents,
+                    global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
+                    global const GpuTexture* textures, global const uint* texels,
                     global const GpuShadowRay* shadow_rays, volatile global uint* counters,
                     global GpuPath* paths) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_SHADOW]) return;
+    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
     GpuShadowRay r = shadow_rays[i];
-    GpuHit hit = traverse(nodes, tris, r.origin.xyz, r.direction.xyz, 0.0f, r.origin.w, true,
-                          &counters[COUNT_OVERFLOW]);
+    GpuHit hit = traverse(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, 0.0f, r.origin.w,
+                          true, &counters[COUNT_OVERFLOW]);
     if (hit.prim == NO_HIT) paths[as_uint(r.direction.w)].radiance.xyz += r.contribution.xyz;
 }
 

@@ -1,23 +1,32 @@
 // Kernels for tests and benchmarks: traversal alone, and the layout probe.
 
 kernel void trace_closest(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                          global const GpuTriShading* shading,
+                          global const GpuTriTangents* tangents,
+                          global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
+                          global const GpuTexture* textures, global const uint* texels,
                           global const GpuRay* rays, uint count, global GpuHit* hits,
                           volatile global uint* counters) {
     uint i = get_global_id(0);
     if (i >= count) return;
+    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
     GpuRay r = rays[i];
-    hits[i] = traverse(nodes, tris, r.origin.xyz, r.direction.xyz, r.origin.w, r.direction.w,
-                       false, &counters[COUNT_OVERFLOW]);
+    hits[i] = traverse(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, r.origin.w,
+                       r.direction.w, false, &counters[COUNT_OVERFLOW]);
 }
 
 kernel void trace_any(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                      global const GpuTriShading* shading, global const GpuTriTangents* tangents,
+                      global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
+                      global const GpuTexture* textures, global const uint* texels,
                       global const GpuRay* rays, uint count, global uint* occluded,
                       volatile global uint* counters) {
     uint i = get_global_id(0);
     if (i >= count) return;
+    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
     GpuRay r = rays[i];
-    GpuHit h = traverse(nodes, tris, r.origin.xyz, r.direction.xyz, r.origin.w, r.direction.w,
-                        true, &counters[COUNT_OVERFLOW]);
+    GpuHit h = traverse(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, r.origin.w,
+                        r.direction.w, true, &counters[COUNT_OVERFLOW]);
     occluded[i] = h.prim != NO_HIT ? 1u : 0u;
 }
 
@@ -36,7 +45,19 @@ kernel void probe_layout(global uint* out) {
     PROBE_SIZE(GpuTriShading);
     PROBE_FIELD(GpuTriShading, n0); PROBE_FIELD(GpuTriShading, n1);
     PROBE_FIELD(GpuTriShading, n2); PROBE_FIELD(GpuTriShading, uv01);
-    PROBE_FIELD(GpuTriShading, uv2);
+    PROBE_FIELD(GpuTriShading, uv2); PROBE_FIELD(GpuTriShading, uv1_12);
+    PROBE_SIZE(GpuTriTangents);
+    PROBE_FIELD(GpuTriTangents, t0); PROBE_FIELD(GpuTriTangents, t1);
+    PROBE_FIELD(GpuTriTangents, t2);
+    PROBE_SIZE(GpuTexture);
+    PROBE_FIELD(GpuTexture, offset); PROBE_FIELD(GpuTexture, width);
+    PROBE_FIELD(GpuTexture, height); PROBE_FIELD(GpuTexture, flags);
+    PROBE_SIZE(GpuTexRef);
+    PROBE_FIELD(GpuTexRef, m0); PROBE_FIELD(GpuTexRef, m1); PROBE_FIELD(GpuTexRef, info);
+    PROBE_SIZE(GpuEnvironment);
+    PROBE_FIELD(GpuEnvironment, scale); PROBE_FIELD(GpuEnvironment, rotation);
+    PROBE_FIELD(GpuEnvironment, width); PROBE_FIELD(GpuEnvironment, height);
+    PROBE_FIELD(GpuEnvironment, light); PROBE_FIELD(GpuEnvironment, pad);
     PROBE_SIZE(GpuMaterial);
     PROBE_FIELD(GpuMaterial, base_color); PROBE_FIELD(GpuMaterial, emission);
     PROBE_FIELD(GpuMaterial, params); PROBE_FIELD(GpuMaterial, specular);
@@ -67,4 +88,53 @@ kernel void probe_layout(global uint* out) {
     PROBE_SIZE(GpuRay);
     PROBE_FIELD(GpuRay, origin); PROBE_FIELD(GpuRay, direction);
     out[n] = 0xffffffffu;
+}
+
+// Texture lookups for the tests: query i reads reference (int bits of .w) at uv .xy and level
+// of detail .z (the texel-footprint level before the texture's own size is added; -INFINITY
+// reads level 0, and a fractional level is rounded down).
+kernel void sample_texture_test(global const GpuTexRef* tex_refs, global const GpuTexture* textures,
+                                global const uint* texels, global const float4* queries,
+                                uint count, global float4* out) {
+    uint i = get_global_id(0);
+    if (i >= count) return;
+#ifdef HAS_TEXTURES
+    SceneSurfaces surf;
+    surf.refs = tex_refs;
+    surf.textures = textures;
+    surf.texels = texels;
+    float4 q = queries[i];
+    TexCoords tc;
+    tc.uv0 = q.xy;
+    tc.uv1 = q.xy;
+    tc.lod0 = q.z;
+    tc.lod1 = q.z;
+    tc.xi = 1.0f;
+    out[i] = texture_sample(&surf, as_int(q.w), &tc);
+#else
+    out[i] = (float4)(0.0f);
+#endif
+}
+
+// Environment samples for the tests: direction (.xyz) and pdf (.w) of sample i from the
+// uniform pair u[i], and the pdf that env_radiance gives the same direction.
+kernel void sample_env_test(GpuEnvironment environment, global const float* env_texels,
+                            global const float* env_marginal, global const float* env_conditional,
+                            global const float2* u, uint count, global float4* out,
+                            global float* eval_pdf) {
+    uint i = get_global_id(0);
+    if (i >= count) return;
+#ifdef HAS_ENV_MAP
+    EnvMap env = {environment, env_texels, env_marginal, env_conditional};
+    float3 radiance;
+    float pdf;
+    float3 d = env_sample(&env, u[i].x, u[i].y, &radiance, &pdf);
+    out[i] = (float4)(d, pdf);
+    float check;
+    env_radiance(&env, d, &check);
+    eval_pdf[i] = check;
+#else
+    out[i] = (float4)(0.0f);
+    eval_pdf[i] = 0.0f;
+#endif
 }

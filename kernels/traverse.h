@@ -86,9 +86,11 @@ inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float
 
 // Closest hit (any_hit = false) or first hit (any_hit = true). On a stack overflow, which the
 // builder's depth limit rules out, the overflow counter is raised instead of failing silently.
-inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle* tris, float3 o,
-                       float3 d, float tmin, float tmax, bool any_hit,
-                       volatile global uint* overflow) {
+// With HAS_ALPHA, hits that the material's alpha cuts out (MASK) or lets through (BLEND, at
+// random) are skipped; `surf` is read only then.
+inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                       const SceneSurfaces* surf, float3 o, float3 d, float tmin, float tmax,
+                       bool any_hit, volatile global uint* overflow) {
     RayPrep r = prepare_ray(o, d);
     GpuHit hit;
     hit.t = tmax;
@@ -117,10 +119,23 @@ inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle*
             uint count = as_uint(hi.w);
             for (uint p = first; p < first + count; ++p) {
                 GpuTriangle t = tris[p];
+#ifdef HAS_ALPHA
+                float t_hit = hit.t;
+                float bu, bv;
+                if (intersect_triangle(&r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv) &&
+                    !alpha_passes(surf, p, as_uint(t.v0.w), bu, bv, o, d)) {
+                    hit.t = t_hit;
+                    hit.u = bu;
+                    hit.v = bv;
+                    hit.prim = p;
+                    if (any_hit) return hit;
+                }
+#else
                 if (intersect_triangle(&r, t.v0, t.v1, t.v2, tmin, &hit.t, &hit.u, &hit.v)) {
                     hit.prim = p;
                     if (any_hit) return hit;
                 }
+#endif
             }
         }
         if (child[0] >= 0 && child[1] >= 0) {

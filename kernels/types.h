@@ -19,8 +19,44 @@ typedef struct {
     float4 n1;    // normal at vertex 1
     float4 n2;    // normal at vertex 2
     float4 uv01;  // TEXCOORD_0 of vertices 0 (.xy) and 1 (.zw)
-    float4 uv2;   // TEXCOORD_0 of vertex 2 (.xy)
+    float4 uv2;   // TEXCOORD_0 of vertex 2 (.xy); TEXCOORD_1 of vertex 0 (.zw)
+    float4 uv1_12;  // TEXCOORD_1 of vertices 1 (.xy) and 2 (.zw)
 } GpuTriShading;
+
+typedef struct {
+    float4 t0;  // unit tangent at vertex 0; .w = bitangent sign
+    float4 t1;
+    float4 t2;
+} GpuTriTangents;
+
+#define TEXTURE_SRGB 0x100u
+#define TEXTURE_LEVELS_MASK 0xffu
+
+typedef struct {
+    uint offset;  // first texel of level 0; levels follow, level l is max(1, w >> l) x max(1, h >> l)
+    uint width;   // of level 0
+    uint height;
+    uint flags;   // mip level count (TEXTURE_LEVELS_MASK bits) | TEXTURE_SRGB
+} GpuTexture;
+
+#define WRAP_REPEAT 0
+#define WRAP_CLAMP 1
+#define WRAP_MIRROR 2
+
+typedef struct {
+    float4 m0;  // first row of the UV transform; .w = texture coordinate set (uint bits)
+    float4 m1;  // second row; .w = 0.5 * log2 |det| (mip bias)
+    int4 info;  // .x texture index, .y wrap S, .z wrap T (WRAP_*)
+} GpuTexRef;
+
+typedef struct {
+    float4 scale;     // .x intensity, .y pdf normalization W*H / (sum f * 2 pi^2), .z NEE pick probability
+    float4 rotation;  // .x cos, .y sin of the rotation about +Y
+    uint width;
+    uint height;
+    uint light;       // index in the light list
+    uint pad;
+} GpuEnvironment;
 
 #define MATERIAL_DOUBLE_SIDED 1u
 
@@ -43,6 +79,7 @@ typedef struct {
 #define LIGHT_SPOT 1u
 #define LIGHT_DIRECTIONAL 2u
 #define LIGHT_TRIANGLE 3u
+#define LIGHT_ENVIRONMENT 4u
 
 typedef struct {
     float4 position;   // position, or travel direction (directional); .w = kind (uint bits)

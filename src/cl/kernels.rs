@@ -137,6 +137,8 @@ pub struct Program {
     trace_closest: Kernel,
     trace_any: Kernel,
     probe_layout: Kernel,
+    sample_texture_test: Kernel,
+    sample_env_test: Kernel,
     local_size: usize,
     /// Features it was built with.
     pub features: KernelFeatures,
@@ -165,6 +167,8 @@ impl Program {
             trace_closest: k("trace_closest")?,
             trace_any: k("trace_any")?,
             probe_layout: k("probe_layout")?,
+            sample_texture_test: k("sample_texture_test")?,
+            sample_env_test: k("sample_env_test")?,
             local_size: 64.min(max_group),
             features,
         })
@@ -199,6 +203,7 @@ impl Program {
         paths: &Buffer<GpuPath>,
         queue: &Buffer<u32>,
         counters: &Buffer<u32>,
+        cones: &Buffer<[f32; 2]>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(gpu, "generate", &self.generate, slots, |e| unsafe {
@@ -206,17 +211,17 @@ impl Program {
                 .set_arg(camera)
                 .set_arg(&paths.mem())
                 .set_arg(&queue.mem())
-                .set_arg(&counters.mem());
+                .set_arg(&counters.mem())
+                .set_arg(&cones.mem());
         })
     }
 
-    /// `extend`: closest hits of the queued paths' rays.
+    /// `extend`: closest hits of the queued paths' rays (alpha-tested with `HAS_ALPHA`).
     #[allow(clippy::too_many_arguments)]
     pub fn extend(
         &self,
         gpu: &Gpu,
-        nodes: &Buffer<GpuBvhNode>,
-        tris: &Buffer<GpuTriangle>,
+        scene: &SceneBuffers,
         paths: &Buffer<GpuPath>,
         queue: &Buffer<u32>,
         counters: &Buffer<u32>,
@@ -224,9 +229,10 @@ impl Program {
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(gpu, "extend", &self.extend, slots, |e| unsafe {
-            e.set_arg(&nodes.mem())
-                .set_arg(&tris.mem())
-                .set_arg(&paths.mem())
+            e.set_arg(&scene.nodes.mem())
+                .set_arg(&scene.triangles.mem());
+            set_surfaces(e, scene);
+            e.set_arg(&paths.mem())
                 .set_arg(&queue.mem())
                 .set_arg(&counters.mem())
                 .set_arg(&hits.mem());
@@ -239,6 +245,7 @@ impl Program {
         &self,
         gpu: &Gpu,
         frame: &GpuFrame,
+        env: &EnvBuffers,
         scene: &SceneBuffers,
         paths: &Buffer<GpuPath>,
         queue_in: &Buffer<u32>,
@@ -246,13 +253,17 @@ impl Program {
         queue_out: &Buffer<u32>,
         shadow_rays: &Buffer<GpuShadowRay>,
         counters: &Buffer<u32>,
+        cones: &Buffer<[f32; 2]>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(gpu, "shade", &self.shade, slots, |e| unsafe {
             e.set_arg(frame)
-                .set_arg(&scene.triangles.mem())
-                .set_arg(&scene.shading.mem())
-                .set_arg(&scene.materials.mem())
+                .set_arg(&env.info)
+                .set_arg(&scene.triangles.mem());
+            set_surfaces(e, scene);
+            e.set_arg(&env.texels.mem())
+                .set_arg(&env.marginal.mem())
+                .set_arg(&env.conditional.mem())
                 .set_arg(&scene.lights.mem())
                 .set_arg(&scene.light_cdf.mem())
                 .set_arg(&paths.mem())
@@ -260,26 +271,26 @@ impl Program {
                 .set_arg(&hits.mem())
                 .set_arg(&queue_out.mem())
                 .set_arg(&shadow_rays.mem())
-                .set_arg(&counters.mem());
+                .set_arg(&counters.mem())
+                .set_arg(&cones.mem());
         })
     }
 
     /// `connect`: traces the queued shadow rays (any hit) and adds the visible contributions.
-    #[allow(clippy::too_many_arguments)]
     pub fn connect(
         &self,
         gpu: &Gpu,
-        nodes: &Buffer<GpuBvhNode>,
-        tris: &Buffer<GpuTriangle>,
+        scene: &SceneBuffers,
         shadow_rays: &Buffer<GpuShadowRay>,
         counters: &Buffer<u32>,
         paths: &Buffer<GpuPath>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(gpu, "connect", &self.connect, slots, |e| unsafe {
-            e.set_arg(&nodes.mem())
-                .set_arg(&tris.mem())
-                .set_arg(&shadow_rays.mem())
+            e.set_arg(&scene.nodes.mem())
+                .set_arg(&scene.triangles.mem());
+            set_surfaces(e, scene);
+            e.set_arg(&shadow_rays.mem())
                 .set_arg(&counters.mem())
                 .set_arg(&paths.mem());
         })
@@ -331,9 +342,9 @@ impl Program {
             &self.trace_closest,
             rays.len(),
             |e| unsafe {
-                e.set_arg(&bvh.nodes.mem())
-                    .set_arg(&bvh.triangles.mem())
-                    .set_arg(&rays.mem())
+                e.set_arg(&bvh.nodes.mem()).set_arg(&bvh.triangles.mem());
+                set_surfaces(e, bvh);
+                e.set_arg(&rays.mem())
                     .set_arg(&count)
                     .set_arg(&hits.mem())
                     .set_arg(&counters.mem());
@@ -352,9 +363,9 @@ impl Program {
     ) -> Result<Launch, ClError> {
         let count = rays.len() as u32;
         self.run(gpu, "trace_any", &self.trace_any, rays.len(), |e| unsafe {
-            e.set_arg(&bvh.nodes.mem())
-                .set_arg(&bvh.triangles.mem())
-                .set_arg(&rays.mem())
+            e.set_arg(&bvh.nodes.mem()).set_arg(&bvh.triangles.mem());
+            set_surfaces(e, bvh);
+            e.set_arg(&rays.mem())
                 .set_arg(&count)
                 .set_arg(&occluded.mem())
                 .set_arg(&counters.mem());
@@ -369,6 +380,95 @@ impl Program {
         })?;
         out.read(gpu)
     }
+
+    /// `sample_texture_test`: texture lookups; query .xy = uv, .z = footprint level (see
+    /// kernels/tools.cl), .w = texture reference (i32 bits). Zeros without `HAS_TEXTURES`.
+    pub fn sample_texture_test(
+        &self,
+        gpu: &Gpu,
+        scene: &SceneBuffers,
+        queries: &[[f32; 4]],
+    ) -> Result<Vec<[f32; 4]>, ClError> {
+        let q = Buffer::from_slice(gpu, queries)?;
+        let out = Buffer::<[f32; 4]>::new(gpu, queries.len())?;
+        let count = queries.len() as u32;
+        self.run(
+            gpu,
+            "sample_texture_test",
+            &self.sample_texture_test,
+            queries.len(),
+            |e| unsafe {
+                e.set_arg(&scene.tex_refs.mem())
+                    .set_arg(&scene.textures.mem())
+                    .set_arg(&scene.texels.mem())
+                    .set_arg(&q.mem())
+                    .set_arg(&count)
+                    .set_arg(&out.mem());
+            },
+        )?;
+        out.read(gpu)
+    }
+
+    /// `sample_env_test`: environment samples from uniform pairs: (direction, pdf) each, and
+    /// the pdf the miss shader gives the same direction. Zeros without `HAS_ENV_MAP`.
+    #[allow(clippy::type_complexity)]
+    pub fn sample_env_test(
+        &self,
+        gpu: &Gpu,
+        env: &EnvBuffers,
+        u: &[[f32; 2]],
+    ) -> Result<(Vec<[f32; 4]>, Vec<f32>), ClError> {
+        let ub = Buffer::from_slice(gpu, u)?;
+        let out = Buffer::<[f32; 4]>::new(gpu, u.len())?;
+        let eval = Buffer::<f32>::new(gpu, u.len())?;
+        let count = u.len() as u32;
+        self.run(
+            gpu,
+            "sample_env_test",
+            &self.sample_env_test,
+            u.len(),
+            |e| unsafe {
+                e.set_arg(&env.info)
+                    .set_arg(&env.texels.mem())
+                    .set_arg(&env.marginal.mem())
+                    .set_arg(&env.conditional.mem())
+                    .set_arg(&ub.mem())
+                    .set_arg(&count)
+                    .set_arg(&out.mem())
+                    .set_arg(&eval.mem());
+            },
+        )?;
+        Ok((out.read(gpu)?, eval.read(gpu)?))
+    }
+}
+
+/// Sets the six surface arguments every traversing kernel takes after the triangles, in the
+/// order of `SceneSurfaces` (kernels/textures.h).
+///
+/// # Safety
+/// Only for kernels whose next six parameters are exactly those.
+unsafe fn set_surfaces(e: &mut ExecuteKernel, scene: &SceneBuffers) {
+    // SAFETY: the caller's kernel declares these six buffers next, in this order.
+    unsafe {
+        e.set_arg(&scene.shading.mem())
+            .set_arg(&scene.tangents.mem())
+            .set_arg(&scene.materials.mem())
+            .set_arg(&scene.tex_refs.mem())
+            .set_arg(&scene.textures.mem())
+            .set_arg(&scene.texels.mem());
+    }
+}
+
+/// The environment map on the device (a 1×1 black placeholder when there is none).
+pub struct EnvBuffers {
+    /// Constants.
+    pub info: GpuEnvironment,
+    /// RGB f32 texels.
+    pub texels: Buffer<f32>,
+    /// Cumulative row probabilities.
+    pub marginal: Buffer<f32>,
+    /// Cumulative column probabilities per row.
+    pub conditional: Buffer<f32>,
 }
 
 /// The scene on the device: BVH, triangles, shading data, materials and lights.
@@ -379,6 +479,14 @@ pub struct SceneBuffers {
     pub triangles: Buffer<GpuTriangle>,
     /// Shading data in BVH order.
     pub shading: Buffer<GpuTriShading>,
+    /// Tangents in BVH order (one placeholder element without normal maps).
+    pub tangents: Buffer<GpuTriTangents>,
+    /// Texture references (materials index them).
+    pub tex_refs: Buffer<GpuTexRef>,
+    /// Texture descriptors.
+    pub textures: Buffer<GpuTexture>,
+    /// RGBA8 texels of every mip level of every texture.
+    pub texels: Buffer<u32>,
     /// Materials.
     pub materials: Buffer<GpuMaterial>,
     /// Lights (punctual first, then emissive triangles).

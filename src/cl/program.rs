@@ -8,10 +8,16 @@ const SOURCES: &[(&str, &str)] = &[
     ("kernels/types.h", include_str!("../../kernels/types.h")),
     ("kernels/rng.h", include_str!("../../kernels/rng.h")),
     (
+        "kernels/textures.h",
+        include_str!("../../kernels/textures.h"),
+    ),
+    (
         "kernels/traverse.h",
         include_str!("../../kernels/traverse.h"),
     ),
     ("kernels/bsdf.h", include_str!("../../kernels/bsdf.h")),
+    ("kernels/surface.h", include_str!("../../kernels/surface.h")),
+    ("kernels/env.h", include_str!("../../kernels/env.h")),
     ("kernels/lights.h", include_str!("../../kernels/lights.h")),
     ("kernels/stages.cl", include_str!("../../kernels/stages.cl")),
     ("kernels/tools.cl", include_str!("../../kernels/tools.cl")),
@@ -22,14 +28,34 @@ const SOURCES: &[(&str, &str)] = &[
 pub struct KernelFeatures {
     /// Some triangles emit light (area lights with MIS).
     pub triangle_lights: bool,
+    /// Some material has a texture (`HAS_TEXTURES`).
+    pub textures: bool,
+    /// Some material has a normal map (`HAS_NORMAL_MAPS`; implies textures).
+    pub normal_maps: bool,
+    /// Some material is alpha-masked or blended (`HAS_ALPHA`: alpha tests in traversal).
+    pub alpha: bool,
+    /// Some material transmits light (`HAS_TRANSMISSION`).
+    pub transmission: bool,
+    /// An environment map lights the scene (`HAS_ENV_MAP`).
+    pub env_map: bool,
 }
 
 impl KernelFeatures {
     /// The `-D` options for these features.
     pub fn defines(&self) -> String {
         let mut d = String::new();
-        if self.triangle_lights {
-            d.push_str(" -DHAS_TRIANGLE_LIGHTS");
+        for (on, name) in [
+            (self.triangle_lights, "HAS_TRIANGLE_LIGHTS"),
+            (self.textures, "HAS_TEXTURES"),
+            (self.normal_maps, "HAS_NORMAL_MAPS"),
+            (self.alpha, "HAS_ALPHA"),
+            (self.transmission, "HAS_TRANSMISSION"),
+            (self.env_map, "HAS_ENV_MAP"),
+        ] {
+            if on {
+                d.push_str(" -D");
+                d.push_str(name);
+            }
         }
         d
     }

@@ -39,7 +39,7 @@ pub struct GpuTriangle {
 }
 const _: () = assert!(size_of::<GpuTriangle>() == 48);
 
-/// Per-vertex shading data of a triangle, in BVH order (80 bytes).
+/// Per-vertex shading data of a triangle, in BVH order (96 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuTriShading {
@@ -51,10 +51,89 @@ pub struct GpuTriShading {
     pub n2: [f32; 4],
     /// `TEXCOORD_0` of vertices 0 and 1 (`.xy`, `.zw`).
     pub uv01: [f32; 4],
-    /// `TEXCOORD_0` of vertex 2 (`.xy`); `.zw` unused (reserved for `TEXCOORD_1`).
+    /// `TEXCOORD_0` of vertex 2 (`.xy`); `TEXCOORD_1` of vertex 0 (`.zw`).
     pub uv2: [f32; 4],
+    /// `TEXCOORD_1` of vertices 1 and 2 (`.xy`, `.zw`).
+    pub uv1_12: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuTriShading>() == 80);
+const _: () = assert!(size_of::<GpuTriShading>() == 96);
+
+/// Per-vertex tangents of a triangle, in BVH order (48 bytes); uploaded only when the scene
+/// has normal maps.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuTriTangents {
+    /// Unit tangent at vertex 0; `.w` = bitangent sign (±1).
+    pub t0: [f32; 4],
+    /// Tangent at vertex 1; `.w` = bitangent sign.
+    pub t1: [f32; 4],
+    /// Tangent at vertex 2; `.w` = bitangent sign.
+    pub t2: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuTriTangents>() == 48);
+
+/// `GpuTexture::flags`: the texels hold sRGB-encoded color (alpha stays linear).
+pub const TEXTURE_SRGB: u32 = 1 << 8;
+/// `GpuTexture::flags`: the mip level count sits in these bits.
+pub const TEXTURE_LEVELS_MASK: u32 = 0xff;
+
+/// One texture in the packed texel buffer (16 bytes). Its mip levels follow each other from
+/// `offset`, level `l` being `max(1, width >> l)` × `max(1, height >> l)` RGBA8 texels.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuTexture {
+    /// Index of the first texel of level 0 in the texel buffer.
+    pub offset: u32,
+    /// Width of level 0.
+    pub width: u32,
+    /// Height of level 0.
+    pub height: u32,
+    /// Mip level count (`TEXTURE_LEVELS_MASK` bits) and `TEXTURE_SRGB`.
+    pub flags: u32,
+}
+const _: () = assert!(size_of::<GpuTexture>() == 16);
+
+/// Sampler wrap modes in `GpuTexRef::info.yz`.
+pub const WRAP_REPEAT: i32 = 0;
+/// Clamp to the edge texel.
+pub const WRAP_CLAMP: i32 = 1;
+/// Mirrored repeat.
+pub const WRAP_MIRROR: i32 = 2;
+
+/// A material's use of a texture: which one, the sampler and the `KHR_texture_transform`
+/// (48 bytes). The lookup coordinate is `(dot(m0.xyz, (u, v, 1)), dot(m1.xyz, (u, v, 1)))`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuTexRef {
+    /// First row of the UV transform; `.w` = texture coordinate set (u32 bits, 0 or 1).
+    pub m0: [f32; 4],
+    /// Second row of the UV transform; `.w` = ½·log2 |det| of the transform (mip bias).
+    pub m1: [f32; 4],
+    /// `.x` texture index, `.y` wrap S, `.z` wrap T (`WRAP_*`), `.w` unused.
+    pub info: [i32; 4],
+}
+const _: () = assert!(size_of::<GpuTexRef>() == 48);
+
+/// The environment map's constants (48 bytes). Texels are RGB f32 triples, row 0 at the top
+/// (+Y); the map's centre column looks along −Z before rotation.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuEnvironment {
+    /// `.x` radiance scale (intensity), `.y` pdf normalization W·H / (Σf · 2π²), `.z`
+    /// probability that next-event estimation picks the environment, `.w` unused.
+    pub scale: [f32; 4],
+    /// `.x` cos and `.y` sin of the rotation about +Y; `.zw` unused.
+    pub rotation: [f32; 4],
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Index of the environment in the light list.
+    pub light: u32,
+    /// Padding.
+    pub pad: u32,
+}
+const _: () = assert!(size_of::<GpuEnvironment>() == 48);
 
 /// Material flags in `GpuMaterial::emission.w`.
 pub const MATERIAL_DOUBLE_SIDED: u32 = 1;
@@ -98,6 +177,8 @@ pub const LIGHT_SPOT: u32 = 1;
 pub const LIGHT_DIRECTIONAL: u32 = 2;
 /// An emissive triangle, sampled by area.
 pub const LIGHT_TRIANGLE: u32 = 3;
+/// The environment map, sampled by its luminance table.
+pub const LIGHT_ENVIRONMENT: u32 = 4;
 
 /// One light for next-event estimation (64 bytes).
 #[repr(C)]
@@ -229,7 +310,11 @@ pub fn layouts() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
     vec![
         layout!(GpuBvhNode, left_min, left_max, right_min, right_max),
         layout!(GpuTriangle, v0, v1, v2),
-        layout!(GpuTriShading, n0, n1, n2, uv01, uv2),
+        layout!(GpuTriShading, n0, n1, n2, uv01, uv2, uv1_12),
+        layout!(GpuTriTangents, t0, t1, t2),
+        layout!(GpuTexture, offset, width, height, flags),
+        layout!(GpuTexRef, m0, m1, info),
+        layout!(GpuEnvironment, scale, rotation, width, height, light, pad),
         layout!(
             GpuMaterial,
             base_color,

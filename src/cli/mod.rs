@@ -6,7 +6,9 @@ mod render;
 
 use crate::cl::DeviceChoice;
 use crate::render::{RenderSettings, Strategy};
-use crate::scene::{Camera, Light, LightKind, Scene, default_light_radius, load_or_bundled};
+use crate::scene::{
+    Camera, EnvMap, Light, LightKind, Scene, default_light_radius, load_or_bundled,
+};
 use anyhow::{Result, bail};
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
@@ -72,6 +74,79 @@ pub struct CommonArgs {
     /// Uniform sky radiance as R,G,B (or one value for gray); default black.
     #[arg(long, value_parser = parse_color)]
     pub sky: Option<[f32; 3]>,
+    /// Environment light: an equirectangular .hdr or .exr image (importance-sampled), or a
+    /// uniform color R,G,B / gray value (like --sky). Either replaces the default light rig.
+    #[arg(long, value_name = "FILE|COLOR", conflicts_with = "sky")]
+    pub env: Option<String>,
+    /// Radiance scale of the --env image.
+    #[arg(long, default_value_t = 1.0)]
+    pub env_intensity: f32,
+    /// Rotation of the --env image about the up (+Y) axis in degrees, counter-clockwise seen
+    /// from above.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub env_rotation: f32,
+    /// Depth of field: thin-lens radius in scene units (0 = pinhole, everything sharp).
+    #[arg(long, default_value_t = 0.0)]
+    pub aperture: f32,
+    /// Distance from the eye to the plane in focus, along the view axis, in scene units
+    /// (default: the distance to what the image centre sees).
+    #[arg(long)]
+    pub focus_distance: Option<f32>,
+    /// Camera position X,Y,Z (replaces the file's camera; use with --look-at).
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "look_at")]
+    pub eye: Option<[f64; 3]>,
+    /// Point the camera looks at, X,Y,Z (use with --eye).
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "eye")]
+    pub look_at: Option<[f64; 3]>,
+    /// Vertical field of view in degrees (default: the camera's).
+    #[arg(long)]
+    pub fov: Option<f64>,
+}
+
+impl Default for CommonArgs {
+    /// The command line's defaults.
+    fn default() -> Self {
+        Self {
+            device: None,
+            width: None,
+            height: None,
+            spp: None,
+            bounces: 4,
+            seed: 0,
+            camera: None,
+            light_radius: None,
+            hard_shadows: false,
+            sky: None,
+            env: None,
+            env_intensity: 1.0,
+            env_rotation: 0.0,
+            aperture: 0.0,
+            focus_distance: None,
+            eye: None,
+            look_at: None,
+            fov: None,
+        }
+    }
+}
+
+/// What `--env` asked for.
+pub enum EnvChoice {
+    /// A uniform radiance.
+    Color([f32; 3]),
+    /// An environment image.
+    Map(EnvMap),
+}
+
+fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}' is not a point: use X,Y,Z"))?;
+    match parts.as_slice() {
+        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(format!("'{s}' is not a point: use X,Y,Z")),
+    }
 }
 
 /// Options of the viewer.
@@ -200,14 +275,59 @@ impl CommonArgs {
         {
             bail!("--light-radius {r} must be a finite number >= 0");
         }
+        for (name, v) in [
+            ("--env-intensity", self.env_intensity),
+            ("--aperture", self.aperture),
+            ("--focus-distance", self.focus_distance.unwrap_or(1.0)),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                bail!("{name} {v} must be a finite number >= 0");
+            }
+        }
+        if self.focus_distance == Some(0.0) {
+            bail!("--focus-distance must be greater than 0");
+        }
+        if !self.env_rotation.is_finite() {
+            bail!("--env-rotation {} must be finite", self.env_rotation);
+        }
+        if let Some(f) = self.fov
+            && !(f > 0.0 && f < 180.0)
+        {
+            bail!("--fov {f} is out of range (0..180 degrees)");
+        }
+        let sky = match self.env.as_deref().map(parse_color) {
+            Some(Ok(c)) => c,
+            _ => self.sky.unwrap_or([0.0; 3]),
+        };
         Ok(RenderSettings {
             width,
             height,
             bounces: self.bounces,
             seed: self.seed,
-            sky: self.sky.unwrap_or([0.0; 3]),
+            sky,
+            env_intensity: self.env_intensity,
+            env_rotation: self.env_rotation,
+            lens_radius: self.aperture,
+            focus_distance: self.focus_distance.unwrap_or(1.0),
             ..RenderSettings::default()
         })
+    }
+
+    /// What `--env` asks for: a color, or an image loaded now; `None` without `--env`.
+    pub fn environment(&self) -> Result<Option<EnvChoice>> {
+        let Some(arg) = self.env.as_deref() else {
+            return Ok(None);
+        };
+        if let Ok(c) = parse_color(arg) {
+            return Ok(Some(EnvChoice::Color(c)));
+        }
+        let path = std::path::Path::new(arg);
+        if !path.is_file() {
+            bail!("--env {arg}: neither a color (R,G,B) nor an existing .hdr/.exr file");
+        }
+        Ok(Some(EnvChoice::Map(
+            EnvMap::load(path).map_err(anyhow::Error::msg)?,
+        )))
     }
 
     /// Loads the scene (or the bundled one) and applies camera and light options.
@@ -218,13 +338,13 @@ impl CommonArgs {
         for w in &scene.warnings {
             log::warn!("{}: {w}", scene.source);
         }
-        if scene.default_rig {
+        if scene.default_rig && self.env.is_none() {
             eprintln!(
                 "penumbra: {} has no lights; using the default light rig",
                 scene.source
             );
         }
-        let camera = match self.camera {
+        let mut camera = match self.camera {
             None => scene.cameras[0].clone(),
             Some(i) => match scene.cameras.get(i) {
                 Some(c) => c.clone(),
@@ -235,6 +355,22 @@ impl CommonArgs {
                 ),
             },
         };
+        if let (Some(eye), Some(target)) = (self.eye, self.look_at) {
+            let (eye, target) = (glam::DVec3::from(eye), glam::DVec3::from(target));
+            if (target - eye).length() < 1e-12 {
+                bail!("--eye and --look-at are the same point");
+            }
+            camera = Camera::look_at("command line", eye, target, camera.yfov);
+        }
+        if let Some(fov) = self.fov {
+            camera.yfov = fov.to_radians();
+        }
+        let mut scene = scene;
+        if self.env.is_some() && scene.default_rig {
+            // The environment lights the scene instead of the default rig.
+            scene.lights.clear();
+            scene.default_rig = false;
+        }
         let diagonal = scene.bounds().diagonal();
         let light_radius = if self.hard_shadows {
             0.0

@@ -1,6 +1,6 @@
 //! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary.
 
-use super::RenderArgs;
+use super::{EnvChoice, RenderArgs};
 use crate::image_io::{Format, write_exr, write_png};
 use crate::render::{Renderer, tonemap::ToneMapper};
 use anyhow::{Context, Result};
@@ -25,12 +25,27 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let spp = args.common.spp.unwrap_or(DEFAULT_SPP);
     let prepared = args.common.prepare(Some(&args.scene))?;
+    let environment = args.common.environment()?;
     let mut renderer = Renderer::new(&args.common.device_choice()?)?;
     renderer.set_settings(&settings)?;
+    if let Some(EnvChoice::Map(map)) = environment {
+        renderer.set_environment(Some(map))?;
+    }
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| format!("{}", args.scene.display()))?;
     renderer.set_camera(&prepared.camera)?;
+    if settings.lens_radius > 0.0 && args.common.focus_distance.is_none() {
+        // Focus on what the image centre sees (else the scene's centre).
+        let focus = renderer
+            .focus_distance_at(settings.width as f32 * 0.5, settings.height as f32 * 0.5)
+            .unwrap_or_else(|| {
+                (prepared.scene.bounds().center() - prepared.camera.eye)
+                    .dot(prepared.camera.forward)
+                    .max(1e-3) as f32
+            });
+        renderer.set_lens(settings.lens_radius, focus)?;
+    }
 
     let bar = ProgressBar::new(spp as u64).with_style(
         ProgressStyle::with_template(
@@ -97,6 +112,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "lights": prepared.lights.len(),
         "default_light_rig": prepared.scene.default_rig,
         "nonfinite_samples": stats.nonfinite_samples,
+        "textures": scene_stats.textures,
+        "texture_bytes": scene_stats.texture_bytes,
+        "environment": renderer.environment().map(|m| m.name.clone()),
+        "aperture": renderer.settings().lens_radius,
+        "focus_distance": renderer.settings().focus_distance,
         "kernel_ms": stats.stage_ms,
     });
     println!("{summary}");

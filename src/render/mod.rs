@@ -6,15 +6,20 @@ pub mod tonemap;
 mod upload;
 
 pub use settings::{RenderSettings, Strategy};
-pub use upload::{HostScene, gpu_camera, gpu_lights};
+pub use upload::{HostScene, TexturePack, gpu_camera, gpu_lights};
 
-use crate::bvh::Bvh;
-use crate::cl::kernels::{Launch, SceneBuffers};
+use crate::bvh::{Bvh, Ray};
+use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
-use crate::scene::{Camera, Light, Scene};
+use crate::scene::{AlphaMode, Camera, EnvMap, EnvSampling, Light, Scene};
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::time::Instant;
+
+/// Texel memory allowed for a scene's textures (less where the device's largest buffer is
+/// smaller); larger sets are downscaled by halves.
+pub const TEXTURE_BUDGET_BYTES: usize = 1 << 30;
 
 /// Paths in flight per wave on a GPU, and on other devices.
 const WAVE_PATHS_GPU: usize = 1 << 21;
@@ -33,8 +38,14 @@ pub struct SceneStats {
     pub bvh_build_ms: f64,
     /// Kernel build time (0 when the kernels were reused).
     pub kernel_build_ms: f64,
-    /// Upload time of the scene buffers.
+    /// Upload time of the scene buffers (texture mip chains included).
     pub upload_ms: f64,
+    /// Textures on the device (one per image and color space).
+    pub textures: usize,
+    /// Bytes of texels on the device (all mip levels).
+    pub texture_bytes: usize,
+    /// Largest texture side kept (4096 unless the budget forced less).
+    pub texture_max_side: u32,
 }
 
 /// Counters of the work done since the last reset.
@@ -69,6 +80,8 @@ struct Frame {
     queues: [Buffer<u32>; 2],
     hits: Buffer<GpuHit>,
     shadow_rays: Buffer<GpuShadowRay>,
+    /// Ray cone (width, spread angle) per slot, for texture filtering.
+    cones: Buffer<[f32; 2]>,
 }
 
 /// The path tracer on one OpenCL device.
@@ -83,6 +96,13 @@ pub struct Renderer {
     settings: RenderSettings,
     camera: GpuCamera,
     light_count: u32,
+    /// Features of the loaded scene (without the environment map's).
+    scene_features: KernelFeatures,
+    /// The lights as last given, and the scene's diagonal, to rebuild the light table.
+    lights: Vec<Light>,
+    diagonal: f64,
+    environment: Option<(Arc<EnvMap>, EnvSampling)>,
+    env: EnvBuffers,
     samples: u32,
     stats: RenderStats,
     pending: Vec<Launch>,
@@ -94,6 +114,12 @@ impl Renderer {
         let gpu = Gpu::open(choice)?;
         let counters = Buffer::new(&gpu, 8)?;
         let stats_buffer = Buffer::new(&gpu, 4)?;
+        let env = EnvBuffers {
+            info: GpuEnvironment::default(),
+            texels: Buffer::from_slice(&gpu, &[0.0; 3])?,
+            marginal: Buffer::from_slice(&gpu, &[1.0])?,
+            conditional: Buffer::from_slice(&gpu, &[1.0])?,
+        };
         let mut r = Self {
             gpu,
             program: None,
@@ -104,6 +130,11 @@ impl Renderer {
             settings: RenderSettings::default(),
             camera: GpuCamera::default(),
             light_count: 0,
+            scene_features: KernelFeatures::default(),
+            lights: Vec::new(),
+            diagonal: 1.0,
+            environment: None,
+            env,
             samples: 0,
             stats: RenderStats::default(),
             pending: Vec::new(),
@@ -123,25 +154,47 @@ impl Renderer {
 
         let t = Instant::now();
         let host = HostScene::new(&world, bvh, &scene.materials);
-        let features = KernelFeatures {
+        let used = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
+        self.scene_features = KernelFeatures {
             triangle_lights: !host.emissive.is_empty(),
+            textures: used(&|m| m.textures.any()),
+            normal_maps: used(&|m| m.textures.normal.is_some()) && !host.tangents.is_empty(),
+            alpha: used(&|m| m.alpha != AlphaMode::Opaque),
+            transmission: used(&|m| m.transmission > 0.0),
+            env_map: false,
         };
-        let mut kernel_build_ms = 0.0;
-        if self.program.as_ref().is_none_or(|p| p.features != features) {
-            let tk = Instant::now();
-            self.program = Some(Program::build(&self.gpu, features)?);
-            kernel_build_ms = tk.elapsed().as_secs_f64() * 1e3;
-        }
-        let (glights, cdf) = gpu_lights(lights, &host, scene.bounds().diagonal());
+        let budget = self
+            .gpu
+            .device
+            .max_mem_alloc_size()
+            .map_or(TEXTURE_BUDGET_BYTES, |m| {
+                (m as usize).min(TEXTURE_BUDGET_BYTES)
+            });
+        let pack = TexturePack::new(scene, budget);
+        let kernel_build_ms = self.ensure_program()?;
+        self.lights = lights.to_vec();
+        self.diagonal = scene.bounds().diagonal();
+        let (glights, cdf) = self.light_table(&host);
+        let placeholder = [GpuTriTangents::default()];
+        let tangents: &[GpuTriTangents] = if host.tangents.is_empty() {
+            &placeholder
+        } else {
+            &host.tangents
+        };
         let buffers = SceneBuffers {
             nodes: Buffer::from_slice(&self.gpu, &host.bvh.nodes)?,
             triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
             shading: Buffer::from_slice(&self.gpu, &host.shading)?,
+            tangents: Buffer::from_slice(&self.gpu, tangents)?,
+            tex_refs: Buffer::from_slice(&self.gpu, &pack.refs)?,
+            textures: Buffer::from_slice(&self.gpu, &pack.textures)?,
+            texels: Buffer::from_slice(&self.gpu, &pack.texels)?,
             materials: Buffer::from_slice(&self.gpu, &host.materials)?,
             lights: Buffer::from_slice(&self.gpu, &glights)?,
             light_cdf: Buffer::from_slice(&self.gpu, &cdf)?,
         };
         self.light_count = glights.len() as u32;
+        self.update_env_info(&glights);
         let stats = SceneStats {
             triangles: host.triangles.len(),
             nodes: host.bvh.nodes.len(),
@@ -149,34 +202,176 @@ impl Renderer {
             bvh_build_ms,
             kernel_build_ms,
             upload_ms: t.elapsed().as_secs_f64() * 1e3 - kernel_build_ms,
+            textures: pack.textures.len(),
+            texture_bytes: pack.bytes(),
+            texture_max_side: pack.max_side,
         };
         self.scene = Some((buffers, host));
         self.reset()?;
         Ok(stats)
     }
 
-    /// Replaces the lights without touching the BVH. Resets the film.
-    pub fn set_lights(&mut self, lights: &[Light], scene_diagonal: f64) -> Result<(), ClError> {
-        let Some((buffers, host)) = self.scene.as_mut() else {
+    /// Builds the kernels when the scene's features (with the environment's) changed; returns
+    /// the build time in milliseconds (0 when the kernels were reused).
+    fn ensure_program(&mut self) -> Result<f64, ClError> {
+        let features = KernelFeatures {
+            env_map: self.environment.is_some(),
+            ..self.scene_features
+        };
+        if self
+            .program
+            .as_ref()
+            .is_some_and(|p| p.features == features)
+        {
+            return Ok(0.0);
+        }
+        let t = Instant::now();
+        self.program = Some(Program::build(&self.gpu, features)?);
+        Ok(t.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// The light list and selection table for the current lights and environment.
+    fn light_table(&self, host: &HostScene) -> (Vec<GpuLight>, Vec<f32>) {
+        let env_luminance = self
+            .environment
+            .as_ref()
+            .map(|(_, t)| t.mean_luminance * self.settings.env_intensity);
+        gpu_lights(&self.lights, host, self.diagonal, env_luminance)
+    }
+
+    /// Fills the environment constants from the settings and the light list.
+    fn update_env_info(&mut self, lights: &[GpuLight]) {
+        let Some((map, table)) = self.environment.as_ref() else {
+            self.env.info = GpuEnvironment::default();
+            return;
+        };
+        let light = lights
+            .iter()
+            .position(|l| l.position[3].to_bits() == LIGHT_ENVIRONMENT);
+        let (sin, cos) = self.settings.env_rotation.to_radians().sin_cos();
+        self.env.info = GpuEnvironment {
+            scale: [
+                self.settings.env_intensity,
+                table.norm,
+                light.map_or(0.0, |i| lights[i].extra[1]),
+                0.0,
+            ],
+            rotation: [cos, sin, 0.0, 0.0],
+            width: map.width,
+            height: map.height,
+            light: light.map_or(u32::MAX, |i| i as u32),
+            pad: 0,
+        };
+    }
+
+    /// Rebuilds the light table on the device (after lights, environment or its intensity
+    /// changed).
+    fn upload_lights(&mut self) -> Result<(), ClError> {
+        let Some((_, host)) = self.scene.as_ref() else {
             return Ok(());
         };
-        let (glights, cdf) = gpu_lights(lights, host, scene_diagonal);
+        let (glights, cdf) = self.light_table(host);
+        let Some((buffers, _)) = self.scene.as_mut() else {
+            return Ok(());
+        };
         buffers.lights = Buffer::from_slice(&self.gpu, &glights)?;
         buffers.light_cdf = Buffer::from_slice(&self.gpu, &cdf)?;
         self.light_count = glights.len() as u32;
+        self.update_env_info(&glights);
+        Ok(())
+    }
+
+    /// Sets (or with `None` removes) the environment map: it lights the scene with importance
+    /// sampling and MIS, and replaces the uniform sky. Rebuilds the kernels when the map appears
+    /// or goes. Resets the film.
+    pub fn set_environment(&mut self, map: Option<EnvMap>) -> Result<(), ClError> {
+        match map {
+            Some(map) => {
+                let table = map.sampling();
+                let texels: Vec<f32> = map.texels.iter().flatten().copied().collect();
+                self.env.texels = Buffer::from_slice(&self.gpu, &texels)?;
+                self.env.marginal = Buffer::from_slice(&self.gpu, &table.marginal)?;
+                self.env.conditional = Buffer::from_slice(&self.gpu, &table.conditional)?;
+                self.environment = Some((Arc::new(map), table));
+            }
+            None => self.environment = None,
+        }
+        if self.scene.is_some() {
+            self.ensure_program()?;
+        }
+        self.upload_lights()?;
+        self.reset()
+    }
+
+    /// The environment map, if one is set.
+    pub fn environment(&self) -> Option<&EnvMap> {
+        self.environment.as_ref().map(|(m, _)| m.as_ref())
+    }
+
+    /// Sets the thin lens: `lens_radius` in scene units (0: pinhole) and the distance of the
+    /// plane in focus along the view axis. Resets the film.
+    pub fn set_lens(&mut self, lens_radius: f32, focus_distance: f32) -> Result<(), ClError> {
+        self.settings.lens_radius = lens_radius.max(0.0);
+        self.settings.focus_distance = focus_distance.max(1e-6);
+        self.apply_lens();
+        self.reset()
+    }
+
+    fn apply_lens(&mut self) {
+        self.camera.origin[3] = self.settings.lens_radius;
+        self.camera.forward[3] = self.settings.focus_distance;
+    }
+
+    /// The distance along the view axis to the surface seen through pixel (x, y) (pixel
+    /// coordinates, fractional allowed) of the current camera, from the host BVH; `None`
+    /// where the pixel sees nothing. For click-to-focus: pass it to [`Renderer::set_lens`].
+    pub fn focus_distance_at(&self, x: f32, y: f32) -> Option<f32> {
+        let (_, host) = self.scene.as_ref()?;
+        let c = &self.camera;
+        let fx = x / self.settings.width.max(1) as f32;
+        let fy = y / self.settings.height.max(1) as f32;
+        let v = |a: [f32; 4]| glam::Vec3::new(a[0], a[1], a[2]);
+        let forward = v(c.forward);
+        let dir = forward + (2.0 * fx - 1.0) * v(c.right) + (1.0 - 2.0 * fy) * v(c.up);
+        let unit = dir.normalize();
+        let ray = Ray {
+            origin: v(c.origin),
+            direction: unit,
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        };
+        let hit = host.bvh.intersect(&ray, &host.vertices)?;
+        Some(hit.t * unit.dot(forward.normalize()))
+    }
+
+    /// Replaces the lights without touching the BVH. Resets the film.
+    pub fn set_lights(&mut self, lights: &[Light], scene_diagonal: f64) -> Result<(), ClError> {
+        if self.scene.is_none() {
+            return Ok(());
+        }
+        self.lights = lights.to_vec();
+        self.diagonal = scene_diagonal;
+        self.upload_lights()?;
         self.reset()
     }
 
     /// Sets the camera. Resets the film.
     pub fn set_camera(&mut self, camera: &Camera) -> Result<(), ClError> {
         self.camera = gpu_camera(camera, self.settings.aspect());
+        self.apply_lens();
         self.reset()
     }
 
     /// Applies settings, resizing buffers as needed. Resets the film.
     pub fn set_settings(&mut self, settings: &RenderSettings) -> Result<(), ClError> {
         let aspect_changed = settings.aspect() != self.settings.aspect();
+        let env_changed = settings.env_intensity != self.settings.env_intensity
+            || settings.env_rotation != self.settings.env_rotation;
         self.settings = settings.clone();
+        self.apply_lens();
+        if env_changed && self.environment.is_some() {
+            self.upload_lights()?;
+        }
         if aspect_changed {
             let aspect = settings.aspect();
             let up_len = self.camera.up[0]
@@ -274,6 +469,7 @@ impl Renderer {
             queues: [Buffer::new(gpu, slots)?, Buffer::new(gpu, slots)?],
             hits: Buffer::new(gpu, slots)?,
             shadow_rays: Buffer::new(gpu, slots)?,
+            cones: Buffer::new(gpu, slots)?,
         });
         self.samples = 0;
         Ok(())
@@ -349,6 +545,7 @@ impl Renderer {
                 &f.paths,
                 &f.queues[0],
                 &self.counters,
+                &f.cones,
                 slots,
             )?);
             for bounce in 0..=self.settings.bounces + 1 {
@@ -356,8 +553,7 @@ impl Renderer {
                 let (qi, qo) = if bounce % 2 == 0 { (0, 1) } else { (1, 0) };
                 launches.push(program.extend(
                     gpu,
-                    &scene.nodes,
-                    &scene.triangles,
+                    scene,
                     &f.paths,
                     &f.queues[qi],
                     &self.counters,
@@ -367,6 +563,7 @@ impl Renderer {
                 launches.push(program.shade(
                     gpu,
                     &frame,
+                    &self.env,
                     scene,
                     &f.paths,
                     &f.queues[qi],
@@ -374,12 +571,12 @@ impl Renderer {
                     &f.queues[qo],
                     &f.shadow_rays,
                     &self.counters,
+                    &f.cones,
                     slots,
                 )?);
                 launches.push(program.connect(
                     gpu,
-                    &scene.nodes,
-                    &scene.triangles,
+                    scene,
                     &f.shadow_rays,
                     &self.counters,
                     &f.paths,

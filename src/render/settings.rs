@@ -29,8 +29,17 @@ pub struct RenderSettings {
     pub russian_roulette: Option<u32>,
     /// Direct-light strategy.
     pub strategy: Strategy,
-    /// Uniform sky radiance (linear RGB).
+    /// Uniform sky radiance (linear RGB); replaced by the environment map when one is set
+    /// (`Renderer::set_environment`).
     pub sky: [f32; 3],
+    /// Environment map radiance scale.
+    pub env_intensity: f32,
+    /// Environment map rotation about +Y in degrees (counter-clockwise seen from above).
+    pub env_rotation: f32,
+    /// Thin-lens radius in scene units; 0 is a pinhole (everything sharp).
+    pub lens_radius: f32,
+    /// Distance from the eye to the plane in focus, along the view axis, in scene units.
+    pub focus_distance: f32,
 }
 
 impl Default for RenderSettings {
@@ -43,6 +52,10 @@ impl Default for RenderSettings {
             russian_roulette: Some(3),
             strategy: Strategy::Mis,
             sky: [0.0; 3],
+            env_intensity: 1.0,
+            env_rotation: 0.0,
+            lens_radius: 0.0,
+            focus_distance: 1.0,
         }
     }
 }

@@ -3,8 +3,13 @@
 
 use crate::bvh::Bvh;
 use crate::cl::types::*;
-use crate::scene::{AlphaMode, Camera, Light, LightKind, Material, WorldTriangle};
+use crate::scene::{
+    AlphaMode, Camera, Light, LightKind, MAX_TEXTURE_SIDE, Material, Scene, WorldTriangle, Wrap,
+    mip_chain,
+};
 use glam::Vec3;
+use rayon::prelude::*;
+use std::collections::HashMap;
 
 /// The scene as uploaded, kept on the host for picking and for tests.
 pub struct HostScene {
@@ -16,6 +21,8 @@ pub struct HostScene {
     pub vertices: Vec<[Vec3; 3]>,
     /// Shading data in BVH order.
     pub shading: Vec<GpuTriShading>,
+    /// Tangents in BVH order; empty when no triangle is normal-mapped.
+    pub tangents: Vec<GpuTriTangents>,
     /// Materials.
     pub materials: Vec<GpuMaterial>,
     /// Emissive triangles (BVH order index, area, emitted power for selection).
@@ -69,11 +76,20 @@ pub fn gpu_material(m: &Material) -> GpuMaterial {
                 AlphaMode::Blend => ALPHA_BLEND,
             }),
             m.thickness,
-            1.0,
+            m.normal_scale,
         ],
-        textures: [-1; 4],
-        textures2: [-1; 4],
+        textures: [
+            slot(m.textures.base_color),
+            slot(m.textures.metallic_roughness),
+            slot(m.textures.normal),
+            slot(m.textures.emissive),
+        ],
+        textures2: [slot(m.textures.transmission), -1, -1, -1],
     }
+}
+
+fn slot(r: Option<u32>) -> i32 {
+    r.map_or(-1, |r| r as i32)
 }
 
 impl HostScene {
@@ -83,6 +99,8 @@ impl HostScene {
         let mut triangles = Vec::with_capacity(world.len());
         let mut shading = Vec::with_capacity(world.len());
         let mut vertices = Vec::with_capacity(world.len());
+        let normal_mapped = world.iter().any(|t| t.tangents.is_some());
+        let mut tangents = Vec::new();
         for (order, &index) in bvh.tri_indices.iter().enumerate() {
             let t = &world[index as usize];
             let m = &materials[t.material as usize];
@@ -105,8 +123,17 @@ impl HostScene {
                 n1: f4(t.n[1], 0.0),
                 n2: f4(t.n[2], 0.0),
                 uv01: [t.uv[0].x, t.uv[0].y, t.uv[1].x, t.uv[1].y],
-                uv2: [t.uv[2].x, t.uv[2].y, 0.0, 0.0],
+                uv2: [t.uv[2].x, t.uv[2].y, t.uv1[0].x, t.uv1[0].y],
+                uv1_12: [t.uv1[1].x, t.uv1[1].y, t.uv1[2].x, t.uv1[2].y],
             });
+            if normal_mapped {
+                let c = t.tangents.unwrap_or_default().map(|v| v.to_array());
+                tangents.push(GpuTriTangents {
+                    t0: c[0],
+                    t1: c[1],
+                    t2: c[2],
+                });
+            }
             vertices.push(t.v);
         }
         Self {
@@ -114,6 +141,7 @@ impl HostScene {
             triangles,
             vertices,
             shading,
+            tangents,
             materials: materials.iter().map(gpu_material).collect(),
             emissive,
         }
@@ -126,12 +154,15 @@ impl HostScene {
 }
 
 /// The light list (emissive triangles first, so a triangle's light index is its position in
-/// `HostScene::emissive`, then the punctual lights) and its cumulative selection table,
-/// proportional to each light's power.
+/// `HostScene::emissive`, then the punctual lights, then the environment map when
+/// `env_luminance` (its mean luminance × intensity) is given) and its cumulative selection
+/// table, proportional to each light's power. An environment's power is taken as that of
+/// a directional light of irradiance π·L̄ over the scene's disc.
 pub fn gpu_lights(
     lights: &[Light],
     host: &HostScene,
     scene_diagonal: f64,
+    env_luminance: Option<f32>,
 ) -> (Vec<GpuLight>, Vec<f32>) {
     let mut out = Vec::new();
     let mut weights = Vec::new();
@@ -177,6 +208,16 @@ pub fn gpu_lights(
         });
         weights.push(power);
     }
+    if let Some(l) = env_luminance {
+        let power = pi * l * pi * scene_radius * scene_radius;
+        if power > 0.0 && power.is_finite() {
+            out.push(GpuLight {
+                position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_ENVIRONMENT)],
+                ..GpuLight::default()
+            });
+            weights.push(power);
+        }
+    }
     let total: f32 = weights.iter().sum();
     let mut cdf = Vec::with_capacity(weights.len());
     let mut acc = 0.0;
@@ -203,5 +244,120 @@ pub fn gpu_camera(c: &Camera, aspect: f32) -> GpuCamera {
         forward: f4(forward, 1.0),
         right: f4(right * h * aspect, 0.0),
         up: f4(up * h, 0.0),
+    }
+}
+
+/// Textures as the device stores them: every (image, color space) pair used by a material
+/// becomes one RGBA8 mip chain in a single texel buffer; materials point at `refs`.
+#[derive(Clone, Debug, Default)]
+pub struct TexturePack {
+    /// One descriptor per texture.
+    pub textures: Vec<GpuTexture>,
+    /// One entry per `Scene::texture_refs` entry.
+    pub refs: Vec<GpuTexRef>,
+    /// RGBA8 texels (R in the low byte) of every level of every texture.
+    pub texels: Vec<u32>,
+    /// The largest side kept (smaller than [`MAX_TEXTURE_SIDE`] when the budget forced it).
+    pub max_side: u32,
+}
+
+fn wrap_code(w: Wrap) -> i32 {
+    match w {
+        Wrap::Repeat => WRAP_REPEAT,
+        Wrap::Clamp => WRAP_CLAMP,
+        Wrap::Mirror => WRAP_MIRROR,
+    }
+}
+
+impl TexturePack {
+    /// Packs the scene's textures. Mip chains are box-filtered on the host (in linear space for
+    /// sRGB textures); levels above [`MAX_TEXTURE_SIDE`] are dropped, and while the texels would
+    /// exceed `budget_bytes` the largest side allowed is halved.
+    pub fn new(scene: &Scene, budget_bytes: usize) -> Self {
+        let mut keys: Vec<(u32, bool)> = Vec::new();
+        let mut index: HashMap<(u32, bool), u32> = HashMap::new();
+        for r in &scene.texture_refs {
+            index.entry((r.image, r.srgb)).or_insert_with(|| {
+                keys.push((r.image, r.srgb));
+                keys.len() as u32 - 1
+            });
+        }
+        // Texels of a chain whose level 0 is capped at `side`.
+        let chain_texels = |w: u32, h: u32, side: u32| -> usize {
+            let (mut w, mut h) = (w, h);
+            while w > side || h > side {
+                w = (w / 2).max(1);
+                h = (h / 2).max(1);
+            }
+            let mut n = 0usize;
+            loop {
+                n += (w * h) as usize;
+                if w == 1 && h == 1 {
+                    return n;
+                }
+                w = (w / 2).max(1);
+                h = (h / 2).max(1);
+            }
+        };
+        let mut max_side = MAX_TEXTURE_SIDE;
+        while max_side > 1 {
+            let total: usize = keys
+                .iter()
+                .map(|&(i, _)| {
+                    let im = &scene.images[i as usize];
+                    chain_texels(im.width, im.height, max_side)
+                })
+                .sum();
+            if total * 4 <= budget_bytes {
+                break;
+            }
+            max_side /= 2;
+        }
+        let chains: Vec<Vec<crate::scene::MipLevel>> = keys
+            .par_iter()
+            .map(|&(i, srgb)| mip_chain(&scene.images[i as usize], srgb, max_side))
+            .collect();
+        let mut textures = Vec::with_capacity(chains.len());
+        let mut texels = Vec::new();
+        for (chain, &(_, srgb)) in chains.iter().zip(&keys) {
+            textures.push(GpuTexture {
+                offset: texels.len() as u32,
+                width: chain[0].width,
+                height: chain[0].height,
+                flags: chain.len() as u32 | if srgb { TEXTURE_SRGB } else { 0 },
+            });
+            for level in chain {
+                texels.extend(level.rgba.iter().map(|&t| u32::from_le_bytes(t)));
+            }
+        }
+        let refs = scene
+            .texture_refs
+            .iter()
+            .map(|r| {
+                let [a, b] = r.transform.rows();
+                let det = (a[0] * b[1] - a[1] * b[0]).abs().max(1e-12);
+                GpuTexRef {
+                    m0: [a[0], a[1], a[2], f32::from_bits(r.tex_coord)],
+                    m1: [b[0], b[1], b[2], 0.5 * det.log2()],
+                    info: [
+                        index[&(r.image, r.srgb)] as i32,
+                        wrap_code(r.wrap_s),
+                        wrap_code(r.wrap_t),
+                        0,
+                    ],
+                }
+            })
+            .collect();
+        Self {
+            textures,
+            refs,
+            texels,
+            max_side,
+        }
+    }
+
+    /// Bytes of texel memory on the device.
+    pub fn bytes(&self) -> usize {
+        self.texels.len() * 4
     }
 }

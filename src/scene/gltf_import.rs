@@ -1,12 +1,16 @@
 //! glTF 2.0 import (`.gltf` with external or embedded buffers, and `.glb`).
 
+use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
     default_light_rig,
 };
-use glam::{DMat4, DQuat, DVec3, Vec2, Vec3};
+use glam::{DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
+use rayon::prelude::*;
+use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 /// Extensions penumbra understands (or can safely ignore when rendering).
 const SUPPORTED_EXTENSIONS: &[&str] = &[
@@ -44,15 +48,27 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         .map_err(|e| format!("cannot load buffers: {e}"))?;
     let buffer_data: Vec<&[u8]> = buffers.iter().map(|b| b.0.as_slice()).collect();
 
-    let materials = document
+    let mut table = TextureTable::default();
+    let mut materials = document
         .materials()
-        .map(import_material)
+        .map(|m| import_material(m, &mut table, &mut warnings))
         .collect::<Vec<_>>();
+    let images = decode_images(&document, base, &buffers, &mut table, &mut warnings);
+    for m in &mut materials {
+        table.drop_missing(&mut m.textures);
+    }
     let default_material = materials.len() as u32;
+    // The texture coordinate set of each material's normal map (tangents are made for it).
+    let normal_sets: Vec<Option<u32>> = materials
+        .iter()
+        .map(|m| m.textures.normal.map(|r| table.refs[r as usize].tex_coord))
+        .collect();
 
     let mut scene = Scene {
         source: source.to_string(),
         materials,
+        images,
+        texture_refs: table.refs,
         ..Scene::default()
     };
     scene.materials.push(Material::default());
@@ -84,7 +100,13 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
                 .or(mesh.name())
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("mesh {}", mesh.index()));
-            let m = import_mesh(&mesh, &buffer_data, default_material, &mut warnings)?;
+            let m = import_mesh(
+                &mesh,
+                &buffer_data,
+                default_material,
+                &normal_sets,
+                &mut warnings,
+            )?;
             if !m.indices.is_empty() {
                 scene.objects.push(Object {
                     name,
@@ -190,13 +212,200 @@ fn node_matrix(node: &gltf::Node) -> DMat4 {
     DMat4::from_scale_rotation_translation(s, r, t)
 }
 
-fn import_material(m: gltf::Material) -> Material {
+/// Texture references collected while importing materials, and the images they need.
+#[derive(Default)]
+struct TextureTable {
+    refs: Vec<TextureRef>,
+    /// glTF image index → index in `Scene::images` (decode order).
+    images: HashMap<usize, u32>,
+    /// glTF image index of each scene image.
+    order: Vec<usize>,
+    /// Scene images that could not be decoded.
+    failed: Vec<bool>,
+}
+
+impl TextureTable {
+    /// Adds a reference to `texture` with a texture coordinate set and an optional
+    /// `KHR_texture_transform` object; returns its index.
+    fn add(
+        &mut self,
+        texture: gltf::Texture,
+        tex_coord: u32,
+        transform: Option<&serde_json::Value>,
+        srgb: bool,
+        what: &str,
+        warnings: &mut Vec<String>,
+    ) -> Option<u32> {
+        let source = texture.source();
+        let next = self.order.len() as u32;
+        let image = *self.images.entry(source.index()).or_insert(next);
+        if image == next {
+            self.order.push(source.index());
+        }
+        let mut t = TexTransform::default();
+        let mut tex_coord = tex_coord;
+        if let Some(x) = transform {
+            let pair = |key: &str, default: [f32; 2]| {
+                x.get(key)
+                    .and_then(|v| v.as_array())
+                    .and_then(|a| Some([a.first()?.as_f64()? as f32, a.get(1)?.as_f64()? as f32]))
+                    .unwrap_or(default)
+            };
+            t.offset = pair("offset", [0.0; 2]);
+            t.scale = pair("scale", [1.0; 2]);
+            t.rotation = x.get("rotation").and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
+            if let Some(set) = x.get("texCoord").and_then(|v| v.as_u64()) {
+                tex_coord = set as u32;
+            }
+        }
+        if tex_coord > 1 {
+            warnings.push(format!(
+                "{what}: TEXCOORD_{tex_coord} is not supported, TEXCOORD_0 is used"
+            ));
+            tex_coord = 0;
+        }
+        let sampler = texture.sampler();
+        self.refs.push(TextureRef {
+            image,
+            srgb,
+            wrap_s: Wrap::from(sampler.wrap_s()),
+            wrap_t: Wrap::from(sampler.wrap_t()),
+            tex_coord,
+            transform: t,
+        });
+        Some(self.refs.len() as u32 - 1)
+    }
+
+    fn info(
+        &mut self,
+        info: Option<gltf::texture::Info>,
+        srgb: bool,
+        what: &str,
+        warnings: &mut Vec<String>,
+    ) -> Option<u32> {
+        let info = info?;
+        let transform = info.texture_transform().map(|t| {
+            let mut v = serde_json::json!({
+                "offset": t.offset(),
+                "rotation": t.rotation(),
+                "scale": t.scale(),
+            });
+            if let Some(set) = t.tex_coord() {
+                v["texCoord"] = serde_json::json!(set);
+            }
+            v
+        });
+        self.add(
+            info.texture(),
+            info.tex_coord(),
+            transform.as_ref(),
+            srgb,
+            what,
+            warnings,
+        )
+    }
+
+    /// Clears the slots whose image failed to decode.
+    fn drop_missing(&self, slots: &mut MaterialTextures) {
+        for slot in [
+            &mut slots.base_color,
+            &mut slots.metallic_roughness,
+            &mut slots.normal,
+            &mut slots.emissive,
+            &mut slots.transmission,
+        ] {
+            if let Some(r) = *slot
+                && self.failed[self.refs[r as usize].image as usize]
+            {
+                *slot = None;
+            }
+        }
+    }
+}
+
+/// Decodes the images the materials use, in parallel. An image that cannot be read is a
+/// warning and its texture slots fall back to the factors.
+fn decode_images(
+    document: &gltf::Document,
+    base: Option<&Path>,
+    buffers: &[gltf::buffer::Data],
+    table: &mut TextureTable,
+    warnings: &mut Vec<String>,
+) -> Vec<Arc<Image>> {
+    let all: Vec<gltf::Image> = document.images().collect();
+    let base = base.unwrap_or(Path::new("."));
+    let decoded: Vec<Result<Image, String>> = table
+        .order
+        .par_iter()
+        .map(|&i| {
+            let image = &all[i];
+            let name = match image.source() {
+                gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
+                    format!("{i} ({uri})")
+                }
+                _ => image
+                    .name()
+                    .map_or_else(|| i.to_string(), |n| format!("{i} ({n})")),
+            };
+            let data = gltf::image::Data::from_source(image.source(), Some(base), buffers)
+                .map_err(|e| format!("image {name}: cannot decode: {e}"))?;
+            to_rgba8(&data, &name)
+        })
+        .collect();
+    let mut images = Vec::with_capacity(decoded.len());
+    for d in decoded {
+        match d {
+            Ok(image) => {
+                images.push(Arc::new(image));
+                table.failed.push(false);
+            }
+            Err(e) => {
+                warnings.push(format!("{e}; its textures are left out"));
+                images.push(Arc::new(Image {
+                    name: String::new(),
+                    width: 1,
+                    height: 1,
+                    rgba: vec![[255; 4]],
+                }));
+                table.failed.push(true);
+            }
+        }
+    }
+    images
+}
+
+fn import_material(
+    m: gltf::Material,
+    table: &mut TextureTable,
+    warnings: &mut Vec<String>,
+) -> Material {
     let pbr = m.pbr_metallic_roughness();
     let strength = m.emissive_strength().unwrap_or(1.0);
     let emissive = m.emissive_factor().map(|e| e * strength);
     let (specular_factor, specular_color) = match m.specular() {
         Some(s) => (s.specular_factor(), s.specular_color_factor()),
         None => (1.0, [1.0; 3]),
+    };
+    let what = format!("material {}", m.index().unwrap_or(0));
+    let normal = m.normal_texture();
+    let textures = MaterialTextures {
+        base_color: table.info(pbr.base_color_texture(), true, &what, warnings),
+        metallic_roughness: table.info(pbr.metallic_roughness_texture(), false, &what, warnings),
+        normal: normal.as_ref().and_then(|n| {
+            let transform = n.extension_value("KHR_texture_transform").cloned();
+            table.add(
+                n.texture(),
+                n.tex_coord(),
+                transform.as_ref(),
+                false,
+                &what,
+                warnings,
+            )
+        }),
+        emissive: table.info(m.emissive_texture(), true, &what, warnings),
+        transmission: m
+            .transmission()
+            .and_then(|t| table.info(t.transmission_texture(), false, &what, warnings)),
     };
     Material {
         name: m
@@ -222,6 +431,8 @@ fn import_material(m: gltf::Material) -> Material {
             gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         },
+        textures,
+        normal_scale: normal.as_ref().map_or(1.0, |n| n.scale()),
     }
 }
 
@@ -256,6 +467,7 @@ fn import_mesh(
     mesh: &gltf::Mesh,
     buffers: &[&[u8]],
     default_material: u32,
+    normal_sets: &[Option<u32>],
     warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
     let mut out = Mesh::default();
@@ -291,10 +503,21 @@ fn import_mesh(
         if !normals.is_empty() && normals.len() != positions.len() {
             return Err(format!("{what}: NORMAL count differs from POSITION count"));
         }
-        let uvs: Vec<Vec2> = reader
-            .read_tex_coords(0)
-            .map(|t| t.into_f32().map(Vec2::from).collect())
-            .unwrap_or_default();
+        let read_uvs = |set: u32| -> Vec<Vec2> {
+            reader
+                .read_tex_coords(set)
+                .map(|t| t.into_f32().map(Vec2::from).collect())
+                .unwrap_or_default()
+        };
+        let uvs = read_uvs(0);
+        let uvs1 = read_uvs(1);
+        for (set, list) in [(0, &uvs), (1, &uvs1)] {
+            if !list.is_empty() && list.len() != positions.len() {
+                return Err(format!(
+                    "{what}: TEXCOORD_{set} count differs from POSITION count"
+                ));
+            }
+        }
         let flat: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..positions.len() as u32).collect(),
@@ -333,6 +556,40 @@ fn import_mesh(
             positions.len(),
         );
         pad_attribute(&mut out.uvs, out.positions.len(), &uvs, positions.len());
+        pad_attribute(&mut out.uvs1, out.positions.len(), &uvs1, positions.len());
+        // Tangents at the corners of normal-mapped triangles: the file's, else MikkTSpace's.
+        let tangents: Vec<[Vec4; 3]> = match normal_sets.get(material as usize).copied().flatten() {
+            None => Vec::new(),
+            Some(set) => match reader.read_tangents() {
+                Some(t) => {
+                    let t: Vec<Vec4> = t.map(Vec4::from).collect();
+                    if t.len() != positions.len() {
+                        return Err(format!("{what}: TANGENT count differs from POSITION count"));
+                    }
+                    triangles
+                        .iter()
+                        .map(|tri| tri.map(|i| t[i as usize]))
+                        .collect()
+                }
+                None => {
+                    let set_uvs = if set == 1 { &uvs1 } else { &uvs };
+                    if set_uvs.is_empty() {
+                        warnings.push(format!(
+                            "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"
+                        ));
+                        Vec::new()
+                    } else {
+                        super::tangents::generate(&positions, &normals, set_uvs, &triangles)
+                    }
+                }
+            },
+        };
+        pad_attribute(
+            &mut out.tangents,
+            out.indices.len(),
+            &tangents,
+            triangles.len(),
+        );
         out.positions.extend_from_slice(&positions);
         out.indices
             .extend(triangles.iter().map(|t| t.map(|i| i + base)));

@@ -3,14 +3,23 @@
 //! Transforms are composed in f64; geometry is stored per object in object space and flattened
 //! into world-space triangles (f32) whenever the scene changes.
 
+mod environment;
 mod gltf_import;
 mod lights;
+mod tangents;
+mod textures;
 
+pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
 pub use gltf_import::{AUTO_YFOV, load, load_from_bytes};
 pub use lights::{LightPreset, default_light_radius, default_light_rig, preset_lights};
+pub use textures::{
+    Image, MAX_TEXTURE_SIDE, MaterialTextures, MipLevel, TexTransform, TextureRef, Wrap,
+    linear_to_srgb, mip_chain, srgb_to_linear,
+};
 
-use glam::{DMat4, DVec3, Vec2, Vec3};
+use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The bundled default scene (made by `scripts/cornell_box.py`).
 pub const BUNDLED_SCENE: &[u8] = include_bytes!("../../assets/cornell-box.glb");
@@ -54,6 +63,12 @@ pub struct Mesh {
     pub indices: Vec<[u32; 3]>,
     /// Material index of each triangle.
     pub materials: Vec<u32>,
+    /// `TEXCOORD_1`; empty when absent.
+    pub uvs1: Vec<Vec2>,
+    /// Tangents at each triangle's corners (xyz, w = bitangent sign), from the file's
+    /// `TANGENT` or generated (MikkTSpace) for normal-mapped primitives; empty when no
+    /// primitive of the mesh is normal-mapped. Zero where unknown.
+    pub tangents: Vec<[Vec4; 3]>,
 }
 
 /// One placed mesh: a glTF node's mesh with its world transform.
@@ -112,6 +127,10 @@ pub struct Material {
     pub attenuation_distance: f32,
     /// Alpha mode.
     pub alpha: AlphaMode,
+    /// Texture slots.
+    pub textures: MaterialTextures,
+    /// Normal texture scale (x and y of the tangent-space normal).
+    pub normal_scale: f32,
 }
 
 impl Default for Material {
@@ -131,6 +150,8 @@ impl Default for Material {
             attenuation_color: [1.0; 3],
             attenuation_distance: f32::INFINITY,
             alpha: AlphaMode::Opaque,
+            textures: MaterialTextures::default(),
+            normal_scale: 1.0,
         }
     }
 }
@@ -280,6 +301,10 @@ pub struct WorldTriangle {
     pub smooth: bool,
     /// `TEXCOORD_0` per vertex.
     pub uv: [Vec2; 3],
+    /// `TEXCOORD_1` per vertex.
+    pub uv1: [Vec2; 3],
+    /// World-space tangents per vertex (w = bitangent sign), when the mesh has them.
+    pub tangents: Option<[Vec4; 3]>,
     /// Material index.
     pub material: u32,
     /// Object index.
@@ -303,6 +328,10 @@ pub struct Scene {
     pub default_rig: bool,
     /// Warnings raised while loading (unsupported optional extensions, skipped primitives).
     pub warnings: Vec<String>,
+    /// Decoded images used by the materials (only those).
+    pub images: Vec<Arc<Image>>,
+    /// Texture uses, indexed by `MaterialTextures`.
+    pub texture_refs: Vec<TextureRef>,
 }
 
 impl Scene {
@@ -366,7 +395,8 @@ fn object_triangles(object: u32, o: &Object) -> Vec<WorldTriangle> {
         .indices
         .iter()
         .zip(&o.mesh.materials)
-        .map(|(&[a, b, c], &material)| {
+        .enumerate()
+        .map(|(ti, (&[a, b, c], &material))| {
             let idx = if flip { [a, c, b] } else { [a, b, c] };
             let v = idx.map(|i| world[i as usize]);
             let geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
@@ -384,11 +414,29 @@ fn object_triangles(object: u32, o: &Object) -> Vec<WorldTriangle> {
             } else {
                 idx.map(|i| o.mesh.uvs[i as usize])
             };
+            let uv1 = if o.mesh.uvs1.is_empty() {
+                [Vec2::ZERO; 3]
+            } else {
+                idx.map(|i| o.mesh.uvs1[i as usize])
+            };
+            let tangents = o.mesh.tangents.get(ti).map(|t| {
+                let corners = if flip { [t[0], t[2], t[1]] } else { *t };
+                corners.map(|t| {
+                    let d = m
+                        .transform_vector3(t.truncate().as_dvec3())
+                        .normalize_or_zero()
+                        .as_vec3();
+                    // A mirroring transform flips the bitangent too.
+                    d.extend(if flip { -t.w } else { t.w })
+                })
+            });
             WorldTriangle {
                 v,
                 n,
                 smooth,
                 uv,
+                uv1,
+                tangents,
                 material,
                 object,
             }

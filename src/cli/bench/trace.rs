@@ -285,6 +285,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         light_radius: None,
         hard_shadows: true,
         sky: None,
+        ..CommonArgs::default()
     };
     let settings = common.settings((args.width, args.height))?;
     let prepared = common.prepare(args.scene.as_deref())?;

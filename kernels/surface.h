@@ -1,0 +1,51 @@
+// What a hit's textures do to its material: base color, metallic-roughness and emission, and
+// the shading normal from a tangent-space normal map.
+
+#ifdef HAS_TEXTURES
+// Multiplies the material's factors by its textures at the hit.
+inline void apply_textures(SurfaceMaterial* m, global const GpuMaterial* mat,
+                           const SceneSurfaces* s, const TexCoords* tc) {
+    if (mat->textures.x >= 0) m->base_color *= texture_sample(s, mat->textures.x, tc).xyz;
+    if (mat->textures.y >= 0) {
+        float4 mr = texture_sample(s, mat->textures.y, tc);
+        m->roughness *= mr.y;
+        m->metallic *= mr.z;
+    }
+}
+
+// Emitted radiance at the hit: the factor times the emissive texture.
+inline float3 textured_emission(global const GpuMaterial* mat, const SceneSurfaces* s,
+                                const TexCoords* tc) {
+    float3 e = mat->emission.xyz;
+    if (mat->textures.w >= 0) e *= texture_sample(s, mat->textures.w, tc).xyz;
+    return e;
+}
+#endif
+
+#ifdef HAS_NORMAL_MAPS
+// The shading normal from the normal map. ns and ng face the side the ray came from; `front`
+// says whether that is the triangle's front, in which case the tangent frame is the file's,
+// else every axis of it is reversed (glTF reverses back-face normals of double-sided
+// materials). The result is bent to stay above the geometric surface.
+inline float3 normal_map(const SceneSurfaces* s, global const GpuMaterial* mat,
+                         const TexCoords* tc, uint prim, float u, float v, float3 ns, float3 ng,
+                         bool front) {
+    GpuTriTangents tt = s->tangents[prim];
+    float w0 = 1.0f - u - v;
+    float3 t = w0 * tt.t0.xyz + u * tt.t1.xyz + v * tt.t2.xyz;
+    float3 n = front ? ns : -ns;
+    t -= n * dot(n, t);
+    float len = length(t);
+    if (!(len > 1e-8f)) return ns;
+    t /= len;
+    float3 b = cross(n, t) * (tt.t0.w < 0.0f ? -1.0f : 1.0f);
+    float3 c = texture_sample(s, mat->textures.z, tc).xyz * 2.0f - 1.0f;
+    float scale = mat->alpha.w;
+    float3 mapped = normalize(c.x * scale * t + c.y * scale * b + c.z * n);
+    if (!all(isfinite(mapped))) return ns;
+    if (!front) mapped = -mapped;
+    float cos_g = dot(mapped, ng);
+    if (cos_g < 0.01f) mapped = normalize(mapped + (0.01f - cos_g) * ng);
+    return mapped;
+}
+#endif

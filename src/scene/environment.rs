@@ -1,0 +1,265 @@
+//! The environment light: an equirectangular (latitude-longitude) radiance image around the
+//! scene, with the table that importance-samples it by luminance × sin θ.
+//!
+//! Directions: row 0 of the image is straight up (+Y), the last row straight down; the centre
+//! column looks along −Z and u grows towards +X (seen from inside, the image is not mirrored).
+//! With φ = 2π(u − ½) and θ = πv, the direction is (sin θ sin φ, cos θ, −sin θ cos φ).
+
+use glam::Vec3;
+use std::f32::consts::PI;
+use std::path::Path;
+
+/// Environment images wider than this are box-filtered down by halves on load.
+pub const MAX_ENV_WIDTH: u32 = 4096;
+
+/// An environment image in linear radiance.
+#[derive(Clone)]
+pub struct EnvMap {
+    /// File name, for messages.
+    pub name: String,
+    /// Width in texels (the full circle of longitude).
+    pub width: u32,
+    /// Height in texels (pole to pole).
+    pub height: u32,
+    /// Linear RGB radiance, row 0 at the top.
+    pub texels: Vec<[f32; 3]>,
+}
+
+impl std::fmt::Debug for EnvMap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "EnvMap({:?}, {}x{})", self.name, self.width, self.height)
+    }
+}
+
+/// The importance-sampling table of an [`EnvMap`]: a 2D CDF over f = luminance × sin θ per
+/// texel (the marginal over rows, then one conditional per row), each ending at exactly 1.
+#[derive(Clone, Debug, Default)]
+pub struct EnvSampling {
+    /// Cumulative row probabilities (`height` entries).
+    pub marginal: Vec<f32>,
+    /// Cumulative column probabilities of each row (`width × height` entries).
+    pub conditional: Vec<f32>,
+    /// W·H / (Σf · 2π²): a texel's solid-angle pdf is `f × norm / sin θ`.
+    pub norm: f32,
+    /// Mean luminance over the sphere (solid-angle weighted), for the light selection table.
+    pub mean_luminance: f32,
+}
+
+fn luminance(c: [f32; 3]) -> f32 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}
+
+impl EnvMap {
+    /// Loads a `.hdr` (Radiance RGBE) or `.exr` image. Non-finite and negative values become 0;
+    /// images wider than [`MAX_ENV_WIDTH`] are halved until they fit.
+    pub fn load(path: &Path) -> Result<Self, String> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        let (width, height, texels) = match ext.as_str() {
+            "exr" => crate::image_io::read_exr(path).map_err(|e| format!("{e:#}"))?,
+            "hdr" => {
+                let image = image::open(path)
+                    .map_err(|e| format!("{}: cannot read the HDR image: {e}", path.display()))?
+                    .into_rgb32f();
+                let (w, h) = image.dimensions();
+                let texels = image.pixels().map(|p| p.0).collect();
+                (w, h, texels)
+            }
+            _ => {
+                return Err(format!(
+                    "{}: an environment map must be a .hdr or .exr file",
+                    path.display()
+                ));
+            }
+        };
+        if width == 0 || height == 0 {
+            return Err(format!("{}: the image is empty", path.display()));
+        }
+        let mut map = Self {
+            name: path.display().to_string(),
+            width,
+            height,
+            texels: texels
+                .into_iter()
+                .map(|p: [f32; 3]| p.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 }))
+                .collect(),
+        };
+        while map.width > MAX_ENV_WIDTH {
+            map = map.halved();
+        }
+        Ok(map)
+    }
+
+    /// A map of one radiance everywhere (`height` rows so that sin θ shapes the sampling).
+    pub fn uniform(radiance: [f32; 3], width: u32, height: u32) -> Self {
+        Self {
+            name: "uniform".into(),
+            width,
+            height,
+            texels: vec![radiance; (width * height) as usize],
+        }
+    }
+
+    fn halved(&self) -> Self {
+        let w = (self.width / 2).max(1);
+        let h = (self.height / 2).max(1);
+        let mut texels = vec![[0.0f32; 3]; (w * h) as usize];
+        for y in 0..h {
+            for x in 0..w {
+                let mut sum = [0.0f32; 3];
+                let mut n = 0.0;
+                for sy in (2 * y)..(2 * y + 2).min(self.height) {
+                    for sx in (2 * x)..(2 * x + 2).min(self.width) {
+                        let t = self.texels[(sy * self.width + sx) as usize];
+                        for c in 0..3 {
+                            sum[c] += t[c];
+                        }
+                        n += 1.0;
+                    }
+                }
+                texels[(y * w + x) as usize] = sum.map(|s| s / n);
+            }
+        }
+        Self {
+            name: self.name.clone(),
+            width: w,
+            height: h,
+            texels,
+        }
+    }
+
+    /// The sampling table.
+    pub fn sampling(&self) -> EnvSampling {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let mut marginal = Vec::with_capacity(h);
+        let mut conditional = Vec::with_capacity(w * h);
+        let mut rows = Vec::with_capacity(h);
+        let mut total = 0.0f64;
+        let mut solid = 0.0f64;
+        for y in 0..h {
+            let sin = ((y as f64 + 0.5) / h as f64 * std::f64::consts::PI).sin();
+            let mut acc = 0.0f64;
+            let start = conditional.len();
+            for x in 0..w {
+                let l = luminance(self.texels[y * w + x]) as f64;
+                acc += l * sin;
+                conditional.push(acc);
+            }
+            for (i, c) in conditional[start..].iter_mut().enumerate() {
+                // A black row is never picked; keep its table valid anyway.
+                *c = if acc > 0.0 {
+                    *c / acc
+                } else {
+                    (i + 1) as f64 / w as f64
+                };
+            }
+            conditional[start + w - 1] = 1.0;
+            rows.push(acc);
+            total += acc;
+            solid += sin * w as f64;
+        }
+        let mut acc = 0.0;
+        for r in &rows {
+            acc += r;
+            marginal.push(if total > 0.0 { acc / total } else { 0.0 });
+        }
+        if let Some(last) = marginal.last_mut() {
+            *last = 1.0;
+        }
+        let norm = if total > 0.0 {
+            (w * h) as f64 / (total * 2.0 * std::f64::consts::PI * std::f64::consts::PI)
+        } else {
+            0.0
+        };
+        EnvSampling {
+            marginal: marginal.into_iter().map(|v| v as f32).collect(),
+            conditional: conditional.into_iter().map(|v| v as f32).collect(),
+            norm: norm as f32,
+            mean_luminance: if solid > 0.0 {
+                (total / solid) as f32
+            } else {
+                0.0
+            },
+        }
+    }
+
+    /// The map coordinates (u, v) in [0, 1]² of a unit direction in the map's frame.
+    pub fn uv_of(d: Vec3) -> (f32, f32) {
+        let u = d.x.atan2(-d.z) / (2.0 * PI) + 0.5;
+        let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+        (u.rem_euclid(1.0), v)
+    }
+
+    /// The unit direction of map coordinates (u, v).
+    pub fn direction(u: f32, v: f32) -> Vec3 {
+        let phi = 2.0 * PI * (u - 0.5);
+        let theta = PI * v;
+        Vec3::new(
+            theta.sin() * phi.sin(),
+            theta.cos(),
+            -theta.sin() * phi.cos(),
+        )
+    }
+
+    /// The texel a direction (in the map's frame) falls into.
+    pub fn texel_of(&self, d: Vec3) -> (u32, u32) {
+        let (u, v) = Self::uv_of(d);
+        let x = ((u * self.width as f32) as u32).min(self.width - 1);
+        let y = ((v * self.height as f32) as u32).min(self.height - 1);
+        (x, y)
+    }
+
+    /// The solid-angle pdf of sampling direction `d` (map frame) with `table`, as the kernel
+    /// computes it: f(texel) × norm / sin θ, with f = luminance × sin θ(texel centre).
+    pub fn pdf(&self, table: &EnvSampling, d: Vec3) -> f32 {
+        let (x, y) = self.texel_of(d);
+        let sin_centre = ((y as f32 + 0.5) / self.height as f32 * PI).sin();
+        let sin = (1.0 - d.y * d.y).max(0.0).sqrt();
+        if sin <= 0.0 {
+            return 0.0;
+        }
+        let l = luminance(self.texels[(y * self.width + x) as usize]);
+        l * sin_centre * table.norm / sin
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn directions_and_coordinates_invert() {
+        for &(u, v) in &[(0.5, 0.5), (0.75, 0.3), (0.1, 0.9), (0.99, 0.01)] {
+            let d = EnvMap::direction(u, v);
+            let (u2, v2) = EnvMap::uv_of(d);
+            assert!((u - u2).abs() < 1e-5 && (v - v2).abs() < 1e-5, "{u},{v}");
+        }
+        assert!((EnvMap::direction(0.5, 0.5) - Vec3::NEG_Z).length() < 1e-6);
+        assert!((EnvMap::direction(0.75, 0.5) - Vec3::X).length() < 1e-6);
+        assert!((EnvMap::direction(0.2, 0.0) - Vec3::Y).length() < 1e-6);
+    }
+
+    #[test]
+    fn the_pdf_integrates_to_one() {
+        let mut map = EnvMap::uniform([1.0; 3], 16, 8);
+        map.texels[37] = [50.0, 20.0, 5.0];
+        let table = map.sampling();
+        // Integrate over the sphere by texels: pdf × solid angle of each texel.
+        let mut sum = 0.0f64;
+        let n = 64;
+        for j in 0..n {
+            for i in 0..2 * n {
+                let u = (i as f32 + 0.5) / (2 * n) as f32;
+                let v = (j as f32 + 0.5) / n as f32;
+                let d = EnvMap::direction(u, v);
+                let dw = (2.0 * PI / (2 * n) as f32) * (PI / n as f32) * (PI * v).sin();
+                sum += (map.pdf(&table, d) * dw) as f64;
+            }
+        }
+        assert!((sum - 1.0).abs() < 0.02, "∫pdf = {sum}");
+        assert_eq!(*table.marginal.last().unwrap(), 1.0);
+    }
+}
