@@ -389,7 +389,7 @@ impl Gui {
         egui::CollapsingHeader::new("Scene")
             .default_open(true)
             .show(ui, |ui| {
-                ui.label(m.scene.source.as_str());
+                ui.add(egui::Label::new(m.scene.source.as_str()).truncate());
                 ui.horizontal(|ui| {
                     let field = ui.add(
                         egui::TextEdit::singleline(&mut self.path_text)
@@ -427,6 +427,7 @@ impl Gui {
                 egui::ScrollArea::vertical()
                     .id_salt("objects")
                     .max_height(140.0)
+                    .min_scrolled_height(140.0)
                     .show(ui, |ui| {
                         for (i, o) in m.scene.objects.iter_mut().enumerate() {
                             ui.horizontal(|ui| {

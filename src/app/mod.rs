@@ -172,6 +172,8 @@ struct Input {
     pan: bool,
     shift: bool,
     ctrl: bool,
+    /// A button pressed while the overlay is shown, handled after egui's next pass.
+    press: Option<MouseButton>,
 }
 
 struct App {
@@ -281,19 +283,15 @@ impl ApplicationHandler for App {
             }
             WindowEvent::MouseInput { state, button, .. } => {
                 let pressed = state == ElementState::Pressed;
-                let free = !egui_wants_pointer && !consumed;
-                match button {
-                    MouseButton::Left if pressed && free => self.pick(),
-                    MouseButton::Right if self.input.shift && pressed && free => {
-                        self.input.pan = true
-                    }
-                    MouseButton::Right if pressed && free => self.input.look = true,
-                    MouseButton::Middle if pressed && free => self.input.pan = true,
-                    MouseButton::Right | MouseButton::Middle if !pressed => {
-                        self.input.look = false;
-                        self.input.pan = false;
-                    }
-                    _ => {}
+                if pressed && self.overlay {
+                    // egui learns where the pointer is only when it runs: decide in the next
+                    // frame whether the press was on the overlay or on the image.
+                    self.input.press = Some(button);
+                } else if pressed {
+                    self.press(button);
+                } else if matches!(button, MouseButton::Right | MouseButton::Middle) {
+                    self.input.look = false;
+                    self.input.pan = false;
                 }
             }
             WindowEvent::CursorMoved { position, .. } => {
@@ -410,6 +408,17 @@ impl App {
             || self.last_motion.is_some_and(|t| now - t < MOVING_FOR)
     }
 
+    /// A mouse button pressed on the image: pick, look or pan.
+    fn press(&mut self, button: MouseButton) {
+        match button {
+            MouseButton::Left => self.pick(),
+            MouseButton::Right if self.input.shift => self.input.pan = true,
+            MouseButton::Right => self.input.look = true,
+            MouseButton::Middle => self.input.pan = true,
+            _ => {}
+        }
+    }
+
     fn camera_moved(&mut self) {
         self.last_motion = Some(Instant::now());
         self.frame_loop.invalidate(Changes {
@@ -454,6 +463,7 @@ impl App {
     }
 
     fn lights_changed(&mut self) {
+        self.last_motion = Some(Instant::now());
         self.lights = self.model.view.lights();
         self.frame_loop.invalidate(Changes {
             lights: true,
@@ -471,7 +481,9 @@ impl App {
         };
         let (w, h) = (self.size.0 as f32, self.size.1 as f32);
         let ray = pick::primary_ray(&self.model.camera.camera, w / h, x as f32 / w, y as f32 / h);
-        match pick::pick(host, &ray) {
+        let hit = pick::pick(host, &ray);
+        log::debug!("pick at ({x:.0}, {y:.0}): {hit:?}");
+        match hit {
             Some(hit) => {
                 self.model.selected = Some(hit.object);
                 if self.model.camera.mode == Mode::Orbit {
@@ -628,7 +640,14 @@ impl App {
             }
         });
         self.wake = now.checked_add(repaint);
-        if actions.changes.camera {
+        if let Some(button) = self.input.press.take()
+            && !(overlay && gfx.framework.context().is_pointer_over_egui())
+        {
+            self.press(button);
+        }
+        // Any edit counts as motion: dragging a slider or an object renders at a reduced
+        // resolution like moving the camera does, and returns to full resolution after it.
+        if actions.changes.any() {
             self.last_motion = Some(now);
         }
         if actions.changes.lights || actions.changes.scene {
@@ -667,6 +686,10 @@ impl App {
             }
         }
         self.update_display(new_image);
+        if new_image {
+            // The overlay above was drawn with the previous figures: draw once more.
+            self.wake = Some(now);
+        }
         if actions.screenshot {
             self.screenshot();
         }
