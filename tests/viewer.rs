@@ -139,7 +139,11 @@ fn viewer_command(x: &Xvfb, dir: &Path, args: &[&str]) -> Command {
         .current_dir(dir)
         .env("DISPLAY", &x.display)
         .env_remove("WAYLAND_DISPLAY")
-        .env("PENUMBRA_DEVICE", test_device());
+        .env("PENUMBRA_DEVICE", test_device())
+        // Quiet the windowing stack's warnings about Xvfb (no XSETTINGS, a 0 mm screen) and
+        // Mesa's about a missing runtime folder.
+        .env("RUST_LOG", "warn,winit=error,egui_wgpu=error")
+        .env("XDG_RUNTIME_DIR", dir);
     c
 }
 
