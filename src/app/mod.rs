@@ -69,8 +69,15 @@ pub fn run(args: ViewArgs) -> Result<()> {
     let settings = args.common.settings(DEFAULT_SIZE)?;
     let prepared = args.common.prepare(args.scene.as_deref())?;
     let event_loop = EventLoop::new().map_err(|e| {
+        // winit's message starts with its source location; keep the reason only.
+        let text = e.to_string();
+        let reason = text.rsplit(": ").next().unwrap_or(&text).to_string();
+        let display = std::env::var("WAYLAND_DISPLAY")
+            .or_else(|_| std::env::var("DISPLAY"))
+            .unwrap_or_default();
         anyhow!(
-            "cannot open a window ({e}); use `penumbra render SCENE -o OUT.png` without a display"
+            "cannot open a window on display '{display}' ({reason}); use `penumbra render SCENE \
+             -o OUT.png` to render without one"
         )
     })?;
     let renderer = Renderer::new(&args.common.device_choice()?)
