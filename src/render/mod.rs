@@ -303,6 +303,11 @@ impl Renderer {
         self.reset()
     }
 
+    /// The environment map on the device, for tests.
+    pub fn env_buffers(&self) -> &EnvBuffers {
+        &self.env
+    }
+
     /// The environment map, if one is set.
     pub fn environment(&self) -> Option<&EnvMap> {
         self.environment.as_ref().map(|(m, _)| m.as_ref())

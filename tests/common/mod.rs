@@ -56,6 +56,8 @@ pub struct Gltf {
     pub used: Vec<String>,
     /// extensionsRequired.
     pub required: Vec<String>,
+    /// More top-level entries (images, textures, samplers).
+    pub extra: serde_json::Map<String, Value>,
 }
 
 impl Gltf {
@@ -71,6 +73,26 @@ impl Gltf {
         }
         self.views.push(view);
         self.views.len() - 1
+    }
+
+    /// Adds raw bytes (an encoded image) as a buffer view; returns its index.
+    pub fn bytes_view(&mut self, bytes: &[u8]) -> usize {
+        self.push_data(bytes, None)
+    }
+
+    /// Adds a float accessor of `N` components (VEC2 or VEC4); returns its index.
+    pub fn float_accessor<const N: usize>(&mut self, data: &[[f32; N]]) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
+        let view = self.push_data(&bytes, Some(34962));
+        let kind = format!("VEC{N}");
+        self.accessors.push(
+            json!({"bufferView": view, "componentType": 5126, "count": data.len(), "type": kind}),
+        );
+        self.accessors.len() - 1
     }
 
     fn vec3_accessor(&mut self, data: &[[f32; 3]]) -> usize {
@@ -187,6 +209,9 @@ impl Gltf {
         });
         if !self.cameras.is_empty() {
             doc["cameras"] = json!(self.cameras);
+        }
+        for (k, v) in &self.extra {
+            doc[k] = v.clone();
         }
         let mut used = self.used.clone();
         if !self.lights.is_empty() {

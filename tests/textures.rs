@@ -1,0 +1,709 @@
+//! Textures on the default OpenCL device (PoCL in CI): lookups through a test kernel against a
+//! host reference of the glTF sampler (wrap modes, bilinear filtering, sRGB, texture
+//! transforms), and renders for what only the whole path shows (sRGB albedo under a uniform
+//! sky, normal-map orientation, alpha cut-outs and stochastic transparency in shadow rays).
+//! Fixtures are tiny PNGs written by the tests into temporary glTF files.
+
+mod common;
+
+use common::{Gltf, Prim, render_exr};
+use penumbra::cl::DeviceChoice;
+use penumbra::render::Renderer;
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+
+fn renderer() -> Renderer {
+    let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
+    Renderer::new(&choice).expect("the test's OpenCL device is available")
+}
+
+/// PNG bytes of RGBA texels, row by row from the top.
+fn png(width: u32, height: u32, texels: &[[u8; 4]]) -> Vec<u8> {
+    let raw: Vec<u8> = texels.iter().flatten().copied().collect();
+    let image = image::RgbaImage::from_raw(width, height, raw).unwrap();
+    let mut out = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    out.into_inner()
+}
+
+/// glTF sampler wrap codes.
+const REPEAT: u32 = 10497;
+const CLAMP: u32 = 33071;
+const MIRROR: u32 = 33648;
+
+/// Images, samplers and textures of a fixture, written into `Gltf::extra`.
+#[derive(Default)]
+struct TextureSet {
+    images: Vec<Value>,
+    samplers: Vec<Value>,
+    textures: Vec<Value>,
+}
+
+impl TextureSet {
+    /// Embeds a PNG in the binary buffer; returns the image index.
+    fn embedded(&mut self, g: &mut Gltf, bytes: &[u8]) -> usize {
+        let view = g.bytes_view(bytes);
+        self.images
+            .push(json!({"bufferView": view, "mimeType": "image/png"}));
+        self.images.len() - 1
+    }
+
+    /// A texture of `image` with a sampler wrapping both axes by `wrap`.
+    fn texture(&mut self, image: usize, wrap: u32) -> usize {
+        self.samplers.push(json!({"wrapS": wrap, "wrapT": wrap}));
+        self.textures
+            .push(json!({"source": image, "sampler": self.samplers.len() - 1}));
+        self.textures.len() - 1
+    }
+
+    fn finish(self, g: &mut Gltf) {
+        g.extra.insert("images".into(), json!(self.images));
+        g.extra.insert("samplers".into(), json!(self.samplers));
+        g.extra.insert("textures".into(), json!(self.textures));
+    }
+}
+
+/// A 2×2 quad in the XY plane facing +Z with glTF's usual UVs (u along +X, v down the image,
+/// i.e. along −Y), or u mirrored along −X.
+fn quad(g: &mut Gltf, material: usize, mirrored_u: bool, tangents: bool) -> usize {
+    let positions = vec![
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+    ];
+    let mut uvs = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
+    if mirrored_u {
+        for uv in &mut uvs {
+            uv[0] = 1.0 - uv[0];
+        }
+    }
+    let mesh = g.mesh(vec![Prim {
+        positions,
+        normals: vec![[0.0, 0.0, 1.0]; 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material: Some(material),
+        mode: 4,
+    }]);
+    let uv = g.float_accessor(&uvs);
+    g.meshes[mesh]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv);
+    if tangents {
+        let t = g.float_accessor(&[[1.0f32, 0.0, 0.0, 1.0]; 4]);
+        g.meshes[mesh]["primitives"][0]["attributes"]["TANGENT"] = json!(t);
+    }
+    mesh
+}
+
+/// A Lambertian (specularFactor 0) material; `extra` is merged into its JSON.
+fn lambert(g: &mut Gltf, color: [f32; 4], extra: Value) -> usize {
+    g.use_ext("KHR_materials_specular");
+    let mut m = json!({
+        "pbrMetallicRoughness": {"baseColorFactor": color, "metallicFactor": 0.0, "roughnessFactor": 1.0},
+        "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}
+    });
+    merge(&mut m, extra);
+    g.materials.push(m);
+    g.materials.len() - 1
+}
+
+fn merge(dst: &mut Value, src: Value) {
+    match (dst, src) {
+        (Value::Object(d), Value::Object(s)) => {
+            for (k, v) in s {
+                merge(d.entry(k).or_insert(Value::Null), v);
+            }
+        }
+        (d, s) => *d = s,
+    }
+}
+
+fn srgb(v: u8) -> f32 {
+    let c = v as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The glTF sampler on the host: wrap, then bilinear between texel centres.
+fn reference(
+    texels: &[[u8; 4]],
+    w: i64,
+    h: i64,
+    wrap: u32,
+    is_srgb: bool,
+    st: [f32; 2],
+) -> [f32; 4] {
+    let fold = |i: i64, n: i64| -> i64 {
+        match wrap {
+            CLAMP => i.clamp(0, n - 1),
+            MIRROR => {
+                let m = i.rem_euclid(2 * n);
+                if m < n { m } else { 2 * n - 1 - m }
+            }
+            _ => i.rem_euclid(n),
+        }
+    };
+    let decode = |t: [u8; 4]| -> [f32; 4] {
+        let c = |v: u8| {
+            if is_srgb { srgb(v) } else { v as f32 / 255.0 }
+        };
+        [c(t[0]), c(t[1]), c(t[2]), t[3] as f32 / 255.0]
+    };
+    let x = st[0] * w as f32 - 0.5;
+    let y = st[1] * h as f32 - 0.5;
+    let (fx, fy) = (x.floor(), y.floor());
+    let (ax, ay) = (x - fx, y - fy);
+    let at = |i: i64, j: i64| decode(texels[(fold(j, h) * w + fold(i, w)) as usize]);
+    let (x0, y0) = (fx as i64, fy as i64);
+    let (c00, c10, c01, c11) = (
+        at(x0, y0),
+        at(x0 + 1, y0),
+        at(x0, y0 + 1),
+        at(x0 + 1, y0 + 1),
+    );
+    let mut out = [0.0; 4];
+    for k in 0..4 {
+        let top = c00[k] + (c10[k] - c00[k]) * ax;
+        let bottom = c01[k] + (c11[k] - c01[k]) * ax;
+        out[k] = top + (bottom - top) * ay;
+    }
+    out
+}
+
+/// Deterministic pseudo-random numbers in [0, 1).
+fn lcg(seed: u64) -> impl FnMut() -> f32 {
+    let mut s = seed;
+    move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// A 4×4 texture with distinct channels per texel.
+fn test_texels() -> Vec<[u8; 4]> {
+    (0..16u8)
+        .map(|i| [i * 15, 255 - i * 15, (i % 4) * 60 + 10, 255 - i * 7])
+        .collect()
+}
+
+/// An 8×8 black-and-white checker (sRGB 0 and 255).
+fn checker() -> Vec<[u8; 4]> {
+    (0..64)
+        .map(|i| {
+            let v = if (i % 8 + i / 8) % 2 == 0 { 255 } else { 0 };
+            [v, v, v, 255]
+        })
+        .collect()
+}
+
+/// KHR_texture_transform's matrix as the extension's text writes it, applied to uv.
+fn transform(offset: [f32; 2], rotation: f32, scale: [f32; 2], uv: [f32; 2]) -> [f32; 2] {
+    let (s, c) = rotation.sin_cos();
+    let (x, y) = (uv[0] * scale[0], uv[1] * scale[1]);
+    [c * x + s * y + offset[0], -s * x + c * y + offset[1]]
+}
+
+/// The transforms the lookup test uses: (offset, rotation, scale).
+const TRANSFORMS: [([f32; 2], f32, [f32; 2]); 3] = [
+    ([0.25, -0.125], 0.0, [1.0, 1.0]),
+    ([0.0, 0.0], 0.0, [2.0, 0.5]),
+    ([0.1, 0.3], 0.6, [1.5, 0.75]),
+];
+
+/// Materials 0–2: metallic-roughness (linear) textures of `test_texels` with repeat, clamp and
+/// mirror; 3: a 1×1 base color of 128 gray and alpha 128; 4–6: base color checkers with the
+/// transforms (the last one with a texCoord override). One texture per material, so texture
+/// reference i belongs to material i.
+fn lookup_fixture(dir: &Path) -> PathBuf {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let texels = test_texels();
+    let image = t.embedded(&mut g, &png(4, 4, &texels));
+    for wrap in [REPEAT, CLAMP, MIRROR] {
+        let tex = t.texture(image, wrap);
+        lambert(
+            &mut g,
+            [1.0; 4],
+            json!({"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": tex}}}),
+        );
+    }
+    let gray = t.embedded(&mut g, &png(1, 1, &[[128, 128, 128, 128]]));
+    let tex = t.texture(gray, REPEAT);
+    lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": tex}}}),
+    );
+    let check = t.embedded(&mut g, &png(8, 8, &checker()));
+    g.use_ext("KHR_texture_transform");
+    for (i, (offset, rotation, scale)) in TRANSFORMS.iter().enumerate() {
+        let tex = t.texture(check, REPEAT);
+        let mut x = json!({"offset": offset, "rotation": rotation, "scale": scale});
+        if i == 2 {
+            x["texCoord"] = json!(1);
+        }
+        lambert(
+            &mut g,
+            [1.0; 4],
+            json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": tex, "extensions": {"KHR_texture_transform": x}}}}),
+        );
+    }
+    t.finish(&mut g);
+    let mesh = quad(&mut g, 0, false, false);
+    g.node(json!({"mesh": mesh}));
+    g.write_glb(dir, "lookups")
+}
+
+#[test]
+fn lookups_wrap_filter_decode_srgb_and_transform_like_the_gltf_sampler() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = penumbra::scene::load(&lookup_fixture(dir.path())).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.texture_refs.len(), 7);
+    let mut r = renderer();
+    r.load_scene(&scene, &[]).unwrap();
+    let program = r.program().unwrap();
+    assert!(program.features.textures);
+    let buffers = r.scene_buffers().unwrap();
+    let mut rnd = lcg(3);
+    let mut queries = vec![];
+    let mut expect = vec![];
+    let texels = test_texels();
+    for (reference_index, wrap) in [REPEAT, CLAMP, MIRROR].into_iter().enumerate() {
+        for k in 0..400 {
+            // Texel centres (exact texel values), then arbitrary points, mostly outside [0, 1].
+            let st = if k < 64 {
+                [(k % 8) as f32 * 0.25 - 0.875, (k / 8) as f32 * 0.25 - 0.875]
+            } else {
+                [rnd() * 4.6 - 1.8, rnd() * 4.6 - 1.8]
+            };
+            queries.push([
+                st[0],
+                st[1],
+                f32::NEG_INFINITY,
+                f32::from_bits(reference_index as u32),
+            ]);
+            expect.push(reference(&texels, 4, 4, wrap, false, st));
+        }
+    }
+    // sRGB: a base color texel of 128 reads 0.2158605 linear; alpha stays linear.
+    queries.push([0.3, 0.7, f32::NEG_INFINITY, f32::from_bits(3)]);
+    let g = srgb(128);
+    expect.push([g, g, g, 128.0 / 255.0]);
+    // Transforms move the checker as the extension's matrix says.
+    let check = checker();
+    for (i, (offset, rotation, scale)) in TRANSFORMS.iter().enumerate() {
+        for _ in 0..200 {
+            let uv = [rnd() * 2.0 - 0.5, rnd() * 2.0 - 0.5];
+            queries.push([
+                uv[0],
+                uv[1],
+                f32::NEG_INFINITY,
+                f32::from_bits(4 + i as u32),
+            ]);
+            let st = transform(*offset, *rotation, *scale, uv);
+            expect.push(reference(&check, 8, 8, REPEAT, true, st));
+        }
+    }
+    let got = program
+        .sample_texture_test(&r.gpu, buffers, &queries)
+        .unwrap();
+    for (i, (g, e)) in got.iter().zip(&expect).enumerate() {
+        for c in 0..4 {
+            assert!(
+                (g[c] - e[c]).abs() < 2e-4,
+                "query {i} {:?}: device {g:?}, reference {e:?}",
+                queries[i]
+            );
+        }
+    }
+    assert!((got[1200][0] - 0.2158605).abs() < 1e-6);
+}
+
+#[test]
+fn mip_levels_follow_the_footprint_and_average_in_linear_space() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = penumbra::scene::load(&lookup_fixture(dir.path())).unwrap();
+    let mut r = renderer();
+    r.load_scene(&scene, &[]).unwrap();
+    // Reference 4 is the 8×8 checker moved by (0.25, -0.125): this uv reads the centre of its
+    // white texel (0, 0). Footprint levels are per unit of UV area, and the 8×8 texture adds
+    // log2(8) = 3, so -3 reads level 0; -2 and above read 4×4 and smaller levels, where every
+    // texel is the linear mean of black and white, 0.5 (sRGB 188, read back as 0.5029).
+    let q = |lod: f32| [-0.1875, 0.1875, lod, f32::from_bits(4)];
+    let got = r
+        .program()
+        .unwrap()
+        .sample_texture_test(
+            &r.gpu,
+            r.scene_buffers().unwrap(),
+            &[q(-9.0), q(-3.0), q(-2.5), q(-2.0), q(0.0), q(9.0)],
+        )
+        .unwrap();
+    let levels: Vec<f32> = got.iter().map(|g| g[0]).collect();
+    let mean = srgb(188);
+    let expect = [1.0, 1.0, 1.0, mean, mean, mean];
+    for (g, e) in levels.iter().zip(expect) {
+        assert!(
+            (g - e).abs() < 1e-4,
+            "levels read {levels:?}, expected {expect:?}"
+        );
+    }
+}
+
+/// A large Lambertian floor with a uniform 128-gray base color texture, seen from above.
+fn gray_floor(dir: &Path) -> PathBuf {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let gray = t.embedded(&mut g, &png(2, 2, &[[128, 128, 128, 255]; 4]));
+    let tex = t.texture(gray, REPEAT);
+    let m = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": tex}}}),
+    );
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, false, false);
+    // The quad faces +Z; turn it to face +Y and make it 2000 units wide.
+    g.node(json!({"mesh": mesh, "rotation": [-0.70710678, 0.0, 0.0, 0.70710678], "scale": [1000.0, 1000.0, 1.0]}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 1.0, 0.0], "rotation": [-0.70710678, 0.0, 0.0, 0.70710678]}));
+    g.write_glb(dir, "floor")
+}
+
+fn mean(px: &[[f32; 3]], c: usize) -> f64 {
+    px.iter().map(|p| p[c] as f64).sum::<f64>() / px.len() as f64
+}
+
+#[test]
+fn an_srgb_128_floor_under_a_unit_sky_reflects_0_2158() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = gray_floor(dir.path());
+    let out = dir.path().join("floor.exr");
+    // A Lambertian floor under a uniform sky of radiance 1 (irradiance π) has radiance
+    // albedo × E / π = albedo; every BSDF sample escapes, so there is no noise.
+    let (summary, px) = render_exr(
+        &scene,
+        &out,
+        &[
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--spp",
+            "4",
+            "--bounces",
+            "0",
+            "--env",
+            "1",
+        ],
+    );
+    assert_eq!(summary["nonfinite_samples"], 0);
+    assert_eq!(summary["textures"], 1);
+    for c in 0..3 {
+        let m = mean(&px, c);
+        assert!((m - 0.2158605).abs() < 1e-3, "channel {c}: {m}");
+    }
+}
+
+/// A 2×2 quad facing the camera with a uniform normal map texel `normal`, lit by a directional
+/// light of irradiance π travelling along `light` (unit).
+fn normal_mapped(
+    dir: &Path,
+    name: &str,
+    normal: [u8; 3],
+    light_rotation: [f64; 4],
+    mirrored_u: bool,
+    tangents: bool,
+) -> PathBuf {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let image = t.embedded(
+        &mut g,
+        &png(2, 2, &[[normal[0], normal[1], normal[2], 255]; 4]),
+    );
+    let tex = t.texture(image, REPEAT);
+    let m = lambert(&mut g, [1.0; 4], json!({"normalTexture": {"index": tex}}));
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, mirrored_u, tangents);
+    g.node(json!({"mesh": mesh}));
+    g.lights
+        .push(json!({"type": "directional", "intensity": std::f32::consts::PI}));
+    g.node(
+        json!({"extensions": {"KHR_lights_punctual": {"light": 0}}, "rotation": light_rotation}),
+    );
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.4, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 3.0]}));
+    g.write_glb(dir, name)
+}
+
+#[test]
+fn normal_maps_tilt_towards_u_and_up_the_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = std::f64::consts::FRAC_PI_8.sin();
+    let c = std::f64::consts::FRAC_PI_8.cos();
+    // Light from +X at 45° (travelling along (-1, 0, -1)/√2), and from +Y at 45°.
+    let from_x = [0.0, s, 0.0, c];
+    let from_y = [-s, 0.0, 0.0, c];
+    let flat = [128, 128, 255];
+    let toward_u = [218, 128, 218];
+    let away_u = [38, 128, 218];
+    let up_image = [128, 218, 218];
+    // Lambertian, albedo 1, irradiance π: radiance is the cosine between normal and light.
+    let cases: [(&str, [u8; 3], [f64; 4], bool, bool, f64); 7] = [
+        (
+            "flat",
+            flat,
+            from_x,
+            false,
+            false,
+            std::f64::consts::FRAC_1_SQRT_2,
+        ),
+        ("toward-u", toward_u, from_x, false, false, 1.0),
+        ("away-u", away_u, from_x, false, false, 0.0),
+        ("toward-u-file-tangents", toward_u, from_x, false, true, 1.0),
+        // With u running along -X, "towards +u" faces away from the light.
+        ("toward-u-mirrored", toward_u, from_x, true, false, 0.0),
+        (
+            "up-flat",
+            flat,
+            from_y,
+            false,
+            false,
+            std::f64::consts::FRAC_1_SQRT_2,
+        ),
+        ("up-image", up_image, from_y, false, false, 1.0),
+    ];
+    for (name, normal, light, mirrored, tangents, expect) in cases {
+        let scene = normal_mapped(dir.path(), name, normal, light, mirrored, tangents);
+        let out = dir.path().join(format!("{name}.exr"));
+        let (summary, px) = render_exr(
+            &scene,
+            &out,
+            &[
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--spp",
+                "2",
+                "--bounces",
+                "0",
+                "--hard-shadows",
+            ],
+        );
+        assert_eq!(summary["nonfinite_samples"], 0);
+        let m = mean(&px, 1);
+        assert!(
+            (m - expect).abs() < 0.015,
+            "{name}: radiance {m}, expected {expect}"
+        );
+    }
+}
+
+/// A white floor (y = 0) under a red quad (y = 1, |x|, |z| < 1) with `occluder` as the red
+/// material's extra JSON, lit straight from above; the camera looks down from y = 5 and sees
+/// x, z in ±1.5 on the floor.
+fn shadowed_floor(dir: &Path, name: &str, alpha_texture: bool, occluder: Value) -> PathBuf {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let mut occluder = occluder;
+    if alpha_texture {
+        // Alpha 0 for u < 0.5, 1 beyond, along u (+X).
+        let image = t.embedded(
+            &mut g,
+            &png(
+                4,
+                1,
+                &[[255, 255, 255, 0], [255, 255, 255, 0], [255; 4], [255; 4]],
+            ),
+        );
+        let tex = t.texture(image, CLAMP);
+        merge(
+            &mut occluder,
+            json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": tex}}}),
+        );
+    }
+    let white = lambert(&mut g, [1.0; 4], json!({}));
+    let red = lambert(&mut g, [1.0, 0.0, 0.0, 1.0], occluder);
+    t.finish(&mut g);
+    let face_up = [-0.70710678, 0.0, 0.0, 0.70710678];
+    let floor = quad(&mut g, white, false, false);
+    g.node(json!({"mesh": floor, "rotation": face_up, "scale": [3.0, 3.0, 1.0]}));
+    let top = quad(&mut g, red, false, false);
+    g.node(json!({"mesh": top, "rotation": face_up, "translation": [0.0, 1.0, 0.0]}));
+    g.lights
+        .push(json!({"type": "directional", "intensity": std::f32::consts::PI}));
+    g.node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}, "rotation": face_up}));
+    let yfov = 2.0 * (1.5f64 / 5.0).atan();
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": yfov, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 5.0, 0.0], "rotation": face_up}));
+    g.write_glb(dir, name)
+}
+
+/// Pixels of a `side`² image whose ray crosses the occluder's plane (y = 1) within
+/// |x|, |z| < 0.75 (the floor behind, within ±0.94, is all in the quad's shadow): the camera
+/// sees ±1.5 at the floor, so ±1.2 at the occluder.
+fn under_occluder(side: usize) -> Vec<usize> {
+    let mut out = vec![];
+    for j in 0..side {
+        for i in 0..side {
+            let x = (-1.0 + 2.0 * (i as f64 + 0.5) / side as f64) * 1.2;
+            let z = (-1.0 + 2.0 * (j as f64 + 0.5) / side as f64) * 1.2;
+            if x.abs() < 0.75 && z.abs() < 0.75 {
+                out.push(j * side + i);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn masked_cut_outs_let_camera_and_shadow_rays_through() {
+    let dir = tempfile::tempdir().unwrap();
+    let side = 40;
+    let size = side.to_string();
+    let args = [
+        "--width",
+        &size,
+        "--height",
+        &size,
+        "--spp",
+        "4",
+        "--bounces",
+        "0",
+        "--hard-shadows",
+    ];
+    let region = under_occluder(side);
+    let fractions = |px: &[[f32; 3]]| {
+        let lit = region.iter().filter(|&&i| px[i][1] > 0.9).count();
+        let red = region
+            .iter()
+            .filter(|&&i| px[i][0] > 0.9 && px[i][1] < 0.05)
+            .count();
+        (
+            lit as f64 / region.len() as f64,
+            red as f64 / region.len() as f64,
+        )
+    };
+    // Opaque: the red quad hides the floor.
+    let scene = shadowed_floor(dir.path(), "opaque", true, json!({}));
+    let (_, px) = render_exr(&scene, &dir.path().join("o.exr"), &args);
+    assert_eq!(fractions(&px), (0.0, 1.0));
+    // Masked at 0.5: the half with alpha below the cutoff (u < 0.5, x < 0) shows the floor, lit,
+    // so shadow rays passed the cut-out too.
+    let scene = shadowed_floor(
+        dir.path(),
+        "mask",
+        true,
+        json!({"alphaMode": "MASK", "alphaCutoff": 0.5}),
+    );
+    let (summary, px) = render_exr(&scene, &dir.path().join("m.exr"), &args);
+    assert_eq!(summary["nonfinite_samples"], 0);
+    let (lit, red) = fractions(&px);
+    assert!((0.45..0.55).contains(&lit), "lit floor fraction {lit}");
+    assert!((0.45..0.55).contains(&red), "red quad fraction {red}");
+}
+
+#[test]
+fn blended_surfaces_pass_camera_and_shadow_rays_with_probability_one_minus_alpha() {
+    let dir = tempfile::tempdir().unwrap();
+    let side = 24;
+    let size = side.to_string();
+    let scene = shadowed_floor(
+        dir.path(),
+        "blend",
+        false,
+        json!({"alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1.0, 0.0, 0.0, 0.4]}}),
+    );
+    let (summary, px) = render_exr(
+        &scene,
+        &dir.path().join("b.exr"),
+        &[
+            "--width",
+            &size,
+            "--height",
+            &size,
+            "--spp",
+            "64",
+            "--bounces",
+            "0",
+            "--hard-shadows",
+        ],
+    );
+    assert_eq!(summary["nonfinite_samples"], 0);
+    // Green comes only from the white floor, seen with probability 0.6 and lit with 0.6.
+    let region = under_occluder(side);
+    let g = region.iter().map(|&i| px[i][1] as f64).sum::<f64>() / region.len() as f64;
+    assert!((g - 0.36).abs() < 0.02, "mean green under the quad {g}");
+    // Red: the quad itself (0.4 × 1 × cos) plus the floor behind it (0.36).
+    let r = region.iter().map(|&i| px[i][0] as f64).sum::<f64>() / region.len() as f64;
+    assert!((r - 0.76).abs() < 0.03, "mean red under the quad {r}");
+}
+
+#[test]
+fn images_load_from_glb_views_data_uris_and_files_and_unused_ones_are_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = png(4, 4, &test_texels());
+    std::fs::write(dir.path().join("tex ture.png"), &bytes).unwrap();
+    let data_uri = {
+        const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut s = String::from("data:image/png;base64,");
+        for c in bytes.chunks(3) {
+            let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
+            let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
+            for i in 0..4 {
+                s.push(if i <= c.len() {
+                    T[(n >> (18 - 6 * i)) as usize & 63] as char
+                } else {
+                    '='
+                });
+            }
+        }
+        s
+    };
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let view = t.embedded(&mut g, &bytes);
+    t.images.push(json!({"uri": data_uri}));
+    t.images.push(json!({"uri": "tex%20ture.png"}));
+    // Referenced by no material: must not be read.
+    t.images.push(json!({"uri": "missing.png"}));
+    for image in [view, 1, 2] {
+        let tex = t.texture(image, REPEAT);
+        lambert(
+            &mut g,
+            [1.0; 4],
+            json!({"emissiveTexture": {"index": tex}, "emissiveFactor": [1.0, 1.0, 1.0]}),
+        );
+    }
+    t.finish(&mut g);
+    let mesh = quad(&mut g, 0, false, false);
+    g.node(json!({"mesh": mesh}));
+    let path = g.write_gltf(dir.path(), "sources");
+    let scene = penumbra::scene::load(&path).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.images.len(), 3);
+    let texels = test_texels();
+    for image in &scene.images {
+        assert_eq!((image.width, image.height), (4, 4));
+        assert_eq!(image.rgba, texels, "{}", image.name);
+    }
+    // A broken image is a warning, and its slot falls back to the factor.
+    std::fs::write(dir.path().join("tex ture.png"), b"not a png").unwrap();
+    let scene = penumbra::scene::load(&path).unwrap();
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(
+        scene.warnings[0].contains("tex%20ture.png"),
+        "{:?}",
+        scene.warnings
+    );
+    assert!(scene.materials[2].textures.emissive.is_none());
+}
