@@ -131,6 +131,18 @@ mod tests {
     }
 
     #[test]
+    fn a_build_error_names_the_kernel_file_and_line() {
+        let gpu = Gpu::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
+        let source = "#line 1 \"kernels/broken.cl\"\nkernel void f(global int* x) {\n  x[0] = undeclared;\n}\n";
+        let err = build_source(&gpu, source, KernelFeatures::default())
+            .err()
+            .expect("the source does not compile")
+            .to_string();
+        assert!(err.contains("kernels/broken.cl:2"), "{err}");
+        assert!(!err.contains('\n'), "one line: {err}");
+    }
+
+    #[test]
     fn first_error_picks_the_error_line() {
         let log = "warning: x\nkernels/stages.cl:12:5: error: use of undeclared identifier\n";
         assert_eq!(
