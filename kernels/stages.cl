@@ -187,7 +187,13 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     float alpha_r = m.roughness * m.roughness;
     cones[slot] = (float2)(cone_width, cone.y + alpha_r);
 #endif
-    float3 origin = offset_ray(p, ng);
+
+    // Hit from behind, a transmissive volume was travelled through: attenuate the segment
+    // (Beer–Lambert) and see the interface from inside. Other back faces shade as front faces.
+    if (!front && m.transmission > 0.0f && m.thickness > 0.0f) {
+        throughput *= volume_transmittance(&m, hit.t);
+        material_from_inside(&m);
+    }
 
     // Next-event estimation: one light sample, traced later by `connect`.
     if (frame.strategy != STRATEGY_BSDF && frame.light_count > 0u) {
@@ -195,7 +201,12 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
         float u1 = rng_next(&rng);
         float u2 = rng_next(&rng);
         LightSample ls = sample_light(lights, tris, materials, &surf, &env, index, p, u1, u2);
-        if (dot(ls.wi, ng) > 0.0f && (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
+        // A light behind the surface is reached through transmission when bsdf_eval says so;
+        // the geometric and shading normals must agree on the side. Transmissive surfaces
+        // block shadow rays (no caustics through next-event estimation).
+        float side = dot(ls.wi, ng);
+        if (side * dot(ls.wi, ns) > 0.0f &&
+            (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
             float bsdf_pdf;
             float3 f = bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
             float weight = (frame.strategy == STRATEGY_MIS && ls.pdf > 0.0f)
@@ -205,7 +216,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
             if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
                 uint s = atomic_inc(&counters[COUNT_SHADOW]);
                 GpuShadowRay ray;
-                ray.origin = (float4)(origin, ls.distance * 0.9999f);
+                ray.origin = (float4)(offset_ray(p, side > 0.0f ? ng : -ng), ls.distance * 0.9999f);
                 ray.direction = (float4)(ls.wi, as_float(slot));
                 ray.contribution = (float4)(contribution, 0.0f);
                 shadow_rays[s] = ray;
@@ -219,9 +230,11 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     bool specular;
     float u1 = rng_next(&rng);
     float u2 = rng_next(&rng);
-    float3 weight = bsdf_sample(&m, ns, wo, u1, u2, &wi, &pdf, &specular);
+    float u3 = m.transmission > 0.0f ? rng_next(&rng) : 0.0f;
+    float3 weight = bsdf_sample(&m, ns, wo, (float3)(u1, u2, u3), &wi, &pdf, &specular);
     throughput *= weight;
-    bool alive = pdf > 0.0f && dot(wi, ng) > 0.0f &&
+    float side = dot(wi, ng);
+    bool alive = pdf > 0.0f && side * dot(wi, ns) > 0.0f &&
                  (throughput.x > 0.0f || throughput.y > 0.0f || throughput.z > 0.0f);
     if (alive && frame.bounce >= frame.rr_depth) {
         float q = fmin(fmax(throughput.x, fmax(throughput.y, throughput.z)), 0.95f);
@@ -233,7 +246,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     }
     path.radiance = (float4)(radiance, as_float(rng));
     if (alive) {
-        path.origin = (float4)(origin, pdf);
+        path.origin = (float4)(offset_ray(p, side > 0.0f ? ng : -ng), pdf);
         path.direction = (float4)(wi, as_float(specular ? PATH_SPECULAR : 0u));
         path.throughput.xyz = throughput;
         queue_out[atomic_inc(&counters[COUNT_OUT])] = slot;

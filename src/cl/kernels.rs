@@ -139,6 +139,8 @@ pub struct Program {
     probe_layout: Kernel,
     sample_texture_test: Kernel,
     sample_env_test: Kernel,
+    bsdf_sample_test: Kernel,
+    bsdf_eval_test: Kernel,
     local_size: usize,
     /// Features it was built with.
     pub features: KernelFeatures,
@@ -169,6 +171,8 @@ impl Program {
             probe_layout: k("probe_layout")?,
             sample_texture_test: k("sample_texture_test")?,
             sample_env_test: k("sample_env_test")?,
+            bsdf_sample_test: k("bsdf_sample_test")?,
+            bsdf_eval_test: k("bsdf_eval_test")?,
             local_size: 64.min(max_group),
             features,
         })
@@ -439,6 +443,76 @@ impl Program {
             },
         )?;
         Ok((out.read(gpu)?, eval.read(gpu)?))
+    }
+
+    /// `bsdf_sample_test`: `count` BSDF samples of `material` at (`wo`, `n`), seen from inside
+    /// its volume when `inside`; returns (wi, pdf) and (weight, 1 for a delta lobe) per sample.
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    pub fn bsdf_sample_test(
+        &self,
+        gpu: &Gpu,
+        material: &GpuMaterial,
+        wo: [f32; 4],
+        n: [f32; 4],
+        inside: bool,
+        count: usize,
+        seed: u32,
+    ) -> Result<(Vec<[f32; 4]>, Vec<[f32; 4]>), ClError> {
+        let material = Buffer::from_slice(gpu, &[*material])?;
+        let wi_pdf = Buffer::<[f32; 4]>::new(gpu, count)?;
+        let weight = Buffer::<[f32; 4]>::new(gpu, count)?;
+        let inside = inside as u32;
+        let count32 = count as u32;
+        self.run(
+            gpu,
+            "bsdf_sample_test",
+            &self.bsdf_sample_test,
+            count,
+            |e| unsafe {
+                e.set_arg(&material.mem())
+                    .set_arg(&wo)
+                    .set_arg(&n)
+                    .set_arg(&inside)
+                    .set_arg(&count32)
+                    .set_arg(&seed)
+                    .set_arg(&wi_pdf.mem())
+                    .set_arg(&weight.mem());
+            },
+        )?;
+        Ok((wi_pdf.read(gpu)?, weight.read(gpu)?))
+    }
+
+    /// `bsdf_eval_test`: (f·|cos|, pdf) of `material` at (`wo`, `n`) for each direction of `wi`.
+    pub fn bsdf_eval_test(
+        &self,
+        gpu: &Gpu,
+        material: &GpuMaterial,
+        wo: [f32; 4],
+        n: [f32; 4],
+        inside: bool,
+        wi: &[[f32; 4]],
+    ) -> Result<Vec<[f32; 4]>, ClError> {
+        let material = Buffer::from_slice(gpu, &[*material])?;
+        let wi_buf = Buffer::from_slice(gpu, wi)?;
+        let out = Buffer::<[f32; 4]>::new(gpu, wi.len())?;
+        let inside = inside as u32;
+        let count = wi.len() as u32;
+        self.run(
+            gpu,
+            "bsdf_eval_test",
+            &self.bsdf_eval_test,
+            wi.len(),
+            |e| unsafe {
+                e.set_arg(&material.mem())
+                    .set_arg(&wo)
+                    .set_arg(&n)
+                    .set_arg(&inside)
+                    .set_arg(&count)
+                    .set_arg(&wi_buf.mem())
+                    .set_arg(&out.mem());
+            },
+        )?;
+        out.read(gpu)
     }
 }
 

@@ -21,6 +21,10 @@ const SOURCES: &[(&str, &str)] = &[
     ("kernels/lights.h", include_str!("../../kernels/lights.h")),
     ("kernels/stages.cl", include_str!("../../kernels/stages.cl")),
     ("kernels/tools.cl", include_str!("../../kernels/tools.cl")),
+    (
+        "kernels/bsdf_test.cl",
+        include_str!("../../kernels/bsdf_test.cl"),
+    ),
 ];
 
 /// The scene features that decide which kernel code is compiled in.

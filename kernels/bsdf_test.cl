@@ -1,0 +1,39 @@
+// Kernels that run the BSDF on given inputs for tests/bsdf.rs (χ² tests of sampling against the
+// pdf, and albedo checks).
+
+inline SurfaceMaterial bsdf_test_material(global const GpuMaterial* material, uint inside) {
+    SurfaceMaterial m = surface_material(material);
+    if (inside != 0u) material_from_inside(&m);
+    return m;
+}
+
+// `count` samples of the BSDF at (wo, n) with random numbers drawn as the shade kernel draws them.
+// Writes (wi, pdf) and (weight, 1 for a delta lobe else 0).
+kernel void bsdf_sample_test(global const GpuMaterial* material, float4 wo, float4 n, uint inside,
+                             uint count, uint seed, global float4* wi_pdf,
+                             global float4* weight_specular) {
+    uint i = get_global_id(0);
+    if (i >= count) return;
+    SurfaceMaterial m = bsdf_test_material(material, inside);
+    uint rng = hash_u32(hash_u32(i * 0x9e3779b9u + 1u) ^ hash_u32(seed));
+    float u1 = rng_next(&rng);
+    float u2 = rng_next(&rng);
+    float u3 = rng_next(&rng);
+    float3 wi;
+    float pdf;
+    bool specular;
+    float3 weight = bsdf_sample(&m, n.xyz, wo.xyz, (float3)(u1, u2, u3), &wi, &pdf, &specular);
+    wi_pdf[i] = (float4)(wi, pdf);
+    weight_specular[i] = (float4)(weight, specular ? 1.0f : 0.0f);
+}
+
+// bsdf_eval at (wo, n) for `count` directions wi: writes (f * |cos|, pdf).
+kernel void bsdf_eval_test(global const GpuMaterial* material, float4 wo, float4 n, uint inside,
+                           uint count, global const float4* wi, global float4* value_pdf) {
+    uint i = get_global_id(0);
+    if (i >= count) return;
+    SurfaceMaterial m = bsdf_test_material(material, inside);
+    float pdf;
+    float3 f = bsdf_eval(&m, n.xyz, wo.xyz, wi[i].xyz, &pdf);
+    value_pdf[i] = (float4)(f, pdf);
+}
