@@ -319,6 +319,12 @@ impl ApplicationHandler for App {
                 self.input.cursor = Some(now);
             }
             WindowEvent::CursorLeft { .. } => self.input.cursor = None,
+            // Releases that happen elsewhere never arrive: nothing stays held.
+            WindowEvent::Focused(false) => {
+                self.input.motion = Motion::default();
+                self.input.look = false;
+                self.input.pan = false;
+            }
             WindowEvent::MouseWheel { delta, .. } if !egui_wants_pointer && !consumed => {
                 let notches = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y as f64,
