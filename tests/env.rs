@@ -1,0 +1,450 @@
+//! The environment light on the default OpenCL device (PoCL in CI): χ² of the kernel's
+//! importance sampling against the table's pdf, a white furnace under a uniform environment
+//! image, MIS against BSDF-only and light-only estimates, rotation and intensity.
+
+mod common;
+
+use common::{Gltf, Prim, render_exr, sphere};
+use glam::Vec3;
+use penumbra::cl::DeviceChoice;
+use penumbra::render::Renderer;
+use penumbra::scene::{EnvMap, Material, Mesh, Object, Scene};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+fn renderer() -> Renderer {
+    let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
+    Renderer::new(&choice).expect("the test's OpenCL device is available")
+}
+
+/// One triangle far below the origin, so that a scene loads.
+fn speck() -> Scene {
+    let mesh = Mesh {
+        positions: vec![
+            Vec3::new(0.0, -100.0, 0.0),
+            Vec3::new(0.01, -100.0, 0.0),
+            Vec3::new(0.0, -100.0, 0.01),
+        ],
+        indices: vec![[0, 1, 2]],
+        materials: vec![0],
+        ..Mesh::default()
+    };
+    Scene {
+        source: "speck".into(),
+        objects: vec![Object {
+            name: "speck".into(),
+            world_from_object: glam::DMat4::IDENTITY,
+            visible: true,
+            mesh,
+        }],
+        materials: vec![Material::default()],
+        ..Scene::default()
+    }
+}
+
+/// A sky-like map: a gradient, a bright sun and a dark band.
+fn test_map() -> EnvMap {
+    let (w, h) = (32u32, 16u32);
+    let mut texels = vec![];
+    for y in 0..h {
+        for x in 0..w {
+            let mut c = [0.2 + 0.05 * x as f32 / w as f32, 0.3, 0.6 - 0.03 * y as f32];
+            if (5..8).contains(&x) && (3..5).contains(&y) {
+                c = [40.0, 35.0, 30.0];
+            }
+            if y == 12 {
+                c = [0.0; 3];
+            }
+            texels.push(c);
+        }
+    }
+    EnvMap {
+        name: "test".into(),
+        width: w,
+        height: h,
+        texels,
+    }
+}
+
+fn ln_gamma(x: f64) -> f64 {
+    // Lanczos approximation (g = 7, n = 9).
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    let x = x - 1.0;
+    let mut a = C[0];
+    let t = x + 7.5;
+    for (i, c) in C.iter().enumerate().skip(1) {
+        a += c / (x + i as f64);
+    }
+    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// The upper regularized incomplete gamma function Q(a, x) (Numerical Recipes 6.2).
+fn gamma_q(a: f64, x: f64) -> f64 {
+    if x < a + 1.0 {
+        let (mut sum, mut term, mut n) = (1.0 / a, 1.0 / a, a);
+        for _ in 0..10_000 {
+            n += 1.0;
+            term *= x / n;
+            sum += term;
+            if term.abs() < sum.abs() * 1e-15 {
+                break;
+            }
+        }
+        1.0 - sum * (-x + a * x.ln() - ln_gamma(a)).exp()
+    } else {
+        let mut b = x + 1.0 - a;
+        let mut c = 1.0 / 1e-300;
+        let mut d = 1.0 / b;
+        let mut h = d;
+        for i in 1..10_000 {
+            let an = -(i as f64) * (i as f64 - a);
+            b += 2.0;
+            d = an * d + b;
+            if d.abs() < 1e-300 {
+                d = 1e-300;
+            }
+            c = b + an / c;
+            if c.abs() < 1e-300 {
+                c = 1e-300;
+            }
+            d = 1.0 / d;
+            let delta = d * c;
+            h *= delta;
+            if (delta - 1.0).abs() < 1e-15 {
+                break;
+            }
+        }
+        (-x + a * x.ln() - ln_gamma(a)).exp() * h
+    }
+}
+
+#[test]
+fn environment_sampling_matches_its_pdf_chi_square() {
+    let map = test_map();
+    let table = map.sampling();
+    let rotations = [0.0f32, 75.0];
+    // Šidák: an overall 1% chance of a false failure over both rotations.
+    let alpha = 1.0 - 0.99f64.powf(1.0 / rotations.len() as f64);
+    let mut r = renderer();
+    r.load_scene(&speck(), &[]).unwrap();
+    r.set_environment(Some(map.clone())).unwrap();
+    for rotation in rotations {
+        let settings = penumbra::render::RenderSettings {
+            env_rotation: rotation,
+            ..r.settings().clone()
+        };
+        r.set_settings(&settings).unwrap();
+        let n = 200_000;
+        let mut s = 11u64;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let u: Vec<[f32; 2]> = (0..n).map(|_| [rnd(), rnd()]).collect();
+        let program = r.program().unwrap();
+        assert!(program.features.env_map);
+        let (samples, eval) = program
+            .sample_env_test(&r.gpu, r.env_buffers(), &u)
+            .unwrap();
+        // Back into the map's frame: undo the rotation about +Y.
+        let (sin, cos) = rotation.to_radians().sin_cos();
+        let mut counts = vec![0f64; (map.width * map.height) as usize];
+        for (k, s) in samples.iter().enumerate() {
+            let d = Vec3::new(s[0], s[1], s[2]);
+            assert!((d.length() - 1.0).abs() < 1e-4, "sample {k} not unit: {d}");
+            let m = Vec3::new(cos * d.x - sin * d.z, d.y, sin * d.x + cos * d.z);
+            let host_pdf = map.pdf(&table, m);
+            assert!(
+                (s[3] - eval[k]).abs() <= 1e-3 * eval[k].max(1e-3),
+                "sample {k}: pdf {} but the miss shader says {}",
+                s[3],
+                eval[k]
+            );
+            assert!(
+                (s[3] - host_pdf).abs() <= 2e-3 * host_pdf.max(1e-3),
+                "sample {k}: pdf {} but the host says {host_pdf}",
+                s[3]
+            );
+            let (x, y) = map.texel_of(m);
+            counts[(y * map.width + x) as usize] += 1.0;
+        }
+        // Expected counts from the luminance × sin θ of each texel, computed here.
+        let lum = |c: [f32; 3]| 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64;
+        let f: Vec<f64> = (0..map.height)
+            .flat_map(|y| {
+                let sin = ((y as f64 + 0.5) / map.height as f64 * std::f64::consts::PI).sin();
+                let map = &map;
+                (0..map.width).map(move |x| lum(map.texels[(y * map.width + x) as usize]) * sin)
+            })
+            .collect();
+        let total: f64 = f.iter().sum();
+        let (mut chi2, mut bins, mut pool_e, mut pool_o) = (0.0, 0, 0.0, 0.0);
+        for (fi, &o) in f.iter().zip(&counts) {
+            let e = n as f64 * fi / total;
+            if e == 0.0 {
+                assert_eq!(o, 0.0, "a texel of zero luminance was sampled");
+                continue;
+            }
+            if e < 5.0 {
+                pool_e += e;
+                pool_o += o;
+                continue;
+            }
+            chi2 += (o - e) * (o - e) / e;
+            bins += 1;
+        }
+        if pool_e > 0.0 {
+            chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+            bins += 1;
+        }
+        let p = gamma_q((bins - 1) as f64 / 2.0, chi2 / 2.0);
+        assert!(
+            p > alpha,
+            "rotation {rotation}: chi2 {chi2} over {bins} bins, p = {p} < {alpha}"
+        );
+    }
+}
+
+/// Writes a `w`×`h` EXR environment; `texel(u, v)` gives the radiance.
+fn write_env(
+    dir: &Path,
+    name: &str,
+    w: u32,
+    h: u32,
+    texel: impl Fn(f32, f32) -> [f32; 3],
+) -> PathBuf {
+    let mut px = vec![];
+    for y in 0..h {
+        for x in 0..w {
+            px.push(texel(
+                (x as f32 + 0.5) / w as f32,
+                (y as f32 + 0.5) / h as f32,
+            ));
+        }
+    }
+    let path = dir.join(format!("{name}.exr"));
+    penumbra::image_io::write_exr(&path, w, h, &px).unwrap();
+    path
+}
+
+/// A white (albedo 1) Lambertian sphere of radius 1 at the origin seen from z = 4; a floor
+/// below it when `floor`.
+fn white_sphere(dir: &Path, floor: bool) -> PathBuf {
+    let mut g = Gltf::default();
+    let m = g.lambert([1.0; 3], [0.0; 3], 1.0, false);
+    let (positions, normals, indices) = sphere(1.0, 32, 64, false);
+    let mut prims = vec![Prim {
+        positions,
+        normals,
+        indices,
+        material: Some(m),
+        mode: 4,
+    }];
+    if floor {
+        let gray = g.lambert([0.5; 3], [0.0; 3], 1.0, false);
+        prims.push(Prim::triangles(
+            vec![
+                [-5.0, -1.0, -5.0],
+                [5.0, -1.0, -5.0],
+                [5.0, -1.0, 5.0],
+                [-5.0, -1.0, 5.0],
+            ],
+            vec![0, 2, 1, 0, 3, 2],
+            gray,
+        ));
+    }
+    let mesh = g.mesh(prims);
+    g.node(json!({"mesh": mesh}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 4.0]}));
+    g.write_glb(dir, if floor { "sphere-floor" } else { "sphere" })
+}
+
+fn mean(px: &[[f32; 3]]) -> f64 {
+    px.iter()
+        .map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0)
+        .sum::<f64>()
+        / px.len() as f64
+}
+
+#[test]
+fn a_white_sphere_under_a_uniform_environment_disappears() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = write_env(dir.path(), "uniform", 64, 32, |_, _| [0.5; 3]);
+    let scene = white_sphere(dir.path(), false);
+    let out = dir.path().join("f.exr");
+    let (summary, px) = render_exr(
+        &scene,
+        &out,
+        &[
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--spp",
+            "64",
+            "--bounces",
+            "3",
+            "--env",
+            env.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(summary["nonfinite_samples"], 0);
+    assert_eq!(summary["default_light_rig"], false);
+    // A convex albedo-1 Lambertian surface under uniform radiance L reflects exactly L.
+    let m = mean(&px);
+    assert!((m - 0.5).abs() < 0.005, "mean {m}, expected 0.5");
+    // The centre 8×8 is all sphere.
+    let centre: Vec<[f32; 3]> = (8..16)
+        .flat_map(|y| (8..16).map(move |x| y * 24 + x))
+        .map(|i| px[i])
+        .collect();
+    let c = mean(&centre);
+    assert!((c - 0.5).abs() < 0.01, "sphere mean {c}, expected 0.5");
+}
+
+#[test]
+fn mis_bsdf_only_and_light_only_agree_under_an_environment_with_a_sun() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = write_env(dir.path(), "sun", 32, 16, |u, v| {
+        if (0.6..0.7).contains(&u) && (0.2..0.3).contains(&v) {
+            [30.0, 28.0, 25.0]
+        } else {
+            [0.3, 0.4, 0.6]
+        }
+    });
+    let scene = white_sphere(dir.path(), true);
+    let out = dir.path().join("m.exr");
+    let mut means = vec![];
+    let mut images = vec![];
+    for strategy in ["mis", "bsdf", "lights"] {
+        let (summary, px) = render_exr(
+            &scene,
+            &out,
+            &[
+                "--width",
+                "24",
+                "--height",
+                "24",
+                "--spp",
+                "192",
+                "--bounces",
+                "1",
+                "--strategy",
+                strategy,
+                "--env",
+                env.to_str().unwrap(),
+            ],
+        );
+        assert_eq!(summary["nonfinite_samples"], 0);
+        means.push(mean(&px));
+        images.push(px);
+    }
+    for (s, m) in ["bsdf", "lights"].iter().zip(&means[1..]) {
+        let rel = (m - means[0]).abs() / means[0];
+        assert!(rel < 0.03, "{s}: mean {m} vs MIS {} ({rel:.4})", means[0]);
+    }
+    // MIS is less noisy than BSDF sampling alone (squared error against the light-only image).
+    let err = |a: &[[f32; 3]], b: &[[f32; 3]]| {
+        a.iter()
+            .zip(b)
+            .map(|(p, q)| ((p[1] - q[1]) as f64).powi(2))
+            .sum::<f64>()
+    };
+    assert!(
+        err(&images[0], &images[2]) < err(&images[1], &images[2]),
+        "MIS is not better than BSDF sampling"
+    );
+}
+
+#[test]
+fn rotation_turns_the_environment_about_up_and_intensity_scales_it() {
+    let dir = tempfile::tempdir().unwrap();
+    // Bright only around +X (u = 0.75).
+    let env = write_env(dir.path(), "east", 64, 32, |u, _| {
+        if (0.7..0.8).contains(&u) {
+            [2.0, 1.0, 0.5]
+        } else {
+            [0.0; 3]
+        }
+    });
+    let mut g = Gltf::default();
+    let m = g.lambert([0.5; 3], [0.0; 3], 1.0, false);
+    let mesh = g.mesh(vec![Prim::triangles(
+        vec![[0.0, -50.0, 0.0], [0.1, -50.0, 0.0], [0.0, -50.0, 0.1]],
+        vec![0, 1, 2],
+        m,
+    )]);
+    g.node(json!({"mesh": mesh}));
+    // The glTF camera looks along -Z.
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.1, "znear": 0.01}}));
+    g.node(json!({"camera": 0}));
+    let scene = g.write_glb(dir.path(), "look");
+    let out = dir.path().join("r.exr");
+    let look = |rotation: &str, intensity: &str| {
+        let (_, px) = render_exr(
+            &scene,
+            &out,
+            &[
+                "--width",
+                "4",
+                "--height",
+                "4",
+                "--spp",
+                "1",
+                "--bounces",
+                "0",
+                "--env",
+                env.to_str().unwrap(),
+                "--env-rotation",
+                rotation,
+                "--env-intensity",
+                intensity,
+            ],
+        );
+        px
+    };
+    assert_eq!(mean(&look("0", "1")), 0.0, "-Z is dark without rotation");
+    // Turning the map 90° counter-clockwise seen from above brings +X to -Z.
+    let px = look("90", "1");
+    assert!(px.iter().all(|p| *p == [2.0, 1.0, 0.5]), "{:?}", px[0]);
+    assert_eq!(mean(&look("-90", "1")), 0.0, "-90° turns +X to +Z");
+    let px = look("90", "2.5");
+    assert!(px.iter().all(|p| *p == [5.0, 2.5, 1.25]), "{:?}", px[0]);
+}
+
+#[test]
+fn bad_environment_arguments_fail_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = white_sphere(dir.path(), false);
+    let bad = dir.path().join("bad.hdr");
+    std::fs::write(&bad, b"not an image").unwrap();
+    for env in [bad.to_str().unwrap(), "nowhere.exr", "1,2"] {
+        let o = common::penumbra(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            dir.path().join("x.exr").to_str().unwrap(),
+            "--env",
+            env,
+        ]);
+        assert!(!o.status.success(), "--env {env} was accepted");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
