@@ -281,6 +281,32 @@ impl Gui {
                     c.camera.yfov = fov.to_radians();
                     actions.changes.camera = true;
                 }
+                let v = &mut m.view;
+                ui.horizontal(|ui| {
+                    ui.label("lens");
+                    let size = v.diagonal() as f32;
+                    let a = ui
+                        .add(
+                            egui::DragValue::new(&mut v.aperture)
+                                .speed(0.0005 * size)
+                                .range(0.0..=size)
+                                .prefix("aperture "),
+                        )
+                        .on_hover_text("thin-lens radius; 0 keeps everything sharp");
+                    let f = ui
+                        .add_enabled(
+                            v.aperture > 0.0,
+                            egui::DragValue::new(&mut v.focus_distance)
+                                .speed(0.002 * size)
+                                .range(1e-4..=1e6)
+                                .prefix("focus "),
+                        )
+                        .on_hover_text("distance in focus; a click on the image focuses there");
+                    if a.changed() || f.changed() {
+                        actions.changes.settings = true;
+                    }
+                });
+                let c: &mut CameraController = &mut m.camera;
                 ui.horizontal(|ui| {
                     ui.label("fly speed");
                     let speed = c.speed;

@@ -11,7 +11,7 @@ mod pick;
 mod screenshot;
 mod state;
 
-use crate::cli::ViewArgs;
+use crate::cli::{EnvChoice, ViewArgs};
 use crate::render::Renderer;
 use crate::render::tonemap::{ToneMapper, to_rgba8};
 use crate::scene::{Light, Scene, SceneError};
@@ -51,7 +51,10 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("wheel", "fly speed (fly) / zoom to the pivot (orbit)"),
     ("+ / −", "fly speed"),
     ("O", "switch fly / orbit mode"),
-    ("left click", "pick an object (orbit: also sets the pivot)"),
+    (
+        "left click",
+        "pick an object (orbit: also the pivot; with a lens: focus)",
+    ),
     ("R", "reset the view"),
     ("H", "hard / soft shadows"),
     ("F12", "screenshot (PNG + EXR in screenshots/)"),
@@ -67,6 +70,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         check_screenshot_path(p)?;
     }
     let settings = args.common.settings(DEFAULT_SIZE)?;
+    let size = (settings.width, settings.height);
     let prepared = args.common.prepare(args.scene.as_deref())?;
     let event_loop = EventLoop::new().map_err(|e| {
         // winit's message starts with its source location; keep the reason only.
@@ -80,10 +84,18 @@ pub fn run(args: ViewArgs) -> Result<()> {
              -o OUT.png` to render without one"
         )
     })?;
-    let renderer = Renderer::new(&args.common.device_choice()?)
+    let environment = args.common.environment()?;
+    let mut renderer = Renderer::new(&args.common.device_choice()?)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
+    if let Some(EnvChoice::Map(map)) = environment {
+        renderer
+            .set_environment(Some(map))
+            .context("cannot upload the environment map")?;
+    }
     let bounds = prepared.scene.bounds();
-    let view = ViewState::from_args(&args.common, &prepared.scene.lights, bounds);
+    // With a lens but no focus distance, focus on what the image centre sees once loaded.
+    let autofocus = settings.lens_radius > 0.0 && args.common.focus_distance.is_none();
+    let view = ViewState::from_args(&args.common, settings, &prepared.scene.lights, bounds);
     let camera = CameraController::new(prepared.camera.clone(), &bounds);
     let path_text = args
         .scene
@@ -91,7 +103,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         .map(|p| p.display().to_string())
         .unwrap_or_default();
     let mut app = App {
-        size: (settings.width, settings.height),
+        size,
         device: renderer.gpu.description(),
         frame_loop: FrameLoop::new(renderer),
         lights: view.lights(),
@@ -118,6 +130,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
         last_screenshot: None,
         converged: false,
         quit: false,
+        autofocus,
+        env_lights: args.common.env.is_some(),
     };
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.fatal.take() {
@@ -219,6 +233,10 @@ struct App {
     converged: bool,
     /// Ctrl+Q was pressed.
     quit: bool,
+    /// Focus the lens on the image centre once the scene is on the device.
+    autofocus: bool,
+    /// `--env` lights the scene: files without lights get no default rig.
+    env_lights: bool,
 }
 
 impl ApplicationHandler for App {
@@ -502,6 +520,15 @@ impl App {
                 if self.model.camera.mode == Mode::Orbit {
                     self.model.camera.set_pivot(hit.point);
                 }
+                // With a lens, a click also focuses on the clicked point.
+                if self.model.view.aperture > 0.0 {
+                    let cam = &self.model.camera.camera;
+                    self.model.view.focus_distance = (hit.point - cam.eye).dot(cam.forward) as f32;
+                    self.frame_loop.invalidate(Changes {
+                        settings: true,
+                        ..Changes::default()
+                    });
+                }
             }
             None => self.model.selected = None,
         }
@@ -536,7 +563,13 @@ impl App {
         };
         self.loader = None;
         match result {
-            Ok((scene, ms)) => {
+            Ok((mut scene, ms)) => {
+                if self.env_lights && scene.default_rig {
+                    // The environment lights the scene instead of the default rig.
+                    scene.lights.clear();
+                    scene.default_rig = false;
+                }
+                self.autofocus = self.model.view.aperture > 0.0;
                 for w in &scene.warnings {
                     log::warn!("{}: {w}", scene.source);
                 }
@@ -696,6 +729,20 @@ impl App {
                     eprintln!("penumbra: device error: {message}");
                     self.device_error = Some(message);
                 }
+            }
+        }
+        if self.autofocus
+            && let Some(host) = self.frame_loop.renderer.host_scene()
+        {
+            self.autofocus = false;
+            let aspect = self.size.0 as f32 / self.size.1.max(1) as f32;
+            let cam = &self.model.camera.camera;
+            if let Some(hit) = pick::pick(host, &pick::primary_ray(cam, aspect, 0.5, 0.5)) {
+                self.model.view.focus_distance = (hit.point - cam.eye).dot(cam.forward) as f32;
+                self.frame_loop.invalidate(Changes {
+                    settings: true,
+                    ..Changes::default()
+                });
             }
         }
         self.update_display(new_image);

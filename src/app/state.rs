@@ -61,6 +61,10 @@ pub struct ViewState {
     pub seed: u32,
     /// Uniform sky radiance.
     pub sky: [f32; 3],
+    /// Thin-lens radius in scene units (0: pinhole, everything sharp).
+    pub aperture: f32,
+    /// Distance of the plane in focus along the view axis.
+    pub focus_distance: f32,
     /// Stop accumulating at this many samples per pixel; `None` renders on and on.
     pub spp_target: Option<u32>,
     /// Shadow softness: the radius of point and spot lights in scene units (directional
@@ -76,15 +80,26 @@ pub struct ViewState {
     pub rig: Vec<RigLight>,
     /// The scene's bounds, which size new lights and the softness range.
     pub bounds: Bounds,
+    /// What the command line set that the overlay does not edit (environment intensity and
+    /// rotation, Russian roulette, strategy).
+    base: RenderSettings,
 }
 
 impl ViewState {
-    /// The state the command line asks for on a scene with `lights` and `bounds`.
-    pub fn from_args(args: &CommonArgs, lights: &[Light], bounds: Bounds) -> Self {
+    /// The state the command line asks for (`base` is its validated render settings) on a
+    /// scene with `lights` and `bounds`.
+    pub fn from_args(
+        args: &CommonArgs,
+        base: RenderSettings,
+        lights: &[Light],
+        bounds: Bounds,
+    ) -> Self {
         let mut s = Self {
-            bounces: args.bounces,
-            seed: args.seed,
-            sky: args.sky.unwrap_or([0.0; 3]),
+            bounces: base.bounces,
+            seed: base.seed,
+            sky: base.sky,
+            aperture: base.lens_radius,
+            focus_distance: base.focus_distance,
             spp_target: args.spp,
             softness: args
                 .light_radius
@@ -94,6 +109,7 @@ impl ViewState {
             tone_mapper: ToneMapper::default(),
             rig: Vec::new(),
             bounds,
+            base,
         };
         s.replace_scene_lights(lights, bounds);
         s
@@ -128,7 +144,9 @@ impl ViewState {
             bounces: self.bounces,
             seed: self.seed,
             sky: self.sky,
-            ..RenderSettings::default()
+            lens_radius: self.aperture.max(0.0),
+            focus_distance: self.focus_distance.max(1e-6),
+            ..self.base.clone()
         }
     }
 
@@ -232,6 +250,12 @@ mod tests {
     use super::*;
     use clap::Parser;
 
+    fn state(extra: &[&str], lights: &[Light]) -> ViewState {
+        let a = args(extra);
+        let base = a.settings((64, 64)).unwrap();
+        ViewState::from_args(&a, base, lights, bounds())
+    }
+
     fn args(extra: &[&str]) -> CommonArgs {
         let mut argv = vec!["penumbra", "view"];
         argv.extend_from_slice(extra);
@@ -270,8 +294,8 @@ mod tests {
 
     #[test]
     fn command_line_options_map_to_render_settings() {
-        let s = ViewState::from_args(
-            &args(&[
+        let s = state(
+            &[
                 "--bounces",
                 "2",
                 "--seed",
@@ -280,19 +304,23 @@ mod tests {
                 "0.5",
                 "--spp",
                 "9",
-            ]),
+                "--aperture",
+                "0.01",
+                "--focus-distance",
+                "2",
+            ],
             &[point()],
-            bounds(),
         );
         let r = s.render_settings((160, 120));
         assert_eq!((r.width, r.height, r.bounces, r.seed), (160, 120, 2, 7));
         assert_eq!(r.sky, [0.5; 3]);
+        assert_eq!((r.lens_radius, r.focus_distance), (0.01, 2.0));
         assert_eq!(s.spp_target, Some(9));
     }
 
     #[test]
     fn the_default_softness_is_visibly_soft() {
-        let s = ViewState::from_args(&args(&[]), &[point(), sun()], bounds());
+        let s = state(&[], &[point(), sun()]);
         assert_eq!(s.softness, default_light_radius(&bounds()));
         let lights = s.lights();
         assert_eq!(lights[0].radius, s.softness);
@@ -303,7 +331,7 @@ mod tests {
 
     #[test]
     fn the_hard_toggle_gives_radius_zero_and_restores_the_softness() {
-        let mut s = ViewState::from_args(&args(&["--light-radius", "0.1"]), &[point()], bounds());
+        let mut s = state(&["--light-radius", "0.1"], &[point()]);
         s.add_light(NewLight::Sphere);
         let soft = s.lights();
         assert_eq!(soft[0].radius, 0.1);
@@ -313,7 +341,7 @@ mod tests {
         s.toggle_hard_shadows();
         assert_eq!(s.lights(), soft);
         // --hard-shadows starts hard but keeps the default softness for the toggle.
-        let mut h = ViewState::from_args(&args(&["--hard-shadows"]), &[point()], bounds());
+        let mut h = state(&["--hard-shadows"], &[point()]);
         assert_eq!(h.lights()[0].radius, 0.0);
         h.toggle_hard_shadows();
         assert_eq!(h.lights()[0].radius, default_light_radius(&bounds()));
@@ -321,7 +349,7 @@ mod tests {
 
     #[test]
     fn the_softness_follows_the_slider_unless_set_by_hand() {
-        let mut s = ViewState::from_args(&args(&[]), &[point(), point()], bounds());
+        let mut s = state(&[], &[point(), point()]);
         s.rig[1].follows_softness = false;
         s.rig[1].light.radius = 0.3;
         s.softness = 0.05;
@@ -331,7 +359,7 @@ mod tests {
 
     #[test]
     fn disabled_lights_are_left_out_and_presets_replace_or_extend() {
-        let mut s = ViewState::from_args(&args(&[]), &[point()], bounds());
+        let mut s = state(&[], &[point()]);
         s.apply_preset(LightPreset::ThreePointStudio, false);
         assert_eq!(s.lights().len(), 4);
         s.rig[0].enabled = false;
