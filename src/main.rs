@@ -1,7 +1,7 @@
 use clap::Parser;
 
 fn main() {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,egui_wgpu=error,winit=error"))
         .format_timestamp(None)
         .init();
     let cli = penumbra::cli::Cli::parse();
