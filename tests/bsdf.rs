@@ -1056,7 +1056,6 @@ fn white_furnace_lambertian_sphere_disappears() {
 
 #[test]
 fn white_furnace_spheres_lose_energy_only_as_the_model_predicts() {
-    let d = Device::new();
     let dir = tempfile::tempdir().unwrap();
     let n = [0.0, 0.0, 1.0];
     let white = [1.0f32; 3];
@@ -1069,15 +1068,27 @@ fn white_furnace_spheres_lose_energy_only_as_the_model_predicts() {
         ("glossy dielectric", Mat::dielectric(white, 0.2)),
         ("rough dielectric", Mat::dielectric(white, 0.7)),
     ];
+    // Render first: a GPU in exclusive-process mode serves one process, so the renderer (a
+    // child process) must run before this process opens the device.
+    let renders: Vec<(f64, f64)> = cases
+        .iter()
+        .enumerate()
+        .map(|(k, (name, m))| {
+            let scene = furnace_scene(dir.path(), &format!("furnace{k}"), m);
+            let (summary, px) = furnace_render(&scene, 64, 4);
+            assert_eq!(summary["nonfinite_samples"], 0, "{name}");
+            sphere_mean(&px, &pixels)
+        })
+        .collect();
+    let d = Device::new();
     let mut report = vec![];
-    for (k, (name, m)) in cases.iter().enumerate() {
+    for (k, ((name, m), (mean, err))) in cases.iter().zip(renders).enumerate() {
         // The directional albedo A(cos theta_o) from the sampling kernel; on a convex object
         // under a uniform sky every pixel shows A times the sky.
-        let mus: Vec<f64> = (0..=32).map(|i| i as f64 / 32.0).collect();
-        let albedo: Vec<f64> = mus
-            .iter()
-            .map(|mu| {
-                let wo = direction_at(n, mu.max(1e-3).acos().to_degrees());
+        let albedo: Vec<f64> = (0..=32)
+            .map(|i| {
+                let mu = (i as f64 / 32.0).max(1e-3);
+                let wo = direction_at(n, mu.acos().to_degrees());
                 let s = d.sample(m, wo, n, false, 1 << 15, 7 + k as u32);
                 s.w.iter()
                     .map(|w| (w[0] + w[1] + w[2]) as f64 / 3.0)
@@ -1094,10 +1105,6 @@ fn white_furnace_spheres_lose_energy_only_as_the_model_predicts() {
             })
             .sum::<f64>()
             / pixels.len() as f64;
-        let scene = furnace_scene(dir.path(), &format!("furnace{k}"), m);
-        let (summary, px) = furnace_render(&scene, 64, 4);
-        assert_eq!(summary["nonfinite_samples"], 0, "{name}");
-        let (mean, err) = sphere_mean(&px, &pixels);
         report.push(format!(
             "{name}: mean {mean:.4} ± {err:.4}, predicted {predicted:.4}"
         ));
