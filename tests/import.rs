@@ -106,7 +106,7 @@ fn cameras_lights_and_materials_are_read() {
     g.lights
         .push(json!({"type": "directional", "intensity": 3.0}));
     for i in 0..3 {
-        g.node(json!({"extensions": {"KHR_lights_punctual": {"light": i}}, "translation": [0.0, 2.0, 0.0], "rotation": [-0.7071068, 0.0, 0.0, 0.7071068]}));
+        g.node(json!({"extensions": {"KHR_lights_punctual": {"light": i}}, "translation": [0.0, 2.0, 0.0], "rotation": common::LOOK_DOWN}));
     }
     let dir = tempfile::tempdir().unwrap();
     let s = load(&g.write_glb(dir.path(), "l")).unwrap();

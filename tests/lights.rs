@@ -22,14 +22,15 @@ fn floor_scene(light: Value, light_height: f32) -> Gltf {
         m,
     )]);
     g.node(json!({"mesh": mesh}));
-    g.cameras.push(json!({"type": "perspective", "perspective": {"yfov": 0.02, "znear": 0.01}}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.02, "znear": 0.01}}));
     // Looking straight down from 3 units up (rotation -90 degrees about x).
-    g.node(json!({"camera": 0, "translation": [0.0, 3.0, 0.0], "rotation": [-0.70710678, 0.0, 0.0, 0.70710678]}));
+    g.node(json!({"camera": 0, "translation": [0.0, 3.0, 0.0], "rotation": common::LOOK_DOWN}));
     g.lights.push(light);
     g.node(json!({
         "extensions": {"KHR_lights_punctual": {"light": 0}},
         "translation": [0.0, light_height, 0.0],
-        "rotation": [-0.70710678, 0.0, 0.0, 0.70710678]
+        "rotation": common::LOOK_DOWN
     }));
     g
 }
@@ -38,7 +39,16 @@ fn mean_radiance(g: &Gltf, name: &str, extra: &[&str]) -> f32 {
     let dir = tempfile::tempdir().unwrap();
     let scene = g.write_glb(dir.path(), name);
     let out = dir.path().join("o.exr");
-    let mut args = vec!["--width", "16", "--height", "16", "--spp", "256", "--bounces", "0"];
+    let mut args = vec![
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "256",
+        "--bounces",
+        "0",
+    ];
     args.extend_from_slice(extra);
     let (summary, px) = render_exr(&scene, &out, &args);
     assert_eq!(summary["nonfinite_samples"], 0);
@@ -47,7 +57,11 @@ fn mean_radiance(g: &Gltf, name: &str, extra: &[&str]) -> f32 {
 
 fn assert_close(got: f32, want: f32, what: &str) {
     let rel = (got - want).abs() / want;
-    assert!(rel < 0.02, "{what}: {got} vs {want} ({:.2}% off)", rel * 100.0);
+    assert!(
+        rel < 0.02,
+        "{what}: {got} vs {want} ({:.2}% off)",
+        rel * 100.0
+    );
 }
 
 #[test]
@@ -55,8 +69,16 @@ fn point_light_intensity_is_used_one_to_one_hard_and_soft() {
     let (i, h) = (10.0, 2.0);
     let g = floor_scene(json!({"type": "point", "intensity": i}), h);
     let want = ALBEDO / PI * i / (h * h);
-    assert_close(mean_radiance(&g, "p", &["--hard-shadows"]), want, "hard point light");
-    assert_close(mean_radiance(&g, "p", &["--light-radius", "0.5"]), want, "sphere light");
+    assert_close(
+        mean_radiance(&g, "p", &["--hard-shadows"]),
+        want,
+        "hard point light",
+    );
+    assert_close(
+        mean_radiance(&g, "p", &["--light-radius", "0.5"]),
+        want,
+        "sphere light",
+    );
 }
 
 #[test]
@@ -67,8 +89,16 @@ fn spot_light_inside_its_cone_equals_a_point_light() {
         h,
     );
     let want = ALBEDO / PI * i / (h * h);
-    assert_close(mean_radiance(&g, "s", &["--hard-shadows"]), want, "spot light");
-    assert_close(mean_radiance(&g, "s", &["--light-radius", "0.2"]), want, "soft spot light");
+    assert_close(
+        mean_radiance(&g, "s", &["--hard-shadows"]),
+        want,
+        "spot light",
+    );
+    assert_close(
+        mean_radiance(&g, "s", &["--light-radius", "0.2"]),
+        want,
+        "soft spot light",
+    );
 }
 
 #[test]
@@ -87,7 +117,15 @@ fn directional_light_irradiance_is_used_one_to_one_hard_and_soft() {
     let e = 3.0;
     let g = floor_scene(json!({"type": "directional", "intensity": e}), 5.0);
     let want = ALBEDO / PI * e;
-    assert_close(mean_radiance(&g, "d", &["--hard-shadows"]), want, "hard sun");
+    assert_close(
+        mean_radiance(&g, "d", &["--hard-shadows"]),
+        want,
+        "hard sun",
+    );
     // Angular radius 2 * 4 / diagonal(40 * sqrt 2) = 0.14 rad.
-    assert_close(mean_radiance(&g, "d", &["--light-radius", "4"]), want, "soft sun");
+    assert_close(
+        mean_radiance(&g, "d", &["--light-radius", "4"]),
+        want,
+        "soft sun",
+    );
 }

@@ -369,10 +369,10 @@ fn gray_floor(dir: &Path) -> PathBuf {
     t.finish(&mut g);
     let mesh = quad(&mut g, m, false, false);
     // The quad faces +Z; turn it to face +Y and make it 2000 units wide.
-    g.node(json!({"mesh": mesh, "rotation": [-0.70710678, 0.0, 0.0, 0.70710678], "scale": [1000.0, 1000.0, 1.0]}));
+    g.node(json!({"mesh": mesh, "rotation": common::LOOK_DOWN, "scale": [1000.0, 1000.0, 1.0]}));
     g.cameras
         .push(json!({"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.01}}));
-    g.node(json!({"camera": 0, "translation": [0.0, 1.0, 0.0], "rotation": [-0.70710678, 0.0, 0.0, 0.70710678]}));
+    g.node(json!({"camera": 0, "translation": [0.0, 1.0, 0.0], "rotation": common::LOOK_DOWN}));
     g.write_glb(dir, "floor")
 }
 
@@ -533,7 +533,7 @@ fn shadowed_floor(dir: &Path, name: &str, alpha_texture: bool, occluder: Value) 
     let white = lambert(&mut g, [1.0; 4], json!({}));
     let red = lambert(&mut g, [1.0, 0.0, 0.0, 1.0], occluder);
     t.finish(&mut g);
-    let face_up = [-0.70710678, 0.0, 0.0, 0.70710678];
+    let face_up = common::LOOK_DOWN;
     let floor = quad(&mut g, white, false, false);
     g.node(json!({"mesh": floor, "rotation": face_up, "scale": [3.0, 3.0, 1.0]}));
     let top = quad(&mut g, red, false, false);

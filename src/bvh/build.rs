@@ -143,7 +143,8 @@ fn find_split(prims: &[Prim], bounds: Aabb) -> Option<(usize, f32, f32)> {
     let area = bounds.area().max(f32::MIN_POSITIVE);
     let mut best: Option<(usize, f32, f32)> = None;
     for axis in 0..3 {
-        if !(extent[axis] > 0.0) {
+        // Skip flat axes (and a NaN extent, which no finite input makes).
+        if extent[axis].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
         let scale = BINS as f32 / extent[axis];
@@ -278,14 +279,8 @@ mod tests {
             .collect()
     }
 
-    /// Walks the tree checking boxes and returning (leaf ranges, max depth).
-    fn check_node(
-        bvh: &Bvh,
-        node: u32,
-        tris: &[[Vec3; 3]],
-        depth: u32,
-        ranges: &mut Vec<(u32, u32)>,
-    ) {
+    /// Walks the tree checking boxes, collecting the leaf ranges.
+    fn check_node(bvh: &Bvh, node: u32, tris: &[[Vec3; 3]], ranges: &mut Vec<(u32, u32)>) {
         for side in 0..2 {
             let (b, child) = bvh.child(node, side);
             match child {
@@ -295,7 +290,7 @@ mod tests {
                     let (cb2, _) = bvh.child(n, 1);
                     assert!(b.contains(cb.min) && b.contains(cb.max));
                     assert!(b.contains(cb2.min) && b.contains(cb2.max));
-                    check_node(bvh, n, tris, depth + 1, ranges);
+                    check_node(bvh, n, tris, ranges);
                 }
                 Child::Leaf { first, count } => {
                     for p in first..first + count {
@@ -315,7 +310,7 @@ mod tests {
         let tris = random_triangles(5000, 7);
         let bvh = build(&tris);
         let mut ranges = vec![];
-        check_node(&bvh, 0, &tris, 0, &mut ranges);
+        check_node(&bvh, 0, &tris, &mut ranges);
         ranges.sort();
         let mut next = 0;
         for (first, count) in ranges {
@@ -371,7 +366,7 @@ mod tests {
         let bvh = build(&vec![t; 1000]);
         assert!(bvh.depth <= MAX_DEPTH);
         let mut ranges = vec![];
-        check_node(&bvh, 0, &vec![t; 1000], 0, &mut ranges);
+        check_node(&bvh, 0, &vec![t; 1000], &mut ranges);
         assert_eq!(ranges.iter().map(|r| r.1).sum::<u32>(), 1000);
     }
 

@@ -120,7 +120,7 @@ fn box_entry(lo: Vec3, hi: Vec3, origin: Vec3, inv: Vec3, tmin: f32, tmax: f32) 
     let t0 = (lo - origin) * inv;
     let t1 = (hi - origin) * inv;
     let near = t0.min(t1).max_element().max(tmin);
-    let far = t0.max(t1).min_element() * 1.000_000_24;
+    let far = t0.max(t1).min_element() * (1.0 + 2.0 * f32::EPSILON);
     (near <= far && near < tmax).then_some(near)
 }
 

@@ -139,8 +139,7 @@ mod tests {
         let gpu = Gpu::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
         let source = "#line 1 \"kernels/broken.cl\"\nkernel void f(global int* x) {\n  x[0] = undeclared;\n}\n";
         let err = build_source(&gpu, source, KernelFeatures::default())
-            .err()
-            .expect("the source does not compile")
+            .expect_err("the source does not compile")
             .to_string();
         assert!(err.contains("kernels/broken.cl:2"), "{err}");
         assert!(!err.contains('\n'), "one line: {err}");

@@ -300,8 +300,11 @@ pub struct GpuRay {
 }
 const _: () = assert!(size_of::<GpuRay>() == 32);
 
+/// A struct's name, size and (field, offset) list.
+pub type StructLayout = (&'static str, usize, Vec<(&'static str, usize)>);
+
 /// Every shared struct with its size and field offsets, for the layout probe test.
-pub fn layouts() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
+pub fn layouts() -> Vec<StructLayout> {
     macro_rules! layout {
         ($t:ty, $($f:ident),*) => {
             (stringify!($t), size_of::<$t>(), vec![$((stringify!($f), offset_of!($t, $f))),*])

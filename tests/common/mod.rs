@@ -3,8 +3,12 @@
 #![allow(dead_code)]
 
 use serde_json::{Value, json};
+use std::f32::consts::FRAC_1_SQRT_2;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+/// A node rotation of −90° about x: the node's −Z (where cameras and lights point) faces −Y.
+pub const LOOK_DOWN: [f32; 4] = [-FRAC_1_SQRT_2, 0.0, 0.0, FRAC_1_SQRT_2];
 
 /// One mesh primitive of a fixture.
 pub struct Prim {
@@ -62,7 +66,7 @@ pub struct Gltf {
 
 impl Gltf {
     fn push_data(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let offset = self.bin.len();
@@ -232,11 +236,11 @@ impl Gltf {
     /// GLB bytes.
     pub fn glb(&self) -> Vec<u8> {
         let mut json = serde_json::to_vec(&self.json(None)).unwrap();
-        while json.len() % 4 != 0 {
+        while !json.len().is_multiple_of(4) {
             json.push(b' ');
         }
         let mut bin = self.bin.clone();
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let total = 12 + 8 + json.len() + 8 + bin.len();
