@@ -1,5 +1,5 @@
-// What a hit's textures do to its material: base color, metallic-roughness and emission, and
-// the shading normal from a tangent-space normal map.
+// What a hit's textures do to its material: base color, metallic-roughness, transmission and
+// emission, and the shading normal from a tangent-space normal map.
 
 #ifdef HAS_TEXTURES
 // Multiplies the material's factors by its textures at the hit.
@@ -11,6 +11,9 @@ inline void apply_textures(SurfaceMaterial* m, global const GpuMaterial* mat,
         m->roughness *= mr.y;
         m->metallic *= mr.z;
     }
+#ifdef HAS_TRANSMISSION
+    if (mat->textures2.x >= 0) m->transmission *= texture_sample(s, mat->textures2.x, tc).x;
+#endif
 }
 
 // Emitted radiance at the hit: the factor times the emissive texture.
