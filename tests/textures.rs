@@ -456,7 +456,9 @@ fn normal_maps_tilt_towards_u_and_up_the_image() {
     let away_u = [38, 128, 218];
     let up_image = [128, 218, 218];
     // Lambertian, albedo 1, irradiance π: radiance is the cosine between normal and light.
-    let cases: [(&str, [u8; 3], [f64; 4], bool, bool, f64); 7] = [
+    // (name, normal texel, light rotation, u mirrored, file tangents, expected radiance)
+    type Case = (&'static str, [u8; 3], [f64; 4], bool, bool, f64);
+    let cases: [Case; 7] = [
         (
             "flat",
             flat,
