@@ -264,6 +264,11 @@ fn lookups_wrap_filter_decode_srgb_and_transform_like_the_gltf_sampler() {
     let scene = penumbra::scene::load(&lookup_fixture(dir.path())).unwrap();
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     assert_eq!(scene.texture_refs.len(), 7);
+    use penumbra::scene::Wrap;
+    let wraps: Vec<Wrap> = scene.texture_refs[..3].iter().map(|r| r.wrap_s).collect();
+    assert_eq!(wraps, [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror]);
+    assert!(!scene.texture_refs[0].srgb && scene.texture_refs[3].srgb);
+    assert_eq!(scene.texture_refs[6].tex_coord, 1, "texCoord override");
     let mut r = renderer();
     r.load_scene(&scene, &[]).unwrap();
     let program = r.program().unwrap();

@@ -361,3 +361,69 @@ impl TexturePack {
         self.texels.len() * 4
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Image, TexTransform, TextureRef};
+    use std::sync::Arc;
+
+    fn scene_with(sides: &[u32]) -> Scene {
+        let images = sides
+            .iter()
+            .map(|&s| {
+                Arc::new(Image {
+                    name: format!("{s}"),
+                    width: s,
+                    height: s / 2,
+                    rgba: vec![[200, 100, 50, 255]; (s * s / 2) as usize],
+                })
+            })
+            .collect();
+        let texture_refs = (0..sides.len() as u32)
+            .flat_map(|image| {
+                [false, true].map(|srgb| TextureRef {
+                    image,
+                    srgb,
+                    wrap_s: Wrap::Repeat,
+                    wrap_t: Wrap::Mirror,
+                    tex_coord: 0,
+                    transform: TexTransform::default(),
+                })
+            })
+            .collect();
+        Scene {
+            images,
+            texture_refs,
+            ..Scene::default()
+        }
+    }
+
+    #[test]
+    fn textures_pack_their_mip_chains_one_after_another() {
+        let pack = TexturePack::new(&scene_with(&[8, 4]), usize::MAX);
+        // Each image twice (linear and sRGB): 8×4 → 4×2 → 2×1 → 1×1, and 4×2 → 2×1 → 1×1.
+        assert_eq!(pack.textures.len(), 4);
+        let big = 32 + 8 + 2 + 1;
+        let small = 8 + 2 + 1;
+        assert_eq!(pack.texels.len(), 2 * big + 2 * small);
+        assert_eq!(pack.textures[1].offset, big as u32);
+        assert_eq!(pack.textures[0].flags, 4);
+        assert_eq!(pack.textures[1].flags, 4 | TEXTURE_SRGB);
+        assert_eq!(pack.refs[3].info, [3, WRAP_REPEAT, WRAP_MIRROR, 0]);
+        assert_eq!(pack.bytes(), pack.texels.len() * 4);
+        assert_eq!(pack.texels[0], u32::from_le_bytes([200, 100, 50, 255]));
+    }
+
+    #[test]
+    fn a_tight_budget_halves_the_largest_side() {
+        // Two 64×32 chains (linear and sRGB) of 2048 + 512 + 128 + 32 + 8 + 2 + 1 texels each.
+        let full = TexturePack::new(&scene_with(&[64]), usize::MAX);
+        assert_eq!(full.max_side, MAX_TEXTURE_SIDE);
+        let budget = full.bytes() / 2;
+        let pack = TexturePack::new(&scene_with(&[64]), budget);
+        assert!(pack.bytes() <= budget);
+        assert_eq!(pack.max_side, 32);
+        assert_eq!((pack.textures[0].width, pack.textures[0].height), (32, 16));
+    }
+}
