@@ -153,7 +153,8 @@ impl Renderer {
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
 
         let t = Instant::now();
-        let host = HostScene::new(&world, bvh, &scene.materials);
+        let mut host = HostScene::new(&world, bvh, &scene.materials);
+        host.scale_emitter_power(&upload::emissive_texture_means(scene));
         let used = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
         self.scene_features = KernelFeatures {
             triangle_lights: !host.emissive.is_empty(),

@@ -5,7 +5,7 @@ use crate::bvh::Bvh;
 use crate::cl::types::*;
 use crate::scene::{
     AlphaMode, Camera, Light, LightKind, MAX_TEXTURE_SIDE, Material, Scene, WorldTriangle, Wrap,
-    mip_chain,
+    mip_chain, srgb_to_linear,
 };
 use glam::Vec3;
 use rayon::prelude::*;
@@ -147,10 +147,50 @@ impl HostScene {
         }
     }
 
+    /// Scales each emissive triangle's selection power by its material's factor in
+    /// `per_material` (see [`emissive_texture_means`]).
+    pub fn scale_emitter_power(&mut self, per_material: &[f32]) {
+        for (prim, _, power) in &mut self.emissive {
+            let material = self.triangles[*prim as usize].v0[3].to_bits() as usize;
+            *power *= per_material.get(material).copied().unwrap_or(1.0);
+        }
+    }
+
     /// The object index of a triangle in BVH order.
     pub fn object_of(&self, prim: u32) -> u32 {
         self.triangles[prim as usize].v2[3].to_bits()
     }
+}
+
+/// For each material, the mean linear luminance of its emissive texture (1 without one, at least
+/// 10⁻³), so that the light table weighs textured emitters by what they emit on average.
+pub fn emissive_texture_means(scene: &Scene) -> Vec<f32> {
+    scene
+        .materials
+        .iter()
+        .map(|m| {
+            let Some(r) = m.textures.emissive.filter(|_| m.is_emissive()) else {
+                return 1.0;
+            };
+            let r = &scene.texture_refs[r as usize];
+            let image = &scene.images[r.image as usize];
+            let sum: f64 = image
+                .rgba
+                .par_iter()
+                .map(|t| {
+                    let c = |v: u8| {
+                        if r.srgb {
+                            srgb_to_linear(v)
+                        } else {
+                            v as f32 / 255.0
+                        }
+                    };
+                    luminance([c(t[0]), c(t[1]), c(t[2])]) as f64
+                })
+                .sum();
+            ((sum / image.rgba.len().max(1) as f64) as f32).max(1e-3)
+        })
+        .collect()
 }
 
 /// The light list (emissive triangles first, so a triangle's light index is its position in
