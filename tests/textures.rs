@@ -714,3 +714,52 @@ fn images_load_from_glb_views_data_uris_and_files_and_unused_ones_are_not_read()
     );
     assert!(scene.materials[2].textures.emissive.is_none());
 }
+
+#[test]
+fn a_texture_can_read_texcoord_1() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    // Four white texels, then four black: u < 0.4375 reads white, u > 0.5625 black.
+    let mut texels = vec![[255u8; 4]; 4];
+    texels.extend([[0, 0, 0, 255]; 4]);
+    let image = t.embedded(&mut g, &png(8, 1, &texels));
+    let tex = t.texture(image, CLAMP);
+    let m = lambert(
+        &mut g,
+        [0.0, 0.0, 0.0, 1.0],
+        json!({"emissiveFactor": [1.0, 1.0, 1.0], "emissiveTexture": {"index": tex, "texCoord": 1}}),
+    );
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, false, false);
+    // TEXCOORD_0 reads black everywhere; TEXCOORD_1 carries the real coordinates.
+    let uv1 = g.meshes[mesh]["primitives"][0]["attributes"]["TEXCOORD_0"].clone();
+    let uv0 = g.float_accessor(&[[0.9f32, 0.5]; 4]);
+    g.meshes[mesh]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv0);
+    g.meshes[mesh]["primitives"][0]["attributes"]["TEXCOORD_1"] = uv1;
+    g.node(json!({"mesh": mesh}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.4, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 3.0]}));
+    let scene = g.write_glb(dir.path(), "uv1");
+    let (_, px) = render_exr(
+        &scene,
+        &dir.path().join("uv1.exr"),
+        &[
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--spp",
+            "4",
+            "--bounces",
+            "0",
+        ],
+    );
+    // The camera sees x in ±0.61 of the quad, u = (x + 1) / 2 in 0.2..0.8: the left two
+    // columns (u below 0.35) are white, the right two (above 0.65) black.
+    for row in px.chunks(8) {
+        assert!(row[0][1] > 0.99 && row[1][1] > 0.99, "{row:?}");
+        assert!(row[6][1] < 0.01 && row[7][1] < 0.01, "{row:?}");
+    }
+}
