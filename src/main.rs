@@ -1,9 +1,11 @@
 use clap::Parser;
 
 fn main() {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,egui_wgpu=error,winit=error"))
-        .format_timestamp(None)
-        .init();
+    env_logger::Builder::from_env(
+        env_logger::Env::default().default_filter_or("warn,egui_wgpu=error,winit=error"),
+    )
+    .format_timestamp(None)
+    .init();
     let cli = penumbra::cli::Cli::parse();
     if let Err(e) = penumbra::cli::run(cli) {
         // One line: the error and its causes, outermost first.

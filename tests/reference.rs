@@ -11,14 +11,25 @@ use std::path::Path;
 fn cornell_box_agrees_with_mitsuba() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let (w, h, reference) =
-        penumbra::image_io::read_exr(&root.join("tests/references/cornell-box-mitsuba-64.exr")).unwrap();
+        penumbra::image_io::read_exr(&root.join("tests/references/cornell-box-mitsuba-64.exr"))
+            .unwrap();
     assert_eq!((w, h), (64, 64));
     let out = output_dir("reference");
     let actual_path = out.join("cornell-box-actual.exr");
     let (summary, actual) = render_exr(
         &root.join("assets/cornell-box.glb"),
         &actual_path,
-        &["--width", "64", "--height", "64", "--bounces", "8", "--hard-shadows", "--spp", "1024"],
+        &[
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--bounces",
+            "8",
+            "--hard-shadows",
+            "--spp",
+            "1024",
+        ],
     );
     assert_eq!(summary["nonfinite_samples"], 0);
 
@@ -65,7 +76,8 @@ fn cornell_box_agrees_with_mitsuba() {
             .zip(&reference)
             .map(|(a, r)| [0, 1, 2].map(|c| (a[c] - r[c]).abs()))
             .collect();
-        penumbra::image_io::write_exr(&out.join("cornell-box-difference.exr"), 64, 64, &diff).unwrap();
+        penumbra::image_io::write_exr(&out.join("cornell-box-difference.exr"), 64, 64, &diff)
+            .unwrap();
     }
     assert!(
         ok,

@@ -70,6 +70,8 @@ pub struct Actions {
     pub screenshot: bool,
     /// Open this file.
     pub open: Option<PathBuf>,
+    /// Load this environment map (`Some(None)`: remove it).
+    pub environment: Option<Option<PathBuf>>,
     /// Hide the overlay.
     pub hide_overlay: bool,
 }
@@ -114,16 +116,25 @@ pub struct Gui {
     edit: Option<TransformEdit>,
     /// The last error about a file (shown in red until the next file loads).
     pub file_error: Option<String>,
+    /// The environment map path field.
+    pub env_text: String,
+    /// The last error about an environment map.
+    pub env_error: Option<String>,
+    /// Whether an environment map is loaded (shows its controls).
+    pub env_loaded: bool,
 }
 
 impl Gui {
-    /// The overlay with `path` in its file field.
-    pub fn new(path: String) -> Self {
+    /// The overlay with `path` in its file field; `env_loaded` when an environment map is on.
+    pub fn new(path: String, env_loaded: bool) -> Self {
         Self {
             path_text: path,
             preset: LightPreset::ThreePointStudio,
             edit: None,
             file_error: None,
+            env_text: String::new(),
+            env_error: None,
+            env_loaded,
         }
     }
 
@@ -237,6 +248,47 @@ impl Gui {
                         actions.changes.settings = true;
                     }
                 });
+                ui.horizontal(|ui| {
+                    ui.label("environment");
+                    let field = ui.add(
+                        egui::TextEdit::singleline(&mut self.env_text)
+                            .hint_text("sky.hdr / .exr")
+                            .desired_width(120.0),
+                    );
+                    let entered =
+                        field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                    if ui.button("Load").clicked() || entered {
+                        let path = self.env_text.trim();
+                        if path.is_empty() {
+                            self.env_error = Some("type a .hdr or .exr path first".into());
+                        } else {
+                            actions.environment = Some(Some(PathBuf::from(path)));
+                        }
+                    }
+                    if self.env_loaded && ui.button("Remove").clicked() {
+                        actions.environment = Some(None);
+                    }
+                });
+                if let Some(e) = &self.env_error {
+                    ui.label(RichText::new(e).color(Color32::LIGHT_RED));
+                }
+                if self.env_loaded {
+                    ui.horizontal(|ui| {
+                        let i = ui.add(
+                            egui::DragValue::new(&mut v.env_intensity)
+                                .range(0.0..=1.0e6)
+                                .speed(0.01)
+                                .prefix("intensity × "),
+                        );
+                        let r = ui.add(
+                            egui::Slider::new(&mut v.env_rotation, -180.0..=180.0)
+                                .text("rotation (°)"),
+                        );
+                        if i.changed() || r.changed() {
+                            actions.changes.settings = true;
+                        }
+                    });
+                }
                 ui.add(egui::Slider::new(&mut v.exposure, -10.0..=10.0).text("exposure (stops)"));
                 egui::ComboBox::from_label("tone mapper")
                     .selected_text(v.tone_mapper.name())

@@ -87,6 +87,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
     let environment = args.common.environment()?;
     let mut renderer = Renderer::new(&args.common.device_choice()?)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
+    let env_loaded = matches!(environment, Some(EnvChoice::Map(_)));
     if let Some(EnvChoice::Map(map)) = environment {
         renderer
             .set_environment(Some(map))
@@ -109,7 +110,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         lights: view.lights(),
         diagonal: bounds.diagonal(),
         model: Model::new(prepared.scene, view, camera),
-        gui: Gui::new(path_text),
+        gui: Gui::new(path_text, env_loaded),
         load_ms: prepared.load_ms,
         frames_limit: args.frames,
         screenshot_on_exit: args.screenshot.clone(),
@@ -535,6 +536,30 @@ impl App {
     }
 
     /// Loads `path` on a background thread; the current scene stays until it succeeds.
+    /// Loads (or with `None` removes) the environment map; an error stays in the overlay and
+    /// the current environment is kept.
+    fn set_environment(&mut self, path: Option<PathBuf>) {
+        let map = match path.as_deref().map(crate::scene::EnvMap::load).transpose() {
+            Ok(map) => map,
+            Err(e) => {
+                self.gui.env_error = Some(e);
+                return;
+            }
+        };
+        let loaded = map.is_some();
+        match self.frame_loop.renderer.set_environment(map) {
+            Ok(()) => {
+                self.gui.env_error = None;
+                self.gui.env_loaded = loaded;
+                self.frame_loop.invalidate(Changes {
+                    settings: true,
+                    ..Changes::default()
+                });
+            }
+            Err(e) => self.gui.env_error = Some(e.to_string()),
+        }
+    }
+
     fn open(&mut self, path: PathBuf) {
         self.gui.path_text = path.display().to_string();
         let (tx, rx) = std::sync::mpsc::channel();
@@ -708,6 +733,9 @@ impl App {
         }
         if let Some(path) = actions.open {
             self.open(path);
+        }
+        if let Some(env) = actions.environment {
+            self.set_environment(env);
         }
 
         // Collect a finished batch and start the next one before showing this image.

@@ -61,6 +61,10 @@ pub struct ViewState {
     pub seed: u32,
     /// Uniform sky radiance.
     pub sky: [f32; 3],
+    /// Environment map intensity (a scale on its radiance).
+    pub env_intensity: f32,
+    /// Environment map rotation about +Y in degrees.
+    pub env_rotation: f32,
     /// Thin-lens radius in scene units (0: pinhole, everything sharp).
     pub aperture: f32,
     /// Distance of the plane in focus along the view axis.
@@ -80,8 +84,7 @@ pub struct ViewState {
     pub rig: Vec<RigLight>,
     /// The scene's bounds, which size new lights and the softness range.
     pub bounds: Bounds,
-    /// What the command line set that the overlay does not edit (environment intensity and
-    /// rotation, Russian roulette, strategy).
+    /// What the command line set that the overlay does not edit (Russian roulette, strategy).
     base: RenderSettings,
 }
 
@@ -98,6 +101,8 @@ impl ViewState {
             bounces: base.bounces,
             seed: base.seed,
             sky: base.sky,
+            env_intensity: base.env_intensity,
+            env_rotation: base.env_rotation,
             aperture: base.lens_radius,
             focus_distance: base.focus_distance,
             spp_target: args.spp,
@@ -144,6 +149,8 @@ impl ViewState {
             bounces: self.bounces,
             seed: self.seed,
             sky: self.sky,
+            env_intensity: self.env_intensity.max(0.0),
+            env_rotation: self.env_rotation,
             lens_radius: self.aperture.max(0.0),
             focus_distance: self.focus_distance.max(1e-6),
             ..self.base.clone()
@@ -316,6 +323,20 @@ mod tests {
         assert_eq!(r.sky, [0.5; 3]);
         assert_eq!((r.lens_radius, r.focus_distance), (0.01, 2.0));
         assert_eq!(s.spp_target, Some(9));
+    }
+
+    #[test]
+    fn environment_edits_reach_the_render_settings() {
+        let mut s = state(
+            &["--env-intensity", "2", "--env-rotation", "30"],
+            &[point()],
+        );
+        let r = s.render_settings((8, 8));
+        assert_eq!((r.env_intensity, r.env_rotation), (2.0, 30.0));
+        s.env_intensity = 0.25;
+        s.env_rotation = -90.0;
+        let r = s.render_settings((8, 8));
+        assert_eq!((r.env_intensity, r.env_rotation), (0.25, -90.0));
     }
 
     #[test]
