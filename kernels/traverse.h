@@ -8,25 +8,13 @@
 
 typedef struct {
     float3 origin;
-    float3 inv;  // safe reciprocal of the direction
-    // The watertight test's permutation and shear as three rows: for a vertex offset A,
-    // (dot3(A, row_x), dot3(A, row_y), dot3(A, row_z)) = (A[kx] - Sx A[kz], A[ky] - Sy A[kz],
-    // Sz A[kz]), exactly (the other products are zeros), without per-vertex shuffles.
-    float3 row_x;
-    float3 row_y;
-    float3 row_z;
+    float3 inv;    // safe reciprocal of the direction
+    uint4 perm;    // (kx, ky, kz, 3) for shuffle()
+    float3 shear;  // (dx/dz, dy/dz, 1/dz) in the permuted frame
 } RayPrep;
 
 inline float safe_rcp(float x) {
     return 1.0f / (fabs(x) > 1e-20f ? x : copysign(1e-20f, x));
-}
-
-inline float dot3(float3 a, float3 r) {
-    return (a.x * r.x + a.y * r.y) + a.z * r.z;
-}
-
-inline float3 unit_axis(uint k, float s) {
-    return (float3)(k == 0u ? s : 0.0f, k == 1u ? s : 0.0f, k == 2u ? s : 0.0f);
 }
 
 inline RayPrep prepare_ray(float3 o, float3 d) {
@@ -37,34 +25,32 @@ inline RayPrep prepare_ray(float3 o, float3 d) {
     uint kz = a.x > a.y ? (a.x > a.z ? 0u : 2u) : (a.y > a.z ? 1u : 2u);
     uint kx = (kz + 1u) % 3u;
     uint ky = (kx + 1u) % 3u;
+    float4 d4 = (float4)(d, 0.0f);
     float dz = kz == 0u ? d.x : (kz == 1u ? d.y : d.z);
     if (dz < 0.0f) {
         uint tmp = kx;
         kx = ky;
         ky = tmp;
     }
-    float dx = kx == 0u ? d.x : (kx == 1u ? d.y : d.z);
-    float dy = ky == 0u ? d.x : (ky == 1u ? d.y : d.z);
-    float sx = dx / dz;
-    float sy = dy / dz;
-    r.row_x = unit_axis(kx, 1.0f) + unit_axis(kz, -sx);
-    r.row_y = unit_axis(ky, 1.0f) + unit_axis(kz, -sy);
-    r.row_z = unit_axis(kz, 1.0f / dz);
+    r.perm = (uint4)(kx, ky, kz, 3u);
+    float4 p = shuffle(d4, r.perm);
+    r.shear = (float3)(p.x / p.z, p.y / p.z, 1.0f / p.z);
     return r;
 }
 
 // Returns true on a hit in (tmin, *tmax), updating *tmax and the barycentrics.
 inline bool intersect_triangle(const RayPrep* r, float4 v0, float4 v1, float4 v2, float tmin,
                                float* tmax, float* bu, float* bv) {
-    float3 a = v0.xyz - r->origin;
-    float3 b = v1.xyz - r->origin;
-    float3 c = v2.xyz - r->origin;
-    float ax = dot3(a, r->row_x);
-    float ay = dot3(a, r->row_y);
-    float bx = dot3(b, r->row_x);
-    float by = dot3(b, r->row_y);
-    float cx = dot3(c, r->row_x);
-    float cy = dot3(c, r->row_y);
+    float4 o = (float4)(r->origin, 0.0f);
+    float4 a = shuffle(v0 - o, r->perm);
+    float4 b = shuffle(v1 - o, r->perm);
+    float4 c = shuffle(v2 - o, r->perm);
+    float ax = a.x - r->shear.x * a.z;
+    float ay = a.y - r->shear.y * a.z;
+    float bx = b.x - r->shear.x * b.z;
+    float by = b.y - r->shear.y * b.z;
+    float cx = c.x - r->shear.x * c.z;
+    float cy = c.y - r->shear.y * c.z;
     float u = cx * by - cy * bx;
     float v = ax * cy - ay * cx;
     float w = bx * ay - by * ax;
@@ -78,7 +64,7 @@ inline bool intersect_triangle(const RayPrep* r, float4 v0, float4 v1, float4 v2
     if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
     float det = u + v + w;
     if (det == 0.0f) return false;
-    float t = (u * dot3(a, r->row_z) + v * dot3(b, r->row_z) + w * dot3(c, r->row_z)) / det;
+    float t = (u * (r->shear.z * a.z) + v * (r->shear.z * b.z) + w * (r->shear.z * c.z)) / det;
     if (!(t > tmin && t < *tmax)) return false;
     *tmax = t;
     *bu = v / det;
@@ -102,47 +88,6 @@ inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float
 // builder's depth limit rules out, the overflow counter is raised instead of failing silently.
 // With HAS_ALPHA, hits that the material's alpha cuts out (MASK) or lets through (BLEND, at
 // random) are skipped; `surf` is read only then.
-// Tests one child of a node: returns its node index when it is an interior node whose box the
-// ray enters (entry distance in *dist), -1 otherwise; a leaf child's triangles are intersected
-// on the spot. *done is set when an any-hit query found its hit.
-inline int visit_child(float4 lo, float4 hi, const RayPrep* r, global const GpuTriangle* tris,
-                       const SceneSurfaces* surf, float3 o, float3 d, float tmin, bool any_hit,
-                       GpuHit* hit, float* dist, bool* done) {
-    *dist = box_entry(lo, hi, r, tmin, hit->t);
-    if (*dist == INFINITY) return -1;
-    int ref = as_int(lo.w);
-    if (ref >= 0) return ref;
-    uint first = (uint)(~ref);
-    uint count = as_uint(hi.w);
-    for (uint p = first; p < first + count; ++p) {
-        GpuTriangle t = tris[p];
-#ifdef HAS_ALPHA
-        float t_hit = hit->t;
-        float bu, bv;
-        if (intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv) &&
-            !alpha_passes(surf, p, as_uint(t.v0.w), bu, bv, o, d)) {
-            hit->t = t_hit;
-            hit->u = bu;
-            hit->v = bv;
-            hit->prim = p;
-            if (any_hit) {
-                *done = true;
-                return -1;
-            }
-        }
-#else
-        if (intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &hit->t, &hit->u, &hit->v)) {
-            hit->prim = p;
-            if (any_hit) {
-                *done = true;
-                return -1;
-            }
-        }
-#endif
-    }
-    return -1;
-}
-
 inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
                        const SceneSurfaces* surf, float3 o, float3 d, float tmin, float tmax,
                        bool any_hit, volatile global uint* overflow) {
@@ -155,29 +100,57 @@ inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle*
     uint stack[STACK_SIZE];
     uint sp = 0;
     uint node = 0;
-    bool done = false;
     for (;;) {
-        global const GpuBvhNode* n = &nodes[node];
-        float dl, dr;
-        int left = visit_child(n->left_min, n->left_max, &r, tris, surf, o, d, tmin, any_hit,
-                               &hit, &dl, &done);
-        if (done) return hit;
-        int right = visit_child(n->right_min, n->right_max, &r, tris, surf, o, d, tmin, any_hit,
-                                &hit, &dr, &done);
-        if (done) return hit;
-        if (left >= 0 && right >= 0) {
-            uint first = dl <= dr ? (uint)left : (uint)right;
-            uint second = dl <= dr ? (uint)right : (uint)left;
+        GpuBvhNode n = nodes[node];
+        float dist[2];
+        int child[2];
+        for (int side = 0; side < 2; ++side) {
+            float4 lo = side == 0 ? n.left_min : n.right_min;
+            float4 hi = side == 0 ? n.left_max : n.right_max;
+            child[side] = -1;
+            dist[side] = box_entry(lo, hi, &r, tmin, hit.t);
+            if (dist[side] == INFINITY) continue;
+            int ref = as_int(lo.w);
+            if (ref >= 0) {
+                child[side] = ref;
+                continue;
+            }
+            uint first = (uint)(~ref);
+            uint count = as_uint(hi.w);
+            for (uint p = first; p < first + count; ++p) {
+                GpuTriangle t = tris[p];
+#ifdef HAS_ALPHA
+                float t_hit = hit.t;
+                float bu, bv;
+                if (intersect_triangle(&r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv) &&
+                    !alpha_passes(surf, p, as_uint(t.v0.w), bu, bv, o, d)) {
+                    hit.t = t_hit;
+                    hit.u = bu;
+                    hit.v = bv;
+                    hit.prim = p;
+                    if (any_hit) return hit;
+                }
+#else
+                if (intersect_triangle(&r, t.v0, t.v1, t.v2, tmin, &hit.t, &hit.u, &hit.v)) {
+                    hit.prim = p;
+                    if (any_hit) return hit;
+                }
+#endif
+            }
+        }
+        if (child[0] >= 0 && child[1] >= 0) {
+            uint first = dist[0] <= dist[1] ? (uint)child[0] : (uint)child[1];
+            uint second = dist[0] <= dist[1] ? (uint)child[1] : (uint)child[0];
             if (sp == STACK_SIZE) {
                 atomic_inc(overflow);
                 return hit;
             }
             stack[sp++] = second;
             node = first;
-        } else if (left >= 0) {
-            node = (uint)left;
-        } else if (right >= 0) {
-            node = (uint)right;
+        } else if (child[0] >= 0) {
+            node = (uint)child[0];
+        } else if (child[1] >= 0) {
+            node = (uint)child[1];
         } else {
             if (sp == 0) return hit;
             node = stack[--sp];
