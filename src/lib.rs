@@ -5,6 +5,7 @@ pub mod app;
 pub mod bvh;
 pub mod cl;
 pub mod cli;
+pub mod date;
 pub mod image_io;
 pub mod render;
 pub mod scene;

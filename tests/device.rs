@@ -196,13 +196,6 @@ fn furnace(dir: &std::path::Path, albedo: f32, le: f32, inward: bool) -> std::pa
     g.write_glb(dir, if inward { "furnace" } else { "furnace-outward" })
 }
 
-fn mean(px: &[[f32; 3]]) -> f64 {
-    px.iter()
-        .map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0)
-        .sum::<f64>()
-        / px.len() as f64
-}
-
 #[test]
 fn furnace_sphere_converges_to_le_over_one_minus_albedo() {
     let dir = tempfile::tempdir().unwrap();
@@ -223,7 +216,7 @@ fn furnace_sphere_converges_to_le_over_one_minus_albedo() {
             "40",
         ],
     );
-    let m = mean(&px);
+    let m = common::mean_gray(&px);
     assert!((m - 2.0).abs() < 0.03, "furnace mean {m}, expected 2.0");
     assert_eq!(summary["nonfinite_samples"], 0);
     // Direct light only: emission seen plus one reflection of it, Le (1 + albedo).
@@ -241,7 +234,7 @@ fn furnace_sphere_converges_to_le_over_one_minus_albedo() {
             "0",
         ],
     );
-    let m = mean(&px);
+    let m = common::mean_gray(&px);
     assert!((m - 1.5).abs() < 0.02, "direct-only mean {m}, expected 1.5");
 }
 
@@ -267,7 +260,7 @@ fn single_sided_emitters_do_not_emit_from_their_back() {
     );
     // Facing inwards the same sphere reads 2.0; sliver triangles at the poles, whose winding
     // rounding can flip, may leak a trace, so allow a millionth of that.
-    let m = mean(&px);
+    let m = common::mean_gray(&px);
     assert!(m < 2e-6, "back faces emitted: mean {m}");
 }
 

@@ -273,13 +273,6 @@ fn white_sphere(dir: &Path, floor: bool) -> PathBuf {
     g.write_glb(dir, if floor { "sphere-floor" } else { "sphere" })
 }
 
-fn mean(px: &[[f32; 3]]) -> f64 {
-    px.iter()
-        .map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0)
-        .sum::<f64>()
-        / px.len() as f64
-}
-
 #[test]
 fn a_white_sphere_under_a_uniform_environment_disappears() {
     let dir = tempfile::tempdir().unwrap();
@@ -305,14 +298,14 @@ fn a_white_sphere_under_a_uniform_environment_disappears() {
     assert_eq!(summary["nonfinite_samples"], 0);
     assert_eq!(summary["default_light_rig"], false);
     // A convex albedo-1 Lambertian surface under uniform radiance L reflects exactly L.
-    let m = mean(&px);
+    let m = common::mean_gray(&px);
     assert!((m - 0.5).abs() < 0.005, "mean {m}, expected 0.5");
     // The centre 8×8 is all sphere.
     let centre: Vec<[f32; 3]> = (8..16)
         .flat_map(|y| (8..16).map(move |x| y * 24 + x))
         .map(|i| px[i])
         .collect();
-    let c = mean(&centre);
+    let c = common::mean_gray(&centre);
     assert!((c - 0.5).abs() < 0.01, "sphere mean {c}, expected 0.5");
 }
 
@@ -350,7 +343,7 @@ fn mis_bsdf_only_and_light_only_agree_under_an_environment_with_a_sun() {
             ],
         );
         assert_eq!(summary["nonfinite_samples"], 0);
-        means.push(mean(&px));
+        means.push(common::mean_gray(&px));
         images.push(px);
     }
     for (s, m) in ["bsdf", "lights"].iter().zip(&means[1..]) {
@@ -418,11 +411,19 @@ fn rotation_turns_the_environment_about_up_and_intensity_scales_it() {
         );
         px
     };
-    assert_eq!(mean(&look("0", "1")), 0.0, "-Z is dark without rotation");
+    assert_eq!(
+        common::mean_gray(&look("0", "1")),
+        0.0,
+        "-Z is dark without rotation"
+    );
     // Turning the map 90° counter-clockwise seen from above brings +X to -Z.
     let px = look("90", "1");
     assert!(px.iter().all(|p| *p == [2.0, 1.0, 0.5]), "{:?}", px[0]);
-    assert_eq!(mean(&look("-90", "1")), 0.0, "-90° turns +X to +Z");
+    assert_eq!(
+        common::mean_gray(&look("-90", "1")),
+        0.0,
+        "-90° turns +X to +Z"
+    );
     let px = look("90", "2.5");
     assert!(px.iter().all(|p| *p == [5.0, 2.5, 1.25]), "{:?}", px[0]);
 }

@@ -176,15 +176,33 @@ pub struct RenderArgs {
     /// Shared options.
     #[command(flatten)]
     pub common: CommonArgs,
+    /// Sampling options.
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+    /// Exposure in stops for PNG output.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+}
+
+/// How paths are sampled (`render`, `bench frame`).
+#[derive(Args, Debug, Clone)]
+pub struct SamplingArgs {
     /// Direct-light strategy.
     #[arg(long, value_enum, default_value_t = StrategyArg::Mis)]
     pub strategy: StrategyArg,
     /// Disable Russian roulette.
     #[arg(long)]
     pub no_russian_roulette: bool,
-    /// Exposure in stops for PNG output.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub exposure: f32,
+}
+
+impl SamplingArgs {
+    /// Applies the strategy and Russian roulette choice to `settings`.
+    pub fn apply(&self, settings: &mut RenderSettings) {
+        settings.strategy = self.strategy.into();
+        if self.no_russian_roulette {
+            settings.russian_roulette = None;
+        }
+    }
 }
 
 /// `--strategy` values.

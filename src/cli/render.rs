@@ -19,10 +19,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         anyhow::bail!("{}: the output folder does not exist", dir.display());
     }
     let mut settings = args.common.settings((640, 480))?;
-    settings.strategy = args.strategy.into();
-    if args.no_russian_roulette {
-        settings.russian_roulette = None;
-    }
+    args.sampling.apply(&mut settings);
     let spp = args.common.spp.unwrap_or(DEFAULT_SPP);
     let prepared = args.common.prepare(Some(&args.scene))?;
     let environment = args.common.environment()?;

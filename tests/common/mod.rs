@@ -395,3 +395,11 @@ pub fn output_dir(test: &str) -> PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// The mean over pixels of the channels' mean.
+pub fn mean_gray(px: &[[f32; 3]]) -> f64 {
+    px.iter()
+        .map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0)
+        .sum::<f64>()
+        / px.len() as f64
+}

@@ -7,8 +7,9 @@
 //! axes. A curve that flattens is bias (or a reference that does not match the render).
 
 use super::stats::{ImageError, image_error, log_log_slope};
-use super::{device_json, device_line, plot, today};
+use super::{device_json, device_line, plot};
 use crate::cli::CommonArgs;
+use crate::date::today;
 use crate::image_io::read_exr;
 use crate::render::{Renderer, Strategy};
 use crate::scene::{AUTO_YFOV, Camera};

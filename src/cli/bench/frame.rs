@@ -1,8 +1,9 @@
 //! `penumbra bench frame SCENE`: samples per second of the whole path tracer and where the
 //! time goes, stage by stage (kernel time from OpenCL profiling events).
 
-use super::{device_json, device_line, thousands, today};
-use crate::cli::{CommonArgs, StrategyArg};
+use super::{device_json, device_line, thousands};
+use crate::cli::{CommonArgs, SamplingArgs};
+use crate::date::today;
 use crate::render::Renderer;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -18,12 +19,9 @@ pub struct FrameArgs {
     /// 1920×1080).
     #[command(flatten)]
     pub common: CommonArgs,
-    /// Direct-light strategy.
-    #[arg(long, value_enum, default_value_t = StrategyArg::Mis)]
-    pub strategy: StrategyArg,
-    /// Disable Russian roulette.
-    #[arg(long)]
-    pub no_russian_roulette: bool,
+    /// Sampling options.
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
     /// Untimed samples per pixel rendered first (buffers, caches, clocks).
     #[arg(long, default_value_t = 1)]
     pub warmup: u32,
@@ -35,10 +33,7 @@ pub struct FrameArgs {
 /// Runs the benchmark.
 pub fn run(args: &FrameArgs) -> Result<()> {
     let mut settings = args.common.settings((1920, 1080))?;
-    settings.strategy = args.strategy.into();
-    if args.no_russian_roulette {
-        settings.russian_roulette = None;
-    }
+    args.sampling.apply(&mut settings);
     let spp = args.common.spp.unwrap_or(16);
     let prepared = args.common.prepare(args.scene.as_deref())?;
     let source = prepared.scene.source.clone();

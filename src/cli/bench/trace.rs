@@ -9,12 +9,13 @@
 
 use super::rays::{self, LightTargets, MISS};
 use super::stats::median;
-use super::{device_json, device_line, thousands, today};
+use super::{device_json, device_line, thousands};
 use crate::bvh::Bvh;
 use crate::cl::kernels::{Launch, SceneBuffers};
 use crate::cl::types::{GpuHit, GpuRay};
 use crate::cl::{Buffer, Gpu, Program, call_err};
 use crate::cli::CommonArgs;
+use crate::date::today;
 use crate::render::{Renderer, gpu_camera};
 use crate::scene::LightKind;
 use anyhow::{Context, Result, anyhow};
