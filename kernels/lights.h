@@ -5,6 +5,9 @@ typedef struct {
     float distance;     // distance to the sampled point (INFINITY for directional lights)
     float3 radiance;    // incident radiance divided by the solid-angle pdf (selection included)
     float pdf;          // solid-angle pdf including selection; 0 for delta lights
+    float3 target;      // emissive triangles: the sampled point moved off the light towards
+                        // the shading point, where the shadow ray ends
+    bool on_surface;    // whether `target` is set (the light is geometry the shadow ray could hit)
 } LightSample;
 
 // Spot cone attenuation as the glTF KHR_lights_punctual specification writes it.
@@ -43,6 +46,8 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
     s.radiance = (float3)(0.0f);
     s.wi = (float3)(0.0f, 0.0f, 1.0f);
     s.distance = 0.0f;
+    s.target = p;
+    s.on_surface = false;
     if (kind == LIGHT_DIRECTIONAL) {
         float3 axis = -l->position.xyz;
         s.distance = INFINITY;
@@ -87,6 +92,10 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
         if (dist2 <= 0.0f) return s;
         s.distance = sqrt(dist2);
         s.wi = d / s.distance;
+        // End the shadow ray a few ulps off the light, on the shading point's side, so that it
+        // can neither hit the light itself nor stop short of an occluder, at any scale.
+        s.target = offset_ray(q, dot(ng, p - q) > 0.0f ? ng : -ng);
+        s.on_surface = true;
         global const GpuMaterial* m = &materials[as_uint(t.v0.w)];
         float cos_l = -dot(ng, s.wi);
         bool two_sided = (as_uint(m->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;

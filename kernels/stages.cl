@@ -7,17 +7,6 @@
 #define STRATEGY_BSDF 1u
 #define STRATEGY_LIGHTS 2u
 
-// Moves p off the surface along the geometric normal n by a few ulps of its coordinates
-// (Wächter and Binder, Ray Tracing Gems, chapter 6).
-inline float3 offset_ray(float3 p, float3 n) {
-    const float origin = 1.0f / 32.0f;
-    const float float_scale = 1.0f / 65536.0f;
-    const float int_scale = 256.0f;
-    int3 of_i = convert_int3(int_scale * n);
-    int3 p_i = as_int3(p) + select(of_i, -of_i, p < 0.0f);
-    return select(as_float3(p_i), p + float_scale * n, fabs(p) < origin);
-}
-
 inline float power_heuristic(float a, float b) {
     float a2 = a * a;
     float b2 = b * b;
@@ -216,8 +205,17 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
             if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
                 uint s = atomic_inc(&counters[COUNT_SHADOW]);
                 GpuShadowRay ray;
-                ray.origin = (float4)(offset_ray(p, side > 0.0f ? ng : -ng), ls.distance * 0.9999f);
-                ray.direction = (float4)(ls.wi, as_float(slot));
+                float3 from = offset_ray(p, side > 0.0f ? ng : -ng);
+                float3 dir = ls.wi;
+                // Virtual lights (spheres, discs, the sky) are not geometry: trace to them.
+                float tmax = ls.distance;
+                if (ls.on_surface) {
+                    float3 seg = ls.target - from;
+                    tmax = length(seg);
+                    dir = seg / tmax;
+                }
+                ray.origin = (float4)(from, tmax);
+                ray.direction = (float4)(dir, as_float(slot));
                 ray.contribution = (float4)(contribution, 0.0f);
                 shadow_rays[s] = ray;
             }

@@ -196,6 +196,68 @@ fn furnace(dir: &std::path::Path, albedo: f32, le: f32, inward: bool) -> std::pa
     g.write_glb(dir, if inward { "furnace" } else { "furnace-outward" })
 }
 
+/// The furnace sphere and its camera moved to `translation` and scaled by `scale` together.
+fn furnace_placed(
+    dir: &std::path::Path,
+    name: &str,
+    translation: [f64; 3],
+    scale: f64,
+) -> std::path::PathBuf {
+    let mut g = Gltf::default();
+    let m = g.lambert([0.5; 3], [1.0; 3], 1.0, false);
+    let (positions, normals, indices) = sphere(1.0, 24, 48, true);
+    let mesh = g.mesh(vec![Prim {
+        positions,
+        normals,
+        indices,
+        material: Some(m),
+        mode: 4,
+    }]);
+    let sphere_node = g.node(json!({"mesh": mesh}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 1.2, "znear": 0.0001}}));
+    let camera_node = g.node(json!({"camera": 0, "translation": [0.0, 0.0, 0.3]}));
+    g.node(json!({
+        "children": [sphere_node, camera_node],
+        "translation": translation,
+        "scale": [scale, scale, scale]
+    }));
+    g.write_glb(dir, name)
+}
+
+/// Spawned rays are offset in ulps of the hit point, not by a fixed epsilon: the furnace must
+/// give the same answer 10 km from the origin, where an f32 ulp is a millimetre, and at a
+/// millimetre's scale, where a fixed epsilon would leak or self-intersect.
+#[test]
+fn the_furnace_holds_far_from_the_origin_and_at_small_scale() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f.exr");
+    let args = [
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "64",
+        "--bounces",
+        "40",
+    ];
+    for (name, translation, scale) in [
+        ("far", [1.0e4, -2.0e4, 1.5e4], 1.0),
+        ("tiny", [0.0, 0.0, 0.0], 1.0e-3),
+        ("huge", [3.0e3, 0.0, 0.0], 1.0e3),
+    ] {
+        let scene = furnace_placed(dir.path(), name, translation, scale);
+        let (summary, px) = render_exr(&scene, &out, &args);
+        let m = common::mean_gray(&px);
+        assert!(
+            (m - 2.0).abs() < 0.04,
+            "{name}: furnace mean {m}, expected 2.0"
+        );
+        assert_eq!(summary["nonfinite_samples"], 0, "{name}");
+    }
+}
+
 #[test]
 fn furnace_sphere_converges_to_le_over_one_minus_albedo() {
     let dir = tempfile::tempdir().unwrap();
