@@ -95,9 +95,10 @@ inline int wrap_texel(int i, int n, int mode) {
     return m < 0 ? m + n : m;
 }
 
-// Bilinear lookup of level `level` at texture coordinate st (texel centres at half-integers).
+// Bilinear (or with `nearest`, nearest-texel) lookup of level `level` at texture coordinate st
+// (texel centres at half-integers).
 inline float4 texture_level(const SceneSurfaces* s, GpuTexture t, int wrap_s, int wrap_t,
-                            float2 st, uint level) {
+                            float2 st, uint level, bool nearest) {
     uint offset = t.offset;
     uint w = t.width;
     uint h = t.height;
@@ -119,6 +120,12 @@ inline float4 texture_level(const SceneSurfaces* s, GpuTexture t, int wrap_s, in
     int yb = wrap_texel(y0 + 1, (int)h, wrap_t);
     bool srgb = (t.flags & TEXTURE_SRGB) != 0u;
     global const uint* texels = s->texels + offset;
+    if (nearest) {
+        // The texel whose square holds st: the nearer of the bilinear pair on each axis.
+        int x = a.x < 0.5f ? xa : xb;
+        int y = a.y < 0.5f ? ya : yb;
+        return unpack_texel(texels[y * (int)w + x], srgb);
+    }
     float4 c00 = unpack_texel(texels[ya * (int)w + xa], srgb);
     float4 c10 = unpack_texel(texels[ya * (int)w + xb], srgb);
     float4 c01 = unpack_texel(texels[yb * (int)w + xa], srgb);
@@ -139,7 +146,8 @@ inline float4 texture_sample(const SceneSurfaces* s, int ref, const TexCoords* t
     lod = clamp(lod, 0.0f, (float)(levels - 1u));
     uint level = (uint)lod;
     if (tc->xi < lod - (float)level) level = min(level + 1u, levels - 1u);
-    return texture_level(s, t, r.info.y, r.info.z, st, level);
+    if ((r.info.w & TEXREF_NO_MIPS) != 0) level = 0u;
+    return texture_level(s, t, r.info.y, r.info.z, st, level, (r.info.w & TEXREF_NEAREST) != 0);
 }
 
 #endif

@@ -46,8 +46,11 @@ typedef struct {
 typedef struct {
     float4 m0;  // first row of the UV transform; .w = texture coordinate set (uint bits)
     float4 m1;  // second row; .w = 0.5 * log2 |det| (mip bias)
-    int4 info;  // .x texture index, .y wrap S, .z wrap T (WRAP_*)
+    int4 info;  // .x texture index, .y wrap S, .z wrap T (WRAP_*), .w flags (TEXREF_*)
 } GpuTexRef;
+
+#define TEXREF_NEAREST 1  // nearest-texel lookups (sampler magFilter NEAREST)
+#define TEXREF_NO_MIPS 2  // finest level only (minFilter without mipmaps)
 
 typedef struct {
     float4 scale;     // .x intensity, .y pdf normalization W*H / (sum f * 2 pi^2), .z NEE pick probability

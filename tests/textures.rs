@@ -329,6 +329,71 @@ fn lookups_wrap_filter_decode_srgb_and_transform_like_the_gltf_sampler() {
     assert!((got[1200][0] - 0.2158605).abs() < 1e-6);
 }
 
+/// Samplers with magFilter NEAREST read one texel, and a minFilter without mipmaps keeps the
+/// finest level whatever the footprint.
+#[test]
+fn nearest_samplers_read_one_texel_and_mipless_ones_stay_at_level_0() {
+    const NEAREST: u32 = 9728;
+    const LINEAR: u32 = 9729;
+    let dir = tempfile::tempdir().unwrap();
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let texels = test_texels();
+    let image = t.embedded(&mut g, &png(4, 4, &texels));
+    for (mag, min) in [(NEAREST, NEAREST), (LINEAR, LINEAR)] {
+        t.samplers
+            .push(json!({"wrapS": MIRROR, "wrapT": MIRROR, "magFilter": mag, "minFilter": min}));
+        t.textures
+            .push(json!({"source": image, "sampler": t.samplers.len() - 1}));
+        let tex = t.textures.len() - 1;
+        lambert(
+            &mut g,
+            [1.0; 4],
+            json!({"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": tex}}}),
+        );
+    }
+    t.finish(&mut g);
+    let mesh = quad(&mut g, 0, false, false);
+    g.node(json!({"mesh": mesh}));
+    let scene = penumbra::scene::load(&g.write_glb(dir.path(), "nearest")).unwrap();
+    assert!(scene.texture_refs[0].nearest && !scene.texture_refs[0].mipmaps);
+    assert!(!scene.texture_refs[1].nearest && !scene.texture_refs[1].mipmaps);
+    let mut r = renderer();
+    r.load_scene(&scene, &[]).unwrap();
+    let decode = |t: [u8; 4]| t.map(|v| v as f32 / 255.0);
+    let mut rnd = lcg(9);
+    let mut queries = vec![];
+    let mut expect = vec![];
+    for _ in 0..500 {
+        let st = [rnd() * 4.6 - 1.8, rnd() * 4.6 - 1.8];
+        // A coarse footprint (level 3) must not matter: neither sampler has mipmaps.
+        queries.push([st[0], st[1], 3.0, f32::from_bits(0)]);
+        let mirror = |c: f32| {
+            let m = ((c * 4.0).floor() as i64).rem_euclid(8);
+            if m < 4 { m } else { 7 - m }
+        };
+        expect.push(decode(texels[(mirror(st[1]) * 4 + mirror(st[0])) as usize]));
+        queries.push([st[0], st[1], 3.0, f32::from_bits(1)]);
+        expect.push(reference(&texels, 4, 4, MIRROR, false, st));
+    }
+    let got = r
+        .program()
+        .unwrap()
+        .sample_texture_test(&r.gpu, r.scene_buffers().unwrap(), &queries)
+        .unwrap();
+    for (i, (g, e)) in got.iter().zip(&expect).enumerate() {
+        // Nearest reads are exact texel values; bilinear ones round a little.
+        let tolerance = if i % 2 == 0 { 1e-6 } else { 2e-4 };
+        for c in 0..4 {
+            assert!(
+                (g[c] - e[c]).abs() < tolerance,
+                "query {i} {:?}: {g:?} vs {e:?}",
+                queries[i]
+            );
+        }
+    }
+}
+
 #[test]
 fn mip_levels_follow_the_footprint_and_average_in_linear_space() {
     let dir = tempfile::tempdir().unwrap();

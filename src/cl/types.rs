@@ -100,6 +100,11 @@ pub const WRAP_CLAMP: i32 = 1;
 /// Mirrored repeat.
 pub const WRAP_MIRROR: i32 = 2;
 
+/// `GpuTexRef::info.w` flag: nearest-texel lookups (sampler magFilter NEAREST).
+pub const TEXREF_NEAREST: i32 = 1;
+/// `GpuTexRef::info.w` flag: the finest level only (minFilter NEAREST or LINEAR, no mipmaps).
+pub const TEXREF_NO_MIPS: i32 = 2;
+
 /// A material's use of a texture: which one, the sampler and the `KHR_texture_transform`
 /// (48 bytes). The lookup coordinate is `(dot(m0.xyz, (u, v, 1)), dot(m1.xyz, (u, v, 1)))`.
 #[repr(C)]
@@ -109,7 +114,7 @@ pub struct GpuTexRef {
     pub m0: [f32; 4],
     /// Second row of the UV transform; `.w` = ½·log2 |det| of the transform (mip bias).
     pub m1: [f32; 4],
-    /// `.x` texture index, `.y` wrap S, `.z` wrap T (`WRAP_*`), `.w` unused.
+    /// `.x` texture index, `.y` wrap S, `.z` wrap T (`WRAP_*`), `.w` filter flags (`TEXREF_*`).
     pub info: [i32; 4],
 }
 const _: () = assert!(size_of::<GpuTexRef>() == 48);

@@ -383,7 +383,8 @@ impl TexturePack {
                         index[&(r.image, r.srgb)] as i32,
                         wrap_code(r.wrap_s),
                         wrap_code(r.wrap_t),
-                        0,
+                        if r.nearest { TEXREF_NEAREST } else { 0 }
+                            | if r.mipmaps { 0 } else { TEXREF_NO_MIPS },
                     ],
                 }
             })
@@ -428,6 +429,8 @@ mod tests {
                     wrap_s: Wrap::Repeat,
                     wrap_t: Wrap::Mirror,
                     tex_coord: 0,
+                    nearest: false,
+                    mipmaps: true,
                     transform: TexTransform::default(),
                 })
             })

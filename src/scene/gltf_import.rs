@@ -271,6 +271,11 @@ impl TextureTable {
             wrap_s: Wrap::from(sampler.wrap_s()),
             wrap_t: Wrap::from(sampler.wrap_t()),
             tex_coord,
+            nearest: sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest),
+            mipmaps: !matches!(
+                sampler.min_filter(),
+                Some(gltf::texture::MinFilter::Nearest | gltf::texture::MinFilter::Linear)
+            ),
             transform: t,
         });
         Some(self.refs.len() as u32 - 1)

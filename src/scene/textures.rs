@@ -102,6 +102,11 @@ pub struct TextureRef {
     pub wrap_t: Wrap,
     /// Texture coordinate set (0 or 1), after the transform's override.
     pub tex_coord: u32,
+    /// Nearest-texel lookups (the sampler's magFilter is NEAREST).
+    pub nearest: bool,
+    /// Whether coarser levels are used for minification (false when the sampler's minFilter
+    /// has no mipmaps).
+    pub mipmaps: bool,
     /// The texture transform.
     pub transform: TexTransform,
 }
