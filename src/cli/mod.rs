@@ -439,6 +439,21 @@ pub fn run(cli: Cli) -> Result<()> {
 mod tests {
     use super::*;
 
+    /// clap's own consistency checks (unique names, valid `requires` and `conflicts_with`);
+    /// release builds skip them at run time, so a duplicate option would go unnoticed.
+    #[test]
+    fn the_command_line_definition_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn vectors_parse() {
+        assert_eq!(parse_vec3("-278, 273,800"), Ok([-278.0, 273.0, 800.0]));
+        assert!(parse_vec3("1,2").is_err());
+        assert!(parse_vec3("1,nan,2").is_err());
+    }
+
     #[test]
     fn colors_parse_or_fail_clearly() {
         assert_eq!(parse_color("0.5").unwrap(), [0.5; 3]);

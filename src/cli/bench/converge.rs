@@ -12,10 +12,8 @@ use crate::cli::CommonArgs;
 use crate::date::today;
 use crate::image_io::read_exr;
 use crate::render::{Renderer, Strategy};
-use crate::scene::{AUTO_YFOV, Camera};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use glam::DVec3;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -47,15 +45,6 @@ pub struct ConvergeArgs {
     /// punctual light).
     #[arg(long)]
     pub no_punctual: bool,
-    /// Camera position X,Y,Z (with --look-at; replaces the file's camera).
-    #[arg(long, value_parser = parse_vec3, requires = "look_at", allow_negative_numbers = true)]
-    pub look_from: Option<DVec3>,
-    /// Point the camera looks at, X,Y,Z.
-    #[arg(long, value_parser = parse_vec3, requires = "look_from", allow_negative_numbers = true)]
-    pub look_at: Option<DVec3>,
-    /// Vertical field of view in degrees of the --look-from camera.
-    #[arg(long)]
-    pub fov: Option<f64>,
     /// Write the steps as CSV here.
     #[arg(long)]
     pub csv: Option<PathBuf>,
@@ -119,18 +108,6 @@ fn parse_config(s: &str) -> Result<Config, String> {
         .ok_or_else(|| {
             format!("'{s}' is not a configuration (mis, bsdf, lights, each optionally +rr)")
         })
-}
-
-fn parse_vec3(s: &str) -> Result<DVec3, String> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("'{s}' is not X,Y,Z"))?;
-    match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(DVec3::new(*x, *y, *z)),
-        _ => Err(format!("'{s}' is not X,Y,Z")),
-    }
 }
 
 /// One recorded step.
@@ -219,12 +196,6 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     let source = prepared.scene.source.clone();
     if args.no_punctual {
         prepared.lights.clear();
-    }
-    if let (Some(eye), Some(target)) = (args.look_from, args.look_at) {
-        let yfov = args.fov.map_or(AUTO_YFOV, f64::to_radians);
-        prepared.camera = Camera::look_at("look-from", eye, target, yfov);
-    } else if args.fov.is_some() {
-        bail!("--fov needs --look-from and --look-at");
     }
     if !prepared.lights.is_empty() && configs.iter().any(|c| c.strategy == Strategy::Bsdf) {
         eprintln!(
@@ -405,15 +376,6 @@ mod tests {
         for c in Config::ALL {
             assert_eq!(parse_config(&c.name()), Ok(c));
         }
-    }
-
-    #[test]
-    fn vectors_parse() {
-        assert_eq!(
-            parse_vec3("-278, 273,800"),
-            Ok(DVec3::new(-278.0, 273.0, 800.0))
-        );
-        assert!(parse_vec3("1,2").is_err());
     }
 
     #[test]
