@@ -56,8 +56,6 @@ pub struct World<'a> {
     pub scene: &'a Scene,
     /// The lights as rendered (radii applied).
     pub lights: &'a [Light],
-    /// The scene's diagonal (scales directional lights).
-    pub diagonal: f64,
     /// The camera.
     pub camera: &'a Camera,
     /// Full-resolution settings (the window's size).
@@ -255,7 +253,7 @@ impl FrameLoop {
             self.scene_stats = Some(self.renderer.load_scene(world.scene, world.lights)?);
             self.loaded = true;
         } else if pending.lights {
-            self.renderer.set_lights(world.lights, world.diagonal)?;
+            self.renderer.set_lights(world.lights)?;
         }
         if pending.camera {
             self.renderer.set_camera(world.camera)?;

@@ -108,7 +108,6 @@ pub fn run(args: ViewArgs) -> Result<()> {
         device: renderer.gpu.description(),
         frame_loop: FrameLoop::new(renderer),
         lights: view.lights(),
-        diagonal: bounds.diagonal(),
         model: Model::new(prepared.scene, view, camera),
         gui: Gui::new(path_text, env_loaded),
         load_ms: prepared.load_ms,
@@ -205,9 +204,8 @@ struct App {
     frame_loop: FrameLoop,
     model: Model,
     gui: Gui,
-    /// The lights as rendered, and the scene's diagonal, kept in step with the model.
+    /// The lights as rendered, kept in step with the model.
     lights: Vec<Light>,
-    diagonal: f64,
     load_ms: f64,
     frames_limit: Option<u64>,
     screenshot_on_exit: Option<PathBuf>,
@@ -608,7 +606,6 @@ impl App {
                 }
                 self.model = Model::new(scene, view, camera);
                 self.load_ms = ms;
-                self.diagonal = bounds.diagonal();
                 self.lights = self.model.view.lights();
                 self.gui.file_error = None;
                 self.device_error = None;
@@ -724,9 +721,6 @@ impl App {
         if actions.changes.lights || actions.changes.scene {
             self.lights = self.model.view.lights();
         }
-        if actions.changes.scene {
-            self.diagonal = self.model.scene.bounds().diagonal();
-        }
         self.frame_loop.invalidate(actions.changes);
         if actions.hide_overlay {
             self.overlay = false;
@@ -744,7 +738,6 @@ impl App {
             let world = World {
                 scene: &self.model.scene,
                 lights: &self.lights,
-                diagonal: self.diagonal,
                 camera: &self.model.camera.camera,
                 settings: self.model.view.render_settings(self.size),
                 spp_target: self.model.view.spp_target,

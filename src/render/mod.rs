@@ -98,9 +98,8 @@ pub struct Renderer {
     light_count: u32,
     /// Features of the loaded scene (without the environment map's).
     scene_features: KernelFeatures,
-    /// The lights as last given, and the scene's diagonal, to rebuild the light table.
+    /// The lights as last given, to rebuild the light table.
     lights: Vec<Light>,
-    diagonal: f64,
     environment: Option<(Arc<EnvMap>, EnvSampling)>,
     env: EnvBuffers,
     samples: u32,
@@ -132,7 +131,6 @@ impl Renderer {
             light_count: 0,
             scene_features: KernelFeatures::default(),
             lights: Vec::new(),
-            diagonal: 1.0,
             environment: None,
             env,
             samples: 0,
@@ -174,7 +172,6 @@ impl Renderer {
         let pack = TexturePack::new(scene, budget);
         let kernel_build_ms = self.ensure_program()?;
         self.lights = lights.to_vec();
-        self.diagonal = scene.bounds().diagonal();
         let (glights, cdf) = self.light_table(&host);
         let placeholder = [GpuTriTangents::default()];
         let tangents: &[GpuTriTangents] = if host.tangents.is_empty() {
@@ -237,7 +234,7 @@ impl Renderer {
             .environment
             .as_ref()
             .map(|(_, t)| t.mean_luminance * self.settings.env_intensity);
-        gpu_lights(&self.lights, host, self.diagonal, env_luminance)
+        gpu_lights(&self.lights, host, env_luminance)
     }
 
     /// Fills the environment constants from the settings and the light list.
@@ -351,12 +348,11 @@ impl Renderer {
     }
 
     /// Replaces the lights without touching the BVH. Resets the film.
-    pub fn set_lights(&mut self, lights: &[Light], scene_diagonal: f64) -> Result<(), ClError> {
+    pub fn set_lights(&mut self, lights: &[Light]) -> Result<(), ClError> {
         if self.scene.is_none() {
             return Ok(());
         }
         self.lights = lights.to_vec();
-        self.diagonal = scene_diagonal;
         self.upload_lights()?;
         self.reset()
     }

@@ -156,6 +156,17 @@ impl HostScene {
         }
     }
 
+    /// The middle and the diagonal of the scene's box (from the BVH root's two children).
+    pub fn bounds(&self) -> (Vec3, f32) {
+        let (a, _) = self.bvh.child(0, 0);
+        let (b, _) = self.bvh.child(0, 1);
+        let u = a.union(b);
+        if u.min.cmpgt(u.max).any() {
+            return (Vec3::ZERO, 1.0);
+        }
+        ((u.min + u.max) * 0.5, (u.max - u.min).length())
+    }
+
     /// The object index of a triangle in BVH order.
     pub fn object_of(&self, prim: u32) -> u32 {
         self.triangles[prim as usize].v2[3].to_bits()
@@ -196,41 +207,52 @@ pub fn emissive_texture_means(scene: &Scene) -> Vec<f32> {
 /// The light list (emissive triangles first, so a triangle's light index is its position in
 /// `HostScene::emissive`, then the punctual lights, then the environment map when
 /// `env_luminance` (its mean luminance × intensity) is given) and its cumulative selection
-/// table, proportional to each light's power. An environment's power is taken as that of
-/// a directional light of irradiance π·L̄ over the scene's disc.
+/// table.
+///
+/// A light is picked in proportion to an estimate of the irradiance it sends to the middle of
+/// the scene: I / d² for point and spot lights, E for directional lights, π L̄ for the
+/// environment, L A / d² for an emissive triangle (d clamped below at 5 % of the diagonal).
+/// Weighing by emitted power instead made a sun, whose power grows with the scene's area, and
+/// a point light a few scene sizes away differ by 40× in probability while lighting a surface
+/// about equally: the rarely picked one then showed as speckle. Any positive weights keep the
+/// estimator unbiased; these keep its variance down.
 pub fn gpu_lights(
     lights: &[Light],
     host: &HostScene,
-    scene_diagonal: f64,
     env_luminance: Option<f32>,
 ) -> (Vec<GpuLight>, Vec<f32>) {
     let mut out = Vec::new();
     let mut weights = Vec::new();
+    let (center, diagonal) = host.bounds();
+    let near = (0.05 * diagonal).max(1e-12);
+    let inverse_square = |p: Vec3| 1.0 / (p - center).length_squared().max(near * near);
     for &(prim, area, power) in &host.emissive {
+        let v = &host.vertices[prim as usize];
+        let centroid = (v[0] + v[1] + v[2]) / 3.0;
         out.push(GpuLight {
             position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_TRIANGLE)],
             intensity: [0.0; 4],
             spot: [f32::from_bits(prim), area, 0.0, 0.0],
             extra: [0.0; 4],
         });
-        weights.push(power);
+        // `power` is π L A (× 2 when double-sided), so power / π is the intensity scale L A.
+        weights.push(power / std::f32::consts::PI * inverse_square(centroid));
     }
-    let scene_radius = (scene_diagonal * 0.5) as f32;
     let pi = std::f32::consts::PI;
     for l in lights {
         let color = l.color.map(|c| c * l.intensity);
         let (kind, position, power) = match l.kind {
-            LightKind::Point => (LIGHT_POINT, l.position, luminance(color) * 4.0 * pi),
-            LightKind::Spot { outer, .. } => (
+            LightKind::Point => (
+                LIGHT_POINT,
+                l.position,
+                luminance(color) * inverse_square(l.position.as_vec3()),
+            ),
+            LightKind::Spot { .. } => (
                 LIGHT_SPOT,
                 l.position,
-                luminance(color) * 2.0 * pi * (1.0 - outer.cos()).max(0.05),
+                luminance(color) * inverse_square(l.position.as_vec3()),
             ),
-            LightKind::Directional => (
-                LIGHT_DIRECTIONAL,
-                l.direction,
-                luminance(color) * pi * scene_radius * scene_radius,
-            ),
+            LightKind::Directional => (LIGHT_DIRECTIONAL, l.direction, luminance(color)),
         };
         if !(power > 0.0 && power.is_finite()) {
             continue;
@@ -249,7 +271,7 @@ pub fn gpu_lights(
         weights.push(power);
     }
     if let Some(l) = env_luminance {
-        let power = pi * l * pi * scene_radius * scene_radius;
+        let power = pi * l;
         if power > 0.0 && power.is_finite() {
             out.push(GpuLight {
                 position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_ENVIRONMENT)],
@@ -408,6 +430,61 @@ mod tests {
     use super::*;
     use crate::scene::{Image, TexTransform, TextureRef};
     use std::sync::Arc;
+
+    /// A 10-unit floor centred at the origin, as the host would upload it.
+    fn floor() -> HostScene {
+        let v = [
+            Vec3::new(-5.0, 0.0, -5.0),
+            Vec3::new(5.0, 0.0, 5.0),
+            Vec3::new(5.0, 0.0, -5.0),
+        ];
+        let world = [WorldTriangle {
+            v,
+            n: [Vec3::Y; 3],
+            ..WorldTriangle::default()
+        }];
+        let bvh = crate::bvh::build(&[v]);
+        HostScene::new(&world, bvh, &[Material::default()])
+    }
+
+    fn light(kind: LightKind, position: glam::DVec3, intensity: f32) -> Light {
+        Light {
+            name: "l".into(),
+            kind,
+            position,
+            direction: glam::DVec3::NEG_Y,
+            color: [1.0; 3],
+            intensity,
+            radius: 0.0,
+        }
+    }
+
+    #[test]
+    fn lights_that_light_the_scene_equally_are_picked_equally() {
+        let host = floor();
+        // A sun of irradiance 2 and a point light 20 units up with I / d² = 2 at the middle.
+        let lights = [
+            light(LightKind::Directional, glam::DVec3::ZERO, 2.0),
+            light(LightKind::Point, glam::DVec3::new(0.0, 20.0, 0.0), 800.0),
+        ];
+        let (gpu, cdf) = gpu_lights(&lights, &host, None);
+        assert_eq!(gpu.len(), 2);
+        for l in &gpu {
+            assert!((l.extra[1] - 0.5).abs() < 1e-3, "{:?}", l.extra);
+        }
+        assert_eq!(*cdf.last().unwrap(), 1.0);
+        // A light at the middle is clamped to 5 % of the diagonal, not infinitely likely.
+        let close = [
+            light(LightKind::Directional, glam::DVec3::ZERO, 1.0),
+            light(LightKind::Point, glam::DVec3::ZERO, 1.0),
+        ];
+        let (gpu, _) = gpu_lights(&close, &host, None);
+        assert!(
+            gpu[1].extra[1] < 0.99 && gpu[1].extra[1] > 0.5,
+            "{:?}",
+            gpu[1].extra
+        );
+    }
 
     fn scene_with(sides: &[u32]) -> Scene {
         let images = sides
