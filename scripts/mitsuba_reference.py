@@ -58,6 +58,11 @@ def make_mesh(obj, material):
     if "emissive_factor" in material:
         radiance = [f * material["emissive_strength"] for f in material["emissive_factor"]]
         props["emitter"] = mi.load_dict({"type": "area", "radiance": _rgb(radiance)})
+    return mesh_with(obj, props)
+
+
+def mesh_with(obj, props):
+    """A Mitsuba mesh of `obj`'s positions, normals and indices with `props` (bsdf, emitter)."""
     nv, nf = len(obj["positions"]), len(obj["indices"]) // 3
     mesh = mi.Mesh(obj["name"], nv, nf, props, has_vertex_normals=True)
     params = mi.traverse(mesh)

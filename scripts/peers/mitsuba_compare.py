@@ -144,14 +144,7 @@ def _twosided_mesh(obj, material):
     props = mi.Properties()
     props["bsdf"] = mi.load_dict({"type": "twosided", "bsdf": {
         "type": "diffuse", "reflectance": mitsuba_reference._rgb(material["color"])}})
-    nv, nf = len(obj["positions"]), len(obj["indices"]) // 3
-    mesh = mi.Mesh(obj["name"], nv, nf, props, has_vertex_normals=True)
-    params = mi.traverse(mesh)
-    params["vertex_positions"] = mi.Float([c for p in obj["positions"] for c in p])
-    params["vertex_normals"] = mi.Float([c for n in obj["normals"] for c in n])
-    params["faces"] = mi.UInt32(obj["indices"])
-    params.update()
-    return mesh
+    return mitsuba_reference.mesh_with(obj, props)
 
 
 # ---------------------------------------------------------------------------------------

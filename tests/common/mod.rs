@@ -2,6 +2,8 @@
 //! binary.
 #![allow(dead_code)]
 
+pub mod stats;
+
 use serde_json::{Value, json};
 use std::f32::consts::FRAC_1_SQRT_2;
 use std::path::{Path, PathBuf};
