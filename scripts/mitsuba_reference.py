@@ -51,18 +51,17 @@ def _rgb(c):
     return {"type": "rgb", "value": [float(v) for v in c]}
 
 
-def make_mesh(obj, material):
-    """A Mitsuba triangle mesh from one cornell_box mesh dict (positions/normals/indices)."""
+def make_mesh(obj, material, twosided=False):
+    """A Mitsuba triangle mesh from one cornell_box mesh dict (positions/normals/indices);
+    `twosided` wraps a non-emissive material's diffuse BSDF so both faces scatter."""
     props = mi.Properties()
-    props["bsdf"] = mi.load_dict({"type": "diffuse", "reflectance": _rgb(material["color"])})
+    bsdf = {"type": "diffuse", "reflectance": _rgb(material["color"])}
+    if twosided and "emissive_factor" not in material:
+        bsdf = {"type": "twosided", "bsdf": bsdf}
+    props["bsdf"] = mi.load_dict(bsdf)
     if "emissive_factor" in material:
         radiance = [f * material["emissive_strength"] for f in material["emissive_factor"]]
         props["emitter"] = mi.load_dict({"type": "area", "radiance": _rgb(radiance)})
-    return mesh_with(obj, props)
-
-
-def mesh_with(obj, props):
-    """A Mitsuba mesh of `obj`'s positions, normals and indices with `props` (bsdf, emitter)."""
     nv, nf = len(obj["positions"]), len(obj["indices"]) // 3
     mesh = mi.Mesh(obj["name"], nv, nf, props, has_vertex_normals=True)
     params = mi.traverse(mesh)
@@ -73,8 +72,10 @@ def mesh_with(obj, props):
     return mesh
 
 
-def build_scene(width, height, spp_per_pass, bounces):
-    sc = cornell_box.scene()
+def build_scene(width, height, spp_per_pass, bounces, sc=None, twosided=False):
+    """The Mitsuba scene of a cornell_box.scene()-style description (the Cornell box itself
+    when `sc` is None); `twosided` as in make_mesh."""
+    sc = sc or cornell_box.scene()
     cam = sc["camera"]
     eye = cam["eye"]
     target = tuple(e + f for e, f in zip(eye, cam["forward"]))
@@ -97,7 +98,7 @@ def build_scene(width, height, spp_per_pass, bounces):
         },
     }
     for obj in sc["meshes"]:
-        d["mesh_" + obj["name"]] = make_mesh(obj, sc["materials"][obj["material"]])
+        d["mesh_" + obj["name"]] = make_mesh(obj, sc["materials"][obj["material"]], twosided)
     for i, pl in enumerate(sc["point_lights"]):
         d[f"point_{i}"] = {"type": "point", "position": list(pl["position"]),
                            "intensity": _rgb([c * pl["intensity"] for c in pl["color"]])}

@@ -108,43 +108,8 @@ def bunny_scene(glb_path):
 
 
 def mitsuba_scene(sc, width, height, bounces, twosided):
-    """The Mitsuba scene of a cornell_box.scene()-style description."""
-    cam = sc["camera"]
-    eye = cam["eye"]
-    target = tuple(e + f for e, f in zip(eye, cam["forward"]))
-    d = {
-        "type": "scene",
-        "integrator": {"type": "path", "max_depth": bounces + 2, "rr_depth": bounces + 100,
-                       "hide_emitters": False},
-        "sensor": {
-            "type": "perspective", "fov_axis": "y", "fov": cam["yfov_deg"],
-            "near_clip": cam["znear"], "far_clip": cam["zfar"],
-            "to_world": mi.ScalarTransform4f().look_at(origin=list(eye), target=list(target),
-                                                       up=list(cam["up"])),
-            "sampler": {"type": "independent", "sample_count": 1},
-            "film": {"type": "hdrfilm", "width": width, "height": height,
-                     "rfilter": {"type": "box"}, "pixel_format": "rgb",
-                     "component_format": "float32"},
-        },
-    }
-    for obj in sc["meshes"]:
-        m = sc["materials"][obj["material"]]
-        if twosided and "emissive_factor" not in m:
-            d["mesh_" + obj["name"]] = _twosided_mesh(obj, m)
-        else:
-            d["mesh_" + obj["name"]] = mitsuba_reference.make_mesh(obj, m)
-    for i, pl in enumerate(sc["point_lights"]):
-        d[f"point_{i}"] = {"type": "point", "position": list(pl["position"]),
-                           "intensity": mitsuba_reference._rgb(
-                               [c * pl["intensity"] for c in pl["color"]])}
-    return mi.load_dict(d)
-
-
-def _twosided_mesh(obj, material):
-    props = mi.Properties()
-    props["bsdf"] = mi.load_dict({"type": "twosided", "bsdf": {
-        "type": "diffuse", "reflectance": mitsuba_reference._rgb(material["color"])}})
-    return mitsuba_reference.mesh_with(obj, props)
+    """The Mitsuba scene of a cornell_box.scene()-style description, one sample per pass."""
+    return mitsuba_reference.build_scene(width, height, 1, bounces, sc=sc, twosided=twosided)
 
 
 # ---------------------------------------------------------------------------------------
