@@ -12,16 +12,6 @@ typedef struct {
 
 #ifdef HAS_ENV_MAP
 
-// First index i in [0, n) with u < cdf[i].
-inline uint cdf_search(global const float* cdf, uint n, float u) {
-    uint lo = 0, hi = n - 1;
-    while (lo < hi) {
-        uint mid = (lo + hi) >> 1;
-        if (u < cdf[mid]) hi = mid; else lo = mid + 1;
-    }
-    return lo;
-}
-
 // Radiance arriving from world direction d (unit), and the solid-angle pdf of sampling it.
 inline float3 env_radiance(const EnvMap* e, float3 d, float* pdf) {
     float c = e->info.rotation.x;

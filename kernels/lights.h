@@ -21,16 +21,6 @@ inline float spot_falloff(global const GpuLight* l, float3 to_point) {
     return a * a;
 }
 
-// Picks a light with probability proportional to the table built on the host.
-inline uint pick_light(global const float* cdf, uint count, float u) {
-    uint lo = 0, hi = count - 1;
-    while (lo < hi) {
-        uint mid = (lo + hi) >> 1;
-        if (u < cdf[mid]) hi = mid; else lo = mid + 1;
-    }
-    return lo;
-}
-
 // Samples light `index` from point p. Punctual lights with radius r > 0 become spheres of the
 // same power (radiance I / (pi r^2)); directional lights with angular radius a > 0 become discs
 // of directions (radiance E / (pi sin^2 a)).

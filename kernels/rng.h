@@ -61,3 +61,14 @@ inline float2 sample_triangle(float u1, float u2) {
 inline float luminance(float3 c) {
     return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
 }
+
+// First index i in [0, n) with u < cdf[i]: samples a discrete distribution from its
+// cumulative table (light selection, environment map rows and columns).
+inline uint cdf_search(global const float* cdf, uint n, float u) {
+    uint lo = 0, hi = n - 1;
+    while (lo < hi) {
+        uint mid = (lo + hi) >> 1;
+        if (u < cdf[mid]) hi = mid; else lo = mid + 1;
+    }
+    return lo;
+}

@@ -186,7 +186,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
 
     // Next-event estimation: one light sample, traced later by `connect`.
     if (frame.strategy != STRATEGY_BSDF && frame.light_count > 0u) {
-        uint index = pick_light(light_cdf, frame.light_count, rng_next(&rng));
+        uint index = cdf_search(light_cdf, frame.light_count, rng_next(&rng));
         float u1 = rng_next(&rng);
         float u2 = rng_next(&rng);
         LightSample ls = sample_light(lights, tris, materials, &surf, &env, index, p, u1, u2);
