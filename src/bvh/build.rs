@@ -38,6 +38,14 @@ struct Prim {
 }
 
 impl Prim {
+    /// Primitive `index` with box `b` (the index rides in `min.w`).
+    fn new(index: usize, b: Aabb) -> Self {
+        Prim {
+            min: b.min.extend(f32::from_bits(index as u32)),
+            max: b.max.extend(0.0),
+        }
+    }
+
     /// The box centre (`.w` = 0). Computed on three lanes: the index in `min.w` is a denormal
     /// float, and SIMD arithmetic on denormals is many times slower.
     fn centroid(&self) -> Vec4 {
@@ -136,18 +144,28 @@ struct Split {
 
 /// Builds a BVH over triangles given as three vertices each.
 pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
-    // Gather the primitive boxes (the triangle index rides in `min.w`).
-    let mut prims: Vec<Prim> = triangles
-        .par_iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let b = Aabb::EMPTY.grow(t[0]).grow(t[1]).grow(t[2]);
-            Prim {
-                min: b.min.extend(f32::from_bits(i as u32)),
-                max: b.max.extend(0.0),
-            }
-        })
-        .collect();
+    build_prims(
+        triangles
+            .par_iter()
+            .enumerate()
+            .map(|(i, t)| Prim::new(i, Aabb::EMPTY.grow(t[0]).grow(t[1]).grow(t[2])))
+            .collect(),
+    )
+}
+
+/// Builds a BVH over boxes (the instances of a top-level tree); `tri_indices` then index
+/// `boxes`.
+pub fn build_boxes(boxes: &[Aabb]) -> Bvh {
+    build_prims(
+        boxes
+            .par_iter()
+            .enumerate()
+            .map(|(i, &b)| Prim::new(i, b))
+            .collect(),
+    )
+}
+
+fn build_prims(mut prims: Vec<Prim>) -> Bvh {
     let info = NodeInfo::of(&prims);
     let root = build_subtree(&mut prims, 0, 0, info);
     let tri_indices = prims.par_iter().map(Prim::index).collect();
@@ -157,7 +175,7 @@ pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
         Built::Top { .. } => {
             let mut nodes = Vec::with_capacity(root.node_count());
             nodes.push(GpuBvhNode::default());
-            assemble(&root, 0, &mut nodes);
+            assemble(root, 0, &mut nodes);
             nodes
         }
         Built::Leaf {
@@ -292,7 +310,8 @@ fn emit(
 
 /// Writes the parallel levels below the interior node at `slot` into `nodes`, in the layout
 /// [`emit`] gives: interior children next to each other, then the left subtree, then the right.
-fn assemble(node: &Built, slot: usize, nodes: &mut Vec<GpuBvhNode>) {
+/// Each task's block is freed as soon as it is copied.
+fn assemble(node: Built, slot: usize, nodes: &mut Vec<GpuBvhNode>) {
     let Built::Top { children, .. } = node else {
         unreachable!("assemble is only called on split nodes")
     };
@@ -314,7 +333,8 @@ fn assemble(node: &Built, slot: usize, nodes: &mut Vec<GpuBvhNode>) {
         }
     }
     nodes[slot] = gpu;
-    for (child, index) in children.iter().zip(pending) {
+    let [left, right] = *children;
+    for (child, index) in [left, right].into_iter().zip(pending) {
         let Some(index) = index else { continue };
         match child {
             Built::Top { .. } => assemble(child, index, nodes),

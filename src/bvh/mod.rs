@@ -3,11 +3,13 @@
 //! same rules the kernels use (the reference the device is tested against).
 
 mod build;
+mod instances;
 mod refit;
 mod stats;
 mod traverse;
 
-pub use build::{MAX_DEPTH, build};
+pub use build::{MAX_DEPTH, build, build_boxes};
+pub use instances::{Blas, Instance, InstanceHit, TwoLevel};
 pub use refit::{REFIT_MAX_GROWTH, Update};
 pub use stats::{BvhReport, report};
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};
