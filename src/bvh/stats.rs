@@ -1,11 +1,11 @@
 //! What `penumbra bench bvh` measures: the cost of building and updating the BVH of a scene on
 //! the host, without a device.
 
-use super::build;
+use super::{TwoLevel, build};
 use crate::scene::{Object, Scene};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use serde::Serialize;
-use std::collections::HashSet;
+use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::time::Instant;
 
@@ -24,10 +24,15 @@ pub struct BvhReport {
     pub depth: u32,
     /// Gathering the world-space triangles of every instance.
     pub gather_ms: f64,
-    /// Building the whole BVH.
+    /// Building the whole flat BVH (what the renderer uploads today).
     pub full_build_ms: f64,
-    /// Moving one instance: with one flat BVH this is moving its triangles and building the
-    /// whole tree again.
+    /// Moving one instance in the flat BVH: moving its triangles and building the whole tree
+    /// again.
+    pub flat_move_ms: f64,
+    /// Building the host two-level form: one BLAS per distinct mesh and the TLAS.
+    pub two_level_build_ms: f64,
+    /// Moving one instance in the two-level form: its transform and a new TLAS (host only; the
+    /// device does not traverse two levels yet, so nothing is uploaded).
     pub instance_move_ms: f64,
     /// Refitting the whole tree after one instance moved.
     pub refit_ms: f64,
@@ -89,28 +94,52 @@ pub fn report(scene: &Scene, runs: usize) -> BvhReport {
             }
         }
     };
-    let (mut instance_move_ms, mut refit_ms) = (f64::INFINITY, f64::INFINITY);
+    let (mut flat_move_ms, mut refit_ms) = (f64::INFINITY, f64::INFINITY);
     let mut refit_sah_cost = sah_cost;
     for run in 0..runs {
         let sign = if run % 2 == 0 { 1.0 } else { -1.0 };
         let t = Instant::now();
         shift(&mut tris, sign);
         let rebuilt = build(&tris);
-        instance_move_ms = instance_move_ms.min(ms(t));
+        flat_move_ms = flat_move_ms.min(ms(t));
         drop(rebuilt);
         let t = Instant::now();
         bvh.refit(&tris);
         refit_ms = refit_ms.min(ms(t));
         refit_sah_cost = bvh.sah_cost;
     }
+    drop(bvh);
+    drop(tris);
+
+    // The two-level form: one BLAS per distinct mesh, instances placed by their transforms.
+    let (meshes, placed) = instances(&visible);
+    let mut two_level_build_ms = f64::INFINITY;
+    let mut two = TwoLevel::new(&meshes, &placed);
+    for _ in 0..runs {
+        let t = Instant::now();
+        two = TwoLevel::new(&meshes, &placed);
+        two_level_build_ms = two_level_build_ms.min(ms(t));
+    }
+    let mut instance_move_ms = f64::INFINITY;
+    if let Some(i) = visible.iter().position(|(i, _)| Some(*i as u32) == moved) {
+        let home = placed[i].1;
+        for run in 0..runs {
+            let d = if run % 2 == 0 { extent * 0.1 } else { 0.0 };
+            let t = Instant::now();
+            two.set_transform(i, Mat4::from_translation(Vec3::X * d) * home);
+            instance_move_ms = instance_move_ms.min(ms(t));
+        }
+    }
     BvhReport {
-        triangles: tris.len(),
-        unique_triangles: unique_triangles(&visible),
+        triangles: objects.len(),
+        unique_triangles: meshes.iter().map(Vec::len).sum(),
         instances: visible.len(),
         nodes,
         depth,
         gather_ms,
         full_build_ms,
+        flat_move_ms,
+        two_level_build_ms,
         instance_move_ms,
         refit_ms,
         sah_cost,
@@ -119,23 +148,37 @@ pub fn report(scene: &Scene, runs: usize) -> BvhReport {
     }
 }
 
-/// Triangles of the distinct meshes among `objects`. The importer gives each node its own copy
-/// of the mesh, so meshes are told apart by their content.
-fn unique_triangles(objects: &[(usize, &Object)]) -> usize {
-    let mut seen = HashSet::new();
-    objects
+/// A mesh's triangles as vertex positions.
+type Triangles = Vec<[Vec3; 3]>;
+
+/// The distinct meshes among `objects` (object-space triangles) and each object's mesh index
+/// and transform. The importer gives each node its own copy of the mesh, so meshes are told
+/// apart by their content.
+fn instances(objects: &[(usize, &Object)]) -> (Vec<Triangles>, Vec<(u32, Mat4)>) {
+    let mut index: HashMap<u64, u32> = HashMap::new();
+    let mut meshes = vec![];
+    let placed = objects
         .iter()
-        .filter(|(_, o)| {
+        .map(|(_, o)| {
             let mut h = std::collections::hash_map::DefaultHasher::new();
             let m = &o.mesh;
             m.indices.hash(&mut h);
             for p in &m.positions {
                 p.to_array().map(f32::to_bits).hash(&mut h);
             }
-            seen.insert(h.finish())
+            let mesh = *index.entry(h.finish()).or_insert_with(|| {
+                meshes.push(
+                    m.indices
+                        .iter()
+                        .map(|t| t.map(|i| m.positions[i as usize]))
+                        .collect(),
+                );
+                meshes.len() as u32 - 1
+            });
+            (mesh, o.world_from_object.as_mat4())
         })
-        .map(|(_, o)| o.mesh.indices.len())
-        .sum()
+        .collect();
+    (meshes, placed)
 }
 
 fn ms(t: Instant) -> f64 {
