@@ -1,6 +1,7 @@
 //! The renderer: owns the OpenCL device, the scene on it and the film, and runs the wavefront
 //! stages. It knows nothing of windows; the viewer and the command line drive it alike.
 
+pub mod camera;
 mod lights;
 mod settings;
 mod textures;
@@ -248,15 +249,12 @@ impl Renderer {
         let c = &self.camera;
         let fx = x / self.settings.width.max(1) as f32;
         let fy = y / self.settings.height.max(1) as f32;
-        let v = |a: [f32; 4]| glam::Vec3::new(a[0], a[1], a[2]);
-        let forward = v(c.forward);
-        let dir = forward + (2.0 * fx - 1.0) * v(c.right) + (1.0 - 2.0 * fy) * v(c.up);
-        let unit = dir.normalize();
+        let forward = glam::Vec3::new(c.forward[0], c.forward[1], c.forward[2]);
+        let ray = camera::primary_ray(c, fx, fy);
+        let unit = ray.direction.normalize();
         let ray = Ray {
-            origin: v(c.origin),
             direction: unit,
-            tmin: 0.0,
-            tmax: f32::INFINITY,
+            ..ray
         };
         let hit = host.bvh.intersect(&ray, &host.vertices)?;
         Some(hit.t * unit.dot(forward.normalize()))
