@@ -187,7 +187,7 @@ mod tests {
     use super::*;
     use crate::render::lights::gpu_lights;
     use crate::render::textures::TexturePack;
-    use crate::scene::{Image, TexTransform, TextureRef};
+    use crate::scene::{Image, MAX_TEXTURE_SIDE, TexTransform, TextureRef, Wrap};
     use crate::scene::{Light, LightKind, Scene};
     use std::sync::Arc;
 
