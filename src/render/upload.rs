@@ -187,8 +187,8 @@ mod tests {
     use super::*;
     use crate::render::lights::gpu_lights;
     use crate::render::textures::TexturePack;
-    use crate::scene::{Image, MAX_TEXTURE_SIDE, TexTransform, TextureRef, Wrap};
-    use crate::scene::{Light, LightKind, Scene};
+    use crate::scene::{Image, TexTransform, TextureRef};
+    use crate::scene::{Light, LightKind, MAX_TEXTURE_SIDE, Scene, Wrap};
     use std::sync::Arc;
 
     /// A 10-unit floor centred at the origin, as the host would upload it.
