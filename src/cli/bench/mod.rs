@@ -1,11 +1,12 @@
 //! `penumbra bench`: ray throughput of the traversal kernels (`trace`), where a frame's time
 //! goes (`frame`), error against run time (`converge`), and a generator of large test scenes
-//! (`generate`). What each measures, and the figures, are in `docs/benchmarks.md`.
+//! (`generate`), and the host BVH build and update (`bvh`). What each measures, and the figures,
+//! are in `docs/benchmarks.md`.
 
 mod bvh;
 mod converge;
 mod frame;
-mod generate;
+pub mod generate;
 mod plot;
 mod rays;
 mod stats;
