@@ -64,11 +64,18 @@ fn split_glb(bytes: &[u8]) -> Option<Glb> {
 /// data URIs).
 fn as_gltf(glb: &Glb) -> Vec<u8> {
     let mut json = glb.json.clone();
-    if let Some(b) = json["buffers"].get_mut(0) {
-        b["uri"] = json!(format!(
-            "data:application/octet-stream;base64,{}",
-            base64::encode(&glb.bin)
-        ));
+    if let Some(b) = json
+        .get_mut("buffers")
+        .and_then(|b| b.get_mut(0))
+        .and_then(Value::as_object_mut)
+    {
+        b.insert(
+            "uri".into(),
+            json!(format!(
+                "data:application/octet-stream;base64,{}",
+                base64::encode(&glb.bin)
+            )),
+        );
     }
     serde_json::to_vec(&json).unwrap_or_default()
 }
@@ -517,12 +524,18 @@ fn check(s: &Scene) -> Result<(), String> {
     Ok(())
 }
 
+/// Set while the loader runs (on any thread, rayon's included): its panics are failures
+/// reported with their input, so the panic hook keeps them off stderr.
+static IN_LOADER: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 /// Loads `bytes` in-process; `Err` describes a failure (a panic, a broken scene, too slow).
 fn run_one(bytes: &[u8], base: &Path) -> Result<(), String> {
     let start = Instant::now();
+    IN_LOADER.store(true, std::sync::atomic::Ordering::Relaxed);
     let result = catch_unwind(AssertUnwindSafe(|| {
         load_from_bytes(bytes, Some(base), "fuzz input")
     }));
+    IN_LOADER.store(false, std::sync::atomic::Ordering::Relaxed);
     let elapsed = start.elapsed();
     let outcome = match result {
         Err(panic) => Err(format!(
@@ -576,7 +589,12 @@ fn fuzz_the_loader() {
     let last = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fuzz-last-input");
     let quiet = std::env::var_os("PENUMBRA_FUZZ_VERBOSE").is_none();
     if quiet {
-        std::panic::set_hook(Box::new(|_| {}));
+        let report = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !IN_LOADER.load(std::sync::atomic::Ordering::Relaxed) {
+                report(info);
+            }
+        }));
     }
     let deadline = Instant::now() + Duration::from_secs(seconds);
     let (mut runs, mut failures) = (0u64, Vec::new());

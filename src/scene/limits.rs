@@ -1,5 +1,5 @@
 //! Resource limits of the glTF import, in one place: whatever a file claims, loading it never
-//! allocates more than these allow. Each limit is documented in docs/limits.md; a file past one
+//! allocates more than these allow. Each limit is documented in docs/robustness.md; a file past one
 //! fails with an error naming the element.
 
 /// The most nodes the walk of the node graph visits, counting a node once for every path from

@@ -18,6 +18,16 @@ pub fn load_buffers(
     for buffer in document.buffers() {
         let i = buffer.index();
         let length = buffer.length();
+        if matches!(buffer.source(), gltf::buffer::Source::Bin)
+            && buffer.extension_value("EXT_meshopt_compression").is_some()
+        {
+            // A meshopt fallback buffer: no bytes in the file; its views are compressed
+            // elsewhere and are decoded into it, never allocated from byteLength here.
+            return Err(format!(
+                "buffers[{i}]: an EXT_meshopt_compression fallback buffer, and this build \
+                 cannot decode EXT_meshopt_compression"
+            ));
+        }
         let mut data = match buffer.source() {
             gltf::buffer::Source::Bin => blob
                 .take()
