@@ -75,6 +75,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         .rev()
         .map(|n| (n, DMat4::IDENTITY, 0))
         .collect();
+    let mut meshes: HashMap<usize, Mesh> = HashMap::new();
     let mut placed = 0usize;
     let mut triangles = 0usize;
     while let Some((node, parent, depth)) = stack.pop() {
@@ -119,13 +120,21 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
                 .or(mesh.name())
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("mesh {}", mesh.index()));
-            let m = import_mesh(
-                &mesh,
-                &buffer_data,
-                default_material,
-                &normal_sets,
-                &mut warnings,
-            )?;
+            // Each mesh is read once, however many nodes place it.
+            let m = match meshes.get(&mesh.index()) {
+                Some(m) => m.clone(),
+                None => {
+                    let m = import_mesh(
+                        &mesh,
+                        &buffer_data,
+                        default_material,
+                        &normal_sets,
+                        &mut warnings,
+                    )?;
+                    meshes.insert(mesh.index(), m.clone());
+                    m
+                }
+            };
             if m.positions.iter().any(|p| {
                 let w = world.transform_point3(p.as_dvec3());
                 w.abs().max_element().partial_cmp(&limits::MAX_COORDINATE)

@@ -6,7 +6,7 @@
 /// a scene root to it (a node listed as a child twice is placed twice). Bounds the number of
 /// mesh instances, cameras and lights, and stops graphs that list children repeatedly at every
 /// level from multiplying without end.
-pub const MAX_NODE_INSTANCES: usize = 1_000_000;
+pub const MAX_NODE_INSTANCES: usize = 200_000;
 
 /// The most triangles over all placed mesh instances (after instancing). At about 200 bytes per
 /// world-space triangle on the host this keeps a scene under 4 GB.
