@@ -12,8 +12,6 @@
 //! (default: from the clock, printed). Seeds: the bundled Cornell box, and with
 //! `PENUMBRA_SCENES` set, the shared Cubes, CornellBox and Fox.
 
-mod common;
-
 use penumbra::scene::{BUNDLED_SCENE, LightKind, Scene, limits, load_from_bytes};
 use serde_json::{Value, json};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -386,14 +384,20 @@ fn make_input(seed: &[u8], rng: &mut Rng) -> (&'static str, Vec<u8>) {
             if rng.chance(30) {
                 ("json", as_gltf(&glb))
             } else {
-                ("json", common::glb_bytes(&glb.json, &glb.bin))
+                (
+                    "json",
+                    penumbra::cli::bench::generate::glb(&glb.json, &glb.bin),
+                )
             }
         }
         6 | 7 => {
             for _ in 0..1 + rng.below(8) {
                 mutate_bytes(&mut glb.bin, rng);
             }
-            ("bin", common::glb_bytes(&glb.json, &glb.bin))
+            (
+                "bin",
+                penumbra::cli::bench::generate::glb(&glb.json, &glb.bin),
+            )
         }
         8 => {
             let mut b = as_gltf(&glb);
