@@ -218,9 +218,9 @@ fn bad_files_fail_with_one_clear_line() {
     assert_clean_failure(&nan.write_glb(d, "nan"), "not finite");
 
     let mut req = one_quad_scene();
-    req.use_ext("EXT_meshopt_compression");
-    req.required.push("EXT_meshopt_compression".into());
-    assert_clean_failure(&req.write_glb(d, "meshopt"), "EXT_meshopt_compression");
+    req.use_ext("EXT_mesh_gpu_instancing");
+    req.required.push("EXT_mesh_gpu_instancing".into());
+    assert_clean_failure(&req.write_glb(d, "instancing"), "EXT_mesh_gpu_instancing");
 
     assert_clean_failure(&d.join("does-not-exist.glb"), "cannot read");
     let junk = d.join("junk.gltf");

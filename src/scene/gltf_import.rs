@@ -1,11 +1,16 @@
 //! glTF 2.0 import (`.gltf` with external or embedded buffers, and `.glb`).
 
-use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
+use super::accessor::{self, BufferData};
+use super::compression;
+use super::textures::{
+    Image, MaterialTextures, TexTransform, TextureRef, Wrap, decode_webp, to_rgba8,
+};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
     default_light_rig,
 };
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
+use gltf::json::validation::Checked;
 use gltf::mesh::Mode;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -22,6 +27,9 @@ const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_volume",
     "KHR_texture_transform",
     "KHR_mesh_quantization",
+    "EXT_meshopt_compression",
+    "KHR_draco_mesh_compression",
+    "EXT_texture_webp",
 ];
 
 /// Vertical field of view of the automatic camera.
@@ -44,11 +52,19 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
     let gltf = gltf::Gltf::from_slice_without_validation(bytes)
         .map_err(|e| format!("not a valid glTF file: {e}"))?;
     let document = gltf.document;
-    let buffers = gltf::import_buffers(&document, base, gltf.blob)
-        .map_err(|e| format!("cannot load buffers: {e}"))?;
-    let buffer_data: Vec<&[u8]> = buffers.iter().map(|b| b.0.as_slice()).collect();
+    let buffers = import_buffers(&document, base, gltf.blob)?;
+    let root = document.as_json();
+    let mut buffer_data = BufferData {
+        buffers: buffers.iter().map(|b| b.0.as_slice()).collect(),
+        decoded_views: HashMap::new(),
+    };
+    buffer_data.decoded_views = compression::decode_meshopt_views(root, &buffer_data.buffers)?;
+    let rest = rest_worlds(&document);
 
-    let mut table = TextureTable::default();
+    let mut table = TextureTable {
+        sources: texture_sources(root),
+        ..TextureTable::default()
+    };
     let mut materials = document
         .materials()
         .map(|m| import_material(m, &mut table, &mut warnings))
@@ -100,9 +116,12 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
                 .or(mesh.name())
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("mesh {}", mesh.index()));
+            let pose = node_pose(&node, &mesh, root, &buffer_data, &rest)?;
             let m = import_mesh(
                 &mesh,
+                root,
                 &buffer_data,
+                &pose,
                 default_material,
                 &normal_sets,
                 &mut warnings,
@@ -110,7 +129,13 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
             if !m.indices.is_empty() {
                 scene.objects.push(Object {
                     name,
-                    world_from_object: world,
+                    // A skinned mesh is placed by its joints alone; its node's transform is
+                    // ignored (glTF 2.0 § 3.7.3).
+                    world_from_object: if pose.joints.is_empty() {
+                        world
+                    } else {
+                        DMat4::IDENTITY
+                    },
                     visible: true,
                     mesh: m,
                 });
@@ -204,6 +229,34 @@ fn check_extensions_json(json: &[u8], warnings: &mut Vec<String>) -> Result<(), 
     Ok(())
 }
 
+/// Loads every buffer; an `EXT_meshopt_compression` fallback buffer is left empty (every
+/// view into it is decoded from compressed data instead).
+fn import_buffers(
+    document: &gltf::Document,
+    base: Option<&Path>,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<gltf::buffer::Data>, String> {
+    document
+        .buffers()
+        .map(|buffer| {
+            if compression::is_meshopt_fallback(document.as_json(), buffer.index()) {
+                return Ok(gltf::buffer::Data(Vec::new()));
+            }
+            let data = gltf::buffer::Data::from_source_and_blob(buffer.source(), base, &mut blob)
+                .map_err(|e| format!("cannot load buffers: {e}"))?;
+            if data.len() < buffer.length() {
+                return Err(format!(
+                    "cannot load buffers: buffers[{}] has {} bytes where byteLength says {}",
+                    buffer.index(),
+                    data.len(),
+                    buffer.length()
+                ));
+            }
+            Ok(data)
+        })
+        .collect()
+}
+
 fn node_matrix(node: &gltf::Node) -> DMat4 {
     let (t, r, s) = node.transform().decomposed();
     let t = DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64);
@@ -222,6 +275,28 @@ struct TextureTable {
     order: Vec<usize>,
     /// Scene images that could not be decoded.
     failed: Vec<bool>,
+    /// The image each glTF texture shows (its `EXT_texture_webp` source, else its plain
+    /// source), if any.
+    sources: Vec<Option<usize>>,
+}
+
+/// The image each texture shows: the `EXT_texture_webp` source where present, else the
+/// core `source` (a `KHR_texture_basisu` image is not decoded, so only its fallback counts).
+fn texture_sources(root: &gltf::json::Root) -> Vec<Option<usize>> {
+    root.textures
+        .iter()
+        .map(|t| {
+            let webp = t
+                .extensions
+                .as_ref()
+                .and_then(|e| e.others.get("EXT_texture_webp"))
+                .and_then(|w| w.get("source"))
+                .and_then(serde_json::Value::as_u64)
+                .map(|i| i as usize);
+            let core = Some(t.source.value()).filter(|&i| i != u32::MAX as usize);
+            webp.or(core).filter(|&i| i < root.images.len())
+        })
+        .collect()
 }
 
 impl TextureTable {
@@ -236,11 +311,17 @@ impl TextureTable {
         what: &str,
         warnings: &mut Vec<String>,
     ) -> Option<u32> {
-        let source = texture.source();
+        let Some(source) = self.sources.get(texture.index()).copied().flatten() else {
+            warnings.push(format!(
+                "{what}: textures[{}] has no image penumbra can decode, left out",
+                texture.index()
+            ));
+            return None;
+        };
         let next = self.order.len() as u32;
-        let image = *self.images.entry(source.index()).or_insert(next);
+        let image = *self.images.entry(source).or_insert(next);
         if image == next {
-            self.order.push(source.index());
+            self.order.push(source);
         }
         let mut t = TexTransform::default();
         let mut tex_coord = tex_coord;
@@ -352,6 +433,9 @@ fn decode_images(
                     .name()
                     .map_or_else(|| i.to_string(), |n| format!("{i} ({n})")),
             };
+            if let Some(bytes) = webp_bytes(image, base, buffers) {
+                return decode_webp(&bytes?, &name);
+            }
             let data = gltf::image::Data::from_source(image.source(), Some(base), buffers)
                 .map_err(|e| format!("image {name}: cannot decode: {e}"))?;
             to_rgba8(&data, &name)
@@ -377,6 +461,39 @@ fn decode_images(
         }
     }
     images
+}
+
+/// The encoded bytes of a WebP image (`EXT_texture_webp`), or `None` for other formats.
+fn webp_bytes(
+    image: &gltf::Image,
+    base: &Path,
+    buffers: &[gltf::buffer::Data],
+) -> Option<Result<Vec<u8>, String>> {
+    let what = format!("images[{}]", image.index());
+    match image.source() {
+        gltf::image::Source::View { view, mime_type } => {
+            if mime_type != "image/webp" {
+                return None;
+            }
+            let data = buffers.get(view.buffer().index())?;
+            let bytes = data
+                .get(view.offset()..view.offset().saturating_add(view.length()))
+                .map(<[u8]>::to_vec)
+                .ok_or_else(|| format!("{what}: its bufferView lies outside its buffer"));
+            Some(bytes)
+        }
+        gltf::image::Source::Uri { uri, mime_type } => {
+            let webp =
+                mime_type == Some("image/webp") || uri.to_ascii_lowercase().ends_with(".webp");
+            if !webp || uri.starts_with("data:") {
+                return None;
+            }
+            Some(
+                std::fs::read(base.join(uri))
+                    .map_err(|e| format!("{what} ({uri}): cannot read: {e}")),
+            )
+        }
+    }
 }
 
 fn import_material(
@@ -468,16 +585,269 @@ fn import_light(light: &gltf::khr_lights_punctual::Light, world: &DMat4) -> Ligh
     }
 }
 
+/// The pose a mesh is drawn in: morph target weights and skin joint matrices.
+#[derive(Default)]
+struct Pose {
+    /// Morph target weights (the node's, else the mesh's; missing ones are 0).
+    weights: Vec<f32>,
+    /// `world_from_joint × inverse bind matrix` of each joint of the node's skin; empty
+    /// when the node has no skin.
+    joints: Vec<DMat4>,
+}
+
+/// World transforms of every node at its rest transform, as the scene graph nests them
+/// (a node no scene reaches is placed by its own transform). Used for skin joints.
+fn rest_worlds(document: &gltf::Document) -> Vec<DMat4> {
+    let count = document.nodes().len();
+    let mut parent: Vec<Option<usize>> = vec![None; count];
+    for node in document.nodes() {
+        for child in node.children() {
+            if child.index() != node.index() && parent[child.index()].is_none() {
+                parent[child.index()] = Some(node.index());
+            }
+        }
+    }
+    let local: Vec<DMat4> = document.nodes().map(|n| node_matrix(&n)).collect();
+    (0..count)
+        .map(|mut i| {
+            // Walk up to the root (at most `count` steps, so a cycle ends).
+            let mut world = local[i];
+            for _ in 0..count {
+                match parent[i] {
+                    Some(p) => {
+                        world = local[p] * world;
+                        i = p;
+                    }
+                    None => break,
+                }
+            }
+            world
+        })
+        .collect()
+}
+
+/// The pose of `node`'s mesh: its morph weights and, with a skin, its joint matrices.
+fn node_pose(
+    node: &gltf::Node,
+    mesh: &gltf::Mesh,
+    root: &gltf::json::Root,
+    data: &BufferData,
+    worlds: &[DMat4],
+) -> Result<Pose, String> {
+    let weights = node
+        .weights()
+        .or(mesh.weights())
+        .map(<[f32]>::to_vec)
+        .unwrap_or_default();
+    let Some(skin) = node.skin() else {
+        return Ok(Pose {
+            weights,
+            joints: Vec::new(),
+        });
+    };
+    let path = format!("skins[{}]", skin.index());
+    let json = &root.skins[skin.index()];
+    let inverse_binds = match json.inverse_bind_matrices {
+        Some(a) => accessor::read_floats::<16>(root, data, a.value())
+            .map_err(|e| format!("{path}.inverseBindMatrices: {e}"))?,
+        None => Vec::new(),
+    };
+    if !inverse_binds.is_empty() && inverse_binds.len() < json.joints.len() {
+        return Err(format!(
+            "{path}: {} inverse bind matrices for {} joints",
+            inverse_binds.len(),
+            json.joints.len()
+        ));
+    }
+    let joints = json
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(k, joint)| {
+            let world = worlds.get(joint.value()).ok_or_else(|| {
+                format!(
+                    "{path}.joints[{k}]: nodes[{}] does not exist",
+                    joint.value()
+                )
+            })?;
+            let inverse_bind = inverse_binds.get(k).map_or(DMat4::IDENTITY, |m| {
+                DMat4::from_cols_array(&m.map(f64::from))
+            });
+            Ok(*world * inverse_bind)
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok(Pose { weights, joints })
+}
+
+/// The vertex attributes of one primitive, from its accessors or its Draco data.
+struct Attributes<'a> {
+    root: &'a gltf::json::Root,
+    data: &'a BufferData<'a>,
+    accessors: HashMap<String, usize>,
+    draco: Option<compression::DracoPrimitive>,
+    path: String,
+}
+
+impl Attributes<'_> {
+    /// Attribute `semantic` with `N` components, if present.
+    fn floats<const N: usize>(&self, semantic: &str) -> Result<Option<Vec<[f32; N]>>, String> {
+        if let Some(values) = self.draco.as_ref().and_then(|d| d.attributes.get(semantic)) {
+            return Ok(Some(
+                values
+                    .iter()
+                    .map(|v| std::array::from_fn(|c| v[c]))
+                    .collect(),
+            ));
+        }
+        let Some(&index) = self.accessors.get(semantic) else {
+            return Ok(None);
+        };
+        accessor::read_floats::<N>(self.root, self.data, index)
+            .map(Some)
+            .map_err(|e| format!("{}.attributes.{semantic}: {e}", self.path))
+    }
+
+    /// Attribute `semantic` as unsigned integers (`JOINTS_n`), if present.
+    fn uints(&self, semantic: &str) -> Result<Option<Vec<[u32; 4]>>, String> {
+        if let Some(values) = self.draco.as_ref().and_then(|d| d.attributes.get(semantic)) {
+            return Ok(Some(values.iter().map(|v| v.map(|c| c as u32)).collect()));
+        }
+        let Some(&index) = self.accessors.get(semantic) else {
+            return Ok(None);
+        };
+        accessor::read_uints::<4>(self.root, self.data, index)
+            .map(Some)
+            .map_err(|e| format!("{}.attributes.{semantic}: {e}", self.path))
+    }
+}
+
+/// Applies morph targets at `weights` to the vertex attributes of a primitive.
+fn apply_morph_targets(
+    attributes: &Attributes,
+    prim: &gltf::json::mesh::Primitive,
+    weights: &[f32],
+    positions: &mut [Vec3],
+    normals: &mut [Vec3],
+    tangents: &mut [Vec4],
+) -> Result<(), String> {
+    let (root, data, path) = (attributes.root, attributes.data, &attributes.path);
+    let targets = prim.targets.as_deref().unwrap_or_default();
+    for (k, target) in targets.iter().enumerate() {
+        let w = weights.get(k).copied().unwrap_or(0.0);
+        if w == 0.0 || !w.is_finite() {
+            continue;
+        }
+        // The target's displacements of one attribute with `len` vertices, if it has them.
+        let deltas =
+            |a: Option<gltf::json::Index<gltf::json::Accessor>>, name: &str, len: usize| {
+                let Some(a) = a.filter(|_| len > 0) else {
+                    return Ok(Vec::new());
+                };
+                let d = accessor::read_floats::<3>(root, data, a.value())
+                    .map_err(|e| format!("{path}.targets[{k}].{name}: {e}"))?;
+                if d.len() != len {
+                    return Err(format!(
+                        "{path}.targets[{k}].{name}: count differs from the attribute's"
+                    ));
+                }
+                Ok(d)
+            };
+        let moved = deltas(target.positions, "POSITION", positions.len())?;
+        for (v, d) in positions.iter_mut().zip(moved) {
+            *v += w * Vec3::from(d);
+        }
+        let moved = deltas(target.normals, "NORMAL", normals.len())?;
+        for (v, d) in normals.iter_mut().zip(moved) {
+            *v += w * Vec3::from(d);
+        }
+        let moved = deltas(target.tangents, "TANGENT", tangents.len())?;
+        for (t, d) in tangents.iter_mut().zip(moved) {
+            *t += w * Vec3::from(d).extend(0.0);
+        }
+    }
+    Ok(())
+}
+
+/// Moves vertices by their skin: each is `Σ weight × joint matrix` of its (up to eight)
+/// joints, normals by the inverse transpose of that blend.
+fn apply_skin(
+    attributes: &Attributes,
+    joints: &[DMat4],
+    positions: &mut [Vec3],
+    normals: &mut [Vec3],
+    tangents: &mut [Vec4],
+) -> Result<(), String> {
+    let mut blend = vec![DMat4::ZERO; positions.len()];
+    let mut any = false;
+    for set in 0..2 {
+        let (Some(j), Some(w)) = (
+            attributes.uints(&format!("JOINTS_{set}"))?,
+            attributes.floats::<4>(&format!("WEIGHTS_{set}"))?,
+        ) else {
+            continue;
+        };
+        if j.len() != positions.len() || w.len() != positions.len() {
+            return Err(format!(
+                "{}: JOINTS_{set}/WEIGHTS_{set} count differs from POSITION count",
+                attributes.path
+            ));
+        }
+        for (v, (j, w)) in j.iter().zip(&w).enumerate() {
+            for c in 0..4 {
+                if w[c] == 0.0 {
+                    continue;
+                }
+                let m = joints.get(j[c] as usize).ok_or_else(|| {
+                    format!(
+                        "{}: JOINTS_{set} {v} names joint {} of a skin with {}",
+                        attributes.path,
+                        j[c],
+                        joints.len()
+                    )
+                })?;
+                blend[v] += *m * w[c] as f64;
+            }
+        }
+        any = true;
+    }
+    if !any {
+        return Ok(());
+    }
+    for (v, m) in blend.iter().enumerate() {
+        if *m == DMat4::ZERO {
+            continue;
+        }
+        positions[v] = m.transform_point3(positions[v].as_dvec3()).as_vec3();
+        let normal_matrix = m.inverse().transpose();
+        if let Some(n) = normals.get_mut(v) {
+            *n = normal_matrix
+                .transform_vector3(n.as_dvec3())
+                .normalize_or_zero()
+                .as_vec3();
+        }
+        if let Some(t) = tangents.get_mut(v) {
+            let xyz = m
+                .transform_vector3(t.truncate().as_dvec3())
+                .normalize_or_zero();
+            *t = xyz.as_vec3().extend(t.w);
+        }
+    }
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
 fn import_mesh(
     mesh: &gltf::Mesh,
-    buffers: &[&[u8]],
+    root: &gltf::json::Root,
+    data: &BufferData,
+    pose: &Pose,
     default_material: u32,
     normal_sets: &[Option<u32>],
     warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
     let mut out = Mesh::default();
     for prim in mesh.primitives() {
-        let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+        let what = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
         let mode = prim.mode();
         if !matches!(
             mode,
@@ -486,36 +856,52 @@ fn import_mesh(
             warnings.push(format!("{what}: mode {mode:?} is not triangles, skipped"));
             continue;
         }
-        let reader = prim.reader(|b| buffers.get(b.index()).copied());
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| format!("{what}: POSITION is missing or unreadable"))?
+        let json = &root.meshes[mesh.index()].primitives[prim.index()];
+        let attributes = Attributes {
+            root,
+            data,
+            accessors: json
+                .attributes
+                .iter()
+                .filter_map(|(k, v)| match k {
+                    Checked::Valid(s) => Some((s.to_string(), v.value())),
+                    Checked::Invalid => None,
+                })
+                .collect(),
+            draco: compression::decode_draco(root, data, json, &what)?,
+            path: what.clone(),
+        };
+        let mut positions: Vec<Vec3> = attributes
+            .floats::<3>("POSITION")?
+            .ok_or_else(|| format!("{what}: POSITION is missing"))?
+            .into_iter()
             .map(Vec3::from)
             .collect();
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("{what}: POSITION {i} is not finite"));
         }
-        let normals: Vec<Vec3> = reader
-            .read_normals()
+        let mut normals: Vec<Vec3> = attributes
+            .floats::<3>("NORMAL")?
+            .unwrap_or_default()
+            .into_iter()
             .map(|n| {
-                n.map(|n| {
-                    let n = Vec3::from(n);
-                    if n.is_finite() { n } else { Vec3::ZERO }
-                })
-                .collect()
+                let n = Vec3::from(n);
+                if n.is_finite() { n } else { Vec3::ZERO }
             })
-            .unwrap_or_default();
+            .collect();
         if !normals.is_empty() && normals.len() != positions.len() {
             return Err(format!("{what}: NORMAL count differs from POSITION count"));
         }
-        let read_uvs = |set: u32| -> Vec<Vec2> {
-            reader
-                .read_tex_coords(set)
-                .map(|t| t.into_f32().map(Vec2::from).collect())
+        let read_uvs = |set: u32| -> Result<Vec<Vec2>, String> {
+            Ok(attributes
+                .floats::<2>(&format!("TEXCOORD_{set}"))?
                 .unwrap_or_default()
+                .into_iter()
+                .map(Vec2::from)
+                .collect())
         };
-        let uvs = read_uvs(0);
-        let uvs1 = read_uvs(1);
+        let uvs = read_uvs(0)?;
+        let uvs1 = read_uvs(1)?;
         for (set, list) in [(0, &uvs), (1, &uvs1)] {
             if !list.is_empty() && list.len() != positions.len() {
                 return Err(format!(
@@ -523,9 +909,49 @@ fn import_mesh(
                 ));
             }
         }
-        let flat: Vec<u32> = match reader.read_indices() {
-            Some(i) => i.into_u32().collect(),
-            None => (0..positions.len() as u32).collect(),
+        let material = prim
+            .material()
+            .index()
+            .map_or(default_material, |i| i as u32);
+        let normal_set = normal_sets.get(material as usize).copied().flatten();
+        let mut file_tangents: Vec<Vec4> = match normal_set {
+            Some(_) => attributes
+                .floats::<4>("TANGENT")?
+                .unwrap_or_default()
+                .into_iter()
+                .map(Vec4::from)
+                .collect(),
+            None => Vec::new(),
+        };
+        if !file_tangents.is_empty() && file_tangents.len() != positions.len() {
+            return Err(format!("{what}: TANGENT count differs from POSITION count"));
+        }
+        // Pose the vertices: morph targets in the mesh's space, then the skin.
+        apply_morph_targets(
+            &attributes,
+            json,
+            &pose.weights,
+            &mut positions,
+            &mut normals,
+            &mut file_tangents,
+        )?;
+        if !pose.joints.is_empty() {
+            apply_skin(
+                &attributes,
+                &pose.joints,
+                &mut positions,
+                &mut normals,
+                &mut file_tangents,
+            )?;
+        }
+        let flat: Vec<u32> = match (&attributes.draco, json.indices) {
+            (Some(d), _) => d.indices.clone(),
+            (None, Some(a)) => accessor::read_uints::<1>(root, data, a.value())
+                .map_err(|e| format!("{what}.indices: {e}"))?
+                .into_iter()
+                .map(|[i]| i)
+                .collect(),
+            (None, None) => (0..positions.len() as u32).collect(),
         };
         if let Some(&bad) = flat.iter().find(|&&i| i as usize >= positions.len()) {
             return Err(format!(
@@ -549,10 +975,6 @@ fn import_mesh(
                 .collect(),
         };
         let base = out.positions.len() as u32;
-        let material = prim
-            .material()
-            .index()
-            .map_or(default_material, |i| i as u32);
         // Keep the per-vertex arrays aligned when only some primitives have normals or UVs.
         pad_attribute(
             &mut out.normals,
@@ -563,31 +985,23 @@ fn import_mesh(
         pad_attribute(&mut out.uvs, out.positions.len(), &uvs, positions.len());
         pad_attribute(&mut out.uvs1, out.positions.len(), &uvs1, positions.len());
         // Tangents at the corners of normal-mapped triangles: the file's, else MikkTSpace's.
-        let tangents: Vec<[Vec4; 3]> = match normal_sets.get(material as usize).copied().flatten() {
+        let tangents: Vec<[Vec4; 3]> = match normal_set {
             None => Vec::new(),
-            Some(set) => match reader.read_tangents() {
-                Some(t) => {
-                    let t: Vec<Vec4> = t.map(Vec4::from).collect();
-                    if t.len() != positions.len() {
-                        return Err(format!("{what}: TANGENT count differs from POSITION count"));
-                    }
-                    triangles
-                        .iter()
-                        .map(|tri| tri.map(|i| t[i as usize]))
-                        .collect()
+            Some(_) if !file_tangents.is_empty() => triangles
+                .iter()
+                .map(|tri| tri.map(|i| file_tangents[i as usize]))
+                .collect(),
+            Some(set) => {
+                let set_uvs = if set == 1 { &uvs1 } else { &uvs };
+                if set_uvs.is_empty() {
+                    warnings.push(format!(
+                        "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"
+                    ));
+                    Vec::new()
+                } else {
+                    super::tangents::generate(&positions, &normals, set_uvs, &triangles)
                 }
-                None => {
-                    let set_uvs = if set == 1 { &uvs1 } else { &uvs };
-                    if set_uvs.is_empty() {
-                        warnings.push(format!(
-                            "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"
-                        ));
-                        Vec::new()
-                    } else {
-                        super::tangents::generate(&positions, &normals, set_uvs, &triangles)
-                    }
-                }
-            },
+            }
         };
         pad_attribute(
             &mut out.tangents,

@@ -3,6 +3,8 @@
 //! Transforms are composed in f64; geometry is stored per object in object space and flattened
 //! into world-space triangles (f32) whenever the scene changes.
 
+mod accessor;
+mod compression;
 mod environment;
 mod gltf_import;
 mod lights;

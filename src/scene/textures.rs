@@ -298,6 +298,19 @@ pub fn to_rgba8(data: &gltf::image::Data, name: &str) -> Result<Image, String> {
     })
 }
 
+/// Decodes a WebP image (`EXT_texture_webp`) to 8-bit RGBA.
+pub fn decode_webp(bytes: &[u8], name: &str) -> Result<Image, String> {
+    let decoded = image::load_from_memory_with_format(bytes, image::ImageFormat::WebP)
+        .map_err(|e| format!("image {name}: cannot decode WebP: {e}"))?
+        .into_rgba8();
+    Ok(Image {
+        name: name.to_string(),
+        width: decoded.width(),
+        height: decoded.height(),
+        rgba: decoded.pixels().map(|p| p.0).collect(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
