@@ -10,5 +10,4 @@ if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
 fi
 cd tools
 npm ci --no-audit --no-fund --loglevel=error
-./node_modules/.bin/gltfpack -h 2>&1 | head -n 1
-./node_modules/.bin/gltf-transform --version
+npm ls --depth=0

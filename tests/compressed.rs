@@ -5,8 +5,9 @@
 //! gltf-transform webp (EXT_texture_webp). The shared meshopt Lamborghini is compared with its
 //! original too.
 //!
-//! Each pair is rendered at 96×64, 8 spp, seed 0 on the test device, and compared by the mean
-//! and by 16×16-pixel block means (see `compare`). Skipped with a note when the tools or
+//! Each pair is rendered at 96×64, 8 spp, seed 0, under a uniform gray environment (so that
+//! dark scenes such as the Lamborghini show their shapes) on the test device, and compared by
+//! the mean and by 16×16-pixel block means (see `compare`). Skipped with a note when the tools or
 //! PENUMBRA_SCENES are missing, except under CI=true, where that fails.
 
 mod common;
@@ -52,6 +53,8 @@ fn render(scene: &Path, out: &Path) -> Vec<[f32; 3]> {
             "8",
             "--seed",
             "0",
+            "--env",
+            "0.5,0.5,0.5",
         ],
     );
     assert_eq!(summary["nonfinite_samples"], 0, "{}", scene.display());
@@ -72,6 +75,7 @@ fn blocks(px: &[[f32; 3]]) -> Vec<f64> {
 /// Compares a render with its original's; returns the failure, if any, with the figures.
 fn compare(name: &str, original: &[[f32; 3]], other: &[[f32; 3]]) -> Result<String, String> {
     let (a, b) = (mean_gray(original), mean_gray(other));
+    assert!(a > 1e-3, "{name}: the original renders black");
     let mean_diff = (a - b).abs() / a.max(1e-6);
     let block_diff = blocks(original)
         .iter()
