@@ -475,9 +475,11 @@ fn webp_bytes(
             if mime_type != "image/webp" {
                 return None;
             }
-            let data = buffers.get(view.buffer().index())?;
-            let bytes = data
-                .get(view.offset()..view.offset().saturating_add(view.length()))
+            let bytes = buffers
+                .get(view.buffer().index())
+                .and_then(|data| {
+                    data.get(view.offset()..view.offset().saturating_add(view.length()))
+                })
                 .map(<[u8]>::to_vec)
                 .ok_or_else(|| format!("{what}: its bufferView lies outside its buffer"));
             Some(bytes)
@@ -943,6 +945,11 @@ fn import_mesh(
                 &mut normals,
                 &mut file_tangents,
             )?;
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!(
+                "{what}: its morph targets or skin move POSITION {i} to a non-finite point"
+            ));
         }
         let flat: Vec<u32> = match (&attributes.draco, json.indices) {
             (Some(d), _) => d.indices.clone(),
