@@ -16,7 +16,7 @@ for scene in "$@"; do
     "$bin/gltfpack" -i "$scene" -o "$out/$name.pack.glb" >/dev/null
     "$bin/gltfpack" -cc -i "$scene" -o "$out/$name.cc.glb" >/dev/null
     "$bin/gltf-transform" draco "$scene" "$out/$name.draco.glb" >/dev/null
-    if grep -q '"images"' "$scene" 2>/dev/null || grep -aq '"images"' "$scene"; then
+    if grep -aq "\"images\"" "$scene"; then
         "$bin/gltf-transform" webp "$scene" "$out/$name.webp.glb" >/dev/null
     fi
 done

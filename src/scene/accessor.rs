@@ -335,6 +335,48 @@ fn read<T: Copy + Default, const N: usize>(
     Ok(out)
 }
 
+/// The vertex attributes of one primitive, from its accessors or its Draco data.
+pub struct Attributes<'a> {
+    pub root: &'a gltf::json::Root,
+    pub data: &'a BufferData<'a>,
+    pub accessors: HashMap<String, usize>,
+    pub draco: Option<super::compression::DracoPrimitive>,
+    pub path: String,
+}
+
+impl Attributes<'_> {
+    /// Attribute `semantic` with `N` components, if present.
+    pub fn floats<const N: usize>(&self, semantic: &str) -> Result<Option<Vec<[f32; N]>>, String> {
+        if let Some(values) = self.draco.as_ref().and_then(|d| d.attributes.get(semantic)) {
+            return Ok(Some(
+                values
+                    .iter()
+                    .map(|v| std::array::from_fn(|c| v[c]))
+                    .collect(),
+            ));
+        }
+        let Some(&index) = self.accessors.get(semantic) else {
+            return Ok(None);
+        };
+        read_floats::<N>(self.root, self.data, index)
+            .map(Some)
+            .map_err(|e| format!("{}.attributes.{semantic}: {e}", self.path))
+    }
+
+    /// Attribute `semantic` as unsigned integers (`JOINTS_n`), if present.
+    pub fn uints(&self, semantic: &str) -> Result<Option<Vec<[u32; 4]>>, String> {
+        if let Some(values) = self.draco.as_ref().and_then(|d| d.attributes.get(semantic)) {
+            return Ok(Some(values.iter().map(|v| v.map(|c| c as u32)).collect()));
+        }
+        let Some(&index) = self.accessors.get(semantic) else {
+            return Ok(None);
+        };
+        read_uints::<4>(self.root, self.data, index)
+            .map(Some)
+            .map_err(|e| format!("{}.attributes.{semantic}: {e}", self.path))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,6 +8,7 @@ mod compression;
 mod environment;
 mod gltf_import;
 mod lights;
+mod pose;
 mod tangents;
 mod textures;
 
