@@ -1,11 +1,17 @@
 //! glTF 2.0 import (`.gltf` with external or embedded buffers, and `.glb`).
 
-use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
+use super::accessor::{self, Attributes, BufferData};
+use super::compression;
+use super::pose::{Pose, apply_morph_targets, apply_skin, node_pose, rest_worlds};
+use super::textures::{
+    Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8,
+};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
     default_light_rig, limits, sources, validate,
 };
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
+use gltf::json::validation::Checked;
 use gltf::mesh::Mode;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -35,9 +41,18 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
     let parsed = validate::parse(bytes, &mut warnings)?;
     let document = parsed.document;
     let buffers = sources::load_buffers(&document, base, parsed.blob)?;
-    let buffer_data: Vec<&[u8]> = buffers.iter().map(Vec::as_slice).collect();
+    let root = document.as_json();
+    let mut buffer_data = BufferData {
+        buffers: buffers.iter().map(Vec::as_slice).collect(),
+        decoded_views: HashMap::new(),
+    };
+    buffer_data.decoded_views = compression::decode_meshopt_views(root, &buffer_data.buffers)?;
+    let rest = rest_worlds(&document);
 
-    let mut table = TextureTable::default();
+    let mut table = TextureTable {
+        sources: texture_sources(root),
+        ..TextureTable::default()
+    };
     let mut materials = document
         .materials()
         .map(|m| import_material(m, &mut table, &mut warnings))
@@ -120,18 +135,25 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
                 .or(mesh.name())
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("mesh {}", mesh.index()));
-            // Each mesh is read once, however many nodes place it.
-            let m = match meshes.get(&mesh.index()) {
+            // Each mesh is read once, however many nodes place it, unless the node poses it
+            // (a skin or its own morph weights).
+            let pose = node_pose(&node, &mesh, root, &buffer_data, &rest)?;
+            let posed = node.skin().is_some() || node.weights().is_some();
+            let m = match meshes.get(&mesh.index()).filter(|_| !posed) {
                 Some(m) => m.clone(),
                 None => {
                     let m = import_mesh(
                         &mesh,
+                        root,
                         &buffer_data,
+                        &pose,
                         default_material,
                         &normal_sets,
                         &mut warnings,
                     )?;
-                    meshes.insert(mesh.index(), m.clone());
+                    if !posed {
+                        meshes.insert(mesh.index(), m.clone());
+                    }
                     m
                 }
             };
@@ -159,7 +181,13 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
             if !m.indices.is_empty() {
                 scene.objects.push(Object {
                     name,
-                    world_from_object: world,
+                    // A skinned mesh is placed by its joints alone; its node's transform is
+                    // ignored (glTF 2.0 § 3.7.3).
+                    world_from_object: if pose.joints.is_empty() {
+                        world
+                    } else {
+                        DMat4::IDENTITY
+                    },
                     visible: true,
                     mesh: m,
                 });
@@ -209,7 +237,7 @@ fn warn_once(warnings: &mut Vec<String>, warning: String) {
 
 /// The node's local transform, or why it cannot be used: a non-finite value, a zero
 /// quaternion or a singular matrix.
-fn node_matrix(node: &gltf::Node) -> Result<DMat4, &'static str> {
+pub(super) fn node_matrix(node: &gltf::Node) -> Result<DMat4, &'static str> {
     if let gltf::scene::Transform::Matrix { matrix } = node.transform() {
         let m = DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)));
         if !m.is_finite() {
@@ -268,6 +296,28 @@ struct TextureTable {
     order: Vec<usize>,
     /// Scene images that could not be decoded.
     failed: Vec<bool>,
+    /// The image each glTF texture shows (its `EXT_texture_webp` source, else its plain
+    /// source), if any.
+    sources: Vec<Option<usize>>,
+}
+
+/// The image each texture shows: the `EXT_texture_webp` source where present, else the
+/// core `source` (a `KHR_texture_basisu` image is not decoded, so only its fallback counts).
+fn texture_sources(root: &gltf::json::Root) -> Vec<Option<usize>> {
+    root.textures
+        .iter()
+        .map(|t| {
+            let webp = t
+                .extensions
+                .as_ref()
+                .and_then(|e| e.others.get("EXT_texture_webp"))
+                .and_then(|w| w.get("source"))
+                .and_then(serde_json::Value::as_u64)
+                .map(|i| i as usize);
+            let core = Some(t.source.value()).filter(|&i| i != u32::MAX as usize);
+            webp.or(core).filter(|&i| i < root.images.len())
+        })
+        .collect()
 }
 
 impl TextureTable {
@@ -282,11 +332,17 @@ impl TextureTable {
         what: &str,
         warnings: &mut Vec<String>,
     ) -> Option<u32> {
-        let source = texture.source();
+        let Some(source) = self.sources.get(texture.index()).copied().flatten() else {
+            warnings.push(format!(
+                "{what}: textures[{}] has no image penumbra can decode, left out",
+                texture.index()
+            ));
+            return None;
+        };
         let next = self.order.len() as u32;
-        let image = *self.images.entry(source.index()).or_insert(next);
+        let image = *self.images.entry(source).or_insert(next);
         if image == next {
-            self.order.push(source.index());
+            self.order.push(source);
         }
         let mut t = TexTransform::default();
         let mut tex_coord = tex_coord;
@@ -668,16 +724,19 @@ fn spot_cone(inner: f32, outer: f32) -> (f32, f32) {
     (inner, outer)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn import_mesh(
     mesh: &gltf::Mesh,
-    buffers: &[&[u8]],
+    root: &gltf::json::Root,
+    data: &BufferData,
+    pose: &Pose,
     default_material: u32,
     normal_sets: &[Option<u32>],
     warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
     let mut out = Mesh::default();
     for prim in mesh.primitives() {
-        let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+        let what = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
         let mode = prim.mode();
         if !matches!(
             mode,
@@ -686,36 +745,52 @@ fn import_mesh(
             warnings.push(format!("{what}: mode {mode:?} is not triangles, skipped"));
             continue;
         }
-        let reader = prim.reader(|b| buffers.get(b.index()).copied());
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| format!("{what}: POSITION is missing or unreadable"))?
+        let json = &root.meshes[mesh.index()].primitives[prim.index()];
+        let attributes = Attributes {
+            root,
+            data,
+            accessors: json
+                .attributes
+                .iter()
+                .filter_map(|(k, v)| match k {
+                    Checked::Valid(s) => Some((s.to_string(), v.value())),
+                    Checked::Invalid => None,
+                })
+                .collect(),
+            draco: compression::decode_draco(root, data, json, &what)?,
+            path: what.clone(),
+        };
+        let mut positions: Vec<Vec3> = attributes
+            .floats::<3>("POSITION")?
+            .ok_or_else(|| format!("{what}: POSITION is missing"))?
+            .into_iter()
             .map(Vec3::from)
             .collect();
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("{what}: POSITION {i} is not finite"));
         }
-        let normals: Vec<Vec3> = reader
-            .read_normals()
+        let mut normals: Vec<Vec3> = attributes
+            .floats::<3>("NORMAL")?
+            .unwrap_or_default()
+            .into_iter()
             .map(|n| {
-                n.map(|n| {
-                    let n = Vec3::from(n);
-                    if n.is_finite() { n } else { Vec3::ZERO }
-                })
-                .collect()
+                let n = Vec3::from(n);
+                if n.is_finite() { n } else { Vec3::ZERO }
             })
-            .unwrap_or_default();
+            .collect();
         if !normals.is_empty() && normals.len() != positions.len() {
             return Err(format!("{what}: NORMAL count differs from POSITION count"));
         }
-        let read_uvs = |set: u32| -> Vec<Vec2> {
-            reader
-                .read_tex_coords(set)
-                .map(|t| t.into_f32().map(Vec2::from).collect())
+        let read_uvs = |set: u32| -> Result<Vec<Vec2>, String> {
+            Ok(attributes
+                .floats::<2>(&format!("TEXCOORD_{set}"))?
                 .unwrap_or_default()
+                .into_iter()
+                .map(Vec2::from)
+                .collect())
         };
-        let uvs = read_uvs(0);
-        let uvs1 = read_uvs(1);
+        let uvs = read_uvs(0)?;
+        let uvs1 = read_uvs(1)?;
         for (set, list) in [(0, &uvs), (1, &uvs1)] {
             if !list.is_empty() && list.len() != positions.len() {
                 return Err(format!(
@@ -723,9 +798,54 @@ fn import_mesh(
                 ));
             }
         }
-        let flat: Vec<u32> = match reader.read_indices() {
-            Some(i) => i.into_u32().collect(),
-            None => (0..positions.len() as u32).collect(),
+        let material = prim
+            .material()
+            .index()
+            .map_or(default_material, |i| i as u32);
+        let normal_set = normal_sets.get(material as usize).copied().flatten();
+        let mut file_tangents: Vec<Vec4> = match normal_set {
+            Some(_) => attributes
+                .floats::<4>("TANGENT")?
+                .unwrap_or_default()
+                .into_iter()
+                .map(Vec4::from)
+                .collect(),
+            None => Vec::new(),
+        };
+        if !file_tangents.is_empty() && file_tangents.len() != positions.len() {
+            return Err(format!("{what}: TANGENT count differs from POSITION count"));
+        }
+        // Pose the vertices: morph targets in the mesh's space, then the skin.
+        apply_morph_targets(
+            &attributes,
+            json,
+            &pose.weights,
+            &mut positions,
+            &mut normals,
+            &mut file_tangents,
+        )?;
+        if !pose.joints.is_empty() {
+            apply_skin(
+                &attributes,
+                &pose.joints,
+                &mut positions,
+                &mut normals,
+                &mut file_tangents,
+            )?;
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!(
+                "{what}: its morph targets or skin move POSITION {i} to a non-finite point"
+            ));
+        }
+        let flat: Vec<u32> = match (&attributes.draco, json.indices) {
+            (Some(d), _) => d.indices.clone(),
+            (None, Some(a)) => accessor::read_uints::<1>(root, data, a.value())
+                .map_err(|e| format!("{what}.indices: {e}"))?
+                .into_iter()
+                .map(|[i]| i)
+                .collect(),
+            (None, None) => (0..positions.len() as u32).collect(),
         };
         if let Some(&bad) = flat.iter().find(|&&i| i as usize >= positions.len()) {
             return Err(format!(
@@ -749,10 +869,6 @@ fn import_mesh(
                 .collect(),
         };
         let base = out.positions.len() as u32;
-        let material = prim
-            .material()
-            .index()
-            .map_or(default_material, |i| i as u32);
         // Keep the per-vertex arrays aligned when only some primitives have normals or UVs.
         pad_attribute(
             &mut out.normals,
@@ -763,31 +879,23 @@ fn import_mesh(
         pad_attribute(&mut out.uvs, out.positions.len(), &uvs, positions.len());
         pad_attribute(&mut out.uvs1, out.positions.len(), &uvs1, positions.len());
         // Tangents at the corners of normal-mapped triangles: the file's, else MikkTSpace's.
-        let tangents: Vec<[Vec4; 3]> = match normal_sets.get(material as usize).copied().flatten() {
+        let tangents: Vec<[Vec4; 3]> = match normal_set {
             None => Vec::new(),
-            Some(set) => match reader.read_tangents() {
-                Some(t) => {
-                    let t: Vec<Vec4> = t.map(Vec4::from).collect();
-                    if t.len() != positions.len() {
-                        return Err(format!("{what}: TANGENT count differs from POSITION count"));
-                    }
-                    triangles
-                        .iter()
-                        .map(|tri| tri.map(|i| t[i as usize]))
-                        .collect()
+            Some(_) if !file_tangents.is_empty() => triangles
+                .iter()
+                .map(|tri| tri.map(|i| file_tangents[i as usize]))
+                .collect(),
+            Some(set) => {
+                let set_uvs = if set == 1 { &uvs1 } else { &uvs };
+                if set_uvs.is_empty() {
+                    warnings.push(format!(
+                        "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"
+                    ));
+                    Vec::new()
+                } else {
+                    super::tangents::generate(&positions, &normals, set_uvs, &triangles)
                 }
-                None => {
-                    let set_uvs = if set == 1 { &uvs1 } else { &uvs };
-                    if set_uvs.is_empty() {
-                        warnings.push(format!(
-                            "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"
-                        ));
-                        Vec::new()
-                    } else {
-                        super::tangents::generate(&positions, &normals, set_uvs, &triangles)
-                    }
-                }
-            },
+            }
         };
         pad_attribute(
             &mut out.tangents,

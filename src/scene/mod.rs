@@ -3,11 +3,14 @@
 //! Transforms are composed in f64; geometry is stored per object in object space and flattened
 //! into world-space triangles (f32) whenever the scene changes.
 
+mod accessor;
+mod compression;
 mod environment;
 mod gltf_import;
 mod lights;
 pub mod limits;
 mod sources;
+mod pose;
 mod tangents;
 mod textures;
 mod validate;

@@ -18,15 +18,11 @@ pub fn load_buffers(
     for buffer in document.buffers() {
         let i = buffer.index();
         let length = buffer.length();
-        if matches!(buffer.source(), gltf::buffer::Source::Bin)
-            && buffer.extension_value("EXT_meshopt_compression").is_some()
-        {
-            // A meshopt fallback buffer: no bytes in the file; its views are compressed
-            // elsewhere and are decoded into it, never allocated from byteLength here.
-            return Err(format!(
-                "buffers[{i}]: an EXT_meshopt_compression fallback buffer, and this build \
-                 cannot decode EXT_meshopt_compression"
-            ));
+        if super::compression::is_meshopt_fallback(document.as_json(), i) {
+            // A meshopt fallback buffer: no bytes in the file; its views are decoded from
+            // compressed data instead, never allocated from byteLength here.
+            out.push(Vec::new());
+            continue;
         }
         let mut data = match buffer.source() {
             gltf::buffer::Source::Bin => blob
