@@ -1,34 +1,38 @@
 // Kernels for tests and benchmarks: traversal alone, and the layout probe.
 
-kernel void trace_closest(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
-                          global const GpuTriShading* shading,
-                          global const GpuTriTangents* tangents,
-                          global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
-                          global const GpuTexture* textures, global const uint* texels,
-                          global const GpuRay* rays, uint count, global GpuHit* hits,
-                          volatile global uint* counters) {
-    uint i = get_global_id(0);
-    if (i >= count) return;
-    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
-    GpuRay r = rays[i];
-    hits[i] = traverse(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, r.origin.w,
-                       r.direction.w, false, &counters[COUNT_OVERFLOW]);
-}
+// Closest hits and occlusion of arbitrary rays through the binary BVH (traverse.h) and the
+// 4-wide one (traverse_wide.h); one definition for both.
+#define TRACE_KERNELS(SUFFIX, NODE, TRAVERSE)                                                   \
+    kernel void trace_closest##SUFFIX(                                                           \
+        global const NODE* nodes, global const GpuTriangle* tris,                                \
+        global const GpuTriShading* shading, global const GpuTriTangents* tangents,              \
+        global const GpuMaterial* materials, global const GpuTexRef* tex_refs,                   \
+        global const GpuTexture* textures, global const uint* texels, global const GpuRay* rays, \
+        uint count, global GpuHit* hits, volatile global uint* counters) {                       \
+        uint i = get_global_id(0);                                                               \
+        if (i >= count) return;                                                                  \
+        SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};         \
+        GpuRay r = rays[i];                                                                      \
+        hits[i] = TRAVERSE(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, r.origin.w,        \
+                           r.direction.w, false, &counters[COUNT_OVERFLOW]);                     \
+    }                                                                                            \
+    kernel void trace_any##SUFFIX(                                                               \
+        global const NODE* nodes, global const GpuTriangle* tris,                                \
+        global const GpuTriShading* shading, global const GpuTriTangents* tangents,              \
+        global const GpuMaterial* materials, global const GpuTexRef* tex_refs,                   \
+        global const GpuTexture* textures, global const uint* texels, global const GpuRay* rays, \
+        uint count, global uint* occluded, volatile global uint* counters) {                     \
+        uint i = get_global_id(0);                                                               \
+        if (i >= count) return;                                                                  \
+        SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};         \
+        GpuRay r = rays[i];                                                                      \
+        GpuHit h = TRAVERSE(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, r.origin.w,       \
+                            r.direction.w, true, &counters[COUNT_OVERFLOW]);                     \
+        occluded[i] = h.prim != NO_HIT ? 1u : 0u;                                                \
+    }
 
-kernel void trace_any(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
-                      global const GpuTriShading* shading, global const GpuTriTangents* tangents,
-                      global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
-                      global const GpuTexture* textures, global const uint* texels,
-                      global const GpuRay* rays, uint count, global uint* occluded,
-                      volatile global uint* counters) {
-    uint i = get_global_id(0);
-    if (i >= count) return;
-    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
-    GpuRay r = rays[i];
-    GpuHit h = traverse(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, r.origin.w,
-                        r.direction.w, true, &counters[COUNT_OVERFLOW]);
-    occluded[i] = h.prim != NO_HIT ? 1u : 0u;
-}
+TRACE_KERNELS(, GpuBvhNode, traverse)
+TRACE_KERNELS(_wide, GpuWideNode, traverse_wide)
 
 // Writes, per shared struct, its size then each field's offset, in the order of
 // src/cl/types.rs::layouts().
@@ -87,6 +91,11 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuShadowRay, contribution);
     PROBE_SIZE(GpuRay);
     PROBE_FIELD(GpuRay, origin); PROBE_FIELD(GpuRay, direction);
+    PROBE_SIZE(GpuWideNode);
+    PROBE_FIELD(GpuWideNode, min_x); PROBE_FIELD(GpuWideNode, min_y);
+    PROBE_FIELD(GpuWideNode, min_z); PROBE_FIELD(GpuWideNode, max_x);
+    PROBE_FIELD(GpuWideNode, max_y); PROBE_FIELD(GpuWideNode, max_z);
+    PROBE_FIELD(GpuWideNode, child); PROBE_FIELD(GpuWideNode, count);
     out[n] = 0xffffffffu;
 }
 

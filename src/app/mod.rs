@@ -87,6 +87,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
     let environment = args.common.environment()?;
     let mut renderer = Renderer::new(&args.common.device_choice()?)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
+    renderer.set_kernel(args.common.kernel)?;
     let env_loaded = matches!(environment, Some(EnvChoice::Map(_)));
     if let Some(EnvChoice::Map(map)) = environment {
         renderer

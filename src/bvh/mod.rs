@@ -4,9 +4,11 @@
 
 mod build;
 mod traverse;
+mod wide;
 
 pub use build::{MAX_DEPTH, build};
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};
+pub use wide::{WIDE_STACK_SIZE, WIDTH, WideBvh};
 
 use crate::cl::types::GpuBvhNode;
 use glam::Vec3;

@@ -5,7 +5,7 @@ mod devices;
 mod render;
 
 use crate::cl::DeviceChoice;
-use crate::render::{RenderSettings, Strategy};
+use crate::render::{KernelChoice, RenderSettings, Strategy};
 use crate::scene::{
     Camera, EnvMap, Light, LightKind, Scene, default_light_radius, load_or_bundled,
 };
@@ -46,6 +46,10 @@ pub struct CommonArgs {
     /// first CPU; also PENUMBRA_DEVICE).
     #[arg(long)]
     pub device: Option<String>,
+    /// Kernels: wavefront (queued stages per bounce), megakernel (whole paths per work item)
+    /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
+    #[arg(long, default_value = "auto", value_parser = parse_kernel)]
+    pub kernel: KernelChoice,
     /// Image width in pixels.
     #[arg(long)]
     pub width: Option<u32>,
@@ -108,6 +112,7 @@ impl Default for CommonArgs {
     fn default() -> Self {
         Self {
             device: None,
+            kernel: KernelChoice::Auto,
             width: None,
             height: None,
             spp: None,
@@ -135,6 +140,10 @@ pub enum EnvChoice {
     Color([f32; 3]),
     /// An environment image.
     Map(EnvMap),
+}
+
+fn parse_kernel(s: &str) -> Result<KernelChoice, String> {
+    s.parse()
 }
 
 fn parse_vec3(s: &str) -> Result<[f64; 3], String> {

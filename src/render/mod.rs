@@ -1,14 +1,16 @@
 //! The renderer: owns the OpenCL device, the scene on it and the film, and runs the wavefront
 //! stages. It knows nothing of windows; the viewer and the command line drive it alike.
 
+mod megakernel;
 mod settings;
 pub mod tonemap;
 mod upload;
 
+pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use upload::{HostScene, TexturePack, gpu_camera, gpu_lights};
 
-use crate::bvh::{Bvh, Ray};
+use crate::bvh::{Bvh, Ray, WideBvh};
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
@@ -105,6 +107,8 @@ pub struct Renderer {
     samples: u32,
     stats: RenderStats,
     pending: Vec<Launch>,
+    /// Whether frames run as the megakernel (else the wavefront); see [`KernelChoice`].
+    megakernel: bool,
 }
 
 impl Renderer {
@@ -136,8 +140,9 @@ impl Renderer {
             samples: 0,
             stats: RenderStats::default(),
             pending: Vec::new(),
+            megakernel: false,
         };
-        r.reset()?;
+        r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
     }
 
@@ -181,6 +186,7 @@ impl Renderer {
         };
         let buffers = SceneBuffers {
             nodes: Buffer::from_slice(&self.gpu, &host.bvh.nodes)?,
+            wide_nodes: Buffer::from_slice(&self.gpu, &WideBvh::collapse(&host.bvh).nodes)?,
             triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
             shading: Buffer::from_slice(&self.gpu, &host.shading)?,
             tangents: Buffer::from_slice(&self.gpu, tangents)?,
@@ -521,6 +527,9 @@ impl Renderer {
 
     /// Enqueues the stages for `spp` more samples without waiting.
     fn enqueue(&mut self, spp: u32) -> Result<Vec<Launch>, ClError> {
+        if self.megakernel {
+            return self.enqueue_megakernel(spp);
+        }
         self.ensure_frame()?;
         let (Some(program), Some((scene, _)), Some(f)) = (
             self.program.as_ref(),

@@ -1,0 +1,116 @@
+//! The megakernel: on CPU devices a frame is one kernel launch in which each work item traces
+//! whole paths for one pixel (kernels/megakernel.cl). It computes the wavefront's estimator
+//! (the same shading function, kernels/path.h) without its queues, path buffers and per-bounce
+//! launches, which cost more than they save where there are only a few cores.
+
+use super::Renderer;
+use crate::cl::ClError;
+use crate::cl::kernels::Launch;
+use opencl3::device::CL_DEVICE_TYPE_CPU;
+use std::str::FromStr;
+
+/// Which kernels render: the wavefront stages or the megakernel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum KernelChoice {
+    /// The megakernel on CPU devices (CL_DEVICE_TYPE_CPU), the wavefront elsewhere.
+    #[default]
+    Auto,
+    /// Queued stages per bounce (what GPUs run best).
+    Wavefront,
+    /// One path per work item, all bounces in one kernel.
+    Megakernel,
+}
+
+impl FromStr for KernelChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "" | "auto" => Ok(Self::Auto),
+            "wavefront" => Ok(Self::Wavefront),
+            "megakernel" => Ok(Self::Megakernel),
+            _ => Err(format!(
+                "kernel '{s}' is not 'wavefront', 'megakernel' or 'auto'"
+            )),
+        }
+    }
+}
+
+/// Paths one megakernel launch may trace at most, so that its 32-bit ray counters cannot
+/// overflow (each path traces at most bounces + 2 extension rays and as many shadow rays).
+const MAX_RAYS_PER_LAUNCH: u64 = 1 << 31;
+
+impl Renderer {
+    /// Chooses the kernels (resolving `Auto` by the device type). Resets the film.
+    pub fn set_kernel(&mut self, choice: KernelChoice) -> Result<(), ClError> {
+        self.megakernel = match choice {
+            KernelChoice::Auto => self
+                .gpu
+                .device
+                .dev_type()
+                .is_ok_and(|t| t & CL_DEVICE_TYPE_CPU != 0),
+            KernelChoice::Wavefront => false,
+            KernelChoice::Megakernel => true,
+        };
+        self.reset()
+    }
+
+    /// The kernels in use (never `Auto`).
+    pub fn kernel(&self) -> KernelChoice {
+        if self.megakernel {
+            KernelChoice::Megakernel
+        } else {
+            KernelChoice::Wavefront
+        }
+    }
+
+    /// Enqueues `spp` more samples per pixel as megakernel launches (as few as the ray
+    /// counters allow), each followed by `advance` to move the ray counts into the totals.
+    pub(super) fn enqueue_megakernel(&mut self, spp: u32) -> Result<Vec<Launch>, ClError> {
+        self.ensure_frame()?;
+        let (Some(program), Some((scene, _)), Some(f)) = (
+            self.program.as_ref(),
+            self.scene.as_ref(),
+            self.frame.as_ref(),
+        ) else {
+            return Err(ClError::Device("no scene is loaded".into()));
+        };
+        let gpu = &self.gpu;
+        let pixels = u64::from(f.width * f.height).max(1);
+        let rays_per_sample = 2 * (u64::from(self.settings.bounces) + 2);
+        let per_launch = (MAX_RAYS_PER_LAUNCH / (pixels * rays_per_sample)).clamp(1, 1 << 16);
+        let mut launches = Vec::new();
+        let mut done = 0;
+        while done < spp {
+            let n = (per_launch as u32).min(spp - done);
+            let mut frame = self.settings.gpu_frame(self.light_count);
+            frame.samples_in_wave = n;
+            frame.first_sample = self.samples + done;
+            launches.push(program.megakernel(
+                gpu,
+                &frame,
+                &self.camera,
+                &self.env,
+                scene,
+                &f.film,
+                &self.counters,
+            )?);
+            launches.push(program.advance(gpu, &self.counters, &self.stats_buffer)?);
+            done += n;
+        }
+        self.samples += spp;
+        Ok(launches)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_kernel_choices() {
+        assert_eq!("auto".parse(), Ok(KernelChoice::Auto));
+        assert_eq!("Wavefront".parse(), Ok(KernelChoice::Wavefront));
+        assert_eq!("megakernel".parse(), Ok(KernelChoice::Megakernel));
+        assert!("fast".parse::<KernelChoice>().is_err());
+    }
+}
