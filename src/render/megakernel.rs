@@ -8,6 +8,7 @@ use crate::cl::ClError;
 use crate::cl::kernels::Launch;
 use opencl3::device::CL_DEVICE_TYPE_CPU;
 use std::str::FromStr;
+use std::time::Instant;
 
 /// Which kernels render: the wavefront stages or the megakernel.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -61,6 +62,42 @@ impl Renderer {
         } else {
             KernelChoice::Wavefront
         }
+    }
+
+    /// Launches the megakernel once over no pixels and waits, so that a driver which compiles
+    /// kernels at their first launch (PoCL does, per work-group size) does it now, in the
+    /// kernel build time, and not in the first frame. Returns the milliseconds it took.
+    pub(super) fn prime_megakernel(&mut self) -> Result<f64, ClError> {
+        if !self.megakernel {
+            return Ok(0.0);
+        }
+        let t = Instant::now();
+        self.ensure_frame()?;
+        let (Some(program), Some((scene, _)), Some(f)) = (
+            self.program.as_ref(),
+            self.scene.as_ref(),
+            self.frame.as_ref(),
+        ) else {
+            return Ok(0.0);
+        };
+        let mut frame = self.settings.gpu_frame(self.light_count);
+        frame.width = 0;
+        frame.height = 0;
+        frame.samples_in_wave = 0;
+        program.megakernel(
+            &self.gpu,
+            &frame,
+            &self.camera,
+            &self.env,
+            scene,
+            &f.film,
+            &self.counters,
+        )?;
+        self.gpu
+            .queue
+            .finish()
+            .map_err(crate::cl::call_err("building the megakernel"))?;
+        Ok(t.elapsed().as_secs_f64() * 1e3)
     }
 
     /// Enqueues `spp` more samples per pixel as megakernel launches (as few as the ray

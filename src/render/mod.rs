@@ -211,6 +211,8 @@ impl Renderer {
             texture_max_side: pack.max_side,
         };
         self.scene = Some((buffers, host));
+        let mut stats = stats;
+        stats.kernel_build_ms += self.prime_megakernel()?;
         self.reset()?;
         Ok(stats)
     }
