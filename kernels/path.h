@@ -5,10 +5,6 @@
 //     the light sample later in `connect`;
 //   - the megakernel (megakernel.cl) keeps it in registers and traces the light sample at once.
 
-#define STRATEGY_MIS 0u
-#define STRATEGY_BSDF 1u
-#define STRATEGY_LIGHTS 2u
-
 inline float power_heuristic(float a, float b) {
     float a2 = a * a;
     float b2 = b * b;

@@ -4,8 +4,8 @@
 //! launches, which cost more than they save where there are only a few cores.
 
 use super::Renderer;
-use crate::cl::ClError;
 use crate::cl::kernels::Launch;
+use crate::cl::{ClError, Stage};
 use opencl3::device::CL_DEVICE_TYPE_CPU;
 use std::str::FromStr;
 use std::time::Instant;
@@ -102,7 +102,7 @@ impl Renderer {
 
     /// Enqueues `spp` more samples per pixel as megakernel launches (as few as the ray
     /// counters allow), each followed by `advance` to move the ray counts into the totals.
-    pub(super) fn enqueue_megakernel(&mut self, spp: u32) -> Result<Vec<Launch>, ClError> {
+    pub(super) fn enqueue_megakernel(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
         self.ensure_frame()?;
         let (Some(program), Some((scene, _)), Some(f)) = (
             self.program.as_ref(),
@@ -122,7 +122,7 @@ impl Renderer {
             let mut frame = self.settings.gpu_frame(self.light_count);
             frame.samples_in_wave = n;
             frame.first_sample = self.samples + done;
-            launches.push(program.megakernel(
+            let l = program.megakernel(
                 gpu,
                 &frame,
                 &self.camera,
@@ -130,8 +130,10 @@ impl Renderer {
                 scene,
                 &f.film,
                 &self.counters,
-            )?);
-            launches.push(program.advance(gpu, &self.counters, &self.stats_buffer)?);
+            )?;
+            launches.push((Stage::Megakernel, l));
+            let l = program.advance(gpu, &self.counters, &self.stats_buffer)?;
+            launches.push((Stage::Advance, l));
             done += n;
         }
         self.samples += spp;
