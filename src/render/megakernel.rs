@@ -5,6 +5,7 @@
 
 use super::Renderer;
 use crate::cl::kernels::Launch;
+use crate::cl::types::GpuFrame;
 use crate::cl::{ClError, Stage};
 use opencl3::device::CL_DEVICE_TYPE_CPU;
 use std::str::FromStr;
@@ -68,31 +69,16 @@ impl Renderer {
     /// kernels at their first launch (PoCL does, per work-group size) does it now, in the
     /// kernel build time, and not in the first frame. Returns the milliseconds it took.
     pub(super) fn prime_megakernel(&mut self) -> Result<f64, ClError> {
-        if !self.megakernel {
+        if !self.megakernel || self.scene.is_none() {
             return Ok(0.0);
         }
         let t = Instant::now();
         self.ensure_frame()?;
-        let (Some(program), Some((scene, _)), Some(f)) = (
-            self.program.as_ref(),
-            self.scene.as_ref(),
-            self.frame.as_ref(),
-        ) else {
-            return Ok(0.0);
-        };
         let mut frame = self.settings.gpu_frame(self.light_count);
         frame.width = 0;
         frame.height = 0;
         frame.samples_in_wave = 0;
-        program.megakernel(
-            &self.gpu,
-            &frame,
-            &self.camera,
-            &self.env,
-            scene,
-            &f.film,
-            &self.counters,
-        )?;
+        self.launch_megakernel(&frame)?;
         self.gpu
             .queue
             .finish()
@@ -100,10 +86,9 @@ impl Renderer {
         Ok(t.elapsed().as_secs_f64() * 1e3)
     }
 
-    /// Enqueues `spp` more samples per pixel as megakernel launches (as few as the ray
-    /// counters allow), each followed by `advance` to move the ray counts into the totals.
-    pub(super) fn enqueue_megakernel(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
-        self.ensure_frame()?;
+    /// One megakernel launch for `frame`, then `advance` to move its ray counts into the
+    /// totals.
+    fn launch_megakernel(&self, frame: &GpuFrame) -> Result<[(Stage, Launch); 2], ClError> {
         let (Some(program), Some((scene, _)), Some(f)) = (
             self.program.as_ref(),
             self.scene.as_ref(),
@@ -111,8 +96,25 @@ impl Renderer {
         ) else {
             return Err(ClError::Device("no scene is loaded".into()));
         };
-        let gpu = &self.gpu;
-        let pixels = u64::from(f.width * f.height).max(1);
+        let (gpu, counters) = (&self.gpu, &self.counters);
+        let l = program.megakernel(
+            gpu,
+            frame,
+            &self.camera,
+            &self.env,
+            scene,
+            &f.film,
+            counters,
+        )?;
+        let a = program.advance(gpu, counters, &self.stats_buffer)?;
+        Ok([(Stage::Megakernel, l), (Stage::Advance, a)])
+    }
+
+    /// Enqueues `spp` more samples per pixel as megakernel launches (as few as the ray
+    /// counters allow).
+    pub(super) fn enqueue_megakernel(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
+        self.ensure_frame()?;
+        let pixels = u64::from(self.settings.width * self.settings.height).max(1);
         let rays_per_sample = 2 * (u64::from(self.settings.bounces) + 2);
         let per_launch = (MAX_RAYS_PER_LAUNCH / (pixels * rays_per_sample)).clamp(1, 1 << 16);
         let mut launches = Vec::new();
@@ -122,18 +124,7 @@ impl Renderer {
             let mut frame = self.settings.gpu_frame(self.light_count);
             frame.samples_in_wave = n;
             frame.first_sample = self.samples + done;
-            let l = program.megakernel(
-                gpu,
-                &frame,
-                &self.camera,
-                &self.env,
-                scene,
-                &f.film,
-                &self.counters,
-            )?;
-            launches.push((Stage::Megakernel, l));
-            let l = program.advance(gpu, &self.counters, &self.stats_buffer)?;
-            launches.push((Stage::Advance, l));
+            launches.extend(self.launch_megakernel(&frame)?);
             done += n;
         }
         self.samples += spp;
