@@ -7,12 +7,14 @@ mod instances;
 mod refit;
 mod stats;
 mod traverse;
+mod wide;
 
 pub use build::{MAX_DEPTH, build, build_boxes};
 pub use instances::{Blas, Instance, InstanceHit, TwoLevel};
 pub use refit::{REFIT_MAX_GROWTH, Update};
 pub use stats::{BvhReport, report};
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};
+pub use wide::{WIDE_STACK_SIZE, WIDTH, WideBvh};
 
 use crate::cl::types::GpuBvhNode;
 use glam::Vec3;

@@ -103,7 +103,7 @@ fn intersect_sheared(ray: &Ray, sh: &Shear, tri: &[Vec3; 3]) -> Option<(f32, f32
 }
 
 /// Direction reciprocal that stays finite for axis-parallel rays.
-fn safe_inverse(d: Vec3) -> Vec3 {
+pub(super) fn safe_inverse(d: Vec3) -> Vec3 {
     let fix = |x: f32| {
         if x.abs() > 1e-20 {
             1.0 / x
@@ -116,7 +116,14 @@ fn safe_inverse(d: Vec3) -> Vec3 {
 
 /// Slab test; the far distance is scaled up by two ulps so that rounding never loses a hit
 /// (Ize 2013). Returns the entry distance.
-fn box_entry(lo: Vec3, hi: Vec3, origin: Vec3, inv: Vec3, tmin: f32, tmax: f32) -> Option<f32> {
+pub(super) fn box_entry(
+    lo: Vec3,
+    hi: Vec3,
+    origin: Vec3,
+    inv: Vec3,
+    tmin: f32,
+    tmax: f32,
+) -> Option<f32> {
     let t0 = (lo - origin) * inv;
     let t1 = (hi - origin) * inv;
     let near = t0.min(t1).max_element().max(tmin);

@@ -5,7 +5,7 @@ mod devices;
 mod render;
 
 use crate::cl::DeviceChoice;
-use crate::render::{RenderSettings, Strategy};
+use crate::render::{KernelChoice, RenderSettings, Strategy};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
 use anyhow::{Result, bail};
 use clap::{Args, Parser, Subcommand};
@@ -44,6 +44,10 @@ pub struct CommonArgs {
     /// first CPU; also PENUMBRA_DEVICE).
     #[arg(long)]
     pub device: Option<String>,
+    /// Kernels: wavefront (queued stages per bounce), megakernel (whole paths per work item)
+    /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
+    #[arg(long, default_value = "auto", value_parser = parse_kernel)]
+    pub kernel: KernelChoice,
     /// Image width in pixels.
     #[arg(long, allow_negative_numbers = true)]
     pub width: Option<u32>,
@@ -134,6 +138,10 @@ pub enum EnvChoice {
     Color([f32; 3]),
     /// An environment image.
     Map(EnvMap),
+}
+
+fn parse_kernel(s: &str) -> Result<KernelChoice, String> {
+    s.parse()
 }
 
 fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
@@ -509,6 +517,7 @@ fn view(args: ViewArgs) -> Result<()> {
         settings,
         spp_target: common.spp,
         device,
+        kernel: common.kernel,
         env_map: match environment {
             Some(EnvChoice::Map(map)) => Some(map),
             _ => None,

@@ -209,7 +209,7 @@ pub const MAX_WAVES_PER_BATCH: u32 = 64;
 
 impl Renderer {
     /// Allocates the film and the per-slot buffers for the current size.
-    fn ensure_frame(&mut self) -> Result<(), ClError> {
+    pub(super) fn ensure_frame(&mut self) -> Result<(), ClError> {
         let (w, h) = (self.settings.width, self.settings.height);
         let pixels = (w * h) as usize;
         let wave = if self.gpu.info.is_gpu {
@@ -305,6 +305,9 @@ impl Renderer {
     /// Enqueues the stages for `spp` more samples without waiting: per wave, `generate`, then
     /// `extend`, `shade`, `connect` and `advance` for each bounce, then `accumulate`.
     fn enqueue(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
+        if self.megakernel {
+            return self.enqueue_megakernel(spp);
+        }
         self.ensure_frame()?;
         let (Some(program), Some((scene, _)), Some(f)) = (
             self.program.as_ref(),

@@ -206,6 +206,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
 
     let mut renderer = Renderer::new(&args.common.device_choice()?)?;
+    renderer.set_kernel(args.common.kernel)?;
     renderer.set_settings(&settings)?;
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
