@@ -3,9 +3,7 @@
 use super::accessor::{self, Attributes, BufferData};
 use super::compression;
 use super::pose::{Pose, apply_morph_targets, apply_skin, node_pose, rest_worlds};
-use super::textures::{
-    Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8,
-};
+use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
     default_light_rig, limits, sources, validate,
