@@ -464,7 +464,7 @@ fn import_light(light: &gltf::khr_lights_punctual::Light, world: &DMat4) -> Ligh
         direction: (-world.transform_vector3(DVec3::Z)).normalize_or(DVec3::NEG_Y),
         color: light.color(),
         intensity: light.intensity().max(0.0),
-        radius: 0.0,
+        light_radius: 0.0,
     }
 }
 
