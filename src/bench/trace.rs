@@ -33,7 +33,7 @@ pub struct TraceArgs {
     /// The device.
     #[command(flatten)]
     pub device: DeviceArgs,
-    /// Size of the primary ray grid (default 1280×720).
+    /// Size of the primary ray grid (default 1280×720, see `BenchCommand::Trace`).
     #[command(flatten)]
     pub size: SizeArgs,
     /// The camera the primary rays start from.
