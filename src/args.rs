@@ -36,10 +36,10 @@ impl DeviceArgs {
 #[derive(Args, Debug, Clone, Default)]
 pub struct SizeArgs {
     /// Image width in pixels.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub width: Option<u32>,
     /// Image height in pixels.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub height: Option<u32>,
 }
 
@@ -61,7 +61,7 @@ impl SizeArgs {
 #[derive(Args, Debug, Clone, Default)]
 pub struct CameraArgs {
     /// Camera of the glTF file to use (index; the automatic camera when the file has none).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub camera: Option<usize>,
     /// Camera position X,Y,Z (replaces the file's camera; use with --look-at).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "look_at")]
@@ -70,7 +70,7 @@ pub struct CameraArgs {
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "eye")]
     pub look_at: Option<[f64; 3]>,
     /// Vertical field of view in degrees (default: the camera's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_fov)]
     pub fov: Option<f64>,
 }
 
@@ -116,11 +116,16 @@ impl CameraArgs {
 #[derive(Args, Debug, Clone)]
 pub struct LensArgs {
     /// Depth of field: thin-lens radius in scene units (0 = pinhole, everything sharp).
-    #[arg(long, default_value_t = RenderSettings::default().lens_radius)]
+    #[arg(
+        long,
+        default_value_t = RenderSettings::default().lens_radius,
+        allow_negative_numbers = true,
+        value_parser = parse_non_negative
+    )]
     pub aperture: f32,
     /// Distance from the eye to the plane in focus, along the view axis, in scene units
     /// (default: the distance to what the image centre sees).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_positive)]
     pub focus_distance: Option<f32>,
 }
 
@@ -128,13 +133,13 @@ pub struct LensArgs {
 #[derive(Args, Debug, Clone)]
 pub struct SamplingArgs {
     /// Samples per pixel.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub spp: Option<u32>,
     /// Bounces after the first hit (0 = direct light only).
-    #[arg(long, default_value_t = RenderSettings::default().bounces)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().bounces)]
     pub bounces: u32,
     /// Seed of the random sequence.
-    #[arg(long, default_value_t = RenderSettings::default().seed)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().seed)]
     pub seed: u32,
 }
 
@@ -143,7 +148,7 @@ pub struct SamplingArgs {
 pub struct ShadowArgs {
     /// Radius of point and spot lights in scene units (soft shadows); default 2% of the
     /// scene's diagonal. Directional lights get an angular radius of 2·R/diagonal radians.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_non_negative)]
     pub light_radius: Option<f32>,
     /// Hard shadows: every light radius 0.
     #[arg(long, conflicts_with = "light_radius")]
@@ -173,14 +178,20 @@ pub struct EnvArgs {
     #[arg(long, value_name = "FILE|COLOR", conflicts_with = "sky")]
     pub env: Option<String>,
     /// Radiance scale of the --env image.
-    #[arg(long, default_value_t = RenderSettings::default().env_intensity)]
+    #[arg(
+        long,
+        default_value_t = RenderSettings::default().env_intensity,
+        allow_negative_numbers = true,
+        value_parser = parse_non_negative
+    )]
     pub env_intensity: f32,
     /// Rotation of the --env image about the up (+Y) axis in degrees, counter-clockwise seen
     /// from above.
     #[arg(
         long,
         default_value_t = RenderSettings::default().env_rotation,
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        value_parser = parse_finite
     )]
     pub env_rotation: f32,
 }
@@ -441,6 +452,48 @@ fn parse_color(s: &str) -> Result<[f32; 3], String> {
         ));
     }
     Ok(c)
+}
+
+/// A finite number (NaN and ±inf are refused).
+pub(crate) fn parse_finite(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("'{s}' is not a finite number")),
+    }
+}
+
+/// A finite number ≥ 0.
+fn parse_non_negative(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v >= 0.0 => Ok(v),
+        _ => Err(format!("'{s}' must be a finite number >= 0")),
+    }
+}
+
+/// A finite number > 0.
+fn parse_positive(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v > 0.0 => Ok(v),
+        _ => Err(format!("'{s}' must be a finite number > 0")),
+    }
+}
+
+/// A vertical field of view in degrees, strictly between 0 and 180.
+fn parse_fov(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
+        _ => Err(format!("'{s}' is not a field of view in degrees (0..180)")),
+    }
+}
+
+/// A duration in seconds: finite and > 0.
+pub(crate) fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "'{s}' is not a duration in seconds (a finite number > 0)"
+        )),
+    }
 }
 
 #[cfg(test)]

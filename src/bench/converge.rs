@@ -35,7 +35,7 @@ pub struct ConvergeArgs {
     #[arg(long, value_delimiter = ',', value_parser = parse_config)]
     pub configs: Vec<Config>,
     /// Stop a configuration after the step that passes this many seconds of rendering.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = crate::args::parse_seconds)]
     pub max_seconds: f64,
     /// Fit the slopes over the steps with at least this many samples per pixel.
     #[arg(long, default_value_t = 4)]

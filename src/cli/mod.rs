@@ -3,7 +3,7 @@
 mod devices;
 mod render;
 
-use crate::args::{CommonArgs, EnvChoice, StrategyArgs};
+use crate::args::{CommonArgs, EnvChoice, StrategyArgs, parse_finite};
 use crate::bench;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
@@ -66,8 +66,40 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub strategy: StrategyArgs,
     /// Exposure in stops for PNG output.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_exposure)]
     pub exposure: f32,
+}
+
+/// The most stops `--exposure` may brighten or darken by.
+pub const MAX_EXPOSURE: f32 = 64.0;
+
+/// An exposure in stops within ±[`MAX_EXPOSURE`].
+fn parse_exposure(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v.abs() <= MAX_EXPOSURE => Ok(v),
+        _ => Err(format!(
+            "'{s}' is out of range (-{MAX_EXPOSURE}..={MAX_EXPOSURE} stops)"
+        )),
+    }
+}
+
+/// One line for a command-line usage error (`penumbra: error: …`, exit code 2): clap's first
+/// line without its `error: ` prefix, and where to find the usage.
+pub fn usage_error(e: &clap::Error) -> String {
+    // clap's first paragraph says what is wrong; tips and the usage follow a blank line.
+    let rendered = e.render().to_string();
+    let what: Vec<&str> = rendered
+        .lines()
+        .map(str::trim)
+        .skip_while(|l| l.is_empty())
+        .take_while(|l| !l.is_empty())
+        .collect();
+    let what = what.join(" ");
+    let what = what.strip_prefix("error: ").unwrap_or(&what);
+    if what.is_empty() {
+        return "invalid command line (see penumbra --help)".into();
+    }
+    format!("{what} (see penumbra --help)")
 }
 
 /// Runs the command line; errors come back as one line for `main` to print.

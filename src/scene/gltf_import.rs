@@ -3,7 +3,7 @@
 use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
-    default_light_rig,
+    default_light_rig, limits, sources, validate,
 };
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
@@ -11,18 +11,6 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
-
-/// Extensions penumbra understands (or can safely ignore when rendering).
-const SUPPORTED_EXTENSIONS: &[&str] = &[
-    "KHR_lights_punctual",
-    "KHR_materials_emissive_strength",
-    "KHR_materials_ior",
-    "KHR_materials_specular",
-    "KHR_materials_transmission",
-    "KHR_materials_volume",
-    "KHR_texture_transform",
-    "KHR_mesh_quantization",
-];
 
 /// Vertical field of view of the automatic camera.
 pub const AUTO_YFOV: f64 = 0.8;
@@ -33,6 +21,10 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         path: path.to_path_buf(),
         message,
     };
+    let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
+    if !meta.is_file() {
+        return Err(fail("cannot read file: not a regular file".into()));
+    }
     let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
     load_from_bytes(&bytes, path.parent(), &path.display().to_string()).map_err(fail)
 }
@@ -40,13 +32,10 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 /// Loads glTF or GLB bytes; external files are resolved against `base`.
 pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Result<Scene, String> {
     let mut warnings = Vec::new();
-    check_extensions(bytes, &mut warnings)?;
-    let gltf = gltf::Gltf::from_slice_without_validation(bytes)
-        .map_err(|e| format!("not a valid glTF file: {e}"))?;
-    let document = gltf.document;
-    let buffers = gltf::import_buffers(&document, base, gltf.blob)
-        .map_err(|e| format!("cannot load buffers: {e}"))?;
-    let buffer_data: Vec<&[u8]> = buffers.iter().map(|b| b.0.as_slice()).collect();
+    let parsed = validate::parse(bytes, &mut warnings)?;
+    let document = parsed.document;
+    let buffers = sources::load_buffers(&document, base, parsed.blob)?;
+    let buffer_data: Vec<&[u8]> = buffers.iter().map(Vec::as_slice).collect();
 
     let mut table = TextureTable::default();
     let mut materials = document
@@ -86,27 +75,87 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         .rev()
         .map(|n| (n, DMat4::IDENTITY, 0))
         .collect();
+    let mut meshes: HashMap<usize, Mesh> = HashMap::new();
+    let mut placed = 0usize;
+    let mut triangles = 0usize;
     while let Some((node, parent, depth)) = stack.pop() {
-        if depth > 256 {
+        let at = format!("nodes[{}]", node.index());
+        placed += 1;
+        if placed > limits::MAX_NODE_INSTANCES {
             return Err(format!(
-                "node {} is nested too deeply (a cycle?)",
-                node.index()
+                "{at}: the node graph places more than {} nodes (a child listed more than once?)",
+                limits::MAX_NODE_INSTANCES
             ));
         }
-        let world = parent * node_matrix(&node);
+        if depth > limits::MAX_NODE_DEPTH {
+            return Err(format!(
+                "{at}: nested more than {} deep (a cycle?)",
+                limits::MAX_NODE_DEPTH
+            ));
+        }
+        // A node whose transform is not usable is left out with everything below it.
+        let world = match node_matrix(&node) {
+            Ok(local) => parent * local,
+            Err(why) => {
+                warn_once(
+                    &mut warnings,
+                    format!("{at}: {why}; the node and its children are skipped"),
+                );
+                continue;
+            }
+        };
+        // The GPU gets f32: the transform and its inverse must stay finite there too.
+        if !world.as_mat4().is_finite() || !world.inverse().as_mat4().is_finite() {
+            warn_once(
+                &mut warnings,
+                format!(
+                    "{at}: its world transform is singular or not finite; the node and its children are skipped"
+                ),
+            );
+            continue;
+        }
         if let Some(mesh) = node.mesh() {
             let name = node
                 .name()
                 .or(mesh.name())
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("mesh {}", mesh.index()));
-            let m = import_mesh(
-                &mesh,
-                &buffer_data,
-                default_material,
-                &normal_sets,
-                &mut warnings,
-            )?;
+            // Each mesh is read once, however many nodes place it.
+            let m = match meshes.get(&mesh.index()) {
+                Some(m) => m.clone(),
+                None => {
+                    let m = import_mesh(
+                        &mesh,
+                        &buffer_data,
+                        default_material,
+                        &normal_sets,
+                        &mut warnings,
+                    )?;
+                    meshes.insert(mesh.index(), m.clone());
+                    m
+                }
+            };
+            if m.positions.iter().any(|p| {
+                let w = world.transform_point3(p.as_dvec3());
+                w.abs().max_element().partial_cmp(&limits::MAX_COORDINATE)
+                    != Some(std::cmp::Ordering::Less)
+            }) {
+                warn_once(
+                    &mut warnings,
+                    format!(
+                        "{at}: vertices lie farther than {:e} from the origin; skipped",
+                        limits::MAX_COORDINATE
+                    ),
+                );
+                continue;
+            }
+            triangles += m.indices.len();
+            if triangles > limits::MAX_TRIANGLES {
+                return Err(format!(
+                    "{at}: the scene has more than {} triangles after instancing",
+                    limits::MAX_TRIANGLES
+                ));
+            }
             if !m.indices.is_empty() {
                 scene.objects.push(Object {
                     name,
@@ -117,28 +166,15 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
             }
         }
         if let Some(camera) = node.camera() {
-            if let gltf::camera::Projection::Perspective(p) = camera.projection() {
-                let forward = -world.transform_vector3(DVec3::Z).normalize();
-                let up = world.transform_vector3(DVec3::Y).normalize();
-                scene.cameras.push(Camera {
-                    name: camera
-                        .name()
-                        .map(str::to_string)
-                        .unwrap_or_else(|| format!("camera {}", camera.index())),
-                    eye: world.transform_point3(DVec3::ZERO),
-                    forward,
-                    up,
-                    yfov: p.yfov() as f64,
-                });
-            } else {
-                warnings.push(format!(
-                    "camera {}: orthographic cameras are not supported, skipped",
-                    camera.index()
-                ));
+            match import_camera(&camera, &world) {
+                Ok(c) => scene.cameras.push(c),
+                Err(why) => warn_once(&mut warnings, why),
             }
         }
-        if let Some(light) = node.light() {
-            scene.lights.push(import_light(&light, &world));
+        if let Some(light) = node.light()
+            && let Some(l) = import_light(&light, &world, &mut warnings)
+        {
+            scene.lights.push(l);
         }
         let children: Vec<gltf::Node> = node.children().collect();
         for child in children.into_iter().rev() {
@@ -164,52 +200,62 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
     Ok(scene)
 }
 
-/// Rejects unsupported required extensions and warns about unsupported optional ones.
-fn check_extensions(bytes: &[u8], warnings: &mut Vec<String>) -> Result<(), String> {
-    let json: &[u8] = if bytes.starts_with(b"glTF") {
-        let glb = gltf::Glb::from_slice(bytes).map_err(|e| format!("not a valid GLB file: {e}"))?;
-        return check_extensions_json(&glb.json, warnings);
-    } else {
-        bytes
-    };
-    check_extensions_json(json, warnings)
+/// Adds `warning` unless the same one was given already (a node placed many times warns once).
+fn warn_once(warnings: &mut Vec<String>, warning: String) {
+    if !warnings.contains(&warning) {
+        warnings.push(warning);
+    }
 }
 
-fn check_extensions_json(json: &[u8], warnings: &mut Vec<String>) -> Result<(), String> {
-    let value: serde_json::Value =
-        serde_json::from_slice(json).map_err(|e| format!("not a valid glTF file: {e}"))?;
-    let list = |key: &str| -> Vec<String> {
-        value
-            .get(key)
-            .and_then(|v| v.as_array())
-            .map(|a| {
-                a.iter()
-                    .filter_map(|s| s.as_str().map(str::to_string))
-                    .collect()
-            })
-            .unwrap_or_default()
-    };
-    for ext in list("extensionsRequired") {
-        if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
-            return Err(format!("requires the unsupported extension {ext}"));
+/// The node's local transform, or why it cannot be used: a non-finite value, a zero
+/// quaternion or a singular matrix.
+fn node_matrix(node: &gltf::Node) -> Result<DMat4, &'static str> {
+    if let gltf::scene::Transform::Matrix { matrix } = node.transform() {
+        let m = DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)));
+        if !m.is_finite() {
+            return Err("matrix is not finite");
+        }
+        if !m.inverse().is_finite() || m.determinant() == 0.0 {
+            return Err("matrix is singular");
         }
     }
-    for ext in list("extensionsUsed") {
-        if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
-            warnings.push(format!(
-                "optional extension {ext} is not supported and is ignored"
-            ));
-        }
-    }
-    Ok(())
-}
-
-fn node_matrix(node: &gltf::Node) -> DMat4 {
     let (t, r, s) = node.transform().decomposed();
     let t = DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64);
-    let r = DQuat::from_xyzw(r[0] as f64, r[1] as f64, r[2] as f64, r[3] as f64).normalize();
+    let r = DQuat::from_xyzw(r[0] as f64, r[1] as f64, r[2] as f64, r[3] as f64);
     let s = DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64);
-    DMat4::from_scale_rotation_translation(s, r, t)
+    if !(t.is_finite() && r.is_finite() && s.is_finite()) {
+        return Err("translation, rotation or scale is not finite");
+    }
+    if r.length_squared() < 1e-24 {
+        return Err("rotation is a zero quaternion");
+    }
+    Ok(DMat4::from_scale_rotation_translation(s, r.normalize(), t))
+}
+
+/// A perspective camera placed by `world`, or a warning saying why it is left out.
+fn import_camera(camera: &gltf::Camera, world: &DMat4) -> Result<Camera, String> {
+    let at = format!("cameras[{}]", camera.index());
+    let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+        return Err(format!(
+            "{at}: orthographic cameras are not supported, skipped"
+        ));
+    };
+    let yfov = p.yfov() as f64;
+    if !(yfov > 0.0 && yfov < std::f64::consts::PI) {
+        return Err(format!(
+            "{at}.perspective.yfov: {yfov} is outside (0, π), camera skipped"
+        ));
+    }
+    Ok(Camera {
+        name: camera
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("camera {}", camera.index())),
+        eye: world.transform_point3(DVec3::ZERO),
+        forward: -world.transform_vector3(DVec3::Z).normalize(),
+        up: world.transform_vector3(DVec3::Y).normalize(),
+        yfov,
+    })
 }
 
 /// Texture references collected while importing materials, and the images they need.
@@ -333,12 +379,11 @@ impl TextureTable {
 fn decode_images(
     document: &gltf::Document,
     base: Option<&Path>,
-    buffers: &[gltf::buffer::Data],
+    buffers: &[Vec<u8>],
     table: &mut TextureTable,
     warnings: &mut Vec<String>,
 ) -> Vec<Arc<Image>> {
     let all: Vec<gltf::Image> = document.images().collect();
-    let base = base.unwrap_or(Path::new("."));
     let decoded: Vec<Result<Image, String>> = table
         .order
         .par_iter()
@@ -352,8 +397,10 @@ fn decode_images(
                     .name()
                     .map_or_else(|| i.to_string(), |n| format!("{i} ({n})")),
             };
-            let data = gltf::image::Data::from_source(image.source(), Some(base), buffers)
-                .map_err(|e| format!("image {name}: cannot decode: {e}"))?;
+            let data = sources::decode_image(image, base, buffers).map_err(|e| {
+                let detail = name.strip_prefix(&i.to_string()).unwrap_or_default();
+                format!("images[{i}]{detail}: cannot decode: {e}")
+            })?;
             to_rgba8(&data, &name)
         })
         .collect();
@@ -385,10 +432,24 @@ fn import_material(
     warnings: &mut Vec<String>,
 ) -> Material {
     let pbr = m.pbr_metallic_roughness();
-    let strength = m.emissive_strength().unwrap_or(1.0);
-    let emissive = m.emissive_factor().map(|e| e * strength);
+    // Factors outside their ranges are clamped; one warning per material lists the changes.
+    let mut fix = Fixes::default();
+    let strength = fix.range(
+        "emissiveStrength",
+        m.emissive_strength().unwrap_or(1.0),
+        0.0,
+        limits::MAX_INTENSITY,
+        1.0,
+    );
+    let emissive = m
+        .emissive_factor()
+        .map(|e| fix.range("emissiveFactor", e, 0.0, 1.0, 0.0) * strength);
     let (specular_factor, specular_color) = match m.specular() {
-        Some(s) => (s.specular_factor(), s.specular_color_factor()),
+        Some(s) => (
+            fix.range("specularFactor", s.specular_factor(), 0.0, 1.0, 1.0),
+            s.specular_color_factor()
+                .map(|c| fix.range("specularColorFactor", c, 0.0, f32::MAX, 1.0)),
+        ),
         None => (1.0, [1.0; 3]),
     };
     let what = format!("material {}", m.index().unwrap_or(0));
@@ -412,49 +473,173 @@ fn import_material(
             .transmission()
             .and_then(|t| table.info(t.transmission_texture(), false, &what, warnings)),
     };
-    Material {
+    let volume = m.volume();
+    let material = Material {
         name: m
             .name()
             .map(str::to_string)
             .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0))),
-        base_color: pbr.base_color_factor(),
-        metallic: pbr.metallic_factor().clamp(0.0, 1.0),
-        roughness: pbr.roughness_factor().clamp(0.0, 1.0),
+        base_color: pbr
+            .base_color_factor()
+            .map(|c| fix.range("baseColorFactor", c, 0.0, 1.0, 1.0)),
+        metallic: fix.range("metallicFactor", pbr.metallic_factor(), 0.0, 1.0, 1.0),
+        roughness: fix.range("roughnessFactor", pbr.roughness_factor(), 0.0, 1.0, 1.0),
         emission: emissive.map(|e| if e.is_finite() { e.max(0.0) } else { 0.0 }),
         double_sided: m.double_sided(),
-        ior: m.ior().unwrap_or(1.5),
+        ior: fix.ior(m.ior().unwrap_or(1.5)),
         specular_factor,
         specular_color,
-        transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
-        thickness: m.volume().map_or(0.0, |v| v.thickness_factor()),
-        attenuation_color: m.volume().map_or([1.0; 3], |v| v.attenuation_color()),
-        attenuation_distance: m
-            .volume()
-            .map_or(f32::INFINITY, |v| v.attenuation_distance()),
+        transmission: fix.range(
+            "transmissionFactor",
+            m.transmission().map_or(0.0, |t| t.transmission_factor()),
+            0.0,
+            1.0,
+            0.0,
+        ),
+        thickness: fix.range(
+            "thicknessFactor",
+            volume.as_ref().map_or(0.0, |v| v.thickness_factor()),
+            0.0,
+            f32::MAX,
+            0.0,
+        ),
+        attenuation_color: volume.as_ref().map_or([1.0; 3], |v| {
+            v.attenuation_color()
+                .map(|c| fix.range("attenuationColor", c, 0.0, 1.0, 1.0))
+        }),
+        attenuation_distance: fix.attenuation_distance(
+            volume
+                .as_ref()
+                .map_or(f32::INFINITY, |v| v.attenuation_distance()),
+        ),
         alpha: match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-            gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+            gltf::material::AlphaMode::Mask => AlphaMode::Mask(fix.range(
+                "alphaCutoff",
+                m.alpha_cutoff().unwrap_or(0.5),
+                0.0,
+                f32::MAX,
+                0.5,
+            )),
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         },
         textures,
-        normal_scale: normal.as_ref().map_or(1.0, |n| n.scale()),
+        normal_scale: fix.range(
+            "normalTexture.scale",
+            normal.as_ref().map_or(1.0, |n| n.scale()),
+            -f32::MAX,
+            f32::MAX,
+            1.0,
+        ),
+    };
+    if !fix.0.is_empty() {
+        warnings.push(format!(
+            "materials[{}]: {}",
+            m.index().unwrap_or(0),
+            fix.0.join(", ")
+        ));
+    }
+    material
+}
+
+/// Material values brought into their ranges, with a note for each change.
+#[derive(Default)]
+struct Fixes(Vec<String>);
+
+impl Fixes {
+    /// `v` clamped to `lo..=hi`; NaN becomes `default`.
+    fn range(&mut self, name: &str, v: f32, lo: f32, hi: f32, default: f32) -> f32 {
+        let out = if v.is_nan() { default } else { v.clamp(lo, hi) };
+        if out != v {
+            self.0
+                .push(format!("{name} {v} is out of range, {out} is used"));
+        }
+        out
+    }
+
+    /// The index of refraction: at least 1, or 0 (the extension's special value, kept as
+    /// the smallest ratio the BSDF accepts); anything else becomes the default 1.5.
+    fn ior(&mut self, ior: f32) -> f32 {
+        if ior == 0.0 {
+            1e-3
+        } else if ior.is_finite() && ior >= 1.0 {
+            ior
+        } else {
+            self.0
+                .push(format!("ior {ior} is below 1 or not finite, 1.5 is used"));
+            1.5
+        }
+    }
+
+    /// `attenuationDistance`: positive (infinite means no absorption).
+    fn attenuation_distance(&mut self, d: f32) -> f32 {
+        if d > 0.0 {
+            d
+        } else {
+            self.0.push(format!(
+                "attenuationDistance {d} is not positive, no absorption is used"
+            ));
+            f32::INFINITY
+        }
     }
 }
 
-fn import_light(light: &gltf::khr_lights_punctual::Light, world: &DMat4) -> Light {
+/// A punctual light placed by `world`; `None` (with a warning) when its color or intensity is
+/// negative or not finite. Spot cones are clamped to 0 ≤ inner < outer ≤ π/2.
+fn import_light(
+    light: &gltf::khr_lights_punctual::Light,
+    world: &DMat4,
+    warnings: &mut Vec<String>,
+) -> Option<Light> {
     use gltf::khr_lights_punctual::Kind;
+    let at = format!("extensions.KHR_lights_punctual.lights[{}]", light.index());
+    let color = light.color();
+    let intensity = light.intensity();
+    if !(color.iter().all(|c| c.is_finite() && *c >= 0.0)
+        && intensity.is_finite()
+        && intensity >= 0.0)
+    {
+        warn_once(
+            warnings,
+            format!("{at}: color or intensity is negative or not finite, light skipped"),
+        );
+        return None;
+    }
+    let clamped = (
+        color.map(|c| c.min(limits::MAX_INTENSITY)),
+        intensity.min(limits::MAX_INTENSITY),
+    );
+    if clamped != (color, intensity) {
+        warn_once(
+            warnings,
+            format!(
+                "{at}: color or intensity above {:e}, clamped",
+                limits::MAX_INTENSITY
+            ),
+        );
+    }
+    let (color, intensity) = clamped;
     let kind = match light.kind() {
         Kind::Point => LightKind::Point,
         Kind::Directional => LightKind::Directional,
         Kind::Spot {
             inner_cone_angle,
             outer_cone_angle,
-        } => LightKind::Spot {
-            inner: inner_cone_angle,
-            outer: outer_cone_angle,
-        },
+        } => {
+            let (inner, outer) = spot_cone(inner_cone_angle, outer_cone_angle);
+            if (inner, outer) != (inner_cone_angle, outer_cone_angle) {
+                warn_once(
+                    warnings,
+                    format!(
+                        "{at}.spot: cone angles {inner_cone_angle}, {outer_cone_angle} are \
+                         clamped to {inner}, {outer} (0 ≤ inner < outer ≤ π/2)"
+                    ),
+                );
+            }
+            LightKind::Spot { inner, outer }
+        }
     };
-    Light {
+    Some(Light {
         name: light
             .name()
             .map(str::to_string)
@@ -462,10 +647,25 @@ fn import_light(light: &gltf::khr_lights_punctual::Light, world: &DMat4) -> Ligh
         kind,
         position: world.transform_point3(DVec3::ZERO),
         direction: (-world.transform_vector3(DVec3::Z)).normalize_or(DVec3::NEG_Y),
-        color: light.color(),
-        intensity: light.intensity().max(0.0),
+        color,
+        intensity,
         light_radius: 0.0,
-    }
+    })
+}
+
+/// Spot cone angles clamped to 0 ≤ inner < outer ≤ π/2 (non-finite values take the
+/// extension's defaults, 0 and π/4).
+fn spot_cone(inner: f32, outer: f32) -> (f32, f32) {
+    use std::f32::consts::FRAC_PI_2;
+    let outer = if outer.is_finite() {
+        outer
+    } else {
+        FRAC_PI_2 / 2.0
+    };
+    let inner = if inner.is_finite() { inner } else { 0.0 };
+    let outer = outer.clamp(1e-4, FRAC_PI_2);
+    let inner = inner.clamp(0.0, outer * 0.9999);
+    (inner, outer)
 }
 
 fn import_mesh(

@@ -6,8 +6,11 @@
 mod environment;
 mod gltf_import;
 mod lights;
+pub mod limits;
+mod sources;
 mod tangents;
 mod textures;
+mod validate;
 
 pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
 pub use gltf_import::{AUTO_YFOV, load, load_from_bytes};
@@ -16,6 +19,7 @@ pub use textures::{
     Image, MAX_TEXTURE_SIDE, MaterialTextures, MipLevel, TexTransform, TextureRef, Wrap,
     linear_to_srgb, mip_chain, srgb_to_linear,
 };
+pub use validate::SUPPORTED_EXTENSIONS;
 
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
