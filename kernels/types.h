@@ -77,7 +77,7 @@ typedef struct {
 
 typedef struct {
     float4 position;   // position, or travel direction (directional); .w = kind (uint bits)
-    float4 intensity;  // intensity (point/spot) or irradiance (directional); .w = radius
+    float4 intensity;  // intensity (point/spot) or irradiance (directional); .w = light radius
     float4 spot;       // spot axis; .w = cos outer angle. Triangle: .x = index bits, .y = area
     float4 extra;      // .x = cos inner angle, .y = selection probability
 } GpuLight;

@@ -384,20 +384,14 @@ fn make_input(seed: &[u8], rng: &mut Rng) -> (&'static str, Vec<u8>) {
             if rng.chance(30) {
                 ("json", as_gltf(&glb))
             } else {
-                (
-                    "json",
-                    penumbra::cli::bench::generate::glb(&glb.json, &glb.bin),
-                )
+                ("json", penumbra::bench::generate::glb(&glb.json, &glb.bin))
             }
         }
         6 | 7 => {
             for _ in 0..1 + rng.below(8) {
                 mutate_bytes(&mut glb.bin, rng);
             }
-            (
-                "bin",
-                penumbra::cli::bench::generate::glb(&glb.json, &glb.bin),
-            )
+            ("bin", penumbra::bench::generate::glb(&glb.json, &glb.bin))
         }
         8 => {
             let mut b = as_gltf(&glb);

@@ -1,6 +1,6 @@
 //! Every scene in PENUMBRA_SCENES (the meshopt-compressed one included) renders without an
 //! error and without non-finite samples. Skipped (with a note) when PENUMBRA_SCENES is not
-//! set; fails when it is set but names no folder of scenes.
+//! set; fails when it is set but empty or names no folder of scenes.
 
 mod common;
 
@@ -9,8 +9,8 @@ use std::path::PathBuf;
 
 fn scene_files() -> Vec<PathBuf> {
     let Some(dir) = scenes_dir() else {
-        let set = std::env::var_os("PENUMBRA_SCENES").filter(|v| !v.is_empty());
-        if let Some(v) = set {
+        if let Some(v) = std::env::var_os("PENUMBRA_SCENES") {
+            assert!(!v.is_empty(), "PENUMBRA_SCENES is set but empty");
             panic!("PENUMBRA_SCENES={} is not a folder", v.to_string_lossy());
         }
         eprintln!("PENUMBRA_SCENES is not set: skipping the shared scenes");

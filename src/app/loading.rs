@@ -76,10 +76,8 @@ impl App {
         self.loader = None;
         match result {
             Ok((mut scene, ms)) => {
-                if self.env_lights && scene.default_rig {
-                    // The environment lights the scene instead of the default rig.
-                    scene.lights.clear();
-                    scene.default_rig = false;
+                if self.env_lights {
+                    scene.light_by_environment();
                 }
                 self.autofocus = self.model.view.aperture > 0.0;
                 for w in &scene.warnings {

@@ -292,8 +292,9 @@ const _: () = assert!(size_of::<GpuMaterial>() == 128);
 pub struct GpuLight {
     /// Position (point/spot), or the direction light travels (directional); `.w` = kind (u32 bits).
     pub position: [f32; 4],
-    /// Radiant intensity (point/spot) or irradiance (directional) per channel; `.w` = radius
-    /// (world units; an angular radius in radians for a directional light).
+    /// Radiant intensity (point/spot) or irradiance (directional) per channel; `.w` = the light
+    /// radius, `Light::light_radius` (world units; an angular radius in radians for a
+    /// directional light).
     pub intensity: [f32; 4],
     /// Spot axis (direction light travels); `.w` = cos of the outer cone angle.
     /// For a triangle light: `.x` = triangle index (u32 bits), `.y` = area.

@@ -1,6 +1,7 @@
 //! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary.
 
-use super::{EnvChoice, RenderArgs};
+use super::RenderArgs;
+use crate::args::EnvChoice;
 use crate::image_io::{Format, write_exr};
 use crate::render::tonemap::write_png;
 use crate::render::{Renderer, tonemap::ToneMapper};
@@ -20,8 +21,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         anyhow::bail!("{}: the output folder does not exist", dir.display());
     }
     let mut settings = args.common.settings((640, 480))?;
-    args.sampling.apply(&mut settings);
-    let spp = args.common.spp.unwrap_or(DEFAULT_SPP);
+    args.strategy.apply(&mut settings);
+    let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
     let prepared = args.common.prepare(Some(&args.scene))?;
     let environment = args.common.environment()?;
     let mut renderer = Renderer::new(&args.common.device_choice()?)?;
@@ -34,7 +35,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| format!("{}", args.scene.display()))?;
     renderer.set_camera(&prepared.camera)?;
-    if settings.lens_radius > 0.0 && args.common.focus_distance.is_none() {
+    if settings.lens_radius > 0.0 && args.common.lens.focus_distance.is_none() {
         // Focus on what the image centre sees (else the scene's centre).
         let focus = renderer
             .focus_distance_at(settings.width as f32 * 0.5, settings.height as f32 * 0.5)

@@ -703,7 +703,7 @@ fn import_light(
         direction: (-world.transform_vector3(DVec3::Z)).normalize_or(DVec3::NEG_Y),
         color,
         intensity,
-        radius: 0.0,
+        light_radius: 0.0,
     })
 }
 

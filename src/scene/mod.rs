@@ -201,9 +201,9 @@ pub struct Light {
     pub color: [f32; 3],
     /// Radiant intensity (W/sr, point and spot) or irradiance (directional), used 1:1.
     pub intensity: f32,
-    /// Radius in world units (an angular radius in radians for directional lights);
-    /// 0 gives hard shadows.
-    pub radius: f32,
+    /// The light radius (`--light-radius`, "light radius" in the overlay): in world units, an
+    /// angular radius in radians for directional lights; 0 gives hard shadows.
+    pub light_radius: f32,
 }
 
 /// A perspective camera.

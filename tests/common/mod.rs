@@ -237,7 +237,7 @@ impl Gltf {
 
     /// GLB bytes, written by the library's GLB writer (the one `bench generate` uses).
     pub fn glb(&self) -> Vec<u8> {
-        penumbra::cli::bench::generate::glb(&self.json(None), &self.bin)
+        penumbra::bench::generate::glb(&self.json(None), &self.bin)
     }
 
     /// Writes `name.glb` into `dir`.

@@ -27,6 +27,10 @@ use clap::Subcommand;
 pub enum BenchCommand {
     /// Rays per second of the traversal kernels alone (primary, diffuse-bounce and shadow
     /// rays), validated against the host traversal.
+    #[command(
+        mut_arg("width", |a| a.help("Width of the primary ray grid [default: 1280]")),
+        mut_arg("height", |a| a.help("Height of the primary ray grid [default: 720]"))
+    )]
     Trace(Box<TraceArgs>),
     /// Samples per second of the whole path tracer and the kernel time of each stage.
     Frame(Box<FrameArgs>),
