@@ -118,7 +118,8 @@ pub fn problems(root: &json::Root) -> Vec<String> {
 /// gltf-json reports that penumbra accepts: required extensions (checked against
 /// [`SUPPORTED_EXTENSIONS`] instead of gltf-json's own list), POSITION without min/max
 /// (exporters often leave them out and nothing here reads them), and an accessor without a
-/// buffer view (Draco-compressed primitives have none; reading such an accessor fails there).
+/// buffer view (Draco-compressed primitives have none; reading such an accessor fails there),
+/// and a texture whose only source is an extension's.
 fn tolerated(path: &str, error: JsonError) -> bool {
     match error {
         JsonError::Unsupported => path.starts_with("extensionsRequired"),
@@ -126,6 +127,9 @@ fn tolerated(path: &str, error: JsonError) -> bool {
             path.ends_with("attributes[\"POSITION\"].min")
                 || path.ends_with("attributes[\"POSITION\"].max")
                 || (path.starts_with("accessors[") && path.ends_with("].bufferView"))
+                // EXT_texture_webp (or KHR_texture_basisu) names the texture's image in its
+                // extension; the importer falls back to it, or leaves the texture out.
+                || (path.starts_with("textures[") && path.ends_with("].source"))
         }
         _ => false,
     }
