@@ -1,6 +1,7 @@
 //! The renderer: owns the OpenCL device, the scene on it and the film, and runs the wavefront
 //! stages. It knows nothing of windows; the viewer and the command line drive it alike.
 
+pub mod exposure;
 mod settings;
 pub mod tonemap;
 mod upload;

@@ -4,6 +4,7 @@
 //! into world-space triangles (f32) whenever the scene changes.
 
 mod environment;
+pub mod framing;
 mod gltf_import;
 mod lights;
 mod tangents;
