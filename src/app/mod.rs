@@ -71,7 +71,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
     }
     let settings = args.common.settings(DEFAULT_SIZE)?;
     let size = (settings.width, settings.height);
-    let prepared = args.common.prepare(args.scene.as_deref())?;
+    let mut prepared = args.common.prepare(args.scene.as_deref())?;
     let event_loop = EventLoop::new().map_err(|e| {
         // winit's message starts with its source location; keep the reason only.
         let text = e.to_string();
@@ -84,7 +84,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
              -o OUT.png` to render without one"
         )
     })?;
-    let environment = args.common.environment()?;
+    let environment = prepared.environment.take();
     let mut renderer = Renderer::new(&args.common.device_choice()?)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
     let env_loaded = matches!(environment, Some(EnvChoice::Map(_)));

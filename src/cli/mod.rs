@@ -2,6 +2,7 @@
 
 pub mod bench;
 mod devices;
+pub mod first_image;
 mod render;
 
 use crate::cl::DeviceChoice;
@@ -74,9 +75,15 @@ pub struct CommonArgs {
     /// Uniform sky radiance as R,G,B (or one value for gray); default black.
     #[arg(long, value_parser = parse_color)]
     pub sky: Option<[f32; 3]>,
-    /// Environment light: an equirectangular .hdr or .exr image (importance-sampled), or a
-    /// uniform color R,G,B / gray value (like --sky). Either replaces the default light rig.
-    #[arg(long, value_name = "FILE|COLOR", conflicts_with = "sky")]
+    /// Environment light: `studio` or `outdoor` (bundled), `none`, an equirectangular .hdr or
+    /// .exr image (importance-sampled), or a uniform color R,G,B / gray value (like --sky).
+    /// Default: `studio` when the scene's own lights do not light the view (docs/viewer.md).
+    /// Any environment replaces the default light rig.
+    #[arg(
+        long,
+        value_name = "studio|outdoor|none|FILE|COLOR",
+        conflicts_with = "sky"
+    )]
     pub env: Option<String>,
     /// Radiance scale of the --env image.
     #[arg(long, default_value_t = 1.0)]
@@ -179,9 +186,12 @@ pub struct RenderArgs {
     /// Sampling options.
     #[command(flatten)]
     pub sampling: SamplingArgs,
-    /// Exposure in stops for PNG output.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub exposure: f32,
+    /// Exposure in stops for PNG output (default: automatic, metered on the image).
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "ev100")]
+    pub exposure: Option<f32>,
+    /// Physical exposure for PNG output: a camera at this EV100 (15: sunlit scenes in lux).
+    #[arg(long, allow_negative_numbers = true)]
+    pub ev100: Option<f32>,
 }
 
 /// How paths are sampled (`render`, `bench frame`).
@@ -262,6 +272,10 @@ pub struct Prepared {
     pub load_ms: f64,
     /// Light radius applied to point and spot lights.
     pub light_radius: f32,
+    /// The environment: asked for with `--env`, or the one the first image needs.
+    pub environment: Option<EnvChoice>,
+    /// What the first-view analysis found.
+    pub first_view: first_image::FirstImage,
 }
 
 impl CommonArgs {
@@ -333,9 +347,11 @@ impl CommonArgs {
 
     /// What `--env` asks for: a color, or an image loaded now; `None` without `--env`.
     pub fn environment(&self) -> Result<Option<EnvChoice>> {
-        let Some(arg) = self.env.as_deref() else {
-            return Ok(None);
+        let arg = match first_image::EnvArg::parse(self.env.as_deref()) {
+            first_image::EnvArg::Other(arg) => arg,
+            named => return Ok(first_image::environment(&named, None)),
         };
+        let arg = arg.as_str();
         if let Ok(c) = parse_color(arg) {
             return Ok(Some(EnvChoice::Color(c)));
         }
@@ -355,12 +371,6 @@ impl CommonArgs {
         let load_ms = t.elapsed().as_secs_f64() * 1e3;
         for w in &scene.warnings {
             log::warn!("{}: {w}", scene.source);
-        }
-        if scene.default_rig && self.env.is_none() {
-            eprintln!(
-                "penumbra: {} has no lights; using the default light rig",
-                scene.source
-            );
         }
         let mut camera = match self.camera {
             None => scene.cameras[0].clone(),
@@ -384,10 +394,51 @@ impl CommonArgs {
             camera.yfov = fov.to_radians();
         }
         let mut scene = scene;
-        if self.env.is_some() && scene.default_rig {
+        // The first image: the automatic camera gives way to the first view, and the rule
+        // "the scene's lights light the view" decides the environment (first_image.rs).
+        let env_arg = first_image::EnvArg::parse(self.env.as_deref());
+        let camera_chosen = self.camera.is_some()
+            || self.eye.is_some()
+            || scene.cameras[0].name != crate::scene::framing::AUTO_CAMERA;
+        let own_lights = if scene.default_rig {
+            Vec::new()
+        } else {
+            scene.lights.clone()
+        };
+        let aspect = match (self.width, self.height) {
+            (Some(w), Some(h)) if h > 0 => w as f64 / h as f64,
+            _ => 4.0 / 3.0,
+        };
+        let first = first_image::decide(
+            &scene,
+            &own_lights,
+            camera_chosen.then_some(&camera),
+            aspect,
+        );
+        if let Some(c) = &first.camera {
+            camera = c.clone();
+            if let Some(fov) = self.fov {
+                camera.yfov = fov.to_radians();
+            }
+        }
+        let environment = match env_arg {
+            first_image::EnvArg::Auto => first_image::environment(&env_arg, first.environment),
+            _ => self.environment()?,
+        };
+        if environment.is_some() && scene.default_rig {
             // The environment lights the scene instead of the default rig.
             scene.lights.clear();
             scene.default_rig = false;
+        }
+        if env_arg == first_image::EnvArg::Auto {
+            if let Some(preset) = first.environment {
+                eprintln!(
+                    "penumbra: {}: its own lights do not light the view; using the {} environment",
+                    scene.source,
+                    preset.name()
+                );
+            }
+            scene.lights.extend(first.lights.iter().cloned());
         }
         let diagonal = scene.bounds().diagonal();
         let light_radius = if self.hard_shadows {
@@ -397,12 +448,20 @@ impl CommonArgs {
                 .unwrap_or_else(|| default_light_radius(&scene.bounds()))
         };
         let lights = with_radius(&scene.lights, light_radius, diagonal);
+        if scene.default_rig {
+            eprintln!(
+                "penumbra: {} has no lights; using the default light rig",
+                scene.source
+            );
+        }
         Ok(Prepared {
             scene,
             lights,
             camera,
             load_ms,
             light_radius,
+            environment,
+            first_view: first,
         })
     }
 }

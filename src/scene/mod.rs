@@ -3,6 +3,7 @@
 //! Transforms are composed in f64; geometry is stored per object in object space and flattened
 //! into world-space triangles (f32) whenever the scene changes.
 
+mod env_presets;
 mod environment;
 pub mod framing;
 mod gltf_import;
@@ -10,6 +11,7 @@ mod lights;
 mod tangents;
 mod textures;
 
+pub use env_presets::EnvPreset;
 pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
 pub use gltf_import::{AUTO_YFOV, load, load_from_bytes};
 pub use lights::{LightPreset, default_light_radius, default_light_rig, preset_lights};
