@@ -6,6 +6,7 @@ use super::camera::{CameraController, Mode};
 use super::frame_loop::{Changes, Film, Progress};
 use super::state::{NewLight, RigLight, ViewState};
 use crate::render::SceneStats;
+use crate::render::exposure::AutoExposure;
 use crate::render::tonemap::ToneMapper;
 use crate::scene::{LightKind, LightPreset, Scene};
 use egui::{Color32, RichText, Ui};
@@ -289,7 +290,18 @@ impl Gui {
                         }
                     });
                 }
-                ui.add(egui::Slider::new(&mut v.exposure, -10.0..=10.0).text("exposure (stops)"));
+                ui.horizontal(|ui| {
+                    let mut auto = v.auto_exposure.is_some();
+                    if ui.checkbox(&mut auto, "auto").changed() {
+                        v.auto_exposure = auto.then(AutoExposure::default);
+                    }
+                    let s = ui.add(
+                        egui::Slider::new(&mut v.exposure, -24.0..=24.0).text("exposure (stops)"),
+                    );
+                    if s.changed() {
+                        v.auto_exposure = None;
+                    }
+                });
                 egui::ComboBox::from_label("tone mapper")
                     .selected_text(v.tone_mapper.name())
                     .show_ui(ui, |ui| {

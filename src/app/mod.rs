@@ -13,6 +13,7 @@ mod state;
 
 use crate::cli::{EnvChoice, ViewArgs};
 use crate::render::Renderer;
+use crate::render::exposure::meter;
 use crate::render::tonemap::{ToneMapper, to_rgba8};
 use crate::scene::{Light, Scene, SceneError};
 use anyhow::{Context, Result, anyhow, bail};
@@ -820,6 +821,9 @@ impl App {
         let film = &self.frame_loop.film;
         if film.pixels.is_empty() {
             return;
+        }
+        if new_image && let Some(auto) = self.model.view.auto_exposure.as_mut() {
+            self.model.view.exposure = auto.update(meter(&film.pixels).as_ref());
         }
         let v = &self.model.view;
         let key = (v.exposure, v.tone_mapper, film.spp, film.pixels.len());

@@ -3,6 +3,7 @@
 
 use crate::cli::{CommonArgs, with_radius};
 use crate::render::RenderSettings;
+use crate::render::exposure::{AutoExposure, ExposureMode};
 use crate::render::tonemap::ToneMapper;
 use crate::scene::{Bounds, Light, LightKind, LightPreset, default_light_radius, preset_lights};
 use glam::DVec3;
@@ -78,6 +79,8 @@ pub struct ViewState {
     pub hard_shadows: bool,
     /// Exposure in stops.
     pub exposure: f32,
+    /// Automatic exposure (metered on the film) while set; the slider turns it off.
+    pub auto_exposure: Option<AutoExposure>,
     /// Tone curve.
     pub tone_mapper: ToneMapper,
     /// The lights: the scene's, presets' and the user's.
@@ -110,7 +113,8 @@ impl ViewState {
                 .light_radius
                 .unwrap_or_else(|| default_light_radius(&bounds)),
             hard_shadows: args.hard_shadows,
-            exposure: 0.0,
+            exposure: args.exposure_mode().stops(None),
+            auto_exposure: (args.exposure_mode() == ExposureMode::Auto).then(AutoExposure::default),
             tone_mapper: ToneMapper::default(),
             rig: Vec::new(),
             bounds,

@@ -108,6 +108,12 @@ pub struct CommonArgs {
     /// Vertical field of view in degrees (default: the camera's).
     #[arg(long)]
     pub fov: Option<f64>,
+    /// Exposure in stops (default: automatic, metered on the image as it converges).
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "ev100")]
+    pub exposure: Option<f32>,
+    /// Physical exposure: a camera at this EV100 (about 15 for a scene lit by a sun in lux).
+    #[arg(long, allow_negative_numbers = true)]
+    pub ev100: Option<f32>,
 }
 
 impl Default for CommonArgs {
@@ -132,6 +138,8 @@ impl Default for CommonArgs {
             eye: None,
             look_at: None,
             fov: None,
+            exposure: None,
+            ev100: None,
         }
     }
 }
@@ -186,12 +194,6 @@ pub struct RenderArgs {
     /// Sampling options.
     #[command(flatten)]
     pub sampling: SamplingArgs,
-    /// Exposure in stops for PNG output (default: automatic, metered on the image).
-    #[arg(long, allow_negative_numbers = true, conflicts_with = "ev100")]
-    pub exposure: Option<f32>,
-    /// Physical exposure for PNG output: a camera at this EV100 (15: sunlit scenes in lux).
-    #[arg(long, allow_negative_numbers = true)]
-    pub ev100: Option<f32>,
 }
 
 /// How paths are sampled (`render`, `bench frame`).
@@ -279,6 +281,16 @@ pub struct Prepared {
 }
 
 impl CommonArgs {
+    /// How the exposure is chosen: `--exposure`, `--ev100`, else automatically.
+    pub fn exposure_mode(&self) -> crate::render::exposure::ExposureMode {
+        use crate::render::exposure::ExposureMode;
+        match (self.exposure, self.ev100) {
+            (Some(stops), _) => ExposureMode::Manual(stops),
+            (None, Some(ev)) => ExposureMode::Ev100(ev),
+            (None, None) => ExposureMode::Auto,
+        }
+    }
+
     /// The device choice from `--device` or `PENUMBRA_DEVICE`.
     pub fn device_choice(&self) -> Result<DeviceChoice> {
         DeviceChoice::from_arg_or_env(self.device.as_deref()).map_err(anyhow::Error::msg)

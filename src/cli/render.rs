@@ -70,11 +70,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     bar.finish_and_clear();
 
     let image = renderer.image()?;
-    let mode = match (args.exposure, args.ev100) {
-        (Some(stops), _) => ExposureMode::Manual(stops),
-        (None, Some(ev)) => ExposureMode::Ev100(ev),
-        (None, None) => ExposureMode::Auto,
-    };
+    let mode = args.common.exposure_mode();
     let metering = exposure::meter(&image);
     let exposure = mode.stops(metering.as_ref());
     match format {

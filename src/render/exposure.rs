@@ -114,7 +114,7 @@ impl ExposureMode {
 }
 
 /// Automatic exposure that settles quickly and then holds still (see the module docs).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct AutoExposure {
     stops: Option<f32>,
 }

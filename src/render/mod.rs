@@ -224,6 +224,8 @@ impl Renderer {
         {
             return Ok(0.0);
         }
+        // A cold build takes seconds (the drivers cache built programs on disk: see README).
+        eprintln!("penumbra: compiling kernels…");
         let t = Instant::now();
         self.program = Some(Program::build(&self.gpu, features)?);
         Ok(t.elapsed().as_secs_f64() * 1e3)
