@@ -594,6 +594,9 @@ impl App {
                     scene.default_rig = false;
                 }
                 self.autofocus = self.model.view.aperture > 0.0;
+                if let Some(auto) = self.model.view.auto_exposure.as_mut() {
+                    auto.reset();
+                }
                 for w in &scene.warnings {
                     log::warn!("{}: {w}", scene.source);
                 }

@@ -7,8 +7,8 @@
 //! pixels, leaving out black ones (escaped paths, pixels without samples yet) and non-finite
 //! ones, and trimming the brightest [`HIGHLIGHT_TRIM`] so that a few lamps or fireflies in view
 //! do not darken the rest. Automatic exposure puts the key at middle grey
-//! ([`MIDDLE_GREY`]), limited so that the 97th percentile is not pushed far past the tone curve's
-//! shoulder (a few percent of the image may clip: lamps, the sun).
+//! ([`MIDDLE_GREY`]), limited so that the 90th percentile stays below [`BRIGHT_LIMIT`] (a bright subject before a
+//! dark background keeps its shading; lamps and the sun, a few percent of the image, may clip).
 //!
 //! **Settling.** [`AutoExposure`] takes the first metering as it is, then follows later ones
 //! halfway per update, and not at all while they stay within [`DEAD_BAND`] stops of the current
@@ -23,8 +23,9 @@
 pub const MIDDLE_GREY: f32 = 0.18;
 /// Share of the brightest metered pixels left out of the key.
 pub const HIGHLIGHT_TRIM: f32 = 0.03;
-/// The 97th percentile of luminance may map at most this far above 1 (ACES reaches 0.96 at 8).
-pub const HIGHLIGHT_LIMIT: f32 = 16.0;
+/// The 90th percentile of luminance may map at most to this (ACES: 0.9), so that a bright
+/// subject in front of a dark background is not blown out.
+pub const BRIGHT_LIMIT: f32 = 3.0;
 /// Changes of the metered exposure smaller than this (stops) are ignored once settled.
 pub const DEAD_BAND: f32 = 0.3;
 /// The most pixels metered (a regular subset of larger images).
@@ -40,8 +41,8 @@ pub fn luminance(c: [f32; 3]) -> f32 {
 pub struct Metering {
     /// Log-average luminance of the metered pixels (the key).
     pub key: f32,
-    /// 97th percentile luminance (the brightest pixels that may not clip).
-    pub p97: f32,
+    /// 90th percentile luminance.
+    pub p90: f32,
     /// Share of the image's pixels that were metered (finite and not black).
     pub coverage: f32,
 }
@@ -67,17 +68,20 @@ pub fn meter(image: &[[f32; 3]]) -> Option<Metering> {
     let kept = ((lum.len() as f32 * (1.0 - HIGHLIGHT_TRIM)).ceil() as usize).clamp(1, lum.len());
     let log_sum: f64 = lum[..kept].iter().map(|&l| (l as f64).ln()).sum();
     let key = (log_sum / kept as f64).exp() as f32;
-    let p97 = lum[((lum.len() as f32 * 0.97) as usize).min(lum.len() - 1)];
-    Some(Metering { key, p97, coverage })
+    let at = |q: f32| lum[((lum.len() as f32 * q) as usize).min(lum.len() - 1)];
+    Some(Metering {
+        key,
+        p90: at(0.90),
+        coverage,
+    })
 }
 
 /// The exposure in stops that the metering asks for: the key to middle grey, lowered where the
-/// 97th percentile would go past [`HIGHLIGHT_LIMIT`], never raising it by more than the key
-/// allows.
+/// 90th percentile would go past [`BRIGHT_LIMIT`].
 pub fn auto_stops(m: &Metering) -> f32 {
     let key_stops = (MIDDLE_GREY / m.key).log2();
-    let highlight_stops = (HIGHLIGHT_LIMIT / m.p97).log2();
-    key_stops.min(highlight_stops)
+    let bright_stops = (BRIGHT_LIMIT / m.p90).log2();
+    key_stops.min(bright_stops)
 }
 
 /// The exposure in stops of a camera at `ev100`: 2^stops = 1 / (1.2 · 2^EV100).
@@ -197,12 +201,20 @@ mod tests {
 
     #[test]
     fn highlights_limit_the_exposure() {
-        // Half the image dark, half bright: the bright half may not be pushed past the limit.
+        // Half the image dark, half bright: the bright half keeps its shading (at most
+        // BRIGHT_LIMIT), though the key alone would push it a stop higher.
         let mut image = vec![[0.001f32; 3]; 500];
         image.extend(vec![[1.0; 3]; 500]);
         let m = meter(&image).unwrap();
         let stops = auto_stops(&m);
-        assert!(2f32.powf(stops) <= HIGHLIGHT_LIMIT * 1.001, "{stops}");
+        assert!((2f32.powf(stops) - BRIGHT_LIMIT).abs() < 1e-3, "{stops}");
+        assert!((MIDDLE_GREY / m.key).log2() > stops + 1.0);
+        // Lamps on 5% of the image clip; they do not darken the rest.
+        let mut image = vec![[0.1f32; 3]; 950];
+        image.extend(vec![[100.0; 3]; 50]);
+        let m = meter(&image).unwrap();
+        assert_eq!(auto_stops(&m), (MIDDLE_GREY / m.key).log2());
+        assert!(auto_stops(&m) > 0.5);
     }
 
     #[test]
