@@ -131,7 +131,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
     })?;
     let mut renderer = Renderer::new(&config.device)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
-    let env_loaded = config.env_map.is_some();
+    let env_name = config.env_map.as_ref().map(|m| m.name.clone());
     if let Some(map) = config.env_map {
         renderer
             .set_environment(Some(map))
@@ -158,7 +158,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         frame_loop: FrameLoop::new(renderer),
         lights: view.lights(),
         model: Model::new(config.scene, view, camera),
-        gui: Gui::new(path_text, env_loaded),
+        gui: Gui::new(path_text, env_name),
         load_ms: config.load_ms,
         frames_limit: config.frames,
         screenshot_on_exit: config.screenshot,
