@@ -77,6 +77,18 @@ pub struct Actions {
     pub hide_overlay: bool,
 }
 
+/// A line in the middle of the window (e.g. while the kernels build).
+pub fn notice(ctx: &egui::Context, text: &str) {
+    egui::Area::new(egui::Id::new("notice"))
+        .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+        .interactable(false)
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.label(RichText::new(text).size(18.0).color(Color32::WHITE));
+            });
+        });
+}
+
 /// An environment the overlay asks for.
 #[derive(Clone, Debug, PartialEq)]
 pub enum EnvSource {

@@ -181,6 +181,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         quit: false,
         autofocus: config.autofocus,
         env_lights: config.env_lights,
+        notice_shown: false,
     };
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.fatal.take() {
@@ -270,6 +271,9 @@ struct App {
     autofocus: bool,
     /// `--env` lights the scene: files without lights get no default rig.
     env_lights: bool,
+    /// A frame saying "Compiling kernels…" was shown before the first scene's (blocking)
+    /// upload and kernel build.
+    notice_shown: bool,
 }
 
 impl ApplicationHandler for App {
@@ -487,8 +491,16 @@ impl App {
         let screenshot = actions.screenshot;
         self.apply(actions, now);
 
-        // Collect a finished batch and start the next one before showing this image.
-        let new_image = self.step_frame_loop(now);
+        // Collect a finished batch and start the next one before showing this image. The first
+        // step builds the kernels and blocks for seconds with a cold cache: show a frame that
+        // says so first.
+        let new_image = if self.frame_loop.first_load() && !self.notice_shown {
+            self.notice_shown = true;
+            self.wake = Some(now);
+            false
+        } else {
+            self.step_frame_loop(now)
+        };
         self.autofocus_once();
         self.update_display(new_image);
         if new_image {
@@ -522,9 +534,13 @@ impl App {
         };
         let mut actions = gui::Actions::default();
         let (overlay, gui, model) = (self.overlay, &mut self.gui, &mut self.model);
+        let compiling = self.frame_loop.first_load() && self.device_error.is_none();
         let repaint = gfx.framework.prepare(&gfx.window, |ui| {
             if overlay {
                 actions = gui.ui(ui, model, &info);
+            }
+            if compiling {
+                gui::notice(ui.ctx(), "Compiling kernels…");
             }
         });
         self.wake = now.checked_add(repaint);
@@ -614,8 +630,9 @@ impl App {
             event_loop.exit();
         }
         if let Some(limit) = self.frames_limit {
+            // The "Compiling kernels…" frame before the first load renders nothing.
             let target_reached = self.device_error.is_some()
-                || self.model.view.spp_target.is_none()
+                || self.model.view.spp_target.is_none() && !self.frame_loop.first_load()
                 || self.frame_loop.converged(self.model.view.spp_target);
             if self.frames >= limit && target_reached {
                 event_loop.exit();
