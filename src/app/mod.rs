@@ -181,7 +181,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         quit: false,
         autofocus: config.autofocus,
         env_lights: config.env_lights,
-        notice_shown: false,
+        notice_frames: 0,
     };
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.fatal.take() {
@@ -271,9 +271,9 @@ struct App {
     autofocus: bool,
     /// `--env` lights the scene: files without lights get no default rig.
     env_lights: bool,
-    /// A frame saying "Compiling kernels…" was shown before the first scene's (blocking)
-    /// upload and kernel build.
-    notice_shown: bool,
+    /// Frames saying "Compiling kernels…" shown before the first scene's (blocking) upload and
+    /// kernel build: egui lays a new area out unseen in its first frame, so it takes two.
+    notice_frames: u8,
 }
 
 impl ApplicationHandler for App {
@@ -494,8 +494,8 @@ impl App {
         // Collect a finished batch and start the next one before showing this image. The first
         // step builds the kernels and blocks for seconds with a cold cache: show a frame that
         // says so first.
-        let new_image = if self.frame_loop.first_load() && !self.notice_shown {
-            self.notice_shown = true;
+        let new_image = if self.frame_loop.first_load() && self.notice_frames < 2 {
+            self.notice_frames += 1;
             self.wake = Some(now);
             false
         } else {
