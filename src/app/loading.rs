@@ -81,10 +81,8 @@ impl App {
         self.loader = None;
         match result {
             Ok((mut scene, ms)) => {
-                if self.env_lights && scene.default_rig {
-                    // The environment lights the scene instead of the default rig.
-                    scene.lights.clear();
-                    scene.default_rig = false;
+                if self.env_lights {
+                    scene.light_by_environment();
                 }
                 self.autofocus = self.model.view.aperture > 0.0;
                 if let Some(auto) = self.model.view.auto_exposure.as_mut() {

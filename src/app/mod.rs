@@ -88,6 +88,8 @@ pub struct ViewerConfig {
     pub spp_target: Option<u32>,
     /// The OpenCL device.
     pub device: DeviceChoice,
+    /// The kernels (`--kernel`).
+    pub kernel: crate::render::KernelChoice,
     /// The environment map, if one lights the scene.
     pub env_map: Option<EnvMap>,
     /// An environment (map or color) lights the scene: files opened later without lights get
@@ -131,6 +133,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
     })?;
     let mut renderer = Renderer::new(&config.device)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
+    renderer.set_kernel(config.kernel)?;
     let env_name = config.env_map.as_ref().map(|m| m.name.clone());
     if let Some(map) = config.env_map {
         renderer

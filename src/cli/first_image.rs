@@ -2,7 +2,7 @@
 //! camera wins), an environment when the scene's own lights do not light that view, and lights
 //! inside an interior that nothing lights.
 
-use super::EnvChoice;
+use crate::args::EnvChoice;
 use crate::scene::framing::{self, FirstView};
 use crate::scene::{Camera, EnvPreset, Light, Scene};
 

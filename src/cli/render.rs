@@ -1,6 +1,7 @@
 //! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary.
 
-use super::{EnvChoice, RenderArgs};
+use super::RenderArgs;
+use crate::args::EnvChoice;
 use crate::image_io::{Format, write_exr};
 use crate::render::exposure::{self, ExposureMode};
 use crate::render::tonemap::write_png;
@@ -22,11 +23,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         anyhow::bail!("{}: the output folder does not exist", dir.display());
     }
     let mut settings = args.common.settings((640, 480))?;
-    args.sampling.apply(&mut settings);
-    let spp = args.common.spp.unwrap_or(DEFAULT_SPP);
+    args.strategy.apply(&mut settings);
+    let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
     let mut prepared = args.common.prepare(Some(&args.scene))?;
     let environment = prepared.environment.take();
     let mut renderer = Renderer::new(&args.common.device_choice()?)?;
+    renderer.set_kernel(args.common.kernel)?;
     renderer.set_settings(&settings)?;
     if let Some(EnvChoice::Map(map)) = environment {
         renderer.set_environment(Some(map))?;
@@ -35,7 +37,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| format!("{}", args.scene.display()))?;
     renderer.set_camera(&prepared.camera)?;
-    if settings.lens_radius > 0.0 && args.common.focus_distance.is_none() {
+    if settings.lens_radius > 0.0 && args.common.lens.focus_distance.is_none() {
         // Focus on what the image centre sees (else the scene's centre).
         let focus = renderer
             .focus_distance_at(settings.width as f32 * 0.5, settings.height as f32 * 0.5)
@@ -99,6 +101,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "scene": args.scene.display().to_string(),
         "output": args.output.display().to_string(),
         "device": renderer.gpu.description(),
+        "kernel": renderer.kernel(),
         "width": settings.width,
         "height": settings.height,
         "spp": spp,
@@ -125,12 +128,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "environment": renderer.environment().map(|m| m.name.clone()),
         "exposure": exposure,
         "auto_exposure": mode == ExposureMode::Auto,
-        "first_view": {
-            "interior": prepared.first_view.view.interior,
-            "lights_light_view": prepared.first_view.view.lit,
-            "lit_fraction": prepared.first_view.view.lit_fraction,
-            "coverage": prepared.first_view.view.coverage,
-        },
+        "first_view": prepared.first_view.as_ref().map(|f| serde_json::json!({
+            "interior": f.view.interior,
+            "lights_light_view": f.view.lit,
+            "lit_fraction": f.view.lit_fraction,
+            "coverage": f.view.coverage,
+        })),
         "aperture": renderer.settings().lens_radius,
         "focus_distance": renderer.settings().focus_distance,
         "kernel_ms": stats.stage_ms,

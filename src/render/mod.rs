@@ -4,6 +4,7 @@
 pub mod camera;
 pub mod exposure;
 mod lights;
+mod megakernel;
 mod settings;
 mod textures;
 pub mod tonemap;
@@ -11,12 +12,13 @@ mod upload;
 mod wavefront;
 
 pub use lights::gpu_lights;
+pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
 pub use upload::{HostScene, gpu_camera};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
-use crate::bvh::{Bvh, Ray};
+use crate::bvh::{Bvh, Ray, WideBvh};
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
@@ -73,6 +75,8 @@ pub struct Renderer {
     samples: u32,
     stats: RenderStats,
     pending: Vec<(Stage, Launch)>,
+    /// Whether frames run as the megakernel (else the wavefront); see [`KernelChoice`].
+    megakernel: bool,
 }
 
 impl Renderer {
@@ -104,8 +108,9 @@ impl Renderer {
             samples: 0,
             stats: RenderStats::default(),
             pending: Vec::new(),
+            megakernel: false,
         };
-        r.reset()?;
+        r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
     }
 
@@ -149,6 +154,7 @@ impl Renderer {
         };
         let buffers = SceneBuffers {
             nodes: Buffer::from_slice(&self.gpu, &host.bvh.nodes)?,
+            wide_nodes: Buffer::from_slice(&self.gpu, &WideBvh::collapse(&host.bvh).nodes)?,
             triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
             shading: Buffer::from_slice(&self.gpu, &host.shading)?,
             tangents: Buffer::from_slice(&self.gpu, tangents)?,
@@ -173,6 +179,8 @@ impl Renderer {
             texture_max_side: pack.max_side,
         };
         self.scene = Some((buffers, host));
+        let mut stats = stats;
+        stats.kernel_build_ms += self.prime_megakernel()?;
         self.reset()?;
         Ok(stats)
     }

@@ -215,7 +215,7 @@ mod tests {
             direction: glam::DVec3::NEG_Y,
             color: [1.0; 3],
             intensity,
-            radius: 0.0,
+            light_radius: 0.0,
         }
     }
 

@@ -742,7 +742,7 @@ pub fn light_near_camera(camera: &Camera, distance: f64, name: &str) -> Light {
         direction: to_subject.normalize_or(DVec3::NEG_Y),
         color: [1.0, 1.0, 1.0],
         intensity: (d * d) as f32,
-        radius: (0.02 * distance) as f32,
+        light_radius: (0.02 * distance) as f32,
     }
 }
 
@@ -829,7 +829,7 @@ mod tests {
             direction: DVec3::NEG_Y,
             color: [1.0; 3],
             intensity,
-            radius: 0.0,
+            light_radius: 0.0,
         }
     }
 

@@ -3,13 +3,19 @@
 //! Transforms are composed in f64; geometry is stored per object in object space and flattened
 //! into world-space triangles (f32) whenever the scene changes.
 
+mod accessor;
+mod compression;
 mod env_presets;
 mod environment;
 pub mod framing;
 mod gltf_import;
 mod lights;
+pub mod limits;
+mod pose;
+mod sources;
 mod tangents;
 mod textures;
+mod validate;
 
 pub use env_presets::EnvPreset;
 pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
@@ -19,6 +25,7 @@ pub use textures::{
     Image, MAX_TEXTURE_SIDE, MaterialTextures, MipLevel, TexTransform, TextureRef, Wrap,
     linear_to_srgb, mip_chain, srgb_to_linear,
 };
+pub use validate::SUPPORTED_EXTENSIONS;
 
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -197,9 +204,9 @@ pub struct Light {
     pub color: [f32; 3],
     /// Radiant intensity (W/sr, point and spot) or irradiance (directional), used 1:1.
     pub intensity: f32,
-    /// Radius in world units (an angular radius in radians for directional lights);
-    /// 0 gives hard shadows.
-    pub radius: f32,
+    /// The light radius (`--light-radius`, "light radius" in the overlay): in world units, an
+    /// angular radius in radians for directional lights; 0 gives hard shadows.
+    pub light_radius: f32,
 }
 
 /// A perspective camera.
