@@ -397,7 +397,11 @@ impl CommonArgs {
     pub fn prepare(&self, path: Option<&Path>) -> Result<Prepared> {
         let (mut scene, load_ms) = load(path)?;
         let mut camera = self.camera.choose(&scene)?;
-        let env_arg = first_image::EnvArg::parse(self.env.env.as_deref());
+        // `--sky` alone is an explicit choice of lighting too: no automatic environment.
+        let env_arg = match (&self.env.env, self.env.sky) {
+            (None, Some(_)) => first_image::EnvArg::Off,
+            (env, _) => first_image::EnvArg::parse(env.as_deref()),
+        };
         let camera_chosen = self.camera.camera.is_some()
             || self.camera.eye.is_some()
             || scene.cameras[0].name != crate::scene::framing::AUTO_CAMERA;
