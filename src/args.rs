@@ -5,6 +5,8 @@
 //! (`bench trace`) flattens only those.
 
 use crate::cl::DeviceChoice;
+use crate::cli::first_image;
+use crate::render::exposure::ExposureMode;
 use crate::render::{KernelChoice, RenderSettings, Strategy};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
 use anyhow::{Result, bail};
@@ -173,9 +175,15 @@ pub struct EnvArgs {
     /// Uniform sky radiance as R,G,B (or one value for gray); default black.
     #[arg(long, value_parser = parse_color)]
     pub sky: Option<[f32; 3]>,
-    /// Environment light: an equirectangular .hdr or .exr image (importance-sampled), or a
-    /// uniform color R,G,B / gray value (like --sky). Either replaces the default light rig.
-    #[arg(long, value_name = "FILE|COLOR", conflicts_with = "sky")]
+    /// Environment light: `studio` or `outdoor` (bundled), `none`, an equirectangular .hdr or
+    /// .exr image (importance-sampled), or a uniform color R,G,B / gray value (like --sky).
+    /// Default: `studio` when the scene's own lights do not light the view (docs/viewer.md).
+    /// Any environment replaces the default light rig.
+    #[arg(
+        long,
+        value_name = "studio|outdoor|none|FILE|COLOR",
+        conflicts_with = "sky"
+    )]
     pub env: Option<String>,
     /// Radiance scale of the --env image.
     #[arg(
@@ -215,9 +223,11 @@ impl EnvArgs {
 
     /// What `--env` asks for: a color, or an image loaded now; `None` without `--env`.
     pub fn environment(&self) -> Result<Option<EnvChoice>> {
-        let Some(arg) = self.env.as_deref() else {
-            return Ok(None);
+        let arg = match first_image::EnvArg::parse(self.env.as_deref()) {
+            first_image::EnvArg::Other(arg) => arg,
+            named => return Ok(first_image::environment(&named, None)),
         };
+        let arg = arg.as_str();
         if let Ok(c) = parse_color(arg) {
             return Ok(Some(EnvChoice::Color(c)));
         }
@@ -228,6 +238,46 @@ impl EnvArgs {
         Ok(Some(EnvChoice::Map(
             EnvMap::load(path).map_err(anyhow::Error::msg)?,
         )))
+    }
+}
+
+/// The most stops `--exposure` may brighten or darken by.
+pub const MAX_EXPOSURE: f32 = 64.0;
+
+/// An exposure in stops within ±[`MAX_EXPOSURE`].
+fn parse_exposure(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v.abs() <= MAX_EXPOSURE => Ok(v),
+        _ => Err(format!(
+            "'{s}' is out of range (-{MAX_EXPOSURE}..={MAX_EXPOSURE} stops)"
+        )),
+    }
+}
+
+/// How bright the image is shown and written.
+#[derive(Args, Debug, Clone, Default)]
+pub struct ExposureArgs {
+    /// Exposure in stops (default: automatic, metered on the image as it converges).
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        conflicts_with = "ev100",
+        value_parser = parse_exposure
+    )]
+    pub exposure: Option<f32>,
+    /// Physical exposure: a camera at this EV100 (about 15 for a scene lit by a sun in lux).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_finite)]
+    pub ev100: Option<f32>,
+}
+
+impl ExposureArgs {
+    /// How the exposure is chosen: `--exposure`, `--ev100`, else automatically.
+    pub fn mode(&self) -> ExposureMode {
+        match (self.exposure, self.ev100) {
+            (Some(stops), _) => ExposureMode::Manual(stops),
+            (None, Some(ev)) => ExposureMode::Ev100(ev),
+            (None, None) => ExposureMode::Auto,
+        }
     }
 }
 
@@ -255,6 +305,9 @@ pub struct CommonArgs {
     /// Depth of field.
     #[command(flatten)]
     pub lens: LensArgs,
+    /// Exposure.
+    #[command(flatten)]
+    pub exposure: ExposureArgs,
     /// Kernels: wavefront (queued stages per bounce), megakernel (whole paths per work item)
     /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
     #[arg(long, default_value = "auto", value_parser = parse_kernel)]
@@ -333,9 +386,73 @@ impl CommonArgs {
         self.env.environment()
     }
 
-    /// Loads the scene (or the bundled one) and applies camera and light options.
+    /// How the exposure is chosen: `--exposure`, `--ev100`, else automatically.
+    pub fn exposure_mode(&self) -> ExposureMode {
+        self.exposure.mode()
+    }
+
+    /// Loads the scene (or the bundled one), applies camera and light options and decides the
+    /// first image: the automatic camera gives way to the first view, and the rule "the
+    /// scene's lights light the view" decides the environment (`cli/first_image.rs`).
     pub fn prepare(&self, path: Option<&Path>) -> Result<Prepared> {
-        prepare(path, &self.camera, &self.shadows, self.env.env.is_some())
+        let (mut scene, load_ms) = load(path)?;
+        let mut camera = self.camera.choose(&scene)?;
+        // `--sky` alone is an explicit choice of lighting too: no automatic environment.
+        let env_arg = match (&self.env.env, self.env.sky) {
+            (None, Some(_)) => first_image::EnvArg::Off,
+            (env, _) => first_image::EnvArg::parse(env.as_deref()),
+        };
+        let camera_chosen = self.camera.camera.is_some()
+            || self.camera.eye.is_some()
+            || scene.cameras[0].name != crate::scene::framing::AUTO_CAMERA;
+        let own_lights = if scene.default_rig {
+            Vec::new()
+        } else {
+            scene.lights.clone()
+        };
+        let aspect = match (self.size.width, self.size.height) {
+            (Some(w), Some(h)) if h > 0 => w as f64 / h as f64,
+            _ => 4.0 / 3.0,
+        };
+        let first = first_image::decide(
+            &scene,
+            &own_lights,
+            camera_chosen.then_some(&camera),
+            aspect,
+        );
+        if let Some(c) = &first.camera {
+            camera = c.clone();
+            if let Some(fov) = self.camera.fov {
+                camera.yfov = fov.to_radians();
+            }
+        }
+        let environment = match env_arg {
+            first_image::EnvArg::Auto => first_image::environment(&env_arg, first.environment),
+            _ => self.environment()?,
+        };
+        if environment.is_some() {
+            scene.light_by_environment();
+        }
+        if env_arg == first_image::EnvArg::Auto {
+            if let Some(preset) = first.environment {
+                eprintln!(
+                    "penumbra: {}: its own lights do not light the view; using the {} environment",
+                    scene.source,
+                    preset.name()
+                );
+            }
+            scene.lights.extend(first.lights.iter().cloned());
+        }
+        if scene.default_rig {
+            eprintln!(
+                "penumbra: {} has no lights; using the default light rig",
+                scene.source
+            );
+        }
+        let mut prepared = finish(scene, camera, &self.shadows, load_ms);
+        prepared.environment = environment;
+        prepared.first_view = Some(first);
+        Ok(prepared)
     }
 }
 
@@ -351,6 +468,38 @@ pub struct Prepared {
     pub load_ms: f64,
     /// The light radius rule applied to `lights`.
     pub shadows: Shadows,
+    /// The environment: asked for with `--env`, or the one the first image needs
+    /// ([`CommonArgs::prepare`] only).
+    pub environment: Option<EnvChoice>,
+    /// What the first-view analysis found ([`CommonArgs::prepare`] only).
+    pub first_view: Option<first_image::FirstImage>,
+}
+
+/// Loads the scene at `path` (or the bundled one) and logs its warnings; the loading time in ms.
+fn load(path: Option<&Path>) -> Result<(Scene, f64)> {
+    let t = std::time::Instant::now();
+    let scene = load_or_bundled(path)?;
+    let load_ms = t.elapsed().as_secs_f64() * 1e3;
+    for w in &scene.warnings {
+        log::warn!("{}: {w}", scene.source);
+    }
+    Ok((scene, load_ms))
+}
+
+/// Sizes the lights of `scene` by the light radius rule.
+fn finish(scene: Scene, camera: Camera, shadows: &ShadowArgs, load_ms: f64) -> Prepared {
+    let bounds = scene.bounds();
+    let shadows = Shadows::new(shadows.light_radius, shadows.hard_shadows, &bounds);
+    let lights = shadows.apply(&scene.lights, bounds.diagonal());
+    Prepared {
+        scene,
+        lights,
+        camera,
+        load_ms,
+        shadows,
+        environment: None,
+        first_view: None,
+    }
 }
 
 /// Loads the scene at `path` (or the bundled one), chooses its camera and sizes its lights;
@@ -361,12 +510,7 @@ pub fn prepare(
     shadows: &ShadowArgs,
     environment: bool,
 ) -> Result<Prepared> {
-    let t = std::time::Instant::now();
-    let mut scene = load_or_bundled(path)?;
-    let load_ms = t.elapsed().as_secs_f64() * 1e3;
-    for w in &scene.warnings {
-        log::warn!("{}: {w}", scene.source);
-    }
+    let (mut scene, load_ms) = load(path)?;
     if scene.default_rig && !environment {
         eprintln!(
             "penumbra: {} has no lights; using the default light rig",
@@ -377,16 +521,7 @@ pub fn prepare(
     if environment {
         scene.light_by_environment();
     }
-    let bounds = scene.bounds();
-    let shadows = Shadows::new(shadows.light_radius, shadows.hard_shadows, &bounds);
-    let lights = shadows.apply(&scene.lights, bounds.diagonal());
-    Ok(Prepared {
-        scene,
-        lights,
-        camera,
-        load_ms,
-        shadows,
-    })
+    Ok(finish(scene, camera, shadows, load_ms))
 }
 
 /// How paths are sampled (`render`, `bench frame`).

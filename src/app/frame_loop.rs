@@ -125,6 +125,11 @@ pub struct FrameLoop {
 }
 
 impl FrameLoop {
+    /// Whether the next step loads the first scene, which builds the kernels.
+    pub fn first_load(&self) -> bool {
+        !self.loaded
+    }
+
     /// A loop around `renderer` that will load everything on its first step.
     pub fn new(renderer: Renderer) -> Self {
         Self {

@@ -2,6 +2,7 @@
 //! with its light radius, exposure and tone mapping.
 
 use crate::render::RenderSettings;
+use crate::render::exposure::{AutoExposure, ExposureMode};
 use crate::render::tonemap::ToneMapper;
 use crate::scene::{
     Bounds, Light, LightKind, LightPreset, Shadows, default_light_radius, preset_lights,
@@ -77,6 +78,8 @@ pub struct ViewState {
     pub shadows: Shadows,
     /// Exposure in stops.
     pub exposure: f32,
+    /// Automatic exposure (metered on the film) while set; the slider turns it off.
+    pub auto_exposure: Option<AutoExposure>,
     /// Tone curve.
     pub tone_mapper: ToneMapper,
     /// The lights: the scene's, presets' and the user's.
@@ -88,12 +91,13 @@ pub struct ViewState {
 }
 
 impl ViewState {
-    /// The state the command line asks for (`base` is its validated render settings) on a
-    /// scene with `lights` and `bounds`.
+    /// The state the command line asks for (`base` is its validated render settings, `exposure`
+    /// automatic, manual or EV100) on a scene with `lights` and `bounds`.
     pub fn new(
         base: RenderSettings,
         spp_target: Option<u32>,
         shadows: Shadows,
+        exposure: ExposureMode,
         lights: &[Light],
         bounds: Bounds,
     ) -> Self {
@@ -107,7 +111,8 @@ impl ViewState {
             focus_distance: base.focus_distance,
             spp_target,
             shadows,
-            exposure: 0.0,
+            exposure: exposure.stops(None),
+            auto_exposure: (exposure == ExposureMode::Auto).then(AutoExposure::default),
             tone_mapper: ToneMapper::default(),
             rig: Vec::new(),
             bounds,
@@ -255,7 +260,14 @@ mod tests {
         let a = args(extra);
         let base = a.settings((64, 64)).unwrap();
         let shadows = Shadows::new(a.shadows.light_radius, a.shadows.hard_shadows, &bounds());
-        ViewState::new(base, a.sampling.spp, shadows, lights, bounds())
+        ViewState::new(
+            base,
+            a.sampling.spp,
+            shadows,
+            a.exposure_mode(),
+            lights,
+            bounds(),
+        )
     }
 
     fn args(extra: &[&str]) -> CommonArgs {

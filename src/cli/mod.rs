@@ -1,9 +1,10 @@
 //! The command line: `view` (default), `render`, `devices`, `bench`.
 
 mod devices;
+pub mod first_image;
 mod render;
 
-use crate::args::{CommonArgs, EnvChoice, StrategyArgs, parse_finite};
+use crate::args::{CommonArgs, EnvChoice, StrategyArgs};
 use crate::bench;
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
@@ -65,22 +66,6 @@ pub struct RenderArgs {
     /// Direct-light strategy and Russian roulette.
     #[command(flatten)]
     pub strategy: StrategyArgs,
-    /// Exposure in stops for PNG output.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_exposure)]
-    pub exposure: f32,
-}
-
-/// The most stops `--exposure` may brighten or darken by.
-pub const MAX_EXPOSURE: f32 = 64.0;
-
-/// An exposure in stops within ±[`MAX_EXPOSURE`].
-fn parse_exposure(s: &str) -> Result<f32, String> {
-    match parse_finite(s)? {
-        v if v.abs() <= MAX_EXPOSURE => Ok(v),
-        _ => Err(format!(
-            "'{s}' is out of range (-{MAX_EXPOSURE}..={MAX_EXPOSURE} stops)"
-        )),
-    }
 }
 
 /// One line for a command-line usage error (`penumbra: error: …`, exit code 2): clap's first
@@ -121,8 +106,8 @@ fn view(args: ViewArgs) -> Result<()> {
     crate::app::preflight(args.screenshot.as_deref())?;
     let common = &args.common;
     let settings = common.settings(DEFAULT_SIZE)?;
-    let prepared = common.prepare(args.scene.as_deref())?;
-    let environment = common.environment()?;
+    let mut prepared = common.prepare(args.scene.as_deref())?;
+    let environment = prepared.environment.take();
     let device = common.device_choice()?;
     // With a lens but no focus distance, focus on what the image centre sees once loaded.
     let autofocus = settings.lens_radius > 0.0 && common.lens.focus_distance.is_none();
@@ -136,12 +121,13 @@ fn view(args: ViewArgs) -> Result<()> {
         settings,
         spp_target: common.sampling.spp,
         device,
+        env_lights: environment.is_some(),
         kernel: common.kernel,
         env_map: match environment {
             Some(EnvChoice::Map(map)) => Some(map),
             _ => None,
         },
-        env_lights: common.env.env.is_some(),
+        exposure: common.exposure_mode(),
         autofocus,
         frames: args.frames,
         screenshot: args.screenshot,

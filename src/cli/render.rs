@@ -3,10 +3,12 @@
 use super::RenderArgs;
 use crate::args::EnvChoice;
 use crate::image_io::{Format, write_exr};
+use crate::render::exposure::{self, ExposureMode};
 use crate::render::tonemap::write_png;
 use crate::render::{Renderer, tonemap::ToneMapper};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
 use std::time::Instant;
 
 /// Samples per pixel when `--spp` is not given.
@@ -23,8 +25,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut settings = args.common.settings((640, 480))?;
     args.strategy.apply(&mut settings);
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
-    let prepared = args.common.prepare(Some(&args.scene))?;
-    let environment = args.common.environment()?;
+    let mut prepared = args.common.prepare(Some(&args.scene))?;
+    let environment = prepared.environment.take();
     let mut renderer = Renderer::new(&args.common.device_choice()?)?;
     renderer.set_kernel(args.common.kernel)?;
     renderer.set_settings(&settings)?;
@@ -53,6 +55,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         )
         .expect("the progress template is valid"),
     );
+    // Without a terminal (a log, CI), plain lines every 10% or 2 s instead of the bar.
+    let mut lines = (!std::io::stderr().is_terminal()).then(|| ProgressLines::new(spp));
     let chunk = spp.div_ceil(50).max(1);
     let start = Instant::now();
     let mut done = 0;
@@ -61,11 +65,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         renderer.render(n)?;
         done += n;
         bar.set_position(done as u64);
+        if let Some(l) = lines.as_mut() {
+            l.update(done, start.elapsed().as_secs_f64());
+        }
     }
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
     let image = renderer.image()?;
+    let mode = args.common.exposure_mode();
+    let metering = exposure::meter(&image);
+    let exposure = mode.stops(metering.as_ref());
     match format {
         Format::Exr => write_exr(&args.output, settings.width, settings.height, &image)?,
         Format::Png => write_png(
@@ -73,7 +83,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             settings.width,
             settings.height,
             &image,
-            args.exposure,
+            exposure,
             ToneMapper::default(),
         )?,
     }
@@ -116,10 +126,47 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "textures": scene_stats.textures,
         "texture_bytes": scene_stats.texture_bytes,
         "environment": renderer.environment().map(|m| m.name.clone()),
+        "exposure": exposure,
+        "auto_exposure": mode == ExposureMode::Auto,
+        "first_view": prepared.first_view.as_ref().map(|f| serde_json::json!({
+            "interior": f.view.interior,
+            "lights_light_view": f.view.lit,
+            "lit_fraction": f.view.lit_fraction,
+            "coverage": f.view.coverage,
+        })),
         "aperture": renderer.settings().lens_radius,
         "focus_distance": renderer.settings().focus_distance,
         "kernel_ms": stats.stage_ms,
     });
     println!("{summary}");
     Ok(())
+}
+
+/// Progress as plain lines on stderr: one each 10% of the samples or 2 s, whichever comes first.
+struct ProgressLines {
+    spp: u32,
+    next_percent: u32,
+    last: f64,
+}
+
+impl ProgressLines {
+    fn new(spp: u32) -> Self {
+        Self {
+            spp,
+            next_percent: 10,
+            last: 0.0,
+        }
+    }
+
+    fn update(&mut self, done: u32, seconds: f64) {
+        let percent = (done as u64 * 100 / self.spp.max(1) as u64) as u32;
+        if percent >= self.next_percent || seconds - self.last >= 2.0 {
+            eprintln!(
+                "penumbra: render {percent}% ({done}/{} spp, {seconds:.1} s)",
+                self.spp
+            );
+            self.next_percent = (percent / 10 + 1) * 10;
+            self.last = seconds;
+        }
+    }
 }

@@ -2,6 +2,7 @@
 //! stages. It knows nothing of windows; the viewer and the command line drive it alike.
 
 pub mod camera;
+pub mod exposure;
 mod lights;
 mod megakernel;
 mod settings;
@@ -198,6 +199,8 @@ impl Renderer {
         {
             return Ok(0.0);
         }
+        // A cold build takes seconds (the drivers cache built programs on disk: see README).
+        eprintln!("penumbra: compiling kernels…");
         let t = Instant::now();
         self.program = Some(Program::build(&self.gpu, features)?);
         Ok(t.elapsed().as_secs_f64() * 1e3)

@@ -5,7 +5,9 @@
 
 mod accessor;
 mod compression;
+mod env_presets;
 mod environment;
+pub mod framing;
 mod gltf_import;
 mod lights;
 pub mod limits;
@@ -15,6 +17,7 @@ mod tangents;
 mod textures;
 mod validate;
 
+pub use env_presets::EnvPreset;
 pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
 pub use gltf_import::{AUTO_YFOV, load, load_from_bytes};
 pub use lights::{LightPreset, Shadows, default_light_radius, default_light_rig, preset_lights};
