@@ -3,7 +3,8 @@
 #   NAME.pack.glb   gltfpack (KHR_mesh_quantization)
 #   NAME.cc.glb     gltfpack -cc (EXT_meshopt_compression + quantization)
 #   NAME.draco.glb  gltf-transform draco (KHR_draco_mesh_compression)
-#   NAME.webp.glb   gltf-transform webp (EXT_texture_webp; only for scenes with textures)
+#   NAME.webp.glb   gltf-transform webp --lossless (EXT_texture_webp; only for scenes with textures;
+#                   lossless, so the comparison checks the decoder, not the codec's loss)
 # Usage: scripts/optimized_scenes.sh OUT_DIR SCENE.glb|SCENE.gltf...
 # The tools come from tools/node_modules (scripts/install_gltf_tools.sh).
 set -euo pipefail
@@ -17,6 +18,6 @@ for scene in "$@"; do
     "$bin/gltfpack" -cc -i "$scene" -o "$out/$name.cc.glb" >/dev/null
     "$bin/gltf-transform" draco "$scene" "$out/$name.draco.glb" >/dev/null
     if grep -aq "\"images\"" "$scene"; then
-        "$bin/gltf-transform" webp "$scene" "$out/$name.webp.glb" >/dev/null
+        "$bin/gltf-transform" webp --lossless true "$scene" "$out/$name.webp.glb" >/dev/null
     fi
 done

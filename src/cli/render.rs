@@ -128,6 +128,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "environment": renderer.environment().map(|m| m.name.clone()),
         "exposure": exposure,
         "auto_exposure": mode == ExposureMode::Auto,
+        "camera": {
+            "eye": prepared.camera.eye.to_array(),
+            "forward": prepared.camera.forward.to_array(),
+            "yfov_degrees": prepared.camera.yfov.to_degrees(),
+        },
         "first_view": prepared.first_view.as_ref().map(|f| serde_json::json!({
             "interior": f.view.interior,
             "lights_light_view": f.view.lit,
