@@ -7,7 +7,7 @@
 use crate::cl::DeviceChoice;
 use crate::cli::first_image;
 use crate::render::exposure::ExposureMode;
-use crate::render::{KernelChoice, RenderSettings, Strategy};
+use crate::render::{KernelChoice, RenderSettings, Renderer, Strategy};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
 use anyhow::{Result, bail};
 use clap::Args;
@@ -331,6 +331,14 @@ impl Default for CommonArgs {
 }
 
 impl CommonArgs {
+    /// Opens the chosen device with the chosen kernel shape and `settings`.
+    pub fn open_renderer(&self, settings: &RenderSettings) -> Result<Renderer> {
+        let mut renderer = Renderer::new(&self.device_choice()?)?;
+        renderer.set_kernel(self.kernel)?;
+        renderer.set_settings(settings)?;
+        Ok(renderer)
+    }
+
     /// The device choice from `--device` or `PENUMBRA_DEVICE`.
     pub fn device_choice(&self) -> Result<DeviceChoice> {
         self.device.device_choice()

@@ -11,7 +11,7 @@ use super::{device_json, device_line, plot};
 use crate::args::CommonArgs;
 use crate::date::today;
 use crate::image_io::read_exr;
-use crate::render::{Renderer, Strategy};
+use crate::render::Strategy;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -205,9 +205,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
 
-    let mut renderer = Renderer::new(&args.common.device_choice()?)?;
-    renderer.set_kernel(args.common.kernel)?;
-    renderer.set_settings(&settings)?;
+    let mut renderer = args.common.open_renderer(&settings)?;
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| source.clone())?;

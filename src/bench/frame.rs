@@ -4,7 +4,6 @@
 use super::{device_json, device_line, thousands};
 use crate::args::{CommonArgs, StrategyArgs};
 use crate::date::today;
-use crate::render::Renderer;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -37,9 +36,7 @@ pub fn run(args: &FrameArgs) -> Result<()> {
     let spp = args.common.sampling.spp.unwrap_or(16);
     let prepared = args.common.prepare(args.scene.as_deref())?;
     let source = prepared.scene.source.clone();
-    let mut renderer = Renderer::new(&args.common.device_choice()?)?;
-    renderer.set_kernel(args.common.kernel)?;
-    renderer.set_settings(&settings)?;
+    let mut renderer = args.common.open_renderer(&settings)?;
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| source.clone())?;

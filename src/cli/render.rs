@@ -4,8 +4,8 @@ use super::RenderArgs;
 use crate::args::EnvChoice;
 use crate::image_io::{Format, write_exr};
 use crate::render::exposure::{self, ExposureMode};
+use crate::render::tonemap::ToneMapper;
 use crate::render::tonemap::write_png;
-use crate::render::{Renderer, tonemap::ToneMapper};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -27,9 +27,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
     let mut prepared = args.common.prepare(Some(&args.scene))?;
     let environment = prepared.environment.take();
-    let mut renderer = Renderer::new(&args.common.device_choice()?)?;
-    renderer.set_kernel(args.common.kernel)?;
-    renderer.set_settings(&settings)?;
+    let mut renderer = args.common.open_renderer(&settings)?;
     if let Some(EnvChoice::Map(map)) = environment {
         renderer.set_environment(Some(map))?;
     }
