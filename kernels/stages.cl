@@ -109,7 +109,8 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
 
     GpuTriangle tri = tris[hit.prim];
     float w0 = 1.0f - hit.u - hit.v;
-    float3 p = w0 * tri.v0.xyz + hit.u * tri.v1.xyz + hit.v * tri.v2.xyz;
+    float3 p_err;
+    float3 p = surface_point(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, hit.u, hit.v, &p_err);
     float3 ng = normalize(cross(tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz));
     global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
     bool front = dot(ng, wo) > 0.0f;
@@ -201,7 +202,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
             if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
                 uint s = atomic_inc(&counters[COUNT_SHADOW]);
                 GpuShadowRay ray;
-                float3 from = offset_ray(p, side > 0.0f ? ng : -ng);
+                float3 from = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
                 float3 dir = ls.wi;
                 // Virtual lights (spheres, discs, the sky) are not geometry: trace to them.
                 float tmax = ls.distance;
@@ -240,7 +241,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     }
     path.radiance = (float4)(radiance, as_float(rng));
     if (alive) {
-        path.origin = (float4)(offset_ray(p, side > 0.0f ? ng : -ng), pdf);
+        path.origin = (float4)(offset_ray(p, p_err, side > 0.0f ? ng : -ng), pdf);
         path.direction = (float4)(wi, as_float(specular ? PATH_SPECULAR : 0u));
         path.throughput.xyz = throughput;
         queue_out[atomic_inc(&counters[COUNT_OUT])] = slot;
