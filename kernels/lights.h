@@ -77,7 +77,7 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
         float2 b = sample_triangle(u1, u2);
         float3 q_err;
         float3 q = surface_point(t.v0.xyz, t.v1.xyz, t.v2.xyz, b.x, b.y, &q_err);
-        float3 ng = normalize(cross(t.v1.xyz - t.v0.xyz, t.v2.xyz - t.v0.xyz));
+        float3 ng = triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz);
         float3 d = q - p;
         float dist2 = dot(d, d);
         if (dist2 <= 0.0f) return s;

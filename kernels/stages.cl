@@ -111,7 +111,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     float w0 = 1.0f - hit.u - hit.v;
     float3 p_err;
     float3 p = surface_point(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, hit.u, hit.v, &p_err);
-    float3 ng = normalize(cross(tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz));
+    float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
     global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
     bool front = dot(ng, wo) > 0.0f;
     GpuTriShading sh = shading[hit.prim];

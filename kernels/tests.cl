@@ -121,7 +121,7 @@ kernel void spawn_test(global const float4* verts, global const uint4* groups,
     if (i >= count) return;
     uint first = groups[i].x;
     float3 v0 = verts[3 * first].xyz, v1 = verts[3 * first + 1].xyz, v2 = verts[3 * first + 2].xyz;
-    float3 ng = normalize(cross(v1 - v0, v2 - v0));
+    float3 ng = triangle_normal(v0, v1, v2);
     float3 d = dirs[i].xyz;
     float3 err;
     float3 p = surface_point(v0, v1, v2, bary[i].x, bary[i].y, &err);

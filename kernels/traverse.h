@@ -158,14 +158,31 @@ inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle*
     }
 }
 
-// The point at barycentrics (u, v) of a triangle and a bound on its rounding error per
-// coordinate: pbrt-v4's gamma(7) times the barycentric sum of the vertices' magnitudes. The
-// bound follows the vertices, not a scene-wide epsilon, so it holds at any scale and offset.
+// The point at barycentrics (u, v) of a triangle and a bound on how far a spawned ray's origin
+// must move off it, per coordinate: pbrt-v4's gamma(7) times the barycentric sum of the
+// vertices' magnitudes (the rounding of p), plus gamma(64) times the triangle's extent around p
+// in every coordinate, which stands in for pbrt's conservative t check in the ray-triangle test
+// (a point exactly on a triangle in the plane x = 0 has no rounding error, yet the sheared
+// ray-triangle test can still find it at a tiny positive t). Both follow the vertices, not a
+// scene-wide epsilon, so they hold at any scale and offset.
 inline float3 surface_point(float3 v0, float3 v1, float3 v2, float u, float v, float3* err) {
     float w = 1.0f - u - v;
     const float gamma7 = 7.0f * 0x1p-24f / (1.0f - 7.0f * 0x1p-24f);
-    *err = gamma7 * (fabs(w * v0) + fabs(u * v1) + fabs(v * v2));
-    return w * v0 + u * v1 + v * v2;
+    const float gamma64 = 64.0f * 0x1p-24f / (1.0f - 64.0f * 0x1p-24f);
+    float3 p = w * v0 + u * v1 + v * v2;
+    float3 extent = fmax(fmax(fabs(v0 - p), fabs(v1 - p)), fabs(v2 - p));
+    float reach = fmax(fmax(extent.x, extent.y), extent.z);
+    *err = gamma7 * (fabs(w * v0) + fabs(u * v1) + fabs(v * v2)) + gamma64 * reach;
+    return p;
+}
+
+// The unit geometric normal of a triangle (counter-clockwise front). The cross product is
+// scaled by a power of two before normalizing, so triangles of 1e-10 or 1e10 units do not
+// underflow or overflow its squared length.
+inline float3 triangle_normal(float3 v0, float3 v1, float3 v2) {
+    float3 c = cross(v1 - v0, v2 - v0);
+    float m = fmax(fmax(fabs(c.x), fabs(c.y)), fabs(c.z));
+    return m > 0.0f ? normalize(c * ldexp(1.0f, -ilogb(m))) : c;
 }
 
 // Moves p, whose coordinates are off by at most err, off the surface along the geometric

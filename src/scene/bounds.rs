@@ -45,7 +45,10 @@ pub fn robust_bounds(triangles: &[[DVec3; 3]]) -> Bounds {
         (b - a).max_element()
     });
     let size = (hi - lo).max_element().max(median(extents.collect(), 0.5));
-    let (lo, hi) = (lo - DVec3::splat(64.0 * size), hi + DVec3::splat(64.0 * size));
+    let (lo, hi) = (
+        lo - DVec3::splat(64.0 * size),
+        hi + DVec3::splat(64.0 * size),
+    );
     for (t, c) in sane.iter().zip(&centroids) {
         if c.cmpge(lo).all() && c.cmple(hi).all() {
             t.iter().for_each(|&p| b.grow(p));

@@ -51,7 +51,7 @@ impl Rng {
         Self(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
     }
     /// Uniform in [0, 1).
-    pub fn next(&mut self) -> f64 {
+    pub fn uniform(&mut self) -> f64 {
         self.0 = self
             .0
             .wrapping_mul(6364136223846793005)
@@ -60,8 +60,8 @@ impl Rng {
     }
     /// A uniform unit vector.
     pub fn direction(&mut self) -> DVec3 {
-        let z = 2.0 * self.next() - 1.0;
-        let phi = std::f64::consts::TAU * self.next();
+        let z = 2.0 * self.uniform() - 1.0;
+        let phi = std::f64::consts::TAU * self.uniform();
         let r = (1.0 - z * z).max(0.0).sqrt();
         DVec3::new(r * phi.cos(), r * phi.sin(), z)
     }
@@ -266,7 +266,7 @@ pub fn leaks(
     let mut rng = Rng::new(rays as u64 ^ center.x.to_bits());
     let gpu_rays: Vec<GpuRay> = (0..rays)
         .map(|_| {
-            let o = space.point(center + rng.direction() * (0.5 * radius * rng.next()));
+            let o = space.point(center + rng.direction() * (0.5 * radius * rng.uniform()));
             let d = rng.direction().as_vec3();
             GpuRay {
                 origin: [o.x, o.y, o.z, 0.0],
@@ -307,51 +307,75 @@ pub fn leaks(
 fn random_vertex(rng: &mut Rng, exponent: f64) -> Vec3 {
     let s = 10f64.powf(exponent);
     DVec3::new(
-        (rng.next() * 20.0 - 10.0) * s,
-        (rng.next() * 20.0 - 10.0) * s,
-        (rng.next() * 20.0 - 10.0) * s,
+        (rng.uniform() * 20.0 - 10.0) * s,
+        (rng.uniform() * 20.0 - 10.0) * s,
+        (rng.uniform() * 20.0 - 10.0) * s,
     )
     .as_vec3()
 }
 
 /// pbrt-v4's reintersection test on the device: for each decade 10^e, e = −8 … 8, `cases`
 /// random triangles with coordinates in [−10, 10] × 10^e (half of them moved away from the
-/// origin by up to 10³ times their size), a random point on each (the kernels' hit point) and a
+/// origin by up to 10³ times their size, a quarter lying in a coordinate plane), a random point on each (the kernels' hit point) and a
 /// random direction; the spawned ray (the kernels' offset) must not hit its own triangle.
 /// Returns (exponent, rays that re-hit) per decade. The kernels must have been built.
 pub fn reintersections(renderer: &Renderer, cases: usize) -> Result<Vec<(i32, usize)>> {
     let mut rng = Rng::new(11);
     let mut out = Vec::new();
     for e in -8..=8 {
-        let (mut verts, mut groups, mut bary, mut dirs) = (vec![], vec![], vec![], vec![]);
-        for i in 0..cases {
-            let shift = if i % 2 == 0 {
-                Vec3::ZERO
-            } else {
-                let up = 3.0 * rng.next();
-                random_vertex(&mut rng, e as f64 + up)
-            };
-            let v = [0, 1, 2].map(|_| random_vertex(&mut rng, e as f64) + shift);
-            let n = (v[1] - v[0]).cross(v[2] - v[0]);
-            if !(n.length() > 0.0) {
-                continue;
-            }
-            let (mut u, mut w) = (rng.next() as f32, rng.next() as f32);
-            if u + w > 1.0 {
-                (u, w) = (1.0 - u, 1.0 - w);
-            }
-            let k = verts.len() as u32 / 3;
-            groups.push([k, k, 1, 0]);
-            verts.extend(v.map(|p| [p.x, p.y, p.z, 0.0]));
-            bary.push([u, w]);
-            let d = rng.direction().as_vec3();
-            dirs.push([d.x, d.y, d.z, f32::INFINITY]);
-        }
+        let c = reintersection_cases(&mut rng, e, cases);
         let program = renderer.program().expect("the kernels were built");
-        let hits = program.spawn_test(&renderer.gpu, &verts, &groups, &bary, &dirs)?;
+        let hits = program.spawn_test(&renderer.gpu, &c.verts, &c.groups, &c.bary, &c.dirs)?;
         out.push((e, hits.iter().filter(|&&h| h > 0).count()));
     }
     Ok(out)
+}
+
+/// Inputs of `Program::spawn_test`.
+#[derive(Clone, Debug, Default)]
+pub struct SpawnCases {
+    /// Triangle vertices, three per triangle (xyz).
+    pub verts: Vec<[f32; 4]>,
+    /// (spawning triangle, first triangle traced, count, unused).
+    pub groups: Vec<[u32; 4]>,
+    /// Barycentrics of the spawn point.
+    pub bary: Vec<[f32; 2]>,
+    /// Direction (xyz) and tmax (w).
+    pub dirs: Vec<[f32; 4]>,
+}
+
+/// The cases of [`reintersections`] for the decade 10^e.
+pub fn reintersection_cases(rng: &mut Rng, e: i32, cases: usize) -> SpawnCases {
+    let mut c = SpawnCases::default();
+    for i in 0..cases {
+        let shift = if i % 2 == 0 {
+            Vec3::ZERO
+        } else {
+            let up = 3.0 * rng.uniform();
+            random_vertex(rng, e as f64 + up)
+        };
+        let mut v = [0, 1, 2].map(|_| random_vertex(rng, e as f64) + shift);
+        if i % 4 == 2 {
+            // In a coordinate plane (the point has no rounding error across it).
+            let axis = i / 4 % 3;
+            v.iter_mut().for_each(|p| p[axis] = 0.0);
+        }
+        let n = (v[1] - v[0]).cross(v[2] - v[0]);
+        if n.length() <= 0.0 || !n.is_finite() {
+            continue;
+        }
+        let (mut u, mut w) = (rng.uniform() as f32, rng.uniform() as f32);
+        if u + w > 1.0 {
+            (u, w) = (1.0 - u, 1.0 - w);
+        }
+        let k = c.verts.len() as u32 / 3;
+        c.groups.push([k, k, 1, 0]);
+        c.verts.extend(v.map(|p| [p.x, p.y, p.z, 0.0]));
+        c.bary.push([u, w]);
+        let d = rng.direction().as_vec3();
+        c.dirs.push([d.x, d.y, d.z, f32::INFINITY]);
+    }
+    c
 }
 
 /// A square of `side` × `side` quads (2 triangles each) spanning [−1, 1]² in the xz plane,
@@ -416,14 +440,14 @@ pub fn grazing_occlusions(
     let mut rng = Rng::new(23);
     let (mut groups, mut bary, mut dirs) = (vec![], vec![], vec![]);
     for _ in 0..rays {
-        let t = (rng.next() * tris.len() as f64) as usize;
+        let t = (rng.uniform() * tris.len() as f64) as usize;
         groups.push([t as u32, 0, tris.len() as u32, 0]);
-        let (mut u, mut w) = (rng.next() as f32, rng.next() as f32);
+        let (mut u, mut w) = (rng.uniform() as f32, rng.uniform() as f32);
         if u + w > 1.0 {
             (u, w) = (1.0 - u, 1.0 - w);
         }
         bary.push([u, w]);
-        let phi = std::f64::consts::TAU * rng.next();
+        let phi = std::f64::consts::TAU * rng.uniform();
         let along = tangent * phi.cos() + bitangent * phi.sin();
         let d = (along * elevation.cos() + normal * elevation.sin()).as_vec3();
         dirs.push([d.x, d.y, d.z, width as f32]);
