@@ -3,12 +3,6 @@
 // Paths live in `paths` by slot (pixel + sample_in_wave * pixels); queues hold the slots of the
 // live paths, compacted by atomic counters, so later bounces only touch live paths.
 
-inline float power_heuristic(float a, float b) {
-    float a2 = a * a;
-    float b2 = b * b;
-    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
-}
-
 kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, global uint* queue,
                      global uint* counters, global float2* cones) {
     uint slot = get_global_id(0);
@@ -20,34 +14,15 @@ kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, gl
         counters[COUNT_SHADOW] = 0;
     }
     if (slot >= total) return;
-    uint pixel = slot % pixels;
-    uint sample = frame.first_sample + slot / pixels;
-    uint rng = hash_u32(hash_u32(pixel ^ hash_u32(frame.seed)) ^ hash_u32(sample * 0x9e3779b9u + 1u));
-
-    // Jitter within the pixel (box filter) and form the pinhole or thin-lens ray.
-    float fx = ((float)(pixel % frame.width) + rng_next(&rng)) / (float)frame.width;
-    float fy = ((float)(pixel / frame.width) + rng_next(&rng)) / (float)frame.height;
-    float3 dir = camera.forward.xyz + (2.0f * fx - 1.0f) * camera.right.xyz +
-                 (1.0f - 2.0f * fy) * camera.up.xyz;
-    float3 origin = camera.origin.xyz;
-    float u1 = rng_next(&rng);
-    float u2 = rng_next(&rng);
-    if (camera.origin.w > 0.0f) {
-        float3 focus = origin + dir * camera.forward.w;
-        float r = camera.origin.w * sqrt(u1);
-        float phi = 2.0f * PI_F * u2;
-        origin += r * cos(phi) * normalize(camera.right.xyz) + r * sin(phi) * normalize(camera.up.xyz);
-        dir = focus - origin;
-    }
+    PathState s = camera_path(&frame, &camera, slot % pixels, frame.first_sample + slot / pixels);
     GpuPath p;
-    p.origin = (float4)(origin, 0.0f);
-    p.direction = (float4)(normalize(dir), as_float(0u));
-    p.throughput = (float4)(1.0f, 1.0f, 1.0f, as_float(slot));
-    p.radiance = (float4)(0.0f, 0.0f, 0.0f, as_float(rng));
+    p.origin = (float4)(s.origin, 0.0f);
+    p.direction = (float4)(s.direction, as_float(0u));
+    p.throughput = (float4)(s.throughput, as_float(slot));
+    p.radiance = (float4)(s.radiance, as_float(s.rng));
     paths[slot] = p;
     queue[slot] = slot;
-    // The ray cone for texture filtering: no width at the eye, one pixel's angle of spread.
-    cones[slot] = (float2)(0.0f, 2.0f * length(camera.up.xyz) / (float)frame.height);
+    cones[slot] = s.cone;
 }
 
 kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
@@ -78,172 +53,39 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     if (i >= counters[COUNT_IN]) return;
     uint slot = queue_in[i];
     GpuPath path = paths[slot];
-    GpuHit hit = hits[i];
-    float3 throughput = path.throughput.xyz;
-    float3 radiance = path.radiance.xyz;
-    uint rng = as_uint(path.radiance.w);
-    float3 wo = -path.direction.xyz;
-    float prev_pdf = path.origin.w;
-    bool prev_specular = (as_uint(path.direction.w) & PATH_SPECULAR) != 0u;
-    bool counts_emission = frame.bounce == 0u || prev_specular || frame.strategy != STRATEGY_LIGHTS;
-    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
-    EnvMap env = {environment, env_texels, env_marginal, env_conditional};
-
-    if (hit.prim == NO_HIT) {
-#ifdef HAS_ENV_MAP
-        // Escaped into the environment map, weighted against its sampling at the last vertex.
-        float env_pdf;
-        float3 le = env_radiance(&env, -wo, &env_pdf);
-        float weight = 1.0f;
-        if (frame.bounce > 0u && !prev_specular && frame.strategy == STRATEGY_MIS) {
-            weight = power_heuristic(prev_pdf, environment.scale.z * env_pdf);
-        }
-        if (counts_emission) radiance += throughput * le * weight;
-#else
-        // Escaped: the uniform sky, reached by BSDF sampling only.
-        if (counts_emission) radiance += throughput * frame.sky.xyz;
-#endif
-        paths[slot].radiance.xyz = radiance;
-        return;
-    }
-
-    GpuTriangle tri = tris[hit.prim];
-    float w0 = 1.0f - hit.u - hit.v;
-    float3 p_err;
-    float3 p = surface_point(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, hit.u, hit.v, &p_err);
-    float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
-    global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
-    bool front = dot(ng, wo) > 0.0f;
-    GpuTriShading sh = shading[hit.prim];
-    TexCoords tc = texcoords_at(sh, hit.u, hit.v);
+    ShadeScene sc = {tris,
+                     {shading, tangents, materials, tex_refs, textures, texels},
+                     {environment, env_texels, env_marginal, env_conditional},
+                     lights,
+                     light_cdf};
+    PathState s;
+    s.origin = path.origin.xyz;
+    s.direction = path.direction.xyz;
+    s.throughput = path.throughput.xyz;
+    s.radiance = path.radiance.xyz;
+    s.prev_pdf = path.origin.w;
+    s.flags = as_uint(path.direction.w);
+    s.rng = as_uint(path.radiance.w);
 #ifdef HAS_TEXTURES
-    // The ray cone's footprint picks the mip levels; it widens by the roughness at each bounce.
-    float2 cone = cones[slot];
-    float cone_width = cone.x + cone.y * hit.t;
-    texcoords_footprint(&tc, sh, tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz, cone_width,
-                        fabs(dot(ng, wo)));
-    tc.xi = rng_next(&rng);
+    s.cone = cones[slot];
 #endif
-
-#ifdef HAS_TRIANGLE_LIGHTS
-    // Emission of a light hit by this ray, weighted against light sampling of the last vertex.
-    int light_index = as_int(tri.v1.w);
-    bool two_sided = (as_uint(mat->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
-    if (light_index >= 0 && (front || two_sided) && counts_emission) {
-        float weight = 1.0f;
-        if (frame.bounce > 0u && !prev_specular && frame.strategy == STRATEGY_MIS) {
-            global const GpuLight* l = &lights[light_index];
-            float cos_l = fabs(dot(ng, wo));
-            float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
-            weight = power_heuristic(prev_pdf, light_pdf);
-        }
+    ShadowQuery q;
+    bool alive = shade_vertex(&frame, frame.bounce, &sc, hits[i], &s, &q);
+    if (q.valid) {
+        GpuShadowRay ray;
+        ray.origin = (float4)(q.origin, q.tmax);
+        ray.direction = (float4)(q.direction, as_float(slot));
+        ray.contribution = (float4)(q.contribution, 0.0f);
+        shadow_rays[atomic_inc(&counters[COUNT_SHADOW])] = ray;
+    }
 #ifdef HAS_TEXTURES
-        // Past the camera ray, emission is read at the finest level, as light sampling reads it.
-        TexCoords etc = frame.bounce == 0u ? tc : texcoords_at(sh, hit.u, hit.v);
-        radiance += throughput * textured_emission(mat, &surf, &etc) * weight;
-#else
-        radiance += throughput * mat->emission.xyz * weight;
+    cones[slot] = s.cone;
 #endif
-    }
-#endif
-
-    // The last extension only looks for emitters (the MIS partner of the last light sample).
-    if (frame.bounce > frame.max_bounces) {
-        paths[slot].radiance.xyz = radiance;
-        return;
-    }
-
-    // Face the normals towards the side the ray came from.
-    if (!front) ng = -ng;
-    float3 ns = ng;
-    if (sh.n0.w > 0.0f) {
-        float3 n = w0 * sh.n0.xyz + hit.u * sh.n1.xyz + hit.v * sh.n2.xyz;
-        float len = length(n);
-        if (len > 0.0f) {
-            ns = n / len;
-            if (dot(ns, ng) < 0.0f) ns = -ns;
-        }
-    }
-#ifdef HAS_NORMAL_MAPS
-    if (mat->textures.z >= 0) ns = normal_map(&surf, mat, &tc, hit.prim, hit.u, hit.v, ns, ng, front);
-#endif
-    SurfaceMaterial m = surface_material(mat);
-#ifdef HAS_TEXTURES
-    apply_textures(&m, mat, &surf, &tc);
-    float alpha_r = m.roughness * m.roughness;
-    cones[slot] = (float2)(cone_width, cone.y + alpha_r);
-#endif
-
-    // Hit from behind, a transmissive volume was travelled through: attenuate the segment
-    // (Beer–Lambert) and see the interface from inside. Other back faces shade as front faces.
-    if (!front && m.transmission > 0.0f && m.thickness > 0.0f) {
-        throughput *= volume_transmittance(&m, hit.t);
-        material_from_inside(&m);
-    }
-
-    // Next-event estimation: one light sample, traced later by `connect`.
-    if (frame.strategy != STRATEGY_BSDF && frame.light_count > 0u) {
-        uint index = cdf_search(light_cdf, frame.light_count, rng_next(&rng));
-        float u1 = rng_next(&rng);
-        float u2 = rng_next(&rng);
-        LightSample ls = sample_light(lights, tris, materials, &surf, &env, index, p, u1, u2);
-        // A light behind the surface is reached through transmission when bsdf_eval says so;
-        // the geometric and shading normals must agree on the side. Transmissive surfaces
-        // block shadow rays (no caustics through next-event estimation).
-        float side = dot(ls.wi, ng);
-        if (side * dot(ls.wi, ns) > 0.0f &&
-            (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
-            float bsdf_pdf;
-            float3 f = bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
-            float weight = (frame.strategy == STRATEGY_MIS && ls.pdf > 0.0f)
-                               ? power_heuristic(ls.pdf, bsdf_pdf)
-                               : 1.0f;
-            float3 contribution = throughput * f * ls.radiance * weight;
-            if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
-                uint s = atomic_inc(&counters[COUNT_SHADOW]);
-                GpuShadowRay ray;
-                float3 from = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
-                float3 dir = ls.wi;
-                // Virtual lights (spheres, discs, the sky) are not geometry: trace to them.
-                float tmax = ls.distance;
-                if (ls.on_surface) {
-                    float3 seg = ls.target - from;
-                    tmax = length(seg);
-                    dir = seg / tmax;
-                }
-                ray.origin = (float4)(from, tmax);
-                ray.direction = (float4)(dir, as_float(slot));
-                ray.contribution = (float4)(contribution, 0.0f);
-                shadow_rays[s] = ray;
-            }
-        }
-    }
-
-    // Sample the BSDF for the next ray; Russian roulette after rr_depth bounces.
-    float3 wi;
-    float pdf;
-    bool specular;
-    float u1 = rng_next(&rng);
-    float u2 = rng_next(&rng);
-    float u3 = m.transmission > 0.0f ? rng_next(&rng) : 0.0f;
-    float3 weight = bsdf_sample(&m, ns, wo, (float3)(u1, u2, u3), &wi, &pdf, &specular);
-    throughput *= weight;
-    float side = dot(wi, ng);
-    bool alive = pdf > 0.0f && side * dot(wi, ns) > 0.0f &&
-                 (throughput.x > 0.0f || throughput.y > 0.0f || throughput.z > 0.0f);
-    if (alive && frame.bounce >= frame.rr_depth) {
-        float q = fmin(fmax(throughput.x, fmax(throughput.y, throughput.z)), 0.95f);
-        if (rng_next(&rng) >= q) {
-            alive = false;
-        } else {
-            throughput /= q;
-        }
-    }
-    path.radiance = (float4)(radiance, as_float(rng));
+    path.radiance = (float4)(s.radiance, as_float(s.rng));
     if (alive) {
-        path.origin = (float4)(offset_ray(p, p_err, side > 0.0f ? ng : -ng), pdf);
-        path.direction = (float4)(wi, as_float(specular ? PATH_SPECULAR : 0u));
-        path.throughput.xyz = throughput;
+        path.origin = (float4)(s.origin, s.prev_pdf);
+        path.direction = (float4)(s.direction, as_float(s.flags));
+        path.throughput.xyz = s.throughput;
         queue_out[atomic_inc(&counters[COUNT_OUT])] = slot;
     }
     paths[slot] = path;

@@ -58,6 +58,11 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuShadowRay, contribution);
     PROBE_SIZE(GpuRay);
     PROBE_FIELD(GpuRay, origin); PROBE_FIELD(GpuRay, direction);
+    PROBE_SIZE(GpuWideNode);
+    PROBE_FIELD(GpuWideNode, min_x); PROBE_FIELD(GpuWideNode, min_y);
+    PROBE_FIELD(GpuWideNode, min_z); PROBE_FIELD(GpuWideNode, max_x);
+    PROBE_FIELD(GpuWideNode, max_y); PROBE_FIELD(GpuWideNode, max_z);
+    PROBE_FIELD(GpuWideNode, child); PROBE_FIELD(GpuWideNode, count);
     out[n] = 0xffffffffu;
 }
 

@@ -84,6 +84,35 @@ inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float
     return (near <= far && near < tmax) ? near : INFINITY;
 }
 
+// Tests the triangles first .. first + count - 1 of a leaf, keeping the closest hit in *hit
+// (with HAS_ALPHA, hits the material's alpha cuts out or lets through are skipped). Returns
+// true when any_hit and a hit was found: the traversal can stop.
+inline bool intersect_leaf(const RayPrep* r, global const GpuTriangle* tris,
+                           const SceneSurfaces* surf, uint first, uint count, float tmin,
+                           float3 o, float3 d, bool any_hit, GpuHit* hit) {
+    for (uint p = first; p < first + count; ++p) {
+        GpuTriangle t = tris[p];
+#ifdef HAS_ALPHA
+        float t_hit = hit->t;
+        float bu, bv;
+        if (intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv) &&
+            !alpha_passes(surf, p, as_uint(t.v0.w), bu, bv, o, d)) {
+            hit->t = t_hit;
+            hit->u = bu;
+            hit->v = bv;
+            hit->prim = p;
+            if (any_hit) return true;
+        }
+#else
+        if (intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &hit->t, &hit->u, &hit->v)) {
+            hit->prim = p;
+            if (any_hit) return true;
+        }
+#endif
+    }
+    return false;
+}
+
 // Closest hit (any_hit = false) or first hit (any_hit = true). On a stack overflow, which the
 // builder's depth limit rules out, the overflow counter is raised instead of failing silently.
 // With HAS_ALPHA, hits that the material's alpha cuts out (MASK) or lets through (BLEND, at
@@ -117,25 +146,8 @@ inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle*
             }
             uint first = (uint)(~ref);
             uint count = as_uint(hi.w);
-            for (uint p = first; p < first + count; ++p) {
-                GpuTriangle t = tris[p];
-#ifdef HAS_ALPHA
-                float t_hit = hit.t;
-                float bu, bv;
-                if (intersect_triangle(&r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv) &&
-                    !alpha_passes(surf, p, as_uint(t.v0.w), bu, bv, o, d)) {
-                    hit.t = t_hit;
-                    hit.u = bu;
-                    hit.v = bv;
-                    hit.prim = p;
-                    if (any_hit) return hit;
-                }
-#else
-                if (intersect_triangle(&r, t.v0, t.v1, t.v2, tmin, &hit.t, &hit.u, &hit.v)) {
-                    hit.prim = p;
-                    if (any_hit) return hit;
-                }
-#endif
+            if (intersect_leaf(&r, tris, surf, first, count, tmin, o, d, any_hit, &hit)) {
+                return hit;
             }
         }
         if (child[0] >= 0 && child[1] >= 0) {

@@ -87,6 +87,8 @@ pub struct ViewerConfig {
     pub spp_target: Option<u32>,
     /// The OpenCL device.
     pub device: DeviceChoice,
+    /// The kernels (`--kernel`).
+    pub kernel: crate::render::KernelChoice,
     /// The environment map, if one lights the scene.
     pub env_map: Option<EnvMap>,
     /// An environment (map or color) lights the scene: files opened later without lights get
@@ -128,6 +130,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
     })?;
     let mut renderer = Renderer::new(&config.device)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
+    renderer.set_kernel(config.kernel)?;
     let env_loaded = config.env_map.is_some();
     if let Some(map) = config.env_map {
         renderer

@@ -127,17 +127,21 @@ pub enum Stage {
     Advance,
     /// The wave's samples into the film.
     Accumulate,
+    /// Whole paths per work item, all bounces in one kernel (CPU devices; no other stage
+    /// but `advance` runs then).
+    Megakernel,
 }
 
 impl Stage {
     /// Every stage, in launch order.
-    pub const ALL: [Stage; 6] = [
+    pub const ALL: [Stage; 7] = [
         Stage::Generate,
         Stage::Extend,
         Stage::Shade,
         Stage::Connect,
         Stage::Advance,
         Stage::Accumulate,
+        Stage::Megakernel,
     ];
 
     /// The kernel's (and the stage's) name.
@@ -149,6 +153,7 @@ impl Stage {
             Stage::Connect => "connect",
             Stage::Advance => "advance",
             Stage::Accumulate => "accumulate",
+            Stage::Megakernel => "megakernel",
         }
     }
 }
@@ -180,6 +185,11 @@ pub struct Program {
     accumulate: Kernel,
     trace_closest: Kernel,
     trace_any: Kernel,
+    trace_closest_wide: Kernel,
+    trace_any_wide: Kernel,
+    megakernel: Kernel,
+    /// Work-group size of the megakernel (see `megakernel_local_size`).
+    mega_local_size: usize,
     /// The test-only kernels, built on first use (never in production).
     tests: OnceLock<TestKernels>,
     local_size: usize,
@@ -221,6 +231,10 @@ impl Program {
             accumulate: k(Stage::Accumulate)?,
             trace_closest: kernel(&program, "trace_closest")?,
             trace_any: kernel(&program, "trace_any")?,
+            trace_closest_wide: kernel(&program, "trace_closest_wide")?,
+            trace_any_wide: kernel(&program, "trace_any_wide")?,
+            megakernel: k(Stage::Megakernel)?,
+            mega_local_size: megakernel_local_size().min(max_group),
             tests: OnceLock::new(),
             local_size: 64.min(max_group),
             features,
@@ -253,10 +267,22 @@ impl Program {
         n: usize,
         set: impl FnOnce(&mut ExecuteKernel),
     ) -> Result<Launch, ClError> {
+        self.run_local(gpu, stage, kernel, n, self.local_size, set)
+    }
+
+    fn run_local(
+        &self,
+        gpu: &Gpu,
+        stage: &'static str,
+        kernel: &Kernel,
+        n: usize,
+        local_size: usize,
+        set: impl FnOnce(&mut ExecuteKernel),
+    ) -> Result<Launch, ClError> {
         let mut exec = ExecuteKernel::new(kernel);
         set(&mut exec);
-        exec.set_global_work_size(global_size(n, self.local_size))
-            .set_local_work_size(self.local_size);
+        exec.set_global_work_size(global_size(n, local_size))
+            .set_local_work_size(local_size);
         // SAFETY: every wrapper below sets exactly the kernel's arguments, in order, with the
         // types the kernel declares; buffers outlive the launch because the queue is in order
         // and every reader of results waits on it.
@@ -424,20 +450,16 @@ impl Program {
         hits: &Buffer<GpuHit>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
-        let count = rays.len() as u32;
-        self.run(
+        let (stage, kernel) = ("trace_closest", &self.trace_closest);
+        self.trace(
             gpu,
-            "trace_closest",
-            &self.trace_closest,
-            rays.len(),
-            |e| unsafe {
-                e.set_arg(&bvh.nodes.mem()).set_arg(&bvh.triangles.mem());
-                set_surfaces(e, bvh);
-                e.set_arg(&rays.mem())
-                    .set_arg(&count)
-                    .set_arg(&hits.mem())
-                    .set_arg(&counters.mem());
-            },
+            stage,
+            kernel,
+            bvh.nodes.mem(),
+            bvh,
+            rays,
+            hits,
+            counters,
         )
     }
 
@@ -450,15 +472,125 @@ impl Program {
         occluded: &Buffer<u32>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
+        let (stage, kernel) = ("trace_any", &self.trace_any);
+        self.trace(
+            gpu,
+            stage,
+            kernel,
+            bvh.nodes.mem(),
+            bvh,
+            rays,
+            occluded,
+            counters,
+        )
+    }
+
+    /// `trace_closest_wide`: as `trace_closest`, through the 4-wide BVH.
+    pub fn trace_closest_wide(
+        &self,
+        gpu: &Gpu,
+        bvh: &SceneBuffers,
+        rays: &Buffer<GpuRay>,
+        hits: &Buffer<GpuHit>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
+        let (stage, kernel) = ("trace_closest_wide", &self.trace_closest_wide);
+        self.trace(
+            gpu,
+            stage,
+            kernel,
+            bvh.wide_nodes.mem(),
+            bvh,
+            rays,
+            hits,
+            counters,
+        )
+    }
+
+    /// `trace_any_wide`: as `trace_any`, through the 4-wide BVH.
+    pub fn trace_any_wide(
+        &self,
+        gpu: &Gpu,
+        bvh: &SceneBuffers,
+        rays: &Buffer<GpuRay>,
+        occluded: &Buffer<u32>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
+        let (stage, kernel) = ("trace_any_wide", &self.trace_any_wide);
+        self.trace(
+            gpu,
+            stage,
+            kernel,
+            bvh.wide_nodes.mem(),
+            bvh,
+            rays,
+            occluded,
+            counters,
+        )
+    }
+
+    /// The four tracing kernels share their arguments: nodes (binary or wide), triangles,
+    /// surfaces, rays, count, results, counters.
+    #[allow(clippy::too_many_arguments)]
+    fn trace<T: Pod>(
+        &self,
+        gpu: &Gpu,
+        stage: &'static str,
+        kernel: &Kernel,
+        nodes: opencl3::types::cl_mem,
+        bvh: &SceneBuffers,
+        rays: &Buffer<GpuRay>,
+        out: &Buffer<T>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
         let count = rays.len() as u32;
-        self.run(gpu, "trace_any", &self.trace_any, rays.len(), |e| unsafe {
-            e.set_arg(&bvh.nodes.mem()).set_arg(&bvh.triangles.mem());
+        self.run(gpu, stage, kernel, rays.len(), |e| unsafe {
+            e.set_arg(&nodes).set_arg(&bvh.triangles.mem());
             set_surfaces(e, bvh);
             e.set_arg(&rays.mem())
                 .set_arg(&count)
-                .set_arg(&occluded.mem())
+                .set_arg(&out.mem())
                 .set_arg(&counters.mem());
         })
+    }
+
+    /// `megakernel`: `frame.samples_in_wave` whole paths per pixel, from the camera to their
+    /// end, added to the film; the ray counts go to the counters that `advance` reads.
+    #[allow(clippy::too_many_arguments)]
+    pub fn megakernel(
+        &self,
+        gpu: &Gpu,
+        frame: &GpuFrame,
+        camera: &GpuCamera,
+        env: &EnvBuffers,
+        scene: &SceneBuffers,
+        film: &Buffer<[f32; 4]>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
+        let pixels = (frame.width * frame.height) as usize;
+        let local = self.mega_local_size;
+        self.run_local(
+            gpu,
+            Stage::Megakernel.name(),
+            &self.megakernel,
+            pixels,
+            local,
+            |e| unsafe {
+                e.set_arg(frame)
+                    .set_arg(camera)
+                    .set_arg(&env.info)
+                    .set_arg(&scene.wide_nodes.mem())
+                    .set_arg(&scene.triangles.mem());
+                set_surfaces(e, scene);
+                e.set_arg(&env.texels.mem())
+                    .set_arg(&env.marginal.mem())
+                    .set_arg(&env.conditional.mem())
+                    .set_arg(&scene.lights.mem())
+                    .set_arg(&scene.light_cdf.mem())
+                    .set_arg(&film.mem())
+                    .set_arg(&counters.mem());
+            },
+        )
     }
 
     /// `probe_layout` (test program): sizes and offsets of the shared structs as the device compiler sees them.
@@ -642,6 +774,18 @@ impl Program {
     }
 }
 
+/// The megakernel's work-group size: `PENUMBRA_MEGAKERNEL_GROUP` when set (for measuring),
+/// else 64. On PoCL's CPU device a work-group is one task of its thread pool whose work items
+/// run one after the other (the kernel's loops defeat vectorisation across work items), so the
+/// size only sets the scheduling grain; docs/benchmarks.md has the measurements.
+fn megakernel_local_size() -> usize {
+    std::env::var("PENUMBRA_MEGAKERNEL_GROUP")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or(64)
+}
+
 /// Sets the six surface arguments every traversing kernel takes after the triangles, in the
 /// order of `SceneSurfaces` (kernels/textures.h).
 ///
@@ -675,6 +819,8 @@ pub struct EnvBuffers {
 pub struct SceneBuffers {
     /// BVH nodes.
     pub nodes: Buffer<GpuBvhNode>,
+    /// The same BVH collapsed to 4-wide nodes (the megakernel's).
+    pub wide_nodes: Buffer<GpuWideNode>,
     /// Triangles in BVH order.
     pub triangles: Buffer<GpuTriangle>,
     /// Shading data in BVH order.

@@ -5,7 +5,7 @@ mod devices;
 mod render;
 
 use crate::cl::DeviceChoice;
-use crate::render::{RenderSettings, Strategy};
+use crate::render::{KernelChoice, RenderSettings, Strategy};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
 use anyhow::{Result, bail};
 use clap::{Args, Parser, Subcommand};
@@ -44,27 +44,31 @@ pub struct CommonArgs {
     /// first CPU; also PENUMBRA_DEVICE).
     #[arg(long)]
     pub device: Option<String>,
+    /// Kernels: wavefront (queued stages per bounce), megakernel (whole paths per work item)
+    /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
+    #[arg(long, default_value = "auto", value_parser = parse_kernel)]
+    pub kernel: KernelChoice,
     /// Image width in pixels.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub width: Option<u32>,
     /// Image height in pixels.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub height: Option<u32>,
     /// Samples per pixel.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub spp: Option<u32>,
     /// Bounces after the first hit (0 = direct light only).
-    #[arg(long, default_value_t = RenderSettings::default().bounces)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().bounces)]
     pub bounces: u32,
     /// Seed of the random sequence.
-    #[arg(long, default_value_t = RenderSettings::default().seed)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().seed)]
     pub seed: u32,
     /// Camera of the glTF file to use (index; the automatic camera when the file has none).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub camera: Option<usize>,
     /// Radius of point and spot lights in scene units (soft shadows); default 2% of the
     /// scene's diagonal. Directional lights get an angular radius of 2·R/diagonal radians.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_non_negative)]
     pub light_radius: Option<f32>,
     /// Hard shadows: every light radius 0.
     #[arg(long, conflicts_with = "light_radius")]
@@ -77,22 +81,33 @@ pub struct CommonArgs {
     #[arg(long, value_name = "FILE|COLOR", conflicts_with = "sky")]
     pub env: Option<String>,
     /// Radiance scale of the --env image.
-    #[arg(long, default_value_t = RenderSettings::default().env_intensity)]
+    #[arg(
+        long,
+        default_value_t = RenderSettings::default().env_intensity,
+        allow_negative_numbers = true,
+        value_parser = parse_non_negative
+    )]
     pub env_intensity: f32,
     /// Rotation of the --env image about the up (+Y) axis in degrees, counter-clockwise seen
     /// from above.
     #[arg(
         long,
         default_value_t = RenderSettings::default().env_rotation,
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        value_parser = parse_finite
     )]
     pub env_rotation: f32,
     /// Depth of field: thin-lens radius in scene units (0 = pinhole, everything sharp).
-    #[arg(long, default_value_t = RenderSettings::default().lens_radius)]
+    #[arg(
+        long,
+        default_value_t = RenderSettings::default().lens_radius,
+        allow_negative_numbers = true,
+        value_parser = parse_non_negative
+    )]
     pub aperture: f32,
     /// Distance from the eye to the plane in focus, along the view axis, in scene units
     /// (default: the distance to what the image centre sees).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_positive)]
     pub focus_distance: Option<f32>,
     /// Camera position X,Y,Z (replaces the file's camera; use with --look-at).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "look_at")]
@@ -101,7 +116,7 @@ pub struct CommonArgs {
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "eye")]
     pub look_at: Option<[f64; 3]>,
     /// Vertical field of view in degrees (default: the camera's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_fov)]
     pub fov: Option<f64>,
 }
 
@@ -123,6 +138,10 @@ pub enum EnvChoice {
     Color([f32; 3]),
     /// An environment image.
     Map(EnvMap),
+}
+
+fn parse_kernel(s: &str) -> Result<KernelChoice, String> {
+    s.parse()
 }
 
 fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
@@ -168,7 +187,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub sampling: SamplingArgs,
     /// Exposure in stops for PNG output.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_exposure)]
     pub exposure: f32,
 }
 
@@ -231,6 +250,80 @@ fn parse_color(s: &str) -> Result<[f32; 3], String> {
         ));
     }
     Ok(c)
+}
+
+/// A finite number (NaN and ±inf are refused).
+fn parse_finite(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("'{s}' is not a finite number")),
+    }
+}
+
+/// A finite number ≥ 0.
+fn parse_non_negative(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v >= 0.0 => Ok(v),
+        _ => Err(format!("'{s}' must be a finite number >= 0")),
+    }
+}
+
+/// A finite number > 0.
+fn parse_positive(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v > 0.0 => Ok(v),
+        _ => Err(format!("'{s}' must be a finite number > 0")),
+    }
+}
+
+/// A vertical field of view in degrees, strictly between 0 and 180.
+fn parse_fov(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
+        _ => Err(format!("'{s}' is not a field of view in degrees (0..180)")),
+    }
+}
+
+/// A duration in seconds: finite and > 0.
+pub(crate) fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "'{s}' is not a duration in seconds (a finite number > 0)"
+        )),
+    }
+}
+
+/// The most stops `--exposure` may brighten or darken by.
+pub const MAX_EXPOSURE: f32 = 64.0;
+
+/// An exposure in stops within ±[`MAX_EXPOSURE`].
+fn parse_exposure(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v.abs() <= MAX_EXPOSURE => Ok(v),
+        _ => Err(format!(
+            "'{s}' is out of range (-{MAX_EXPOSURE}..={MAX_EXPOSURE} stops)"
+        )),
+    }
+}
+
+/// One line for a command-line usage error (`penumbra: error: …`, exit code 2): clap's first
+/// line without its `error: ` prefix, and where to find the usage.
+pub fn usage_error(e: &clap::Error) -> String {
+    // clap's first paragraph says what is wrong; tips and the usage follow a blank line.
+    let rendered = e.render().to_string();
+    let what: Vec<&str> = rendered
+        .lines()
+        .map(str::trim)
+        .skip_while(|l| l.is_empty())
+        .take_while(|l| !l.is_empty())
+        .collect();
+    let what = what.join(" ");
+    let what = what.strip_prefix("error: ").unwrap_or(&what);
+    if what.is_empty() {
+        return "invalid command line (see penumbra --help)".into();
+    }
+    format!("{what} (see penumbra --help)")
 }
 
 /// The largest image side accepted.
@@ -424,6 +517,7 @@ fn view(args: ViewArgs) -> Result<()> {
         settings,
         spp_target: common.spp,
         device,
+        kernel: common.kernel,
         env_map: match environment {
             Some(EnvChoice::Map(map)) => Some(map),
             _ => None,

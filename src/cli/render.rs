@@ -25,6 +25,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let prepared = args.common.prepare(Some(&args.scene))?;
     let environment = args.common.environment()?;
     let mut renderer = Renderer::new(&args.common.device_choice()?)?;
+    renderer.set_kernel(args.common.kernel)?;
     renderer.set_settings(&settings)?;
     if let Some(EnvChoice::Map(map)) = environment {
         renderer.set_environment(Some(map))?;
@@ -97,6 +98,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "scene": args.scene.display().to_string(),
         "output": args.output.display().to_string(),
         "device": renderer.gpu.description(),
+        "kernel": renderer.kernel(),
         "width": settings.width,
         "height": settings.height,
         "spp": spp,

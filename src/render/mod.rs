@@ -3,6 +3,7 @@
 
 pub mod camera;
 mod lights;
+mod megakernel;
 mod settings;
 mod textures;
 pub mod tonemap;
@@ -10,12 +11,13 @@ mod upload;
 mod wavefront;
 
 pub use lights::gpu_lights;
+pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
 pub use upload::{HostScene, gpu_camera};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
-use crate::bvh::{Bvh, Ray};
+use crate::bvh::{Bvh, Ray, WideBvh};
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
@@ -76,6 +78,8 @@ pub struct Renderer {
     samples: u32,
     stats: RenderStats,
     pending: Vec<(Stage, Launch)>,
+    /// Whether frames run as the megakernel (else the wavefront); see [`KernelChoice`].
+    megakernel: bool,
 }
 
 impl Renderer {
@@ -108,8 +112,9 @@ impl Renderer {
             samples: 0,
             stats: RenderStats::default(),
             pending: Vec::new(),
+            megakernel: false,
         };
-        r.reset()?;
+        r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
     }
 
@@ -169,6 +174,7 @@ impl Renderer {
         };
         let buffers = SceneBuffers {
             nodes: Buffer::from_slice(&self.gpu, &host.bvh.nodes)?,
+            wide_nodes: Buffer::from_slice(&self.gpu, &WideBvh::collapse(&host.bvh).nodes)?,
             triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
             shading: Buffer::from_slice(&self.gpu, &host.shading)?,
             tangents: Buffer::from_slice(&self.gpu, tangents)?,
@@ -197,6 +203,8 @@ impl Renderer {
         if let Some(c) = self.world_camera.clone() {
             self.set_camera(&c)?;
         }
+        let mut stats = stats;
+        stats.kernel_build_ms += self.prime_megakernel()?;
         self.reset()?;
         Ok(stats)
     }

@@ -3,12 +3,18 @@
 //! Transforms are composed in f64; geometry is stored per object in object space and flattened
 //! into world-space triangles (f32) whenever the scene changes.
 
+mod accessor;
 mod bounds;
+mod compression;
 mod environment;
 mod gltf_import;
 mod lights;
+pub mod limits;
+mod pose;
+mod sources;
 mod tangents;
 mod textures;
+mod validate;
 
 pub use bounds::{ABSURD_COORDINATE, RenderFrame, is_sane, robust_bounds};
 pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
@@ -18,6 +24,7 @@ pub use textures::{
     Image, MAX_TEXTURE_SIDE, MaterialTextures, MipLevel, TexTransform, TextureRef, Wrap,
     linear_to_srgb, mip_chain, srgb_to_linear,
 };
+pub use validate::SUPPORTED_EXTENSIONS;
 
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};

@@ -35,7 +35,7 @@ pub struct ConvergeArgs {
     #[arg(long, value_delimiter = ',', value_parser = parse_config)]
     pub configs: Vec<Config>,
     /// Stop a configuration after the step that passes this many seconds of rendering.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = crate::cli::parse_seconds)]
     pub max_seconds: f64,
     /// Fit the slopes over the steps with at least this many samples per pixel.
     #[arg(long, default_value_t = 4)]
@@ -206,6 +206,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
 
     let mut renderer = Renderer::new(&args.common.device_choice()?)?;
+    renderer.set_kernel(args.common.kernel)?;
     renderer.set_settings(&settings)?;
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)

@@ -38,6 +38,7 @@ pub fn run(args: &FrameArgs) -> Result<()> {
     let prepared = args.common.prepare(args.scene.as_deref())?;
     let source = prepared.scene.source.clone();
     let mut renderer = Renderer::new(&args.common.device_choice()?)?;
+    renderer.set_kernel(args.common.kernel)?;
     renderer.set_settings(&settings)?;
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
@@ -77,6 +78,7 @@ pub fn run(args: &FrameArgs) -> Result<()> {
             "date": today(),
             "scene": source,
             "device": device_json(&renderer.gpu),
+            "kernel": renderer.kernel(),
             "width": settings.width,
             "height": settings.height,
             "spp": spp,

@@ -1,7 +1,9 @@
 //! `penumbra bench`: ray throughput of the traversal kernels (`trace`), where a frame's time
 //! goes (`frame`), error against run time (`converge`), and a generator of large test scenes
-//! (`generate`). What each measures, and the figures, are in `docs/benchmarks.md`.
+//! (`generate`), and the host BVH build and update (`bvh`). What each measures, and the figures,
+//! are in `docs/benchmarks.md`.
 
+mod bvh;
 mod converge;
 mod frame;
 pub mod generate;
@@ -11,6 +13,7 @@ mod stats;
 pub mod stress;
 mod trace;
 
+pub use bvh::BvhArgs;
 pub use converge::ConvergeArgs;
 pub use frame::FrameArgs;
 pub use generate::GenerateArgs;
@@ -32,6 +35,8 @@ pub enum BenchCommand {
     /// Error (RMSE, relMSE) against run time for several sampling settings, against a
     /// reference image; table, CSV/JSON and a log-log plot.
     Converge(Box<ConvergeArgs>),
+    /// Host time to build the scene's BVH and to update it when one instance moves.
+    Bvh(Box<BvhArgs>),
     /// Writes a large test scene (instanced spheres or copies of a mesh in a closed, lit room).
     Generate(Box<GenerateArgs>),
     /// The same image at any position and scale: moved and scaled copies of the Cornell box
@@ -47,6 +52,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Frame(a) => frame::run(&a),
         BenchCommand::Converge(a) => converge::run(&a),
         BenchCommand::Generate(a) => generate::run(&a),
+        BenchCommand::Bvh(a) => bvh::run(&a),
         BenchCommand::Stress(a) => stress::run(&a),
     }
 }

@@ -58,6 +58,10 @@ pub struct TraceArgs {
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Time the kernels of the 4-wide BVH (the megakernel's, CPU devices) instead of the
+    /// binary BVH's (the wavefront's).
+    #[arg(long)]
+    pub wide: bool,
 }
 
 /// Agreement of device results with the host traversal.
@@ -238,6 +242,7 @@ struct Tracer<'a> {
     counters: Buffer<u32>,
     warmup: usize,
     runs: usize,
+    wide: bool,
 }
 
 impl Tracer<'_> {
@@ -246,9 +251,12 @@ impl Tracer<'_> {
         let buf = Buffer::from_slice(self.gpu, rays)?;
         let hits = Buffer::<GpuHit>::new(self.gpu, rays.len())?;
         let times = time_launches(self.gpu, self.warmup, self.runs, || {
-            Ok(self
-                .program
-                .trace_closest(self.gpu, self.scene, &buf, &hits, &self.counters)?)
+            let (p, s, c) = (self.program, self.scene, &self.counters);
+            Ok(if self.wide {
+                p.trace_closest_wide(self.gpu, s, &buf, &hits, c)?
+            } else {
+                p.trace_closest(self.gpu, s, &buf, &hits, c)?
+            })
         })?;
         let mut out = hits.read(self.gpu)?;
         out.truncate(rays.len());
@@ -260,9 +268,12 @@ impl Tracer<'_> {
         let buf = Buffer::from_slice(self.gpu, rays)?;
         let occluded = Buffer::<u32>::new(self.gpu, rays.len())?;
         let times = time_launches(self.gpu, self.warmup, self.runs, || {
-            Ok(self
-                .program
-                .trace_any(self.gpu, self.scene, &buf, &occluded, &self.counters)?)
+            let (p, s, c) = (self.program, self.scene, &self.counters);
+            Ok(if self.wide {
+                p.trace_any_wide(self.gpu, s, &buf, &occluded, c)?
+            } else {
+                p.trace_any(self.gpu, s, &buf, &occluded, c)?
+            })
         })?;
         let mut out = occluded.read(self.gpu)?;
         out.truncate(rays.len());
@@ -313,6 +324,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         counters,
         warmup: args.warmup,
         runs: args.runs,
+        wide: args.wide,
     };
     let tris = &host.vertices;
     let bvh = &host.bvh;
@@ -366,6 +378,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     if args.json {
         let summary = serde_json::json!({
             "benchmark": "trace",
+            "bvh": if args.wide { "wide" } else { "binary" },
             "date": today(),
             "scene": source,
             "device": device_json(gpu),
@@ -405,9 +418,14 @@ pub fn run(args: &TraceArgs) -> Result<()> {
             stats.kernel_build_ms
         );
         println!(
-            "rays     {}×{} primary from camera '{}'; kernel time from profiling events, median \
-             of {} runs after {} warm-up",
-            args.width, args.height, prepared.camera.name, args.runs, args.warmup
+            "rays     {}×{} primary from camera '{}'; {} BVH kernels; kernel time from profiling \
+             events, median of {} runs after {} warm-up",
+            args.width,
+            args.height,
+            prepared.camera.name,
+            if args.wide { "4-wide" } else { "binary" },
+            args.runs,
+            args.warmup
         );
         println!();
         println!(

@@ -1,0 +1,256 @@
+// One path vertex at a time: the camera ray, and the shading of the vertex a ray found
+// (emission with MIS, one light sample, the BSDF sample and Russian roulette). Both execution
+// shapes call these, so they compute the same estimator with the same random numbers:
+//   - the wavefront (stages.cl) keeps the state in GpuPath slots between kernels and traces
+//     the light sample later in `connect`;
+//   - the megakernel (megakernel.cl) keeps it in registers and traces the light sample at once.
+
+inline float power_heuristic(float a, float b) {
+    float a2 = a * a;
+    float b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+// A path between two vertices.
+typedef struct {
+    float3 origin;      // of the next ray
+    float3 direction;   // of the next ray (unit)
+    float3 throughput;
+    float3 radiance;    // gathered so far
+    float prev_pdf;     // pdf of the BSDF sample that made the ray (0: camera ray)
+    uint flags;         // PATH_SPECULAR
+    uint rng;
+    float2 cone;        // ray cone (width, spread angle) for texture filtering
+} PathState;
+
+// A light sample to test for visibility: `contribution` is added to the path's radiance when
+// the segment (origin, direction, 0..tmax) is unoccluded.
+typedef struct {
+    float3 origin;
+    float3 direction;
+    float tmax;
+    float3 contribution;
+    bool valid;
+} ShadowQuery;
+
+// What shading reads of the scene.
+typedef struct {
+    global const GpuTriangle* tris;
+    SceneSurfaces surf;
+    EnvMap env;
+    global const GpuLight* lights;
+    global const float* light_cdf;
+} ShadeScene;
+
+// The camera ray of sample `sample` of `pixel` (box filter, pinhole or thin lens), with the
+// random state seeded from (pixel, sample, seed).
+inline PathState camera_path(const GpuFrame* frame, const GpuCamera* camera, uint pixel,
+                             uint sample) {
+    uint rng = hash_u32(hash_u32(pixel ^ hash_u32(frame->seed)) ^
+                        hash_u32(sample * 0x9e3779b9u + 1u));
+    // Jitter within the pixel (box filter) and form the pinhole or thin-lens ray.
+    float fx = ((float)(pixel % frame->width) + rng_next(&rng)) / (float)frame->width;
+    float fy = ((float)(pixel / frame->width) + rng_next(&rng)) / (float)frame->height;
+    float3 dir = camera->forward.xyz + (2.0f * fx - 1.0f) * camera->right.xyz +
+                 (1.0f - 2.0f * fy) * camera->up.xyz;
+    float3 origin = camera->origin.xyz;
+    float u1 = rng_next(&rng);
+    float u2 = rng_next(&rng);
+    if (camera->origin.w > 0.0f) {
+        float3 focus = origin + dir * camera->forward.w;
+        float r = camera->origin.w * sqrt(u1);
+        float phi = 2.0f * PI_F * u2;
+        origin += r * cos(phi) * normalize(camera->right.xyz) +
+                  r * sin(phi) * normalize(camera->up.xyz);
+        dir = focus - origin;
+    }
+    PathState s;
+    s.origin = origin;
+    s.direction = normalize(dir);
+    s.throughput = (float3)(1.0f, 1.0f, 1.0f);
+    s.radiance = (float3)(0.0f, 0.0f, 0.0f);
+    s.prev_pdf = 0.0f;
+    s.flags = 0u;
+    s.rng = rng;
+    // The ray cone for texture filtering: no width at the eye, one pixel's angle of spread.
+    s.cone = (float2)(0.0f, 2.0f * length(camera->up.xyz) / (float)frame->height);
+    return s;
+}
+
+// Shades the vertex that the path's ray found at `bounce` (hit.prim == NO_HIT: it escaped).
+// Adds emission to s->radiance, fills *shadow with the light sample to test (valid = false
+// when there is none) and, when the path goes on, sets the next ray. Returns whether it does.
+inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* sc, GpuHit hit,
+                         PathState* s, ShadowQuery* shadow) {
+    shadow->valid = false;
+    float3 throughput = s->throughput;
+    float3 radiance = s->radiance;
+    uint rng = s->rng;
+    float3 wo = -s->direction;
+    float prev_pdf = s->prev_pdf;
+    bool prev_specular = (s->flags & PATH_SPECULAR) != 0u;
+    bool counts_emission = bounce == 0u || prev_specular || frame->strategy != STRATEGY_LIGHTS;
+    const SceneSurfaces* surf = &sc->surf;
+    global const GpuMaterial* materials = surf->materials;
+
+    if (hit.prim == NO_HIT) {
+#ifdef HAS_ENV_MAP
+        // Escaped into the environment map, weighted against its sampling at the last vertex.
+        float env_pdf;
+        float3 le = env_radiance(&sc->env, -wo, &env_pdf);
+        float weight = 1.0f;
+        if (bounce > 0u && !prev_specular && frame->strategy == STRATEGY_MIS) {
+            weight = power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
+        }
+        if (counts_emission) radiance += throughput * le * weight;
+#else
+        // Escaped: the uniform sky, reached by BSDF sampling only.
+        if (counts_emission) radiance += throughput * frame->sky.xyz;
+#endif
+        s->radiance = radiance;
+        return false;
+    }
+
+    GpuTriangle tri = sc->tris[hit.prim];
+    float w0 = 1.0f - hit.u - hit.v;
+    float3 p_err;
+    float3 p = surface_point(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, hit.u, hit.v, &p_err);
+    float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
+    global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
+    bool front = dot(ng, wo) > 0.0f;
+    GpuTriShading sh = surf->shading[hit.prim];
+    TexCoords tc = texcoords_at(sh, hit.u, hit.v);
+#ifdef HAS_TEXTURES
+    // The ray cone's footprint picks the mip levels; it widens by the roughness at each bounce.
+    float2 cone = s->cone;
+    float cone_width = cone.x + cone.y * hit.t;
+    texcoords_footprint(&tc, sh, tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz, cone_width,
+                        fabs(dot(ng, wo)));
+    tc.xi = rng_next(&rng);
+#endif
+
+#ifdef HAS_TRIANGLE_LIGHTS
+    // Emission of a light hit by this ray, weighted against light sampling of the last vertex.
+    int light_index = as_int(tri.v1.w);
+    bool two_sided = (as_uint(mat->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
+    if (light_index >= 0 && (front || two_sided) && counts_emission) {
+        float weight = 1.0f;
+        if (bounce > 0u && !prev_specular && frame->strategy == STRATEGY_MIS) {
+            global const GpuLight* l = &sc->lights[light_index];
+            float cos_l = fabs(dot(ng, wo));
+            float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
+            weight = power_heuristic(prev_pdf, light_pdf);
+        }
+#ifdef HAS_TEXTURES
+        // Past the camera ray, emission is read at the finest level, as light sampling reads it.
+        TexCoords etc = bounce == 0u ? tc : texcoords_at(sh, hit.u, hit.v);
+        radiance += throughput * textured_emission(mat, surf, &etc) * weight;
+#else
+        radiance += throughput * mat->emission.xyz * weight;
+#endif
+    }
+#endif
+
+    // The last extension only looks for emitters (the MIS partner of the last light sample).
+    if (bounce > frame->max_bounces) {
+        s->radiance = radiance;
+        return false;
+    }
+
+    // Face the normals towards the side the ray came from.
+    if (!front) ng = -ng;
+    float3 ns = ng;
+    if (sh.n0.w > 0.0f) {
+        float3 n = w0 * sh.n0.xyz + hit.u * sh.n1.xyz + hit.v * sh.n2.xyz;
+        float len = length(n);
+        if (len > 0.0f) {
+            ns = n / len;
+            if (dot(ns, ng) < 0.0f) ns = -ns;
+        }
+    }
+#ifdef HAS_NORMAL_MAPS
+    if (mat->textures.z >= 0) ns = normal_map(surf, mat, &tc, hit.prim, hit.u, hit.v, ns, ng, front);
+#endif
+    SurfaceMaterial m = surface_material(mat);
+#ifdef HAS_TEXTURES
+    apply_textures(&m, mat, surf, &tc);
+    float alpha_r = m.roughness * m.roughness;
+    s->cone = (float2)(cone_width, cone.y + alpha_r);
+#endif
+
+    // Hit from behind, a transmissive volume was travelled through: attenuate the segment
+    // (Beer–Lambert) and see the interface from inside. Other back faces shade as front faces.
+    if (!front && m.transmission > 0.0f && m.thickness > 0.0f) {
+        throughput *= volume_transmittance(&m, hit.t);
+        material_from_inside(&m);
+    }
+
+    // Next-event estimation: one light sample, its visibility tested by the caller.
+    if (frame->strategy != STRATEGY_BSDF && frame->light_count > 0u) {
+        uint index = cdf_search(sc->light_cdf, frame->light_count, rng_next(&rng));
+        float u1 = rng_next(&rng);
+        float u2 = rng_next(&rng);
+        LightSample ls =
+            sample_light(sc->lights, sc->tris, materials, surf, &sc->env, index, p, u1, u2);
+        // A light behind the surface is reached through transmission when bsdf_eval says so;
+        // the geometric and shading normals must agree on the side. Transmissive surfaces
+        // block shadow rays (no caustics through next-event estimation).
+        float side = dot(ls.wi, ng);
+        if (side * dot(ls.wi, ns) > 0.0f &&
+            (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
+            float bsdf_pdf;
+            float3 f = bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
+            float weight = (frame->strategy == STRATEGY_MIS && ls.pdf > 0.0f)
+                               ? power_heuristic(ls.pdf, bsdf_pdf)
+                               : 1.0f;
+            float3 contribution = throughput * f * ls.radiance * weight;
+            if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
+                float3 from = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
+                float3 dir = ls.wi;
+                // Virtual lights (spheres, discs, the sky) are not geometry: trace to them.
+                float tmax = ls.distance;
+                if (ls.on_surface) {
+                    float3 seg = ls.target - from;
+                    tmax = length(seg);
+                    dir = seg / tmax;
+                }
+                shadow->origin = from;
+                shadow->direction = dir;
+                shadow->tmax = tmax;
+                shadow->contribution = contribution;
+                shadow->valid = true;
+            }
+        }
+    }
+
+    // Sample the BSDF for the next ray; Russian roulette after rr_depth bounces.
+    float3 wi;
+    float pdf;
+    bool specular;
+    float u1 = rng_next(&rng);
+    float u2 = rng_next(&rng);
+    float u3 = m.transmission > 0.0f ? rng_next(&rng) : 0.0f;
+    float3 weight = bsdf_sample(&m, ns, wo, (float3)(u1, u2, u3), &wi, &pdf, &specular);
+    throughput *= weight;
+    float side = dot(wi, ng);
+    bool alive = pdf > 0.0f && side * dot(wi, ns) > 0.0f &&
+                 (throughput.x > 0.0f || throughput.y > 0.0f || throughput.z > 0.0f);
+    if (alive && bounce >= frame->rr_depth) {
+        float q = fmin(fmax(throughput.x, fmax(throughput.y, throughput.z)), 0.95f);
+        if (rng_next(&rng) >= q) {
+            alive = false;
+        } else {
+            throughput /= q;
+        }
+    }
+    s->radiance = radiance;
+    s->rng = rng;
+    if (alive) {
+        s->origin = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
+        s->prev_pdf = pdf;
+        s->direction = wi;
+        s->flags = specular ? PATH_SPECULAR : 0u;
+        s->throughput = throughput;
+    }
+    return alive;
+}
