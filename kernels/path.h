@@ -113,8 +113,9 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
 
     GpuTriangle tri = sc->tris[hit.prim];
     float w0 = 1.0f - hit.u - hit.v;
-    float3 p = w0 * tri.v0.xyz + hit.u * tri.v1.xyz + hit.v * tri.v2.xyz;
-    float3 ng = normalize(cross(tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz));
+    float3 p_err;
+    float3 p = surface_point(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, hit.u, hit.v, &p_err);
+    float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
     global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
     bool front = dot(ng, wo) > 0.0f;
     GpuTriShading sh = surf->shading[hit.prim];
@@ -204,7 +205,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
                                : 1.0f;
             float3 contribution = throughput * f * ls.radiance * weight;
             if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
-                float3 from = offset_ray(p, side > 0.0f ? ng : -ng);
+                float3 from = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
                 float3 dir = ls.wi;
                 // Virtual lights (spheres, discs, the sky) are not geometry: trace to them.
                 float tmax = ls.distance;
@@ -245,7 +246,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     s->radiance = radiance;
     s->rng = rng;
     if (alive) {
-        s->origin = offset_ray(p, side > 0.0f ? ng : -ng);
+        s->origin = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
         s->prev_pdf = pdf;
         s->direction = wi;
         s->flags = specular ? PATH_SPECULAR : 0u;

@@ -102,7 +102,7 @@ impl CameraArgs {
         };
         if let (Some(eye), Some(target)) = (self.eye, self.look_at) {
             let (eye, target) = (glam::DVec3::from(eye), glam::DVec3::from(target));
-            if (target - eye).length() < 1e-12 {
+            if (target - eye).normalize_or_zero() == glam::DVec3::ZERO {
                 bail!("--eye and --look-at are the same point");
             }
             camera = Camera::look_at("command line", eye, target, camera.yfov);

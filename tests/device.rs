@@ -9,7 +9,7 @@ use penumbra::bvh::Ray;
 use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay, layouts};
 use penumbra::cl::{Buffer, DeviceChoice};
 use penumbra::render::Renderer;
-use penumbra::scene::{Material, Mesh, Object, Scene};
+use penumbra::scene::{Material, Mesh, Object, RenderFrame, Scene};
 use serde_json::json;
 
 fn renderer() -> Renderer {
@@ -87,7 +87,9 @@ fn layout_probe_agrees_with_every_shared_rust_struct() {
 fn kernel_traversal_equals_host_traversal() {
     // Binary and 4-wide BVH kernels alike.
     let mut r = renderer();
-    r.load_scene(&random_scene(3000), &[]).unwrap();
+    // In world coordinates (no render frame): the rays below are made in world space.
+    r.load_scene_in(&random_scene(3000), &[], RenderFrame::default())
+        .unwrap();
     let host = r.host_scene().unwrap();
     let mut s = 17u64;
     let mut rnd = || {

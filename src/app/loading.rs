@@ -121,8 +121,7 @@ impl App {
         };
         self.autofocus = false;
         let aspect = self.size.0 as f32 / self.size.1.max(1) as f32;
-        let ray = pick::primary_ray(&self.model.camera.camera, aspect, 0.5, 0.5);
-        if let Some(hit) = pick::pick(host, &ray) {
+        if let Some(hit) = pick::pick(host, &self.model.camera.camera, aspect, 0.5, 0.5) {
             self.focus_at(hit.point);
         }
     }

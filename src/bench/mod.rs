@@ -10,12 +10,14 @@ pub mod generate;
 mod plot;
 mod rays;
 mod stats;
+pub mod stress;
 mod trace;
 
 pub use bvh::BvhArgs;
 pub use converge::ConvergeArgs;
 pub use frame::FrameArgs;
 pub use generate::GenerateArgs;
+pub use stress::StressArgs;
 pub use trace::TraceArgs;
 
 use crate::cl::Gpu;
@@ -41,6 +43,10 @@ pub enum BenchCommand {
     Bvh(Box<BvhArgs>),
     /// Writes a large test scene (instanced spheres or copies of a mesh in a closed, lit room).
     Generate(Box<GenerateArgs>),
+    /// The same image at any position and scale: moved and scaled copies of the Cornell box
+    /// against the original, leaks from closed meshes, spawned-ray reintersection, grazing
+    /// shadow rays and acne; a Markdown table.
+    Stress(Box<StressArgs>),
 }
 
 /// Runs a benchmark.
@@ -51,6 +57,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Converge(a) => converge::run(&a),
         BenchCommand::Generate(a) => generate::run(&a),
         BenchCommand::Bvh(a) => bvh::run(&a),
+        BenchCommand::Stress(a) => stress::run(&a),
     }
 }
 

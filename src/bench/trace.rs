@@ -326,7 +326,11 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     let bvh = &host.bvh;
 
     // Primary rays.
-    let camera = gpu_camera(&prepared.camera, settings.aspect());
+    // Rays are made in the render space the scene was uploaded in.
+    let camera = gpu_camera(
+        &renderer.space().camera(&prepared.camera),
+        settings.aspect(),
+    );
     let primary = rays::primary_rays(&camera, width, height);
     let (primary_hits, times) = tracer.closest(&primary)?;
     let check = timed(|| check_closest(bvh, tris, &primary, &primary_hits, args.validate));
@@ -359,7 +363,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         ));
 
         // Shadow rays from the primary hits to the lights.
-        let targets = light_targets(&prepared.lights, host, tris);
+        let targets = light_targets(&host.space.lights(&prepared.lights), host, tris);
         let shadow = rays::shadow_rays(&points, primary.len(), &targets, args.seed);
         let (occluded, times) = tracer.any(&shadow)?;
         let check = timed(|| check_any(bvh, tris, &shadow, &occluded, args.validate));

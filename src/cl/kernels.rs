@@ -204,6 +204,7 @@ struct TestKernels {
     sample_env_test: Kernel,
     bsdf_sample_test: Kernel,
     bsdf_eval_test: Kernel,
+    spawn_test: Kernel,
 }
 
 fn kernel(program: &opencl3::program::Program, name: &str) -> Result<Kernel, ClError> {
@@ -253,6 +254,7 @@ impl Program {
             sample_env_test: k("sample_env_test")?,
             bsdf_sample_test: k("bsdf_sample_test")?,
             bsdf_eval_test: k("bsdf_eval_test")?,
+            spawn_test: k("spawn_test")?,
         };
         Ok(self.tests.get_or_init(|| built))
     }
@@ -661,6 +663,42 @@ impl Program {
             },
         )?;
         Ok((out.read(gpu)?, eval.read(gpu)?))
+    }
+
+    /// `spawn_test` (test program): rays spawned with the kernels' hit point and offset; case i
+    /// leaves triangle `groups[i][0]` (vertices `verts[3k..3k + 3]`, xyz) at barycentrics
+    /// `bary[i]` along `dirs[i]` (.w = tmax) and counts its hits among the `groups[i][2]`
+    /// triangles from `groups[i][1]` (`groups[i][3]` is unused).
+    pub fn spawn_test(
+        &self,
+        gpu: &Gpu,
+        verts: &[[f32; 4]],
+        groups: &[[u32; 4]],
+        bary: &[[f32; 2]],
+        dirs: &[[f32; 4]],
+    ) -> Result<Vec<u32>, ClError> {
+        let tests = self.tests(gpu)?;
+        let vb = Buffer::from_slice(gpu, verts)?;
+        let gb = Buffer::from_slice(gpu, groups)?;
+        let bb = Buffer::from_slice(gpu, bary)?;
+        let db = Buffer::from_slice(gpu, dirs)?;
+        let hits = Buffer::<u32>::new(gpu, dirs.len())?;
+        let count = dirs.len() as u32;
+        self.run(
+            gpu,
+            "spawn_test",
+            &tests.spawn_test,
+            dirs.len(),
+            |e| unsafe {
+                e.set_arg(&vb.mem())
+                    .set_arg(&gb.mem())
+                    .set_arg(&bb.mem())
+                    .set_arg(&db.mem())
+                    .set_arg(&count)
+                    .set_arg(&hits.mem());
+            },
+        )?;
+        hits.read(gpu)
     }
 
     /// `bsdf_sample_test` (test program): `count` BSDF samples of `material` at (`wo`, `n`), seen from inside

@@ -34,15 +34,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| format!("{}", args.scene.display()))?;
+    if scene_stats.dropped_triangles > 0 {
+        log::warn!(
+            "{}: {} triangles with a non-finite or absurd (beyond 1e30) vertex dropped",
+            args.scene.display(),
+            scene_stats.dropped_triangles
+        );
+    }
     renderer.set_camera(&prepared.camera)?;
     if settings.lens_radius > 0.0 && args.common.lens.focus_distance.is_none() {
         // Focus on what the image centre sees (else the scene's centre).
         let focus = renderer
             .focus_distance_at(settings.width as f32 * 0.5, settings.height as f32 * 0.5)
             .unwrap_or_else(|| {
-                (prepared.scene.bounds().center() - prepared.camera.eye)
+                let bounds = prepared.scene.bounds();
+                (bounds.center() - prepared.camera.eye)
                     .dot(prepared.camera.forward)
-                    .max(1e-3) as f32
+                    .max(1e-3 * bounds.diagonal()) as f32
             });
         renderer.set_lens(settings.lens_radius, focus)?;
     }
@@ -117,6 +125,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "bvh_build_ms": scene_stats.bvh_build_ms,
         "kernel_build_ms": scene_stats.kernel_build_ms,
         "triangles": scene_stats.triangles,
+        "dropped_triangles": scene_stats.dropped_triangles,
         "bvh_nodes": scene_stats.nodes,
         "lights": prepared.lights.len(),
         "default_light_rig": prepared.scene.default_rig,

@@ -149,7 +149,7 @@ impl Renderer {
             .environment
             .as_ref()
             .map(|(_, t)| t.mean_luminance * self.settings.env_intensity);
-        gpu_lights(&self.lights, host, env_luminance)
+        gpu_lights(&host.space.lights(&self.lights), host, env_luminance)
     }
 
     /// Fills the environment constants from the settings and the light list.
