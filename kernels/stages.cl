@@ -26,6 +26,7 @@ kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, gl
 }
 
 kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                   global const GpuInstance* instances, global const GpuTriangle* object_tris,
                    global const GpuTriShading* shading, global const GpuTriTangents* tangents,
                    global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
                    global const GpuTexture* textures, global const uint* texels,
@@ -35,8 +36,8 @@ kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tri
     if (i >= counters[COUNT_IN]) return;
     SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
     global const GpuPath* p = &paths[queue[i]];
-    hits[i] = traverse(nodes, tris, &surf, p->origin.xyz, p->direction.xyz, 0.0f, INFINITY,
-                       false, &counters[COUNT_OVERFLOW]);
+    hits[i] = trace_scene(nodes, tris, instances, object_tris, &surf, p->origin.xyz,
+                          p->direction.xyz, 0.0f, INFINITY, false, &counters[COUNT_OVERFLOW]);
 }
 
 kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTriangle* tris,
@@ -92,6 +93,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
 }
 
 kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                    global const GpuInstance* instances, global const GpuTriangle* object_tris,
                     global const GpuTriShading* shading, global const GpuTriTangents* tangents,
                     global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
                     global const GpuTexture* textures, global const uint* texels,
@@ -101,8 +103,8 @@ kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tr
     if (i >= counters[COUNT_SHADOW]) return;
     SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
     GpuShadowRay r = shadow_rays[i];
-    GpuHit hit = traverse(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, 0.0f, r.origin.w,
-                          true, &counters[COUNT_OVERFLOW]);
+    GpuHit hit = trace_scene(nodes, tris, instances, object_tris, &surf, r.origin.xyz,
+                             r.direction.xyz, 0.0f, r.origin.w, true, &counters[COUNT_OVERFLOW]);
     if (hit.prim == NO_HIT) paths[as_uint(r.direction.w)].radiance.xyz += r.contribution.xyz;
 }
 

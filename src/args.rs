@@ -7,7 +7,7 @@
 use crate::cl::DeviceChoice;
 use crate::cli::first_image;
 use crate::render::exposure::ExposureMode;
-use crate::render::{KernelChoice, RenderSettings, Renderer, Strategy};
+use crate::render::{BvhChoice, KernelChoice, RenderSettings, Renderer, Strategy};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
 use anyhow::{Result, bail};
 use clap::Args;
@@ -312,6 +312,11 @@ pub struct CommonArgs {
     /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
     #[arg(long, default_value = "auto", value_parser = parse_kernel)]
     pub kernel: KernelChoice,
+    /// Acceleration structure: flat (one BVH over every triangle), two-level (a BLAS per
+    /// distinct mesh under a TLAS of instances) or auto (two levels when instancing at least
+    /// halves the triangles).
+    #[arg(long, default_value = "auto")]
+    pub bvh: BvhChoice,
 }
 
 fn parse_kernel(s: &str) -> Result<KernelChoice, String> {
@@ -335,6 +340,7 @@ impl CommonArgs {
     pub fn open_renderer(&self, settings: &RenderSettings) -> Result<Renderer> {
         let mut renderer = Renderer::new(&self.device_choice()?)?;
         renderer.set_kernel(self.kernel)?;
+        renderer.set_bvh_choice(self.bvh);
         renderer.set_settings(settings)?;
         Ok(renderer)
     }

@@ -3,7 +3,7 @@
 
 use super::{TwoLevel, build};
 use crate::scene::{Object, Scene};
-use glam::{Mat4, Vec3};
+use glam::{DMat4, DVec3, Vec3};
 use serde::Serialize;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
@@ -126,7 +126,7 @@ pub fn report(scene: &Scene, runs: usize) -> BvhReport {
         for run in 0..runs {
             let d = if run % 2 == 0 { extent * 0.1 } else { 0.0 };
             let t = Instant::now();
-            two.set_transform(i, Mat4::from_translation(Vec3::X * d) * home);
+            two.set_transform(i, DMat4::from_translation(DVec3::X * d as f64) * home);
             instance_move_ms = instance_move_ms.min(ms(t));
         }
     }
@@ -154,7 +154,7 @@ type Triangles = Vec<[Vec3; 3]>;
 /// The distinct meshes among `objects` (object-space triangles) and each object's mesh index
 /// and transform. The importer gives each node its own copy of the mesh, so meshes are told
 /// apart by their content.
-fn instances(objects: &[(usize, &Object)]) -> (Vec<Triangles>, Vec<(u32, Mat4)>) {
+fn instances(objects: &[(usize, &Object)]) -> (Vec<Triangles>, Vec<(u32, DMat4)>) {
     let mut index: HashMap<u64, u32> = HashMap::new();
     let mut meshes = vec![];
     let placed = objects
@@ -175,7 +175,7 @@ fn instances(objects: &[(usize, &Object)]) -> (Vec<Triangles>, Vec<(u32, Mat4)>)
                 );
                 meshes.len() as u32 - 1
             });
-            (mesh, o.world_from_object.as_mat4())
+            (mesh, o.world_from_object)
         })
         .collect();
     (meshes, placed)

@@ -56,6 +56,8 @@ pub struct KernelFeatures {
     pub transmission: bool,
     /// An environment map lights the scene (`HAS_ENV_MAP`).
     pub env_map: bool,
+    /// Rays descend a top level over instances, then their meshes' bottom levels (`TWO_LEVEL`).
+    pub two_level: bool,
 }
 
 impl KernelFeatures {
@@ -69,6 +71,7 @@ impl KernelFeatures {
             (self.alpha, "HAS_ALPHA"),
             (self.transmission, "HAS_TRANSMISSION"),
             (self.env_map, "HAS_ENV_MAP"),
+            (self.two_level, "TWO_LEVEL"),
         ] {
             if on {
                 d.push_str(" -D");

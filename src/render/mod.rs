@@ -3,6 +3,7 @@
 
 pub mod camera;
 pub mod exposure;
+pub mod instancing;
 mod lights;
 mod megakernel;
 mod settings;
@@ -11,14 +12,15 @@ pub mod tonemap;
 mod upload;
 mod wavefront;
 
+pub use instancing::BvhChoice;
 pub use lights::gpu_lights;
 pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
-pub use upload::{HostScene, gpu_camera};
+pub use upload::{Accel, HostScene, gpu_camera};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
-use crate::bvh::{Bvh, Ray, WideBvh};
+use crate::bvh::{Ray, WideBvh};
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
@@ -54,6 +56,14 @@ pub struct SceneStats {
     pub texture_max_side: u32,
     /// Triangles left out for a non-finite or absurd vertex.
     pub dropped_triangles: usize,
+    /// The acceleration structure: "flat" or "two-level".
+    pub bvh: &'static str,
+    /// Distinct meshes with a BLAS (two levels; 1 when flat).
+    pub meshes: usize,
+    /// Instances in the TLAS (two levels; 0 when flat).
+    pub instances: usize,
+    /// Bytes of every scene buffer on the device (textures included).
+    pub device_bytes: usize,
 }
 
 /// The path tracer on one OpenCL device.
@@ -81,6 +91,8 @@ pub struct Renderer {
     pending: Vec<(Stage, Launch)>,
     /// Whether frames run as the megakernel (else the wavefront); see [`KernelChoice`].
     megakernel: bool,
+    /// The acceleration structure the next scene load builds.
+    bvh_choice: BvhChoice,
 }
 
 impl Renderer {
@@ -114,6 +126,7 @@ impl Renderer {
             stats: RenderStats::default(),
             pending: Vec::new(),
             megakernel: false,
+            bvh_choice: BvhChoice::Auto,
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -137,14 +150,32 @@ impl Renderer {
     ) -> Result<SceneStats, ClError> {
         let t = Instant::now();
         let flat = scene.flatten(&space);
+        let dropped = flat.dropped;
         let world = flat.triangles;
-        let verts: Vec<[glam::Vec3; 3]> = world.iter().map(|t| t.v).collect();
-        let bvh = crate::bvh::build(&verts);
+        let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
+        let (mut host, object_tris) =
+            match instancing::plan(scene, &space, dropped, self.bvh_choice) {
+                Some(plan) => {
+                    let object_tris = object_triangles(&plan);
+                    let host = HostScene::ordered(
+                        &world,
+                        &plan.order,
+                        Accel::TwoLevel(plan.two),
+                        &materials,
+                    );
+                    (host, object_tris)
+                }
+                None => {
+                    let verts: Vec<[glam::Vec3; 3]> = world.iter().map(|t| t.v).collect();
+                    let bvh = crate::bvh::build(&verts);
+                    drop(verts);
+                    (HostScene::new(&world, bvh, &materials), vec![])
+                }
+            };
+        drop(world);
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
 
         let t = Instant::now();
-        let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
-        let mut host = HostScene::new(&world, bvh, &materials);
         host.space = space;
         host.scale_emitter_power(&lights::emissive_texture_means(scene));
         let used = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
@@ -155,6 +186,7 @@ impl Renderer {
             alpha: used(&|m| m.alpha != AlphaMode::Opaque),
             transmission: used(&|m| m.transmission > 0.0),
             env_map: false,
+            two_level: matches!(host.accel, Accel::TwoLevel(_)),
         };
         let budget = self
             .gpu
@@ -173,10 +205,18 @@ impl Renderer {
         } else {
             &host.tangents
         };
+        let (nodes, wide_nodes, instances) = device_accel(&host.accel);
+        let object_tris = if object_tris.is_empty() {
+            vec![GpuTriangle::default()]
+        } else {
+            object_tris
+        };
         let buffers = SceneBuffers {
-            nodes: Buffer::from_slice(&self.gpu, &host.bvh.nodes)?,
-            wide_nodes: Buffer::from_slice(&self.gpu, &WideBvh::collapse(&host.bvh).nodes)?,
+            nodes: Buffer::from_slice(&self.gpu, &nodes)?,
+            wide_nodes: Buffer::from_slice(&self.gpu, &wide_nodes)?,
             triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
+            instances: Buffer::from_slice(&self.gpu, &instances)?,
+            object_triangles: Buffer::from_slice(&self.gpu, &object_tris)?,
             shading: Buffer::from_slice(&self.gpu, &host.shading)?,
             tangents: Buffer::from_slice(&self.gpu, tangents)?,
             tex_refs: Buffer::from_slice(&self.gpu, &pack.refs)?,
@@ -186,19 +226,25 @@ impl Renderer {
             lights: Buffer::from_slice(&self.gpu, &glights)?,
             light_cdf: Buffer::from_slice(&self.gpu, &cdf)?,
         };
+        drop((nodes, wide_nodes, instances, object_tris));
         self.light_count = glights.len() as u32;
         self.update_env_info(&glights);
+        let (meshes, instances) = host.accel.instancing();
         let stats = SceneStats {
             triangles: host.triangles.len(),
-            nodes: host.bvh.nodes.len(),
-            sah_cost: host.bvh.sah_cost,
+            nodes: host.accel.node_count(),
+            sah_cost: host.accel.sah_cost(),
             bvh_build_ms,
             kernel_build_ms,
             upload_ms: t.elapsed().as_secs_f64() * 1e3 - kernel_build_ms,
             textures: pack.textures.len(),
             texture_bytes: pack.bytes(),
             texture_max_side: pack.max_side,
-            dropped_triangles: flat.dropped,
+            dropped_triangles: dropped,
+            bvh: host.accel.name(),
+            meshes,
+            instances,
+            device_bytes: buffers.bytes(),
         };
         self.scene = Some((buffers, host));
         if let Some(c) = self.world_camera.clone() {
@@ -300,7 +346,7 @@ impl Renderer {
             direction: unit,
             ..ray
         };
-        let hit = host.bvh.intersect(&ray, &host.vertices)?;
+        let hit = host.intersect(&ray)?;
         Some((hit.t * unit.dot(forward.normalize())) / host.space.scale as f32)
     }
 
@@ -395,9 +441,14 @@ impl Renderer {
         self.scene.as_ref().map(|(b, _)| b)
     }
 
-    /// The BVH on the host.
-    pub fn bvh(&self) -> Option<&Bvh> {
-        self.scene.as_ref().map(|(_, h)| &h.bvh)
+    /// The acceleration structure on the host.
+    pub fn accel(&self) -> Option<&Accel> {
+        self.scene.as_ref().map(|(_, h)| &h.accel)
+    }
+
+    /// Chooses the acceleration structure of the scenes loaded from now on.
+    pub fn set_bvh_choice(&mut self, choice: BvhChoice) {
+        self.bvh_choice = choice;
     }
 
     /// The film as linear RGB (the mean of the samples), row by row from the top.
@@ -418,4 +469,55 @@ impl Renderer {
             })
             .collect())
     }
+}
+
+/// The device's node arrays (binary and wide) and instances for `accel`; the instances are a
+/// placeholder when flat.
+fn device_accel(accel: &Accel) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec<GpuInstance>) {
+    match accel {
+        Accel::Flat(bvh) => (
+            bvh.nodes.clone(),
+            WideBvh::collapse(bvh).nodes,
+            vec![GpuInstance::default()],
+        ),
+        Accel::TwoLevel(two) => {
+            let (nodes, roots, firsts) = two.device_nodes();
+            let (wide, wide_roots) = two.device_wide_nodes();
+            let instances = two
+                .tlas
+                .tri_indices
+                .iter()
+                .map(|&i| {
+                    let inst = &two.instances[i as usize];
+                    let b = inst.blas as usize;
+                    GpuInstance {
+                        row0: inst.rows[0],
+                        row1: inst.rows[1],
+                        row2: inst.rows[2],
+                        root: roots[b],
+                        wide_root: wide_roots[b],
+                        prim_offset: inst.prim_offset.wrapping_sub(firsts[b]),
+                        flags: inst.mirrored as u32,
+                    }
+                })
+                .collect();
+            (nodes, wide, instances)
+        }
+    }
+}
+
+/// Every distinct mesh's object-space triangles in BLAS order, mesh after mesh, with the
+/// material in `v0.w`.
+fn object_triangles(plan: &instancing::Instancing) -> Vec<GpuTriangle> {
+    plan.two
+        .blases
+        .iter()
+        .flat_map(|b| &b.triangles)
+        .zip(&plan.object_materials)
+        .map(|(t, &m)| GpuTriangle {
+            v0: upload::f4(t[0], f32::from_bits(m)),
+            v1: upload::f4(t[1], 0.0),
+            v2: upload::f4(t[2], 0.0),
+        })
+        .collect()
 }

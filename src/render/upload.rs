@@ -1,16 +1,71 @@
 //! Turning the host scene into the device's structs: triangles and shading data in BVH order,
 //! materials and the camera. The light list is built in `lights`, the textures in `textures`.
 
-use crate::bvh::Bvh;
+use crate::bvh::{Bvh, Hit, Ray, TwoLevel};
 use crate::cl::types::*;
 use crate::scene::{AlphaMode, Camera, Material, RenderFrame, WorldTriangle, robust_bounds};
 use glam::Vec3;
 
+/// The acceleration structure of the scene on the device, with its host reference.
+#[derive(Clone, Debug)]
+pub enum Accel {
+    /// One BVH over the world-space triangles.
+    Flat(Bvh),
+    /// A BLAS per distinct mesh and a TLAS over the instances (render space).
+    TwoLevel(TwoLevel),
+}
+
+impl Accel {
+    /// "flat" or "two-level".
+    pub fn name(&self) -> &'static str {
+        match self {
+            Accel::Flat(_) => "flat",
+            Accel::TwoLevel(_) => "two-level",
+        }
+    }
+
+    /// Nodes over both levels.
+    pub fn node_count(&self) -> usize {
+        match self {
+            Accel::Flat(b) => b.nodes.len(),
+            Accel::TwoLevel(t) => {
+                t.tlas.nodes.len() + t.blases.iter().map(|b| b.bvh.nodes.len()).sum::<usize>()
+            }
+        }
+    }
+
+    /// The SAH cost of the flat BVH, or of the TLAS.
+    pub fn sah_cost(&self) -> f32 {
+        match self {
+            Accel::Flat(b) => b.sah_cost,
+            Accel::TwoLevel(t) => t.tlas.sah_cost,
+        }
+    }
+
+    /// The deepest leaf: of the flat BVH, or the TLAS's depth plus the deepest BLAS's.
+    pub fn depth(&self) -> u32 {
+        match self {
+            Accel::Flat(b) => b.depth,
+            Accel::TwoLevel(t) => {
+                t.tlas.depth + 1 + t.blases.iter().map(|b| b.bvh.depth).max().unwrap_or(0)
+            }
+        }
+    }
+
+    /// Distinct meshes and instances (1 and 0 for the flat BVH).
+    pub fn instancing(&self) -> (usize, usize) {
+        match self {
+            Accel::Flat(_) => (1, 0),
+            Accel::TwoLevel(t) => (t.blases.len(), t.instances.len()),
+        }
+    }
+}
+
 /// The scene as uploaded, kept on the host for picking and for tests.
 pub struct HostScene {
-    /// The BVH.
-    pub bvh: Bvh,
-    /// Triangles in BVH order.
+    /// The acceleration structure.
+    pub accel: Accel,
+    /// Triangles in shading order: the flat BVH's, or instance by instance in BLAS order.
     pub triangles: Vec<GpuTriangle>,
     /// Vertices in BVH order (for the host traversal).
     pub vertices: Vec<[Vec3; 3]>,
@@ -94,13 +149,25 @@ fn slot(r: Option<u32>) -> i32 {
 impl HostScene {
     /// Orders the triangles as the BVH wants them and fills the device structs.
     pub fn new(world: &[WorldTriangle], bvh: Bvh, materials: &[Material]) -> Self {
+        let order = bvh.tri_indices.clone();
+        Self::ordered(world, &order, Accel::Flat(bvh), materials)
+    }
+
+    /// Fills the device structs from `world` taken in `order` (indices into `world`), for
+    /// traversal by `accel`.
+    pub fn ordered(
+        world: &[WorldTriangle],
+        order: &[u32],
+        accel: Accel,
+        materials: &[Material],
+    ) -> Self {
         let mut emissive = Vec::new();
         let mut triangles = Vec::with_capacity(world.len());
         let mut shading = Vec::with_capacity(world.len());
         let mut vertices = Vec::with_capacity(world.len());
         let normal_mapped = world.iter().any(|t| t.tangents.is_some());
         let mut tangents = Vec::new();
-        for (order, &index) in bvh.tri_indices.iter().enumerate() {
+        for (order, &index) in order.iter().enumerate() {
             let t = &world[index as usize];
             let m = &materials[t.material as usize];
             let mut light = -1i32;
@@ -144,7 +211,7 @@ impl HostScene {
             (b.center().as_vec3(), b.diagonal() as f32)
         };
         Self {
-            bvh,
+            accel,
             triangles,
             vertices,
             shading,
@@ -169,6 +236,23 @@ impl HostScene {
     /// count, see [`robust_bounds`]), in render space.
     pub fn bounds(&self) -> (Vec3, f32) {
         self.middle
+    }
+
+    /// The closest hit along `ray` (render space): `prim` in shading order, as the device
+    /// reports it.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        match &self.accel {
+            Accel::Flat(b) => b.intersect(ray, &self.vertices),
+            Accel::TwoLevel(t) => t.shading_hit(ray),
+        }
+    }
+
+    /// Whether anything blocks `ray` within its interval.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        match &self.accel {
+            Accel::Flat(b) => b.occluded(ray, &self.vertices),
+            Accel::TwoLevel(t) => t.occluded(ray),
+        }
     }
 
     /// The object index of a triangle in BVH order.
