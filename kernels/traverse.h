@@ -255,9 +255,61 @@ inline float instance_tmin(const GpuInstance* inst, float3 o, float3 od, float t
     return fmax(tmin, dt);
 }
 
+// The top levels' traversal stack: children still to visit, each an interior node (count 0)
+// or a leaf's instances first .. first + count - 1, with the distance its box starts at.
+typedef struct {
+    uint ref[STACK_SIZE * 3];
+    uint count[STACK_SIZE * 3];
+    float dist[STACK_SIZE * 3];
+    uint sp;
+} TopStack;
+
+inline bool top_push(TopStack* s, uint ref, uint count, float dist,
+                     volatile global uint* overflow) {
+    if (s->sp == STACK_SIZE * 3) {
+        atomic_inc(overflow);
+        return false;
+    }
+    s->ref[s->sp] = ref;
+    s->count[s->sp] = count;
+    s->dist[s->sp++] = dist;
+    return true;
+}
+
+// Pops the next entry that starts before tmax into *ref and *count; false when none is left.
+inline bool top_pop(TopStack* s, float tmax, uint* ref, uint* count) {
+    while (s->sp > 0u) {
+        --s->sp;
+        if (s->dist[s->sp] < tmax) {
+            *ref = s->ref[s->sp];
+            *count = s->count[s->sp];
+            return true;
+        }
+    }
+    return false;
+}
+
+// Enters the instances first .. first + count - 1 of a top-level leaf: carries the ray into
+// each one's object space and walks its bottom level (binary, or 4-wide with WIDE). Returns
+// true when the traversal must end (an any-hit, or an overflow).
+#define ENTER_INSTANCES(WALK, ROOT)                                                            \
+    for (uint i = first; i < first + count; ++i) {                                             \
+        GpuInstance inst = instances[i];                                                       \
+        float3 od = instance_vector(&inst, d);                                                 \
+        RayPrep lr = prepare_ray(instance_point(&inst, o), od);                                \
+        float ltmin = instance_tmin(&inst, o, od, tmin);                                       \
+        if (WALK(nodes, inst.ROOT, object_tris, surf, &lr, o, d, ltmin, any_hit,               \
+                 inst.prim_offset, inst.flags != 0u, &hit, overflow)) {                        \
+            return hit;                                                                        \
+        }                                                                                      \
+    }
+
 // Closest or first hit through the top level (`nodes` from 0, leaves index `instances`) and
 // the instances' bottom levels (in the same node array, from each instance's root; leaves
 // index `object_tris`). Hits are reported in the shading order of the scene's triangles.
+// Unlike a bottom level's leaves, whose few triangles are tested on the spot, a top-level leaf
+// (a whole mesh) waits on the stack with its children's order: nearest first, and skipped once
+// a hit closer than its box is found.
 inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
                                  global const GpuInstance* instances,
                                  global const GpuTriangle* object_tris,
@@ -265,30 +317,33 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
                                  float tmax, bool any_hit, volatile global uint* overflow) {
     RayPrep r = prepare_ray(o, d);
     GpuHit hit = no_hit(tmax);
-    uint stack[STACK_SIZE];
-    uint sp = 0;
-    uint node = 0;
-    for (;;) {
-        GpuBvhNode n = nodes[node];
+    TopStack s;
+    s.sp = 0;
+    top_push(&s, 0u, 0u, tmin, overflow);
+    uint first, count;
+    while (top_pop(&s, hit.t, &first, &count)) {
+        if (count > 0u) {
+            ENTER_INSTANCES(traverse_bvh, root)
+            continue;
+        }
+        GpuBvhNode n = nodes[first];
         float dist[2];
         int child[2];
+        uint firsts[2], counts[2];
         for (int side = 0; side < 2; ++side) {
-            uint first, count;
-            dist[side] = child_entry(&n, side, &r, tmin, hit.t, &child[side], &first, &count);
-            for (uint i = first; i < first + count; ++i) {
-                GpuInstance inst = instances[i];
-                float3 oo = instance_point(&inst, o);
-                float3 od = instance_vector(&inst, d);
-                RayPrep lr = prepare_ray(oo, od);
-                float ltmin = instance_tmin(&inst, o, od, tmin);
-                if (traverse_bvh(nodes, inst.root, object_tris, surf, &lr, o, d, ltmin,
-                                 any_hit, inst.prim_offset, inst.flags != 0u, &hit, overflow)) {
-                    return hit;
-                }
-            }
+            dist[side] = child_entry(&n, side, &r, tmin, hit.t, &child[side], &firsts[side],
+                                     &counts[side]);
         }
-        if (next_node(child, dist, stack, &sp, &node, overflow) != WALK_ON) return hit;
+        // The farther child first, so that the nearer is popped first.
+        int far = dist[0] <= dist[1] ? 1 : 0;
+        for (int k = 0; k < 2; ++k) {
+            int side = k == 0 ? far : 1 - far;
+            bool reached = child[side] >= 0 || counts[side] > 0u;
+            uint ref = child[side] >= 0 ? (uint)child[side] : firsts[side];
+            if (reached && !top_push(&s, ref, counts[side], dist[side], overflow)) return hit;
+        }
     }
+    return hit;
 }
 
 // The scene's traversal: the flat BVH, or with TWO_LEVEL the instances' two levels.

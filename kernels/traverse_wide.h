@@ -122,40 +122,29 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
                                       volatile global uint* overflow) {
     RayPrep r = prepare_ray(o, d);
     GpuHit hit = no_hit(tmax);
-    uint stack[WIDE_STACK_SIZE];
-    uint sp = 0;
-    uint node = 0;
-    for (;;) {
-        global const GpuWideNode* n = &nodes[node];
+    TopStack s;
+    s.sp = 0;
+    top_push(&s, 0u, 0u, tmin, overflow);
+    uint first, count;
+    while (top_pop(&s, hit.t, &first, &count)) {
+        if (count > 0u) {
+            ENTER_INSTANCES(traverse_wide_bvh, wide_root)
+            continue;
+        }
+        global const GpuWideNode* n = &nodes[first];
         float dist[4];
         uint slot[4];
         uint k = wide_children(n, &r, tmin, hit.t, dist, slot);
         int ch[4] = {n->child.x, n->child.y, n->child.z, n->child.w};
         uint cnt[4] = {n->count.x, n->count.y, n->count.z, n->count.w};
-        uint kept[4];
-        uint kept_count = 0;
-        for (uint i = 0; i < k; ++i) {
-            uint c = slot[i];
-            if (!(dist[i] < hit.t)) continue;
-            if (cnt[c] == 0u) {
-                kept[kept_count++] = (uint)ch[c];
-                continue;
-            }
-            uint first = (uint)(~ch[c]);
-            for (uint j = first; j < first + cnt[c]; ++j) {
-                GpuInstance inst = instances[j];
-                float3 od = instance_vector(&inst, d);
-                RayPrep lr = prepare_ray(instance_point(&inst, o), od);
-                float ltmin = instance_tmin(&inst, o, od, tmin);
-                if (traverse_wide_bvh(nodes, inst.wide_root, object_tris, surf, &lr, o, d, ltmin,
-                                      any_hit, inst.prim_offset, inst.flags != 0u, &hit,
-                                      overflow)) {
-                    return hit;
-                }
-            }
+        // Farthest first, so that the nearest is popped first.
+        for (uint i = k; i > 0u; --i) {
+            uint c = slot[i - 1u];
+            uint ref = cnt[c] > 0u ? (uint)(~ch[c]) : (uint)ch[c];
+            if (!top_push(&s, ref, cnt[c], dist[i - 1u], overflow)) return hit;
         }
-        if (wide_next(kept, kept_count, stack, &sp, &node, overflow) != WALK_ON) return hit;
     }
+    return hit;
 }
 
 // The scene's traversal through wide nodes: flat, or with TWO_LEVEL two levels.

@@ -105,25 +105,15 @@ fn trace_all(r: &Renderer, rays: &[GpuRay]) -> ([Vec<GpuHit>; 2], [Vec<u32>; 2],
     )
 }
 
-#[test]
-fn no_ray_leaks_out_of_scaled_or_mirrored_instances_on_the_device() {
-    let mut r = renderer();
-    r.set_bvh_choice(BvhChoice::TwoLevel);
-    let n = 6;
-    let scene = cube_scene(n);
-    // World coordinates: the rays below are made in world space.
-    let stats = r
-        .load_scene_in(&scene, &[], RenderFrame::default())
-        .unwrap();
-    assert_eq!(stats.bvh, "two-level");
-    assert_eq!((stats.meshes, stats.instances), (1, placements().len()));
+/// Rays from each instance's centre towards every vertex and edge midpoint of its cube (in
+/// world space), the hardest directions for a watertight test: each must hit its own cube,
+/// through all four tracing kernels, and the binary ones must find the host reference's hits.
+fn assert_no_leaks(r: &Renderer, placements: &[DMat4], n: usize) {
     let host = r.host_scene().unwrap();
     let cube = closed_cube(n);
-    // From each instance's centre towards every vertex and edge midpoint of its cube (in
-    // world space), the hardest directions for a watertight test.
     let mut rays = vec![];
     let mut owner = vec![];
-    for (i, m) in placements().iter().enumerate() {
+    for (i, m) in placements.iter().enumerate() {
         let centre = m.transform_point3(DVec3::ZERO);
         for t in &cube.indices {
             for k in 0..3 {
@@ -141,7 +131,7 @@ fn no_ray_leaks_out_of_scaled_or_mirrored_instances_on_the_device() {
             }
         }
     }
-    let ([hits, wide_hits], [occluded, wide_occluded], overflow) = trace_all(&r, &rays);
+    let ([hits, wide_hits], [occluded, wide_occluded], overflow) = trace_all(r, &rays);
     assert_eq!(overflow, 0, "no stack overflow");
     let mut leaks = 0;
     for (i, ray) in rays.iter().enumerate() {
@@ -151,7 +141,6 @@ fn no_ray_leaks_out_of_scaled_or_mirrored_instances_on_the_device() {
                 leaks += 1;
             }
         }
-        // The binary kernels follow the host reference hit for hit.
         let host_ray = Ray {
             origin: Vec3::from_slice(&ray.origin[..3]),
             direction: Vec3::from_slice(&ray.direction[..3]),
@@ -168,6 +157,60 @@ fn no_ray_leaks_out_of_scaled_or_mirrored_instances_on_the_device() {
     }
     assert!(rays.len() > 5000);
     assert_eq!(leaks, 0, "rays leaked out of {} (twice each)", rays.len());
+}
+
+#[test]
+fn no_ray_leaks_out_of_scaled_or_mirrored_instances_on_the_device() {
+    let mut r = renderer();
+    r.set_bvh_choice(BvhChoice::TwoLevel);
+    let scene = cube_scene(6);
+    // World coordinates: the rays are made in world space.
+    let stats = r
+        .load_scene_in(&scene, &[], RenderFrame::default())
+        .unwrap();
+    assert_eq!(stats.bvh, "two-level");
+    assert_eq!((stats.meshes, stats.instances), (1, placements().len()));
+    assert_no_leaks(&r, &placements(), 6);
+}
+
+#[test]
+fn moving_instances_updates_the_device_in_place() {
+    let mut r = renderer();
+    r.set_bvh_choice(BvhChoice::TwoLevel);
+    let mut scene = cube_scene(6);
+    let stats = r
+        .load_scene_in(&scene, &[], RenderFrame::default())
+        .unwrap();
+    // Move every other cube, one of them also rescaled and mirrored the other way.
+    let mut moved = placements();
+    for (i, m) in moved.iter_mut().enumerate().filter(|(i, _)| i % 2 == 1) {
+        *m = DMat4::from_translation(DVec3::new(0.5, -20.0 * i as f64, 2.0)) * *m;
+        if i == 3 {
+            *m *= DMat4::from_scale(DVec3::new(-2.0, 0.5, 1.0));
+        }
+        scene.objects[i].world_from_object = *m;
+    }
+    let update = r
+        .move_instances(&scene)
+        .unwrap()
+        .expect("moving instances of a two-level scene needs no reload");
+    assert_eq!(update.moved, 3);
+    let buffers = r.scene_buffers().unwrap();
+    assert_eq!(buffers.bytes(), stats.device_bytes, "no buffer grew");
+    // Written: the TLAS's slots (binary and wide nodes, 64 and 128 bytes), the instances (64
+    // bytes each) and the moved cubes' shading triangles (48 + 96 bytes each), nothing else.
+    let n = placements().len();
+    let tlas = (n - 1) * (64 + 128) + n * 64;
+    let moved_triangles = 3 * 6 * 6 * 6 * 2;
+    assert_eq!(
+        update.bytes,
+        tlas + moved_triangles * (48 + 96),
+        "{update:?}"
+    );
+    assert_no_leaks(&r, &moved, 6);
+    // Hiding a cube changes the instances: that needs a reload.
+    scene.objects[0].visible = false;
+    assert_eq!(r.move_instances(&scene).unwrap(), None);
 }
 
 #[test]

@@ -185,9 +185,15 @@ impl TwoLevel {
 
     /// Moves instance `i` and rebuilds the TLAS.
     pub fn set_transform(&mut self, i: usize, world_from_object: DMat4) {
+        self.place(i, world_from_object);
+        self.rebuild_tlas();
+    }
+
+    /// Moves instance `i` without rebuilding the TLAS (call [`TwoLevel::rebuild_tlas`] after
+    /// the last move).
+    pub fn place(&mut self, i: usize, world_from_object: DMat4) {
         let inst = &mut self.instances[i];
         *inst = Instance::new(inst.blas, world_from_object, inst.prim_offset);
-        self.rebuild_tlas();
     }
 
     /// Builds the TLAS over the instances' current world boxes.
@@ -250,12 +256,20 @@ impl TwoLevel {
         })
     }
 
-    /// The device form: the TLAS's nodes followed by every BLAS's (child indices and leaf
-    /// triangles rebased: BLAS leaves index the object triangles of all meshes one after the
-    /// other, TLAS leaves the instances in TLAS order), each BLAS's root, and each mesh's first
-    /// object triangle.
+    /// Nodes the device reserves for the TLAS at the front of its node arrays (binary and
+    /// wide): as many as a TLAS over these instances can take, so that a rebuilt TLAS is
+    /// written over the old one in place and the BLASes behind it stay where they are.
+    pub fn tlas_slots(&self) -> usize {
+        self.instances.len().saturating_sub(1).max(1)
+    }
+
+    /// The device form: the TLAS's nodes (padded to [`TwoLevel::tlas_slots`]) followed by every
+    /// BLAS's (child indices and leaf triangles rebased: BLAS leaves index the object triangles
+    /// of all meshes one after the other, TLAS leaves the instances in TLAS order), each BLAS's
+    /// root, and each mesh's first object triangle.
     pub fn device_nodes(&self) -> (Vec<GpuBvhNode>, Vec<u32>, Vec<u32>) {
         let mut nodes = self.tlas.nodes.clone();
+        nodes.resize(self.tlas_slots(), GpuBvhNode::default());
         let (mut roots, mut firsts) = (vec![], vec![]);
         let mut tri_base = 0u32;
         for b in &self.blases {
@@ -289,6 +303,7 @@ impl TwoLevel {
     /// collapsed BLAS, rebased alike; and each BLAS's root.
     pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>) {
         let mut nodes = WideBvh::collapse(&self.tlas).nodes;
+        nodes.resize(self.tlas_slots(), GpuWideNode::default());
         let mut roots = vec![];
         let mut tri_base = 0i32;
         for b in &self.blases {

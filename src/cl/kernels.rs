@@ -63,17 +63,24 @@ impl<T: Pod> Buffer<T> {
 
     /// Copies `data` to the start of the buffer (blocking).
     pub fn write(&mut self, gpu: &Gpu, data: &[T]) -> Result<(), ClError> {
+        self.write_at(gpu, 0, data)
+    }
+
+    /// Copies `data` into the buffer from element `at` on (blocking): an update in place, no
+    /// new allocation.
+    pub fn write_at(&mut self, gpu: &Gpu, at: usize, data: &[T]) -> Result<(), ClError> {
         assert!(
-            data.len() <= self.len.max(1),
+            at + data.len() <= self.len.max(1),
             "write past the end of a buffer"
         );
         if data.is_empty() {
             return Ok(());
         }
-        // SAFETY: the slice fits the buffer (checked above); the write is blocking.
+        let offset = at * std::mem::size_of::<T>();
+        // SAFETY: the slice fits the buffer from `at` on (checked above); the write is blocking.
         unsafe {
             gpu.queue
-                .enqueue_write_buffer(&mut self.inner, CL_BLOCKING, 0, data, &[])
+                .enqueue_write_buffer(&mut self.inner, CL_BLOCKING, offset, data, &[])
                 .map_err(call_err("uploading a buffer"))?;
         }
         Ok(())

@@ -4,23 +4,33 @@
 //!
 //! Shading reads the triangles in world space either way (one copy per instance, in the order
 //! the traversal reports them), so images agree; two levels store each distinct mesh's BVH and
-//! object-space triangles once and make moving an object a TLAS rebuild. The automatic choice
-//! (`--bvh auto`) takes two levels when instancing at least halves the triangles the BVH holds
-//! (`triangles >= 2 x unique_triangles`), else the flat BVH, which traverses a little faster on
-//! a static scene (docs/benchmarks.md has the figures).
+//! object-space triangles once and make moving an object a TLAS rebuild written in place
+//! (`Renderer::move_instances`).
+//!
+//! The automatic choice (`--bvh auto`): two levels when the scene is large and instancing
+//! saves most of the flat BVH (at least 4 M triangles over all instances and at least 8 times
+//! the triangles of the distinct meshes), else the flat BVH. On PoCL the two-level kernels
+//! trace 1.0–3.7 times slower than the flat BVH (docs/benchmarks.md, 2026-11-30), so a scene
+//! that fits a flat BVH gets one; `--bvh two-level` trades that for moving objects in
+//! milliseconds in the viewer.
 
 use crate::bvh::{Blas, TwoLevel};
-use crate::scene::{Object, RenderFrame, Scene};
+use crate::scene::{Object, RenderFrame, Scene, distinct_meshes};
 use glam::{DMat4, Vec3};
 use rayon::prelude::*;
-use std::collections::HashMap;
-use std::hash::{Hash, Hasher};
 use std::str::FromStr;
+
+/// Triangles over all instances from which `--bvh auto` considers two levels.
+pub const AUTO_MIN_TRIANGLES: usize = 4_000_000;
+
+/// How many times the distinct meshes' triangles the instances must hold for `--bvh auto` to
+/// take two levels.
+pub const AUTO_MIN_SAVING: usize = 8;
 
 /// `--bvh`: which acceleration structure the device traverses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub enum BvhChoice {
-    /// Two levels when instancing at least halves the triangles, else flat.
+    /// Two levels for large, heavily instanced scenes (see the module's rule), else flat.
     #[default]
     Auto,
     /// One BVH over every world-space triangle.
@@ -49,22 +59,8 @@ pub struct Instancing {
     pub order: Vec<u32>,
     /// Material of each object-space triangle, mesh after mesh, in BLAS order.
     pub object_materials: Vec<u32>,
-}
-
-/// Counts of a scene's instancing: (triangles over all instances, triangles of the distinct
-/// meshes).
-pub fn counts(scene: &Scene) -> (usize, usize) {
-    let placed = placed(scene);
-    let (_, mesh_of) = distinct(&placed);
-    let mut seen = vec![false; placed.len()];
-    let mut unique = 0;
-    for (o, &m) in placed.iter().zip(&mesh_of) {
-        if !seen[m as usize] {
-            seen[m as usize] = true;
-            unique += o.mesh.indices.len();
-        }
-    }
-    (placed.iter().map(|o| o.mesh.indices.len()).sum(), unique)
+    /// The object each instance places (index in `Scene::objects`).
+    pub objects: Vec<u32>,
 }
 
 /// The two levels of `scene` in render space `space`, or `None` when the flat BVH is chosen
@@ -79,11 +75,16 @@ pub fn plan(
     if choice == BvhChoice::Flat || dropped > 0 {
         return None;
     }
-    let placed = placed(scene);
-    let (meshes, mesh_of) = distinct(&placed);
+    let objects = placed_objects(scene);
+    let placed: Vec<&Object> = objects
+        .iter()
+        .map(|&i| &scene.objects[i as usize])
+        .collect();
+    let (meshes, mesh_of) = distinct_meshes(&placed);
     let unique: usize = meshes.iter().map(|&o| placed[o].mesh.indices.len()).sum();
     let total: usize = placed.iter().map(|o| o.mesh.indices.len()).sum();
-    if total == 0 || (choice == BvhChoice::Auto && total < 2 * unique) {
+    let auto_flat = total < AUTO_MIN_TRIANGLES || total < AUTO_MIN_SAVING * unique;
+    if total == 0 || (choice == BvhChoice::Auto && auto_flat) {
         return None;
     }
     let blases: Vec<Blas> = meshes
@@ -128,42 +129,24 @@ pub fn plan(
         two,
         order,
         object_materials,
+        objects,
     })
 }
 
-/// The visible objects that have triangles, in object order.
-fn placed(scene: &Scene) -> Vec<&Object> {
-    scene
-        .objects
-        .iter()
-        .filter(|o| o.visible && !o.mesh.indices.is_empty())
-        .collect()
+/// The render frame's map, (p - origin) * scale, as a matrix: render from object is this times
+/// the node's world from object.
+pub fn render_from_world(space: &RenderFrame) -> DMat4 {
+    DMat4::from_scale(glam::DVec3::splat(space.scale)) * DMat4::from_translation(-space.origin)
 }
 
-/// The distinct meshes among `objects` (the index of the first object using each) and each
-/// object's mesh. The importer gives every node its own copy of its mesh, so meshes are told
-/// apart by content: triangles, positions and materials.
-pub fn distinct(objects: &[&Object]) -> (Vec<usize>, Vec<u32>) {
-    let mut index: HashMap<u64, u32> = HashMap::new();
-    let mut first = vec![];
-    let mesh_of = objects
-        .iter()
-        .enumerate()
-        .map(|(i, o)| {
-            let mut h = std::collections::hash_map::DefaultHasher::new();
-            let m = &o.mesh;
-            m.indices.hash(&mut h);
-            m.materials.hash(&mut h);
-            for p in &m.positions {
-                p.to_array().map(f32::to_bits).hash(&mut h);
-            }
-            *index.entry(h.finish()).or_insert_with(|| {
-                first.push(i);
-                first.len() as u32 - 1
-            })
+/// The indices of the visible objects that have triangles: the instances, in object order.
+pub fn placed_objects(scene: &Scene) -> Vec<u32> {
+    (0..scene.objects.len() as u32)
+        .filter(|&i| {
+            let o = &scene.objects[i as usize];
+            o.visible && !o.mesh.indices.is_empty()
         })
-        .collect();
-    (first, mesh_of)
+        .collect()
 }
 
 #[cfg(test)]

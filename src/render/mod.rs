@@ -9,6 +9,7 @@ mod megakernel;
 mod settings;
 mod textures;
 pub mod tonemap;
+mod update;
 mod upload;
 mod wavefront;
 
@@ -17,6 +18,7 @@ pub use lights::gpu_lights;
 pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
+pub use update::InstanceUpdate;
 pub use upload::{Accel, HostScene, gpu_camera};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
@@ -157,12 +159,13 @@ impl Renderer {
             match instancing::plan(scene, &space, dropped, self.bvh_choice) {
                 Some(plan) => {
                     let object_tris = object_triangles(&plan);
-                    let host = HostScene::ordered(
+                    let mut host = HostScene::ordered(
                         &world,
                         &plan.order,
                         Accel::TwoLevel(plan.two),
                         &materials,
                     );
+                    host.layout.objects = plan.objects;
                     (host, object_tris)
                 }
                 None => {
@@ -199,13 +202,13 @@ impl Renderer {
         let kernel_build_ms = self.ensure_program()?;
         self.lights = lights.to_vec();
         let (glights, cdf) = self.light_table(&host);
+        let (nodes, wide_nodes, instances) = device_accel(&mut host);
         let placeholder = [GpuTriTangents::default()];
         let tangents: &[GpuTriTangents] = if host.tangents.is_empty() {
             &placeholder
         } else {
             &host.tangents
         };
-        let (nodes, wide_nodes, instances) = device_accel(&host.accel);
         let object_tris = if object_tris.is_empty() {
             vec![GpuTriangle::default()]
         } else {
@@ -471,10 +474,10 @@ impl Renderer {
     }
 }
 
-/// The device's node arrays (binary and wide) and instances for `accel`; the instances are a
-/// placeholder when flat.
-fn device_accel(accel: &Accel) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec<GpuInstance>) {
-    match accel {
+/// The device's node arrays (binary and wide) and instances for `host`'s acceleration
+/// structure (the instances are a placeholder when flat); fills `host.layout` for two levels.
+fn device_accel(host: &mut HostScene) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec<GpuInstance>) {
+    match &host.accel {
         Accel::Flat(bvh) => (
             bvh.nodes.clone(),
             WideBvh::collapse(bvh).nodes,
@@ -483,24 +486,10 @@ fn device_accel(accel: &Accel) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec<GpuIns
         Accel::TwoLevel(two) => {
             let (nodes, roots, firsts) = two.device_nodes();
             let (wide, wide_roots) = two.device_wide_nodes();
-            let instances = two
-                .tlas
-                .tri_indices
-                .iter()
-                .map(|&i| {
-                    let inst = &two.instances[i as usize];
-                    let b = inst.blas as usize;
-                    GpuInstance {
-                        row0: inst.rows[0],
-                        row1: inst.rows[1],
-                        row2: inst.rows[2],
-                        root: roots[b],
-                        wide_root: wide_roots[b],
-                        prim_offset: inst.prim_offset.wrapping_sub(firsts[b]),
-                        flags: inst.mirrored as u32,
-                    }
-                })
-                .collect();
+            host.layout.roots = roots;
+            host.layout.wide_roots = wide_roots;
+            host.layout.firsts = firsts;
+            let instances = host.layout.gpu_instances(two);
             (nodes, wide, instances)
         }
     }
