@@ -214,6 +214,31 @@ impl Renderer {
         } else {
             object_tris
         };
+        let bytes = |n: usize, size: usize| n.max(1) * size;
+        fits_device(
+            &[
+                ("BVH nodes", std::mem::size_of_val(nodes.as_slice())),
+                (
+                    "wide BVH nodes",
+                    std::mem::size_of_val(wide_nodes.as_slice()),
+                ),
+                (
+                    "triangles",
+                    std::mem::size_of_val(host.triangles.as_slice()),
+                ),
+                (
+                    "object triangles",
+                    std::mem::size_of_val(object_tris.as_slice()),
+                ),
+                ("instances", std::mem::size_of_val(instances.as_slice())),
+                ("shading", std::mem::size_of_val(host.shading.as_slice())),
+                ("tangents", std::mem::size_of_val(tangents)),
+                ("texels", bytes(pack.texels.len(), 4)),
+            ],
+            self.gpu.device.global_mem_size().ok(),
+            self.gpu.device.max_mem_alloc_size().ok(),
+        )
+        .map_err(ClError::Device)?;
         let buffers = SceneBuffers {
             nodes: Buffer::from_slice(&self.gpu, &nodes)?,
             wide_nodes: Buffer::from_slice(&self.gpu, &wide_nodes)?,
@@ -509,4 +534,53 @@ fn object_triangles(plan: &instancing::Instancing) -> Vec<GpuTriangle> {
             v2: upload::f4(t[2], 0.0),
         })
         .collect()
+}
+
+/// Checks before any allocation that the scene's buffers fit the device: their sum against
+/// `CL_DEVICE_GLOBAL_MEM_SIZE` (`global`) and each against `CL_DEVICE_MAX_MEM_ALLOC_SIZE`
+/// (`max_alloc`), so that a scene too large fails with one clear line instead of an allocation
+/// error halfway through the upload.
+fn fits_device(
+    buffers: &[(&str, usize)],
+    global: Option<u64>,
+    max_alloc: Option<u64>,
+) -> Result<(), String> {
+    let gb = |b: u64| b as f64 / 1e9;
+    let total: usize = buffers.iter().map(|(_, b)| b).sum();
+    if let Some(global) = global
+        && total as u64 > global
+    {
+        return Err(format!(
+            "the scene needs {:.2} GB of device memory and the device has {:.2} GB \
+             (an instanced scene takes less with --bvh two-level)",
+            gb(total as u64),
+            gb(global)
+        ));
+    }
+    if let Some(max) = max_alloc
+        && let Some((name, b)) = buffers.iter().find(|(_, b)| *b as u64 > max)
+    {
+        return Err(format!(
+            "the scene's {name} need a {:.2} GB buffer and the device allows {:.2} GB in one",
+            gb(*b as u64),
+            gb(max)
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod fit_tests {
+    use super::fits_device;
+
+    #[test]
+    fn scenes_too_large_for_the_device_are_refused_with_a_reason() {
+        let buffers = [("triangles", 600), ("shading", 500)];
+        assert!(fits_device(&buffers, Some(2000), Some(1000)).is_ok());
+        assert!(fits_device(&buffers, None, None).is_ok());
+        let total = fits_device(&buffers, Some(1000), Some(1000)).unwrap_err();
+        assert!(total.contains("device memory"), "{total}");
+        let one = fits_device(&buffers, Some(2000), Some(550)).unwrap_err();
+        assert!(one.contains("triangles need"), "{one}");
+    }
 }
