@@ -9,10 +9,11 @@
 //!
 //! The automatic choice (`--bvh auto`): two levels when the scene is large and instancing
 //! saves most of the flat BVH (at least 4 M triangles over all instances and at least 8 times
-//! the triangles of the distinct meshes), else the flat BVH. On PoCL the two-level kernels
-//! trace 1.0–3.7 times slower than the flat BVH (docs/benchmarks.md, 2026-11-30), so a scene
-//! that fits a flat BVH gets one; `--bvh two-level` trades that for moving objects in
-//! milliseconds in the viewer.
+//! the triangles of the distinct meshes), else the flat BVH. With PoCL's default work-group
+//! method the two-level kernels trace 1.0–3.7 times slower than the flat BVH (within −14 …
+//! +29 % with `POCL_WORK_GROUP_METHOD=cbs`; docs/benchmarks.md, 2026-11-30), so a scene that
+//! fits a flat BVH gets one; `--bvh two-level` trades that for moving objects in milliseconds
+//! in the viewer.
 
 use crate::bvh::{Blas, TwoLevel};
 use crate::scene::{Object, RenderFrame, Scene, distinct_meshes};
