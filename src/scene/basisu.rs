@@ -164,16 +164,25 @@ fn unzstd(data: &[u8], want: u64) -> Result<Vec<u8>, String> {
     let window = want.next_power_of_two().max(1 << 20);
     let decoder = ruzstd::decoding::StreamingDecoder::new_with_max_window_size(data, window)
         .map_err(|e| format!("the Zstandard data does not decode: {e}"))?;
-    let mut out = Vec::with_capacity(want as usize);
+    // Grown as the data decodes (a header may claim a large image over a few bytes).
+    let mut out = Vec::new();
     decoder
         .take(want + 1)
         .read_to_end(&mut out)
         .map_err(|e| format!("the Zstandard data does not decode: {e}"))?;
-    if out.len() as u64 != want {
-        return Err(format!(
-            "the Zstandard data decodes to {} bytes, UASTC needs {want}",
-            out.len()
-        ));
+    match (out.len() as u64).cmp(&want) {
+        std::cmp::Ordering::Equal => {}
+        std::cmp::Ordering::Less => {
+            return Err(format!(
+                "the Zstandard data decodes to {} bytes, UASTC needs {want}",
+                out.len()
+            ));
+        }
+        std::cmp::Ordering::Greater => {
+            return Err(format!(
+                "the Zstandard data decodes to more than the {want} bytes UASTC needs"
+            ));
+        }
     }
     Ok(out)
 }

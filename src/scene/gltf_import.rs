@@ -314,14 +314,12 @@ fn texture_sources(root: &gltf::json::Root) -> Vec<Option<usize>> {
                     .map(|i| i as usize)
             };
             let core = Some(t.source.value()).filter(|&i| i != u32::MAX as usize);
-            [
-                extension("KHR_texture_basisu"),
-                extension("EXT_texture_webp"),
-                core,
-            ]
-            .into_iter()
-            .flatten()
-            .find(|&i| i < root.images.len())
+            super::validate::IMAGE_SOURCE_EXTENSIONS
+                .iter()
+                .map(|e| extension(e))
+                .chain([core])
+                .flatten()
+                .find(|&i| i < root.images.len())
         })
         .collect()
 }
