@@ -203,6 +203,10 @@ fn interesting(rng: &mut Rng, doc_len: usize) -> Value {
         json!("orthographic"),
         json!("perspective"),
         json!("image/png"),
+        json!("image/ktx2"),
+        json!("image/webp"),
+        json!("KHR_texture_basisu"),
+        json!("EXT_texture_webp"),
         json!("KHR_materials_sheen"),
         json!("EXT_meshopt_compression"),
     ];
@@ -346,10 +350,12 @@ fn mutate_json(doc: &mut Value, rng: &mut Rng) {
                     "KHR_materials_ior",
                     "KHR_materials_volume",
                     "KHR_lights_punctual",
-                ][rng.below(4)];
+                    "KHR_texture_basisu",
+                    "EXT_texture_webp",
+                ][rng.below(6)];
                 o.insert(
                     "extensions".into(),
-                    json!({ext: {"ior": 0.0, "offset": [1e39, 0], "thicknessFactor": -1, "light": 7}}),
+                    json!({ext: {"ior": 0.0, "offset": [1e39, 0], "thicknessFactor": -1, "light": 7, "source": rng.below(3)}}),
                 );
             } else if let Some(o) = doc.as_object_mut() {
                 o.insert(
