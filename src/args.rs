@@ -246,10 +246,20 @@ pub const MAX_EXPOSURE: f32 = 64.0;
 
 /// An exposure in stops within ±[`MAX_EXPOSURE`].
 fn parse_exposure(s: &str) -> Result<f32, String> {
+    within_max_exposure(s, " stops")
+}
+
+/// An EV100 within ±[`MAX_EXPOSURE`] (the exposure it sets is within a stop of that).
+fn parse_ev100(s: &str) -> Result<f32, String> {
+    within_max_exposure(s, "")
+}
+
+/// A finite number within ±[`MAX_EXPOSURE`]; `unit` follows the range in the message.
+fn within_max_exposure(s: &str, unit: &str) -> Result<f32, String> {
     match parse_finite(s)? {
         v if v.abs() <= MAX_EXPOSURE => Ok(v),
         _ => Err(format!(
-            "'{s}' is out of range (-{MAX_EXPOSURE}..={MAX_EXPOSURE} stops)"
+            "'{s}' is out of range (-{MAX_EXPOSURE}..={MAX_EXPOSURE}{unit})"
         )),
     }
 }
@@ -266,7 +276,7 @@ pub struct ExposureArgs {
     )]
     pub exposure: Option<f32>,
     /// Physical exposure: a camera at this EV100 (about 15 for a scene lit by a sun in lux).
-    #[arg(long, allow_negative_numbers = true, value_parser = parse_finite)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_ev100)]
     pub ev100: Option<f32>,
 }
 

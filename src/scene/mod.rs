@@ -4,6 +4,7 @@
 //! into world-space triangles (f32) whenever the scene changes.
 
 mod accessor;
+mod basisu;
 mod bounds;
 mod compression;
 mod env_presets;

@@ -27,12 +27,45 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_texture_basisu",
 ];
 
+/// Texture extensions that name an image by their `source` (instead of the core `source`), in
+/// the order the importer prefers them.
+pub const IMAGE_SOURCE_EXTENSIONS: &[&str] = &["KHR_texture_basisu", "EXT_texture_webp"];
+
 /// A parsed document that passed validation, with the GLB binary chunk if there was one.
 pub struct Parsed {
     /// The document; every index in it is in range and every enum valid.
     pub document: gltf::Document,
     /// The GLB `BIN` chunk.
     pub blob: Option<Vec<u8>>,
+    /// Node transforms as written, in f64 (gltf-json reads them as f32).
+    pub precise_nodes: Vec<PreciseNode>,
+}
+
+/// A node's transform read from the JSON text in f64, so that a scene placed at survey
+/// coordinates keeps the relative placement of its nodes (f32 keeps only about half a unit at
+/// 10⁷). Empty when the text cannot be read this way; the f32 values are used then.
+#[derive(serde::Deserialize, Default, Clone, Debug)]
+pub struct PreciseNode {
+    /// `translation`.
+    pub translation: Option<[f64; 3]>,
+    /// `rotation` (x, y, z, w).
+    pub rotation: Option<[f64; 4]>,
+    /// `scale`.
+    pub scale: Option<[f64; 3]>,
+    /// `matrix`, column-major.
+    pub matrix: Option<[f64; 16]>,
+}
+
+/// The nodes' transforms in f64, or none when any of them does not read as numbers.
+fn precise_nodes(json: &[u8]) -> Vec<PreciseNode> {
+    #[derive(serde::Deserialize)]
+    struct Nodes {
+        #[serde(default)]
+        nodes: Vec<PreciseNode>,
+    }
+    serde_json::from_slice::<Nodes>(json)
+        .map(|n| n.nodes)
+        .unwrap_or_default()
 }
 
 /// Parses `.gltf` JSON or `.glb` bytes and validates the document. Warnings (unsupported
@@ -55,9 +88,11 @@ pub fn parse(bytes: &[u8], warnings: &mut Vec<String>) -> Result<Parsed, String>
         };
         return Err(format!("{first}{more}"));
     }
+    let precise_nodes = precise_nodes(&json_bytes);
     Ok(Parsed {
         document: gltf::Document::from_json_without_validation(root),
         blob,
+        precise_nodes,
     })
 }
 
@@ -235,6 +270,24 @@ fn beyond_gltf_json(root: &json::Root) -> Vec<String> {
             }
             (None, None) => out.push(format!("images[{i}]: neither uri nor bufferView")),
             _ => {}
+        }
+    }
+    // The image sources the texture extensions name (read as raw JSON by the importer).
+    for (i, t) in root.textures.iter().enumerate() {
+        for ext in IMAGE_SOURCE_EXTENSIONS {
+            let Some(object) = t.extensions.as_ref().and_then(|e| e.others.get(*ext)) else {
+                continue;
+            };
+            let at = format!("textures[{i}].extensions.{ext}");
+            match object.get("source") {
+                None if object.is_object() => out.push(format!("{at}.source: missing")),
+                None => out.push(format!("{at}: invalid value")),
+                Some(s) => match s.as_u64() {
+                    Some(n) if n < root.images.len() as u64 => {}
+                    Some(_) => out.push(format!("{at}.source: index out of range")),
+                    None => out.push(format!("{at}.source: invalid value")),
+                },
+            }
         }
     }
     let quantized = root
