@@ -18,7 +18,7 @@ typedef struct {
     float3 throughput;
     float3 radiance;    // gathered so far
     float prev_pdf;     // pdf of the BSDF sample that made the ray (0: camera ray)
-    uint flags;         // PATH_SPECULAR
+    uint flags;         // PATH_SPECULAR, PATH_ESCAPED
     uint rng;
     float2 cone;        // ray cone (width, spread angle) for texture filtering
 } PathState;
@@ -94,6 +94,12 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     global const GpuMaterial* materials = surf->materials;
 
     if (hit.prim == NO_HIT) {
+        if (bounce == 0u && frame->background == BACKGROUND_CUTOUT) {
+            // An escaped camera ray with the background cut out adds nothing; the film counts
+            // only the samples whose camera ray hit (their share is the pixel's coverage).
+            s->flags |= PATH_ESCAPED;
+            return false;
+        }
 #ifdef HAS_ENV_MAP
         // Escaped into the environment map, weighted against its sampling at the last vertex.
         float env_pdf;

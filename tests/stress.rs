@@ -6,8 +6,8 @@
 mod common;
 
 use glam::DVec3;
-use penumbra::cl::DeviceChoice;
 use penumbra::bench::stress;
+use penumbra::cl::DeviceChoice;
 use penumbra::render::Renderer;
 use penumbra::scene::{Material, Mesh, Object, Scene};
 

@@ -2,10 +2,10 @@
 
 use super::RenderArgs;
 use crate::args::EnvChoice;
-use crate::image_io::{Format, write_exr};
+use crate::image_io::{Format, write_exr, write_exr_rgba};
+use crate::render::background::{self, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
-use crate::render::tonemap::ToneMapper;
-use crate::render::tonemap::write_png;
+use crate::render::tonemap::{ToneMapper, to_rgba8, write_rgba_png};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -79,19 +79,29 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     bar.finish_and_clear();
 
     let image = renderer.image()?;
+    let background = args.common.background;
+    // With the background cut out: the coverage, and the straight color that is metered and
+    // tone-mapped (escaped pixels stay black, which metering leaves out).
+    let coverage = match background.cutout() {
+        true => Some(renderer.coverage()?),
+        false => None,
+    };
+    let straight = coverage.as_ref().map(|c| unpremultiply(&image, c));
+    let shown = straight.as_deref().unwrap_or(&image);
     let mode = args.common.exposure_mode();
-    let metering = exposure::meter(&image);
+    let metering = exposure::meter(shown);
     let exposure = mode.stops(metering.as_ref());
-    match format {
-        Format::Exr => write_exr(&args.output, settings.width, settings.height, &image)?,
-        Format::Png => write_png(
-            &args.output,
-            settings.width,
-            settings.height,
-            &image,
-            exposure,
-            ToneMapper::default(),
-        )?,
+    let (w, h) = (settings.width, settings.height);
+    match (format, &coverage) {
+        (Format::Exr, None) => write_exr(&args.output, w, h, &image)?,
+        (Format::Exr, Some(c)) => write_exr_rgba(&args.output, w, h, &image, c)?,
+        (Format::Png, _) => {
+            let mut rgba = to_rgba8(shown, exposure, ToneMapper::default());
+            if let Some(c) = &coverage {
+                background::apply(&mut rgba, c, background);
+            }
+            write_rgba_png(&args.output, w, h, &rgba)?;
+        }
     }
     let stats = renderer.stats();
     if stats.stack_overflows > 0 {
@@ -133,6 +143,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "textures": scene_stats.textures,
         "texture_bytes": scene_stats.texture_bytes,
         "environment": renderer.environment().map(|m| m.name.clone()),
+        "background": background.name(),
         "exposure": exposure,
         "auto_exposure": mode == ExposureMode::Auto,
         "camera": {
