@@ -55,7 +55,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
             ++nonfinite;
         }
     }
-    if (frame.background != BACKGROUND_CUTOUT) counted = frame.samples_in_wave;
+    if (frame.background == BACKGROUND_ENV) counted = frame.samples_in_wave;
     film[pixel] += (float4)(sum, (float)counted);
     // One atomic per work item for the statistics; `advance` moves them into the totals.
     atomic_add(&counters[COUNT_IN], extension_rays);

@@ -94,11 +94,11 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     global const GpuMaterial* materials = surf->materials;
 
     if (hit.prim == NO_HIT) {
-        if (bounce == 0u && frame->background == BACKGROUND_CUTOUT) {
-            // An escaped camera ray with the background cut out adds nothing; the film counts
-            // only the samples whose camera ray hit (their share is the pixel's coverage).
+        // An escaped camera ray is marked for the film's coverage count (the film's .w then
+        // counts the samples whose camera ray hit); with the background cut out it adds nothing.
+        if (bounce == 0u && frame->background != BACKGROUND_ENV) {
             s->flags |= PATH_ESCAPED;
-            return false;
+            if (frame->background == BACKGROUND_CUTOUT) return false;
         }
 #ifdef HAS_ENV_MAP
         // Escaped into the environment map, weighted against its sampling at the last vertex.

@@ -401,6 +401,7 @@ impl CommonArgs {
             lens_radius: lens.aperture,
             focus_distance: lens.focus_distance.unwrap_or(1.0),
             cutout: self.background.cutout(),
+            count_coverage: true,
             ..RenderSettings::default()
         })
     }

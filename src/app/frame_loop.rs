@@ -75,9 +75,11 @@ pub struct Film {
     pub height: u32,
     /// Linear radiance, rows from the top.
     pub pixels: Vec<[f32; 3]>,
-    /// Each pixel's coverage with the background cut out (`RenderSettings::cutout`); empty
-    /// otherwise. `pixels` is then premultiplied by it.
+    /// Each pixel's coverage (`Renderer::coverage`) when the renderer counts it; else empty.
     pub coverage: Vec<f32>,
+    /// The background is cut out (`RenderSettings::cutout`): `pixels` is premultiplied by
+    /// `coverage`.
+    pub cutout: bool,
     /// Samples per pixel in it.
     pub spp: u32,
     /// Resolution divisor it was rendered at.
@@ -222,11 +224,12 @@ impl FrameLoop {
             width: size.0,
             height: size.1,
             pixels: self.renderer.image()?,
-            coverage: if settings.cutout {
+            coverage: if settings.cutout || settings.count_coverage {
                 self.renderer.coverage()?
             } else {
                 Vec::new()
             },
+            cutout: settings.cutout,
             spp,
             divisor: batch.plan.divisor,
         };

@@ -17,7 +17,7 @@ mod state;
 
 use crate::cl::DeviceChoice;
 use crate::render::background::{Background, unpremultiply};
-use crate::render::exposure::{ExposureMode, meter};
+use crate::render::exposure::{ExposureMode, meter_subject};
 use crate::render::tonemap::{ToneMapper, to_rgba8};
 use crate::render::{RenderSettings, Renderer};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows};
@@ -460,7 +460,7 @@ impl App {
             height: film.height,
             rgba: &self.display,
             linear: &film.pixels,
-            coverage: (!film.coverage.is_empty()).then_some(film.coverage.as_slice()),
+            coverage: film.cutout.then_some(film.coverage.as_slice()),
         };
         match screenshot::save_timestamped(Path::new(screenshot::FOLDER), &shot) {
             Ok(png) => {
@@ -493,7 +493,7 @@ impl App {
             height: film.height,
             rgba: &rgba,
             linear: &film.pixels,
-            coverage: (!film.coverage.is_empty()).then_some(film.coverage.as_slice()),
+            coverage: film.cutout.then_some(film.coverage.as_slice()),
         };
         let exr = screenshot::save_at(path, &shot)?;
         println!(
@@ -731,10 +731,11 @@ impl App {
             return;
         }
         if new_image && let Some(auto) = self.model.view.auto_exposure.as_mut() {
-            let metering = if film.coverage.is_empty() {
-                meter(&film.pixels)
-            } else {
-                meter(&unpremultiply(&film.pixels, &film.coverage))
+            // The subject without the background (the straight color when it is cut out).
+            let coverage = (!film.coverage.is_empty()).then_some(film.coverage.as_slice());
+            let metering = match coverage.filter(|_| film.cutout) {
+                Some(c) => meter_subject(&unpremultiply(&film.pixels, c), coverage),
+                None => meter_subject(&film.pixels, coverage),
             };
             self.model.view.exposure = auto.update(metering.as_ref());
         }
@@ -791,7 +792,7 @@ fn display_rgba(
     mapper: ToneMapper,
     background: Background,
 ) -> Vec<u8> {
-    if film.coverage.is_empty() {
+    if !film.cutout {
         return to_rgba8(&film.pixels, exposure, mapper);
     }
     let mut rgba = to_rgba8(

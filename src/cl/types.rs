@@ -99,13 +99,15 @@ kernel_constants! {
 
     /// `GpuPath::direction.w` flag: the last bounce was specular.
     PATH_SPECULAR: u32 = 1;
-    /// `GpuPath::direction.w` flag: the camera ray escaped with the background cut out.
+    /// `GpuPath::direction.w` flag: the camera ray escaped (with coverage counted).
     PATH_ESCAPED: u32 = 2;
 
     /// `GpuFrame::background`: escaped camera rays see the environment.
     BACKGROUND_ENV: u32 = 0;
     /// Escaped camera rays add nothing and the film's `.w` counts the samples that hit.
     BACKGROUND_CUTOUT: u32 = 1;
+    /// Escaped camera rays see the environment and the film's `.w` counts the samples that hit.
+    BACKGROUND_COUNT: u32 = 2;
 
     /// Slot of the counters buffer (u32): paths in this bounce's input queue.
     COUNT_IN: usize = 0;

@@ -80,26 +80,25 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let image = renderer.image()?;
     let background = args.common.background;
-    // With the background cut out: the coverage, and the straight color that is metered and
-    // tone-mapped (escaped pixels stay black, which metering leaves out).
-    let coverage = match background.cutout() {
-        true => Some(renderer.coverage()?),
-        false => None,
-    };
-    let straight = coverage.as_ref().map(|c| unpremultiply(&image, c));
+    // Each pixel's coverage: the subject is metered without the background. With the background
+    // cut out, the straight color is metered and tone-mapped.
+    let coverage = renderer.coverage()?;
+    let straight = background
+        .cutout()
+        .then(|| unpremultiply(&image, &coverage));
     let shown = straight.as_deref().unwrap_or(&image);
     let mode = args.common.exposure_mode();
-    let metering = exposure::meter(shown);
+    let metering = exposure::meter_subject(shown, Some(&coverage));
     let exposure = mode.stops(metering.as_ref());
     let (w, h) = (settings.width, settings.height);
-    match (format, &coverage) {
-        (Format::Exr, None) => write_exr(&args.output, w, h, &image)?,
-        (Format::Exr, Some(c)) => write_exr_rgba(&args.output, w, h, &image, c)?,
-        (Format::Png, _) => {
+    match format {
+        Format::Exr if background.cutout() => {
+            write_exr_rgba(&args.output, w, h, &image, &coverage)?
+        }
+        Format::Exr => write_exr(&args.output, w, h, &image)?,
+        Format::Png => {
             let mut rgba = to_rgba8(shown, exposure, ToneMapper::default());
-            if let Some(c) = &coverage {
-                background::apply(&mut rgba, c, background);
-            }
+            background::apply(&mut rgba, &coverage, background);
             write_rgba_png(&args.output, w, h, &rgba)?;
         }
     }

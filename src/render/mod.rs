@@ -438,7 +438,7 @@ impl Renderer {
             return Ok(vec![[0.0; 3]; n]);
         };
         let film = f.film.read(&self.gpu)?;
-        if self.settings.cutout {
+        if self.settings.cutout || self.settings.count_coverage {
             // `.w` counts the samples whose camera ray hit: the mean is over all samples.
             let n = self.samples.max(1) as f32;
             return Ok(film
@@ -456,13 +456,14 @@ impl Renderer {
     }
 
     /// Each pixel's coverage: the share of its samples whose camera ray hit the scene, with
-    /// [`RenderSettings::cutout`] (else all 1).
+    /// [`RenderSettings::cutout`] or [`RenderSettings::count_coverage`] (else all 1).
     pub fn coverage(&mut self) -> Result<Vec<f32>, ClError> {
         if !self.pending.is_empty() {
             self.finish()?;
         }
         let n = (self.settings.width * self.settings.height) as usize;
-        let Some(f) = self.frame.as_ref().filter(|_| self.settings.cutout) else {
+        let counted = self.settings.cutout || self.settings.count_coverage;
+        let Some(f) = self.frame.as_ref().filter(|_| counted) else {
             return Ok(vec![1.0; n]);
         };
         let total = self.samples.max(1) as f32;

@@ -1,7 +1,8 @@
 //! What the user controls about a render.
 
 use crate::cl::types::{
-    BACKGROUND_CUTOUT, BACKGROUND_ENV, GpuFrame, STRATEGY_BSDF, STRATEGY_LIGHTS, STRATEGY_MIS,
+    BACKGROUND_COUNT, BACKGROUND_CUTOUT, BACKGROUND_ENV, GpuFrame, STRATEGY_BSDF, STRATEGY_LIGHTS,
+    STRATEGY_MIS,
 };
 
 /// Which estimator feeds direct light.
@@ -46,6 +47,9 @@ pub struct RenderSettings {
     /// keeps each pixel's coverage (`Renderer::coverage`): for `--background transparent` and
     /// `--background COLOR`.
     pub cutout: bool,
+    /// The film keeps each pixel's coverage with the background shown too (for metering the
+    /// subject); the image is the same.
+    pub count_coverage: bool,
 }
 
 impl Default for RenderSettings {
@@ -63,6 +67,7 @@ impl Default for RenderSettings {
             lens_radius: 0.0,
             focus_distance: 1.0,
             cutout: false,
+            count_coverage: false,
         }
     }
 }
@@ -91,10 +96,10 @@ impl RenderSettings {
             sky: [self.sky[0], self.sky[1], self.sky[2], 0.0],
             light_count,
             bounce: 0,
-            background: if self.cutout {
-                BACKGROUND_CUTOUT
-            } else {
-                BACKGROUND_ENV
+            background: match (self.cutout, self.count_coverage) {
+                (true, _) => BACKGROUND_CUTOUT,
+                (false, true) => BACKGROUND_COUNT,
+                (false, false) => BACKGROUND_ENV,
             },
             pad: 0,
         }
