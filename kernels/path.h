@@ -104,6 +104,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
         // Escaped into the environment map, weighted against its sampling at the last vertex.
         float env_pdf;
         float3 le = env_radiance(&sc->env, -wo, &env_pdf);
+        if (bounce == 0u) le = env_background(&sc->env, -wo);  // seen directly: filtered
         float weight = 1.0f;
         if (bounce > 0u && !prev_specular && frame->strategy == STRATEGY_MIS) {
             weight = power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
