@@ -8,7 +8,8 @@ mod common;
 use common::{output_dir, penumbra, scenes_dir};
 use std::path::PathBuf;
 
-/// The scenes, without the meshopt copy (it must fail; tests/scenes.rs checks that).
+/// The scenes, without the meshopt copy (the same model as lamborghini.glb; tests/scenes.rs
+/// renders it).
 fn scene_files() -> Vec<PathBuf> {
     let Some(dir) = scenes_dir() else {
         eprintln!("PENUMBRA_SCENES is not set: skipping the first images");
