@@ -39,10 +39,10 @@ impl DeviceArgs {
 #[derive(Args, Debug, Clone, Default)]
 pub struct SizeArgs {
     /// Image width in pixels.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub width: Option<u32>,
     /// Image height in pixels.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub height: Option<u32>,
 }
 
@@ -136,10 +136,11 @@ pub struct LensArgs {
 #[derive(Args, Debug, Clone)]
 pub struct SamplingArgs {
     /// Samples per pixel.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
     /// Bounces after the first hit (0 = direct light only).
-    #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().bounces)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().bounces,
+          value_parser = clap::value_parser!(u32).range(0..=MAX_BOUNCES as i64))]
     pub bounces: u32,
     /// Seed of the random sequence.
     #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().seed)]
