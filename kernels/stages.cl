@@ -90,6 +90,14 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     float prev_pdf = path.origin.w;
     bool prev_specular = (as_uint(path.direction.w) & PATH_SPECULAR) != 0u;
     bool counts_emission = frame.bounce == 0u || prev_specular || frame.strategy != STRATEGY_LIGHTS;
+    // Seen through a thin wall from a scattering vertex, a light is left to that vertex's light
+    // sample, whose shadow ray passes the wall unweighted (see `connect`).
+    bool mis = frame.bounce > 0u && !prev_specular && frame.strategy == STRATEGY_MIS;
+#ifdef HAS_THIN_WALLS
+    bool light_sampled_only = mis && (as_uint(path.direction.w) & PATH_THROUGH_WALL) != 0u;
+#else
+    bool light_sampled_only = false;
+#endif
     SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
     EnvMap env = {environment, env_texels, env_marginal, env_conditional};
 
@@ -99,9 +107,8 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
         float env_pdf;
         float3 le = env_radiance(&env, -wo, &env_pdf);
         float weight = 1.0f;
-        if (frame.bounce > 0u && !prev_specular && frame.strategy == STRATEGY_MIS) {
-            weight = power_heuristic(prev_pdf, environment.scale.z * env_pdf);
-        }
+        if (mis) weight = power_heuristic(prev_pdf, environment.scale.z * env_pdf);
+        if (light_sampled_only) weight = 0.0f;
         if (counts_emission) radiance += throughput * le * weight;
 #else
         // Escaped: the uniform sky, reached by BSDF sampling only.
@@ -134,12 +141,13 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     bool two_sided = (as_uint(mat->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
     if (light_index >= 0 && (front || two_sided) && counts_emission) {
         float weight = 1.0f;
-        if (frame.bounce > 0u && !prev_specular && frame.strategy == STRATEGY_MIS) {
+        if (mis) {
             global const GpuLight* l = &lights[light_index];
             float cos_l = fabs(dot(ng, wo));
             float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
             weight = power_heuristic(prev_pdf, light_pdf);
         }
+        if (light_sampled_only) weight = 0.0f;
 #ifdef HAS_TEXTURES
         // Past the camera ray, emission is read at the finest level, as light sampling reads it.
         TexCoords etc = frame.bounce == 0u ? tc : texcoords_at(sh, hit.u, hit.v);
@@ -192,7 +200,8 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
         LightSample ls = sample_light(lights, tris, materials, &surf, &env, index, p, u1, u2);
         // A light behind the surface is reached through transmission when bsdf_eval says so;
         // the geometric and shading normals must agree on the side. Transmissive surfaces
-        // block shadow rays (no caustics through next-event estimation).
+        // block shadow rays (no caustics through next-event estimation), except smooth thin
+        // walls, which `connect` passes with their tint and without the MIS weight.
         float side = dot(ls.wi, ng);
         if (side * dot(ls.wi, ns) > 0.0f &&
             (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
@@ -216,7 +225,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
                 }
                 ray.origin = (float4)(from, tmax);
                 ray.direction = (float4)(dir, as_float(slot));
-                ray.contribution = (float4)(contribution, 0.0f);
+                ray.contribution = (float4)(contribution, weight > 0.0f ? 1.0f / weight : 0.0f);
                 shadow_rays[s] = ray;
             }
         }
@@ -244,13 +253,45 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     }
     path.radiance = (float4)(radiance, as_float(rng));
     if (alive) {
+        uint flags = specular ? PATH_SPECULAR : 0u;
+#ifdef HAS_THIN_WALLS
+        // Straight through a thin wall the path keeps its last scattering vertex's pdf and
+        // flags, as the shadow rays of that vertex pass the wall (a camera ray stays direct).
+        if (specular && side < 0.0f && bsdf_passes_straight(&m)) {
+            pdf = prev_pdf;
+            flags = frame.bounce == 0u ? PATH_SPECULAR : as_uint(path.direction.w);
+            if (!prev_specular && frame.bounce > 0u) flags |= PATH_THROUGH_WALL;
+        }
+#endif
         path.origin = (float4)(offset_ray(p, side > 0.0f ? ng : -ng), pdf);
-        path.direction = (float4)(wi, as_float(specular ? PATH_SPECULAR : 0u));
+        path.direction = (float4)(wi, as_float(flags));
         path.throughput.xyz = throughput;
         queue_out[atomic_inc(&counters[COUNT_OUT])] = slot;
     }
     paths[slot] = path;
 }
+
+#ifdef HAS_THIN_WALLS
+// Shadow rays pass at most this many thin walls.
+#define MAX_THIN_WALLS 8u
+
+// Whether the surface hit by a shadow ray along dir is a smooth thin wall; if so, multiplies
+// *tint by what it lets through.
+inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* surf, GpuHit hit,
+                           float3 dir, float3* tint) {
+    GpuTriangle tri = tris[hit.prim];
+    global const GpuMaterial* mat = &surf->materials[as_uint(tri.v0.w)];
+    SurfaceMaterial m = surface_material(mat);
+#ifdef HAS_TEXTURES
+    TexCoords tc = texcoords_at(surf->shading[hit.prim], hit.u, hit.v);
+    apply_textures(&m, mat, surf, &tc);
+#endif
+    if (!bsdf_passes_straight(&m)) return false;
+    float3 ng = normalize(cross(tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz));
+    *tint *= thin_wall_transmittance(&m, fabs(dot(ng, dir)));
+    return true;
+}
+#endif
 
 kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
                     global const GpuTriShading* shading, global const GpuTriTangents* tangents,
@@ -264,7 +305,29 @@ kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tr
     GpuShadowRay r = shadow_rays[i];
     GpuHit hit = traverse(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, 0.0f, r.origin.w,
                           true, &counters[COUNT_OVERFLOW]);
+#ifdef HAS_THIN_WALLS
+    // Something is in the way: if it and everything else in the way are smooth thin walls, the
+    // light comes through, tinted by each wall and no longer shared with the BSDF sample (the
+    // MIS weight undone: BSDF samples through walls leave such lights to light sampling).
+    float3 tint = (float3)(1.0f);
+    if (hit.prim != NO_HIT) {
+        if (!thin_wall_tint(tris, &surf, hit, r.direction.xyz, &tint)) return;
+        // The walls in order, nearest first, each beyond the last.
+        tint = (float3)(r.contribution.w);
+        hit = traverse(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, 0.0f, r.origin.w,
+                       false, &counters[COUNT_OVERFLOW]);
+        for (uint walls = 0u; hit.prim != NO_HIT; ++walls) {
+            if (walls == MAX_THIN_WALLS || !thin_wall_tint(tris, &surf, hit, r.direction.xyz, &tint)) {
+                return;
+            }
+            hit = traverse(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, hit.t, r.origin.w,
+                           false, &counters[COUNT_OVERFLOW]);
+        }
+    }
+    paths[as_uint(r.direction.w)].radiance.xyz += r.contribution.xyz * tint;
+#else
     if (hit.prim == NO_HIT) paths[as_uint(r.direction.w)].radiance.xyz += r.contribution.xyz;
+#endif
 }
 
 // One work item: counts the rays of this bounce and makes the output queue the next input.

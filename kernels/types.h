@@ -116,12 +116,13 @@ typedef struct {
 
 typedef struct {
     float4 origin;      // .w = pdf of the BSDF sample that made this ray (0: camera ray)
-    float4 direction;   // .w = flags (uint bits): PATH_SPECULAR
+    float4 direction;   // .w = flags (uint bits): PATH_SPECULAR, PATH_THROUGH_WALL
     float4 throughput;  // .w = slot (uint bits): pixel + sample_in_wave * pixels
     float4 radiance;    // .w = random state (uint bits)
 } GpuPath;
 
 #define PATH_SPECULAR 1u
+#define PATH_THROUGH_WALL 2u  // went straight through a thin wall since the last scattering vertex
 
 typedef struct {
     float t;

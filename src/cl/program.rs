@@ -42,6 +42,9 @@ pub struct KernelFeatures {
     pub transmission: bool,
     /// An environment map lights the scene (`HAS_ENV_MAP`).
     pub env_map: bool,
+    /// Some material is a transmissive thin wall (`HAS_THIN_WALLS`: shadow rays pass the smooth
+    /// ones).
+    pub thin_walls: bool,
 }
 
 impl KernelFeatures {
@@ -55,6 +58,7 @@ impl KernelFeatures {
             (self.alpha, "HAS_ALPHA"),
             (self.transmission, "HAS_TRANSMISSION"),
             (self.env_map, "HAS_ENV_MAP"),
+            (self.thin_walls, "HAS_THIN_WALLS"),
         ] {
             if on {
                 d.push_str(" -D");

@@ -161,6 +161,7 @@ impl Renderer {
             alpha: used(&|m| m.alpha != AlphaMode::Opaque),
             transmission: used(&|m| m.transmission > 0.0),
             env_map: false,
+            thin_walls: used(&|m| m.transmission > 0.0 && m.thickness <= 0.0),
         };
         let budget = self
             .gpu
