@@ -158,6 +158,19 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     }
 #endif
 
+#ifdef HAS_UNLIT
+    // An unlit material shows its base color (textured) and scatters nothing; nothing else
+    // samples it, so it counts in full.
+    if ((as_uint(mat->emission.w) & MATERIAL_UNLIT) != 0u) {
+        float3 color = mat->base_color.xyz;
+#ifdef HAS_TEXTURES
+        if (mat->textures.x >= 0) color *= texture_sample(&surf, mat->textures.x, &tc).xyz;
+#endif
+        paths[slot].radiance.xyz = radiance + throughput * color;
+        return;
+    }
+#endif
+
     // The last extension only looks for emitters (the MIS partner of the last light sample).
     if (frame.bounce > frame.max_bounces) {
         paths[slot].radiance.xyz = radiance;

@@ -62,6 +62,7 @@ typedef struct {
 } GpuEnvironment;
 
 #define MATERIAL_DOUBLE_SIDED 1u
+#define MATERIAL_UNLIT 2u  // KHR_materials_unlit: shows its base color, scatters nothing
 
 typedef struct {
     float4 base_color;  // linear base color; .w = alpha

@@ -1367,6 +1367,50 @@ fn beer_lambert_absorption_through_a_slab() {
 }
 
 #[test]
+fn unlit_material_shows_its_base_color() {
+    // KHR_materials_unlit under a bright sky: the color, no shading, no reflection of the sky.
+    let dir = tempfile::tempdir().unwrap();
+    let mut g = Gltf::default();
+    g.use_ext("KHR_materials_unlit");
+    let color = [0.2f32, 0.5, 0.8];
+    g.materials.push(json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [color[0], color[1], color[2], 1.0],
+                                 "metallicFactor": 1.0, "roughnessFactor": 0.0},
+        "extensions": {"KHR_materials_unlit": {}}
+    }));
+    let (positions, indices) = cuboid([-2.0, -2.0, -0.5], [2.0, 2.0, 0.5]);
+    let mesh = g.mesh(vec![Prim::triangles(positions, indices, 0)]);
+    g.node(json!({"mesh": mesh}));
+    camera_and_no_light(&mut g, 5.0, 0.2);
+    let scene = g.write_glb(dir.path(), "unlit");
+    let (summary, px) = render_exr(
+        &scene,
+        &dir.path().join("unlit.exr"),
+        &[
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--spp",
+            "4",
+            "--bounces",
+            "4",
+            "--sky",
+            "3,3,3",
+        ],
+    );
+    assert_eq!(summary["nonfinite_samples"], 0);
+    for (i, p) in px.iter().enumerate() {
+        for ch in 0..3 {
+            assert!(
+                (p[ch] - color[ch]).abs() < 1e-5,
+                "pixel {i}: {p:?} instead of the base color {color:?}"
+            );
+        }
+    }
+}
+
+#[test]
 fn no_nonfinite_samples_at_the_extremes() {
     // Smooth-shaded spheres of every extreme material on a floor, lit by a point light, an
     // emissive panel and the sky, seen at a grazing angle.

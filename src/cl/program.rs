@@ -45,6 +45,8 @@ pub struct KernelFeatures {
     /// Some material is a transmissive thin wall (`HAS_THIN_WALLS`: shadow rays pass the smooth
     /// ones).
     pub thin_walls: bool,
+    /// Some material is unlit (`HAS_UNLIT`, `KHR_materials_unlit`).
+    pub unlit: bool,
 }
 
 impl KernelFeatures {
@@ -59,6 +61,7 @@ impl KernelFeatures {
             (self.transmission, "HAS_TRANSMISSION"),
             (self.env_map, "HAS_ENV_MAP"),
             (self.thin_walls, "HAS_THIN_WALLS"),
+            (self.unlit, "HAS_UNLIT"),
         ] {
             if on {
                 d.push_str(" -D");

@@ -142,6 +142,8 @@ const _: () = assert!(size_of::<GpuEnvironment>() == 48);
 
 /// Material flags in `GpuMaterial::emission.w`.
 pub const MATERIAL_DOUBLE_SIDED: u32 = 1;
+/// `KHR_materials_unlit`: the surface shows its base color and ends the path.
+pub const MATERIAL_UNLIT: u32 = 2;
 
 /// Alpha modes in `GpuMaterial::alpha.y`.
 pub const ALPHA_OPAQUE: u32 = 0;

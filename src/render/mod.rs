@@ -162,6 +162,7 @@ impl Renderer {
             transmission: used(&|m| m.transmission > 0.0),
             env_map: false,
             thin_walls: used(&|m| m.transmission > 0.0 && m.thickness <= 0.0),
+            unlit: used(&|m| m.unlit),
         };
         let budget = self
             .gpu

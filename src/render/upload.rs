@@ -43,7 +43,7 @@ pub fn gpu_material(m: &Material) -> GpuMaterial {
         MATERIAL_DOUBLE_SIDED
     } else {
         0
-    };
+    } | if m.unlit { MATERIAL_UNLIT } else { 0 };
     GpuMaterial {
         base_color: m.base_color,
         emission: [

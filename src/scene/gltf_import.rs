@@ -19,6 +19,7 @@ const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_transmission",
+    "KHR_materials_unlit",
     "KHR_materials_volume",
     "KHR_texture_transform",
     "KHR_mesh_quantization",
@@ -438,6 +439,7 @@ fn import_material(
         },
         textures,
         normal_scale: normal.as_ref().map_or(1.0, |n| n.scale()),
+        unlit: m.unlit(),
     }
 }
 

@@ -131,6 +131,8 @@ pub struct Material {
     pub textures: MaterialTextures,
     /// Normal texture scale (x and y of the tangent-space normal).
     pub normal_scale: f32,
+    /// `KHR_materials_unlit`: shows its base color and scatters nothing.
+    pub unlit: bool,
 }
 
 impl Default for Material {
@@ -152,6 +154,7 @@ impl Default for Material {
             alpha: AlphaMode::Opaque,
             textures: MaterialTextures::default(),
             normal_scale: 1.0,
+            unlit: false,
         }
     }
 }
