@@ -3,10 +3,6 @@
 // Paths live in `paths` by slot (pixel + sample_in_wave * pixels); queues hold the slots of the
 // live paths, compacted by atomic counters, so later bounces only touch live paths.
 
-#define STRATEGY_MIS 0u
-#define STRATEGY_BSDF 1u
-#define STRATEGY_LIGHTS 2u
-
 inline float power_heuristic(float a, float b) {
     float a2 = a * a;
     float b2 = b * b;

@@ -1,5 +1,8 @@
 // Structs shared with the host. Each mirrors one in src/cl/types.rs field for field; the layout
 // probe test checks sizes and offsets. No bare float3: payloads ride in .w of a float4.
+// The constants named in comments here (TEXTURE_*, WRAP_*, TEXREF_*, MATERIAL_*, ALPHA_*,
+// LIGHT_*, STRATEGY_*, PATH_*, COUNT_*, STAT_*) are defined once in src/cl/types.rs and
+// generated in front of these sources (src/cl/program.rs).
 
 typedef struct {
     float4 left_min;   // .w = left child (int bits): node index, or ~first triangle for a leaf
@@ -29,9 +32,6 @@ typedef struct {
     float4 t2;
 } GpuTriTangents;
 
-#define TEXTURE_SRGB 0x100u
-#define TEXTURE_LEVELS_MASK 0xffu
-
 typedef struct {
     uint offset;  // first texel of level 0; levels follow, level l is max(1, w >> l) x max(1, h >> l)
     uint width;   // of level 0
@@ -39,18 +39,11 @@ typedef struct {
     uint flags;   // mip level count (TEXTURE_LEVELS_MASK bits) | TEXTURE_SRGB
 } GpuTexture;
 
-#define WRAP_REPEAT 0
-#define WRAP_CLAMP 1
-#define WRAP_MIRROR 2
-
 typedef struct {
     float4 m0;  // first row of the UV transform; .w = texture coordinate set (uint bits)
     float4 m1;  // second row; .w = 0.5 * log2 |det| (mip bias)
     int4 info;  // .x texture index, .y wrap S, .z wrap T (WRAP_*), .w flags (TEXREF_*)
 } GpuTexRef;
-
-#define TEXREF_NEAREST 1  // nearest-texel lookups (sampler magFilter NEAREST)
-#define TEXREF_NO_MIPS 2  // finest level only (minFilter without mipmaps)
 
 typedef struct {
     float4 scale;     // .x intensity, .y pdf normalization W*H / (sum f * 2 pi^2), .z NEE pick probability
@@ -60,9 +53,6 @@ typedef struct {
     uint light;       // index in the light list
     uint pad;
 } GpuEnvironment;
-
-#define MATERIAL_DOUBLE_SIDED 1u
-#define MATERIAL_UNLIT 2u  // KHR_materials_unlit: shows its base color, scatters nothing
 
 typedef struct {
     float4 base_color;  // linear base color; .w = alpha
@@ -74,16 +64,6 @@ typedef struct {
     int4 textures;      // texture refs: base color, metallic-roughness, normal, emissive; -1 none
     int4 textures2;     // texture refs: .x transmission, .y thickness; -1 none
 } GpuMaterial;
-
-#define ALPHA_OPAQUE 0u
-#define ALPHA_MASK 1u
-#define ALPHA_BLEND 2u
-
-#define LIGHT_POINT 0u
-#define LIGHT_SPOT 1u
-#define LIGHT_DIRECTIONAL 2u
-#define LIGHT_TRIANGLE 3u
-#define LIGHT_ENVIRONMENT 4u
 
 typedef struct {
     float4 position;   // position, or travel direction (directional); .w = kind (uint bits)
@@ -107,12 +87,11 @@ typedef struct {
     uint seed;
     uint max_bounces;
     uint rr_depth;
-    uint strategy;  // 0 = MIS, 1 = BSDF only, 2 = lights only
+    uint strategy;  // STRATEGY_*
     float4 sky;     // uniform environment radiance
     uint light_count;
-    float light_weight_total;
     uint bounce;
-    uint pad;
+    uint pad[2];
 } GpuFrame;
 
 typedef struct {
@@ -121,9 +100,6 @@ typedef struct {
     float4 throughput;  // .w = slot (uint bits): pixel + sample_in_wave * pixels
     float4 radiance;    // .w = random state (uint bits)
 } GpuPath;
-
-#define PATH_SPECULAR 1u
-#define PATH_THROUGH_WALL 2u  // went straight through a thin wall since the last scattering vertex
 
 typedef struct {
     float t;
@@ -142,15 +118,3 @@ typedef struct {
     float4 origin;     // .w = tmin
     float4 direction;  // .w = tmax
 } GpuRay;
-
-// Slots of the uint counters buffer.
-#define COUNT_IN 0
-#define COUNT_OUT 1
-#define COUNT_SHADOW 2
-#define COUNT_NONFINITE 3
-#define COUNT_OVERFLOW 4
-#define COUNTER_SLOTS 8
-
-// Slots of the ulong statistics buffer.
-#define STAT_EXTENSION_RAYS 0
-#define STAT_SHADOW_RAYS 1

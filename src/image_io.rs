@@ -1,7 +1,6 @@
-//! Writing and reading images: EXR is linear radiance (RGB float), PNG is exposed, tone-mapped
-//! and sRGB-encoded 8-bit.
+//! Writing and reading linear images: EXR is linear radiance (RGB float). Tone-mapped PNGs are
+//! written by `render::tonemap`.
 
-use crate::render::tonemap::{ToneMapper, to_rgba8};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 
@@ -38,33 +37,6 @@ pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Resu
         (p[0], p[1], p[2])
     })
     .with_context(|| format!("{}: cannot write EXR", path.display()))
-}
-
-/// Writes an exposed, tone-mapped, sRGB-encoded PNG.
-pub fn write_png(
-    path: &Path,
-    width: u32,
-    height: u32,
-    rgb: &[[f32; 3]],
-    exposure: f32,
-    mapper: ToneMapper,
-) -> Result<()> {
-    let rgba = to_rgba8(rgb, exposure, mapper);
-    write_rgba_png(path, width, height, &rgba)
-}
-
-/// Writes RGBA8 pixels as PNG.
-pub fn write_rgba_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
-    image::save_buffer(path, rgba, width, height, image::ColorType::Rgba8)
-        .with_context(|| format!("{}: cannot write PNG", path.display()))
-}
-
-/// Writes `rgb` in the format the path's extension names.
-pub fn write_image(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
-    match Format::of(path)? {
-        Format::Exr => write_exr(path, width, height, rgb),
-        Format::Png => write_png(path, width, height, rgb, 0.0, ToneMapper::default()),
-    }
 }
 
 /// Reads the RGB channels of an EXR file: (width, height, pixels).

@@ -1,5 +1,7 @@
 //! penumbra: an interactive path tracer for glTF scenes with OpenCL kernels.
 #![warn(missing_docs)]
+// All `unsafe` lives in `cl::kernels` (buffer transfers and kernel arguments).
+#![deny(unsafe_code)]
 
 pub mod app;
 pub mod bvh;

@@ -1,3 +1,6 @@
+//! The `penumbra` command: parses the arguments and runs the library's command line.
+#![deny(unsafe_code)]
+
 use clap::Parser;
 
 fn main() {

@@ -6,7 +6,7 @@ mod common;
 use common::{Gltf, Prim, render_exr, sphere};
 use glam::{DMat4, Vec3};
 use penumbra::bvh::Ray;
-use penumbra::cl::types::{GpuHit, GpuRay, layouts};
+use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay, layouts};
 use penumbra::cl::{Buffer, DeviceChoice};
 use penumbra::render::Renderer;
 use penumbra::scene::{Material, Mesh, Object, Scene};
@@ -129,7 +129,7 @@ fn kernel_traversal_equals_host_traversal() {
     let ray_buf = Buffer::from_slice(&r.gpu, &gpu_rays).unwrap();
     let hits = Buffer::<GpuHit>::new(&r.gpu, rays.len()).unwrap();
     let occluded = Buffer::<u32>::new(&r.gpu, rays.len()).unwrap();
-    let mut counters = Buffer::<u32>::new(&r.gpu, 8).unwrap();
+    let mut counters = Buffer::<u32>::new(&r.gpu, COUNTER_SLOTS).unwrap();
     counters.clear(&r.gpu).unwrap();
     let program = r.program().unwrap();
     let scene = r.scene_buffers().unwrap();
@@ -141,7 +141,11 @@ fn kernel_traversal_equals_host_traversal() {
         .unwrap();
     let hits = hits.read(&r.gpu).unwrap();
     let occluded = occluded.read(&r.gpu).unwrap();
-    assert_eq!(counters.read(&r.gpu).unwrap()[4], 0, "no stack overflow");
+    assert_eq!(
+        counters.read(&r.gpu).unwrap()[COUNT_OVERFLOW],
+        0,
+        "no stack overflow"
+    );
     let mut hit_count = 0;
     for (i, (o, d, tmin, tmax)) in rays.iter().enumerate() {
         let ray = Ray {

@@ -1,6 +1,6 @@
 //! Every scene in PENUMBRA_SCENES renders without an error and without non-finite samples;
 //! the meshopt-compressed one fails with a clear message. Skipped (with a note) when
-//! PENUMBRA_SCENES is not set.
+//! PENUMBRA_SCENES is not set; fails when it is set but names no folder of scenes.
 
 mod common;
 
@@ -9,6 +9,10 @@ use std::path::PathBuf;
 
 fn scene_files() -> Vec<PathBuf> {
     let Some(dir) = scenes_dir() else {
+        let set = std::env::var_os("PENUMBRA_SCENES").filter(|v| !v.is_empty());
+        if let Some(v) = set {
+            panic!("PENUMBRA_SCENES={} is not a folder", v.to_string_lossy());
+        }
         eprintln!("PENUMBRA_SCENES is not set: skipping the shared scenes");
         return vec![];
     };
@@ -24,6 +28,11 @@ fn scene_files() -> Vec<PathBuf> {
             }
         }
     }
+    assert!(
+        !files.is_empty(),
+        "PENUMBRA_SCENES={}: no .glb or .gltf file in its subfolders",
+        dir.display()
+    );
     files.sort();
     files
 }

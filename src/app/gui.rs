@@ -4,10 +4,10 @@
 
 use super::camera::{CameraController, Mode};
 use super::frame_loop::{Changes, Film, Progress};
-use super::state::{NewLight, RigLight, ViewState};
+use super::state::ViewState;
 use crate::render::SceneStats;
 use crate::render::tonemap::ToneMapper;
-use crate::scene::{LightKind, LightPreset, Scene};
+use crate::scene::{LightPreset, Scene};
 use egui::{Color32, RichText, Ui};
 use glam::{DMat4, DQuat, DVec3, EulerRot};
 use std::path::PathBuf;
@@ -167,7 +167,7 @@ impl Gui {
                 actions.screenshot = true;
             }
             if ui
-                .checkbox(&mut m.view.hard_shadows, "Hard shadows (H)")
+                .checkbox(&mut m.view.shadows.hard, "Hard shadows (H)")
                 .changed()
             {
                 actions.changes.lights = true;
@@ -381,86 +381,9 @@ impl Gui {
     }
 
     fn lights_section(&mut self, ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
-        egui::CollapsingHeader::new("Shadows & lights")
-            .default_open(true)
-            .show(ui, |ui| {
-                let v = &mut m.view;
-                if ui
-                    .checkbox(&mut v.hard_shadows, "hard shadows (H)")
-                    .changed()
-                {
-                    actions.changes.lights = true;
-                }
-                let max = v.max_softness();
-                if ui
-                    .add_enabled(
-                        !v.hard_shadows,
-                        egui::Slider::new(&mut v.softness, 0.0..=max)
-                            .logarithmic(true)
-                            .text("softness (light radius)"),
-                    )
-                    .changed()
-                {
-                    actions.changes.lights = true;
-                }
-                ui.horizontal(|ui| {
-                    egui::ComboBox::from_id_salt("preset")
-                        .selected_text(self.preset.name())
-                        .show_ui(ui, |ui| {
-                            for p in LightPreset::ALL {
-                                ui.selectable_value(&mut self.preset, p, p.name());
-                            }
-                        });
-                    if ui.button("replace").clicked() {
-                        v.apply_preset(self.preset, true);
-                        actions.changes.lights = true;
-                    }
-                    if ui.button("add").clicked() {
-                        v.apply_preset(self.preset, false);
-                        actions.changes.lights = true;
-                    }
-                });
-                ui.horizontal_wrapped(|ui| {
-                    ui.label("add");
-                    for kind in NewLight::ALL {
-                        if ui.button(kind.name()).clicked() {
-                            v.add_light(kind);
-                            actions.changes.lights = true;
-                        }
-                    }
-                });
-                let mut remove = None;
-                let size = v.diagonal();
-                for i in 0..v.rig.len() {
-                    let radius = v.effective_radius(&v.rig[i]);
-                    let hard = v.hard_shadows;
-                    let l = &mut v.rig[i];
-                    let id = ui.make_persistent_id(("light", i));
-                    egui::collapsing_header::CollapsingState::load_with_default_open(
-                        ui.ctx(),
-                        id,
-                        false,
-                    )
-                    .show_header(ui, |ui| {
-                        if ui.checkbox(&mut l.enabled, "").changed() {
-                            actions.changes.lights = true;
-                        }
-                        ui.label(format!("{} ({})", l.light.name, kind_name(l.light.kind)));
-                        if ui.small_button("✖").on_hover_text("remove").clicked() {
-                            remove = Some(i);
-                        }
-                    })
-                    .body(|ui| {
-                        if light_editor(ui, l, radius, hard, size) {
-                            actions.changes.lights = true;
-                        }
-                    });
-                }
-                if let Some(i) = remove {
-                    v.rig.remove(i);
-                    actions.changes.lights = true;
-                }
-            });
+        if super::light_editor::lights_section(ui, &mut self.preset, &mut m.view) {
+            actions.changes.lights = true;
+        }
     }
 
     fn scene_section(&mut self, ui: &mut Ui, m: &mut Model, info: &Info, actions: &mut Actions) {
@@ -585,126 +508,6 @@ impl Gui {
             actions.changes.scene = true;
         }
     }
-}
-
-fn kind_name(kind: LightKind) -> &'static str {
-    match kind {
-        LightKind::Point => "point",
-        LightKind::Spot { .. } => "spot",
-        LightKind::Directional => "directional",
-    }
-}
-
-/// The editor of one light; returns whether it changed.
-fn light_editor(ui: &mut Ui, l: &mut RigLight, radius: f32, hard: bool, size: f64) -> bool {
-    let mut changed = false;
-    let light = &mut l.light;
-    if light.kind != LightKind::Directional {
-        ui.horizontal(|ui| {
-            ui.label("position");
-            for c in [
-                &mut light.position.x,
-                &mut light.position.y,
-                &mut light.position.z,
-            ] {
-                changed |= ui
-                    .add(egui::DragValue::new(c).speed(0.002 * size))
-                    .changed();
-            }
-        });
-    }
-    if light.kind != LightKind::Point {
-        // Direction as azimuth and elevation (the direction the light travels).
-        let d = light.direction.normalize_or(DVec3::NEG_Y);
-        let mut elevation = d.y.clamp(-1.0, 1.0).asin().to_degrees();
-        let mut azimuth = d.x.atan2(d.z).to_degrees();
-        ui.horizontal(|ui| {
-            ui.label("direction");
-            let a = ui.add(
-                egui::DragValue::new(&mut azimuth)
-                    .speed(0.5)
-                    .range(-180.0..=180.0)
-                    .prefix("az ")
-                    .suffix("°"),
-            );
-            let e = ui.add(
-                egui::DragValue::new(&mut elevation)
-                    .speed(0.5)
-                    .range(-90.0..=90.0)
-                    .prefix("el ")
-                    .suffix("°"),
-            );
-            if a.changed() || e.changed() {
-                let (az, el) = (azimuth.to_radians(), elevation.to_radians());
-                light.direction = DVec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
-                changed = true;
-            }
-        });
-    }
-    if let LightKind::Spot { inner, outer } = &mut light.kind {
-        let mut deg = [inner.to_degrees(), outer.to_degrees()];
-        ui.horizontal(|ui| {
-            ui.label("cone");
-            let a = ui.add(
-                egui::DragValue::new(&mut deg[0])
-                    .range(0.0..=90.0)
-                    .prefix("inner ")
-                    .suffix("°"),
-            );
-            let b = ui.add(
-                egui::DragValue::new(&mut deg[1])
-                    .range(0.0..=90.0)
-                    .prefix("outer ")
-                    .suffix("°"),
-            );
-            if a.changed() || b.changed() {
-                *outer = deg[1].to_radians().max(1e-3);
-                *inner = deg[0].to_radians().min(*outer);
-                changed = true;
-            }
-        });
-    }
-    ui.horizontal(|ui| {
-        ui.label("color");
-        changed |= ui.color_edit_button_rgb(&mut light.color).changed();
-        let speed = (light.intensity.abs() * 0.01).max(1e-3);
-        changed |= ui
-            .add(
-                egui::DragValue::new(&mut light.intensity)
-                    .speed(speed)
-                    .range(0.0..=f32::MAX)
-                    .prefix("intensity "),
-            )
-            .changed();
-    });
-    ui.horizontal(|ui| {
-        let unit = if light.kind == LightKind::Directional {
-            " rad"
-        } else {
-            ""
-        };
-        let mut r = radius;
-        let edited = ui
-            .add_enabled(
-                !hard,
-                egui::DragValue::new(&mut r)
-                    .speed(0.001 * size)
-                    .range(0.0..=f32::MAX)
-                    .prefix("radius ")
-                    .suffix(unit),
-            )
-            .changed();
-        if edited {
-            light.radius = r;
-            l.follows_softness = false;
-            changed = true;
-        }
-        if !l.follows_softness && ui.small_button("follow softness").clicked() {
-            l.follows_softness = true;
-            changed = true;
-        }
-    });
-    changed
 }
 
 fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {

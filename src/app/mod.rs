@@ -7,34 +7,38 @@ mod camera;
 mod frame_loop;
 mod framework;
 mod gui;
+mod input;
+mod light_editor;
+mod loading;
 mod pick;
 mod screenshot;
 mod state;
 
-use crate::cli::{EnvChoice, ViewArgs};
-use crate::render::Renderer;
+use crate::cl::DeviceChoice;
 use crate::render::tonemap::{ToneMapper, to_rgba8};
-use crate::scene::{Light, Scene, SceneError};
+use crate::render::{RenderSettings, Renderer};
+use crate::scene::{Camera, EnvMap, Light, Scene, Shadows};
 use anyhow::{Context, Result, anyhow, bail};
-use camera::{CameraController, Mode, Motion};
+use camera::CameraController;
 use frame_loop::{Changes, FrameLoop, World};
 use framework::Framework;
 use gui::{Gui, Info, Model};
+use input::Input;
+use loading::Loader;
 use pixels::{Pixels, PixelsBuilder, ScalingMode, SurfaceTexture};
 use state::ViewState;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
-use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 /// The window size when `--width`/`--height` are not given.
-const DEFAULT_SIZE: (u32, u32) = (960, 600);
+pub const DEFAULT_SIZE: (u32, u32) = (960, 600);
 /// How long after the last camera change the view still counts as moving.
 const MOVING_FOR: Duration = Duration::from_millis(250);
 /// Display frame interval while something happens, and while only waiting for the device.
@@ -63,15 +67,53 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("drop a file", "open a .gltf / .glb scene"),
 ];
 
-/// Opens the viewer and runs it until the window closes (or `--frames` are shown).
-pub fn run(args: ViewArgs) -> Result<()> {
+/// What the viewer opens with: the command line's choices, checked, with the scene loaded.
+pub struct ViewerConfig {
+    /// The scene file (`None`: the bundled Cornell box); shown in the overlay's path field.
+    pub path: Option<PathBuf>,
+    /// The scene.
+    pub scene: Scene,
+    /// Its lights with the radii `shadows` gives them.
+    pub lights: Vec<Light>,
+    /// The light radius and the hard-shadow switch.
+    pub shadows: Shadows,
+    /// The camera to start from.
+    pub camera: Camera,
+    /// Scene loading time in milliseconds.
+    pub load_ms: f64,
+    /// Render settings; width × height is the window's size.
+    pub settings: RenderSettings,
+    /// Stop accumulating at this many samples per pixel; `None` renders on and on.
+    pub spp_target: Option<u32>,
+    /// The OpenCL device.
+    pub device: DeviceChoice,
+    /// The environment map, if one lights the scene.
+    pub env_map: Option<EnvMap>,
+    /// An environment (map or color) lights the scene: files opened later without lights get
+    /// no default rig.
+    pub env_lights: bool,
+    /// Focus the lens on what the image centre sees once the scene is on the device (a lens
+    /// without a focus distance).
+    pub autofocus: bool,
+    /// Exit after this many frames (for tests).
+    pub frames: Option<u64>,
+    /// Save the final frame to this PNG path on exit (for tests), an EXR beside it.
+    pub screenshot: Option<PathBuf>,
+}
+
+/// Checks what needs no scene before one is loaded: that there is a display to open a window
+/// on, and that `screenshot` names a PNG in an existing folder.
+pub fn preflight(screenshot: Option<&Path>) -> Result<()> {
     check_display()?;
-    if let Some(p) = &args.screenshot {
+    if let Some(p) = screenshot {
         check_screenshot_path(p)?;
     }
-    let settings = args.common.settings(DEFAULT_SIZE)?;
-    let size = (settings.width, settings.height);
-    let prepared = args.common.prepare(args.scene.as_deref())?;
+    Ok(())
+}
+
+/// Opens the viewer and runs it until the window closes (or `frames` are shown).
+pub fn run(config: ViewerConfig) -> Result<()> {
+    let size = (config.settings.width, config.settings.height);
     let event_loop = EventLoop::new().map_err(|e| {
         // winit's message starts with its source location; keep the reason only.
         let text = e.to_string();
@@ -84,22 +126,25 @@ pub fn run(args: ViewArgs) -> Result<()> {
              -o OUT.png` to render without one"
         )
     })?;
-    let environment = args.common.environment()?;
-    let mut renderer = Renderer::new(&args.common.device_choice()?)
+    let mut renderer = Renderer::new(&config.device)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
-    let env_loaded = matches!(environment, Some(EnvChoice::Map(_)));
-    if let Some(EnvChoice::Map(map)) = environment {
+    let env_loaded = config.env_map.is_some();
+    if let Some(map) = config.env_map {
         renderer
             .set_environment(Some(map))
             .context("cannot upload the environment map")?;
     }
-    let bounds = prepared.scene.bounds();
-    // With a lens but no focus distance, focus on what the image centre sees once loaded.
-    let autofocus = settings.lens_radius > 0.0 && args.common.focus_distance.is_none();
-    let view = ViewState::from_args(&args.common, settings, &prepared.scene.lights, bounds);
-    let camera = CameraController::new(prepared.camera.clone(), &bounds);
-    let path_text = args
-        .scene
+    let bounds = config.scene.bounds();
+    let view = ViewState::new(
+        config.settings,
+        config.spp_target,
+        config.shadows,
+        &config.lights,
+        bounds,
+    );
+    let camera = CameraController::new(config.camera, &bounds);
+    let path_text = config
+        .path
         .as_ref()
         .map(|p| p.display().to_string())
         .unwrap_or_default();
@@ -108,11 +153,11 @@ pub fn run(args: ViewArgs) -> Result<()> {
         device: renderer.gpu.description(),
         frame_loop: FrameLoop::new(renderer),
         lights: view.lights(),
-        model: Model::new(prepared.scene, view, camera),
+        model: Model::new(config.scene, view, camera),
         gui: Gui::new(path_text, env_loaded),
-        load_ms: prepared.load_ms,
-        frames_limit: args.frames,
-        screenshot_on_exit: args.screenshot.clone(),
+        load_ms: config.load_ms,
+        frames_limit: config.frames,
+        screenshot_on_exit: config.screenshot,
         gfx: None,
         input: Input::default(),
         overlay: true,
@@ -130,8 +175,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
         last_screenshot: None,
         converged: false,
         quit: false,
-        autofocus,
-        env_lights: args.common.env.is_some(),
+        autofocus: config.autofocus,
+        env_lights: config.env_lights,
     };
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.fatal.take() {
@@ -174,27 +219,11 @@ fn check_screenshot_path(p: &Path) -> Result<()> {
     Ok(())
 }
 
-/// A scene loaded in the background, with its loading time in milliseconds.
-type Loaded = Result<(Scene, f64), SceneError>;
-
 /// The window and what draws into it.
 struct Gfx {
     window: Arc<Window>,
     pixels: Pixels<'static>,
     framework: Framework,
-}
-
-/// Mouse and key state between events.
-#[derive(Default)]
-struct Input {
-    motion: Motion,
-    cursor: Option<(f64, f64)>,
-    look: bool,
-    pan: bool,
-    shift: bool,
-    ctrl: bool,
-    /// A button pressed while the overlay is shown, handled after egui's next pass.
-    press: Option<MouseButton>,
 }
 
 struct App {
@@ -224,7 +253,8 @@ struct App {
     display: Vec<u8>,
     /// Exposure, tone mapper and samples of `display`.
     display_key: Option<(f32, ToneMapper, u32, usize)>,
-    loader: Option<(PathBuf, Receiver<Loaded>)>,
+    /// The scene file being loaded in the background.
+    loader: Option<Loader>,
     device_error: Option<String>,
     fatal: Option<anyhow::Error>,
     last_screenshot: Option<PathBuf>,
@@ -291,68 +321,8 @@ impl ApplicationHandler for App {
                 gfx.framework.set_scale_factor(scale_factor);
             }
             WindowEvent::DroppedFile(path) => self.open(path),
-            WindowEvent::ModifiersChanged(m) => {
-                self.input.shift = m.state().shift_key();
-                self.input.ctrl = m.state().control_key();
-                self.input.motion.fast = self.input.shift;
-            }
-            WindowEvent::KeyboardInput { event, .. } => {
-                if let PhysicalKey::Code(code) = event.physical_key {
-                    let pressed = event.state == ElementState::Pressed;
-                    // Releases always count so no key stays stuck.
-                    if !pressed || !typing {
-                        self.key(code, pressed, event.repeat);
-                    }
-                }
-            }
-            WindowEvent::MouseInput { state, button, .. } => {
-                let pressed = state == ElementState::Pressed;
-                if pressed && self.overlay {
-                    // egui learns where the pointer is only when it runs: decide in the next
-                    // frame whether the press was on the overlay or on the image.
-                    self.input.press = Some(button);
-                } else if pressed {
-                    self.press(button);
-                } else if matches!(button, MouseButton::Right | MouseButton::Middle) {
-                    self.input.look = false;
-                    self.input.pan = false;
-                }
-            }
-            WindowEvent::CursorMoved { position, .. } => {
-                let now = (position.x, position.y);
-                if let Some(last) = self.input.cursor {
-                    let (dx, dy) = (now.0 - last.0, now.1 - last.1);
-                    let moved = if self.input.pan {
-                        self.model.camera.pan(dx, dy, self.size.1 as f64)
-                    } else if self.input.look {
-                        self.model.camera.look(dx, dy)
-                    } else {
-                        false
-                    };
-                    if moved {
-                        self.camera_moved();
-                    }
-                }
-                self.input.cursor = Some(now);
-            }
-            WindowEvent::CursorLeft { .. } => self.input.cursor = None,
-            // Releases that happen elsewhere never arrive: nothing stays held.
-            WindowEvent::Focused(false) => {
-                self.input.motion = Motion::default();
-                self.input.look = false;
-                self.input.pan = false;
-            }
-            WindowEvent::MouseWheel { delta, .. } if !egui_wants_pointer && !consumed => {
-                let notches = match delta {
-                    MouseScrollDelta::LineDelta(_, y) => y as f64,
-                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
-                };
-                if self.model.camera.wheel(notches) {
-                    self.camera_moved();
-                }
-            }
             WindowEvent::RedrawRequested => self.redraw(event_loop),
-            _ => {}
+            other => self.input_event(other, typing, !egui_wants_pointer && !consumed),
         }
     }
 
@@ -438,183 +408,6 @@ impl App {
             || self.last_motion.is_some_and(|t| now - t < MOVING_FOR)
     }
 
-    /// A mouse button pressed on the image: pick, look or pan.
-    fn press(&mut self, button: MouseButton) {
-        match button {
-            MouseButton::Left => self.pick(),
-            MouseButton::Right if self.input.shift => self.input.pan = true,
-            MouseButton::Right => self.input.look = true,
-            MouseButton::Middle => self.input.pan = true,
-            _ => {}
-        }
-    }
-
-    fn camera_moved(&mut self) {
-        self.last_motion = Some(Instant::now());
-        self.frame_loop.invalidate(Changes {
-            camera: true,
-            ..Changes::default()
-        });
-    }
-
-    fn key(&mut self, code: KeyCode, pressed: bool, repeat: bool) {
-        let ctrl = self.input.ctrl;
-        let m = &mut self.input.motion;
-        match code {
-            KeyCode::KeyW => m.forward = pressed,
-            KeyCode::KeyS => m.back = pressed,
-            KeyCode::KeyA => m.left = pressed,
-            KeyCode::KeyD => m.right = pressed,
-            KeyCode::KeyQ if !ctrl || !pressed => m.down = pressed,
-            KeyCode::KeyE => m.up = pressed,
-            _ if !pressed || repeat && !matches!(code, KeyCode::Equal | KeyCode::Minus) => {}
-            KeyCode::KeyR => {
-                self.model.camera.reset();
-                self.camera_moved();
-            }
-            KeyCode::KeyH => {
-                self.model.view.toggle_hard_shadows();
-                self.lights_changed();
-            }
-            KeyCode::KeyO => {
-                let next = match self.model.camera.mode {
-                    Mode::Fly => Mode::Orbit,
-                    Mode::Orbit => Mode::Fly,
-                };
-                self.model.camera.set_mode(next);
-            }
-            KeyCode::Equal | KeyCode::NumpadAdd => self.model.camera.scale_speed(1.0),
-            KeyCode::Minus | KeyCode::NumpadSubtract => self.model.camera.scale_speed(-1.0),
-            KeyCode::KeyQ if ctrl => self.quit = true,
-            KeyCode::Tab | KeyCode::F1 => self.overlay = !self.overlay,
-            KeyCode::F12 => self.screenshot(),
-            _ => {}
-        }
-    }
-
-    fn lights_changed(&mut self) {
-        self.last_motion = Some(Instant::now());
-        self.lights = self.model.view.lights();
-        self.frame_loop.invalidate(Changes {
-            lights: true,
-            ..Changes::default()
-        });
-    }
-
-    /// Picks the object under the cursor (host BVH ray cast).
-    fn pick(&mut self) {
-        let Some((x, y)) = self.input.cursor else {
-            return;
-        };
-        let Some(host) = self.frame_loop.renderer.host_scene() else {
-            return;
-        };
-        let (w, h) = (self.size.0 as f32, self.size.1 as f32);
-        let ray = pick::primary_ray(&self.model.camera.camera, w / h, x as f32 / w, y as f32 / h);
-        let hit = pick::pick(host, &ray);
-        log::debug!("pick at ({x:.0}, {y:.0}): {hit:?}");
-        match hit {
-            Some(hit) => {
-                self.model.selected = Some(hit.object);
-                if self.model.camera.mode == Mode::Orbit {
-                    self.model.camera.set_pivot(hit.point);
-                }
-                // With a lens, a click also focuses on the clicked point.
-                if self.model.view.aperture > 0.0 {
-                    let cam = &self.model.camera.camera;
-                    self.model.view.focus_distance = (hit.point - cam.eye).dot(cam.forward) as f32;
-                    self.frame_loop.invalidate(Changes {
-                        settings: true,
-                        ..Changes::default()
-                    });
-                }
-            }
-            None => self.model.selected = None,
-        }
-    }
-
-    /// Loads `path` on a background thread; the current scene stays until it succeeds.
-    /// Loads (or with `None` removes) the environment map; an error stays in the overlay and
-    /// the current environment is kept.
-    fn set_environment(&mut self, path: Option<PathBuf>) {
-        let map = match path.as_deref().map(crate::scene::EnvMap::load).transpose() {
-            Ok(map) => map,
-            Err(e) => {
-                self.gui.env_error = Some(e);
-                return;
-            }
-        };
-        let loaded = map.is_some();
-        match self.frame_loop.renderer.set_environment(map) {
-            Ok(()) => {
-                self.gui.env_error = None;
-                self.gui.env_loaded = loaded;
-                self.frame_loop.invalidate(Changes {
-                    settings: true,
-                    ..Changes::default()
-                });
-            }
-            Err(e) => self.gui.env_error = Some(e.to_string()),
-        }
-    }
-
-    fn open(&mut self, path: PathBuf) {
-        self.gui.path_text = path.display().to_string();
-        let (tx, rx) = std::sync::mpsc::channel();
-        let p = path.clone();
-        std::thread::spawn(move || {
-            let t = Instant::now();
-            let result = crate::scene::load(&p).map(|s| (s, t.elapsed().as_secs_f64() * 1e3));
-            // The viewer may have closed meanwhile; nobody to tell then.
-            let _ = tx.send(result);
-        });
-        self.loader = Some((path, rx));
-    }
-
-    /// Takes a finished background load.
-    fn poll_loader(&mut self) {
-        let Some((path, rx)) = self.loader.as_ref() else {
-            return;
-        };
-        let result = match rx.try_recv() {
-            Ok(r) => r,
-            Err(TryRecvError::Empty) => return,
-            Err(TryRecvError::Disconnected) => Err(SceneError::Invalid {
-                path: path.clone(),
-                message: "the loader stopped unexpectedly".into(),
-            }),
-        };
-        self.loader = None;
-        match result {
-            Ok((mut scene, ms)) => {
-                if self.env_lights && scene.default_rig {
-                    // The environment lights the scene instead of the default rig.
-                    scene.lights.clear();
-                    scene.default_rig = false;
-                }
-                self.autofocus = self.model.view.aperture > 0.0;
-                for w in &scene.warnings {
-                    log::warn!("{}: {w}", scene.source);
-                }
-                let bounds = scene.bounds();
-                self.model.view.replace_scene_lights(&scene.lights, bounds);
-                let camera = CameraController::new(scene.cameras[0].clone(), &bounds);
-                let view = self.model.view.clone();
-                if let Some(gfx) = &self.gfx {
-                    gfx.window
-                        .set_title(&format!("penumbra — {}", scene.source));
-                }
-                self.model = Model::new(scene, view, camera);
-                self.load_ms = ms;
-                self.lights = self.model.view.lights();
-                self.gui.file_error = None;
-                self.device_error = None;
-                self.frame_loop.invalidate(Changes::ALL);
-            }
-            Err(e) => self.gui.file_error = Some(e.to_string()),
-        }
-    }
-
     /// Saves the frame on screen (PNG) and the film (EXR) into `screenshots/`.
     fn screenshot(&mut self) {
         let film = &self.frame_loop.film;
@@ -684,11 +477,34 @@ impl App {
         if self.model.camera.fly(&self.input.motion, dt) {
             self.camera_moved();
         }
-
-        // The overlay edits the model; what it changed goes to the frame loop.
-        let Some(gfx) = self.gfx.as_mut() else {
+        let Some(actions) = self.overlay_pass(now) else {
             return;
         };
+        let screenshot = actions.screenshot;
+        self.apply(actions, now);
+
+        // Collect a finished batch and start the next one before showing this image.
+        let new_image = self.step_frame_loop(now);
+        self.autofocus_once();
+        self.update_display(new_image);
+        if new_image {
+            // The overlay above was drawn with the previous figures: draw once more.
+            self.wake = Some(now);
+        }
+        if screenshot {
+            self.screenshot();
+        }
+        if let Err(e) = self.present() {
+            self.fail(event_loop, e);
+            return;
+        }
+        self.frame_shown(event_loop);
+    }
+
+    /// Runs the overlay (it edits the model) and a mouse press held back for it; `None` without
+    /// a window.
+    fn overlay_pass(&mut self, now: Instant) -> Option<gui::Actions> {
+        let gfx = self.gfx.as_mut()?;
         let info = Info {
             device: &self.device,
             progress: &self.frame_loop.progress,
@@ -696,7 +512,7 @@ impl App {
             scene_stats: self.frame_loop.scene_stats.as_ref(),
             load_ms: self.load_ms,
             fps: self.fps,
-            loading: self.loader.as_ref().map(|(p, _)| p.as_path()),
+            loading: self.loader.as_ref().map(|l| l.path.as_path()),
             last_screenshot: self.last_screenshot.as_deref(),
             device_error: self.device_error.as_deref(),
         };
@@ -713,6 +529,11 @@ impl App {
         {
             self.press(button);
         }
+        Some(actions)
+    }
+
+    /// Passes what the overlay changed to the frame loop and carries out its requests.
+    fn apply(&mut self, actions: gui::Actions, now: Instant) {
         // Any edit counts as motion: dragging a slider or an object renders at a reduced
         // resolution like moving the camera does, and returns to full resolution after it.
         if actions.changes.any() {
@@ -731,63 +552,50 @@ impl App {
         if let Some(env) = actions.environment {
             self.set_environment(env);
         }
+    }
 
-        // Collect a finished batch and start the next one before showing this image.
-        let mut new_image = false;
-        if self.device_error.is_none() {
-            let world = World {
-                scene: &self.model.scene,
-                lights: &self.lights,
-                camera: &self.model.camera.camera,
-                settings: self.model.view.render_settings(self.size),
-                spp_target: self.model.view.spp_target,
-                moving: self.moving(now),
-            };
-            match self.frame_loop.step(&world) {
-                Ok(new) => new_image = new,
-                Err(e) => {
-                    let message = e.to_string();
-                    eprintln!("penumbra: device error: {message}");
-                    self.device_error = Some(message);
-                }
+    /// One step of the frame loop; returns whether a new image arrived. A device error stops
+    /// rendering and stays in the overlay.
+    fn step_frame_loop(&mut self, now: Instant) -> bool {
+        if self.device_error.is_some() {
+            return false;
+        }
+        let world = World {
+            scene: &self.model.scene,
+            lights: &self.lights,
+            camera: &self.model.camera.camera,
+            settings: self.model.view.render_settings(self.size),
+            spp_target: self.model.view.spp_target,
+            moving: self.moving(now),
+        };
+        match self.frame_loop.step(&world) {
+            Ok(new) => new,
+            Err(e) => {
+                let message = e.to_string();
+                eprintln!("penumbra: device error: {message}");
+                self.device_error = Some(message);
+                false
             }
         }
-        if self.autofocus
-            && let Some(host) = self.frame_loop.renderer.host_scene()
-        {
-            self.autofocus = false;
-            let aspect = self.size.0 as f32 / self.size.1.max(1) as f32;
-            let cam = &self.model.camera.camera;
-            if let Some(hit) = pick::pick(host, &pick::primary_ray(cam, aspect, 0.5, 0.5)) {
-                self.model.view.focus_distance = (hit.point - cam.eye).dot(cam.forward) as f32;
-                self.frame_loop.invalidate(Changes {
-                    settings: true,
-                    ..Changes::default()
-                });
-            }
-        }
-        self.update_display(new_image);
-        if new_image {
-            // The overlay above was drawn with the previous figures: draw once more.
-            self.wake = Some(now);
-        }
-        if actions.screenshot {
-            self.screenshot();
-        }
+    }
 
+    /// Draws the frame and the overlay into the window.
+    fn present(&mut self) -> Result<()> {
         let Some(gfx) = self.gfx.as_mut() else {
-            return;
+            return Ok(());
         };
         let framework = &mut gfx.framework;
-        let result = gfx.pixels.render_with(|encoder, target, context| {
-            context.scaling_renderer.render(encoder, target);
-            framework.render(encoder, target, context);
-            Ok(())
-        });
-        if let Err(e) = result {
-            self.fail(event_loop, anyhow!("cannot draw the window: {e}"));
-            return;
-        }
+        gfx.pixels
+            .render_with(|encoder, target, context| {
+                context.scaling_renderer.render(encoder, target);
+                framework.render(encoder, target, context);
+                Ok(())
+            })
+            .map_err(|e| anyhow!("cannot draw the window: {e}"))
+    }
+
+    /// After a frame is shown: reports convergence, and exits on Ctrl+Q or after `--frames`.
+    fn frame_shown(&mut self, event_loop: &ActiveEventLoop) {
         self.frames += 1;
         let converged = self.frame_loop.converged(self.model.view.spp_target);
         if converged && !self.converged {

@@ -4,7 +4,7 @@
 use crate::bvh::Ray;
 use crate::render::{HostScene, gpu_camera};
 use crate::scene::Camera;
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 
 /// What a click hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,15 +18,7 @@ pub struct Pick {
 /// The primary ray through the point (fx, fy) of the image, both in [0, 1] from the top left,
 /// as the camera kernel makes it (without jitter and lens).
 pub fn primary_ray(camera: &Camera, aspect: f32, fx: f32, fy: f32) -> Ray {
-    let c = gpu_camera(camera, aspect);
-    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
-    let direction = v(c.forward) + (2.0 * fx - 1.0) * v(c.right) + (1.0 - 2.0 * fy) * v(c.up);
-    Ray {
-        origin: v(c.origin),
-        direction,
-        tmin: 0.0,
-        tmax: f32::INFINITY,
-    }
+    crate::render::camera::primary_ray(&gpu_camera(camera, aspect), fx, fy)
 }
 
 /// The object the ray hits first, if any.
@@ -43,7 +35,7 @@ pub fn pick(host: &HostScene, ray: &Ray) -> Option<Pick> {
 mod tests {
     use super::*;
     use crate::scene::{Material, Mesh, Object, Scene};
-    use glam::DMat4;
+    use glam::{DMat4, Vec3};
 
     /// Two unit quads facing +Z: object 0 at x = -2, object 1 at x = +2, and a hidden one in
     /// front of object 1.

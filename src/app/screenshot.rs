@@ -1,7 +1,8 @@
 //! Screenshots: the displayed frame as PNG (exposure, tone curve and sRGB, without the overlay)
 //! and the film as EXR (linear radiance), side by side with the same name.
 
-use crate::image_io::{unique_path, write_exr, write_rgba_png};
+use crate::image_io::{unique_path, write_exr};
+use crate::render::tonemap::write_rgba_png;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;

@@ -1,16 +1,17 @@
 //! What the overlay controls, and how it maps onto the renderer: render settings, the light rig
-//! with shadow softness, exposure and tone mapping.
+//! with its light radius, exposure and tone mapping.
 
-use crate::cli::{CommonArgs, with_radius};
 use crate::render::RenderSettings;
 use crate::render::tonemap::ToneMapper;
-use crate::scene::{Bounds, Light, LightKind, LightPreset, default_light_radius, preset_lights};
+use crate::scene::{
+    Bounds, Light, LightKind, LightPreset, Shadows, default_light_radius, preset_lights,
+};
 use glam::DVec3;
 
 /// Kinds of light the user can add.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum NewLight {
-    /// A point light (follows the shadow softness).
+    /// A point light (follows the light radius).
     Point,
     /// A spot light pointing down.
     Spot,
@@ -43,13 +44,13 @@ impl NewLight {
 /// One light of the rig.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RigLight {
-    /// The light; its `radius` is used when `follows_softness` is false.
+    /// The light; its `radius` is used when `follows_light_radius` is false.
     pub light: Light,
     /// Whether it is rendered.
     pub enabled: bool,
-    /// Whether its radius is the global shadow softness (true for the scene's lights and
-    /// added point, spot and directional lights, until the user sets its radius by hand).
-    pub follows_softness: bool,
+    /// Whether its radius is the global light radius (true for the scene's lights and added
+    /// point, spot and directional lights, until the user sets its radius by hand).
+    pub follows_light_radius: bool,
 }
 
 /// The overlay's render state.
@@ -71,18 +72,16 @@ pub struct ViewState {
     pub focus_distance: f32,
     /// Stop accumulating at this many samples per pixel; `None` renders on and on.
     pub spp_target: Option<u32>,
-    /// Shadow softness: the radius of point and spot lights in scene units (directional
-    /// lights get the matching angular radius).
-    pub softness: f32,
-    /// Hard shadows: every light radius 0. Flipping it back restores the softness.
-    pub hard_shadows: bool,
+    /// The light radius (point and spot lights; directional lights get the matching angular
+    /// radius) and the hard-shadow switch, which keeps the radius for flipping back.
+    pub shadows: Shadows,
     /// Exposure in stops.
     pub exposure: f32,
     /// Tone curve.
     pub tone_mapper: ToneMapper,
     /// The lights: the scene's, presets' and the user's.
     pub rig: Vec<RigLight>,
-    /// The scene's bounds, which size new lights and the softness range.
+    /// The scene's bounds, which size new lights and the light radius range.
     pub bounds: Bounds,
     /// What the command line set that the overlay does not edit (Russian roulette, strategy).
     base: RenderSettings,
@@ -91,9 +90,10 @@ pub struct ViewState {
 impl ViewState {
     /// The state the command line asks for (`base` is its validated render settings) on a
     /// scene with `lights` and `bounds`.
-    pub fn from_args(
-        args: &CommonArgs,
+    pub fn new(
         base: RenderSettings,
+        spp_target: Option<u32>,
+        shadows: Shadows,
         lights: &[Light],
         bounds: Bounds,
     ) -> Self {
@@ -105,11 +105,8 @@ impl ViewState {
             env_rotation: base.env_rotation,
             aperture: base.lens_radius,
             focus_distance: base.focus_distance,
-            spp_target: args.spp,
-            softness: args
-                .light_radius
-                .unwrap_or_else(|| default_light_radius(&bounds)),
-            hard_shadows: args.hard_shadows,
+            spp_target,
+            shadows,
             exposure: 0.0,
             tone_mapper: ToneMapper::default(),
             rig: Vec::new(),
@@ -120,10 +117,11 @@ impl ViewState {
         s
     }
 
-    /// A new scene: its lights replace the rig, the softness goes back to the scene's default.
+    /// A new scene: its lights replace the rig, the light radius goes back to the scene's
+    /// default.
     pub fn replace_scene_lights(&mut self, lights: &[Light], bounds: Bounds) {
         if self.bounds != bounds {
-            self.softness = default_light_radius(&bounds);
+            self.shadows.light_radius = default_light_radius(&bounds);
         }
         self.bounds = bounds;
         self.rig = lights
@@ -131,7 +129,7 @@ impl ViewState {
             .map(|l| RigLight {
                 light: l.clone(),
                 enabled: true,
-                follows_softness: true,
+                follows_light_radius: true,
             })
             .collect();
     }
@@ -159,15 +157,10 @@ impl ViewState {
 
     /// The radius a rig light renders with.
     pub fn effective_radius(&self, l: &RigLight) -> f32 {
-        if self.hard_shadows {
+        if l.follows_light_radius {
+            self.shadows.radius_for(&l.light.kind, self.diagonal())
+        } else if self.shadows.hard {
             0.0
-        } else if l.follows_softness {
-            with_radius(
-                std::slice::from_ref(&l.light),
-                self.softness,
-                self.diagonal(),
-            )[0]
-            .radius
         } else {
             l.light.radius
         }
@@ -187,7 +180,7 @@ impl ViewState {
 
     /// Flips hard shadows (the H key).
     pub fn toggle_hard_shadows(&mut self) {
-        self.hard_shadows = !self.hard_shadows;
+        self.shadows.hard = !self.shadows.hard;
     }
 
     /// Adds a light of `kind` sized and placed for the scene.
@@ -225,7 +218,7 @@ impl ViewState {
                 radius: radius as f32,
             },
             enabled: true,
-            follows_softness: follows,
+            follows_light_radius: follows,
         });
     }
 
@@ -241,13 +234,13 @@ impl ViewState {
                 .map(|light| RigLight {
                     light,
                     enabled: true,
-                    follows_softness: false,
+                    follows_light_radius: false,
                 }),
         );
     }
 
-    /// Largest softness the overlay's slider offers.
-    pub fn max_softness(&self) -> f32 {
+    /// Largest light radius the overlay's slider offers.
+    pub fn max_light_radius(&self) -> f32 {
         (0.2 * self.diagonal()) as f32
     }
 }
@@ -260,10 +253,11 @@ mod tests {
     fn state(extra: &[&str], lights: &[Light]) -> ViewState {
         let a = args(extra);
         let base = a.settings((64, 64)).unwrap();
-        ViewState::from_args(&a, base, lights, bounds())
+        let shadows = Shadows::new(a.light_radius, a.hard_shadows, &bounds());
+        ViewState::new(base, a.spp, shadows, lights, bounds())
     }
 
-    fn args(extra: &[&str]) -> CommonArgs {
+    fn args(extra: &[&str]) -> crate::cli::CommonArgs {
         let mut argv = vec!["penumbra", "view"];
         argv.extend_from_slice(extra);
         match crate::cli::Cli::parse_from(argv).command {
@@ -340,18 +334,18 @@ mod tests {
     }
 
     #[test]
-    fn the_default_softness_is_visibly_soft() {
+    fn the_default_light_radius_is_visibly_soft() {
         let s = state(&[], &[point(), sun()]);
-        assert_eq!(s.softness, default_light_radius(&bounds()));
+        assert_eq!(s.shadows.light_radius, default_light_radius(&bounds()));
         let lights = s.lights();
-        assert_eq!(lights[0].radius, s.softness);
+        assert_eq!(lights[0].radius, s.shadows.light_radius);
         // The sun gets the matching angular radius.
-        let angular = 2.0 * s.softness as f64 / bounds().diagonal();
+        let angular = 2.0 * s.shadows.light_radius as f64 / bounds().diagonal();
         assert!((lights[1].radius as f64 - angular).abs() < 1e-6);
     }
 
     #[test]
-    fn the_hard_toggle_gives_radius_zero_and_restores_the_softness() {
+    fn the_hard_toggle_gives_radius_zero_and_restores_the_light_radius() {
         let mut s = state(&["--light-radius", "0.1"], &[point()]);
         s.add_light(NewLight::Sphere);
         let soft = s.lights();
@@ -361,7 +355,7 @@ mod tests {
         assert!(s.lights().iter().all(|l| l.radius == 0.0));
         s.toggle_hard_shadows();
         assert_eq!(s.lights(), soft);
-        // --hard-shadows starts hard but keeps the default softness for the toggle.
+        // --hard-shadows starts hard but keeps the default light radius for the toggle.
         let mut h = state(&["--hard-shadows"], &[point()]);
         assert_eq!(h.lights()[0].radius, 0.0);
         h.toggle_hard_shadows();
@@ -369,11 +363,11 @@ mod tests {
     }
 
     #[test]
-    fn the_softness_follows_the_slider_unless_set_by_hand() {
+    fn the_light_radius_follows_the_slider_unless_set_by_hand() {
         let mut s = state(&[], &[point(), point()]);
-        s.rig[1].follows_softness = false;
+        s.rig[1].follows_light_radius = false;
         s.rig[1].light.radius = 0.3;
-        s.softness = 0.05;
+        s.shadows.light_radius = 0.05;
         let l = s.lights();
         assert_eq!((l[0].radius, l[1].radius), (0.05, 0.3));
     }
@@ -388,7 +382,7 @@ mod tests {
         s.apply_preset(LightPreset::OverheadSoftbox, true);
         assert_eq!(s.rig.len(), 1);
         // The softbox keeps its large radius.
-        assert!(s.lights()[0].radius > s.softness);
+        assert!(s.lights()[0].radius > s.shadows.light_radius);
         for kind in NewLight::ALL {
             s.add_light(kind);
         }

@@ -1,15 +1,17 @@
 //! Typed wrappers over the kernels and device buffers: the only `unsafe` code and the only
 //! positional kernel arguments in penumbra. Each wrapper takes exactly the kernel's arguments,
 //! launches it under its stage name and returns the profiling event.
+#![allow(unsafe_code)]
 
 use super::types::*;
-use super::{ClError, Gpu, KernelFeatures, build_program, call_err};
+use super::{ClError, Gpu, KernelFeatures, build_program, build_test_program, call_err};
 use bytemuck::Pod;
 use opencl3::event::Event;
 use opencl3::kernel::{ExecuteKernel, Kernel};
 use opencl3::memory::{CL_MEM_READ_WRITE, ClMem};
 use opencl3::types::CL_BLOCKING;
 use std::ptr;
+use std::sync::OnceLock;
 
 /// A typed device buffer of `len` elements (at least one is allocated: OpenCL has no empty
 /// buffers).
@@ -109,9 +111,51 @@ impl<T: Pod> Buffer<T> {
     }
 }
 
-/// A launched kernel: its stage name and profiling event.
+/// The path tracer's wavefront stages, each one kernel, in launch order (`render::wavefront`
+/// launches them; the name is the kernel's, and names the stage in errors and statistics).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Stage {
+    /// Camera rays for every slot of the wave.
+    Generate,
+    /// Closest hits of the queued rays.
+    Extend,
+    /// Emission, a light sample and the next bounce.
+    Shade,
+    /// Shadow rays.
+    Connect,
+    /// Ray counts and the queue swap.
+    Advance,
+    /// The wave's samples into the film.
+    Accumulate,
+}
+
+impl Stage {
+    /// Every stage, in launch order.
+    pub const ALL: [Stage; 6] = [
+        Stage::Generate,
+        Stage::Extend,
+        Stage::Shade,
+        Stage::Connect,
+        Stage::Advance,
+        Stage::Accumulate,
+    ];
+
+    /// The kernel's (and the stage's) name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Generate => "generate",
+            Stage::Extend => "extend",
+            Stage::Shade => "shade",
+            Stage::Connect => "connect",
+            Stage::Advance => "advance",
+            Stage::Accumulate => "accumulate",
+        }
+    }
+}
+
+/// A launched kernel: its name and profiling event.
 pub struct Launch {
-    /// Stage name (the kernel's name).
+    /// The kernel's name.
     pub stage: &'static str,
     /// The event, for profiling.
     pub event: Event,
@@ -126,7 +170,7 @@ impl Launch {
     }
 }
 
-/// The built program with every kernel.
+/// The built program with every production kernel.
 pub struct Program {
     generate: Kernel,
     extend: Kernel,
@@ -136,14 +180,24 @@ pub struct Program {
     accumulate: Kernel,
     trace_closest: Kernel,
     trace_any: Kernel,
+    /// The test-only kernels, built on first use (never in production).
+    tests: OnceLock<TestKernels>,
+    local_size: usize,
+    /// Features it was built with.
+    pub features: KernelFeatures,
+}
+
+/// The kernels only tests use, from their own program (`build_test_program`).
+struct TestKernels {
     probe_layout: Kernel,
     sample_texture_test: Kernel,
     sample_env_test: Kernel,
     bsdf_sample_test: Kernel,
     bsdf_eval_test: Kernel,
-    local_size: usize,
-    /// Features it was built with.
-    pub features: KernelFeatures,
+}
+
+fn kernel(program: &opencl3::program::Program, name: &str) -> Result<Kernel, ClError> {
+    Kernel::create(program, name).map_err(|e| ClError::Build(format!("{name}: {e}")))
 }
 
 /// Rounds `n` up to a multiple of `local` (and at least one group).
@@ -155,27 +209,38 @@ impl Program {
     /// Builds the kernels for `features`.
     pub fn build(gpu: &Gpu, features: KernelFeatures) -> Result<Self, ClError> {
         let program = build_program(gpu, features)?;
-        let k = |name: &str| {
-            Kernel::create(&program, name).map_err(|e| ClError::Build(format!("{name}: {e}")))
-        };
+        let k = |stage: Stage| kernel(&program, stage.name());
         let max_group = gpu.device.max_work_group_size().unwrap_or(64).max(1);
         Ok(Self {
-            generate: k("generate")?,
-            extend: k("extend")?,
-            shade: k("shade")?,
-            connect: k("connect")?,
-            advance: k("advance")?,
-            accumulate: k("accumulate")?,
-            trace_closest: k("trace_closest")?,
-            trace_any: k("trace_any")?,
+            generate: k(Stage::Generate)?,
+            extend: k(Stage::Extend)?,
+            shade: k(Stage::Shade)?,
+            connect: k(Stage::Connect)?,
+            advance: k(Stage::Advance)?,
+            accumulate: k(Stage::Accumulate)?,
+            trace_closest: kernel(&program, "trace_closest")?,
+            trace_any: kernel(&program, "trace_any")?,
+            tests: OnceLock::new(),
+            local_size: 64.min(max_group),
+            features,
+        })
+    }
+
+    /// The test-only kernels for the same features, built the first time a test asks.
+    fn tests(&self, gpu: &Gpu) -> Result<&TestKernels, ClError> {
+        if let Some(t) = self.tests.get() {
+            return Ok(t);
+        }
+        let program = build_test_program(gpu, self.features)?;
+        let k = |name: &str| kernel(&program, name);
+        let built = TestKernels {
             probe_layout: k("probe_layout")?,
             sample_texture_test: k("sample_texture_test")?,
             sample_env_test: k("sample_env_test")?,
             bsdf_sample_test: k("bsdf_sample_test")?,
             bsdf_eval_test: k("bsdf_eval_test")?,
-            local_size: 64.min(max_group),
-            features,
-        })
+        };
+        Ok(self.tests.get_or_init(|| built))
     }
 
     fn run(
@@ -210,14 +275,20 @@ impl Program {
         cones: &Buffer<[f32; 2]>,
         slots: usize,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, "generate", &self.generate, slots, |e| unsafe {
-            e.set_arg(frame)
-                .set_arg(camera)
-                .set_arg(&paths.mem())
-                .set_arg(&queue.mem())
-                .set_arg(&counters.mem())
-                .set_arg(&cones.mem());
-        })
+        self.run(
+            gpu,
+            Stage::Generate.name(),
+            &self.generate,
+            slots,
+            |e| unsafe {
+                e.set_arg(frame)
+                    .set_arg(camera)
+                    .set_arg(&paths.mem())
+                    .set_arg(&queue.mem())
+                    .set_arg(&counters.mem())
+                    .set_arg(&cones.mem());
+            },
+        )
     }
 
     /// `extend`: closest hits of the queued paths' rays (alpha-tested with `HAS_ALPHA`).
@@ -232,7 +303,7 @@ impl Program {
         hits: &Buffer<GpuHit>,
         slots: usize,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, "extend", &self.extend, slots, |e| unsafe {
+        self.run(gpu, Stage::Extend.name(), &self.extend, slots, |e| unsafe {
             e.set_arg(&scene.nodes.mem())
                 .set_arg(&scene.triangles.mem());
             set_surfaces(e, scene);
@@ -260,7 +331,7 @@ impl Program {
         cones: &Buffer<[f32; 2]>,
         slots: usize,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, "shade", &self.shade, slots, |e| unsafe {
+        self.run(gpu, Stage::Shade.name(), &self.shade, slots, |e| unsafe {
             e.set_arg(frame)
                 .set_arg(&env.info)
                 .set_arg(&scene.triangles.mem());
@@ -290,14 +361,20 @@ impl Program {
         paths: &Buffer<GpuPath>,
         slots: usize,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, "connect", &self.connect, slots, |e| unsafe {
-            e.set_arg(&scene.nodes.mem())
-                .set_arg(&scene.triangles.mem());
-            set_surfaces(e, scene);
-            e.set_arg(&shadow_rays.mem())
-                .set_arg(&counters.mem())
-                .set_arg(&paths.mem());
-        })
+        self.run(
+            gpu,
+            Stage::Connect.name(),
+            &self.connect,
+            slots,
+            |e| unsafe {
+                e.set_arg(&scene.nodes.mem())
+                    .set_arg(&scene.triangles.mem());
+                set_surfaces(e, scene);
+                e.set_arg(&shadow_rays.mem())
+                    .set_arg(&counters.mem())
+                    .set_arg(&paths.mem());
+            },
+        )
     }
 
     /// `advance`: counts this bounce's rays and turns the output queue into the next input.
@@ -307,7 +384,7 @@ impl Program {
         counters: &Buffer<u32>,
         stats: &Buffer<u64>,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, "advance", &self.advance, 1, |e| unsafe {
+        self.run(gpu, Stage::Advance.name(), &self.advance, 1, |e| unsafe {
             e.set_arg(&counters.mem()).set_arg(&stats.mem());
         })
     }
@@ -322,12 +399,18 @@ impl Program {
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
-        self.run(gpu, "accumulate", &self.accumulate, pixels, |e| unsafe {
-            e.set_arg(frame)
-                .set_arg(&paths.mem())
-                .set_arg(&film.mem())
-                .set_arg(&counters.mem());
-        })
+        self.run(
+            gpu,
+            Stage::Accumulate.name(),
+            &self.accumulate,
+            pixels,
+            |e| unsafe {
+                e.set_arg(frame)
+                    .set_arg(&paths.mem())
+                    .set_arg(&film.mem())
+                    .set_arg(&counters.mem());
+            },
+        )
     }
 
     /// `trace_closest`: closest hits of arbitrary rays (tests and `bench trace`).
@@ -376,30 +459,32 @@ impl Program {
         })
     }
 
-    /// `probe_layout`: sizes and offsets of the shared structs as the device compiler sees them.
+    /// `probe_layout` (test program): sizes and offsets of the shared structs as the device compiler sees them.
     pub fn probe_layout(&self, gpu: &Gpu) -> Result<Vec<u32>, ClError> {
+        let tests = self.tests(gpu)?;
         let out = Buffer::<u32>::new(gpu, 256)?;
-        self.run(gpu, "probe_layout", &self.probe_layout, 1, |e| unsafe {
+        self.run(gpu, "probe_layout", &tests.probe_layout, 1, |e| unsafe {
             e.set_arg(&out.mem());
         })?;
         out.read(gpu)
     }
 
-    /// `sample_texture_test`: texture lookups; query .xy = uv, .z = footprint level (see
-    /// kernels/tools.cl), .w = texture reference (i32 bits). Zeros without `HAS_TEXTURES`.
+    /// `sample_texture_test` (test program): texture lookups; query .xy = uv, .z = footprint level (see
+    /// kernels/tests.cl), .w = texture reference (i32 bits). Zeros without `HAS_TEXTURES`.
     pub fn sample_texture_test(
         &self,
         gpu: &Gpu,
         scene: &SceneBuffers,
         queries: &[[f32; 4]],
     ) -> Result<Vec<[f32; 4]>, ClError> {
+        let tests = self.tests(gpu)?;
         let q = Buffer::from_slice(gpu, queries)?;
         let out = Buffer::<[f32; 4]>::new(gpu, queries.len())?;
         let count = queries.len() as u32;
         self.run(
             gpu,
             "sample_texture_test",
-            &self.sample_texture_test,
+            &tests.sample_texture_test,
             queries.len(),
             |e| unsafe {
                 e.set_arg(&scene.tex_refs.mem())
@@ -413,7 +498,7 @@ impl Program {
         out.read(gpu)
     }
 
-    /// `sample_env_test`: environment samples from uniform pairs: (direction, pdf) each, and
+    /// `sample_env_test` (test program): environment samples from uniform pairs: (direction, pdf) each, and
     /// the pdf the miss shader gives the same direction. Zeros without `HAS_ENV_MAP`.
     #[allow(clippy::type_complexity)]
     pub fn sample_env_test(
@@ -422,6 +507,7 @@ impl Program {
         env: &EnvBuffers,
         u: &[[f32; 2]],
     ) -> Result<(Vec<[f32; 4]>, Vec<f32>), ClError> {
+        let tests = self.tests(gpu)?;
         let ub = Buffer::from_slice(gpu, u)?;
         let out = Buffer::<[f32; 4]>::new(gpu, u.len())?;
         let eval = Buffer::<f32>::new(gpu, u.len())?;
@@ -429,7 +515,7 @@ impl Program {
         self.run(
             gpu,
             "sample_env_test",
-            &self.sample_env_test,
+            &tests.sample_env_test,
             u.len(),
             |e| unsafe {
                 e.set_arg(&env.info)
@@ -445,7 +531,7 @@ impl Program {
         Ok((out.read(gpu)?, eval.read(gpu)?))
     }
 
-    /// `bsdf_sample_test`: `count` BSDF samples of `material` at (`wo`, `n`), seen from inside
+    /// `bsdf_sample_test` (test program): `count` BSDF samples of `material` at (`wo`, `n`), seen from inside
     /// its volume when `inside`; returns (wi, pdf) and (weight, 1 for a delta lobe) per sample.
     #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     pub fn bsdf_sample_test(
@@ -458,6 +544,7 @@ impl Program {
         count: usize,
         seed: u32,
     ) -> Result<(Vec<[f32; 4]>, Vec<[f32; 4]>), ClError> {
+        let tests = self.tests(gpu)?;
         let material = Buffer::from_slice(gpu, &[*material])?;
         let wi_pdf = Buffer::<[f32; 4]>::new(gpu, count)?;
         let weight = Buffer::<[f32; 4]>::new(gpu, count)?;
@@ -466,7 +553,7 @@ impl Program {
         self.run(
             gpu,
             "bsdf_sample_test",
-            &self.bsdf_sample_test,
+            &tests.bsdf_sample_test,
             count,
             |e| unsafe {
                 e.set_arg(&material.mem())
@@ -482,7 +569,7 @@ impl Program {
         Ok((wi_pdf.read(gpu)?, weight.read(gpu)?))
     }
 
-    /// `bsdf_eval_test`: (f·|cos|, pdf) of `material` at (`wo`, `n`) for each direction of `wi`.
+    /// `bsdf_eval_test` (test program): (f·|cos|, pdf) of `material` at (`wo`, `n`) for each direction of `wi`.
     pub fn bsdf_eval_test(
         &self,
         gpu: &Gpu,
@@ -492,6 +579,7 @@ impl Program {
         inside: bool,
         wi: &[[f32; 4]],
     ) -> Result<Vec<[f32; 4]>, ClError> {
+        let tests = self.tests(gpu)?;
         let material = Buffer::from_slice(gpu, &[*material])?;
         let wi_buf = Buffer::from_slice(gpu, wi)?;
         let out = Buffer::<[f32; 4]>::new(gpu, wi.len())?;
@@ -500,7 +588,7 @@ impl Program {
         self.run(
             gpu,
             "bsdf_eval_test",
-            &self.bsdf_eval_test,
+            &tests.bsdf_eval_test,
             wi.len(),
             |e| unsafe {
                 e.set_arg(&material.mem())
@@ -563,7 +651,7 @@ pub struct SceneBuffers {
     pub texels: Buffer<u32>,
     /// Materials.
     pub materials: Buffer<GpuMaterial>,
-    /// Lights (punctual first, then emissive triangles).
+    /// Lights (emissive triangles first, then punctual lights, then the environment map).
     pub lights: Buffer<GpuLight>,
     /// Cumulative selection probabilities of the lights.
     pub light_cdf: Buffer<f32>,

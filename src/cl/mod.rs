@@ -8,8 +8,8 @@ mod program;
 pub mod types;
 
 pub use device::{DeviceChoice, DeviceInfo, Gpu, list_devices};
-pub use kernels::{Buffer, Program};
-pub use program::{KernelFeatures, build_program};
+pub use kernels::{Buffer, Program, Stage};
+pub use program::{KernelFeatures, build_program, build_test_program};
 
 /// Errors from OpenCL: no usable device, a failed build, a failed launch.
 #[derive(Debug, thiserror::Error)]

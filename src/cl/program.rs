@@ -21,6 +21,11 @@ const SOURCES: &[(&str, &str)] = &[
     ("kernels/lights.h", include_str!("../../kernels/lights.h")),
     ("kernels/stages.cl", include_str!("../../kernels/stages.cl")),
     ("kernels/tools.cl", include_str!("../../kernels/tools.cl")),
+];
+
+/// Kernels only the tests use; [`build_test_program`] adds them after [`SOURCES`].
+const TEST_SOURCES: &[(&str, &str)] = &[
+    ("kernels/tests.cl", include_str!("../../kernels/tests.cl")),
     (
         "kernels/bsdf_test.cl",
         include_str!("../../kernels/bsdf_test.cl"),
@@ -72,16 +77,34 @@ impl KernelFeatures {
     }
 }
 
-/// The full program source: every file behind a `#line` directive so the compiler's messages
-/// name the `.cl` file and line.
+/// The name the generated constants header goes by in compiler messages.
+const DEFINES_NAME: &str = "generated/constants.h";
+
+/// The full program source: the constants shared with the host (generated from
+/// `cl/types.rs`), then every file, each behind a `#line` directive so the compiler's messages
+/// name the file and line.
 pub fn program_source() -> String {
-    let mut s = String::new();
-    for (name, text) in SOURCES {
+    let mut s = format!(
+        "#line 1 \"{DEFINES_NAME}\"\n{}",
+        super::types::kernel_defines()
+    );
+    append_sources(&mut s, SOURCES);
+    s
+}
+
+/// [`program_source`] followed by the test-only kernels.
+pub fn test_program_source() -> String {
+    let mut s = program_source();
+    append_sources(&mut s, TEST_SOURCES);
+    s
+}
+
+fn append_sources(s: &mut String, sources: &[(&str, &str)]) {
+    for (name, text) in sources {
         s.push_str(&format!("#line 1 \"{name}\"\n"));
         s.push_str(text);
         s.push('\n');
     }
-    s
 }
 
 /// Builds the program for `features` on the device. A failure returns the compiler's first
@@ -91,6 +114,15 @@ pub fn build_program(
     features: KernelFeatures,
 ) -> Result<opencl3::program::Program, ClError> {
     build_source(gpu, &program_source(), features)
+}
+
+/// Builds the production kernels together with the test-only ones (layout probe, texture,
+/// environment and BSDF test kernels); only tests reach it, through `Program`'s test wrappers.
+pub fn build_test_program(
+    gpu: &Gpu,
+    features: KernelFeatures,
+) -> Result<opencl3::program::Program, ClError> {
+    build_source(gpu, &test_program_source(), features)
 }
 
 pub(crate) fn build_source(
@@ -135,9 +167,37 @@ mod tests {
 
     #[test]
     fn every_source_is_marked_with_its_file() {
-        let s = program_source();
-        for (name, _) in SOURCES {
+        let s = test_program_source();
+        for (name, _) in SOURCES.iter().chain(TEST_SOURCES) {
             assert!(s.contains(&format!("#line 1 \"{name}\"")), "{name}");
+        }
+    }
+
+    #[test]
+    fn the_production_program_has_no_test_kernels() {
+        let s = program_source();
+        for (name, _) in TEST_SOURCES {
+            assert!(!s.contains(name), "{name}");
+        }
+        assert!(!s.contains("probe_layout") && !s.contains("_test("));
+        assert!(
+            s.contains("kernel void trace_closest"),
+            "bench trace uses it"
+        );
+    }
+
+    #[test]
+    fn the_shared_constants_are_generated_once_before_the_kernels() {
+        let s = program_source();
+        let defines = s.find(DEFINES_NAME).expect("the generated header");
+        assert!(defines < s.find("kernels/types.h").unwrap());
+        assert!(s.contains("#define LIGHT_ENVIRONMENT 4u\n"), "{s:.2000}");
+        assert!(s.contains("#define WRAP_MIRROR 2\n"));
+        assert!(s.contains("#define COUNT_OVERFLOW 4\n"));
+        for line in super::super::types::kernel_defines().lines() {
+            let name = line.split_whitespace().nth(1).unwrap();
+            let written = format!("#define {name} ");
+            assert_eq!(s.matches(&written).count(), 1, "{name} is defined once");
         }
     }
 

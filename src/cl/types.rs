@@ -1,12 +1,130 @@
 //! Structs shared between the host and the kernels.
 //!
 //! Each struct here is mirrored field for field in `kernels/types.h`; the layout probe test
-//! (`tests/layout.rs`) builds a kernel that reports `sizeof` and field offsets on the device and
-//! compares them with these definitions. A bare `float3` never appears: it is 16 bytes in OpenCL,
-//! so three-component payloads travel as `float4` with something useful in `.w`.
+//! (`layout_probe_agrees_with_every_shared_rust_struct` in `tests/device.rs`) runs a kernel that reports
+//! `sizeof` and field offsets on the device and compares them with [`layouts`]. A bare `float3`
+//! never appears: it is 16 bytes in OpenCL, so three-component payloads travel as `float4` with
+//! something useful in `.w`.
+//!
+//! The constants the kernels share (flags, kinds, modes, counter slots) are defined here once;
+//! [`kernel_defines`] writes them as `#define`s in front of the kernel sources.
 
 use bytemuck::{Pod, Zeroable};
 use std::mem::{offset_of, size_of};
+
+/// A value the kernels see as a `#define`, written as an OpenCL C literal.
+pub trait KernelConstant {
+    /// The literal (`1u` for unsigned values, so the kernels' comparisons stay unsigned).
+    fn literal(&self) -> String;
+}
+
+impl KernelConstant for u32 {
+    fn literal(&self) -> String {
+        format!("{self}u")
+    }
+}
+
+impl KernelConstant for i32 {
+    fn literal(&self) -> String {
+        self.to_string()
+    }
+}
+
+impl KernelConstant for usize {
+    fn literal(&self) -> String {
+        self.to_string()
+    }
+}
+
+/// Defines constants shared with the kernels once: each becomes a Rust `pub const` and a line
+/// of [`kernel_defines`], which `cl::program` puts in front of the kernel sources.
+macro_rules! kernel_constants {
+    ($($(#[$doc:meta])* $name:ident: $t:ty = $v:expr;)*) => {
+        $($(#[$doc])* pub const $name: $t = $v;)*
+
+        /// The `#define` of every constant shared with the kernels, one per line.
+        pub fn kernel_defines() -> String {
+            let mut s = String::new();
+            $(s.push_str(&format!("#define {} {}\n", stringify!($name), $name.literal()));)*
+            s
+        }
+    };
+}
+
+kernel_constants! {
+    /// `GpuTexture::flags`: the texels hold sRGB-encoded color (alpha stays linear).
+    TEXTURE_SRGB: u32 = 1 << 8;
+    /// `GpuTexture::flags`: the mip level count sits in these bits.
+    TEXTURE_LEVELS_MASK: u32 = 0xff;
+
+    /// Sampler wrap modes in `GpuTexRef::info.yz`: repeat.
+    WRAP_REPEAT: i32 = 0;
+    /// Clamp to the edge texel.
+    WRAP_CLAMP: i32 = 1;
+    /// Mirrored repeat.
+    WRAP_MIRROR: i32 = 2;
+
+    /// `GpuTexRef::info.w` flag: nearest-texel lookups (sampler magFilter NEAREST).
+    TEXREF_NEAREST: i32 = 1;
+    /// `GpuTexRef::info.w` flag: the finest level only (minFilter NEAREST or LINEAR, no mipmaps).
+    TEXREF_NO_MIPS: i32 = 2;
+
+    /// Material flags in `GpuMaterial::emission.w`: both sides are front faces.
+    MATERIAL_DOUBLE_SIDED: u32 = 1;
+    /// `KHR_materials_unlit`: the surface shows its base color and ends the path.
+    MATERIAL_UNLIT: u32 = 2;
+
+    /// Alpha modes in `GpuMaterial::alpha.y`: opaque.
+    ALPHA_OPAQUE: u32 = 0;
+    /// Cut out below the cutoff.
+    ALPHA_MASK: u32 = 1;
+    /// Stochastic transparency.
+    ALPHA_BLEND: u32 = 2;
+
+    /// Light kinds in `GpuLight::position.w`: a point light.
+    LIGHT_POINT: u32 = 0;
+    /// A spot light: a point light with a cone.
+    LIGHT_SPOT: u32 = 1;
+    /// A directional light (sun).
+    LIGHT_DIRECTIONAL: u32 = 2;
+    /// An emissive triangle, sampled by area.
+    LIGHT_TRIANGLE: u32 = 3;
+    /// The environment map, sampled by its luminance table.
+    LIGHT_ENVIRONMENT: u32 = 4;
+
+    /// `GpuFrame::strategy`: light and BSDF sampling combined by the power heuristic.
+    STRATEGY_MIS: u32 = 0;
+    /// BSDF sampling only.
+    STRATEGY_BSDF: u32 = 1;
+    /// Light sampling only.
+    STRATEGY_LIGHTS: u32 = 2;
+
+    /// `GpuPath::direction.w` flag: the last bounce was specular.
+    PATH_SPECULAR: u32 = 1;
+    /// `GpuPath::direction.w` flag: went straight through a thin wall since the last
+    /// scattering vertex.
+    PATH_THROUGH_WALL: u32 = 2;
+
+    /// Slot of the counters buffer (u32): paths in this bounce's input queue.
+    COUNT_IN: usize = 0;
+    /// Paths queued for the next bounce.
+    COUNT_OUT: usize = 1;
+    /// Shadow rays queued for `connect`.
+    COUNT_SHADOW: usize = 2;
+    /// Samples dropped because they were NaN or infinite.
+    COUNT_NONFINITE: usize = 3;
+    /// Traversal stack overflows.
+    COUNT_OVERFLOW: usize = 4;
+    /// Length of the counters buffer.
+    COUNTER_SLOTS: usize = 8;
+
+    /// Slot of the statistics buffer (u64): extension rays traced.
+    STAT_EXTENSION_RAYS: usize = 0;
+    /// Shadow rays traced.
+    STAT_SHADOW_RAYS: usize = 1;
+    /// Length of the statistics buffer.
+    STAT_SLOTS: usize = 4;
+}
 
 /// One BVH node holding the boxes of both children (Aila–Laine layout, 64 bytes).
 ///
@@ -72,11 +190,6 @@ pub struct GpuTriTangents {
 }
 const _: () = assert!(size_of::<GpuTriTangents>() == 48);
 
-/// `GpuTexture::flags`: the texels hold sRGB-encoded color (alpha stays linear).
-pub const TEXTURE_SRGB: u32 = 1 << 8;
-/// `GpuTexture::flags`: the mip level count sits in these bits.
-pub const TEXTURE_LEVELS_MASK: u32 = 0xff;
-
 /// One texture in the packed texel buffer (16 bytes). Its mip levels follow each other from
 /// `offset`, level `l` being `max(1, width >> l)` × `max(1, height >> l)` RGBA8 texels.
 #[repr(C)]
@@ -92,18 +205,6 @@ pub struct GpuTexture {
     pub flags: u32,
 }
 const _: () = assert!(size_of::<GpuTexture>() == 16);
-
-/// Sampler wrap modes in `GpuTexRef::info.yz`.
-pub const WRAP_REPEAT: i32 = 0;
-/// Clamp to the edge texel.
-pub const WRAP_CLAMP: i32 = 1;
-/// Mirrored repeat.
-pub const WRAP_MIRROR: i32 = 2;
-
-/// `GpuTexRef::info.w` flag: nearest-texel lookups (sampler magFilter NEAREST).
-pub const TEXREF_NEAREST: i32 = 1;
-/// `GpuTexRef::info.w` flag: the finest level only (minFilter NEAREST or LINEAR, no mipmaps).
-pub const TEXREF_NO_MIPS: i32 = 2;
 
 /// A material's use of a texture: which one, the sampler and the `KHR_texture_transform`
 /// (48 bytes). The lookup coordinate is `(dot(m0.xyz, (u, v, 1)), dot(m1.xyz, (u, v, 1)))`.
@@ -140,18 +241,6 @@ pub struct GpuEnvironment {
 }
 const _: () = assert!(size_of::<GpuEnvironment>() == 48);
 
-/// Material flags in `GpuMaterial::emission.w`.
-pub const MATERIAL_DOUBLE_SIDED: u32 = 1;
-/// `KHR_materials_unlit`: the surface shows its base color and ends the path.
-pub const MATERIAL_UNLIT: u32 = 2;
-
-/// Alpha modes in `GpuMaterial::alpha.y`.
-pub const ALPHA_OPAQUE: u32 = 0;
-/// Cut out below the cutoff.
-pub const ALPHA_MASK: u32 = 1;
-/// Stochastic transparency.
-pub const ALPHA_BLEND: u32 = 2;
-
 /// A glTF material as the kernels see it (128 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
@@ -175,17 +264,6 @@ pub struct GpuMaterial {
     pub textures2: [i32; 4],
 }
 const _: () = assert!(size_of::<GpuMaterial>() == 128);
-
-/// Light kinds in `GpuLight::position.w`.
-pub const LIGHT_POINT: u32 = 0;
-/// A spot light: a point light with a cone.
-pub const LIGHT_SPOT: u32 = 1;
-/// A directional light (sun).
-pub const LIGHT_DIRECTIONAL: u32 = 2;
-/// An emissive triangle, sampled by area.
-pub const LIGHT_TRIANGLE: u32 = 3;
-/// The environment map, sampled by its luminance table.
-pub const LIGHT_ENVIRONMENT: u32 = 4;
 
 /// One light for next-event estimation (64 bytes).
 #[repr(C)]
@@ -238,18 +316,16 @@ pub struct GpuFrame {
     pub max_bounces: u32,
     /// Bounce from which Russian roulette applies (u32::MAX: never).
     pub rr_depth: u32,
-    /// Sampling strategy: 0 = MIS, 1 = BSDF only, 2 = lights only.
+    /// Sampling strategy (`STRATEGY_*`).
     pub strategy: u32,
     /// Uniform environment radiance; `.w` unused.
     pub sky: [f32; 4],
     /// Number of lights in the light list.
     pub light_count: u32,
-    /// Total light selection weight (for pdfs).
-    pub light_weight_total: f32,
     /// Current bounce (set per launch by the host).
     pub bounce: u32,
     /// Padding.
-    pub pad: u32,
+    pub pad: [u32; 2],
 }
 const _: () = assert!(size_of::<GpuFrame>() == 64);
 
@@ -350,7 +426,6 @@ pub fn layouts() -> Vec<StructLayout> {
             strategy,
             sky,
             light_count,
-            light_weight_total,
             bounce,
             pad
         ),

@@ -6,9 +6,7 @@ mod render;
 
 use crate::cl::DeviceChoice;
 use crate::render::{RenderSettings, Strategy};
-use crate::scene::{
-    Camera, EnvMap, Light, LightKind, Scene, default_light_radius, load_or_bundled,
-};
+use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
 use anyhow::{Result, bail};
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
@@ -56,10 +54,10 @@ pub struct CommonArgs {
     #[arg(long)]
     pub spp: Option<u32>,
     /// Bounces after the first hit (0 = direct light only).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = RenderSettings::default().bounces)]
     pub bounces: u32,
     /// Seed of the random sequence.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = RenderSettings::default().seed)]
     pub seed: u32,
     /// Camera of the glTF file to use (index; the automatic camera when the file has none).
     #[arg(long)]
@@ -79,14 +77,18 @@ pub struct CommonArgs {
     #[arg(long, value_name = "FILE|COLOR", conflicts_with = "sky")]
     pub env: Option<String>,
     /// Radiance scale of the --env image.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = RenderSettings::default().env_intensity)]
     pub env_intensity: f32,
     /// Rotation of the --env image about the up (+Y) axis in degrees, counter-clockwise seen
     /// from above.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = RenderSettings::default().env_rotation,
+        allow_negative_numbers = true
+    )]
     pub env_rotation: f32,
     /// Depth of field: thin-lens radius in scene units (0 = pinhole, everything sharp).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = RenderSettings::default().lens_radius)]
     pub aperture: f32,
     /// Distance from the eye to the plane in focus, along the view axis, in scene units
     /// (default: the distance to what the image centre sees).
@@ -104,28 +106,14 @@ pub struct CommonArgs {
 }
 
 impl Default for CommonArgs {
-    /// The command line's defaults.
+    /// The command line's defaults: what an empty command line gives.
     fn default() -> Self {
-        Self {
-            device: None,
-            width: None,
-            height: None,
-            spp: None,
-            bounces: 4,
-            seed: 0,
-            camera: None,
-            light_radius: None,
-            hard_shadows: false,
-            sky: None,
-            env: None,
-            env_intensity: 1.0,
-            env_rotation: 0.0,
-            aperture: 0.0,
-            focus_distance: None,
-            eye: None,
-            look_at: None,
-            fov: None,
+        #[derive(Parser)]
+        struct Empty {
+            #[command(flatten)]
+            common: CommonArgs,
         }
+        Empty::parse_from(["penumbra"]).common
     }
 }
 
@@ -260,8 +248,8 @@ pub struct Prepared {
     pub camera: Camera,
     /// Loading time.
     pub load_ms: f64,
-    /// Light radius applied to point and spot lights.
-    pub light_radius: f32,
+    /// The light radius rule applied to `lights`.
+    pub shadows: Shadows,
 }
 
 impl CommonArgs {
@@ -389,50 +377,62 @@ impl CommonArgs {
             scene.lights.clear();
             scene.default_rig = false;
         }
-        let diagonal = scene.bounds().diagonal();
-        let light_radius = if self.hard_shadows {
-            0.0
-        } else {
-            self.light_radius
-                .unwrap_or_else(|| default_light_radius(&scene.bounds()))
-        };
-        let lights = with_radius(&scene.lights, light_radius, diagonal);
+        let bounds = scene.bounds();
+        let shadows = Shadows::new(self.light_radius, self.hard_shadows, &bounds);
+        let lights = shadows.apply(&scene.lights, bounds.diagonal());
         Ok(Prepared {
             scene,
             lights,
             camera,
             load_ms,
-            light_radius,
+            shadows,
         })
     }
-}
-
-/// Lights with the shadow softness applied: point and spot lights get `radius` (scene units),
-/// directional lights an angular radius of 2·radius/diagonal radians (at most 0.5).
-pub fn with_radius(lights: &[Light], radius: f32, diagonal: f64) -> Vec<Light> {
-    lights
-        .iter()
-        .map(|l| Light {
-            radius: match l.kind {
-                LightKind::Directional => {
-                    (2.0 * radius as f64 / diagonal.max(1e-9)).min(0.5) as f32
-                }
-                _ => radius,
-            },
-            ..l.clone()
-        })
-        .collect()
 }
 
 /// Runs the command line; errors come back as one line for `main` to print.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        None => crate::app::run(cli.view),
-        Some(Command::View(v)) => crate::app::run(v),
+        None => view(cli.view),
+        Some(Command::View(v)) => view(v),
         Some(Command::Render(r)) => render::run(&r),
         Some(Command::Devices) => devices::run(),
         Some(Command::Bench(b)) => bench::run(b),
     }
+}
+
+/// Opens the viewer: checks the options, loads the scene and hands the viewer its
+/// configuration.
+fn view(args: ViewArgs) -> Result<()> {
+    use crate::app::{DEFAULT_SIZE, ViewerConfig};
+    // Without a display nothing else is worth loading.
+    crate::app::preflight(args.screenshot.as_deref())?;
+    let common = &args.common;
+    let settings = common.settings(DEFAULT_SIZE)?;
+    let prepared = common.prepare(args.scene.as_deref())?;
+    let environment = common.environment()?;
+    let device = common.device_choice()?;
+    // With a lens but no focus distance, focus on what the image centre sees once loaded.
+    let autofocus = settings.lens_radius > 0.0 && common.focus_distance.is_none();
+    crate::app::run(ViewerConfig {
+        path: args.scene,
+        scene: prepared.scene,
+        lights: prepared.lights,
+        shadows: prepared.shadows,
+        camera: prepared.camera,
+        load_ms: prepared.load_ms,
+        settings,
+        spp_target: common.spp,
+        device,
+        env_map: match environment {
+            Some(EnvChoice::Map(map)) => Some(map),
+            _ => None,
+        },
+        env_lights: common.env.is_some(),
+        autofocus,
+        frames: args.frames,
+        screenshot: args.screenshot,
+    })
 }
 
 #[cfg(test)]
@@ -470,20 +470,5 @@ mod tests {
             panic!("not a render command")
         };
         assert!(r.common.settings((64, 64)).is_err());
-    }
-
-    #[test]
-    fn directional_lights_get_an_angular_radius() {
-        let sun = Light {
-            name: "sun".into(),
-            kind: LightKind::Directional,
-            position: glam::DVec3::ZERO,
-            direction: glam::DVec3::NEG_Y,
-            color: [1.0; 3],
-            intensity: 1.0,
-            radius: 0.0,
-        };
-        let l = with_radius(&[sun], 1.0, 100.0);
-        assert!((l[0].radius - 0.02).abs() < 1e-6);
     }
 }

@@ -1,7 +1,8 @@
 //! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary.
 
 use super::{EnvChoice, RenderArgs};
-use crate::image_io::{Format, write_exr, write_png};
+use crate::image_io::{Format, write_exr};
+use crate::render::tonemap::write_png;
 use crate::render::{Renderer, tonemap::ToneMapper};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -95,7 +96,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "seed": settings.seed,
         "strategy": settings.strategy,
         "russian_roulette": settings.russian_roulette.is_some(),
-        "light_radius": prepared.light_radius,
+        "light_radius": prepared.shadows.point_radius(),
         "seconds": seconds,
         "samples_per_second": samples / seconds,
         "rays_per_second": rays / seconds,

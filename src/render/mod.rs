@@ -1,29 +1,32 @@
 //! The renderer: owns the OpenCL device, the scene on it and the film, and runs the wavefront
 //! stages. It knows nothing of windows; the viewer and the command line drive it alike.
 
+pub mod camera;
+mod lights;
 mod settings;
+mod textures;
 pub mod tonemap;
 mod upload;
+mod wavefront;
 
+pub use lights::gpu_lights;
 pub use settings::{RenderSettings, Strategy};
-pub use upload::{HostScene, TexturePack, gpu_camera, gpu_lights};
+pub use textures::TexturePack;
+pub use upload::{HostScene, gpu_camera};
+pub use wavefront::{RenderStats, Stage, StageTimes};
 
 use crate::bvh::{Bvh, Ray};
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
 use crate::scene::{AlphaMode, Camera, EnvMap, EnvSampling, Light, Scene};
-use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
+use wavefront::Frame;
 
 /// Texel memory allowed for a scene's textures (less where the device's largest buffer is
 /// smaller); larger sets are downscaled by halves.
 pub const TEXTURE_BUDGET_BYTES: usize = 1 << 30;
-
-/// Paths in flight per wave on a GPU, and on other devices.
-const WAVE_PATHS_GPU: usize = 1 << 21;
-const WAVE_PATHS_CPU: usize = 1 << 16;
 
 /// Figures from preparing a scene.
 #[derive(Clone, Debug, Default)]
@@ -48,42 +51,6 @@ pub struct SceneStats {
     pub texture_max_side: u32,
 }
 
-/// Counters of the work done since the last reset.
-#[derive(Clone, Debug, Default)]
-pub struct RenderStats {
-    /// Extension (closest-hit) rays traced.
-    pub extension_rays: u64,
-    /// Shadow (any-hit) rays traced.
-    pub shadow_rays: u64,
-    /// Samples dropped because they were NaN or infinite.
-    pub nonfinite_samples: u64,
-    /// Traversal stack overflows (must stay 0).
-    pub stack_overflows: u64,
-    /// Kernel time per stage in milliseconds, from profiling events.
-    pub stage_ms: BTreeMap<&'static str, f64>,
-}
-
-impl RenderStats {
-    /// Sum of all stages' kernel time.
-    pub fn kernel_ms(&self) -> f64 {
-        self.stage_ms.values().sum()
-    }
-}
-
-/// Per-resolution device buffers.
-struct Frame {
-    width: u32,
-    height: u32,
-    slots: usize,
-    film: Buffer<[f32; 4]>,
-    paths: Buffer<GpuPath>,
-    queues: [Buffer<u32>; 2],
-    hits: Buffer<GpuHit>,
-    shadow_rays: Buffer<GpuShadowRay>,
-    /// Ray cone (width, spread angle) per slot, for texture filtering.
-    cones: Buffer<[f32; 2]>,
-}
-
 /// The path tracer on one OpenCL device.
 pub struct Renderer {
     /// The device, context and queue.
@@ -104,15 +71,15 @@ pub struct Renderer {
     env: EnvBuffers,
     samples: u32,
     stats: RenderStats,
-    pending: Vec<Launch>,
+    pending: Vec<(Stage, Launch)>,
 }
 
 impl Renderer {
     /// Opens the device.
     pub fn new(choice: &DeviceChoice) -> Result<Self, ClError> {
         let gpu = Gpu::open(choice)?;
-        let counters = Buffer::new(&gpu, 8)?;
-        let stats_buffer = Buffer::new(&gpu, 4)?;
+        let counters = Buffer::new(&gpu, COUNTER_SLOTS)?;
+        let stats_buffer = Buffer::new(&gpu, STAT_SLOTS)?;
         let env = EnvBuffers {
             info: GpuEnvironment::default(),
             texels: Buffer::from_slice(&gpu, &[0.0; 3])?,
@@ -152,7 +119,7 @@ impl Renderer {
 
         let t = Instant::now();
         let mut host = HostScene::new(&world, bvh, &scene.materials);
-        host.scale_emitter_power(&upload::emissive_texture_means(scene));
+        host.scale_emitter_power(&lights::emissive_texture_means(scene));
         let used = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
         self.scene_features = KernelFeatures {
             triangle_lights: !host.emissive.is_empty(),
@@ -230,57 +197,6 @@ impl Renderer {
         Ok(t.elapsed().as_secs_f64() * 1e3)
     }
 
-    /// The light list and selection table for the current lights and environment.
-    fn light_table(&self, host: &HostScene) -> (Vec<GpuLight>, Vec<f32>) {
-        let env_luminance = self
-            .environment
-            .as_ref()
-            .map(|(_, t)| t.mean_luminance * self.settings.env_intensity);
-        gpu_lights(&self.lights, host, env_luminance)
-    }
-
-    /// Fills the environment constants from the settings and the light list.
-    fn update_env_info(&mut self, lights: &[GpuLight]) {
-        let Some((map, table)) = self.environment.as_ref() else {
-            self.env.info = GpuEnvironment::default();
-            return;
-        };
-        let light = lights
-            .iter()
-            .position(|l| l.position[3].to_bits() == LIGHT_ENVIRONMENT);
-        let (sin, cos) = self.settings.env_rotation.to_radians().sin_cos();
-        self.env.info = GpuEnvironment {
-            scale: [
-                self.settings.env_intensity,
-                table.norm,
-                light.map_or(0.0, |i| lights[i].extra[1]),
-                0.0,
-            ],
-            rotation: [cos, sin, 0.0, 0.0],
-            width: map.width,
-            height: map.height,
-            light: light.map_or(u32::MAX, |i| i as u32),
-            pad: 0,
-        };
-    }
-
-    /// Rebuilds the light table on the device (after lights, environment or its intensity
-    /// changed).
-    fn upload_lights(&mut self) -> Result<(), ClError> {
-        let Some((_, host)) = self.scene.as_ref() else {
-            return Ok(());
-        };
-        let (glights, cdf) = self.light_table(host);
-        let Some((buffers, _)) = self.scene.as_mut() else {
-            return Ok(());
-        };
-        buffers.lights = Buffer::from_slice(&self.gpu, &glights)?;
-        buffers.light_cdf = Buffer::from_slice(&self.gpu, &cdf)?;
-        self.light_count = glights.len() as u32;
-        self.update_env_info(&glights);
-        Ok(())
-    }
-
     /// Sets (or with `None` removes) the environment map: it lights the scene with importance
     /// sampling and MIS, and replaces the uniform sky. Rebuilds the kernels when the map appears
     /// or goes. Resets the film.
@@ -335,15 +251,12 @@ impl Renderer {
         let c = &self.camera;
         let fx = x / self.settings.width.max(1) as f32;
         let fy = y / self.settings.height.max(1) as f32;
-        let v = |a: [f32; 4]| glam::Vec3::new(a[0], a[1], a[2]);
-        let forward = v(c.forward);
-        let dir = forward + (2.0 * fx - 1.0) * v(c.right) + (1.0 - 2.0 * fy) * v(c.up);
-        let unit = dir.normalize();
+        let forward = glam::Vec3::new(c.forward[0], c.forward[1], c.forward[2]);
+        let ray = camera::primary_ray(c, fx, fy);
+        let unit = ray.direction.normalize();
         let ray = Ray {
-            origin: v(c.origin),
             direction: unit,
-            tmin: 0.0,
-            tmax: f32::INFINITY,
+            ..ray
         };
         let hit = host.bvh.intersect(&ray, &host.vertices)?;
         Some(hit.t * unit.dot(forward.normalize()))
@@ -442,171 +355,6 @@ impl Renderer {
     /// The BVH on the host.
     pub fn bvh(&self) -> Option<&Bvh> {
         self.scene.as_ref().map(|(_, h)| &h.bvh)
-    }
-
-    fn ensure_frame(&mut self) -> Result<(), ClError> {
-        let (w, h) = (self.settings.width, self.settings.height);
-        let pixels = (w * h) as usize;
-        let wave = if self.gpu.info.is_gpu {
-            WAVE_PATHS_GPU
-        } else {
-            WAVE_PATHS_CPU
-        };
-        let slots = pixels * (wave / pixels).max(1);
-        if self
-            .frame
-            .as_ref()
-            .is_some_and(|f| f.width == w && f.height == h && f.slots == slots)
-        {
-            return Ok(());
-        }
-        self.frame = None; // free the old buffers first
-        let gpu = &self.gpu;
-        let mut film = Buffer::new(gpu, pixels)?;
-        film.clear(gpu)?;
-        self.frame = Some(Frame {
-            width: w,
-            height: h,
-            slots,
-            film,
-            paths: Buffer::new(gpu, slots)?,
-            queues: [Buffer::new(gpu, slots)?, Buffer::new(gpu, slots)?],
-            hits: Buffer::new(gpu, slots)?,
-            shadow_rays: Buffer::new(gpu, slots)?,
-            cones: Buffer::new(gpu, slots)?,
-        });
-        self.samples = 0;
-        Ok(())
-    }
-
-    /// Renders `spp` more samples per pixel into the film and waits for them.
-    pub fn render(&mut self, spp: u32) -> Result<(), ClError> {
-        self.start(spp)?;
-        self.finish()
-    }
-
-    /// Enqueues `spp` more samples per pixel and returns at once, so the host can do other
-    /// work (display the last frame) while the device renders; [`Renderer::finish`] waits.
-    pub fn start(&mut self, spp: u32) -> Result<(), ClError> {
-        let launches = self.enqueue(spp)?;
-        self.pending.extend(launches);
-        self.gpu
-            .queue
-            .flush()
-            .map_err(crate::cl::call_err("submitting the frame"))
-    }
-
-    /// Whether the work [`Renderer::start`] enqueued is done (true when nothing is pending).
-    /// Never waits, so a viewer can keep drawing while the device works; the queue is in
-    /// order, so the last launch finishing means all have.
-    pub fn is_finished(&self) -> Result<bool, ClError> {
-        let Some(last) = self.pending.last() else {
-            return Ok(true);
-        };
-        let status = last
-            .event
-            .command_execution_status()
-            .map_err(crate::cl::call_err("polling the frame"))?;
-        // CL_COMPLETE is 0; negative values are errors, which `finish` reports.
-        Ok(status.0 <= 0)
-    }
-
-    /// Waits for the work [`Renderer::start`] enqueued and gathers its statistics.
-    pub fn finish(&mut self) -> Result<(), ClError> {
-        self.gpu
-            .queue
-            .finish()
-            .map_err(crate::cl::call_err("waiting for the frame"))?;
-        let launches = std::mem::take(&mut self.pending);
-        self.collect(launches)
-    }
-
-    /// Enqueues the stages for `spp` more samples without waiting.
-    fn enqueue(&mut self, spp: u32) -> Result<Vec<Launch>, ClError> {
-        self.ensure_frame()?;
-        let (Some(program), Some((scene, _)), Some(f)) = (
-            self.program.as_ref(),
-            self.scene.as_ref(),
-            self.frame.as_mut(),
-        ) else {
-            return Err(ClError::Device("no scene is loaded".into()));
-        };
-        let gpu = &self.gpu;
-        let pixels = (f.width * f.height) as usize;
-        let per_wave = (f.slots / pixels).max(1) as u32;
-        let mut launches = Vec::new();
-        let mut done = 0;
-        while done < spp {
-            let n = per_wave.min(spp - done);
-            let slots = pixels * n as usize;
-            let mut frame = self.settings.gpu_frame(self.light_count);
-            frame.samples_in_wave = n;
-            frame.first_sample = self.samples + done;
-            launches.push(program.generate(
-                gpu,
-                &frame,
-                &self.camera,
-                &f.paths,
-                &f.queues[0],
-                &self.counters,
-                &f.cones,
-                slots,
-            )?);
-            for bounce in 0..=self.settings.bounces + 1 {
-                frame.bounce = bounce;
-                let (qi, qo) = if bounce % 2 == 0 { (0, 1) } else { (1, 0) };
-                launches.push(program.extend(
-                    gpu,
-                    scene,
-                    &f.paths,
-                    &f.queues[qi],
-                    &self.counters,
-                    &f.hits,
-                    slots,
-                )?);
-                launches.push(program.shade(
-                    gpu,
-                    &frame,
-                    &self.env,
-                    scene,
-                    &f.paths,
-                    &f.queues[qi],
-                    &f.hits,
-                    &f.queues[qo],
-                    &f.shadow_rays,
-                    &self.counters,
-                    &f.cones,
-                    slots,
-                )?);
-                launches.push(program.connect(
-                    gpu,
-                    scene,
-                    &f.shadow_rays,
-                    &self.counters,
-                    &f.paths,
-                    slots,
-                )?);
-                launches.push(program.advance(gpu, &self.counters, &self.stats_buffer)?);
-            }
-            launches.push(program.accumulate(gpu, &frame, &f.paths, &f.film, &self.counters)?);
-            done += n;
-        }
-        self.samples += spp;
-        Ok(launches)
-    }
-
-    /// Reads counters and profiling times after the queue has finished.
-    fn collect(&mut self, launches: Vec<Launch>) -> Result<(), ClError> {
-        for l in &launches {
-            *self.stats.stage_ms.entry(l.stage).or_default() += l.millis();
-        }
-        let counters = self.counters.read(&self.gpu)?;
-        let stats = self.stats_buffer.read(&self.gpu)?;
-        self.stats.extension_rays = stats[0];
-        self.stats.shadow_rays = stats[1];
-        self.stats.nonfinite_samples = counters[3] as u64;
-        self.stats.stack_overflows = counters[4] as u64;
-        Ok(())
     }
 
     /// The film as linear RGB (the mean of the samples), row by row from the top.

@@ -1,6 +1,6 @@
 //! What the user controls about a render.
 
-use crate::cl::types::GpuFrame;
+use crate::cl::types::{GpuFrame, STRATEGY_BSDF, STRATEGY_LIGHTS, STRATEGY_MIS};
 
 /// Which estimator feeds direct light.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -77,15 +77,14 @@ impl RenderSettings {
             max_bounces: self.bounces,
             rr_depth: self.russian_roulette.unwrap_or(u32::MAX),
             strategy: match self.strategy {
-                Strategy::Mis => 0,
-                Strategy::Bsdf => 1,
-                Strategy::Lights => 2,
+                Strategy::Mis => STRATEGY_MIS,
+                Strategy::Bsdf => STRATEGY_BSDF,
+                Strategy::Lights => STRATEGY_LIGHTS,
             },
             sky: [self.sky[0], self.sky[1], self.sky[2], 0.0],
             light_count,
-            light_weight_total: 1.0,
             bounce: 0,
-            pad: 0,
+            pad: [0; 2],
         }
     }
 }

@@ -1,4 +1,8 @@
-//! From linear radiance to display values: exposure, a tone curve, sRGB encoding.
+//! From linear radiance to display values: exposure, a tone curve, sRGB encoding, and the
+//! tone-mapped PNG files made from them.
+
+use anyhow::{Context, Result};
+use std::path::Path;
 
 /// Tone curves.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -82,6 +86,25 @@ pub fn to_rgba8(image: &[[f32; 3]], exposure: f32, mapper: ToneMapper) -> Vec<u8
             [e[0], e[1], e[2], 255]
         })
         .collect()
+}
+
+/// Writes an exposed, tone-mapped, sRGB-encoded PNG.
+pub fn write_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    exposure: f32,
+    mapper: ToneMapper,
+) -> Result<()> {
+    let rgba = to_rgba8(rgb, exposure, mapper);
+    write_rgba_png(path, width, height, &rgba)
+}
+
+/// Writes RGBA8 pixels (already tone-mapped) as PNG.
+pub fn write_rgba_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
+    image::save_buffer(path, rgba, width, height, image::ColorType::Rgba8)
+        .with_context(|| format!("{}: cannot write PNG", path.display()))
 }
 
 #[cfg(test)]

@@ -1,15 +1,10 @@
 //! Turning the host scene into the device's structs: triangles and shading data in BVH order,
-//! materials, the light list with its selection table, and the camera.
+//! materials and the camera. The light list is built in `lights`, the textures in `textures`.
 
 use crate::bvh::Bvh;
 use crate::cl::types::*;
-use crate::scene::{
-    AlphaMode, Camera, Light, LightKind, MAX_TEXTURE_SIDE, Material, Scene, WorldTriangle, Wrap,
-    mip_chain, srgb_to_linear,
-};
+use crate::scene::{AlphaMode, Camera, Material, WorldTriangle};
 use glam::Vec3;
-use rayon::prelude::*;
-use std::collections::HashMap;
 
 /// The scene as uploaded, kept on the host for picking and for tests.
 pub struct HostScene {
@@ -29,11 +24,11 @@ pub struct HostScene {
     pub emissive: Vec<(u32, f32, f32)>,
 }
 
-fn f4(v: Vec3, w: f32) -> [f32; 4] {
+pub(super) fn f4(v: Vec3, w: f32) -> [f32; 4] {
     [v.x, v.y, v.z, w]
 }
 
-fn luminance(c: [f32; 3]) -> f32 {
+pub(super) fn luminance(c: [f32; 3]) -> f32 {
     0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
 
@@ -173,139 +168,6 @@ impl HostScene {
     }
 }
 
-/// For each material, the mean linear luminance of its emissive texture (1 without one, at least
-/// 10⁻³), so that the light table weighs textured emitters by what they emit on average.
-pub fn emissive_texture_means(scene: &Scene) -> Vec<f32> {
-    scene
-        .materials
-        .iter()
-        .map(|m| {
-            let Some(r) = m.textures.emissive.filter(|_| m.is_emissive()) else {
-                return 1.0;
-            };
-            let r = &scene.texture_refs[r as usize];
-            let image = &scene.images[r.image as usize];
-            let sum: f64 = image
-                .rgba
-                .par_iter()
-                .map(|t| {
-                    let c = |v: u8| {
-                        if r.srgb {
-                            srgb_to_linear(v)
-                        } else {
-                            v as f32 / 255.0
-                        }
-                    };
-                    luminance([c(t[0]), c(t[1]), c(t[2])]) as f64
-                })
-                .sum();
-            ((sum / image.rgba.len().max(1) as f64) as f32).max(1e-3)
-        })
-        .collect()
-}
-
-/// The light list (emissive triangles first, so a triangle's light index is its position in
-/// `HostScene::emissive`, then the punctual lights, then the environment map when
-/// `env_luminance` (its mean luminance × intensity) is given) and its cumulative selection
-/// table.
-///
-/// A light's probability is the mean of two tables: one in proportion to its emitted power
-/// (4π I for a point light, π r² E for a sun over the scene's disc, π L A for a triangle), one
-/// in proportion to an estimate of the irradiance it sends to the middle of the scene (I / d²,
-/// E, π L̄ for the environment, L A / d², with d clamped below at 5 % of the diagonal). Power
-/// alone made a default-rig sun, whose power grows with the scene's area, 40× less likely than
-/// the key light while both lit surfaces about equally, and the rare sun samples showed as
-/// speckle; irradiance alone suits a room's lights worse than power (the Cornell box's error
-/// grew by a fifth). The mixture is never worse than half of either. Any positive weights keep
-/// the estimator unbiased.
-pub fn gpu_lights(
-    lights: &[Light],
-    host: &HostScene,
-    env_luminance: Option<f32>,
-) -> (Vec<GpuLight>, Vec<f32>) {
-    let mut out = Vec::new();
-    // (by irradiance at the middle, by power) per light.
-    let mut weights: Vec<(f32, f32)> = Vec::new();
-    let (center, diagonal) = host.bounds();
-    let disc = std::f32::consts::PI * (0.5 * diagonal) * (0.5 * diagonal);
-    let near = (0.05 * diagonal).max(1e-12);
-    let inverse_square = |p: Vec3| 1.0 / (p - center).length_squared().max(near * near);
-    for &(prim, area, power) in &host.emissive {
-        let v = &host.vertices[prim as usize];
-        let centroid = (v[0] + v[1] + v[2]) / 3.0;
-        out.push(GpuLight {
-            position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_TRIANGLE)],
-            intensity: [0.0; 4],
-            spot: [f32::from_bits(prim), area, 0.0, 0.0],
-            extra: [0.0; 4],
-        });
-        // `power` is π L A (× 2 when double-sided), so power / π is the intensity scale L A.
-        weights.push((
-            power / std::f32::consts::PI * inverse_square(centroid),
-            power,
-        ));
-    }
-    let pi = std::f32::consts::PI;
-    for l in lights {
-        let color = l.color.map(|c| c * l.intensity);
-        let y = luminance(color);
-        let (kind, position, irradiance, power) = match l.kind {
-            LightKind::Point => (
-                LIGHT_POINT,
-                l.position,
-                y * inverse_square(l.position.as_vec3()),
-                y * 4.0 * pi,
-            ),
-            LightKind::Spot { outer, .. } => (
-                LIGHT_SPOT,
-                l.position,
-                y * inverse_square(l.position.as_vec3()),
-                y * 2.0 * pi * (1.0 - outer.cos()).max(0.05),
-            ),
-            LightKind::Directional => (LIGHT_DIRECTIONAL, l.direction, y, y * disc),
-        };
-        if !(irradiance > 0.0 && irradiance.is_finite() && power.is_finite()) {
-            continue;
-        }
-        let (cos_inner, cos_outer) = match l.kind {
-            LightKind::Spot { inner, outer } => (inner.cos(), outer.cos()),
-            _ => (1.0, -1.0),
-        };
-        let d = l.direction.as_vec3().normalize_or(Vec3::NEG_Y);
-        out.push(GpuLight {
-            position: f4(position.as_vec3(), f32::from_bits(kind)),
-            intensity: [color[0], color[1], color[2], l.radius.max(0.0)],
-            spot: f4(d, cos_outer),
-            extra: [cos_inner, 0.0, 0.0, 0.0],
-        });
-        weights.push((irradiance, power));
-    }
-    if let Some(l) = env_luminance {
-        let irradiance = pi * l;
-        if irradiance > 0.0 && irradiance.is_finite() {
-            out.push(GpuLight {
-                position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_ENVIRONMENT)],
-                ..GpuLight::default()
-            });
-            weights.push((irradiance, irradiance * disc));
-        }
-    }
-    let total_irradiance: f32 = weights.iter().map(|w| w.0).sum();
-    let total_power: f32 = weights.iter().map(|w| w.1).sum();
-    let mut cdf = Vec::with_capacity(weights.len());
-    let mut acc = 0.0;
-    for (l, w) in out.iter_mut().zip(&weights) {
-        let p = 0.5 * (w.0 / total_irradiance + w.1 / total_power);
-        l.extra[1] = p;
-        acc += p;
-        cdf.push(acc);
-    }
-    if let Some(last) = cdf.last_mut() {
-        *last = 1.0;
-    }
-    (out, cdf)
-}
-
 /// The device camera for an aspect ratio (width / height).
 pub fn gpu_camera(c: &Camera, aspect: f32) -> GpuCamera {
     let forward = c.forward.normalize().as_vec3();
@@ -320,126 +182,13 @@ pub fn gpu_camera(c: &Camera, aspect: f32) -> GpuCamera {
     }
 }
 
-/// Textures as the device stores them: every (image, color space) pair used by a material
-/// becomes one RGBA8 mip chain in a single texel buffer; materials point at `refs`.
-#[derive(Clone, Debug, Default)]
-pub struct TexturePack {
-    /// One descriptor per texture.
-    pub textures: Vec<GpuTexture>,
-    /// One entry per `Scene::texture_refs` entry.
-    pub refs: Vec<GpuTexRef>,
-    /// RGBA8 texels (R in the low byte) of every level of every texture.
-    pub texels: Vec<u32>,
-    /// The largest side kept (smaller than [`MAX_TEXTURE_SIDE`] when the budget forced it).
-    pub max_side: u32,
-}
-
-fn wrap_code(w: Wrap) -> i32 {
-    match w {
-        Wrap::Repeat => WRAP_REPEAT,
-        Wrap::Clamp => WRAP_CLAMP,
-        Wrap::Mirror => WRAP_MIRROR,
-    }
-}
-
-impl TexturePack {
-    /// Packs the scene's textures. Mip chains are box-filtered on the host (in linear space for
-    /// sRGB textures); levels above [`MAX_TEXTURE_SIDE`] are dropped, and while the texels would
-    /// exceed `budget_bytes` the largest side allowed is halved.
-    pub fn new(scene: &Scene, budget_bytes: usize) -> Self {
-        let mut keys: Vec<(u32, bool)> = Vec::new();
-        let mut index: HashMap<(u32, bool), u32> = HashMap::new();
-        for r in &scene.texture_refs {
-            index.entry((r.image, r.srgb)).or_insert_with(|| {
-                keys.push((r.image, r.srgb));
-                keys.len() as u32 - 1
-            });
-        }
-        // Texels of a chain whose level 0 is capped at `side`.
-        let chain_texels = |w: u32, h: u32, side: u32| -> usize {
-            let (mut w, mut h) = (w, h);
-            while w > side || h > side {
-                w = (w / 2).max(1);
-                h = (h / 2).max(1);
-            }
-            let mut n = 0usize;
-            loop {
-                n += (w * h) as usize;
-                if w == 1 && h == 1 {
-                    return n;
-                }
-                w = (w / 2).max(1);
-                h = (h / 2).max(1);
-            }
-        };
-        let mut max_side = MAX_TEXTURE_SIDE;
-        while max_side > 1 {
-            let total: usize = keys
-                .iter()
-                .map(|&(i, _)| {
-                    let im = &scene.images[i as usize];
-                    chain_texels(im.width, im.height, max_side)
-                })
-                .sum();
-            if total * 4 <= budget_bytes {
-                break;
-            }
-            max_side /= 2;
-        }
-        let chains: Vec<Vec<crate::scene::MipLevel>> = keys
-            .par_iter()
-            .map(|&(i, srgb)| mip_chain(&scene.images[i as usize], srgb, max_side))
-            .collect();
-        let mut textures = Vec::with_capacity(chains.len());
-        let mut texels = Vec::new();
-        for (chain, &(_, srgb)) in chains.iter().zip(&keys) {
-            textures.push(GpuTexture {
-                offset: texels.len() as u32,
-                width: chain[0].width,
-                height: chain[0].height,
-                flags: chain.len() as u32 | if srgb { TEXTURE_SRGB } else { 0 },
-            });
-            for level in chain {
-                texels.extend(level.rgba.iter().map(|&t| u32::from_le_bytes(t)));
-            }
-        }
-        let refs = scene
-            .texture_refs
-            .iter()
-            .map(|r| {
-                let [a, b] = r.transform.rows();
-                let det = (a[0] * b[1] - a[1] * b[0]).abs().max(1e-12);
-                GpuTexRef {
-                    m0: [a[0], a[1], a[2], f32::from_bits(r.tex_coord)],
-                    m1: [b[0], b[1], b[2], 0.5 * det.log2()],
-                    info: [
-                        index[&(r.image, r.srgb)] as i32,
-                        wrap_code(r.wrap_s),
-                        wrap_code(r.wrap_t),
-                        if r.nearest { TEXREF_NEAREST } else { 0 }
-                            | if r.mipmaps { 0 } else { TEXREF_NO_MIPS },
-                    ],
-                }
-            })
-            .collect();
-        Self {
-            textures,
-            refs,
-            texels,
-            max_side,
-        }
-    }
-
-    /// Bytes of texel memory on the device.
-    pub fn bytes(&self) -> usize {
-        self.texels.len() * 4
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::lights::gpu_lights;
+    use crate::render::textures::TexturePack;
     use crate::scene::{Image, TexTransform, TextureRef};
+    use crate::scene::{Light, LightKind, MAX_TEXTURE_SIDE, Scene, Wrap};
     use std::sync::Arc;
 
     /// A 10-unit floor centred at the origin, as the host would upload it.

@@ -37,6 +37,52 @@ pub fn default_light_radius(bounds: &Bounds) -> f32 {
     (bounds.diagonal() * 0.02) as f32
 }
 
+/// The light radius rule `render`, the benchmarks and the viewer share: how large the lights
+/// are, which sets how soft their shadows are.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shadows {
+    /// Radius of point and spot lights in scene units; directional lights get an angular
+    /// radius of 2·light_radius/diagonal radians (at most 0.5).
+    pub light_radius: f32,
+    /// Hard shadows: every light radius 0 (`light_radius` is kept for switching back).
+    pub hard: bool,
+}
+
+impl Shadows {
+    /// `light_radius`, or without one the default for a scene of `bounds`.
+    pub fn new(light_radius: Option<f32>, hard: bool, bounds: &Bounds) -> Self {
+        Self {
+            light_radius: light_radius.unwrap_or_else(|| default_light_radius(bounds)),
+            hard,
+        }
+    }
+
+    /// The radius point and spot lights render with: 0 with hard shadows.
+    pub fn point_radius(self) -> f32 {
+        if self.hard { 0.0 } else { self.light_radius }
+    }
+
+    /// The radius a light of `kind` renders with in a scene `diagonal` across.
+    pub fn radius_for(self, kind: &LightKind, diagonal: f64) -> f32 {
+        let radius = self.point_radius();
+        match kind {
+            LightKind::Directional => (2.0 * radius as f64 / diagonal.max(1e-9)).min(0.5) as f32,
+            _ => radius,
+        }
+    }
+
+    /// `lights` with the radii they render with.
+    pub fn apply(self, lights: &[Light], diagonal: f64) -> Vec<Light> {
+        lights
+            .iter()
+            .map(|l| Light {
+                radius: self.radius_for(&l.kind, diagonal),
+                ..l.clone()
+            })
+            .collect()
+    }
+}
+
 /// The rig a scene without lights gets: a point key light just above the automatic camera,
 /// bright enough for an irradiance of about 1 at the middle of the scene, and a dimmer sun from
 /// above-front for shape.
@@ -145,6 +191,25 @@ mod tests {
         let ratio = big[0].intensity / small[0].intensity;
         assert!((ratio - 10_000.0).abs() < 1.0, "{ratio}");
         assert!(big[0].radius > small[0].radius);
+    }
+
+    #[test]
+    fn directional_lights_get_an_angular_radius() {
+        let sun = Light {
+            name: "sun".into(),
+            kind: LightKind::Directional,
+            position: glam::DVec3::ZERO,
+            direction: glam::DVec3::NEG_Y,
+            color: [1.0; 3],
+            intensity: 1.0,
+            radius: 0.0,
+        };
+        let shadows = Shadows {
+            light_radius: 1.0,
+            hard: false,
+        };
+        let l = shadows.apply(&[sun], 100.0);
+        assert!((l[0].radius - 0.02).abs() < 1e-6);
     }
 
     #[test]

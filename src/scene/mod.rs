@@ -11,7 +11,7 @@ mod textures;
 
 pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
 pub use gltf_import::{AUTO_YFOV, load, load_from_bytes};
-pub use lights::{LightPreset, default_light_radius, default_light_rig, preset_lights};
+pub use lights::{LightPreset, Shadows, default_light_radius, default_light_rig, preset_lights};
 pub use textures::{
     Image, MAX_TEXTURE_SIDE, MaterialTextures, MipLevel, TexTransform, TextureRef, Wrap,
     linear_to_srgb, mip_chain, srgb_to_linear,

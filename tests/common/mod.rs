@@ -235,28 +235,9 @@ impl Gltf {
         doc
     }
 
-    /// GLB bytes.
+    /// GLB bytes, written by the library's GLB writer (the one `bench generate` uses).
     pub fn glb(&self) -> Vec<u8> {
-        let mut json = serde_json::to_vec(&self.json(None)).unwrap();
-        while !json.len().is_multiple_of(4) {
-            json.push(b' ');
-        }
-        let mut bin = self.bin.clone();
-        while !bin.len().is_multiple_of(4) {
-            bin.push(0);
-        }
-        let total = 12 + 8 + json.len() + 8 + bin.len();
-        let mut out = Vec::with_capacity(total);
-        out.extend_from_slice(b"glTF");
-        out.extend_from_slice(&2u32.to_le_bytes());
-        out.extend_from_slice(&(total as u32).to_le_bytes());
-        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"JSON");
-        out.extend_from_slice(&json);
-        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"BIN\0");
-        out.extend_from_slice(&bin);
-        out
+        penumbra::cli::bench::generate::glb(&self.json(None), &self.bin)
     }
 
     /// Writes `name.glb` into `dir`.

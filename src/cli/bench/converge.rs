@@ -290,7 +290,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             "max_seconds": args.max_seconds,
             "fit_from": args.fit_from,
             "punctual_lights": prepared.lights.len(),
-            "light_radius": if prepared.lights.is_empty() { 0.0 } else { prepared.light_radius },
+            "light_radius": if prepared.lights.is_empty() { 0.0 } else { prepared.shadows.point_radius() },
             "triangles": scene_stats.triangles,
             "curves": curves,
         });

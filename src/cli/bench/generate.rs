@@ -247,6 +247,31 @@ impl GlbWriter {
     }
 }
 
+/// A GLB file: the JSON chunk (padded with spaces) and the binary chunk (padded with zeros) of
+/// a glTF document whose one buffer is `bin`.
+pub fn glb(gltf: &Value, bin: &[u8]) -> Vec<u8> {
+    let mut json = gltf.to_string().into_bytes();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let mut bin = bin.to_vec();
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    out
+}
+
 fn lambertian(name: &str, gray: f32) -> Value {
     json!({
         "name": name,
@@ -396,21 +421,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         "bufferViews": w.views,
         "buffers": [{"byteLength": w.bin.len()}],
     });
-    let mut js = serde_json::to_vec(&gltf)?;
-    while !js.len().is_multiple_of(4) {
-        js.push(b' ');
-    }
-    let total = 12 + 8 + js.len() + 8 + w.bin.len();
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(js.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&js);
-    out.extend_from_slice(&(w.bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&w.bin);
+    let out = glb(&gltf, &w.bin);
     std::fs::write(&args.output, &out)
         .with_context(|| format!("{}: cannot write the scene", args.output.display()))?;
     println!(

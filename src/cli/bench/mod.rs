@@ -4,7 +4,7 @@
 
 mod converge;
 mod frame;
-mod generate;
+pub mod generate;
 mod plot;
 mod rays;
 mod stats;

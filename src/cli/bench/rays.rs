@@ -4,6 +4,7 @@
 
 use crate::bvh::Ray;
 use crate::cl::types::{GpuCamera, GpuHit, GpuRay};
+use crate::render::camera::primary_ray;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -30,20 +31,13 @@ fn gpu_ray(origin: Vec3, direction: Vec3, tmax: f32) -> GpuRay {
 /// One ray through the centre of every pixel, row by row from the top, as the `generate`
 /// kernel forms them (pinhole; no jitter).
 pub fn primary_rays(camera: &GpuCamera, width: u32, height: u32) -> Vec<GpuRay> {
-    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
-    let (origin, forward, right, up) = (
-        v(camera.origin),
-        v(camera.forward),
-        v(camera.right),
-        v(camera.up),
-    );
     (0..width * height)
         .into_par_iter()
         .map(|pixel| {
             let fx = ((pixel % width) as f32 + 0.5) / width as f32;
             let fy = ((pixel / width) as f32 + 0.5) / height as f32;
-            let dir = forward + (2.0 * fx - 1.0) * right + (1.0 - 2.0 * fy) * up;
-            gpu_ray(origin, dir.normalize(), f32::INFINITY)
+            let ray = primary_ray(camera, fx, fy);
+            gpu_ray(ray.origin, ray.direction.normalize(), f32::INFINITY)
         })
         .collect()
 }

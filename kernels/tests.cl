@@ -1,0 +1,111 @@
+// Kernels only the tests use (built into the test program, src/cl/program.rs): the layout
+// probe, texture lookups and environment samples. kernels/bsdf_test.cl holds the BSDF ones.
+
+// Writes, per shared struct, its size then each field's offset, in the order of
+// src/cl/types.rs::layouts().
+#define PROBE_SIZE(T) out[n++] = (uint)sizeof(T)
+#define PROBE_FIELD(T, f) out[n++] = (uint)((size_t)&((T*)0)->f)
+kernel void probe_layout(global uint* out) {
+    if (get_global_id(0) != 0) return;
+    uint n = 0;
+    PROBE_SIZE(GpuBvhNode);
+    PROBE_FIELD(GpuBvhNode, left_min); PROBE_FIELD(GpuBvhNode, left_max);
+    PROBE_FIELD(GpuBvhNode, right_min); PROBE_FIELD(GpuBvhNode, right_max);
+    PROBE_SIZE(GpuTriangle);
+    PROBE_FIELD(GpuTriangle, v0); PROBE_FIELD(GpuTriangle, v1); PROBE_FIELD(GpuTriangle, v2);
+    PROBE_SIZE(GpuTriShading);
+    PROBE_FIELD(GpuTriShading, n0); PROBE_FIELD(GpuTriShading, n1);
+    PROBE_FIELD(GpuTriShading, n2); PROBE_FIELD(GpuTriShading, uv01);
+    PROBE_FIELD(GpuTriShading, uv2); PROBE_FIELD(GpuTriShading, uv1_12);
+    PROBE_SIZE(GpuTriTangents);
+    PROBE_FIELD(GpuTriTangents, t0); PROBE_FIELD(GpuTriTangents, t1);
+    PROBE_FIELD(GpuTriTangents, t2);
+    PROBE_SIZE(GpuTexture);
+    PROBE_FIELD(GpuTexture, offset); PROBE_FIELD(GpuTexture, width);
+    PROBE_FIELD(GpuTexture, height); PROBE_FIELD(GpuTexture, flags);
+    PROBE_SIZE(GpuTexRef);
+    PROBE_FIELD(GpuTexRef, m0); PROBE_FIELD(GpuTexRef, m1); PROBE_FIELD(GpuTexRef, info);
+    PROBE_SIZE(GpuEnvironment);
+    PROBE_FIELD(GpuEnvironment, scale); PROBE_FIELD(GpuEnvironment, rotation);
+    PROBE_FIELD(GpuEnvironment, width); PROBE_FIELD(GpuEnvironment, height);
+    PROBE_FIELD(GpuEnvironment, light); PROBE_FIELD(GpuEnvironment, pad);
+    PROBE_SIZE(GpuMaterial);
+    PROBE_FIELD(GpuMaterial, base_color); PROBE_FIELD(GpuMaterial, emission);
+    PROBE_FIELD(GpuMaterial, params); PROBE_FIELD(GpuMaterial, specular);
+    PROBE_FIELD(GpuMaterial, volume); PROBE_FIELD(GpuMaterial, alpha);
+    PROBE_FIELD(GpuMaterial, textures); PROBE_FIELD(GpuMaterial, textures2);
+    PROBE_SIZE(GpuLight);
+    PROBE_FIELD(GpuLight, position); PROBE_FIELD(GpuLight, intensity);
+    PROBE_FIELD(GpuLight, spot); PROBE_FIELD(GpuLight, extra);
+    PROBE_SIZE(GpuCamera);
+    PROBE_FIELD(GpuCamera, origin); PROBE_FIELD(GpuCamera, forward);
+    PROBE_FIELD(GpuCamera, right); PROBE_FIELD(GpuCamera, up);
+    PROBE_SIZE(GpuFrame);
+    PROBE_FIELD(GpuFrame, width); PROBE_FIELD(GpuFrame, height);
+    PROBE_FIELD(GpuFrame, samples_in_wave); PROBE_FIELD(GpuFrame, first_sample);
+    PROBE_FIELD(GpuFrame, seed); PROBE_FIELD(GpuFrame, max_bounces);
+    PROBE_FIELD(GpuFrame, rr_depth); PROBE_FIELD(GpuFrame, strategy);
+    PROBE_FIELD(GpuFrame, sky); PROBE_FIELD(GpuFrame, light_count);
+    PROBE_FIELD(GpuFrame, bounce);
+    PROBE_FIELD(GpuFrame, pad);
+    PROBE_SIZE(GpuPath);
+    PROBE_FIELD(GpuPath, origin); PROBE_FIELD(GpuPath, direction);
+    PROBE_FIELD(GpuPath, throughput); PROBE_FIELD(GpuPath, radiance);
+    PROBE_SIZE(GpuHit);
+    PROBE_FIELD(GpuHit, t); PROBE_FIELD(GpuHit, u); PROBE_FIELD(GpuHit, v); PROBE_FIELD(GpuHit, prim);
+    PROBE_SIZE(GpuShadowRay);
+    PROBE_FIELD(GpuShadowRay, origin); PROBE_FIELD(GpuShadowRay, direction);
+    PROBE_FIELD(GpuShadowRay, contribution);
+    PROBE_SIZE(GpuRay);
+    PROBE_FIELD(GpuRay, origin); PROBE_FIELD(GpuRay, direction);
+    out[n] = 0xffffffffu;
+}
+
+// Texture lookups for the tests: query i reads reference (int bits of .w) at uv .xy and level
+// of detail .z (the texel-footprint level before the texture's own size is added; -INFINITY
+// reads level 0, and a fractional level is rounded down).
+kernel void sample_texture_test(global const GpuTexRef* tex_refs, global const GpuTexture* textures,
+                                global const uint* texels, global const float4* queries,
+                                uint count, global float4* out) {
+    uint i = get_global_id(0);
+    if (i >= count) return;
+#ifdef HAS_TEXTURES
+    SceneSurfaces surf;
+    surf.refs = tex_refs;
+    surf.textures = textures;
+    surf.texels = texels;
+    float4 q = queries[i];
+    TexCoords tc;
+    tc.uv0 = q.xy;
+    tc.uv1 = q.xy;
+    tc.lod0 = q.z;
+    tc.lod1 = q.z;
+    tc.xi = 1.0f;
+    out[i] = texture_sample(&surf, as_int(q.w), &tc);
+#else
+    out[i] = (float4)(0.0f);
+#endif
+}
+
+// Environment samples for the tests: direction (.xyz) and pdf (.w) of sample i from the
+// uniform pair u[i], and the pdf that env_radiance gives the same direction.
+kernel void sample_env_test(GpuEnvironment environment, global const float* env_texels,
+                            global const float* env_marginal, global const float* env_conditional,
+                            global const float2* u, uint count, global float4* out,
+                            global float* eval_pdf) {
+    uint i = get_global_id(0);
+    if (i >= count) return;
+#ifdef HAS_ENV_MAP
+    EnvMap env = {environment, env_texels, env_marginal, env_conditional};
+    float3 radiance;
+    float pdf;
+    float3 d = env_sample(&env, u[i].x, u[i].y, &radiance, &pdf);
+    out[i] = (float4)(d, pdf);
+    float check;
+    env_radiance(&env, d, &check);
+    eval_pdf[i] = check;
+#else
+    out[i] = (float4)(0.0f);
+    eval_pdf[i] = 0.0f;
+#endif
+}

@@ -1,0 +1,193 @@
+//! Keyboard and mouse: window events become camera moves (fly, look, pan, orbit, zoom) and the
+//! viewer's actions (pick, focus, hard shadows, screenshot, overlay, quit).
+
+use super::camera::{Mode, Motion};
+use super::frame_loop::Changes;
+use super::{App, pick};
+use glam::DVec3;
+use std::time::Instant;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::keyboard::{KeyCode, PhysicalKey};
+
+/// Mouse and key state between events.
+#[derive(Default)]
+pub(super) struct Input {
+    pub motion: Motion,
+    pub cursor: Option<(f64, f64)>,
+    pub look: bool,
+    pub pan: bool,
+    pub shift: bool,
+    pub ctrl: bool,
+    /// A button pressed while the overlay is shown, handled after egui's next pass.
+    pub press: Option<MouseButton>,
+}
+
+impl App {
+    /// Handles a keyboard or mouse event. `typing`: egui has the keyboard (key releases still
+    /// count); `wheel_free`: the wheel is not egui's.
+    pub(super) fn input_event(&mut self, event: WindowEvent, typing: bool, wheel_free: bool) {
+        match event {
+            WindowEvent::ModifiersChanged(m) => {
+                self.input.shift = m.state().shift_key();
+                self.input.ctrl = m.state().control_key();
+                self.input.motion.fast = self.input.shift;
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    let pressed = event.state == ElementState::Pressed;
+                    // Releases always count so no key stays stuck.
+                    if !pressed || !typing {
+                        self.key(code, pressed, event.repeat);
+                    }
+                }
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                let pressed = state == ElementState::Pressed;
+                if pressed && self.overlay {
+                    // egui learns where the pointer is only when it runs: decide in the next
+                    // frame whether the press was on the overlay or on the image.
+                    self.input.press = Some(button);
+                } else if pressed {
+                    self.press(button);
+                } else if matches!(button, MouseButton::Right | MouseButton::Middle) {
+                    self.input.look = false;
+                    self.input.pan = false;
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let now = (position.x, position.y);
+                if let Some(last) = self.input.cursor {
+                    let (dx, dy) = (now.0 - last.0, now.1 - last.1);
+                    let moved = if self.input.pan {
+                        self.model.camera.pan(dx, dy, self.size.1 as f64)
+                    } else if self.input.look {
+                        self.model.camera.look(dx, dy)
+                    } else {
+                        false
+                    };
+                    if moved {
+                        self.camera_moved();
+                    }
+                }
+                self.input.cursor = Some(now);
+            }
+            WindowEvent::CursorLeft { .. } => self.input.cursor = None,
+            // Releases that happen elsewhere never arrive: nothing stays held.
+            WindowEvent::Focused(false) => {
+                self.input.motion = Motion::default();
+                self.input.look = false;
+                self.input.pan = false;
+            }
+            WindowEvent::MouseWheel { delta, .. } if wheel_free => {
+                let notches = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y as f64,
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                if self.model.camera.wheel(notches) {
+                    self.camera_moved();
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// A mouse button pressed on the image: pick, look or pan.
+    pub(super) fn press(&mut self, button: MouseButton) {
+        match button {
+            MouseButton::Left => self.pick(),
+            MouseButton::Right if self.input.shift => self.input.pan = true,
+            MouseButton::Right => self.input.look = true,
+            MouseButton::Middle => self.input.pan = true,
+            _ => {}
+        }
+    }
+
+    pub(super) fn camera_moved(&mut self) {
+        self.last_motion = Some(Instant::now());
+        self.frame_loop.invalidate(Changes {
+            camera: true,
+            ..Changes::default()
+        });
+    }
+
+    fn key(&mut self, code: KeyCode, pressed: bool, repeat: bool) {
+        let ctrl = self.input.ctrl;
+        let m = &mut self.input.motion;
+        match code {
+            KeyCode::KeyW => m.forward = pressed,
+            KeyCode::KeyS => m.back = pressed,
+            KeyCode::KeyA => m.left = pressed,
+            KeyCode::KeyD => m.right = pressed,
+            KeyCode::KeyQ if !ctrl || !pressed => m.down = pressed,
+            KeyCode::KeyE => m.up = pressed,
+            _ if !pressed || repeat && !matches!(code, KeyCode::Equal | KeyCode::Minus) => {}
+            KeyCode::KeyR => {
+                self.model.camera.reset();
+                self.camera_moved();
+            }
+            KeyCode::KeyH => {
+                self.model.view.toggle_hard_shadows();
+                self.lights_changed();
+            }
+            KeyCode::KeyO => {
+                let next = match self.model.camera.mode {
+                    Mode::Fly => Mode::Orbit,
+                    Mode::Orbit => Mode::Fly,
+                };
+                self.model.camera.set_mode(next);
+            }
+            KeyCode::Equal | KeyCode::NumpadAdd => self.model.camera.scale_speed(1.0),
+            KeyCode::Minus | KeyCode::NumpadSubtract => self.model.camera.scale_speed(-1.0),
+            KeyCode::KeyQ if ctrl => self.quit = true,
+            KeyCode::Tab | KeyCode::F1 => self.overlay = !self.overlay,
+            KeyCode::F12 => self.screenshot(),
+            _ => {}
+        }
+    }
+
+    fn lights_changed(&mut self) {
+        self.last_motion = Some(Instant::now());
+        self.lights = self.model.view.lights();
+        self.frame_loop.invalidate(Changes {
+            lights: true,
+            ..Changes::default()
+        });
+    }
+
+    /// Picks the object under the cursor (host BVH ray cast).
+    fn pick(&mut self) {
+        let Some((x, y)) = self.input.cursor else {
+            return;
+        };
+        let Some(host) = self.frame_loop.renderer.host_scene() else {
+            return;
+        };
+        let (w, h) = (self.size.0 as f32, self.size.1 as f32);
+        let ray = pick::primary_ray(&self.model.camera.camera, w / h, x as f32 / w, y as f32 / h);
+        let hit = pick::pick(host, &ray);
+        log::debug!("pick at ({x:.0}, {y:.0}): {hit:?}");
+        match hit {
+            Some(hit) => {
+                self.model.selected = Some(hit.object);
+                if self.model.camera.mode == Mode::Orbit {
+                    self.model.camera.set_pivot(hit.point);
+                }
+                // With a lens, a click also focuses on the clicked point.
+                if self.model.view.aperture > 0.0 {
+                    self.focus_at(hit.point);
+                }
+            }
+            None => self.model.selected = None,
+        }
+    }
+
+    /// Focuses the lens on `point`: the plane in focus goes through it.
+    pub(super) fn focus_at(&mut self, point: DVec3) {
+        let cam = &self.model.camera.camera;
+        self.model.view.focus_distance = (point - cam.eye).dot(cam.forward) as f32;
+        self.frame_loop.invalidate(Changes {
+            settings: true,
+            ..Changes::default()
+        });
+    }
+}

@@ -1,0 +1,123 @@
+//! Scene loading in the viewer: a file opened in the overlay or dropped on the window is loaded
+//! on a background thread, prepared (lights, camera) and handed to the frame loop, which uploads
+//! it; the environment map is loaded and uploaded here too.
+
+use super::camera::CameraController;
+use super::frame_loop::Changes;
+use super::gui::Model;
+use super::{App, pick};
+use crate::scene::{Scene, SceneError};
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, TryRecvError};
+use std::time::Instant;
+
+/// A scene loaded in the background, with its loading time in milliseconds.
+type Loaded = Result<(Scene, f64), SceneError>;
+
+/// A scene file being loaded in the background.
+pub(super) struct Loader {
+    /// The file.
+    pub path: PathBuf,
+    rx: Receiver<Loaded>,
+}
+
+impl App {
+    /// Loads (or with `None` removes) the environment map; an error stays in the overlay and
+    /// the current environment is kept.
+    pub(super) fn set_environment(&mut self, path: Option<PathBuf>) {
+        let map = match path.as_deref().map(crate::scene::EnvMap::load).transpose() {
+            Ok(map) => map,
+            Err(e) => {
+                self.gui.env_error = Some(e);
+                return;
+            }
+        };
+        let loaded = map.is_some();
+        match self.frame_loop.renderer.set_environment(map) {
+            Ok(()) => {
+                self.gui.env_error = None;
+                self.gui.env_loaded = loaded;
+                self.frame_loop.invalidate(Changes {
+                    settings: true,
+                    ..Changes::default()
+                });
+            }
+            Err(e) => self.gui.env_error = Some(e.to_string()),
+        }
+    }
+
+    /// Loads `path` on a background thread; the current scene stays until it succeeds.
+    pub(super) fn open(&mut self, path: PathBuf) {
+        self.gui.path_text = path.display().to_string();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let p = path.clone();
+        std::thread::spawn(move || {
+            let t = Instant::now();
+            let result = crate::scene::load(&p).map(|s| (s, t.elapsed().as_secs_f64() * 1e3));
+            // The viewer may have closed meanwhile; nobody to tell then.
+            let _ = tx.send(result);
+        });
+        self.loader = Some(Loader { path, rx });
+    }
+
+    /// Takes a finished background load.
+    pub(super) fn poll_loader(&mut self) {
+        let Some(Loader { path, rx }) = self.loader.as_ref() else {
+            return;
+        };
+        let result = match rx.try_recv() {
+            Ok(r) => r,
+            Err(TryRecvError::Empty) => return,
+            Err(TryRecvError::Disconnected) => Err(SceneError::Invalid {
+                path: path.clone(),
+                message: "the loader stopped unexpectedly".into(),
+            }),
+        };
+        self.loader = None;
+        match result {
+            Ok((mut scene, ms)) => {
+                if self.env_lights && scene.default_rig {
+                    // The environment lights the scene instead of the default rig.
+                    scene.lights.clear();
+                    scene.default_rig = false;
+                }
+                self.autofocus = self.model.view.aperture > 0.0;
+                for w in &scene.warnings {
+                    log::warn!("{}: {w}", scene.source);
+                }
+                let bounds = scene.bounds();
+                self.model.view.replace_scene_lights(&scene.lights, bounds);
+                let camera = CameraController::new(scene.cameras[0].clone(), &bounds);
+                let view = self.model.view.clone();
+                if let Some(gfx) = &self.gfx {
+                    gfx.window
+                        .set_title(&format!("penumbra — {}", scene.source));
+                }
+                self.model = Model::new(scene, view, camera);
+                self.load_ms = ms;
+                self.lights = self.model.view.lights();
+                self.gui.file_error = None;
+                self.device_error = None;
+                self.frame_loop.invalidate(Changes::ALL);
+            }
+            Err(e) => self.gui.file_error = Some(e.to_string()),
+        }
+    }
+
+    /// Once the scene is on the device and `autofocus` is set, focuses the lens on what the
+    /// image centre sees.
+    pub(super) fn autofocus_once(&mut self) {
+        if !self.autofocus {
+            return;
+        }
+        let Some(host) = self.frame_loop.renderer.host_scene() else {
+            return;
+        };
+        self.autofocus = false;
+        let aspect = self.size.0 as f32 / self.size.1.max(1) as f32;
+        let ray = pick::primary_ray(&self.model.camera.camera, aspect, 0.5, 0.5);
+        if let Some(hit) = pick::pick(host, &ray) {
+            self.focus_at(hit.point);
+        }
+    }
+}

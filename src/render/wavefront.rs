@@ -1,0 +1,348 @@
+//! The wavefront loop (after pbrt-v4's wavefront integrator): each wave of paths runs through
+//! the [`Stage`]s in launch order, one kernel each, with queues of live paths between them.
+//! [`Wave`] has one method per stage; the [`Renderer`] methods here enqueue waves, wait for them
+//! and gather their statistics.
+
+use super::Renderer;
+pub use crate::cl::Stage;
+use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
+use crate::cl::types::*;
+use crate::cl::{Buffer, ClError, Gpu, Program};
+
+/// Kernel time per stage, in launch order ([`Stage::ALL`]); empty until a frame ran.
+#[derive(Clone, Debug, Default)]
+pub struct StageTimes(Vec<(&'static str, f64)>);
+
+impl StageTimes {
+    /// Adds `ms` to `stage`.
+    pub fn add(&mut self, stage: Stage, ms: f64) {
+        if self.0.is_empty() {
+            self.0 = Stage::ALL.iter().map(|s| (s.name(), 0.0)).collect();
+        }
+        self.0[stage as usize].1 += ms;
+    }
+
+    /// The time of `stage` (0 before any frame).
+    pub fn get(&self, stage: Stage) -> f64 {
+        self.0.get(stage as usize).map_or(0.0, |t| t.1)
+    }
+
+    /// (stage name, milliseconds) in launch order.
+    pub fn iter(&self) -> std::slice::Iter<'_, (&'static str, f64)> {
+        self.0.iter()
+    }
+
+    /// Whether no frame ran since the last reset.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+impl<'a> IntoIterator for &'a StageTimes {
+    type Item = &'a (&'static str, f64);
+    type IntoIter = std::slice::Iter<'a, (&'static str, f64)>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter()
+    }
+}
+
+/// A map from stage name to milliseconds, as the JSON summaries print it.
+impl serde::Serialize for StageTimes {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = s.serialize_map(Some(self.0.len()))?;
+        for (name, ms) in &self.0 {
+            map.serialize_entry(name, ms)?;
+        }
+        map.end()
+    }
+}
+
+/// Counters of the work done since the last reset.
+#[derive(Clone, Debug, Default)]
+pub struct RenderStats {
+    /// Extension (closest-hit) rays traced.
+    pub extension_rays: u64,
+    /// Shadow (any-hit) rays traced.
+    pub shadow_rays: u64,
+    /// Samples dropped because they were NaN or infinite.
+    pub nonfinite_samples: u64,
+    /// Traversal stack overflows (must stay 0).
+    pub stack_overflows: u64,
+    /// Kernel time per stage in milliseconds, from profiling events, in launch order.
+    pub stage_ms: StageTimes,
+}
+
+impl RenderStats {
+    /// Sum of all stages' kernel time.
+    pub fn kernel_ms(&self) -> f64 {
+        self.stage_ms.iter().map(|(_, ms)| ms).sum()
+    }
+}
+
+/// Per-resolution device buffers.
+pub(super) struct Frame {
+    pub(super) width: u32,
+    pub(super) height: u32,
+    pub(super) slots: usize,
+    pub(super) film: Buffer<[f32; 4]>,
+    pub(super) paths: Buffer<GpuPath>,
+    pub(super) queues: [Buffer<u32>; 2],
+    pub(super) hits: Buffer<GpuHit>,
+    pub(super) shadow_rays: Buffer<GpuShadowRay>,
+    /// Ray cone (width, spread angle) per slot, for texture filtering.
+    pub(super) cones: Buffer<[f32; 2]>,
+}
+
+/// Paths in flight per wave on a GPU, and on other devices.
+const WAVE_PATHS_GPU: usize = 1 << 21;
+const WAVE_PATHS_CPU: usize = 1 << 16;
+
+/// One wave's launches: the device state every stage reads, and one method per stage.
+struct Wave<'a> {
+    gpu: &'a Gpu,
+    program: &'a Program,
+    scene: &'a SceneBuffers,
+    env: &'a EnvBuffers,
+    camera: &'a GpuCamera,
+    frame: &'a Frame,
+    counters: &'a Buffer<u32>,
+    stats: &'a Buffer<u64>,
+    /// Path slots in this wave.
+    slots: usize,
+    launches: Vec<(Stage, Launch)>,
+}
+
+impl Wave<'_> {
+    fn push(&mut self, stage: Stage, launch: Launch) {
+        self.launches.push((stage, launch));
+    }
+
+    fn generate(&mut self, frame: &GpuFrame) -> Result<(), ClError> {
+        let f = self.frame;
+        let l = self.program.generate(
+            self.gpu,
+            frame,
+            self.camera,
+            &f.paths,
+            &f.queues[0],
+            self.counters,
+            &f.cones,
+            self.slots,
+        )?;
+        self.push(Stage::Generate, l);
+        Ok(())
+    }
+
+    fn extend(&mut self, queue_in: usize) -> Result<(), ClError> {
+        let f = self.frame;
+        let l = self.program.extend(
+            self.gpu,
+            self.scene,
+            &f.paths,
+            &f.queues[queue_in],
+            self.counters,
+            &f.hits,
+            self.slots,
+        )?;
+        self.push(Stage::Extend, l);
+        Ok(())
+    }
+
+    fn shade(
+        &mut self,
+        frame: &GpuFrame,
+        queue_in: usize,
+        queue_out: usize,
+    ) -> Result<(), ClError> {
+        let f = self.frame;
+        let l = self.program.shade(
+            self.gpu,
+            frame,
+            self.env,
+            self.scene,
+            &f.paths,
+            &f.queues[queue_in],
+            &f.hits,
+            &f.queues[queue_out],
+            &f.shadow_rays,
+            self.counters,
+            &f.cones,
+            self.slots,
+        )?;
+        self.push(Stage::Shade, l);
+        Ok(())
+    }
+
+    fn connect(&mut self) -> Result<(), ClError> {
+        let f = self.frame;
+        let l = self.program.connect(
+            self.gpu,
+            self.scene,
+            &f.shadow_rays,
+            self.counters,
+            &f.paths,
+            self.slots,
+        )?;
+        self.push(Stage::Connect, l);
+        Ok(())
+    }
+
+    fn advance(&mut self) -> Result<(), ClError> {
+        let l = self.program.advance(self.gpu, self.counters, self.stats)?;
+        self.push(Stage::Advance, l);
+        Ok(())
+    }
+
+    fn accumulate(&mut self, frame: &GpuFrame) -> Result<(), ClError> {
+        let f = self.frame;
+        let l = self
+            .program
+            .accumulate(self.gpu, frame, &f.paths, &f.film, self.counters)?;
+        self.push(Stage::Accumulate, l);
+        Ok(())
+    }
+}
+
+impl Renderer {
+    /// Allocates the film and the per-slot buffers for the current size.
+    fn ensure_frame(&mut self) -> Result<(), ClError> {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let pixels = (w * h) as usize;
+        let wave = if self.gpu.info.is_gpu {
+            WAVE_PATHS_GPU
+        } else {
+            WAVE_PATHS_CPU
+        };
+        let slots = pixels * (wave / pixels).max(1);
+        if self
+            .frame
+            .as_ref()
+            .is_some_and(|f| f.width == w && f.height == h && f.slots == slots)
+        {
+            return Ok(());
+        }
+        self.frame = None; // free the old buffers first
+        let gpu = &self.gpu;
+        let mut film = Buffer::new(gpu, pixels)?;
+        film.clear(gpu)?;
+        self.frame = Some(Frame {
+            width: w,
+            height: h,
+            slots,
+            film,
+            paths: Buffer::new(gpu, slots)?,
+            queues: [Buffer::new(gpu, slots)?, Buffer::new(gpu, slots)?],
+            hits: Buffer::new(gpu, slots)?,
+            shadow_rays: Buffer::new(gpu, slots)?,
+            cones: Buffer::new(gpu, slots)?,
+        });
+        self.samples = 0;
+        Ok(())
+    }
+
+    /// Renders `spp` more samples per pixel into the film and waits for them.
+    pub fn render(&mut self, spp: u32) -> Result<(), ClError> {
+        self.start(spp)?;
+        self.finish()
+    }
+
+    /// Enqueues `spp` more samples per pixel and returns at once, so the host can do other
+    /// work (display the last frame) while the device renders; [`Renderer::finish`] waits.
+    pub fn start(&mut self, spp: u32) -> Result<(), ClError> {
+        let launches = self.enqueue(spp)?;
+        self.pending.extend(launches);
+        self.gpu
+            .queue
+            .flush()
+            .map_err(crate::cl::call_err("submitting the frame"))
+    }
+
+    /// Whether the work [`Renderer::start`] enqueued is done (true when nothing is pending).
+    /// Never waits, so a viewer can keep drawing while the device works; the queue is in
+    /// order, so the last launch finishing means all have.
+    pub fn is_finished(&self) -> Result<bool, ClError> {
+        let Some((_, last)) = self.pending.last() else {
+            return Ok(true);
+        };
+        let status = last
+            .event
+            .command_execution_status()
+            .map_err(crate::cl::call_err("polling the frame"))?;
+        // CL_COMPLETE is 0; negative values are errors, which `finish` reports.
+        Ok(status.0 <= 0)
+    }
+
+    /// Waits for the work [`Renderer::start`] enqueued and gathers its statistics.
+    pub fn finish(&mut self) -> Result<(), ClError> {
+        self.gpu
+            .queue
+            .finish()
+            .map_err(crate::cl::call_err("waiting for the frame"))?;
+        let launches = std::mem::take(&mut self.pending);
+        self.collect(launches)
+    }
+
+    /// Enqueues the stages for `spp` more samples without waiting: per wave, `generate`, then
+    /// `extend`, `shade`, `connect` and `advance` for each bounce, then `accumulate`.
+    fn enqueue(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
+        self.ensure_frame()?;
+        let (Some(program), Some((scene, _)), Some(f)) = (
+            self.program.as_ref(),
+            self.scene.as_ref(),
+            self.frame.as_ref(),
+        ) else {
+            return Err(ClError::Device("no scene is loaded".into()));
+        };
+        let pixels = (f.width * f.height) as usize;
+        let per_wave = (f.slots / pixels).max(1) as u32;
+        let mut wave = Wave {
+            gpu: &self.gpu,
+            program,
+            scene,
+            env: &self.env,
+            camera: &self.camera,
+            frame: f,
+            counters: &self.counters,
+            stats: &self.stats_buffer,
+            slots: 0,
+            launches: Vec::new(),
+        };
+        let mut done = 0;
+        while done < spp {
+            let n = per_wave.min(spp - done);
+            wave.slots = pixels * n as usize;
+            let mut frame = self.settings.gpu_frame(self.light_count);
+            frame.samples_in_wave = n;
+            frame.first_sample = self.samples + done;
+            wave.generate(&frame)?;
+            for bounce in 0..=self.settings.bounces + 1 {
+                frame.bounce = bounce;
+                // The queues swap roles every bounce.
+                let (qi, qo) = if bounce % 2 == 0 { (0, 1) } else { (1, 0) };
+                wave.extend(qi)?;
+                wave.shade(&frame, qi, qo)?;
+                wave.connect()?;
+                wave.advance()?;
+            }
+            wave.accumulate(&frame)?;
+            done += n;
+        }
+        self.samples += spp;
+        Ok(wave.launches)
+    }
+
+    /// Reads counters and profiling times after the queue has finished.
+    fn collect(&mut self, launches: Vec<(Stage, Launch)>) -> Result<(), ClError> {
+        for (stage, l) in &launches {
+            self.stats.stage_ms.add(*stage, l.millis());
+        }
+        let counters = self.counters.read(&self.gpu)?;
+        let stats = self.stats_buffer.read(&self.gpu)?;
+        self.stats.extension_rays = stats[STAT_EXTENSION_RAYS];
+        self.stats.shadow_rays = stats[STAT_SHADOW_RAYS];
+        self.stats.nonfinite_samples = counters[COUNT_NONFINITE] as u64;
+        self.stats.stack_overflows = counters[COUNT_OVERFLOW] as u64;
+        Ok(())
+    }
+}
