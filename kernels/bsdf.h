@@ -11,6 +11,11 @@
 //   transmission  the dielectric's transmitted share, tinted by base color: rough refraction
 //                 through a volume (Walter et al. 2007, radiance scaled by 1/eta^2), or straight
 //                 through a thin wall (both faces' Fresnel)
+//   clear coat    (HAS_CLEARCOAT, KHR_materials_clearcoat) a GGX dielectric layer of ior 1.5 over
+//                 all the above, in the frame of its own normal, single scattering: it reflects
+//                 c A_c(mu) (A_c its directional albedo). The diffuse base sees coat and specular
+//                 layer as one layer of albedo A_c + (1 - A_c) A, scaled as above; the glossy lobes
+//                 are scaled by 1 - c max(A_c(mu_o), A_c(mu_i)) (reciprocal, never gains energy)
 // Below BSDF_DELTA_ALPHA the glossy lobes are perfect mirror and refraction (delta) lobes.
 //
 // Contract: bsdf_eval returns f(wo, wi) * |cos(n, wi)| and its pdf (solid angle) for the non-delta
@@ -30,6 +35,11 @@ typedef struct {
     float thickness;             // KHR_materials_volume thickness; 0 = thin-walled
     float3 attenuation;          // KHR_materials_volume attenuationColor
     float attenuation_distance;  // INFINITY: no absorption
+#ifdef HAS_CLEARCOAT
+    float clearcoat;             // KHR_materials_clearcoat factor; 0: no coat
+    float coat_roughness;        // perceptual
+    float3 coat_normal;          // the coat's shading normal (world); 0: the shading normal
+#endif
 } SurfaceMaterial;
 
 // The untextured material.
@@ -45,12 +55,21 @@ inline SurfaceMaterial surface_material(global const GpuMaterial* m) {
     s.thickness = m->alpha.z;
     s.attenuation = m->volume.xyz;
     s.attenuation_distance = m->volume.w;
+#ifdef HAS_CLEARCOAT
+    s.clearcoat = m->coat.x;
+    s.coat_roughness = m->coat.y;
+    s.coat_normal = (float3)(0.0f);
+#endif
     return s;
 }
 
-// Seen from inside its volume, the interface's relative index of refraction inverts.
+// Seen from inside its volume, the interface's relative index of refraction inverts (and the
+// clear coat is on the other side).
 inline void material_from_inside(SurfaceMaterial* m) {
     m->ior = 1.0f / m->ior;
+#ifdef HAS_CLEARCOAT
+    m->clearcoat = 0.0f;
+#endif
 }
 
 // Beer–Lambert transmittance over a distance t inside the material's volume: attenuationColor
@@ -381,6 +400,11 @@ typedef struct {
     float3 diffuse;    // Lambertian lobe: base color x its share x (1 - A(mu_o)) / (1 - A_avg)
     float3 ms;         // multiple scattering: its colour x (1 - E(mu_o)) / (1 - E_avg)
     float p_diffuse;   // probability of the cosine-sampled lobes (diffuse and multiple scattering)
+    float albedo;      // estimated albedo at wo of all lobes (luminance)
+#ifdef HAS_CLEARCOAT
+    float coat;        // clamped clearcoat factor
+    float coat_roughness;
+#endif
 } BsdfLobes;
 
 // A(mu): what the dielectric specular layer reflects at one cosine, single and multiple
@@ -390,14 +414,63 @@ inline float layer_albedo(const BsdfLobes* l, float2 e) {
     return l->specular * (f0 * e.x + (1.0f - f0) * e.y + l->ms_layer * (1.0f - e.x));
 }
 
+#ifdef HAS_CLEARCOAT
+// The clear coat's normal-incidence reflectance (ior 1.5).
+#define COAT_F0 0.04f
+
+// What the clear coat reflects at cos(theta) = mu: GGX single scattering with Schlick's Fresnel,
+// f0 E + (1 - f0) E_s; for a smooth coat the Fresnel itself.
+inline float coat_albedo(float mu, float roughness) {
+    if (roughness * roughness < BSDF_DELTA_ALPHA) {
+        return COAT_F0 + (1.0f - COAT_F0) * schlick_weight(mu);
+    }
+    float2 e = ggx_energy(mu, roughness);
+    return COAT_F0 * e.x + (1.0f - COAT_F0) * e.y;
+}
+
+// What coat and specular layer together reflect over the diffuse base at mu, a being the
+// specular layer's albedo there.
+inline float coated_layer_albedo(const BsdfLobes* l, float mu, float a) {
+    float ac = l->coat * coat_albedo(mu, l->coat_roughness);
+    return ac + (1.0f - ac) * a;
+}
+
+// Its cosine-weighted mean, a_avg being the specular layer's: a_avg + c A_c,avg - c ∫A_c A 2mu dmu,
+// the last term by 8-point Gauss–Legendre quadrature (it is 0 over a specularFactor 0 base).
+inline float coated_layer_albedo_avg(const BsdfLobes* l, float a_avg) {
+    float ac_avg;
+    if (l->coat_roughness * l->coat_roughness < BSDF_DELTA_ALPHA) {
+        ac_avg = COAT_F0 + (1.0f - COAT_F0) * (1.0f / 21.0f);
+    } else {
+        float2 e = ggx_energy_avg(l->coat_roughness);
+        ac_avg = COAT_F0 * e.x + (1.0f - COAT_F0) * e.y;
+    }
+    float cross = 0.0f;
+    if (l->specular > 0.0f) {
+        const float x[4] = {0.1834346425f, 0.5255324099f, 0.7966664774f, 0.9602898565f};
+        const float w[4] = {0.3626837834f, 0.3137066459f, 0.2223810345f, 0.1012285363f};
+        for (int k = 0; k < 8; ++k) {
+            float mu = 0.5f + ((k & 1) ? 0.5f : -0.5f) * x[k >> 1];
+            float a = layer_albedo(l, ggx_energy(mu, l->roughness));
+            cross += w[k >> 1] * mu * coat_albedo(mu, l->coat_roughness) * a;
+        }
+    }
+    return a_avg + l->coat * (ac_avg - cross);
+}
+#endif
+
 // The cosine-sampled lobes at wi (wi_cos > 0), f * cos: the diffuse base under the specular
 // layer, scaled by (1 - A(mu_o)) (1 - A(mu_i)) / (1 - A_avg) (albedo scaling of the glTF
 // appendix, made reciprocal: it integrates to exactly 1 - A(mu_o)), and the Kulla–Conty
-// multiple-scattering lobe (1 - E(mu_o)) (1 - E(mu_i)) / (1 - E_avg) of the GGX reflection.
-inline float3 cosine_lobes(const BsdfLobes* l, float wi_cos) {
+// multiple-scattering lobe (1 - E(mu_o)) (1 - E(mu_i)) / (1 - E_avg) of the GGX reflection,
+// times the clear coat's scaling of the glossy lobes, gs.
+inline float3 cosine_lobes(const BsdfLobes* l, float wi_cos, float gs) {
     float2 e_i = ggx_energy(wi_cos, l->roughness);
-    return (l->diffuse * (1.0f - layer_albedo(l, e_i)) + l->ms * (1.0f - e_i.x)) *
-           (wi_cos * INV_PI_F);
+    float a_i = layer_albedo(l, e_i);
+#ifdef HAS_CLEARCOAT
+    if (l->coat > 0.0f) a_i = coated_layer_albedo(l, wi_cos, a_i);
+#endif
+    return (l->diffuse * (1.0f - a_i) + l->ms * ((1.0f - e_i.x) * gs)) * (wi_cos * INV_PI_F);
 }
 
 inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
@@ -429,6 +502,14 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
     }
     float a_o = layer_albedo(&l, e_o);
     float a_avg = layer_albedo(&l, e_avg);
+#ifdef HAS_CLEARCOAT
+    l.coat = clamp(m->clearcoat, 0.0f, 1.0f);
+    l.coat_roughness = clamp(m->coat_roughness, 0.0f, 1.0f);
+    if (l.coat > 0.0f) {
+        a_o = coated_layer_albedo(&l, cos_o, a_o);
+        a_avg = coated_layer_albedo_avg(&l, a_avg);
+    }
+#endif
     l.diffuse = a_avg < 1.0f ? (opaque * ((1.0f - a_o) / (1.0f - a_avg))) * m->base_color
                              : (float3)(0.0f);
     // Pick lobes by their estimated albedo (luminance); inside a volume the dielectric reflects
@@ -442,8 +523,59 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
                   luminance(m->base_color);
     float total = d_est + r_est + t_est;
     l.p_diffuse = total > 0.0f ? d_est / total : 0.0f;
+    l.albedo = total;
     return l;
 }
+
+#ifdef HAS_CLEARCOAT
+// The clear coat as seen from one wo: its frame, its reflection at wo and its sampling share.
+typedef struct {
+    float c;          // clearcoat factor; 0: no coat
+    float roughness;  // perceptual
+    float alpha;
+    bool delta;       // a perfect mirror
+    float3 n, t, b;   // the coat's frame
+    float a_o;        // c A_c(mu_o): what it reflects at wo
+    float p;          // probability of sampling it
+} CoatLobe;
+
+inline CoatLobe coat_lobe(const SurfaceMaterial* m, const BsdfLobes* l, float3 n, float3 wo) {
+    CoatLobe c;
+    c.c = l->coat;
+    c.roughness = l->coat_roughness;
+    c.alpha = c.roughness * c.roughness;
+    c.delta = c.alpha < BSDF_DELTA_ALPHA;
+    c.n = dot(m->coat_normal, m->coat_normal) > 0.0f ? m->coat_normal : n;
+    onb(c.n, &c.t, &c.b);
+    float cos_o = dot(wo, c.n);
+    c.a_o = c.c > 0.0f && cos_o > 0.0f ? c.c * coat_albedo(cos_o, c.roughness) : 0.0f;
+    c.p = c.a_o > 0.0f ? c.a_o / (c.a_o + (1.0f - c.a_o) * l->albedo) : 0.0f;
+    return c;
+}
+
+// What the coat leaves of the glossy lobes between wo and wi: 1 - c max(A_c(mu_o), A_c(mu_i)).
+inline float coat_gloss_scale(const CoatLobe* c, float3 wi) {
+    if (!(c->c > 0.0f)) return 1.0f;
+    float a_i = c->c * coat_albedo(fabs(dot(wi, c->n)), c->roughness);
+    return 1.0f - fmax(c->a_o, a_i);
+}
+
+// The coat's reflection f * cos at (wo, wi) and its visible-normal pdf, for a rough coat.
+inline float coat_eval(const CoatLobe* c, float3 wo_world, float3 wi_world, float* pdf) {
+    *pdf = 0.0f;
+    float3 wo = (float3)(dot(wo_world, c->t), dot(wo_world, c->b), dot(wo_world, c->n));
+    float3 wi = (float3)(dot(wi_world, c->t), dot(wi_world, c->b), dot(wi_world, c->n));
+    if (c->delta || !(c->c > 0.0f) || wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+    float a2 = c->alpha * c->alpha;
+    float3 h = normalize(wo + wi);
+    float d = ggx_d(h, a2);
+    float lambda_o = ggx_lambda(wo, a2);
+    float g2 = 1.0f / (1.0f + lambda_o + ggx_lambda(wi, a2));
+    float fresnel = COAT_F0 + (1.0f - COAT_F0) * schlick_weight(dot(wo, h));
+    *pdf = 0.25f * d / ((1.0f + lambda_o) * wo.z);
+    return c->c * fresnel * 0.25f * d * g2 / wo.z;
+}
+#endif
 
 // Reflectance and transmittance of the glossy layer at a microfacet seen at cos_oh from wo. A
 // thin wall has two faces: light passing between them reflects 2F / (1 + F) in all and
@@ -480,6 +612,9 @@ inline float3 thin_wall_transmittance(const SurfaceMaterial* m, float cos_o) {
     BsdfLobes l = bsdf_lobes(m, cos_o);
     float3 refl, trans;
     bsdf_gloss(m, &l, cos_o, &refl, &trans);
+#ifdef HAS_CLEARCOAT
+    trans *= 1.0f - l.coat * coat_albedo(cos_o, l.coat_roughness);
+#endif
     return trans;
 }
 
@@ -488,6 +623,64 @@ inline float reflect_probability(float3 refl, float3 trans) {
     float r = luminance(refl);
     float t = luminance(trans);
     return r + t > 0.0f ? r / (r + t) : 1.0f;
+}
+
+// The base lobes (all but the coat) at local wo, wi: f * cos with the glossy ones scaled by gs,
+// and their mixture pdf.
+inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo, float3 wi,
+                        float gs, float* pdf) {
+    float3 f = (float3)(0.0f);
+    float p = 0.0f;
+    if (wi.z > 0.0f) {
+        f = cosine_lobes(l, wi.z, gs);
+        p = l->p_diffuse * (wi.z * INV_PI_F);
+    }
+    float p_gloss = 1.0f - l->p_diffuse;
+    if (l->delta || !(p_gloss > 0.0f)) {
+        *pdf = p;
+        return f;
+    }
+    float a2 = l->alpha * l->alpha;
+    float lambda_o = ggx_lambda(wo, a2);
+    float g1 = 1.0f / (1.0f + lambda_o);
+    float inv_cos_o = 1.0f / fmax(wo.z, 1e-20f);
+    float3 refl, trans;
+    if (wi.z > 0.0f || l->thin) {
+        // Reflection, or thin-wall transmission: the reflection mirrored through the surface.
+        float3 wr = (float3)(wi.x, wi.y, fabs(wi.z));
+        float3 h = normalize(wo + wr);
+        bsdf_gloss(m, l, dot(wo, h), &refl, &trans);
+        float d = ggx_d(h, a2);
+        float g2 = 1.0f / (1.0f + lambda_o + ggx_lambda(wr, a2));
+        float pr = reflect_probability(refl, trans);
+        float3 c = wi.z > 0.0f ? refl : trans;
+        f += c * (0.25f * d * g2 * inv_cos_o) * gs;
+        p += p_gloss * (wi.z > 0.0f ? pr : 1.0f - pr) * (0.25f * g1 * d * inv_cos_o);
+    } else {
+        // Refraction through the generalized half vector h ~ wo + eta wi (Walter et al. 2007).
+        float3 h = wo + l->eta * wi;
+        float len = length(h);
+        if (!(len > 0.0f)) {
+            *pdf = p;
+            return f;
+        }
+        h = (h.z < 0.0f ? -h : h) / len;
+        float cos_oh = dot(wo, h);
+        float cos_ih = dot(wi, h);
+        if (cos_oh > 0.0f && cos_ih < 0.0f) {
+            bsdf_gloss(m, l, cos_oh, &refl, &trans);
+            float d = ggx_d(h, a2);
+            float g2 = 1.0f / (1.0f + lambda_o + ggx_lambda(wi, a2));
+            // dwh/dwi; |wo.h + eta wi.h| = len.
+            float jacobian = l->eta * l->eta * -cos_ih / (len * len);
+            float vndf = g1 * d * cos_oh * inv_cos_o;
+            // Radiance crossing into a medium eta times denser is compressed by eta^2.
+            f += trans * (vndf * jacobian * g2 / g1) / (l->eta * l->eta) * gs;
+            p += p_gloss * (1.0f - reflect_probability(refl, trans)) * vndf * jacobian;
+        }
+    }
+    *pdf = p;
+    return f;
 }
 
 inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 wi_world,
@@ -501,58 +694,18 @@ inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, flo
         return (float3)(0.0f);
     }
     BsdfLobes l = bsdf_lobes(m, wo.z);
-    float3 f = (float3)(0.0f);
-    float p = 0.0f;
-    if (wi.z > 0.0f) {
-        f = cosine_lobes(&l, wi.z);
-        p = l.p_diffuse * (wi.z * INV_PI_F);
-    }
-    float p_gloss = 1.0f - l.p_diffuse;
-    if (l.delta || !(p_gloss > 0.0f)) {
-        *pdf = p;
+#ifdef HAS_CLEARCOAT
+    if (l.coat > 0.0f) {
+        CoatLobe c = coat_lobe(m, &l, n, wo_world);
+        float p_base;
+        float3 f = base_eval(m, &l, wo, wi, coat_gloss_scale(&c, wi_world), &p_base);
+        float p_coat;
+        f += coat_eval(&c, wo_world, wi_world, &p_coat);
+        *pdf = (1.0f - c.p) * p_base + c.p * p_coat;
         return f;
     }
-    float a2 = l.alpha * l.alpha;
-    float lambda_o = ggx_lambda(wo, a2);
-    float g1 = 1.0f / (1.0f + lambda_o);
-    float inv_cos_o = 1.0f / fmax(wo.z, 1e-20f);
-    float3 refl, trans;
-    if (wi.z > 0.0f || l.thin) {
-        // Reflection, or thin-wall transmission: the reflection mirrored through the surface.
-        float3 wr = (float3)(wi.x, wi.y, fabs(wi.z));
-        float3 h = normalize(wo + wr);
-        bsdf_gloss(m, &l, dot(wo, h), &refl, &trans);
-        float d = ggx_d(h, a2);
-        float g2 = 1.0f / (1.0f + lambda_o + ggx_lambda(wr, a2));
-        float pr = reflect_probability(refl, trans);
-        float3 c = wi.z > 0.0f ? refl : trans;
-        f += c * (0.25f * d * g2 * inv_cos_o);
-        p += p_gloss * (wi.z > 0.0f ? pr : 1.0f - pr) * (0.25f * g1 * d * inv_cos_o);
-    } else {
-        // Refraction through the generalized half vector h ~ wo + eta wi (Walter et al. 2007).
-        float3 h = wo + l.eta * wi;
-        float len = length(h);
-        if (!(len > 0.0f)) {
-            *pdf = p;
-            return f;
-        }
-        h = (h.z < 0.0f ? -h : h) / len;
-        float cos_oh = dot(wo, h);
-        float cos_ih = dot(wi, h);
-        if (cos_oh > 0.0f && cos_ih < 0.0f) {
-            bsdf_gloss(m, &l, cos_oh, &refl, &trans);
-            float d = ggx_d(h, a2);
-            float g2 = 1.0f / (1.0f + lambda_o + ggx_lambda(wi, a2));
-            // dwh/dwi; |wo.h + eta wi.h| = len.
-            float jacobian = l.eta * l.eta * -cos_ih / (len * len);
-            float vndf = g1 * d * cos_oh * inv_cos_o;
-            // Radiance crossing into a medium eta times denser is compressed by eta^2.
-            f += trans * (vndf * jacobian * g2 / g1) / (l.eta * l.eta);
-            p += p_gloss * (1.0f - reflect_probability(refl, trans)) * vndf * jacobian;
-        }
-    }
-    *pdf = p;
-    return f;
+#endif
+    return base_eval(m, &l, wo, wi, 1.0f, pdf);
 }
 
 inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 u,
@@ -566,6 +719,37 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
     if (wo.z <= 0.0f) return (float3)(0.0f);
     BsdfLobes l = bsdf_lobes(m, wo.z);
     float3 wi;
+#ifdef HAS_CLEARCOAT
+    // The share of the base lobes (all but the coat).
+    float p_base = 1.0f;
+    CoatLobe c;
+    c.c = 0.0f;
+    if (l.coat > 0.0f) {
+        c = coat_lobe(m, &l, n, wo_world);
+        if (u.x < c.p) {
+            // The coat: a visible microfacet of its normal distribution, in its own frame.
+            float3 wo_c = (float3)(dot(wo_world, c.t), dot(wo_world, c.b), dot(wo_world, c.n));
+            float uc = fmin(u.x / c.p, 0x1.fffffep-1f);
+            float3 h = c.delta ? (float3)(0.0f, 0.0f, 1.0f) : ggx_sample_vndf(wo_c, c.alpha, uc, u.y);
+            float3 wi_c = 2.0f * dot(wo_c, h) * h - wo_c;
+            if (wi_c.z <= 0.0f) return (float3)(0.0f);
+            *wi_world = normalize(wi_c.x * c.t + wi_c.y * c.b + wi_c.z * c.n);
+            if (c.delta) {
+                *pdf = c.p;
+                *specular = true;
+                return (float3)(c.c * (COAT_F0 + (1.0f - COAT_F0) * schlick_weight(wo_c.z)) / c.p);
+            }
+            float3 f = bsdf_eval(m, n, wo_world, *wi_world, pdf);
+            if (!(*pdf > 0.0f)) {
+                *pdf = 0.0f;
+                return (float3)(0.0f);
+            }
+            return f / *pdf;
+        }
+        p_base = 1.0f - c.p;
+        u.x = fmin((u.x - c.p) / p_base, 0x1.fffffep-1f);
+    }
+#endif
     if (u.x < l.p_diffuse) {
         wi = sample_cosine(u.x / l.p_diffuse, u.y);
     } else {
@@ -594,7 +778,14 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
             *pdf = chosen;
             *specular = true;
             float3 w = (reflect ? refl : trans) / chosen;
-            return reflect || l.thin ? w : w / (l.eta * l.eta);
+            w = reflect || l.thin ? w : w / (l.eta * l.eta);
+#ifdef HAS_CLEARCOAT
+            if (c.c > 0.0f) {
+                *pdf = chosen * p_base;
+                w *= coat_gloss_scale(&c, *wi_world) / p_base;
+            }
+#endif
+            return w;
         }
     }
     *wi_world = normalize(wi.x * t + wi.y * b + wi.z * n);

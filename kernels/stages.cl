@@ -184,10 +184,26 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
             if (dot(ns, ng) < 0.0f) ns = -ns;
         }
     }
+#ifdef HAS_CLEARCOAT
+    // The coat has its own normal texture; without one it takes the interpolated normal.
+    float3 coat_normal = ns;
 #ifdef HAS_NORMAL_MAPS
-    if (mat->textures.z >= 0) ns = normal_map(&surf, mat, &tc, hit.prim, hit.u, hit.v, ns, ng, front);
+    if (mat->textures3.z >= 0) {
+        coat_normal = normal_map(&surf, mat->textures3.z, mat->coat.z, &tc, hit.prim, hit.u,
+                                 hit.v, ns, ng, front);
+    }
+#endif
+#endif
+#ifdef HAS_NORMAL_MAPS
+    if (mat->textures.z >= 0) {
+        ns = normal_map(&surf, mat->textures.z, mat->alpha.w, &tc, hit.prim, hit.u, hit.v, ns, ng,
+                        front);
+    }
 #endif
     SurfaceMaterial m = surface_material(mat);
+#ifdef HAS_CLEARCOAT
+    m.coat_normal = coat_normal;
+#endif
 #ifdef HAS_TEXTURES
     apply_textures(&m, mat, &surf, &tc);
     float alpha_r = m.roughness * m.roughness;

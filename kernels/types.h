@@ -63,6 +63,8 @@ typedef struct {
     float4 alpha;       // .x alphaCutoff, .y mode (uint bits, ALPHA_*), .z thickness, .w normal scale
     int4 textures;      // texture refs: base color, metallic-roughness, normal, emissive; -1 none
     int4 textures2;     // texture refs: .x transmission, .y thickness; -1 none
+    float4 coat;        // clearcoat: .x factor, .y roughness, .z normal texture scale
+    int4 textures3;     // texture refs: .x clearcoat, .y clearcoat roughness, .z clearcoat normal
 } GpuMaterial;
 
 typedef struct {

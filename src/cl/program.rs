@@ -52,6 +52,8 @@ pub struct KernelFeatures {
     pub thin_walls: bool,
     /// Some material is unlit (`HAS_UNLIT`, `KHR_materials_unlit`).
     pub unlit: bool,
+    /// Some material has a clear coat (`HAS_CLEARCOAT`, `KHR_materials_clearcoat`).
+    pub clearcoat: bool,
 }
 
 impl KernelFeatures {
@@ -67,6 +69,7 @@ impl KernelFeatures {
             (self.env_map, "HAS_ENV_MAP"),
             (self.thin_walls, "HAS_THIN_WALLS"),
             (self.unlit, "HAS_UNLIT"),
+            (self.clearcoat, "HAS_CLEARCOAT"),
         ] {
             if on {
                 d.push_str(" -D");

@@ -241,7 +241,7 @@ pub struct GpuEnvironment {
 }
 const _: () = assert!(size_of::<GpuEnvironment>() == 48);
 
-/// A glTF material as the kernels see it (128 bytes).
+/// A glTF material as the kernels see it (160 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuMaterial {
@@ -262,8 +262,14 @@ pub struct GpuMaterial {
     pub textures: [i32; 4],
     /// More texture references (`.x` transmission, `.y` thickness, `.zw` spare); -1 when absent.
     pub textures2: [i32; 4],
+    /// `KHR_materials_clearcoat`: `.x` clearcoatFactor, `.y` clearcoatRoughnessFactor, `.z`
+    /// clearcoat normal texture scale; `.w` spare.
+    pub coat: [f32; 4],
+    /// Texture references of the extensions: `.x` clearcoat (R), `.y` clearcoat roughness (G),
+    /// `.z` clearcoat normal; `.w` spare; -1 when absent.
+    pub textures3: [i32; 4],
 }
-const _: () = assert!(size_of::<GpuMaterial>() == 128);
+const _: () = assert!(size_of::<GpuMaterial>() == 160);
 
 /// One light for next-event estimation (64 bytes).
 #[repr(C)]
@@ -410,7 +416,9 @@ pub fn layouts() -> Vec<StructLayout> {
             volume,
             alpha,
             textures,
-            textures2
+            textures2,
+            coat,
+            textures3
         ),
         layout!(GpuLight, position, intensity, spot, extra),
         layout!(GpuCamera, origin, forward, right, up),

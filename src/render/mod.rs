@@ -124,12 +124,13 @@ impl Renderer {
         self.scene_features = KernelFeatures {
             triangle_lights: !host.emissive.is_empty(),
             textures: used(&|m| m.textures.any()),
-            normal_maps: used(&|m| m.textures.normal.is_some()) && !host.tangents.is_empty(),
+            normal_maps: used(&|m| m.textures.normal_mapped()) && !host.tangents.is_empty(),
             alpha: used(&|m| m.alpha != AlphaMode::Opaque),
             transmission: used(&|m| m.transmission > 0.0),
             env_map: false,
             thin_walls: used(&|m| m.transmission > 0.0 && m.thickness <= 0.0),
             unlit: used(&|m| m.unlit),
+            clearcoat: used(&|m| m.clearcoat > 0.0),
         };
         let budget = self
             .gpu

@@ -80,6 +80,18 @@ pub fn gpu_material(m: &Material) -> GpuMaterial {
             slot(m.textures.emissive),
         ],
         textures2: [slot(m.textures.transmission), -1, -1, -1],
+        coat: [
+            m.clearcoat,
+            m.clearcoat_roughness,
+            m.clearcoat_normal_scale,
+            0.0,
+        ],
+        textures3: [
+            slot(m.textures.clearcoat),
+            slot(m.textures.clearcoat_roughness),
+            slot(m.textures.clearcoat_normal),
+            -1,
+        ],
     }
 }
 

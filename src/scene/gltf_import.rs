@@ -12,9 +12,12 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
+mod materials;
+
 /// Extensions penumbra understands (or can safely ignore when rendering).
 const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
+    "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_specular",
@@ -52,7 +55,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
     let mut table = TextureTable::default();
     let mut materials = document
         .materials()
-        .map(|m| import_material(m, &mut table, &mut warnings))
+        .map(|m| import_material(m, &document, &mut table, &mut warnings))
         .collect::<Vec<_>>();
     let images = decode_images(&document, base, &buffers, &mut table, &mut warnings);
     for m in &mut materials {
@@ -62,7 +65,11 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
     // The texture coordinate set of each material's normal map (tangents are made for it).
     let normal_sets: Vec<Option<u32>> = materials
         .iter()
-        .map(|m| m.textures.normal.map(|r| table.refs[r as usize].tex_coord))
+        .map(|m| {
+            (m.textures.normal)
+                .or(m.textures.clearcoat_normal)
+                .map(|r| table.refs[r as usize].tex_coord)
+        })
         .collect();
 
     let mut scene = Scene {
@@ -319,6 +326,9 @@ impl TextureTable {
             &mut slots.normal,
             &mut slots.emissive,
             &mut slots.transmission,
+            &mut slots.clearcoat,
+            &mut slots.clearcoat_roughness,
+            &mut slots.clearcoat_normal,
         ] {
             if let Some(r) = *slot
                 && self.failed[self.refs[r as usize].image as usize]
@@ -382,6 +392,7 @@ fn decode_images(
 
 fn import_material(
     m: gltf::Material,
+    document: &gltf::Document,
     table: &mut TextureTable,
     warnings: &mut Vec<String>,
 ) -> Material {
@@ -412,8 +423,9 @@ fn import_material(
         transmission: m
             .transmission()
             .and_then(|t| table.info(t.transmission_texture(), false, &what, warnings)),
+        ..MaterialTextures::default()
     };
-    Material {
+    let mut material = Material {
         name: m
             .name()
             .map(str::to_string)
@@ -440,7 +452,10 @@ fn import_material(
         textures,
         normal_scale: normal.as_ref().map_or(1.0, |n| n.scale()),
         unlit: m.unlit(),
-    }
+        ..Material::default()
+    };
+    materials::read_extensions(&m, document, table, &mut material, warnings);
+    material
 }
 
 fn import_light(light: &gltf::khr_lights_punctual::Light, world: &DMat4) -> Light {

@@ -133,6 +133,12 @@ pub struct Material {
     pub normal_scale: f32,
     /// `KHR_materials_unlit`: shows its base color and scatters nothing.
     pub unlit: bool,
+    /// `KHR_materials_clearcoat` clearcoatFactor (0: no coat).
+    pub clearcoat: f32,
+    /// `KHR_materials_clearcoat` clearcoatRoughnessFactor.
+    pub clearcoat_roughness: f32,
+    /// Scale of the clearcoat normal texture.
+    pub clearcoat_normal_scale: f32,
 }
 
 impl Default for Material {
@@ -155,6 +161,9 @@ impl Default for Material {
             textures: MaterialTextures::default(),
             normal_scale: 1.0,
             unlit: false,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            clearcoat_normal_scale: 1.0,
         }
     }
 }
