@@ -1,7 +1,9 @@
 //! Host-side costs a user waits for when a scene opens: the binned-SAH BVH build (triangles per
-//! second on generated soups of 100k and 1M triangles) and glTF loading (the bundled Cornell box
-//! and, when PENUMBRA_SCENES is set, StanfordBunny). Sample sizes are small so that
-//! `cargo bench --bench bvh` finishes in a few minutes on two cores.
+//! second on generated soups of 100k and 1M triangles and, when PENUMBRA_BVH_SCENE names a glTF
+//! file such as the room of `penumbra bench generate`, on that scene's world triangles), the
+//! refit of the 1M soup, and glTF loading (the bundled Cornell box and, when PENUMBRA_SCENES is
+//! set, StanfordBunny). Sample sizes are small so that `cargo bench --bench bvh` finishes in a
+//! few minutes on two cores.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
@@ -42,6 +44,33 @@ fn bvh_build(c: &mut Criterion) {
             b.iter(|| black_box(penumbra::bvh::build(black_box(tris))))
         });
     }
+    if let Some(path) = std::env::var_os("PENUMBRA_BVH_SCENE") {
+        let scene = penumbra::scene::load(&PathBuf::from(path)).expect("PENUMBRA_BVH_SCENE loads");
+        let tris: Vec<[Vec3; 3]> = scene.world_triangles().iter().map(|t| t.v).collect();
+        group.throughput(Throughput::Elements(tris.len() as u64));
+        group.bench_function("scene", |b| {
+            b.iter(|| black_box(penumbra::bvh::build(black_box(&tris))))
+        });
+    }
+    group.finish();
+
+    // Refit after every vertex moved a little (the topology stays, the boxes change).
+    let mut group = c.benchmark_group("bvh_refit");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(3));
+    let n = 1_000_000;
+    let tris = soup(n);
+    let moved: Vec<[Vec3; 3]> = tris
+        .iter()
+        .map(|t| t.map(|v| v + Vec3::new(v.y, v.z, v.x) * 0.01))
+        .collect();
+    let mut bvh = penumbra::bvh::build(&tris);
+    group.throughput(Throughput::Elements(n as u64));
+    group.bench_function(BenchmarkId::from_parameter(n), |b| {
+        b.iter(|| bvh.refit(black_box(&moved)))
+    });
     group.finish();
 }
 

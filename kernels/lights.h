@@ -75,8 +75,9 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
         float area = l->spot.y;
         GpuTriangle t = tris[prim];
         float2 b = sample_triangle(u1, u2);
-        float3 q = (1.0f - b.x - b.y) * t.v0.xyz + b.x * t.v1.xyz + b.y * t.v2.xyz;
-        float3 ng = normalize(cross(t.v1.xyz - t.v0.xyz, t.v2.xyz - t.v0.xyz));
+        float3 q_err;
+        float3 q = surface_point(t.v0.xyz, t.v1.xyz, t.v2.xyz, b.x, b.y, &q_err);
+        float3 ng = triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz);
         float3 d = q - p;
         float dist2 = dot(d, d);
         if (dist2 <= 0.0f) return s;
@@ -84,7 +85,7 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
         s.wi = d / s.distance;
         // End the shadow ray a few ulps off the light, on the shading point's side, so that it
         // can neither hit the light itself nor stop short of an occluder, at any scale.
-        s.target = offset_ray(q, dot(ng, p - q) > 0.0f ? ng : -ng);
+        s.target = offset_ray(q, q_err, dot(ng, p - q) > 0.0f ? ng : -ng);
         s.on_surface = true;
         global const GpuMaterial* m = &materials[as_uint(t.v0.w)];
         float cos_l = -dot(ng, s.wi);

@@ -59,6 +59,11 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuShadowRay, contribution);
     PROBE_SIZE(GpuRay);
     PROBE_FIELD(GpuRay, origin); PROBE_FIELD(GpuRay, direction);
+    PROBE_SIZE(GpuWideNode);
+    PROBE_FIELD(GpuWideNode, min_x); PROBE_FIELD(GpuWideNode, min_y);
+    PROBE_FIELD(GpuWideNode, min_z); PROBE_FIELD(GpuWideNode, max_x);
+    PROBE_FIELD(GpuWideNode, max_y); PROBE_FIELD(GpuWideNode, max_z);
+    PROBE_FIELD(GpuWideNode, child); PROBE_FIELD(GpuWideNode, count);
     out[n] = 0xffffffffu;
 }
 
@@ -109,4 +114,32 @@ kernel void sample_env_test(GpuEnvironment environment, global const float* env_
     out[i] = (float4)(0.0f);
     eval_pdf[i] = 0.0f;
 #endif
+}
+
+// Spawned rays against the kernel's own hit point and offset (pbrt-v4's reintersection test):
+// case i spawns from triangle groups[i].x at barycentrics bary[i].xy, offset to the side of
+// dirs[i].xyz, and traces a ray along dirs[i].xyz up to dirs[i].w against the groups[i].z
+// triangles from groups[i].y; hits[i] = how many of them it hits.
+kernel void spawn_test(global const float4* verts, global const uint4* groups,
+                       global const float2* bary, global const float4* dirs, uint count,
+                       global uint* hits) {
+    uint i = get_global_id(0);
+    if (i >= count) return;
+    uint first = groups[i].x;
+    float3 v0 = verts[3 * first].xyz, v1 = verts[3 * first + 1].xyz, v2 = verts[3 * first + 2].xyz;
+    float3 ng = triangle_normal(v0, v1, v2);
+    float3 d = dirs[i].xyz;
+    float3 err;
+    float3 p = surface_point(v0, v1, v2, bary[i].x, bary[i].y, &err);
+    float3 o = offset_ray(p, err, dot(d, ng) > 0.0f ? ng : -ng);
+    RayPrep r = prepare_ray(o, d);
+    uint n = 0;
+    for (uint k = groups[i].y; k < groups[i].y + groups[i].z; k++) {
+        float tmax = dirs[i].w;
+        float bu, bv;
+        if (intersect_triangle(&r, verts[3 * k], verts[3 * k + 1], verts[3 * k + 2], 0.0f, &tmax,
+                               &bu, &bv))
+            n++;
+    }
+    hits[i] = n;
 }

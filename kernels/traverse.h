@@ -84,6 +84,35 @@ inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float
     return (near <= far && near < tmax) ? near : INFINITY;
 }
 
+// Tests the triangles first .. first + count - 1 of a leaf, keeping the closest hit in *hit
+// (with HAS_ALPHA, hits the material's alpha cuts out or lets through are skipped). Returns
+// true when any_hit and a hit was found: the traversal can stop.
+inline bool intersect_leaf(const RayPrep* r, global const GpuTriangle* tris,
+                           const SceneSurfaces* surf, uint first, uint count, float tmin,
+                           float3 o, float3 d, bool any_hit, GpuHit* hit) {
+    for (uint p = first; p < first + count; ++p) {
+        GpuTriangle t = tris[p];
+#ifdef HAS_ALPHA
+        float t_hit = hit->t;
+        float bu, bv;
+        if (intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv) &&
+            !alpha_passes(surf, p, as_uint(t.v0.w), bu, bv, o, d)) {
+            hit->t = t_hit;
+            hit->u = bu;
+            hit->v = bv;
+            hit->prim = p;
+            if (any_hit) return true;
+        }
+#else
+        if (intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &hit->t, &hit->u, &hit->v)) {
+            hit->prim = p;
+            if (any_hit) return true;
+        }
+#endif
+    }
+    return false;
+}
+
 // Closest hit (any_hit = false) or first hit (any_hit = true). On a stack overflow, which the
 // builder's depth limit rules out, the overflow counter is raised instead of failing silently.
 // With HAS_ALPHA, hits that the material's alpha cuts out (MASK) or lets through (BLEND, at
@@ -117,25 +146,8 @@ inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle*
             }
             uint first = (uint)(~ref);
             uint count = as_uint(hi.w);
-            for (uint p = first; p < first + count; ++p) {
-                GpuTriangle t = tris[p];
-#ifdef HAS_ALPHA
-                float t_hit = hit.t;
-                float bu, bv;
-                if (intersect_triangle(&r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv) &&
-                    !alpha_passes(surf, p, as_uint(t.v0.w), bu, bv, o, d)) {
-                    hit.t = t_hit;
-                    hit.u = bu;
-                    hit.v = bv;
-                    hit.prim = p;
-                    if (any_hit) return hit;
-                }
-#else
-                if (intersect_triangle(&r, t.v0, t.v1, t.v2, tmin, &hit.t, &hit.u, &hit.v)) {
-                    hit.prim = p;
-                    if (any_hit) return hit;
-                }
-#endif
+            if (intersect_leaf(&r, tris, surf, first, count, tmin, o, d, any_hit, &hit)) {
+                return hit;
             }
         }
         if (child[0] >= 0 && child[1] >= 0) {
@@ -158,17 +170,41 @@ inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle*
     }
 }
 
-// Moves p off the surface along the geometric normal n by a few ulps of its coordinates
-// (Wächter and Binder, Ray Tracing Gems, chapter 6). Their 256 ulps cover a hit point computed
-// as o + t d; ours are interpolated from the vertices with barycentrics, accurate to a few ulps,
-// so 16 suffice — and 256 would move a point 0.25 units at 10^4 from the origin, enough to bias
-// MIS (the light pdf of a BSDF hit is measured from the moved origin). tests/device.rs checks a
-// furnace at 10^4, at 10^-3 and at 10^3 scale.
-inline float3 offset_ray(float3 p, float3 n) {
-    const float origin = 1.0f / 32.0f;
-    const float float_scale = 1.0f / 65536.0f;
-    const float int_scale = 16.0f;
-    int3 of_i = convert_int3(int_scale * n);
-    int3 p_i = as_int3(p) + select(of_i, -of_i, p < 0.0f);
-    return select(as_float3(p_i), p + float_scale * n, fabs(p) < origin);
+// The point at barycentrics (u, v) of a triangle and a bound on how far a spawned ray's origin
+// must move off it, per coordinate: pbrt-v4's gamma(7) times the barycentric sum of the
+// vertices' magnitudes (the rounding of p), plus gamma(64) times the triangle's extent around p
+// in every coordinate, which stands in for pbrt's conservative t check in the ray-triangle test
+// (a point exactly on a triangle in the plane x = 0 has no rounding error, yet the sheared
+// ray-triangle test can still find it at a tiny positive t). Both follow the vertices, not a
+// scene-wide epsilon, so they hold at any scale and offset.
+inline float3 surface_point(float3 v0, float3 v1, float3 v2, float u, float v, float3* err) {
+    float w = 1.0f - u - v;
+    const float gamma7 = 7.0f * 0x1p-24f / (1.0f - 7.0f * 0x1p-24f);
+    const float gamma64 = 64.0f * 0x1p-24f / (1.0f - 64.0f * 0x1p-24f);
+    float3 p = w * v0 + u * v1 + v * v2;
+    float3 extent = fmax(fmax(fabs(v0 - p), fabs(v1 - p)), fabs(v2 - p));
+    float reach = fmax(fmax(extent.x, extent.y), extent.z);
+    *err = gamma7 * (fabs(w * v0) + fabs(u * v1) + fabs(v * v2)) + gamma64 * reach;
+    return p;
+}
+
+// The unit geometric normal of a triangle (counter-clockwise front). The cross product is
+// scaled by a power of two before normalizing, so triangles of 1e-10 or 1e10 units do not
+// underflow or overflow its squared length.
+inline float3 triangle_normal(float3 v0, float3 v1, float3 v2) {
+    float3 c = cross(v1 - v0, v2 - v0);
+    float m = fmax(fmax(fabs(c.x), fabs(c.y)), fabs(c.z));
+    return m > 0.0f ? normalize(c * ldexp(1.0f, -ilogb(m))) : c;
+}
+
+// Moves p, whose coordinates are off by at most err, off the surface along the geometric
+// normal n (pointing to the side the ray leaves on) by the error bound projected on n, then
+// rounds each moved coordinate one more ulp away from p (pbrt-v4's OffsetRayOrigin). A ray
+// from the result can neither re-hit the surface it leaves nor start behind it; tests/stress.rs
+// checks this from 1e-8 to 1e8 through `spawn_test`.
+inline float3 offset_ray(float3 p, float3 err, float3 n) {
+    float3 offset = dot(fabs(n), err) * n;
+    float3 po = p + offset;
+    po = select(po, nextafter(po, (float3)(INFINITY)), offset > 0.0f);
+    return select(po, nextafter(po, (float3)(-INFINITY)), offset < 0.0f);
 }

@@ -11,6 +11,16 @@ typedef struct {
     float4 right_max;  // .w = right leaf triangle count (uint bits)
 } GpuBvhNode;
 
+// A node of the 4-wide BVH: the children's boxes by coordinate (lane i = child i). A child is
+// an interior node (child > 0, count 0), a leaf (child = ~first triangle, count > 0) or an
+// empty slot (child <= 0, count 0).
+typedef struct {
+    float4 min_x, min_y, min_z;
+    float4 max_x, max_y, max_z;
+    int4 child;
+    uint4 count;
+} GpuWideNode;
+
 typedef struct {
     float4 v0;  // .w = material index (uint bits)
     float4 v1;  // .w = emissive light index (int bits), -1 when not emissive
@@ -69,7 +79,7 @@ typedef struct {
 
 typedef struct {
     float4 position;   // position, or travel direction (directional); .w = kind (uint bits)
-    float4 intensity;  // intensity (point/spot) or irradiance (directional); .w = radius
+    float4 intensity;  // intensity (point/spot) or irradiance (directional); .w = light radius
     float4 spot;       // spot axis; .w = cos outer angle. Triangle: .x = index bits, .y = area
     float4 extra;      // .x = cos inner angle, .y = selection probability
 } GpuLight;

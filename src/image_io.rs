@@ -39,6 +39,24 @@ pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Resu
     .with_context(|| format!("{}: cannot write EXR", path.display()))
 }
 
+/// The size of each layer of an EXR file and its chunk count, from the header alone (no pixel
+/// is read): `(width, height, chunks)` per layer.
+pub fn exr_layer_sizes(path: &Path) -> Result<Vec<(u64, u64, u64)>> {
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .with_context(|| format!("{}: cannot read EXR", path.display()))?;
+    Ok(meta
+        .headers
+        .iter()
+        .map(|h| {
+            (
+                h.layer_size.width() as u64,
+                h.layer_size.height() as u64,
+                h.chunk_count as u64,
+            )
+        })
+        .collect())
+}
+
 /// Reads the RGB channels of an EXR file: (width, height, pixels).
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
     use exr::prelude::*;

@@ -4,6 +4,8 @@
 #![deny(unsafe_code)]
 
 pub mod app;
+pub mod args;
+pub mod bench;
 pub mod bvh;
 pub mod cl;
 pub mod cli;

@@ -9,7 +9,15 @@ fn main() {
     )
     .format_timestamp(None)
     .init();
-    let cli = penumbra::cli::Cli::parse();
+    let cli = match penumbra::cli::Cli::try_parse() {
+        Ok(cli) => cli,
+        // --help and --version print as clap makes them, with exit code 0.
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            eprintln!("penumbra: error: {}", penumbra::cli::usage_error(&e));
+            std::process::exit(2);
+        }
+    };
     if let Err(e) = penumbra::cli::run(cli) {
         // One line: the error and its causes, outermost first.
         let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();

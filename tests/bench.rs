@@ -207,15 +207,24 @@ fn converge_slopes_against_the_mitsuba_reference_are_unbiased() {
 
 #[test]
 fn frame_reports_every_stage() {
-    let summary = penumbra_json(&[
-        "bench", "frame", "--width", "32", "--height", "24", "--spp", "2", "--json",
-    ]);
-    let stages = summary["stage_ms_per_frame"].as_object().expect("stages");
-    for stage in ["generate", "extend", "shade", "connect", "accumulate"] {
-        assert!(stages.contains_key(stage), "{stage} missing: {summary:#}");
+    for (kernel, expected) in [
+        (
+            "wavefront",
+            &["generate", "extend", "shade", "connect", "accumulate"][..],
+        ),
+        ("megakernel", &["megakernel"][..]),
+    ] {
+        let summary = penumbra_json(&[
+            "bench", "frame", "--kernel", kernel, "--width", "32", "--height", "24", "--spp", "2",
+            "--json",
+        ]);
+        let stages = summary["stage_ms_per_frame"].as_object().expect("stages");
+        for stage in expected {
+            assert!(stages.contains_key(*stage), "{stage} missing: {summary:#}");
+        }
+        assert!(summary["samples_per_second"].as_f64().unwrap() > 0.0);
+        assert!(summary["extension_rays"].as_u64().unwrap() >= 32 * 24 * 2);
     }
-    assert!(summary["samples_per_second"].as_f64().unwrap() > 0.0);
-    assert!(summary["extension_rays"].as_u64().unwrap() >= 32 * 24 * 2);
 }
 
 #[test]

@@ -9,7 +9,7 @@ use penumbra::bvh::Ray;
 use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay, layouts};
 use penumbra::cl::{Buffer, DeviceChoice};
 use penumbra::render::Renderer;
-use penumbra::scene::{Material, Mesh, Object, Scene};
+use penumbra::scene::{Material, Mesh, Object, RenderFrame, Scene};
 use serde_json::json;
 
 fn renderer() -> Renderer {
@@ -85,8 +85,11 @@ fn layout_probe_agrees_with_every_shared_rust_struct() {
 
 #[test]
 fn kernel_traversal_equals_host_traversal() {
+    // Binary and 4-wide BVH kernels alike.
     let mut r = renderer();
-    r.load_scene(&random_scene(3000), &[]).unwrap();
+    // In world coordinates (no render frame): the rays below are made in world space.
+    r.load_scene_in(&random_scene(3000), &[], RenderFrame::default())
+        .unwrap();
     let host = r.host_scene().unwrap();
     let mut s = 17u64;
     let mut rnd = || {
@@ -139,8 +142,19 @@ fn kernel_traversal_equals_host_traversal() {
     program
         .trace_any(&r.gpu, scene, &ray_buf, &occluded, &counters)
         .unwrap();
+    // The 4-wide BVH (the megakernel's) must find the same hits.
+    let wide_hits = Buffer::<GpuHit>::new(&r.gpu, rays.len()).unwrap();
+    let wide_occluded = Buffer::<u32>::new(&r.gpu, rays.len()).unwrap();
+    program
+        .trace_closest_wide(&r.gpu, scene, &ray_buf, &wide_hits, &counters)
+        .unwrap();
+    program
+        .trace_any_wide(&r.gpu, scene, &ray_buf, &wide_occluded, &counters)
+        .unwrap();
     let hits = hits.read(&r.gpu).unwrap();
     let occluded = occluded.read(&r.gpu).unwrap();
+    let wide_hits = wide_hits.read(&r.gpu).unwrap();
+    let wide_occluded = wide_occluded.read(&r.gpu).unwrap();
     assert_eq!(
         counters.read(&r.gpu).unwrap()[COUNT_OVERFLOW],
         0,
@@ -155,24 +169,25 @@ fn kernel_traversal_equals_host_traversal() {
             tmax: *tmax,
         };
         let expect = host.bvh.intersect(&ray, &host.vertices);
-        let got = hits[i];
-        match expect {
-            Some(h) => {
-                hit_count += 1;
-                assert_eq!(got.prim, h.prim, "ray {i}: device hit {got:?}, host {h:?}");
-                assert_eq!(got.t, h.t, "ray {i}");
-                assert!(
-                    (got.u - h.u).abs() < 1e-6 && (got.v - h.v).abs() < 1e-6,
-                    "ray {i}"
-                );
+        hit_count += expect.is_some() as usize;
+        for (got, occluded) in [(hits[i], occluded[i]), (wide_hits[i], wide_occluded[i])] {
+            match expect {
+                Some(h) => {
+                    assert_eq!(got.prim, h.prim, "ray {i}: device hit {got:?}, host {h:?}");
+                    assert_eq!(got.t, h.t, "ray {i}");
+                    assert!(
+                        (got.u - h.u).abs() < 1e-6 && (got.v - h.v).abs() < 1e-6,
+                        "ray {i}"
+                    );
+                }
+                None => assert_eq!(got.prim, u32::MAX, "ray {i}: device hit, host missed"),
             }
-            None => assert_eq!(got.prim, u32::MAX, "ray {i}: device hit, host missed"),
+            assert_eq!(
+                occluded == 1,
+                expect.is_some(),
+                "ray {i}: any-hit disagrees"
+            );
         }
-        assert_eq!(
-            occluded[i] == 1,
-            expect.is_some(),
-            "ray {i}: any-hit disagrees"
-        );
     }
     assert!(
         hit_count > rays.len() / 10,

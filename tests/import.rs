@@ -2,23 +2,10 @@
 
 mod common;
 
-use common::{Gltf, Prim, penumbra};
+use common::{Gltf, Prim, penumbra, quad};
 use penumbra::scene::{LightKind, load};
 use serde_json::json;
 use std::path::Path;
-
-fn quad() -> Prim {
-    Prim::triangles(
-        vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [1.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-        ],
-        vec![0, 1, 2, 0, 2, 3],
-        0,
-    )
-}
 
 fn one_quad_scene() -> Gltf {
     let mut g = Gltf::default();
@@ -218,9 +205,14 @@ fn bad_files_fail_with_one_clear_line() {
     assert_clean_failure(&nan.write_glb(d, "nan"), "not finite");
 
     let mut req = one_quad_scene();
-    req.use_ext("EXT_meshopt_compression");
-    req.required.push("EXT_meshopt_compression".into());
-    assert_clean_failure(&req.write_glb(d, "meshopt"), "EXT_meshopt_compression");
+    req.use_ext("KHR_materials_pbrSpecularGlossiness");
+    req.required
+        .push("KHR_materials_pbrSpecularGlossiness".into());
+    assert_clean_failure(
+        &req.write_glb(d, "spec-gloss"),
+        "extensionsRequired[0]: requires the unsupported extension \
+         KHR_materials_pbrSpecularGlossiness",
+    );
 
     assert_clean_failure(&d.join("does-not-exist.glb"), "cannot read");
     let junk = d.join("junk.gltf");

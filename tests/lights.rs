@@ -109,7 +109,12 @@ fn spot_light_outside_its_cone_is_dark() {
         1.0,
     );
     g.nodes[2]["translation"] = json!([3.0, 1.0, 0.0]);
-    assert_eq!(mean_radiance(&g, "s2", &["--hard-shadows"]), 0.0);
+    // `--env none`: this scene's light lights nothing in view, which would otherwise bring in
+    // the default environment.
+    assert_eq!(
+        mean_radiance(&g, "s2", &["--hard-shadows", "--env", "none"]),
+        0.0
+    );
 }
 
 #[test]

@@ -83,7 +83,7 @@ def _flat_mesh(name, material, positions, triangles):
             "indices": list(range(len(pos)))}
 
 
-def bunny_scene(glb_path):
+def bunny_scene(glb_path, copies=1):
     gltf, bin_data = cornell_box.read_glb(glb_path)
     prim = gltf["meshes"][0]["primitives"][0]
     positions = cornell_box.read_accessor(gltf, bin_data, prim["attributes"]["POSITION"])
@@ -98,7 +98,12 @@ def bunny_scene(glb_path):
                                (-3.0, y0, 4.0)], (0, 1, 0))
     wall = cornell_box._quad([(-3.0, y0, -1.5), (3.0, y0, -1.5), (3.0, 4.0, -1.5),
                               (-3.0, 4.0, -1.5)], (0, 0, 1))
-    meshes = [_flat_mesh("Bunny", 0, positions, tris)]
+    # Copies side by side and behind (the 1 M-triangle scene: 7 copies), the first in place.
+    offsets = [(0.0, 0.0, 0.0), (-1.1, 0.0, -0.6), (1.1, 0.0, -0.6), (-2.0, 0.0, -1.0),
+               (2.0, 0.0, -1.0), (-0.55, 0.0, -1.2), (0.55, 0.0, -1.2)][:copies]
+    meshes = [_flat_mesh(f"Bunny{i}" if i else "Bunny", 0,
+                         [(p[0] + o[0], p[1] + o[1], p[2] + o[2]) for p in positions], tris)
+              for i, o in enumerate(offsets)]
     for name, mat, (p, n, i) in [("Floor", 1, cornell_box._merge([floor])),
                                  ("Wall", 2, cornell_box._merge([wall]))]:
         meshes.append({"name": name, "material": mat, "positions": p, "normals": n,
@@ -172,12 +177,28 @@ def compare(name, glb, msc, reference, args, results):
     print(f"== {name}: {glb}", file=sys.stderr)
     size, bounces = str(args.size), str(args.bounces)
     common = ["--width", size, "--height", size, "--bounces", bounces, "--hard-shadows",
-              "--device", args.device]
+              "--device", args.device] + (["--kernel", args.kernel] if args.kernel else [])
     # penumbra: time for S spp (kernels built before the clock starts), then the error curve.
     pen_render = run_penumbra(args.penumbra, ["render", glb, "-o",
                                               os.path.join(args.work, f"{name}-penumbra.exr"),
                                               "--spp", str(args.spp), "--no-russian-roulette"]
                               + common)
+    if args.timing_only:
+        _, compile_s = mitsuba_render(msc, 1, 10_000)
+        _, mit_same_spp = mitsuba_render(msc, args.spp, 77)
+        pixels = args.size * args.size
+        r = {"scene": name, "glb": glb, "size": args.size, "bounces": args.bounces,
+             "spp": args.spp, "triangles": pen_render["triangles"],
+             "penumbra_device": pen_render["device"], "penumbra_kernel": pen_render["kernel"],
+             "penumbra_seconds": pen_render["seconds"],
+             "penumbra_kernel_build_ms": pen_render["kernel_build_ms"],
+             "penumbra_samples_per_second": pen_render["samples_per_second"],
+             "mitsuba_seconds": mit_same_spp, "mitsuba_compile_seconds": compile_s,
+             "mitsuba_samples_per_second": pixels * args.spp / mit_same_spp}
+        results.append(r)
+        print(f"   penumbra {r['penumbra_seconds']:.3f} s, Mitsuba {mit_same_spp:.3f} s for "
+              f"{args.spp} spp", file=sys.stderr)
+        return
     pen_conv = run_penumbra(args.penumbra, ["bench", "converge", glb, "--reference", reference,
                                             "--configs", "mis", "--spp", str(args.max_spp),
                                             "--json"] + common)
@@ -236,6 +257,10 @@ def main(argv=None):
     ap.add_argument("--work", default=os.path.join(ROOT, "target", "peers"),
                     help="scratch folder (scenes, cached references)")
     ap.add_argument("--json", default=None, help="write the raw figures here")
+    ap.add_argument("--timing-only", action="store_true",
+                    help="only the time for the same spp (no error curves, no references)")
+    ap.add_argument("--kernel", default=None,
+                    help="penumbra --kernel (wavefront, megakernel; default: penumbra's auto)")
     args = ap.parse_args(argv)
     os.makedirs(args.work, exist_ok=True)
     if not os.path.exists(args.penumbra):
@@ -251,30 +276,30 @@ def main(argv=None):
                                 twosided=False)
             if not os.path.exists(reference):
                 reference = os.path.join(args.work, f"cornell-mitsuba-{args.size}.exr")
-                if not os.path.exists(reference):
+                if not os.path.exists(reference) and not args.timing_only:
                     print(f"rendering {reference}", file=sys.stderr)
                     mi.Bitmap(mitsuba_reference_image(msc, args.ref_spp, 1000, 256)).write(
                         reference)
-        elif name == "bunny":
+        elif name in ("bunny", "bunnies"):
             scenes = os.environ.get("PENUMBRA_SCENES")
             src = os.path.join(scenes or "", "StanfordBunny", "bunny.glb")
             if not scenes or not os.path.exists(src):
                 sys.exit("bunny: set PENUMBRA_SCENES to the folder holding StanfordBunny/")
-            sc = bunny_scene(src)
-            glb = os.path.join(args.work, "bunny-lambert.glb")
+            sc = bunny_scene(src, 7 if name == "bunnies" else 1)
+            glb = os.path.join(args.work, f"{name}-lambert.glb")
             cornell_box.write_glb(glb, *cornell_box.build_gltf(sc))
             msc = mitsuba_scene(sc, args.size, args.size, args.bounces, twosided=True)
             reference = os.path.join(args.work,
                                      f"bunny-mitsuba-{args.size}-{args.bounces}-"
                                      f"{args.ref_spp}.exr")
-            if not os.path.exists(reference):
+            if not os.path.exists(reference) and not args.timing_only:
                 print(f"rendering {reference} ({args.ref_spp} spp)", file=sys.stderr)
                 t = time.perf_counter()
                 mi.Bitmap(mitsuba_reference_image(msc, args.ref_spp, 1000, 256)).write(
                     reference)
                 print(f"   {time.perf_counter() - t:.0f} s", file=sys.stderr)
         else:
-            sys.exit(f"unknown scene '{name}' (cornell, bunny)")
+            sys.exit(f"unknown scene '{name}' (cornell, bunny, bunnies)")
         compare(name, glb, msc, reference, args, results)
 
     cpu = platform.processor() or platform.machine()
@@ -289,6 +314,18 @@ def main(argv=None):
           f"{args.size}x{args.size}, {args.bounces} bounces (max_depth {args.bounces + 2}), "
           f"no Russian roulette, hard shadows, MIS")
     print()
+    if args.timing_only:
+        print("| scene | triangles | spp | penumbra s | Mitsuba s (compile) | penumbra M samples/s "
+              "| Mitsuba M samples/s | penumbra / Mitsuba |")
+        print("|---|---|---|---|---|---|---|---|")
+        for r in results:
+            print(f"| {r['scene']} | {r['triangles']:,} | {r['spp']} "
+                  f"| {r['penumbra_seconds']:.3f} "
+                  f"| {r['mitsuba_seconds']:.3f} ({r['mitsuba_compile_seconds']:.1f}) "
+                  f"| {r['penumbra_samples_per_second'] / 1e6:.2f} "
+                  f"| {r['mitsuba_samples_per_second'] / 1e6:.2f} "
+                  f"| {r['penumbra_samples_per_second'] / r['mitsuba_samples_per_second']:.2f}× |")
+        return 0
     print("| scene | triangles | spp | penumbra s | Mitsuba s (compile) | penumbra M samples/s "
           "| Mitsuba M samples/s | target relMSE | penumbra s to target | Mitsuba s to target "
           "| penumbra slope |")

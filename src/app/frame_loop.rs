@@ -8,7 +8,7 @@
 use super::budget::{Budget, Plan, pixel_count, scaled};
 use crate::cl::ClError;
 use crate::render::{RenderSettings, RenderStats, Renderer, SceneStats};
-use crate::scene::{Camera, Light, Scene};
+use crate::scene::{Camera, Light, RenderFrame, Scene};
 use std::time::Instant;
 
 /// The budget of one batch of kernel work in milliseconds.
@@ -125,6 +125,11 @@ pub struct FrameLoop {
 }
 
 impl FrameLoop {
+    /// Whether the next step loads the first scene, which builds the kernels.
+    pub fn first_load(&self) -> bool {
+        !self.loaded
+    }
+
     /// A loop around `renderer` that will load everything on its first step.
     pub fn new(renderer: Renderer) -> Self {
         Self {
@@ -249,8 +254,23 @@ impl FrameLoop {
             // The camera's aspect follows the film.
             pending.camera = true;
         }
-        if pending.scene || !self.loaded {
-            self.scene_stats = Some(self.renderer.load_scene(world.scene, world.lights)?);
+        // Rebase the render space around the eye when the camera travelled far from its origin.
+        let far = self.loaded && self.renderer.space().is_far(world.camera.eye);
+        if pending.scene || !self.loaded || far {
+            let mut space = RenderFrame::around(&world.scene.bounds());
+            if far || space.is_far(world.camera.eye) {
+                space = RenderFrame::new(&world.scene.bounds(), world.camera.eye);
+            }
+            let stats = self
+                .renderer
+                .load_scene_in(world.scene, world.lights, space)?;
+            if stats.dropped_triangles > 0 && !self.loaded {
+                log::warn!(
+                    "{} triangles with a non-finite or absurd vertex dropped",
+                    stats.dropped_triangles
+                );
+            }
+            self.scene_stats = Some(stats);
             self.loaded = true;
         } else if pending.lights {
             self.renderer.set_lights(world.lights)?;

@@ -6,8 +6,9 @@ use super::camera::{CameraController, Mode};
 use super::frame_loop::{Changes, Film, Progress};
 use super::state::ViewState;
 use crate::render::SceneStats;
+use crate::render::exposure::AutoExposure;
 use crate::render::tonemap::ToneMapper;
-use crate::scene::{LightPreset, Scene};
+use crate::scene::{EnvPreset, LightPreset, Scene};
 use egui::{Color32, RichText, Ui};
 use glam::{DMat4, DQuat, DVec3, EulerRot};
 use std::path::PathBuf;
@@ -70,10 +71,33 @@ pub struct Actions {
     pub screenshot: bool,
     /// Open this file.
     pub open: Option<PathBuf>,
-    /// Load this environment map (`Some(None)`: remove it).
-    pub environment: Option<Option<PathBuf>>,
+    /// Switch to this environment.
+    pub environment: Option<EnvSource>,
     /// Hide the overlay.
     pub hide_overlay: bool,
+}
+
+/// A line in the middle of the window (e.g. while the kernels build).
+pub fn notice(ctx: &egui::Context, text: &str) {
+    egui::Area::new(egui::Id::new("notice"))
+        .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+        .interactable(false)
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.label(RichText::new(text).size(18.0).color(Color32::WHITE));
+            });
+        });
+}
+
+/// An environment the overlay asks for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvSource {
+    /// No environment map (the uniform sky, black by default).
+    None,
+    /// A bundled one.
+    Preset(EnvPreset),
+    /// An .hdr or .exr file.
+    File(PathBuf),
 }
 
 /// The selected object's transform as the overlay edits it.
@@ -120,13 +144,14 @@ pub struct Gui {
     pub env_text: String,
     /// The last error about an environment map.
     pub env_error: Option<String>,
-    /// Whether an environment map is loaded (shows its controls).
-    pub env_loaded: bool,
+    /// The loaded environment map's name (`studio`, `outdoor` or the file's), if any; shows
+    /// its controls.
+    pub env_name: Option<String>,
 }
 
 impl Gui {
-    /// The overlay with `path` in its file field; `env_loaded` when an environment map is on.
-    pub fn new(path: String, env_loaded: bool) -> Self {
+    /// The overlay with `path` in its file field and the environment map `env_name` on.
+    pub fn new(path: String, env_name: Option<String>) -> Self {
         Self {
             path_text: path,
             preset: LightPreset::ThreePointStudio,
@@ -134,7 +159,7 @@ impl Gui {
             file_error: None,
             env_text: String::new(),
             env_error: None,
-            env_loaded,
+            env_name,
         }
     }
 
@@ -250,6 +275,19 @@ impl Gui {
                 });
                 ui.horizontal(|ui| {
                     ui.label("environment");
+                    for p in EnvPreset::ALL {
+                        let on = self.env_name.as_deref() == Some(p.name());
+                        if ui.selectable_label(on, p.name()).clicked() && !on {
+                            actions.environment = Some(EnvSource::Preset(p));
+                        }
+                    }
+                    let none = self.env_name.is_none();
+                    if ui.selectable_label(none, "none").clicked() && !none {
+                        actions.environment = Some(EnvSource::None);
+                    }
+                });
+                ui.horizontal(|ui| {
+                    ui.label("file");
                     let field = ui.add(
                         egui::TextEdit::singleline(&mut self.env_text)
                             .hint_text("sky.hdr / .exr")
@@ -262,17 +300,14 @@ impl Gui {
                         if path.is_empty() {
                             self.env_error = Some("type a .hdr or .exr path first".into());
                         } else {
-                            actions.environment = Some(Some(PathBuf::from(path)));
+                            actions.environment = Some(EnvSource::File(PathBuf::from(path)));
                         }
-                    }
-                    if self.env_loaded && ui.button("Remove").clicked() {
-                        actions.environment = Some(None);
                     }
                 });
                 if let Some(e) = &self.env_error {
                     ui.label(RichText::new(e).color(Color32::LIGHT_RED));
                 }
-                if self.env_loaded {
+                if self.env_name.is_some() {
                     ui.horizontal(|ui| {
                         let i = ui.add(
                             egui::DragValue::new(&mut v.env_intensity)
@@ -289,7 +324,18 @@ impl Gui {
                         }
                     });
                 }
-                ui.add(egui::Slider::new(&mut v.exposure, -10.0..=10.0).text("exposure (stops)"));
+                ui.horizontal(|ui| {
+                    let mut auto = v.auto_exposure.is_some();
+                    if ui.checkbox(&mut auto, "auto").changed() {
+                        v.auto_exposure = auto.then(AutoExposure::default);
+                    }
+                    let s = ui.add(
+                        egui::Slider::new(&mut v.exposure, -24.0..=24.0).text("exposure (stops)"),
+                    );
+                    if s.changed() {
+                        v.auto_exposure = None;
+                    }
+                });
                 egui::ComboBox::from_label("tone mapper")
                     .selected_text(v.tone_mapper.name())
                     .show_ui(ui, |ui| {

@@ -163,8 +163,13 @@ impl App {
             return;
         };
         let (w, h) = (self.size.0 as f32, self.size.1 as f32);
-        let ray = pick::primary_ray(&self.model.camera.camera, w / h, x as f32 / w, y as f32 / h);
-        let hit = pick::pick(host, &ray);
+        let hit = pick::pick(
+            host,
+            &self.model.camera.camera,
+            w / h,
+            x as f32 / w,
+            y as f32 / h,
+        );
         log::debug!("pick at ({x:.0}, {y:.0}): {hit:?}");
         match hit {
             Some(hit) => {

@@ -200,7 +200,7 @@ fn light_editor(ui: &mut Ui, l: &mut RigLight, radius: f32, hard: bool, size: f6
             )
             .changed();
         if edited {
-            light.radius = r;
+            light.light_radius = r;
             l.follows_light_radius = false;
             changed = true;
         }

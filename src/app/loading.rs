@@ -4,7 +4,7 @@
 
 use super::camera::CameraController;
 use super::frame_loop::Changes;
-use super::gui::Model;
+use super::gui::{EnvSource, Model};
 use super::{App, pick};
 use crate::scene::{Scene, SceneError};
 use std::path::PathBuf;
@@ -22,21 +22,26 @@ pub(super) struct Loader {
 }
 
 impl App {
-    /// Loads (or with `None` removes) the environment map; an error stays in the overlay and
-    /// the current environment is kept.
-    pub(super) fn set_environment(&mut self, path: Option<PathBuf>) {
-        let map = match path.as_deref().map(crate::scene::EnvMap::load).transpose() {
+    /// Switches the environment map (a bundled one, a file, or none); an error stays in the
+    /// overlay and the current environment is kept.
+    pub(super) fn set_environment(&mut self, source: EnvSource) {
+        let map = match source {
+            EnvSource::None => Ok(None),
+            EnvSource::Preset(p) => Ok(Some(p.load())),
+            EnvSource::File(path) => crate::scene::EnvMap::load(&path).map(Some),
+        };
+        let map = match map {
             Ok(map) => map,
             Err(e) => {
                 self.gui.env_error = Some(e);
                 return;
             }
         };
-        let loaded = map.is_some();
+        let name = map.as_ref().map(|m| m.name.clone());
         match self.frame_loop.renderer.set_environment(map) {
             Ok(()) => {
                 self.gui.env_error = None;
-                self.gui.env_loaded = loaded;
+                self.gui.env_name = name;
                 self.frame_loop.invalidate(Changes {
                     settings: true,
                     ..Changes::default()
@@ -76,12 +81,13 @@ impl App {
         self.loader = None;
         match result {
             Ok((mut scene, ms)) => {
-                if self.env_lights && scene.default_rig {
-                    // The environment lights the scene instead of the default rig.
-                    scene.lights.clear();
-                    scene.default_rig = false;
+                if self.env_lights {
+                    scene.light_by_environment();
                 }
                 self.autofocus = self.model.view.aperture > 0.0;
+                if let Some(auto) = self.model.view.auto_exposure.as_mut() {
+                    auto.reset();
+                }
                 for w in &scene.warnings {
                     log::warn!("{}: {w}", scene.source);
                 }
@@ -115,8 +121,7 @@ impl App {
         };
         self.autofocus = false;
         let aspect = self.size.0 as f32 / self.size.1.max(1) as f32;
-        let ray = pick::primary_ray(&self.model.camera.camera, aspect, 0.5, 0.5);
-        if let Some(hit) = pick::pick(host, &ray) {
+        if let Some(hit) = pick::pick(host, &self.model.camera.camera, aspect, 0.5, 0.5) {
             self.focus_at(hit.point);
         }
     }

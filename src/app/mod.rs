@@ -15,6 +15,7 @@ mod screenshot;
 mod state;
 
 use crate::cl::DeviceChoice;
+use crate::render::exposure::{ExposureMode, meter};
 use crate::render::tonemap::{ToneMapper, to_rgba8};
 use crate::render::{RenderSettings, Renderer};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows};
@@ -87,11 +88,15 @@ pub struct ViewerConfig {
     pub spp_target: Option<u32>,
     /// The OpenCL device.
     pub device: DeviceChoice,
+    /// The kernels (`--kernel`).
+    pub kernel: crate::render::KernelChoice,
     /// The environment map, if one lights the scene.
     pub env_map: Option<EnvMap>,
     /// An environment (map or color) lights the scene: files opened later without lights get
     /// no default rig.
     pub env_lights: bool,
+    /// How the exposure is chosen: metered on the film, or fixed.
+    pub exposure: ExposureMode,
     /// Focus the lens on what the image centre sees once the scene is on the device (a lens
     /// without a focus distance).
     pub autofocus: bool,
@@ -128,7 +133,8 @@ pub fn run(config: ViewerConfig) -> Result<()> {
     })?;
     let mut renderer = Renderer::new(&config.device)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
-    let env_loaded = config.env_map.is_some();
+    renderer.set_kernel(config.kernel)?;
+    let env_name = config.env_map.as_ref().map(|m| m.name.clone());
     if let Some(map) = config.env_map {
         renderer
             .set_environment(Some(map))
@@ -139,6 +145,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         config.settings,
         config.spp_target,
         config.shadows,
+        config.exposure,
         &config.lights,
         bounds,
     );
@@ -154,7 +161,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         frame_loop: FrameLoop::new(renderer),
         lights: view.lights(),
         model: Model::new(config.scene, view, camera),
-        gui: Gui::new(path_text, env_loaded),
+        gui: Gui::new(path_text, env_name),
         load_ms: config.load_ms,
         frames_limit: config.frames,
         screenshot_on_exit: config.screenshot,
@@ -177,6 +184,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         quit: false,
         autofocus: config.autofocus,
         env_lights: config.env_lights,
+        notice_frames: 0,
     };
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.fatal.take() {
@@ -266,6 +274,9 @@ struct App {
     autofocus: bool,
     /// `--env` lights the scene: files without lights get no default rig.
     env_lights: bool,
+    /// Frames saying "Compiling kernels…" shown before the first scene's (blocking) upload and
+    /// kernel build: egui lays a new area out unseen in its first frame, so it takes two.
+    notice_frames: u8,
 }
 
 impl ApplicationHandler for App {
@@ -483,8 +494,16 @@ impl App {
         let screenshot = actions.screenshot;
         self.apply(actions, now);
 
-        // Collect a finished batch and start the next one before showing this image.
-        let new_image = self.step_frame_loop(now);
+        // Collect a finished batch and start the next one before showing this image. The first
+        // step builds the kernels and blocks for seconds with a cold cache: show a frame that
+        // says so first.
+        let new_image = if self.frame_loop.first_load() && self.notice_frames < 2 {
+            self.notice_frames += 1;
+            self.wake = Some(now);
+            false
+        } else {
+            self.step_frame_loop(now)
+        };
         self.autofocus_once();
         self.update_display(new_image);
         if new_image {
@@ -518,9 +537,13 @@ impl App {
         };
         let mut actions = gui::Actions::default();
         let (overlay, gui, model) = (self.overlay, &mut self.gui, &mut self.model);
+        let compiling = self.frame_loop.first_load() && self.device_error.is_none();
         let repaint = gfx.framework.prepare(&gfx.window, |ui| {
             if overlay {
                 actions = gui.ui(ui, model, &info);
+            }
+            if compiling {
+                gui::notice(ui.ctx(), "Compiling kernels…");
             }
         });
         self.wake = now.checked_add(repaint);
@@ -610,8 +633,9 @@ impl App {
             event_loop.exit();
         }
         if let Some(limit) = self.frames_limit {
+            // The "Compiling kernels…" frame before the first load renders nothing.
             let target_reached = self.device_error.is_some()
-                || self.model.view.spp_target.is_none()
+                || self.model.view.spp_target.is_none() && !self.frame_loop.first_load()
                 || self.frame_loop.converged(self.model.view.spp_target);
             if self.frames >= limit && target_reached {
                 event_loop.exit();
@@ -628,6 +652,9 @@ impl App {
         let film = &self.frame_loop.film;
         if film.pixels.is_empty() {
             return;
+        }
+        if new_image && let Some(auto) = self.model.view.auto_exposure.as_mut() {
+            self.model.view.exposure = auto.update(meter(&film.pixels).as_ref());
         }
         let v = &self.model.view;
         let key = (v.exposure, v.tone_mapper, film.spp, film.pixels.len());

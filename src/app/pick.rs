@@ -1,7 +1,7 @@
 //! Picking: the object under the mouse, found by casting the pixel's primary ray through the
 //! host BVH (the same one the device traverses).
 
-use crate::bvh::Ray;
+use crate::render::camera::primary_ray;
 use crate::render::{HostScene, gpu_camera};
 use crate::scene::Camera;
 use glam::DVec3;
@@ -15,19 +15,16 @@ pub struct Pick {
     pub point: DVec3,
 }
 
-/// The primary ray through the point (fx, fy) of the image, both in [0, 1] from the top left,
-/// as the camera kernel makes it (without jitter and lens).
-pub fn primary_ray(camera: &Camera, aspect: f32, fx: f32, fy: f32) -> Ray {
-    crate::render::camera::primary_ray(&gpu_camera(camera, aspect), fx, fy)
-}
-
-/// The object the ray hits first, if any.
-pub fn pick(host: &HostScene, ray: &Ray) -> Option<Pick> {
-    let hit = host.bvh.intersect(ray, &host.vertices)?;
+/// The object seen through the point (fx, fy) of the image, both in [0, 1] from the top left,
+/// along the primary ray the camera kernel makes (without jitter and lens), cast in the
+/// scene's render space.
+pub fn pick(host: &HostScene, camera: &Camera, aspect: f32, fx: f32, fy: f32) -> Option<Pick> {
+    let ray = primary_ray(&gpu_camera(&host.space.camera(camera), aspect), fx, fy);
+    let hit = host.bvh.intersect(&ray, &host.vertices)?;
     let point = ray.origin + ray.direction * hit.t;
     Some(Pick {
         object: host.object_of(hit.prim) as usize,
-        point: point.as_dvec3(),
+        point: host.space.world_point(point),
     })
 }
 
@@ -84,14 +81,14 @@ mod tests {
         let aspect = 1.0;
         let half = (cam.yfov * 0.5).tan() as f32 * 5.0;
         let fx = |x: f32| 0.5 + 0.5 * x / half;
-        let left = pick(&host, &primary_ray(&cam, aspect, fx(-2.0), 0.5)).unwrap();
+        let left = pick(&host, &cam, aspect, fx(-2.0), 0.5).unwrap();
         assert_eq!(left.object, 0);
         assert!((left.point - DVec3::new(-2.0, 0.0, 0.0)).length() < 1e-3);
         // The hidden quad in front of the right one is not in the BVH.
-        let right = pick(&host, &primary_ray(&cam, aspect, fx(2.0), 0.5)).unwrap();
+        let right = pick(&host, &cam, aspect, fx(2.0), 0.5).unwrap();
         assert_eq!(right.object, 1);
-        assert!(pick(&host, &primary_ray(&cam, aspect, 0.5, 0.5)).is_none());
+        assert!(pick(&host, &cam, aspect, 0.5, 0.5).is_none());
         // The top of the image looks up.
-        assert!(pick(&host, &primary_ray(&cam, aspect, fx(2.0), 0.0)).is_none());
+        assert!(pick(&host, &cam, aspect, fx(2.0), 0.0).is_none());
     }
 }

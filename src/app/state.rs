@@ -2,6 +2,7 @@
 //! with its light radius, exposure and tone mapping.
 
 use crate::render::RenderSettings;
+use crate::render::exposure::{AutoExposure, ExposureMode};
 use crate::render::tonemap::ToneMapper;
 use crate::scene::{
     Bounds, Light, LightKind, LightPreset, Shadows, default_light_radius, preset_lights,
@@ -77,6 +78,8 @@ pub struct ViewState {
     pub shadows: Shadows,
     /// Exposure in stops.
     pub exposure: f32,
+    /// Automatic exposure (metered on the film) while set; the slider turns it off.
+    pub auto_exposure: Option<AutoExposure>,
     /// Tone curve.
     pub tone_mapper: ToneMapper,
     /// The lights: the scene's, presets' and the user's.
@@ -88,12 +91,13 @@ pub struct ViewState {
 }
 
 impl ViewState {
-    /// The state the command line asks for (`base` is its validated render settings) on a
-    /// scene with `lights` and `bounds`.
+    /// The state the command line asks for (`base` is its validated render settings, `exposure`
+    /// automatic, manual or EV100) on a scene with `lights` and `bounds`.
     pub fn new(
         base: RenderSettings,
         spp_target: Option<u32>,
         shadows: Shadows,
+        exposure: ExposureMode,
         lights: &[Light],
         bounds: Bounds,
     ) -> Self {
@@ -107,7 +111,8 @@ impl ViewState {
             focus_distance: base.focus_distance,
             spp_target,
             shadows,
-            exposure: 0.0,
+            exposure: exposure.stops(None),
+            auto_exposure: (exposure == ExposureMode::Auto).then(AutoExposure::default),
             tone_mapper: ToneMapper::default(),
             rig: Vec::new(),
             bounds,
@@ -162,7 +167,7 @@ impl ViewState {
         } else if self.shadows.hard {
             0.0
         } else {
-            l.light.radius
+            l.light.light_radius
         }
     }
 
@@ -172,7 +177,7 @@ impl ViewState {
             .iter()
             .filter(|l| l.enabled)
             .map(|l| Light {
-                radius: self.effective_radius(l),
+                light_radius: self.effective_radius(l),
                 ..l.light.clone()
             })
             .collect()
@@ -215,7 +220,7 @@ impl ViewState {
                 },
                 color: [1.0; 3],
                 intensity: intensity as f32,
-                radius: radius as f32,
+                light_radius: radius as f32,
             },
             enabled: true,
             follows_light_radius: follows,
@@ -248,22 +253,32 @@ impl ViewState {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::args::CommonArgs;
     use clap::Parser;
 
     fn state(extra: &[&str], lights: &[Light]) -> ViewState {
         let a = args(extra);
         let base = a.settings((64, 64)).unwrap();
-        let shadows = Shadows::new(a.light_radius, a.hard_shadows, &bounds());
-        ViewState::new(base, a.spp, shadows, lights, bounds())
+        let shadows = Shadows::new(a.shadows.light_radius, a.shadows.hard_shadows, &bounds());
+        ViewState::new(
+            base,
+            a.sampling.spp,
+            shadows,
+            a.exposure_mode(),
+            lights,
+            bounds(),
+        )
     }
 
-    fn args(extra: &[&str]) -> crate::cli::CommonArgs {
-        let mut argv = vec!["penumbra", "view"];
-        argv.extend_from_slice(extra);
-        match crate::cli::Cli::parse_from(argv).command {
-            Some(crate::cli::Command::View(v)) => v.common,
-            _ => panic!("not a view command"),
+    fn args(extra: &[&str]) -> CommonArgs {
+        #[derive(Parser)]
+        struct View {
+            #[command(flatten)]
+            common: CommonArgs,
         }
+        let mut argv = vec!["penumbra"];
+        argv.extend_from_slice(extra);
+        View::parse_from(argv).common
     }
 
     fn bounds() -> Bounds {
@@ -281,7 +296,7 @@ mod tests {
             direction: DVec3::NEG_Y,
             color: [1.0; 3],
             intensity: 5.0,
-            radius: 0.0,
+            light_radius: 0.0,
         }
     }
 
@@ -338,10 +353,10 @@ mod tests {
         let s = state(&[], &[point(), sun()]);
         assert_eq!(s.shadows.light_radius, default_light_radius(&bounds()));
         let lights = s.lights();
-        assert_eq!(lights[0].radius, s.shadows.light_radius);
+        assert_eq!(lights[0].light_radius, s.shadows.light_radius);
         // The sun gets the matching angular radius.
         let angular = 2.0 * s.shadows.light_radius as f64 / bounds().diagonal();
-        assert!((lights[1].radius as f64 - angular).abs() < 1e-6);
+        assert!((lights[1].light_radius as f64 - angular).abs() < 1e-6);
     }
 
     #[test]
@@ -349,27 +364,27 @@ mod tests {
         let mut s = state(&["--light-radius", "0.1"], &[point()]);
         s.add_light(NewLight::Sphere);
         let soft = s.lights();
-        assert_eq!(soft[0].radius, 0.1);
-        assert!(soft[1].radius > 0.0);
+        assert_eq!(soft[0].light_radius, 0.1);
+        assert!(soft[1].light_radius > 0.0);
         s.toggle_hard_shadows();
-        assert!(s.lights().iter().all(|l| l.radius == 0.0));
+        assert!(s.lights().iter().all(|l| l.light_radius == 0.0));
         s.toggle_hard_shadows();
         assert_eq!(s.lights(), soft);
         // --hard-shadows starts hard but keeps the default light radius for the toggle.
         let mut h = state(&["--hard-shadows"], &[point()]);
-        assert_eq!(h.lights()[0].radius, 0.0);
+        assert_eq!(h.lights()[0].light_radius, 0.0);
         h.toggle_hard_shadows();
-        assert_eq!(h.lights()[0].radius, default_light_radius(&bounds()));
+        assert_eq!(h.lights()[0].light_radius, default_light_radius(&bounds()));
     }
 
     #[test]
     fn the_light_radius_follows_the_slider_unless_set_by_hand() {
         let mut s = state(&[], &[point(), point()]);
         s.rig[1].follows_light_radius = false;
-        s.rig[1].light.radius = 0.3;
+        s.rig[1].light.light_radius = 0.3;
         s.shadows.light_radius = 0.05;
         let l = s.lights();
-        assert_eq!((l[0].radius, l[1].radius), (0.05, 0.3));
+        assert_eq!((l[0].light_radius, l[1].light_radius), (0.05, 0.3));
     }
 
     #[test]
@@ -382,7 +397,7 @@ mod tests {
         s.apply_preset(LightPreset::OverheadSoftbox, true);
         assert_eq!(s.rig.len(), 1);
         // The softbox keeps its large radius.
-        assert!(s.lights()[0].radius > s.shadows.light_radius);
+        assert!(s.lights()[0].light_radius > s.shadows.light_radius);
         for kind in NewLight::ALL {
             s.add_light(kind);
         }

@@ -1,183 +1,489 @@
-//! Binned SAH build (multi-threaded with rayon) and flattening into the GPU node layout.
+//! Binned SAH build and its output in the GPU node layout.
+//!
+//! The builder works on a compact array of primitive boxes (32 bytes a triangle, no allocation
+//! per triangle). Large nodes at the top of the tree bin and partition their primitives in
+//! parallel (rayon chunks, binned per chunk and reduced; partitioned per chunk and the misplaced
+//! runs swapped in parallel), so the top levels scale with cores; below that every subtree is a
+//! task that writes its nodes straight into the final layout. The layout is depth first with the
+//! two children of a node either leaves or next to each other: node 0 is the root, a node's
+//! interior children come after it, and each subtree (less its root) is contiguous.
 
 use super::{Aabb, Bvh};
 use crate::cl::types::GpuBvhNode;
-use glam::Vec3;
+use glam::{Vec3, Vec4};
+use rayon::prelude::*;
 
 /// Number of bins per axis.
 const BINS: usize = 16;
 /// Largest leaf the SAH may choose.
 const MAX_LEAF: usize = 8;
 /// Relative cost of one traversal step against one triangle test.
-const TRAVERSAL_COST: f32 = 1.0;
+pub(super) const TRAVERSAL_COST: f32 = 1.0;
 /// Deepest leaf the builder makes. The kernels' stack holds 64 entries and a traversal pushes
 /// at most one entry per level, so the stack cannot overflow; deeper subtrees become leaves.
 pub const MAX_DEPTH: u32 = 48;
 /// Subtrees with more primitives than this are built on another rayon task.
 const PARALLEL_THRESHOLD: usize = 4096;
+/// Nodes with at least this many primitives bin and partition them in parallel chunks. Smaller
+/// nodes use the serial partition, whose order the trees of small scenes have always had.
+const PARALLEL_SPLIT_THRESHOLD: usize = 1 << 16;
+/// Smallest chunk of a parallel binning or partition.
+const MIN_CHUNK: usize = 1 << 14;
 
-enum BuildNode {
+/// A primitive's box: `min.w` holds the triangle index (u32 bits), `max.w` is unused.
+#[derive(Clone, Copy)]
+struct Prim {
+    min: Vec4,
+    max: Vec4,
+}
+
+impl Prim {
+    /// Primitive `index` with box `b` (the index rides in `min.w`).
+    fn new(index: usize, b: Aabb) -> Self {
+        Prim {
+            min: b.min.extend(f32::from_bits(index as u32)),
+            max: b.max.extend(0.0),
+        }
+    }
+
+    /// The box centre (`.w` = 0). Computed on three lanes: the index in `min.w` is a denormal
+    /// float, and SIMD arithmetic on denormals is many times slower.
+    fn centroid(&self) -> Vec4 {
+        ((self.min.truncate() + self.max.truncate()) * 0.5).extend(0.0)
+    }
+
+    fn index(&self) -> u32 {
+        self.min.w.to_bits()
+    }
+}
+
+/// A box in SIMD lanes (`.w` ignored).
+#[derive(Clone, Copy)]
+struct Bounds4 {
+    min: Vec4,
+    max: Vec4,
+}
+
+impl Bounds4 {
+    const EMPTY: Bounds4 = Bounds4 {
+        min: Vec4::splat(f32::INFINITY),
+        max: Vec4::splat(f32::NEG_INFINITY),
+    };
+
+    fn grow(&mut self, min: Vec4, max: Vec4) {
+        self.min = self.min.min(min);
+        self.max = self.max.max(max);
+    }
+
+    fn union(self, o: Bounds4) -> Bounds4 {
+        Bounds4 {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+
+    fn aabb(self) -> Aabb {
+        Aabb {
+            min: self.min.truncate(),
+            max: self.max.truncate(),
+        }
+    }
+}
+
+/// What the builder knows about a node before splitting it: the box of its primitives and the
+/// box of their centroids.
+#[derive(Clone, Copy)]
+struct NodeInfo {
+    bounds: Bounds4,
+    centroids: Bounds4,
+}
+
+impl NodeInfo {
+    const EMPTY: NodeInfo = NodeInfo {
+        bounds: Bounds4::EMPTY,
+        centroids: Bounds4::EMPTY,
+    };
+
+    fn add(&mut self, p: &Prim) {
+        self.bounds.grow(p.min, p.max);
+        let c = p.centroid();
+        self.centroids.grow(c, c);
+    }
+
+    fn union(self, o: NodeInfo) -> NodeInfo {
+        NodeInfo {
+            bounds: self.bounds.union(o.bounds),
+            centroids: self.centroids.union(o.centroids),
+        }
+    }
+
+    fn of(prims: &[Prim]) -> NodeInfo {
+        let fold = |prims: &[Prim]| {
+            prims.iter().fold(NodeInfo::EMPTY, |mut i, p| {
+                i.add(p);
+                i
+            })
+        };
+        if prims.len() >= PARALLEL_SPLIT_THRESHOLD {
+            prims
+                .par_chunks(MIN_CHUNK)
+                .map(fold)
+                .reduce(|| NodeInfo::EMPTY, NodeInfo::union)
+        } else {
+            fold(prims)
+        }
+    }
+}
+
+/// A decided split: the first `at` primitives go left.
+struct Split {
+    at: usize,
+    left: NodeInfo,
+    right: NodeInfo,
+}
+
+/// Builds a BVH over triangles given as three vertices each.
+pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
+    build_prims(
+        triangles
+            .par_iter()
+            .enumerate()
+            .map(|(i, t)| Prim::new(i, Aabb::EMPTY.grow(t[0]).grow(t[1]).grow(t[2])))
+            .collect(),
+    )
+}
+
+/// Builds a BVH over boxes (the instances of a top-level tree); `tri_indices` then index
+/// `boxes`.
+pub fn build_boxes(boxes: &[Aabb]) -> Bvh {
+    build_prims(
+        boxes
+            .par_iter()
+            .enumerate()
+            .map(|(i, &b)| Prim::new(i, b))
+            .collect(),
+    )
+}
+
+fn build_prims(mut prims: Vec<Prim>) -> Bvh {
+    let info = NodeInfo::of(&prims);
+    let root = build_subtree(&mut prims, 0, 0, info);
+    let tri_indices = prims.par_iter().map(Prim::index).collect();
+    drop(prims);
+    let nodes = match root {
+        Built::Tree { nodes, .. } => nodes,
+        Built::Top { .. } => {
+            let mut nodes = Vec::with_capacity(root.node_count());
+            nodes.push(GpuBvhNode::default());
+            assemble(root, 0, &mut nodes);
+            nodes
+        }
+        Built::Leaf {
+            bounds,
+            first,
+            count,
+        } => {
+            // A root that is a leaf still needs a node: the leaf goes left, an empty leaf right.
+            let mut node = GpuBvhNode::default();
+            write_leaf(&mut node, 0, bounds, first, count);
+            write_leaf(&mut node, 1, Aabb::EMPTY, 0, 0);
+            vec![node]
+        }
+    };
+    let mut bvh = Bvh {
+        nodes,
+        tri_indices,
+        sah_cost: 0.0,
+        built_sah_cost: 0.0,
+        depth: 0,
+    };
+    let (sah_cost, depth) = bvh.sah_and_depth();
+    bvh.sah_cost = sah_cost;
+    bvh.built_sah_cost = sah_cost;
+    bvh.depth = depth;
+    bvh
+}
+
+/// A subtree as a task returns it.
+enum Built {
+    /// A leaf: triangles `first..first + count` in BVH order.
     Leaf {
         bounds: Aabb,
         first: u32,
         count: u32,
     },
-    Interior {
+    /// A subtree built by one task, in the final layout with its root at index 0.
+    Tree {
         bounds: Aabb,
-        children: Box<[BuildNode; 2]>,
+        nodes: Vec<GpuBvhNode>,
+    },
+    /// A node split on the parallel levels.
+    Top {
+        bounds: Aabb,
+        children: Box<[Built; 2]>,
     },
 }
 
-impl BuildNode {
+impl Built {
     fn bounds(&self) -> Aabb {
         match self {
-            BuildNode::Leaf { bounds, .. } | BuildNode::Interior { bounds, .. } => *bounds,
-        }
-    }
-}
-
-#[derive(Clone, Copy)]
-struct Prim {
-    bounds: Aabb,
-    centroid: Vec3,
-    index: u32,
-}
-
-/// Builds a BVH over triangles given as three vertices each.
-pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
-    use rayon::prelude::*;
-    let mut prims: Vec<Prim> = triangles
-        .par_iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let bounds = Aabb::EMPTY.grow(t[0]).grow(t[1]).grow(t[2]);
-            Prim {
-                bounds,
-                centroid: (bounds.min + bounds.max) * 0.5,
-                index: i as u32,
+            Built::Leaf { bounds, .. } | Built::Tree { bounds, .. } | Built::Top { bounds, .. } => {
+                *bounds
             }
-        })
-        .collect();
-    let root = build_node(&mut prims, 0, 0);
-    let tri_indices = prims.iter().map(|p| p.index).collect();
-    let mut bvh = Bvh {
-        nodes: Vec::with_capacity(triangles.len().max(1)),
-        tri_indices,
-        sah_cost: 0.0,
-        depth: 0,
-    };
-    let root_area = root.bounds().area().max(f32::MIN_POSITIVE);
-    bvh.sah_cost = sah_cost(&root, root_area);
-    bvh.depth = depth(&root);
-    match root {
-        BuildNode::Interior { .. } => {
-            bvh.nodes.push(GpuBvhNode::default());
-            flatten(&root, 0, &mut bvh.nodes);
-        }
-        leaf @ BuildNode::Leaf { .. } => {
-            // A root that is a leaf still needs a node: the leaf goes left, an empty leaf right.
-            let empty = BuildNode::Leaf {
-                bounds: Aabb::EMPTY,
-                first: 0,
-                count: 0,
-            };
-            let mut node = GpuBvhNode::default();
-            write_child(&mut node, 0, &leaf, 0);
-            write_child(&mut node, 1, &empty, 0);
-            bvh.nodes.push(node);
         }
     }
-    bvh
+
+    /// Nodes this subtree takes in the final array.
+    fn node_count(&self) -> usize {
+        match self {
+            Built::Leaf { .. } => 0,
+            Built::Tree { nodes, .. } => nodes.len(),
+            Built::Top { children, .. } => 1 + children[0].node_count() + children[1].node_count(),
+        }
+    }
 }
 
-fn build_node(prims: &mut [Prim], first: u32, depth: u32) -> BuildNode {
-    let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(p.bounds));
-    let leaf = BuildNode::Leaf {
-        bounds,
-        first,
-        count: prims.len() as u32,
+/// Builds the subtree over `prims` (triangles `first..` in BVH order): large ones split here
+/// and hand their children to rayon, small ones are built by this task alone.
+fn build_subtree(prims: &mut [Prim], first: u32, depth: u32, info: NodeInfo) -> Built {
+    let bounds = info.bounds.aabb();
+    let count = prims.len() as u32;
+    let Some(split) = decide(prims, info, depth) else {
+        return Built::Leaf {
+            bounds,
+            first,
+            count,
+        };
     };
-    if prims.len() <= 1 || depth >= MAX_DEPTH {
-        return leaf;
+    if prims.len() <= PARALLEL_THRESHOLD {
+        let mut nodes = vec![GpuBvhNode::default()];
+        emit(prims, first, depth, split, 0, &mut nodes);
+        return Built::Tree { bounds, nodes };
     }
-    let split = match find_split(prims, bounds) {
-        Some((axis, position, cost)) => {
-            if cost >= prims.len() as f32 && prims.len() <= MAX_LEAF {
-                return leaf;
-            }
-            partition(prims, |p| p.centroid[axis] < position)
-        }
-        None if prims.len() <= MAX_LEAF => return leaf,
-        // All centroids coincide: split in the middle of the list.
-        None => prims.len() / 2,
-    };
-    let split = if split == 0 || split == prims.len() {
-        prims.len() / 2
-    } else {
-        split
-    };
-    let (left, right) = prims.split_at_mut(split);
-    let right_first = first + split as u32;
-    let (l, r) = if left.len() + right.len() > PARALLEL_THRESHOLD {
-        rayon::join(
-            || build_node(left, first, depth + 1),
-            || build_node(right, right_first, depth + 1),
-        )
-    } else {
-        (
-            build_node(left, first, depth + 1),
-            build_node(right, right_first, depth + 1),
-        )
-    };
-    BuildNode::Interior {
+    let (left, right) = prims.split_at_mut(split.at);
+    let right_first = first + split.at as u32;
+    let (l, r) = rayon::join(
+        || build_subtree(left, first, depth + 1, split.left),
+        || build_subtree(right, right_first, depth + 1, split.right),
+    );
+    Built::Top {
         bounds,
         children: Box::new([l, r]),
     }
 }
 
+/// Writes the interior node at `slot` (already split by `split`), appending its interior
+/// children next to each other and then their subtrees, left first.
+fn emit(
+    prims: &mut [Prim],
+    first: u32,
+    depth: u32,
+    split: Split,
+    slot: usize,
+    nodes: &mut Vec<GpuBvhNode>,
+) {
+    let (left, right) = prims.split_at_mut(split.at);
+    let right_first = first + split.at as u32;
+    let mut children = [
+        (left, first, split.left, None),
+        (right, right_first, split.right, None),
+    ];
+    let mut node = GpuBvhNode::default();
+    for (side, (p, f, info, child)) in children.iter_mut().enumerate() {
+        let bounds = info.bounds.aabb();
+        match decide(p, *info, depth + 1) {
+            Some(s) => {
+                nodes.push(GpuBvhNode::default());
+                write_interior(&mut node, side, bounds, nodes.len() as u32 - 1);
+                *child = Some((s, nodes.len() - 1));
+            }
+            None => write_leaf(&mut node, side, bounds, *f, p.len() as u32),
+        }
+    }
+    nodes[slot] = node;
+    for (p, f, _, child) in children {
+        if let Some((s, index)) = child {
+            emit(p, f, depth + 1, s, index, nodes);
+        }
+    }
+}
+
+/// Writes the parallel levels below the interior node at `slot` into `nodes`, in the layout
+/// [`emit`] gives: interior children next to each other, then the left subtree, then the right.
+/// Each task's block is freed as soon as it is copied.
+fn assemble(node: Built, slot: usize, nodes: &mut Vec<GpuBvhNode>) {
+    let Built::Top { children, .. } = node else {
+        unreachable!("assemble is only called on split nodes")
+    };
+    let mut gpu = GpuBvhNode::default();
+    let mut pending = [None, None];
+    for (side, child) in children.iter().enumerate() {
+        match child {
+            Built::Leaf {
+                bounds,
+                first,
+                count,
+            } => write_leaf(&mut gpu, side, *bounds, *first, *count),
+            Built::Tree { .. } | Built::Top { .. } => {
+                nodes.push(GpuBvhNode::default());
+                let index = nodes.len() - 1;
+                write_interior(&mut gpu, side, child.bounds(), index as u32);
+                pending[side] = Some(index);
+            }
+        }
+    }
+    nodes[slot] = gpu;
+    let [left, right] = *children;
+    for (child, index) in [left, right].into_iter().zip(pending) {
+        let Some(index) = index else { continue };
+        match child {
+            Built::Top { .. } => assemble(child, index, nodes),
+            Built::Tree { nodes: block, .. } => {
+                // The block's root takes the reserved slot, the rest follows: local index i >= 1
+                // lands at start + i - 1.
+                let offset = (nodes.len() - 1) as u32;
+                let shift = |mut n: GpuBvhNode| {
+                    for lo in [&mut n.left_min, &mut n.right_min] {
+                        if (lo[3].to_bits() as i32) >= 0 {
+                            lo[3] = f32::from_bits(lo[3].to_bits() + offset);
+                        }
+                    }
+                    n
+                };
+                nodes[index] = shift(block[0]);
+                nodes.extend(block[1..].iter().map(|&n| shift(n)));
+            }
+            Built::Leaf { .. } => unreachable!("leaves reserve no slot"),
+        }
+    }
+}
+
+/// Decides how to split a node, partitioning its primitives; `None` makes it a leaf.
+fn decide(prims: &mut [Prim], info: NodeInfo, depth: u32) -> Option<Split> {
+    let n = prims.len();
+    if n <= 1 || depth >= MAX_DEPTH {
+        return None;
+    }
+    let at = match find_split(prims, info) {
+        Some((axis, position, cost)) => {
+            if cost >= n as f32 && n <= MAX_LEAF {
+                return None;
+            }
+            let (at, left, right) = if n >= PARALLEL_SPLIT_THRESHOLD {
+                partition_parallel(prims, axis, position)
+            } else {
+                partition(prims, axis, position)
+            };
+            if at != 0 && at != n {
+                return Some(Split { at, left, right });
+            }
+            n / 2
+        }
+        None if n <= MAX_LEAF => return None,
+        // All centroids coincide: split in the middle of the list.
+        None => n / 2,
+    };
+    let (l, r) = prims.split_at(at);
+    Some(Split {
+        at,
+        left: NodeInfo::of(l),
+        right: NodeInfo::of(r),
+    })
+}
+
+/// One bin of one axis.
+#[derive(Clone, Copy)]
+struct Bin {
+    bounds: Bounds4,
+    count: u32,
+}
+
+/// The bins of all three axes.
+#[derive(Clone, Copy)]
+struct Bins([[Bin; BINS]; 3]);
+
+impl Bins {
+    const EMPTY: Bins = Bins(
+        [[Bin {
+            bounds: Bounds4::EMPTY,
+            count: 0,
+        }; BINS]; 3],
+    );
+
+    fn merge(mut self, o: Bins) -> Bins {
+        for (a, b) in self.0.iter_mut().zip(o.0.iter()) {
+            for (x, y) in a.iter_mut().zip(b.iter()) {
+                x.bounds = x.bounds.union(y.bounds);
+                x.count += y.count;
+            }
+        }
+        self
+    }
+}
+
+/// Bins the primitives on all three axes at once.
+fn bin(prims: &[Prim], origin: Vec4, scale: Vec4) -> Bins {
+    let mut bins = Bins::EMPTY;
+    for p in prims {
+        let t = (p.centroid() - origin) * scale;
+        for axis in 0..3 {
+            // `as usize` saturates: negative and NaN (a flat axis) land in bin 0.
+            let b = (t[axis] as usize).min(BINS - 1);
+            let bin = &mut bins.0[axis][b];
+            bin.bounds.grow(p.min, p.max);
+            bin.count += 1;
+        }
+    }
+    bins
+}
+
 /// Finds the cheapest binned split over all three axes: (axis, centroid position, SAH cost
 /// relative to this node's area, including the traversal step).
-fn find_split(prims: &[Prim], bounds: Aabb) -> Option<(usize, f32, f32)> {
-    let centroid_bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.grow(p.centroid));
+fn find_split(prims: &[Prim], info: NodeInfo) -> Option<(usize, f32, f32)> {
+    let centroid_bounds = info.centroids.aabb();
     let extent = centroid_bounds.max - centroid_bounds.min;
-    let area = bounds.area().max(f32::MIN_POSITIVE);
+    let area = info.bounds.aabb().area().max(f32::MIN_POSITIVE);
+    let scale = (Vec3::splat(BINS as f32) / extent).extend(0.0);
+    let origin = centroid_bounds.min.extend(0.0);
+    let bins = if prims.len() >= PARALLEL_SPLIT_THRESHOLD {
+        let chunk = chunk_size(prims.len());
+        prims
+            .par_chunks(chunk)
+            .map(|c| bin(c, origin, scale))
+            .reduce(|| Bins::EMPTY, Bins::merge)
+    } else {
+        bin(prims, origin, scale)
+    };
     let mut best: Option<(usize, f32, f32)> = None;
     for axis in 0..3 {
         // Skip flat axes (and a NaN extent, which no finite input makes).
         if extent[axis].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
-        let scale = BINS as f32 / extent[axis];
-        let bin_of = |c: f32| (((c - centroid_bounds.min[axis]) * scale) as usize).min(BINS - 1);
-        let mut bin_bounds = [Aabb::EMPTY; BINS];
-        let mut bin_counts = [0usize; BINS];
-        for p in prims {
-            let b = bin_of(p.centroid[axis]);
-            bin_bounds[b] = bin_bounds[b].union(p.bounds);
-            bin_counts[b] += 1;
-        }
+        let bins = &bins.0[axis];
         // Sweep from the right to know the cost of every right-hand side.
         let mut right_area = [0.0f32; BINS];
-        let mut right_count = [0usize; BINS];
-        let (mut acc, mut count) = (Aabb::EMPTY, 0);
+        let mut right_count = [0u32; BINS];
+        let (mut acc, mut count) = (Bounds4::EMPTY, 0);
         for i in (1..BINS).rev() {
-            acc = acc.union(bin_bounds[i]);
-            count += bin_counts[i];
-            right_area[i] = acc.area();
+            acc = acc.union(bins[i].bounds);
+            count += bins[i].count;
+            right_area[i] = acc.aabb().area();
             right_count[i] = count;
         }
-        let (mut acc, mut count) = (Aabb::EMPTY, 0);
+        let (mut acc, mut count) = (Bounds4::EMPTY, 0);
         for i in 0..BINS - 1 {
-            acc = acc.union(bin_bounds[i]);
-            count += bin_counts[i];
+            acc = acc.union(bins[i].bounds);
+            count += bins[i].count;
             if count == 0 || right_count[i + 1] == 0 {
                 continue;
             }
             let cost = TRAVERSAL_COST
-                + (acc.area() * count as f32 + right_area[i + 1] * right_count[i + 1] as f32)
+                + (acc.aabb().area() * count as f32
+                    + right_area[i + 1] * right_count[i + 1] as f32)
                     / area;
             if best.is_none_or(|(_, _, c)| cost < c) {
-                let position = centroid_bounds.min[axis] + (i + 1) as f32 / scale;
+                let position = centroid_bounds.min[axis] + (i + 1) as f32 / scale[axis];
                 best = Some((axis, position, cost));
             }
         }
@@ -185,24 +491,119 @@ fn find_split(prims: &[Prim], bounds: Aabb) -> Option<(usize, f32, f32)> {
     best
 }
 
-/// Moves the elements satisfying `left` to the front; returns how many there are.
-fn partition(prims: &mut [Prim], left: impl Fn(&Prim) -> bool) -> usize {
-    let mut i = 0;
-    for j in 0..prims.len() {
-        if left(&prims[j]) {
-            prims.swap(i, j);
-            i += 1;
-        }
-    }
-    i
+/// Chunks for the parallel passes: enough for many threads, none tiny, and independent of the
+/// thread count so that the tree is too.
+fn chunk_size(n: usize) -> usize {
+    n.div_ceil(64).max(MIN_CHUNK)
 }
 
-fn write_child(node: &mut GpuBvhNode, side: usize, child: &BuildNode, index: u32) {
-    let b = child.bounds();
-    let (reference, count) = match child {
-        BuildNode::Leaf { first, count, .. } => (!(*first as i32), *count),
-        BuildNode::Interior { .. } => (index as i32, 0),
-    };
+/// Moves the primitives whose centroid lies below `position` on `axis` to the front; returns
+/// how many there are and what each side holds.
+fn partition(prims: &mut [Prim], axis: usize, position: f32) -> (usize, NodeInfo, NodeInfo) {
+    let (mut left, mut right) = (NodeInfo::EMPTY, NodeInfo::EMPTY);
+    let mut i = 0;
+    for j in 0..prims.len() {
+        let p = prims[j];
+        if p.centroid()[axis] < position {
+            left.add(&p);
+            prims.swap(i, j);
+            i += 1;
+        } else {
+            right.add(&p);
+        }
+    }
+    (i, left, right)
+}
+
+/// [`partition`] in parallel: each chunk partitions itself, then the right-hand runs that lie
+/// in the final left part swap places with the left-hand runs in the final right part.
+fn partition_parallel(
+    prims: &mut [Prim],
+    axis: usize,
+    position: f32,
+) -> (usize, NodeInfo, NodeInfo) {
+    let chunk = chunk_size(prims.len());
+    let parts: Vec<(usize, NodeInfo, NodeInfo)> = prims
+        .par_chunks_mut(chunk)
+        .map(|c| partition(c, axis, position))
+        .collect();
+    let at: usize = parts.iter().map(|p| p.0).sum();
+    let (mut left, mut right) = (NodeInfo::EMPTY, NodeInfo::EMPTY);
+    // Runs out of place: right-hand elements before `at`, left-hand ones from `at` on.
+    let (mut wrong_right, mut wrong_left) = (Vec::new(), Vec::new());
+    for (k, (count, l, r)) in parts.iter().enumerate() {
+        left = left.union(*l);
+        right = right.union(*r);
+        let start = k * chunk;
+        let end = (start + chunk).min(prims.len());
+        let mid = start + count;
+        if mid < end.min(at) {
+            wrong_right.push(mid..end.min(at));
+        }
+        if mid > start.max(at) {
+            wrong_left.push(start.max(at)..mid);
+        }
+    }
+    let (head, tail) = prims.split_at_mut(at);
+    let a = carve(head, 0, &wrong_right);
+    let b = carve(tail, at, &wrong_left);
+    pair_up(a, b)
+        .into_par_iter()
+        .for_each(|(x, y)| x.swap_with_slice(y));
+    (at, left, right)
+}
+
+/// The disjoint, ascending `ranges` (indices from `base`) of `slice` as separate slices.
+fn carve<'a>(
+    mut slice: &'a mut [Prim],
+    mut base: usize,
+    ranges: &[std::ops::Range<usize>],
+) -> Vec<&'a mut [Prim]> {
+    let mut out = Vec::with_capacity(ranges.len());
+    for r in ranges {
+        let (_, rest) = std::mem::take(&mut slice).split_at_mut(r.start - base);
+        let (piece, rest) = rest.split_at_mut(r.end - r.start);
+        out.push(piece);
+        slice = rest;
+        base = r.end;
+    }
+    out
+}
+
+/// Pairs two lists of slices holding the same number of elements into pairs of equal length.
+fn pair_up<'a>(
+    a: Vec<&'a mut [Prim]>,
+    b: Vec<&'a mut [Prim]>,
+) -> Vec<(&'a mut [Prim], &'a mut [Prim])> {
+    let mut out = Vec::new();
+    let (mut a, mut b) = (a.into_iter(), b.into_iter());
+    let (mut x, mut y): (&mut [Prim], &mut [Prim]) = (&mut [], &mut []);
+    loop {
+        if x.is_empty() {
+            match a.next() {
+                Some(s) => x = s,
+                None => break,
+            }
+            continue;
+        }
+        if y.is_empty() {
+            match b.next() {
+                Some(s) => y = s,
+                None => break,
+            }
+            continue;
+        }
+        let n = x.len().min(y.len());
+        let (x0, x1) = std::mem::take(&mut x).split_at_mut(n);
+        let (y0, y1) = std::mem::take(&mut y).split_at_mut(n);
+        out.push((x0, y0));
+        x = x1;
+        y = y1;
+    }
+    out
+}
+
+fn write_child(node: &mut GpuBvhNode, side: usize, b: Aabb, reference: i32, count: u32) {
     let lo = [b.min.x, b.min.y, b.min.z, f32::from_bits(reference as u32)];
     let hi = [b.max.x, b.max.y, b.max.z, f32::from_bits(count)];
     if side == 0 {
@@ -214,49 +615,16 @@ fn write_child(node: &mut GpuBvhNode, side: usize, child: &BuildNode, index: u32
     }
 }
 
-/// Writes the interior node `node` at `index`, appending its interior children depth first.
-fn flatten(node: &BuildNode, index: usize, nodes: &mut Vec<GpuBvhNode>) {
-    let BuildNode::Interior { children, .. } = node else {
-        unreachable!("flatten is only called on interior nodes")
-    };
-    let mut gpu = GpuBvhNode::default();
-    let mut pending = Vec::new();
-    for (side, child) in children.iter().enumerate() {
-        let child_index = if matches!(child, BuildNode::Interior { .. }) {
-            nodes.push(GpuBvhNode::default());
-            pending.push((child, nodes.len() - 1));
-            nodes.len() - 1
-        } else {
-            0
-        };
-        write_child(&mut gpu, side, child, child_index as u32);
-    }
-    nodes[index] = gpu;
-    for (child, child_index) in pending {
-        flatten(child, child_index, nodes);
-    }
+fn write_leaf(node: &mut GpuBvhNode, side: usize, b: Aabb, first: u32, count: u32) {
+    write_child(node, side, b, !(first as i32), count);
 }
 
-fn sah_cost(node: &BuildNode, root_area: f32) -> f32 {
-    match node {
-        BuildNode::Leaf { bounds, count, .. } => bounds.area() / root_area * *count as f32,
-        BuildNode::Interior { bounds, children } => {
-            bounds.area() / root_area * TRAVERSAL_COST
-                + sah_cost(&children[0], root_area)
-                + sah_cost(&children[1], root_area)
-        }
-    }
-}
-
-fn depth(node: &BuildNode) -> u32 {
-    match node {
-        BuildNode::Leaf { .. } => 0,
-        BuildNode::Interior { children, .. } => 1 + depth(&children[0]).max(depth(&children[1])),
-    }
+fn write_interior(node: &mut GpuBvhNode, side: usize, b: Aabb, index: u32) {
+    write_child(node, side, b, index as i32, 0);
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::super::{Child, Ray};
     use super::*;
 
@@ -305,12 +673,11 @@ mod tests {
         }
     }
 
-    #[test]
-    fn every_triangle_is_in_exactly_one_leaf_inside_its_boxes() {
-        let tris = random_triangles(5000, 7);
-        let bvh = build(&tris);
+    /// Checks that every triangle sits in exactly one leaf inside all the boxes above it, that
+    /// the leaves tile the triangle list and that the depth limit holds.
+    pub(crate) fn check_tree(bvh: &Bvh, tris: &[[Vec3; 3]]) {
         let mut ranges = vec![];
-        check_node(&bvh, 0, &tris, &mut ranges);
+        check_node(bvh, 0, tris, &mut ranges);
         ranges.sort();
         let mut next = 0;
         for (first, count) in ranges {
@@ -326,7 +693,55 @@ mod tests {
             "a permutation"
         );
         assert!(bvh.depth <= MAX_DEPTH);
-        assert!(bvh.sah_cost > 0.0 && bvh.sah_cost < tris.len() as f32);
+    }
+
+    #[test]
+    fn every_triangle_is_in_exactly_one_leaf_inside_its_boxes() {
+        // The large soups go through the parallel binning and partition.
+        for (n, seed) in [(5000, 7), (200_000, 8)] {
+            let tris = random_triangles(n, seed);
+            let bvh = build(&tris);
+            check_tree(&bvh, &tris);
+            assert!(bvh.sah_cost > 0.0 && bvh.sah_cost < tris.len() as f32);
+            assert_eq!(bvh.sah_cost, bvh.built_sah_cost);
+        }
+    }
+
+    #[test]
+    fn the_tree_does_not_depend_on_the_thread_count() {
+        let tris = random_triangles(150_000, 21);
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap()
+            .install(|| build(&tris));
+        let four = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap()
+            .install(|| build(&tris));
+        // Leaf references are NaN bits as floats: compare bytes.
+        let bytes = |b: &Bvh| bytemuck::cast_slice::<_, u8>(&b.nodes).to_vec();
+        assert!(bytes(&one) == bytes(&four), "the same nodes");
+        assert!(one.tri_indices == four.tri_indices, "the same order");
+    }
+
+    #[test]
+    fn the_sah_cost_matches_a_recursive_sum() {
+        fn cost(bvh: &Bvh, node: u32, root_area: f32) -> f32 {
+            (0..2)
+                .map(|side| match bvh.child(node, side) {
+                    (b, Child::Node(n)) => b.area() / root_area + cost(bvh, n, root_area),
+                    (b, Child::Leaf { count, .. }) => b.area() / root_area * count as f32,
+                })
+                .sum()
+        }
+        let tris = random_triangles(3000, 4);
+        let bvh = build(&tris);
+        let (l, _) = bvh.child(0, 0);
+        let (r, _) = bvh.child(0, 1);
+        let expect = 1.0 + cost(&bvh, 0, l.union(r).area());
+        assert!((bvh.sah_cost - expect).abs() < 1e-3 * expect, "{expect}");
     }
 
     #[test]
@@ -384,16 +799,11 @@ mod tests {
         best
     }
 
-    /// Random, grazing and axis-parallel rays; the BVH must find the same closest distance as
-    /// testing every triangle, and any-hit must agree on occlusion.
-    #[test]
-    fn host_traversal_equals_brute_force() {
-        let tris = random_triangles(2000, 11);
-        let bvh = build(&tris);
-        let ordered: Vec<[Vec3; 3]> = bvh.tri_indices.iter().map(|&i| tris[i as usize]).collect();
-        let mut s = 99u64;
+    /// Random rays from around the soups of [`random_triangles`], and axis-parallel ones.
+    pub(crate) fn random_rays(n: usize, seed: u64) -> Vec<Ray> {
+        let mut s = seed;
         let mut rays = vec![];
-        for _ in 0..3000 {
+        for _ in 0..n {
             let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 14.0 - 2.0;
             let d = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) - 0.5;
             rays.push(Ray {
@@ -403,7 +813,7 @@ mod tests {
                 tmax: f32::INFINITY,
             });
         }
-        for i in 0..600 {
+        for i in 0..n / 5 {
             // Axis-parallel rays along each axis in both directions.
             let o = Vec3::new(lcg(&mut s), lcg(&mut s), lcg(&mut s)) * 10.0;
             let mut d = Vec3::ZERO;
@@ -415,6 +825,17 @@ mod tests {
                 tmax: f32::INFINITY,
             });
         }
+        rays
+    }
+
+    /// Random, grazing and axis-parallel rays; the BVH must find the same closest distance as
+    /// testing every triangle, and any-hit must agree on occlusion.
+    #[test]
+    fn host_traversal_equals_brute_force() {
+        let tris = random_triangles(2000, 11);
+        let bvh = build(&tris);
+        let ordered: Vec<[Vec3; 3]> = bvh.tri_indices.iter().map(|&i| tris[i as usize]).collect();
+        let mut rays = random_rays(3000, 99);
         for t in tris.iter().take(600) {
             // Grazing rays: in the plane of a triangle, through its edge midpoint.
             let mid = (t[0] + t[1]) * 0.5;

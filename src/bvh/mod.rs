@@ -3,10 +3,18 @@
 //! same rules the kernels use (the reference the device is tested against).
 
 mod build;
+mod instances;
+mod refit;
+mod stats;
 mod traverse;
+mod wide;
 
-pub use build::{MAX_DEPTH, build};
+pub use build::{MAX_DEPTH, build, build_boxes};
+pub use instances::{Blas, Instance, InstanceHit, TwoLevel};
+pub use refit::{REFIT_MAX_GROWTH, Update};
+pub use stats::{BvhReport, report};
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};
+pub use wide::{WIDE_STACK_SIZE, WIDTH, WideBvh};
 
 use crate::cl::types::GpuBvhNode;
 use glam::Vec3;
@@ -64,6 +72,8 @@ pub struct Bvh {
     pub tri_indices: Vec<u32>,
     /// The SAH cost of the tree (traversal cost 1, intersection cost 1 per triangle).
     pub sah_cost: f32,
+    /// The SAH cost right after the last full build (refits compare against it).
+    pub built_sah_cost: f32,
     /// The depth of the deepest leaf (root = 0).
     pub depth: u32,
 }

@@ -103,7 +103,7 @@ fn intersect_sheared(ray: &Ray, sh: &Shear, tri: &[Vec3; 3]) -> Option<(f32, f32
 }
 
 /// Direction reciprocal that stays finite for axis-parallel rays.
-fn safe_inverse(d: Vec3) -> Vec3 {
+pub(super) fn safe_inverse(d: Vec3) -> Vec3 {
     let fix = |x: f32| {
         if x.abs() > 1e-20 {
             1.0 / x
@@ -116,7 +116,14 @@ fn safe_inverse(d: Vec3) -> Vec3 {
 
 /// Slab test; the far distance is scaled up by two ulps so that rounding never loses a hit
 /// (Ize 2013). Returns the entry distance.
-fn box_entry(lo: Vec3, hi: Vec3, origin: Vec3, inv: Vec3, tmin: f32, tmax: f32) -> Option<f32> {
+pub(super) fn box_entry(
+    lo: Vec3,
+    hi: Vec3,
+    origin: Vec3,
+    inv: Vec3,
+    tmin: f32,
+    tmax: f32,
+) -> Option<f32> {
     let t0 = (lo - origin) * inv;
     let t1 = (hi - origin) * inv;
     let near = t0.min(t1).max_element().max(tmin);
@@ -140,6 +147,22 @@ impl Bvh {
 
     fn traverse(&self, ray: &Ray, tris: &[[Vec3; 3]], any: bool) -> Option<Hit> {
         let sh = Shear::new(ray.direction);
+        self.walk(ray, any, |prim, r| {
+            intersect_sheared(r, &sh, &tris[prim as usize])
+                .map(|(t, u, v)| (t, Hit { t, u, v, prim }))
+        })
+    }
+
+    /// Walks the tree along `ray` as the kernels do, calling `test(item, ray)` for each item
+    /// (in BVH order) of every leaf the ray reaches, with `ray.tmax` shortened to the closest hit
+    /// so far; `test` returns the distance of its hit and the hit. Returns the closest hit, or
+    /// with `any` the first one found.
+    pub fn walk<H>(
+        &self,
+        ray: &Ray,
+        any: bool,
+        mut test: impl FnMut(u32, &Ray) -> Option<(f32, H)>,
+    ) -> Option<H> {
         let inv = safe_inverse(ray.direction);
         let mut tmax = ray.tmax;
         let mut best = None;
@@ -156,13 +179,11 @@ impl Bvh {
                 };
                 match child {
                     Child::Leaf { first, count } => {
-                        for prim in first..first + count {
+                        for item in first..first + count {
                             let r = Ray { tmax, ..*ray };
-                            if let Some((t, u, v)) =
-                                intersect_sheared(&r, &sh, &tris[prim as usize])
-                            {
+                            if let Some((t, hit)) = test(item, &r) {
                                 tmax = t;
-                                best = Some(Hit { t, u, v, prim });
+                                best = Some(hit);
                                 if any {
                                     return best;
                                 }

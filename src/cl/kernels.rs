@@ -127,17 +127,21 @@ pub enum Stage {
     Advance,
     /// The wave's samples into the film.
     Accumulate,
+    /// Whole paths per work item, all bounces in one kernel (CPU devices; no other stage
+    /// but `advance` runs then).
+    Megakernel,
 }
 
 impl Stage {
     /// Every stage, in launch order.
-    pub const ALL: [Stage; 6] = [
+    pub const ALL: [Stage; 7] = [
         Stage::Generate,
         Stage::Extend,
         Stage::Shade,
         Stage::Connect,
         Stage::Advance,
         Stage::Accumulate,
+        Stage::Megakernel,
     ];
 
     /// The kernel's (and the stage's) name.
@@ -149,6 +153,7 @@ impl Stage {
             Stage::Connect => "connect",
             Stage::Advance => "advance",
             Stage::Accumulate => "accumulate",
+            Stage::Megakernel => "megakernel",
         }
     }
 }
@@ -180,6 +185,11 @@ pub struct Program {
     accumulate: Kernel,
     trace_closest: Kernel,
     trace_any: Kernel,
+    trace_closest_wide: Kernel,
+    trace_any_wide: Kernel,
+    megakernel: Kernel,
+    /// Work-group size of the megakernel (see `megakernel_local_size`).
+    mega_local_size: usize,
     /// The test-only kernels, built on first use (never in production).
     tests: OnceLock<TestKernels>,
     local_size: usize,
@@ -194,6 +204,7 @@ struct TestKernels {
     sample_env_test: Kernel,
     bsdf_sample_test: Kernel,
     bsdf_eval_test: Kernel,
+    spawn_test: Kernel,
 }
 
 fn kernel(program: &opencl3::program::Program, name: &str) -> Result<Kernel, ClError> {
@@ -220,6 +231,10 @@ impl Program {
             accumulate: k(Stage::Accumulate)?,
             trace_closest: kernel(&program, "trace_closest")?,
             trace_any: kernel(&program, "trace_any")?,
+            trace_closest_wide: kernel(&program, "trace_closest_wide")?,
+            trace_any_wide: kernel(&program, "trace_any_wide")?,
+            megakernel: k(Stage::Megakernel)?,
+            mega_local_size: megakernel_local_size().min(max_group),
             tests: OnceLock::new(),
             local_size: 64.min(max_group),
             features,
@@ -239,6 +254,7 @@ impl Program {
             sample_env_test: k("sample_env_test")?,
             bsdf_sample_test: k("bsdf_sample_test")?,
             bsdf_eval_test: k("bsdf_eval_test")?,
+            spawn_test: k("spawn_test")?,
         };
         Ok(self.tests.get_or_init(|| built))
     }
@@ -251,10 +267,22 @@ impl Program {
         n: usize,
         set: impl FnOnce(&mut ExecuteKernel),
     ) -> Result<Launch, ClError> {
+        self.run_local(gpu, stage, kernel, n, self.local_size, set)
+    }
+
+    fn run_local(
+        &self,
+        gpu: &Gpu,
+        stage: &'static str,
+        kernel: &Kernel,
+        n: usize,
+        local_size: usize,
+        set: impl FnOnce(&mut ExecuteKernel),
+    ) -> Result<Launch, ClError> {
         let mut exec = ExecuteKernel::new(kernel);
         set(&mut exec);
-        exec.set_global_work_size(global_size(n, self.local_size))
-            .set_local_work_size(self.local_size);
+        exec.set_global_work_size(global_size(n, local_size))
+            .set_local_work_size(local_size);
         // SAFETY: every wrapper below sets exactly the kernel's arguments, in order, with the
         // types the kernel declares; buffers outlive the launch because the queue is in order
         // and every reader of results waits on it.
@@ -422,20 +450,16 @@ impl Program {
         hits: &Buffer<GpuHit>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
-        let count = rays.len() as u32;
-        self.run(
+        let (stage, kernel) = ("trace_closest", &self.trace_closest);
+        self.trace(
             gpu,
-            "trace_closest",
-            &self.trace_closest,
-            rays.len(),
-            |e| unsafe {
-                e.set_arg(&bvh.nodes.mem()).set_arg(&bvh.triangles.mem());
-                set_surfaces(e, bvh);
-                e.set_arg(&rays.mem())
-                    .set_arg(&count)
-                    .set_arg(&hits.mem())
-                    .set_arg(&counters.mem());
-            },
+            stage,
+            kernel,
+            bvh.nodes.mem(),
+            bvh,
+            rays,
+            hits,
+            counters,
         )
     }
 
@@ -448,15 +472,125 @@ impl Program {
         occluded: &Buffer<u32>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
+        let (stage, kernel) = ("trace_any", &self.trace_any);
+        self.trace(
+            gpu,
+            stage,
+            kernel,
+            bvh.nodes.mem(),
+            bvh,
+            rays,
+            occluded,
+            counters,
+        )
+    }
+
+    /// `trace_closest_wide`: as `trace_closest`, through the 4-wide BVH.
+    pub fn trace_closest_wide(
+        &self,
+        gpu: &Gpu,
+        bvh: &SceneBuffers,
+        rays: &Buffer<GpuRay>,
+        hits: &Buffer<GpuHit>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
+        let (stage, kernel) = ("trace_closest_wide", &self.trace_closest_wide);
+        self.trace(
+            gpu,
+            stage,
+            kernel,
+            bvh.wide_nodes.mem(),
+            bvh,
+            rays,
+            hits,
+            counters,
+        )
+    }
+
+    /// `trace_any_wide`: as `trace_any`, through the 4-wide BVH.
+    pub fn trace_any_wide(
+        &self,
+        gpu: &Gpu,
+        bvh: &SceneBuffers,
+        rays: &Buffer<GpuRay>,
+        occluded: &Buffer<u32>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
+        let (stage, kernel) = ("trace_any_wide", &self.trace_any_wide);
+        self.trace(
+            gpu,
+            stage,
+            kernel,
+            bvh.wide_nodes.mem(),
+            bvh,
+            rays,
+            occluded,
+            counters,
+        )
+    }
+
+    /// The four tracing kernels share their arguments: nodes (binary or wide), triangles,
+    /// surfaces, rays, count, results, counters.
+    #[allow(clippy::too_many_arguments)]
+    fn trace<T: Pod>(
+        &self,
+        gpu: &Gpu,
+        stage: &'static str,
+        kernel: &Kernel,
+        nodes: opencl3::types::cl_mem,
+        bvh: &SceneBuffers,
+        rays: &Buffer<GpuRay>,
+        out: &Buffer<T>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
         let count = rays.len() as u32;
-        self.run(gpu, "trace_any", &self.trace_any, rays.len(), |e| unsafe {
-            e.set_arg(&bvh.nodes.mem()).set_arg(&bvh.triangles.mem());
+        self.run(gpu, stage, kernel, rays.len(), |e| unsafe {
+            e.set_arg(&nodes).set_arg(&bvh.triangles.mem());
             set_surfaces(e, bvh);
             e.set_arg(&rays.mem())
                 .set_arg(&count)
-                .set_arg(&occluded.mem())
+                .set_arg(&out.mem())
                 .set_arg(&counters.mem());
         })
+    }
+
+    /// `megakernel`: `frame.samples_in_wave` whole paths per pixel, from the camera to their
+    /// end, added to the film; the ray counts go to the counters that `advance` reads.
+    #[allow(clippy::too_many_arguments)]
+    pub fn megakernel(
+        &self,
+        gpu: &Gpu,
+        frame: &GpuFrame,
+        camera: &GpuCamera,
+        env: &EnvBuffers,
+        scene: &SceneBuffers,
+        film: &Buffer<[f32; 4]>,
+        counters: &Buffer<u32>,
+    ) -> Result<Launch, ClError> {
+        let pixels = (frame.width * frame.height) as usize;
+        let local = self.mega_local_size;
+        self.run_local(
+            gpu,
+            Stage::Megakernel.name(),
+            &self.megakernel,
+            pixels,
+            local,
+            |e| unsafe {
+                e.set_arg(frame)
+                    .set_arg(camera)
+                    .set_arg(&env.info)
+                    .set_arg(&scene.wide_nodes.mem())
+                    .set_arg(&scene.triangles.mem());
+                set_surfaces(e, scene);
+                e.set_arg(&env.texels.mem())
+                    .set_arg(&env.marginal.mem())
+                    .set_arg(&env.conditional.mem())
+                    .set_arg(&scene.lights.mem())
+                    .set_arg(&scene.light_cdf.mem())
+                    .set_arg(&film.mem())
+                    .set_arg(&counters.mem());
+            },
+        )
     }
 
     /// `probe_layout` (test program): sizes and offsets of the shared structs as the device compiler sees them.
@@ -529,6 +663,42 @@ impl Program {
             },
         )?;
         Ok((out.read(gpu)?, eval.read(gpu)?))
+    }
+
+    /// `spawn_test` (test program): rays spawned with the kernels' hit point and offset; case i
+    /// leaves triangle `groups[i][0]` (vertices `verts[3k..3k + 3]`, xyz) at barycentrics
+    /// `bary[i]` along `dirs[i]` (.w = tmax) and counts its hits among the `groups[i][2]`
+    /// triangles from `groups[i][1]` (`groups[i][3]` is unused).
+    pub fn spawn_test(
+        &self,
+        gpu: &Gpu,
+        verts: &[[f32; 4]],
+        groups: &[[u32; 4]],
+        bary: &[[f32; 2]],
+        dirs: &[[f32; 4]],
+    ) -> Result<Vec<u32>, ClError> {
+        let tests = self.tests(gpu)?;
+        let vb = Buffer::from_slice(gpu, verts)?;
+        let gb = Buffer::from_slice(gpu, groups)?;
+        let bb = Buffer::from_slice(gpu, bary)?;
+        let db = Buffer::from_slice(gpu, dirs)?;
+        let hits = Buffer::<u32>::new(gpu, dirs.len())?;
+        let count = dirs.len() as u32;
+        self.run(
+            gpu,
+            "spawn_test",
+            &tests.spawn_test,
+            dirs.len(),
+            |e| unsafe {
+                e.set_arg(&vb.mem())
+                    .set_arg(&gb.mem())
+                    .set_arg(&bb.mem())
+                    .set_arg(&db.mem())
+                    .set_arg(&count)
+                    .set_arg(&hits.mem());
+            },
+        )?;
+        hits.read(gpu)
     }
 
     /// `bsdf_sample_test` (test program): `count` BSDF samples of `material` at (`wo`, `n`), seen from inside
@@ -604,6 +774,18 @@ impl Program {
     }
 }
 
+/// The megakernel's work-group size: `PENUMBRA_MEGAKERNEL_GROUP` when set (for measuring),
+/// else 64. On PoCL's CPU device a work-group is one task of its thread pool whose work items
+/// run one after the other (the kernel's loops defeat vectorisation across work items), so the
+/// size only sets the scheduling grain; docs/benchmarks.md has the measurements.
+fn megakernel_local_size() -> usize {
+    std::env::var("PENUMBRA_MEGAKERNEL_GROUP")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or(64)
+}
+
 /// Sets the six surface arguments every traversing kernel takes after the triangles, in the
 /// order of `SceneSurfaces` (kernels/textures.h).
 ///
@@ -637,6 +819,8 @@ pub struct EnvBuffers {
 pub struct SceneBuffers {
     /// BVH nodes.
     pub nodes: Buffer<GpuBvhNode>,
+    /// The same BVH collapsed to 4-wide nodes (the megakernel's).
+    pub wide_nodes: Buffer<GpuWideNode>,
     /// Triangles in BVH order.
     pub triangles: Buffer<GpuTriangle>,
     /// Shading data in BVH order.

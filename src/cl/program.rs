@@ -15,11 +15,20 @@ const SOURCES: &[(&str, &str)] = &[
         "kernels/traverse.h",
         include_str!("../../kernels/traverse.h"),
     ),
+    (
+        "kernels/traverse_wide.h",
+        include_str!("../../kernels/traverse_wide.h"),
+    ),
     ("kernels/bsdf.h", include_str!("../../kernels/bsdf.h")),
     ("kernels/surface.h", include_str!("../../kernels/surface.h")),
     ("kernels/env.h", include_str!("../../kernels/env.h")),
     ("kernels/lights.h", include_str!("../../kernels/lights.h")),
+    ("kernels/path.h", include_str!("../../kernels/path.h")),
     ("kernels/stages.cl", include_str!("../../kernels/stages.cl")),
+    (
+        "kernels/megakernel.cl",
+        include_str!("../../kernels/megakernel.cl"),
+    ),
     ("kernels/tools.cl", include_str!("../../kernels/tools.cl")),
 ];
 

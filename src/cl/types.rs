@@ -144,6 +144,32 @@ pub struct GpuBvhNode {
 }
 const _: () = assert!(size_of::<GpuBvhNode>() == 64);
 
+/// A node of the 4-wide BVH (128 bytes): four child boxes by coordinate, one `float4` per box
+/// plane, so the kernels test a ray against all four at once. A child is an interior node
+/// (`child > 0`, `count == 0`), a leaf (`child = !first` triangle, `count > 0`), or an empty
+/// slot (`child <= 0`, `count == 0`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuWideNode {
+    /// Box minima, x coordinate of each child.
+    pub min_x: [f32; 4],
+    /// Box minima, y.
+    pub min_y: [f32; 4],
+    /// Box minima, z.
+    pub min_z: [f32; 4],
+    /// Box maxima, x.
+    pub max_x: [f32; 4],
+    /// Box maxima, y.
+    pub max_y: [f32; 4],
+    /// Box maxima, z.
+    pub max_z: [f32; 4],
+    /// Node index, or `!first` triangle of a leaf.
+    pub child: [i32; 4],
+    /// Leaf triangle count (0: interior or empty).
+    pub count: [u32; 4],
+}
+const _: () = assert!(size_of::<GpuWideNode>() == 128);
+
 /// A triangle's vertices in world space, in BVH order (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
@@ -277,8 +303,9 @@ const _: () = assert!(size_of::<GpuMaterial>() == 160);
 pub struct GpuLight {
     /// Position (point/spot), or the direction light travels (directional); `.w` = kind (u32 bits).
     pub position: [f32; 4],
-    /// Radiant intensity (point/spot) or irradiance (directional) per channel; `.w` = radius
-    /// (world units; an angular radius in radians for a directional light).
+    /// Radiant intensity (point/spot) or irradiance (directional) per channel; `.w` = the light
+    /// radius, `Light::light_radius` (world units; an angular radius in radians for a
+    /// directional light).
     pub intensity: [f32; 4],
     /// Spot axis (direction light travels); `.w` = cos of the outer cone angle.
     /// For a triangle light: `.x` = triangle index (u32 bits), `.y` = area.
@@ -441,5 +468,16 @@ pub fn layouts() -> Vec<StructLayout> {
         layout!(GpuHit, t, u, v, prim),
         layout!(GpuShadowRay, origin, direction, contribution),
         layout!(GpuRay, origin, direction),
+        layout!(
+            GpuWideNode,
+            min_x,
+            min_y,
+            min_z,
+            max_x,
+            max_y,
+            max_z,
+            child,
+            count
+        ),
     ]
 }

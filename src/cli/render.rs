@@ -1,11 +1,14 @@
 //! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary.
 
-use super::{EnvChoice, RenderArgs};
+use super::RenderArgs;
+use crate::args::EnvChoice;
 use crate::image_io::{Format, write_exr};
+use crate::render::exposure::{self, ExposureMode};
+use crate::render::tonemap::ToneMapper;
 use crate::render::tonemap::write_png;
-use crate::render::{Renderer, tonemap::ToneMapper};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
 use std::time::Instant;
 
 /// Samples per pixel when `--spp` is not given.
@@ -20,27 +23,34 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         anyhow::bail!("{}: the output folder does not exist", dir.display());
     }
     let mut settings = args.common.settings((640, 480))?;
-    args.sampling.apply(&mut settings);
-    let spp = args.common.spp.unwrap_or(DEFAULT_SPP);
-    let prepared = args.common.prepare(Some(&args.scene))?;
-    let environment = args.common.environment()?;
-    let mut renderer = Renderer::new(&args.common.device_choice()?)?;
-    renderer.set_settings(&settings)?;
+    args.strategy.apply(&mut settings);
+    let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
+    let mut prepared = args.common.prepare(Some(&args.scene))?;
+    let environment = prepared.environment.take();
+    let mut renderer = args.common.open_renderer(&settings)?;
     if let Some(EnvChoice::Map(map)) = environment {
         renderer.set_environment(Some(map))?;
     }
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| format!("{}", args.scene.display()))?;
+    if scene_stats.dropped_triangles > 0 {
+        log::warn!(
+            "{}: {} triangles with a non-finite or absurd (beyond 1e30) vertex dropped",
+            args.scene.display(),
+            scene_stats.dropped_triangles
+        );
+    }
     renderer.set_camera(&prepared.camera)?;
-    if settings.lens_radius > 0.0 && args.common.focus_distance.is_none() {
+    if settings.lens_radius > 0.0 && args.common.lens.focus_distance.is_none() {
         // Focus on what the image centre sees (else the scene's centre).
         let focus = renderer
             .focus_distance_at(settings.width as f32 * 0.5, settings.height as f32 * 0.5)
             .unwrap_or_else(|| {
-                (prepared.scene.bounds().center() - prepared.camera.eye)
+                let bounds = prepared.scene.bounds();
+                (bounds.center() - prepared.camera.eye)
                     .dot(prepared.camera.forward)
-                    .max(1e-3) as f32
+                    .max(1e-3 * bounds.diagonal()) as f32
             });
         renderer.set_lens(settings.lens_radius, focus)?;
     }
@@ -51,6 +61,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         )
         .expect("the progress template is valid"),
     );
+    // Without a terminal (a log, CI), plain lines every 10% or 2 s instead of the bar.
+    let mut lines = (!std::io::stderr().is_terminal()).then(|| ProgressLines::new(spp));
     let chunk = spp.div_ceil(50).max(1);
     let start = Instant::now();
     let mut done = 0;
@@ -59,11 +71,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         renderer.render(n)?;
         done += n;
         bar.set_position(done as u64);
+        if let Some(l) = lines.as_mut() {
+            l.update(done, start.elapsed().as_secs_f64());
+        }
     }
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
     let image = renderer.image()?;
+    let mode = args.common.exposure_mode();
+    let metering = exposure::meter(&image);
+    let exposure = mode.stops(metering.as_ref());
     match format {
         Format::Exr => write_exr(&args.output, settings.width, settings.height, &image)?,
         Format::Png => write_png(
@@ -71,7 +89,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             settings.width,
             settings.height,
             &image,
-            args.exposure,
+            exposure,
             ToneMapper::default(),
         )?,
     }
@@ -89,6 +107,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "scene": args.scene.display().to_string(),
         "output": args.output.display().to_string(),
         "device": renderer.gpu.description(),
+        "kernel": renderer.kernel(),
         "width": settings.width,
         "height": settings.height,
         "spp": spp,
@@ -106,6 +125,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "bvh_build_ms": scene_stats.bvh_build_ms,
         "kernel_build_ms": scene_stats.kernel_build_ms,
         "triangles": scene_stats.triangles,
+        "dropped_triangles": scene_stats.dropped_triangles,
         "bvh_nodes": scene_stats.nodes,
         "lights": prepared.lights.len(),
         "default_light_rig": prepared.scene.default_rig,
@@ -113,10 +133,52 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "textures": scene_stats.textures,
         "texture_bytes": scene_stats.texture_bytes,
         "environment": renderer.environment().map(|m| m.name.clone()),
+        "exposure": exposure,
+        "auto_exposure": mode == ExposureMode::Auto,
+        "camera": {
+            "eye": prepared.camera.eye.to_array(),
+            "forward": prepared.camera.forward.to_array(),
+            "yfov_degrees": prepared.camera.yfov.to_degrees(),
+        },
+        "first_view": prepared.first_view.as_ref().map(|f| serde_json::json!({
+            "interior": f.view.interior,
+            "lights_light_view": f.view.lit,
+            "lit_fraction": f.view.lit_fraction,
+            "coverage": f.view.coverage,
+        })),
         "aperture": renderer.settings().lens_radius,
         "focus_distance": renderer.settings().focus_distance,
         "kernel_ms": stats.stage_ms,
     });
     println!("{summary}");
     Ok(())
+}
+
+/// Progress as plain lines on stderr: one each 10% of the samples or 2 s, whichever comes first.
+struct ProgressLines {
+    spp: u32,
+    next_percent: u32,
+    last: f64,
+}
+
+impl ProgressLines {
+    fn new(spp: u32) -> Self {
+        Self {
+            spp,
+            next_percent: 10,
+            last: 0.0,
+        }
+    }
+
+    fn update(&mut self, done: u32, seconds: f64) {
+        let percent = (done as u64 * 100 / self.spp.max(1) as u64) as u32;
+        if percent >= self.next_percent || seconds - self.last >= 2.0 {
+            eprintln!(
+                "penumbra: render {percent}% ({done}/{} spp, {seconds:.1} s)",
+                self.spp
+            );
+            self.next_percent = (percent / 10 + 1) * 10;
+            self.last = seconds;
+        }
+    }
 }

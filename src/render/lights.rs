@@ -110,7 +110,7 @@ pub fn gpu_lights(
         let d = l.direction.as_vec3().normalize_or(Vec3::NEG_Y);
         out.push(GpuLight {
             position: f4(position.as_vec3(), f32::from_bits(kind)),
-            intensity: [color[0], color[1], color[2], l.radius.max(0.0)],
+            intensity: [color[0], color[1], color[2], l.light_radius.max(0.0)],
             spot: f4(d, cos_outer),
             extra: [cos_inner, 0.0, 0.0, 0.0],
         });
@@ -149,7 +149,7 @@ impl Renderer {
             .environment
             .as_ref()
             .map(|(_, t)| t.mean_luminance * self.settings.env_intensity);
-        gpu_lights(&self.lights, host, env_luminance)
+        gpu_lights(&host.space.lights(&self.lights), host, env_luminance)
     }
 
     /// Fills the environment constants from the settings and the light list.

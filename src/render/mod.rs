@@ -2,7 +2,9 @@
 //! stages. It knows nothing of windows; the viewer and the command line drive it alike.
 
 pub mod camera;
+pub mod exposure;
 mod lights;
+mod megakernel;
 mod settings;
 mod textures;
 pub mod tonemap;
@@ -10,16 +12,17 @@ mod upload;
 mod wavefront;
 
 pub use lights::gpu_lights;
+pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
 pub use upload::{HostScene, gpu_camera};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
-use crate::bvh::{Bvh, Ray};
+use crate::bvh::{Bvh, Ray, WideBvh};
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
-use crate::scene::{AlphaMode, Camera, EnvMap, EnvSampling, Light, Scene};
+use crate::scene::{AlphaMode, Camera, EnvMap, EnvSampling, Light, RenderFrame, Scene};
 use std::sync::Arc;
 use std::time::Instant;
 use wavefront::Frame;
@@ -49,6 +52,8 @@ pub struct SceneStats {
     pub texture_bytes: usize,
     /// Largest texture side kept (4096 unless the budget forced less).
     pub texture_max_side: u32,
+    /// Triangles left out for a non-finite or absurd vertex.
+    pub dropped_triangles: usize,
 }
 
 /// The path tracer on one OpenCL device.
@@ -61,6 +66,8 @@ pub struct Renderer {
     counters: Buffer<u32>,
     stats_buffer: Buffer<u64>,
     settings: RenderSettings,
+    /// The world camera as last given (the device's is in render space).
+    world_camera: Option<Camera>,
     camera: GpuCamera,
     light_count: u32,
     /// Features of the loaded scene (without the environment map's).
@@ -72,6 +79,8 @@ pub struct Renderer {
     samples: u32,
     stats: RenderStats,
     pending: Vec<(Stage, Launch)>,
+    /// Whether frames run as the megakernel (else the wavefront); see [`KernelChoice`].
+    megakernel: bool,
 }
 
 impl Renderer {
@@ -94,6 +103,7 @@ impl Renderer {
             counters,
             stats_buffer,
             settings: RenderSettings::default(),
+            world_camera: None,
             camera: GpuCamera::default(),
             light_count: 0,
             scene_features: KernelFeatures::default(),
@@ -103,22 +113,39 @@ impl Renderer {
             samples: 0,
             stats: RenderStats::default(),
             pending: Vec::new(),
+            megakernel: false,
         };
-        r.reset()?;
+        r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
     }
 
     /// Builds the BVH of the scene's visible objects, uploads the scene and its lights, and
-    /// (re)builds the kernels when the scene's features changed. Resets the film.
+    /// (re)builds the kernels when the scene's features changed. The scene goes to the device
+    /// in a render space around its robust middle ([`RenderFrame::around`]). Resets the film.
     pub fn load_scene(&mut self, scene: &Scene, lights: &[Light]) -> Result<SceneStats, ClError> {
+        let bounds = scene.bounds();
+        self.load_scene_in(scene, lights, RenderFrame::around(&bounds))
+    }
+
+    /// [`Renderer::load_scene`] in the render space `space`; the camera, lens and lights
+    /// follow it.
+    pub fn load_scene_in(
+        &mut self,
+        scene: &Scene,
+        lights: &[Light],
+        space: RenderFrame,
+    ) -> Result<SceneStats, ClError> {
         let t = Instant::now();
-        let world = scene.world_triangles();
+        let flat = scene.flatten(&space);
+        let world = flat.triangles;
         let verts: Vec<[glam::Vec3; 3]> = world.iter().map(|t| t.v).collect();
         let bvh = crate::bvh::build(&verts);
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
 
         let t = Instant::now();
-        let mut host = HostScene::new(&world, bvh, &scene.materials);
+        let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
+        let mut host = HostScene::new(&world, bvh, &materials);
+        host.space = space;
         host.scale_emitter_power(&lights::emissive_texture_means(scene));
         let used = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
         self.scene_features = KernelFeatures {
@@ -151,6 +178,7 @@ impl Renderer {
         };
         let buffers = SceneBuffers {
             nodes: Buffer::from_slice(&self.gpu, &host.bvh.nodes)?,
+            wide_nodes: Buffer::from_slice(&self.gpu, &WideBvh::collapse(&host.bvh).nodes)?,
             triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
             shading: Buffer::from_slice(&self.gpu, &host.shading)?,
             tangents: Buffer::from_slice(&self.gpu, tangents)?,
@@ -173,8 +201,14 @@ impl Renderer {
             textures: pack.textures.len(),
             texture_bytes: pack.bytes(),
             texture_max_side: pack.max_side,
+            dropped_triangles: flat.dropped,
         };
         self.scene = Some((buffers, host));
+        if let Some(c) = self.world_camera.clone() {
+            self.set_camera(&c)?;
+        }
+        let mut stats = stats;
+        stats.kernel_build_ms += self.prime_megakernel()?;
         self.reset()?;
         Ok(stats)
     }
@@ -193,6 +227,8 @@ impl Renderer {
         {
             return Ok(0.0);
         }
+        // A cold build takes seconds (the drivers cache built programs on disk: see README).
+        eprintln!("penumbra: compiling kernels…");
         let t = Instant::now();
         self.program = Some(Program::build(&self.gpu, features)?);
         Ok(t.elapsed().as_secs_f64() * 1e3)
@@ -234,14 +270,22 @@ impl Renderer {
     /// plane in focus along the view axis. Resets the film.
     pub fn set_lens(&mut self, lens_radius: f32, focus_distance: f32) -> Result<(), ClError> {
         self.settings.lens_radius = lens_radius.max(0.0);
-        self.settings.focus_distance = focus_distance.max(1e-6);
+        self.settings.focus_distance = focus_distance.max(f32::MIN_POSITIVE);
         self.apply_lens();
         self.reset()
     }
 
     fn apply_lens(&mut self) {
-        self.camera.origin[3] = self.settings.lens_radius;
-        self.camera.forward[3] = self.settings.focus_distance;
+        let space = self.space();
+        self.camera.origin[3] = space.length(self.settings.lens_radius as f64);
+        self.camera.forward[3] = space.length(self.settings.focus_distance as f64);
+    }
+
+    /// The map from world space to the render space of the scene on the device.
+    pub fn space(&self) -> RenderFrame {
+        self.scene
+            .as_ref()
+            .map_or_else(RenderFrame::default, |(_, h)| h.space)
     }
 
     /// The distance along the view axis to the surface seen through pixel (x, y) (pixel
@@ -260,7 +304,7 @@ impl Renderer {
             ..ray
         };
         let hit = host.bvh.intersect(&ray, &host.vertices)?;
-        Some(hit.t * unit.dot(forward.normalize()))
+        Some((hit.t * unit.dot(forward.normalize())) / host.space.scale as f32)
     }
 
     /// Replaces the lights without touching the BVH. Resets the film.
@@ -273,9 +317,10 @@ impl Renderer {
         self.reset()
     }
 
-    /// Sets the camera. Resets the film.
+    /// Sets the camera (in world space). Resets the film.
     pub fn set_camera(&mut self, camera: &Camera) -> Result<(), ClError> {
-        self.camera = gpu_camera(camera, self.settings.aspect());
+        self.world_camera = Some(camera.clone());
+        self.camera = gpu_camera(&self.space().camera(camera), self.settings.aspect());
         self.apply_lens();
         self.reset()
     }

@@ -3,7 +3,7 @@
 
 use crate::bvh::Bvh;
 use crate::cl::types::*;
-use crate::scene::{AlphaMode, Camera, Material, WorldTriangle};
+use crate::scene::{AlphaMode, Camera, Material, RenderFrame, WorldTriangle, robust_bounds};
 use glam::Vec3;
 
 /// The scene as uploaded, kept on the host for picking and for tests.
@@ -22,6 +22,10 @@ pub struct HostScene {
     pub materials: Vec<GpuMaterial>,
     /// Emissive triangles (BVH order index, area, emitted power for selection).
     pub emissive: Vec<(u32, f32, f32)>,
+    /// The map from world space to the render space the triangles are in.
+    pub space: RenderFrame,
+    /// The middle and the diagonal of the robust bounds of the triangles.
+    middle: (Vec3, f32),
 }
 
 pub(super) fn f4(v: Vec3, w: f32) -> [f32; 4] {
@@ -143,6 +147,14 @@ impl HostScene {
             }
             vertices.push(t.v);
         }
+        let corners: Vec<[glam::DVec3; 3]> =
+            world.iter().map(|t| t.v.map(Vec3::as_dvec3)).collect();
+        let b = robust_bounds(&corners);
+        let middle = if b.is_empty() {
+            (Vec3::ZERO, 1.0)
+        } else {
+            (b.center().as_vec3(), b.diagonal() as f32)
+        };
         Self {
             bvh,
             triangles,
@@ -151,6 +163,8 @@ impl HostScene {
             tangents,
             materials: materials.iter().map(gpu_material).collect(),
             emissive,
+            space: RenderFrame::default(),
+            middle,
         }
     }
 
@@ -163,15 +177,10 @@ impl HostScene {
         }
     }
 
-    /// The middle and the diagonal of the scene's box (from the BVH root's two children).
+    /// The middle and the diagonal of the scene's robust box (a lone far-away object does not
+    /// count, see [`robust_bounds`]), in render space.
     pub fn bounds(&self) -> (Vec3, f32) {
-        let (a, _) = self.bvh.child(0, 0);
-        let (b, _) = self.bvh.child(0, 1);
-        let u = a.union(b);
-        if u.min.cmpgt(u.max).any() {
-            return (Vec3::ZERO, 1.0);
-        }
-        ((u.min + u.max) * 0.5, (u.max - u.min).length())
+        self.middle
     }
 
     /// The object index of a triangle in BVH order.
@@ -227,7 +236,7 @@ mod tests {
             direction: glam::DVec3::NEG_Y,
             color: [1.0; 3],
             intensity,
-            radius: 0.0,
+            light_radius: 0.0,
         }
     }
 

@@ -204,9 +204,12 @@ impl Wave<'_> {
     }
 }
 
+/// The most waves [`Renderer::render`] enqueues before it waits for them.
+pub const MAX_WAVES_PER_BATCH: u32 = 64;
+
 impl Renderer {
     /// Allocates the film and the per-slot buffers for the current size.
-    fn ensure_frame(&mut self) -> Result<(), ClError> {
+    pub(super) fn ensure_frame(&mut self) -> Result<(), ClError> {
         let (w, h) = (self.settings.width, self.settings.height);
         let pixels = (w * h) as usize;
         let wave = if self.gpu.info.is_gpu {
@@ -242,9 +245,25 @@ impl Renderer {
     }
 
     /// Renders `spp` more samples per pixel into the film and waits for them.
+    ///
+    /// The samples go in batches of at most [`MAX_WAVES_PER_BATCH`] waves: every launch holds
+    /// an event on the host until the queue finishes, so one batch of any `spp` would grow host
+    /// memory with it. Batches are whole waves, so the image is the same as in one batch.
     pub fn render(&mut self, spp: u32) -> Result<(), ClError> {
-        self.start(spp)?;
-        self.finish()
+        self.ensure_frame()?;
+        let per_wave = match &self.frame {
+            Some(f) => (f.slots / (f.width * f.height) as usize).max(1) as u32,
+            None => 1,
+        };
+        let batch = per_wave.saturating_mul(MAX_WAVES_PER_BATCH);
+        let mut left = spp;
+        while left > 0 {
+            let n = left.min(batch);
+            self.start(n)?;
+            self.finish()?;
+            left -= n;
+        }
+        Ok(())
     }
 
     /// Enqueues `spp` more samples per pixel and returns at once, so the host can do other
@@ -286,6 +305,9 @@ impl Renderer {
     /// Enqueues the stages for `spp` more samples without waiting: per wave, `generate`, then
     /// `extend`, `shade`, `connect` and `advance` for each bounce, then `accumulate`.
     fn enqueue(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
+        if self.megakernel {
+            return self.enqueue_megakernel(spp);
+        }
         self.ensure_frame()?;
         let (Some(program), Some((scene, _)), Some(f)) = (
             self.program.as_ref(),

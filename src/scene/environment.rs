@@ -5,12 +5,30 @@
 //! column looks along −Z and u grows towards +X (seen from inside, the image is not mirrored).
 //! With φ = 2π(u − ½) and θ = πv, the direction is (sin θ sin φ, cos θ, −sin θ cos φ).
 
+use super::limits;
 use glam::Vec3;
 use std::f32::consts::PI;
 use std::path::Path;
 
 /// Environment images wider than this are box-filtered down by halves on load.
 pub const MAX_ENV_WIDTH: u32 = 4096;
+
+/// Checks an environment image's size (from its header) against [`limits::MAX_ENV_SIDE`] and
+/// [`limits::MAX_ENV_PIXELS`].
+fn check_env_size(width: u64, height: u64) -> Result<(), String> {
+    if width == 0 || height == 0 {
+        return Err("the image is empty".into());
+    }
+    let side = limits::MAX_ENV_SIDE as u64;
+    if width > side || height > side || width * height > limits::MAX_ENV_PIXELS {
+        return Err(format!(
+            "{width}×{height} pixels is more than the limit for environment images ({side} per \
+             side, {} pixels)",
+            limits::MAX_ENV_PIXELS
+        ));
+    }
+    Ok(())
+}
 
 /// An environment image in linear radiance.
 #[derive(Clone)]
@@ -58,12 +76,35 @@ impl EnvMap {
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase)
             .unwrap_or_default();
+        if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+            return Err(format!("{}: not a regular file", path.display()));
+        }
+        let too_big = |e: String| format!("{}: {e}", path.display());
         let (width, height, texels) = match ext.as_str() {
-            "exr" => crate::image_io::read_exr(path).map_err(|e| format!("{e:#}"))?,
+            "exr" => {
+                // Check every layer's size from the header before any pixel is allocated.
+                let layers =
+                    crate::image_io::exr_layer_sizes(path).map_err(|e| format!("{e:#}"))?;
+                for (w, h, chunks) in layers {
+                    check_env_size(w, h).map_err(too_big)?;
+                    if chunks > limits::MAX_ENV_PIXELS / 16 {
+                        return Err(too_big(format!("{chunks} chunks is too many")));
+                    }
+                }
+                crate::image_io::read_exr(path).map_err(|e| format!("{e:#}"))?
+            }
             "hdr" => {
-                let image = image::open(path)
-                    .map_err(|e| format!("{}: cannot read the HDR image: {e}", path.display()))?
-                    .into_rgb32f();
+                let cannot = |e: image::ImageError| {
+                    format!("{}: cannot read the HDR image: {e}", path.display())
+                };
+                let open = || image::ImageReader::open(path).map_err(|e| cannot(e.into()));
+                let (w, h) = open()?.into_dimensions().map_err(cannot)?;
+                check_env_size(w as u64, h as u64).map_err(too_big)?;
+                let mut reader = open()?;
+                let mut caps = image::Limits::default();
+                caps.max_alloc = Some(limits::MAX_ENV_PIXELS * 16);
+                reader.limits(caps);
+                let image = reader.decode().map_err(cannot)?.into_rgb32f();
                 let (w, h) = image.dimensions();
                 let texels = image.pixels().map(|p| p.0).collect();
                 (w, h, texels)

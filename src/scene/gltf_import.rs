@@ -1,11 +1,15 @@
 //! glTF 2.0 import (`.gltf` with external or embedded buffers, and `.glb`).
 
+use super::accessor::{self, Attributes, BufferData};
+use super::compression;
+use super::pose::{Pose, apply_morph_targets, apply_skin, node_pose, rest_worlds};
 use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
-    default_light_rig,
+    default_light_rig, limits, sources, validate,
 };
 use glam::{DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
+use gltf::json::validation::Checked;
 use gltf::mesh::Mode;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -13,20 +17,6 @@ use std::path::Path;
 use std::sync::Arc;
 
 mod materials;
-
-/// Extensions penumbra understands (or can safely ignore when rendering).
-const SUPPORTED_EXTENSIONS: &[&str] = &[
-    "KHR_lights_punctual",
-    "KHR_materials_clearcoat",
-    "KHR_materials_emissive_strength",
-    "KHR_materials_ior",
-    "KHR_materials_specular",
-    "KHR_materials_transmission",
-    "KHR_materials_unlit",
-    "KHR_materials_volume",
-    "KHR_texture_transform",
-    "KHR_mesh_quantization",
-];
 
 /// Vertical field of view of the automatic camera.
 pub const AUTO_YFOV: f64 = 0.8;
@@ -37,6 +27,10 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         path: path.to_path_buf(),
         message,
     };
+    let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
+    if !meta.is_file() {
+        return Err(fail("cannot read file: not a regular file".into()));
+    }
     let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
     load_from_bytes(&bytes, path.parent(), &path.display().to_string()).map_err(fail)
 }
@@ -44,15 +38,21 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 /// Loads glTF or GLB bytes; external files are resolved against `base`.
 pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Result<Scene, String> {
     let mut warnings = Vec::new();
-    check_extensions(bytes, &mut warnings)?;
-    let gltf = gltf::Gltf::from_slice_without_validation(bytes)
-        .map_err(|e| format!("not a valid glTF file: {e}"))?;
-    let document = gltf.document;
-    let buffers = gltf::import_buffers(&document, base, gltf.blob)
-        .map_err(|e| format!("cannot load buffers: {e}"))?;
-    let buffer_data: Vec<&[u8]> = buffers.iter().map(|b| b.0.as_slice()).collect();
+    let parsed = validate::parse(bytes, &mut warnings)?;
+    let document = parsed.document;
+    let buffers = sources::load_buffers(&document, base, parsed.blob)?;
+    let root = document.as_json();
+    let mut buffer_data = BufferData {
+        buffers: buffers.iter().map(Vec::as_slice).collect(),
+        decoded_views: HashMap::new(),
+    };
+    buffer_data.decoded_views = compression::decode_meshopt_views(root, &buffer_data.buffers)?;
+    let rest = rest_worlds(&document);
 
-    let mut table = TextureTable::default();
+    let mut table = TextureTable {
+        sources: texture_sources(root),
+        ..TextureTable::default()
+    };
     let mut materials = document
         .materials()
         .map(|m| import_material(m, &document, &mut table, &mut warnings))
@@ -94,59 +94,119 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         .rev()
         .map(|n| (n, DMat4::IDENTITY, 0))
         .collect();
+    let mut meshes: HashMap<usize, Mesh> = HashMap::new();
+    let mut placed = 0usize;
+    let mut triangles = 0usize;
     while let Some((node, parent, depth)) = stack.pop() {
-        if depth > 256 {
+        let at = format!("nodes[{}]", node.index());
+        placed += 1;
+        if placed > limits::MAX_NODE_INSTANCES {
             return Err(format!(
-                "node {} is nested too deeply (a cycle?)",
-                node.index()
+                "{at}: the node graph places more than {} nodes (a child listed more than once?)",
+                limits::MAX_NODE_INSTANCES
             ));
         }
-        let world = parent * node_matrix(&node);
+        if depth > limits::MAX_NODE_DEPTH {
+            return Err(format!(
+                "{at}: nested more than {} deep (a cycle?)",
+                limits::MAX_NODE_DEPTH
+            ));
+        }
+        // A node whose transform is not usable is left out with everything below it.
+        let world = match node_matrix(&node) {
+            Ok(local) => parent * local,
+            Err(why) => {
+                warn_once(
+                    &mut warnings,
+                    format!("{at}: {why}; the node and its children are skipped"),
+                );
+                continue;
+            }
+        };
+        // The GPU gets f32: the transform and its inverse must stay finite there too.
+        if !world.as_mat4().is_finite() || !world.inverse().as_mat4().is_finite() {
+            warn_once(
+                &mut warnings,
+                format!(
+                    "{at}: its world transform is singular or not finite; the node and its children are skipped"
+                ),
+            );
+            continue;
+        }
         if let Some(mesh) = node.mesh() {
             let name = node
                 .name()
                 .or(mesh.name())
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("mesh {}", mesh.index()));
-            let m = import_mesh(
-                &mesh,
-                &buffer_data,
-                default_material,
-                &normal_sets,
-                &mut warnings,
-            )?;
+            // Each mesh is read once, however many nodes place it, unless the node poses it
+            // (a skin or its own morph weights).
+            let pose = node_pose(&node, &mesh, root, &buffer_data, &rest)?;
+            let posed = node.skin().is_some() || node.weights().is_some();
+            let m = match meshes.get(&mesh.index()).filter(|_| !posed) {
+                Some(m) => m.clone(),
+                None => {
+                    let m = import_mesh(
+                        &mesh,
+                        root,
+                        &buffer_data,
+                        &pose,
+                        default_material,
+                        &normal_sets,
+                        &mut warnings,
+                    )?;
+                    if !posed {
+                        meshes.insert(mesh.index(), m.clone());
+                    }
+                    m
+                }
+            };
+            if m.positions.iter().any(|p| {
+                let w = world.transform_point3(p.as_dvec3());
+                w.abs().max_element().partial_cmp(&limits::MAX_COORDINATE)
+                    != Some(std::cmp::Ordering::Less)
+            }) {
+                warn_once(
+                    &mut warnings,
+                    format!(
+                        "{at}: vertices lie farther than {:e} from the origin; skipped",
+                        limits::MAX_COORDINATE
+                    ),
+                );
+                continue;
+            }
+            triangles += m.indices.len();
+            if triangles > limits::MAX_TRIANGLES {
+                return Err(format!(
+                    "{at}: the scene has more than {} triangles after instancing",
+                    limits::MAX_TRIANGLES
+                ));
+            }
             if !m.indices.is_empty() {
                 scene.objects.push(Object {
                     name,
-                    world_from_object: world,
+                    // A skinned mesh is placed by its joints alone; its node's transform is
+                    // ignored (glTF 2.0 § 3.7.3).
+                    world_from_object: if pose.joints.is_empty() {
+                        world
+                    } else {
+                        DMat4::IDENTITY
+                    },
                     visible: true,
                     mesh: m,
                 });
             }
         }
         if let Some(camera) = node.camera() {
-            if let gltf::camera::Projection::Perspective(p) = camera.projection() {
-                let forward = -world.transform_vector3(DVec3::Z).normalize();
-                let up = world.transform_vector3(DVec3::Y).normalize();
-                scene.cameras.push(Camera {
-                    name: camera
-                        .name()
-                        .map(str::to_string)
-                        .unwrap_or_else(|| format!("camera {}", camera.index())),
-                    eye: world.transform_point3(DVec3::ZERO),
-                    forward,
-                    up,
-                    yfov: p.yfov() as f64,
-                });
-            } else {
-                warnings.push(format!(
-                    "camera {}: orthographic cameras are not supported, skipped",
-                    camera.index()
-                ));
+            match import_camera(&camera, &world) {
+                Ok(c) => scene.cameras.push(c),
+                Err(why) => warn_once(&mut warnings, why),
             }
         }
-        if let Some(light) = node.light() {
-            scene.lights.push(import_light(&light, &world));
+        if let Some(light) = node.light()
+            && let Some(l) = import_light(&light, &world, &mut warnings)
+        {
+            scene.lights.push(l);
         }
         let children: Vec<gltf::Node> = node.children().collect();
         for child in children.into_iter().rev() {
@@ -172,52 +232,62 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
     Ok(scene)
 }
 
-/// Rejects unsupported required extensions and warns about unsupported optional ones.
-fn check_extensions(bytes: &[u8], warnings: &mut Vec<String>) -> Result<(), String> {
-    let json: &[u8] = if bytes.starts_with(b"glTF") {
-        let glb = gltf::Glb::from_slice(bytes).map_err(|e| format!("not a valid GLB file: {e}"))?;
-        return check_extensions_json(&glb.json, warnings);
-    } else {
-        bytes
-    };
-    check_extensions_json(json, warnings)
+/// Adds `warning` unless the same one was given already (a node placed many times warns once).
+fn warn_once(warnings: &mut Vec<String>, warning: String) {
+    if !warnings.contains(&warning) {
+        warnings.push(warning);
+    }
 }
 
-fn check_extensions_json(json: &[u8], warnings: &mut Vec<String>) -> Result<(), String> {
-    let value: serde_json::Value =
-        serde_json::from_slice(json).map_err(|e| format!("not a valid glTF file: {e}"))?;
-    let list = |key: &str| -> Vec<String> {
-        value
-            .get(key)
-            .and_then(|v| v.as_array())
-            .map(|a| {
-                a.iter()
-                    .filter_map(|s| s.as_str().map(str::to_string))
-                    .collect()
-            })
-            .unwrap_or_default()
-    };
-    for ext in list("extensionsRequired") {
-        if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
-            return Err(format!("requires the unsupported extension {ext}"));
+/// The node's local transform, or why it cannot be used: a non-finite value, a zero
+/// quaternion or a singular matrix.
+pub(super) fn node_matrix(node: &gltf::Node) -> Result<DMat4, &'static str> {
+    if let gltf::scene::Transform::Matrix { matrix } = node.transform() {
+        let m = DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)));
+        if !m.is_finite() {
+            return Err("matrix is not finite");
+        }
+        if !m.inverse().is_finite() || m.determinant() == 0.0 {
+            return Err("matrix is singular");
         }
     }
-    for ext in list("extensionsUsed") {
-        if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
-            warnings.push(format!(
-                "optional extension {ext} is not supported and is ignored"
-            ));
-        }
-    }
-    Ok(())
-}
-
-fn node_matrix(node: &gltf::Node) -> DMat4 {
     let (t, r, s) = node.transform().decomposed();
     let t = DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64);
-    let r = DQuat::from_xyzw(r[0] as f64, r[1] as f64, r[2] as f64, r[3] as f64).normalize();
+    let r = DQuat::from_xyzw(r[0] as f64, r[1] as f64, r[2] as f64, r[3] as f64);
     let s = DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64);
-    DMat4::from_scale_rotation_translation(s, r, t)
+    if !(t.is_finite() && r.is_finite() && s.is_finite()) {
+        return Err("translation, rotation or scale is not finite");
+    }
+    if r.length_squared() < 1e-24 {
+        return Err("rotation is a zero quaternion");
+    }
+    Ok(DMat4::from_scale_rotation_translation(s, r.normalize(), t))
+}
+
+/// A perspective camera placed by `world`, or a warning saying why it is left out.
+fn import_camera(camera: &gltf::Camera, world: &DMat4) -> Result<Camera, String> {
+    let at = format!("cameras[{}]", camera.index());
+    let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+        return Err(format!(
+            "{at}: orthographic cameras are not supported, skipped"
+        ));
+    };
+    let yfov = p.yfov() as f64;
+    if !(yfov > 0.0 && yfov < std::f64::consts::PI) {
+        return Err(format!(
+            "{at}.perspective.yfov: {yfov} is outside (0, π), camera skipped"
+        ));
+    }
+    Ok(Camera {
+        name: camera
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("camera {}", camera.index())),
+        eye: world.transform_point3(DVec3::ZERO),
+        forward: -world.transform_vector3(DVec3::Z).normalize(),
+        up: world.transform_vector3(DVec3::Y).normalize(),
+        yfov,
+    })
 }
 
 /// Texture references collected while importing materials, and the images they need.
@@ -230,6 +300,28 @@ struct TextureTable {
     order: Vec<usize>,
     /// Scene images that could not be decoded.
     failed: Vec<bool>,
+    /// The image each glTF texture shows (its `EXT_texture_webp` source, else its plain
+    /// source), if any.
+    sources: Vec<Option<usize>>,
+}
+
+/// The image each texture shows: the `EXT_texture_webp` source where present, else the
+/// core `source` (a `KHR_texture_basisu` image is not decoded, so only its fallback counts).
+fn texture_sources(root: &gltf::json::Root) -> Vec<Option<usize>> {
+    root.textures
+        .iter()
+        .map(|t| {
+            let webp = t
+                .extensions
+                .as_ref()
+                .and_then(|e| e.others.get("EXT_texture_webp"))
+                .and_then(|w| w.get("source"))
+                .and_then(serde_json::Value::as_u64)
+                .map(|i| i as usize);
+            let core = Some(t.source.value()).filter(|&i| i != u32::MAX as usize);
+            webp.or(core).filter(|&i| i < root.images.len())
+        })
+        .collect()
 }
 
 impl TextureTable {
@@ -244,11 +336,17 @@ impl TextureTable {
         what: &str,
         warnings: &mut Vec<String>,
     ) -> Option<u32> {
-        let source = texture.source();
+        let Some(source) = self.sources.get(texture.index()).copied().flatten() else {
+            warnings.push(format!(
+                "{what}: textures[{}] has no image penumbra can decode, left out",
+                texture.index()
+            ));
+            return None;
+        };
         let next = self.order.len() as u32;
-        let image = *self.images.entry(source.index()).or_insert(next);
+        let image = *self.images.entry(source).or_insert(next);
         if image == next {
-            self.order.push(source.index());
+            self.order.push(source);
         }
         let mut t = TexTransform::default();
         let mut tex_coord = tex_coord;
@@ -344,12 +442,11 @@ impl TextureTable {
 fn decode_images(
     document: &gltf::Document,
     base: Option<&Path>,
-    buffers: &[gltf::buffer::Data],
+    buffers: &[Vec<u8>],
     table: &mut TextureTable,
     warnings: &mut Vec<String>,
 ) -> Vec<Arc<Image>> {
     let all: Vec<gltf::Image> = document.images().collect();
-    let base = base.unwrap_or(Path::new("."));
     let decoded: Vec<Result<Image, String>> = table
         .order
         .par_iter()
@@ -363,8 +460,10 @@ fn decode_images(
                     .name()
                     .map_or_else(|| i.to_string(), |n| format!("{i} ({n})")),
             };
-            let data = gltf::image::Data::from_source(image.source(), Some(base), buffers)
-                .map_err(|e| format!("image {name}: cannot decode: {e}"))?;
+            let data = sources::decode_image(image, base, buffers).map_err(|e| {
+                let detail = name.strip_prefix(&i.to_string()).unwrap_or_default();
+                format!("images[{i}]{detail}: cannot decode: {e}")
+            })?;
             to_rgba8(&data, &name)
         })
         .collect();
@@ -397,10 +496,24 @@ fn import_material(
     warnings: &mut Vec<String>,
 ) -> Material {
     let pbr = m.pbr_metallic_roughness();
-    let strength = m.emissive_strength().unwrap_or(1.0);
-    let emissive = m.emissive_factor().map(|e| e * strength);
+    // Factors outside their ranges are clamped; one warning per material lists the changes.
+    let mut fix = Fixes::default();
+    let strength = fix.range(
+        "emissiveStrength",
+        m.emissive_strength().unwrap_or(1.0),
+        0.0,
+        limits::MAX_INTENSITY,
+        1.0,
+    );
+    let emissive = m
+        .emissive_factor()
+        .map(|e| fix.range("emissiveFactor", e, 0.0, 1.0, 0.0) * strength);
     let (specular_factor, specular_color) = match m.specular() {
-        Some(s) => (s.specular_factor(), s.specular_color_factor()),
+        Some(s) => (
+            fix.range("specularFactor", s.specular_factor(), 0.0, 1.0, 1.0),
+            s.specular_color_factor()
+                .map(|c| fix.range("specularColorFactor", c, 0.0, f32::MAX, 1.0)),
+        ),
         None => (1.0, [1.0; 3]),
     };
     let what = format!("material {}", m.index().unwrap_or(0));
@@ -425,53 +538,176 @@ fn import_material(
             .and_then(|t| table.info(t.transmission_texture(), false, &what, warnings)),
         ..MaterialTextures::default()
     };
+    let volume = m.volume();
     let mut material = Material {
         name: m
             .name()
             .map(str::to_string)
             .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0))),
-        base_color: pbr.base_color_factor(),
-        metallic: pbr.metallic_factor().clamp(0.0, 1.0),
-        roughness: pbr.roughness_factor().clamp(0.0, 1.0),
+        base_color: pbr
+            .base_color_factor()
+            .map(|c| fix.range("baseColorFactor", c, 0.0, 1.0, 1.0)),
+        metallic: fix.range("metallicFactor", pbr.metallic_factor(), 0.0, 1.0, 1.0),
+        roughness: fix.range("roughnessFactor", pbr.roughness_factor(), 0.0, 1.0, 1.0),
         emission: emissive.map(|e| if e.is_finite() { e.max(0.0) } else { 0.0 }),
         double_sided: m.double_sided(),
-        ior: m.ior().unwrap_or(1.5),
+        ior: fix.ior(m.ior().unwrap_or(1.5)),
         specular_factor,
         specular_color,
-        transmission: m.transmission().map_or(0.0, |t| t.transmission_factor()),
-        thickness: m.volume().map_or(0.0, |v| v.thickness_factor()),
-        attenuation_color: m.volume().map_or([1.0; 3], |v| v.attenuation_color()),
-        attenuation_distance: m
-            .volume()
-            .map_or(f32::INFINITY, |v| v.attenuation_distance()),
+        transmission: fix.range(
+            "transmissionFactor",
+            m.transmission().map_or(0.0, |t| t.transmission_factor()),
+            0.0,
+            1.0,
+            0.0,
+        ),
+        thickness: fix.range(
+            "thicknessFactor",
+            volume.as_ref().map_or(0.0, |v| v.thickness_factor()),
+            0.0,
+            f32::MAX,
+            0.0,
+        ),
+        attenuation_color: volume.as_ref().map_or([1.0; 3], |v| {
+            v.attenuation_color()
+                .map(|c| fix.range("attenuationColor", c, 0.0, 1.0, 1.0))
+        }),
+        attenuation_distance: fix.attenuation_distance(
+            volume
+                .as_ref()
+                .map_or(f32::INFINITY, |v| v.attenuation_distance()),
+        ),
         alpha: match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-            gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+            gltf::material::AlphaMode::Mask => AlphaMode::Mask(fix.range(
+                "alphaCutoff",
+                m.alpha_cutoff().unwrap_or(0.5),
+                0.0,
+                f32::MAX,
+                0.5,
+            )),
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         },
         textures,
-        normal_scale: normal.as_ref().map_or(1.0, |n| n.scale()),
+        normal_scale: fix.range(
+            "normalTexture.scale",
+            normal.as_ref().map_or(1.0, |n| n.scale()),
+            -f32::MAX,
+            f32::MAX,
+            1.0,
+        ),
         unlit: m.unlit(),
         ..Material::default()
     };
     materials::read_extensions(&m, document, table, &mut material, warnings);
+    if !fix.0.is_empty() {
+        warnings.push(format!(
+            "materials[{}]: {}",
+            m.index().unwrap_or(0),
+            fix.0.join(", ")
+        ));
+    }
     material
 }
 
-fn import_light(light: &gltf::khr_lights_punctual::Light, world: &DMat4) -> Light {
+/// Material values brought into their ranges, with a note for each change.
+#[derive(Default)]
+struct Fixes(Vec<String>);
+
+impl Fixes {
+    /// `v` clamped to `lo..=hi`; NaN becomes `default`.
+    fn range(&mut self, name: &str, v: f32, lo: f32, hi: f32, default: f32) -> f32 {
+        let out = if v.is_nan() { default } else { v.clamp(lo, hi) };
+        if out != v {
+            self.0
+                .push(format!("{name} {v} is out of range, {out} is used"));
+        }
+        out
+    }
+
+    /// The index of refraction: at least 1, or 0 (the extension's special value, kept as
+    /// the smallest ratio the BSDF accepts); anything else becomes the default 1.5.
+    fn ior(&mut self, ior: f32) -> f32 {
+        if ior == 0.0 {
+            1e-3
+        } else if ior.is_finite() && ior >= 1.0 {
+            ior
+        } else {
+            self.0
+                .push(format!("ior {ior} is below 1 or not finite, 1.5 is used"));
+            1.5
+        }
+    }
+
+    /// `attenuationDistance`: positive (infinite means no absorption).
+    fn attenuation_distance(&mut self, d: f32) -> f32 {
+        if d > 0.0 {
+            d
+        } else {
+            self.0.push(format!(
+                "attenuationDistance {d} is not positive, no absorption is used"
+            ));
+            f32::INFINITY
+        }
+    }
+}
+
+/// A punctual light placed by `world`; `None` (with a warning) when its color or intensity is
+/// negative or not finite. Spot cones are clamped to 0 ≤ inner < outer ≤ π/2.
+fn import_light(
+    light: &gltf::khr_lights_punctual::Light,
+    world: &DMat4,
+    warnings: &mut Vec<String>,
+) -> Option<Light> {
     use gltf::khr_lights_punctual::Kind;
+    let at = format!("extensions.KHR_lights_punctual.lights[{}]", light.index());
+    let color = light.color();
+    let intensity = light.intensity();
+    if !(color.iter().all(|c| c.is_finite() && *c >= 0.0)
+        && intensity.is_finite()
+        && intensity >= 0.0)
+    {
+        warn_once(
+            warnings,
+            format!("{at}: color or intensity is negative or not finite, light skipped"),
+        );
+        return None;
+    }
+    let clamped = (
+        color.map(|c| c.min(limits::MAX_INTENSITY)),
+        intensity.min(limits::MAX_INTENSITY),
+    );
+    if clamped != (color, intensity) {
+        warn_once(
+            warnings,
+            format!(
+                "{at}: color or intensity above {:e}, clamped",
+                limits::MAX_INTENSITY
+            ),
+        );
+    }
+    let (color, intensity) = clamped;
     let kind = match light.kind() {
         Kind::Point => LightKind::Point,
         Kind::Directional => LightKind::Directional,
         Kind::Spot {
             inner_cone_angle,
             outer_cone_angle,
-        } => LightKind::Spot {
-            inner: inner_cone_angle,
-            outer: outer_cone_angle,
-        },
+        } => {
+            let (inner, outer) = spot_cone(inner_cone_angle, outer_cone_angle);
+            if (inner, outer) != (inner_cone_angle, outer_cone_angle) {
+                warn_once(
+                    warnings,
+                    format!(
+                        "{at}.spot: cone angles {inner_cone_angle}, {outer_cone_angle} are \
+                         clamped to {inner}, {outer} (0 ≤ inner < outer ≤ π/2)"
+                    ),
+                );
+            }
+            LightKind::Spot { inner, outer }
+        }
     };
-    Light {
+    Some(Light {
         name: light
             .name()
             .map(str::to_string)
@@ -479,22 +715,40 @@ fn import_light(light: &gltf::khr_lights_punctual::Light, world: &DMat4) -> Ligh
         kind,
         position: world.transform_point3(DVec3::ZERO),
         direction: (-world.transform_vector3(DVec3::Z)).normalize_or(DVec3::NEG_Y),
-        color: light.color(),
-        intensity: light.intensity().max(0.0),
-        radius: 0.0,
-    }
+        color,
+        intensity,
+        light_radius: 0.0,
+    })
 }
 
+/// Spot cone angles clamped to 0 ≤ inner < outer ≤ π/2 (non-finite values take the
+/// extension's defaults, 0 and π/4).
+fn spot_cone(inner: f32, outer: f32) -> (f32, f32) {
+    use std::f32::consts::FRAC_PI_2;
+    let outer = if outer.is_finite() {
+        outer
+    } else {
+        FRAC_PI_2 / 2.0
+    };
+    let inner = if inner.is_finite() { inner } else { 0.0 };
+    let outer = outer.clamp(1e-4, FRAC_PI_2);
+    let inner = inner.clamp(0.0, outer * 0.9999);
+    (inner, outer)
+}
+
+#[allow(clippy::too_many_arguments)]
 fn import_mesh(
     mesh: &gltf::Mesh,
-    buffers: &[&[u8]],
+    root: &gltf::json::Root,
+    data: &BufferData,
+    pose: &Pose,
     default_material: u32,
     normal_sets: &[Option<u32>],
     warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
     let mut out = Mesh::default();
     for prim in mesh.primitives() {
-        let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+        let what = format!("meshes[{}].primitives[{}]", mesh.index(), prim.index());
         let mode = prim.mode();
         if !matches!(
             mode,
@@ -503,36 +757,52 @@ fn import_mesh(
             warnings.push(format!("{what}: mode {mode:?} is not triangles, skipped"));
             continue;
         }
-        let reader = prim.reader(|b| buffers.get(b.index()).copied());
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| format!("{what}: POSITION is missing or unreadable"))?
+        let json = &root.meshes[mesh.index()].primitives[prim.index()];
+        let attributes = Attributes {
+            root,
+            data,
+            accessors: json
+                .attributes
+                .iter()
+                .filter_map(|(k, v)| match k {
+                    Checked::Valid(s) => Some((s.to_string(), v.value())),
+                    Checked::Invalid => None,
+                })
+                .collect(),
+            draco: compression::decode_draco(root, data, json, &what)?,
+            path: what.clone(),
+        };
+        let mut positions: Vec<Vec3> = attributes
+            .floats::<3>("POSITION")?
+            .ok_or_else(|| format!("{what}: POSITION is missing"))?
+            .into_iter()
             .map(Vec3::from)
             .collect();
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("{what}: POSITION {i} is not finite"));
         }
-        let normals: Vec<Vec3> = reader
-            .read_normals()
+        let mut normals: Vec<Vec3> = attributes
+            .floats::<3>("NORMAL")?
+            .unwrap_or_default()
+            .into_iter()
             .map(|n| {
-                n.map(|n| {
-                    let n = Vec3::from(n);
-                    if n.is_finite() { n } else { Vec3::ZERO }
-                })
-                .collect()
+                let n = Vec3::from(n);
+                if n.is_finite() { n } else { Vec3::ZERO }
             })
-            .unwrap_or_default();
+            .collect();
         if !normals.is_empty() && normals.len() != positions.len() {
             return Err(format!("{what}: NORMAL count differs from POSITION count"));
         }
-        let read_uvs = |set: u32| -> Vec<Vec2> {
-            reader
-                .read_tex_coords(set)
-                .map(|t| t.into_f32().map(Vec2::from).collect())
+        let read_uvs = |set: u32| -> Result<Vec<Vec2>, String> {
+            Ok(attributes
+                .floats::<2>(&format!("TEXCOORD_{set}"))?
                 .unwrap_or_default()
+                .into_iter()
+                .map(Vec2::from)
+                .collect())
         };
-        let uvs = read_uvs(0);
-        let uvs1 = read_uvs(1);
+        let uvs = read_uvs(0)?;
+        let uvs1 = read_uvs(1)?;
         for (set, list) in [(0, &uvs), (1, &uvs1)] {
             if !list.is_empty() && list.len() != positions.len() {
                 return Err(format!(
@@ -540,9 +810,54 @@ fn import_mesh(
                 ));
             }
         }
-        let flat: Vec<u32> = match reader.read_indices() {
-            Some(i) => i.into_u32().collect(),
-            None => (0..positions.len() as u32).collect(),
+        let material = prim
+            .material()
+            .index()
+            .map_or(default_material, |i| i as u32);
+        let normal_set = normal_sets.get(material as usize).copied().flatten();
+        let mut file_tangents: Vec<Vec4> = match normal_set {
+            Some(_) => attributes
+                .floats::<4>("TANGENT")?
+                .unwrap_or_default()
+                .into_iter()
+                .map(Vec4::from)
+                .collect(),
+            None => Vec::new(),
+        };
+        if !file_tangents.is_empty() && file_tangents.len() != positions.len() {
+            return Err(format!("{what}: TANGENT count differs from POSITION count"));
+        }
+        // Pose the vertices: morph targets in the mesh's space, then the skin.
+        apply_morph_targets(
+            &attributes,
+            json,
+            &pose.weights,
+            &mut positions,
+            &mut normals,
+            &mut file_tangents,
+        )?;
+        if !pose.joints.is_empty() {
+            apply_skin(
+                &attributes,
+                &pose.joints,
+                &mut positions,
+                &mut normals,
+                &mut file_tangents,
+            )?;
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!(
+                "{what}: its morph targets or skin move POSITION {i} to a non-finite point"
+            ));
+        }
+        let flat: Vec<u32> = match (&attributes.draco, json.indices) {
+            (Some(d), _) => d.indices.clone(),
+            (None, Some(a)) => accessor::read_uints::<1>(root, data, a.value())
+                .map_err(|e| format!("{what}.indices: {e}"))?
+                .into_iter()
+                .map(|[i]| i)
+                .collect(),
+            (None, None) => (0..positions.len() as u32).collect(),
         };
         if let Some(&bad) = flat.iter().find(|&&i| i as usize >= positions.len()) {
             return Err(format!(
@@ -566,10 +881,6 @@ fn import_mesh(
                 .collect(),
         };
         let base = out.positions.len() as u32;
-        let material = prim
-            .material()
-            .index()
-            .map_or(default_material, |i| i as u32);
         // Keep the per-vertex arrays aligned when only some primitives have normals or UVs.
         pad_attribute(
             &mut out.normals,
@@ -580,31 +891,23 @@ fn import_mesh(
         pad_attribute(&mut out.uvs, out.positions.len(), &uvs, positions.len());
         pad_attribute(&mut out.uvs1, out.positions.len(), &uvs1, positions.len());
         // Tangents at the corners of normal-mapped triangles: the file's, else MikkTSpace's.
-        let tangents: Vec<[Vec4; 3]> = match normal_sets.get(material as usize).copied().flatten() {
+        let tangents: Vec<[Vec4; 3]> = match normal_set {
             None => Vec::new(),
-            Some(set) => match reader.read_tangents() {
-                Some(t) => {
-                    let t: Vec<Vec4> = t.map(Vec4::from).collect();
-                    if t.len() != positions.len() {
-                        return Err(format!("{what}: TANGENT count differs from POSITION count"));
-                    }
-                    triangles
-                        .iter()
-                        .map(|tri| tri.map(|i| t[i as usize]))
-                        .collect()
+            Some(_) if !file_tangents.is_empty() => triangles
+                .iter()
+                .map(|tri| tri.map(|i| file_tangents[i as usize]))
+                .collect(),
+            Some(set) => {
+                let set_uvs = if set == 1 { &uvs1 } else { &uvs };
+                if set_uvs.is_empty() {
+                    warnings.push(format!(
+                        "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"
+                    ));
+                    Vec::new()
+                } else {
+                    super::tangents::generate(&positions, &normals, set_uvs, &triangles)
                 }
-                None => {
-                    let set_uvs = if set == 1 { &uvs1 } else { &uvs };
-                    if set_uvs.is_empty() {
-                        warnings.push(format!(
-                            "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"
-                        ));
-                        Vec::new()
-                    } else {
-                        super::tangents::generate(&positions, &normals, set_uvs, &triangles)
-                    }
-                }
-            },
+            }
         };
         pad_attribute(
             &mut out.tangents,

@@ -1,6 +1,6 @@
 //! The default light rig and the presets the viewer offers.
 
-use super::{Bounds, Light, LightKind};
+use super::{Bounds, Light, LightKind, Scene};
 use glam::DVec3;
 
 /// Light rigs the viewer can put in place of, or beside, the scene's lights.
@@ -76,7 +76,7 @@ impl Shadows {
         lights
             .iter()
             .map(|l| Light {
-                radius: self.radius_for(&l.kind, diagonal),
+                light_radius: self.radius_for(&l.kind, diagonal),
                 ..l.clone()
             })
             .collect()
@@ -100,7 +100,7 @@ pub fn default_light_rig(bounds: &Bounds) -> Vec<Light> {
             direction: (center - key).normalize_or(DVec3::NEG_Y),
             color: [1.0, 0.97, 0.92],
             intensity: (distance * distance) as f32,
-            radius: default_light_radius(bounds),
+            light_radius: default_light_radius(bounds),
         },
         Light {
             name: "default sun".into(),
@@ -109,9 +109,20 @@ pub fn default_light_rig(bounds: &Bounds) -> Vec<Light> {
             direction: DVec3::new(-0.4, -1.0, -0.5).normalize(),
             color: [1.0, 0.95, 0.85],
             intensity: 0.6,
-            radius: 0.02,
+            light_radius: 0.02,
         },
     ]
+}
+
+impl Scene {
+    /// An environment light (`--env`) lights the scene instead of the default rig: a scene
+    /// that only has the rig loses it; a scene with its own lights keeps them.
+    pub fn light_by_environment(&mut self) {
+        if self.default_rig {
+            self.lights.clear();
+            self.default_rig = false;
+        }
+    }
 }
 
 /// The lights of a preset, sized to the scene.
@@ -126,7 +137,7 @@ pub fn preset_lights(preset: LightPreset, bounds: &Bounds) -> Vec<Light> {
         direction: (-offset).normalize_or(DVec3::NEG_Y),
         color,
         intensity: (power * size * size) as f32,
-        radius,
+        light_radius: radius,
     };
     match preset {
         LightPreset::ThreePointStudio => vec![
@@ -142,7 +153,7 @@ pub fn preset_lights(preset: LightPreset, bounds: &Bounds) -> Vec<Light> {
                 direction: DVec3::new(-0.3, -0.8, -0.5).normalize(),
                 color: [1.0, 0.93, 0.8],
                 intensity: 3.0,
-                radius: 0.01,
+                light_radius: 0.01,
             },
             Light {
                 name: "sky fill".into(),
@@ -151,7 +162,7 @@ pub fn preset_lights(preset: LightPreset, bounds: &Bounds) -> Vec<Light> {
                 direction: DVec3::NEG_Y,
                 color: [0.5, 0.65, 1.0],
                 intensity: 0.5,
-                radius: 0.5,
+                light_radius: 0.5,
             },
         ],
         LightPreset::OverheadSoftbox => vec![Light {
@@ -164,7 +175,7 @@ pub fn preset_lights(preset: LightPreset, bounds: &Bounds) -> Vec<Light> {
             direction: DVec3::NEG_Y,
             color: [1.0, 1.0, 1.0],
             intensity: (1.5 * size * size) as f32,
-            radius: (0.15 * size) as f32,
+            light_radius: (0.15 * size) as f32,
         }],
     }
 }
@@ -190,7 +201,7 @@ mod tests {
         assert_eq!(small.len(), big.len());
         let ratio = big[0].intensity / small[0].intensity;
         assert!((ratio - 10_000.0).abs() < 1.0, "{ratio}");
-        assert!(big[0].radius > small[0].radius);
+        assert!(big[0].light_radius > small[0].light_radius);
     }
 
     #[test]
@@ -202,14 +213,32 @@ mod tests {
             direction: glam::DVec3::NEG_Y,
             color: [1.0; 3],
             intensity: 1.0,
-            radius: 0.0,
+            light_radius: 0.0,
         };
         let shadows = Shadows {
             light_radius: 1.0,
             hard: false,
         };
         let l = shadows.apply(&[sun], 100.0);
-        assert!((l[0].radius - 0.02).abs() < 1e-6);
+        assert!((l[0].light_radius - 0.02).abs() < 1e-6);
+    }
+
+    #[test]
+    fn an_environment_replaces_only_the_default_rig() {
+        let rig = default_light_rig(&unit_box());
+        let mut lit_by_rig = Scene {
+            lights: rig.clone(),
+            default_rig: true,
+            ..Scene::default()
+        };
+        lit_by_rig.light_by_environment();
+        assert!(lit_by_rig.lights.is_empty() && !lit_by_rig.default_rig);
+        let mut own_lights = Scene {
+            lights: rig.clone(),
+            ..Scene::default()
+        };
+        own_lights.light_by_environment();
+        assert_eq!(own_lights.lights, rig);
     }
 
     #[test]

@@ -3,12 +3,23 @@
 //! Transforms are composed in f64; geometry is stored per object in object space and flattened
 //! into world-space triangles (f32) whenever the scene changes.
 
+mod accessor;
+mod bounds;
+mod compression;
+mod env_presets;
 mod environment;
+pub mod framing;
 mod gltf_import;
 mod lights;
+pub mod limits;
+mod pose;
+mod sources;
 mod tangents;
 mod textures;
+mod validate;
 
+pub use bounds::{ABSURD_COORDINATE, RenderFrame, is_sane, robust_bounds};
+pub use env_presets::EnvPreset;
 pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
 pub use gltf_import::{AUTO_YFOV, load, load_from_bytes};
 pub use lights::{LightPreset, Shadows, default_light_radius, default_light_rig, preset_lights};
@@ -16,6 +27,7 @@ pub use textures::{
     Image, MAX_TEXTURE_SIDE, MaterialTextures, MipLevel, TexTransform, TextureRef, Wrap,
     linear_to_srgb, mip_chain, srgb_to_linear,
 };
+pub use validate::SUPPORTED_EXTENSIONS;
 
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -206,9 +218,9 @@ pub struct Light {
     pub color: [f32; 3],
     /// Radiant intensity (W/sr, point and spot) or irradiance (directional), used 1:1.
     pub intensity: f32,
-    /// Radius in world units (an angular radius in radians for directional lights);
-    /// 0 gives hard shadows.
-    pub radius: f32,
+    /// The light radius (`--light-radius`, "light radius" in the overlay): in world units, an
+    /// angular radius in radians for directional lights; 0 gives hard shadows.
+    pub light_radius: f32,
 }
 
 /// A perspective camera.
@@ -347,28 +359,45 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// World-space triangles of the visible objects, in object order.
+    /// World-space triangles of the visible objects, in object order (absurd ones dropped).
     pub fn world_triangles(&self) -> Vec<WorldTriangle> {
+        self.flatten(&RenderFrame::default()).triangles
+    }
+
+    /// The visible objects' triangles in the render space of `frame`, in object order: moved
+    /// and scaled in f64 before they become f32. Triangles with a non-finite or absurd vertex
+    /// (see [`is_sane`]) are dropped and counted.
+    pub fn flatten(&self, frame: &RenderFrame) -> Flattened {
         use rayon::prelude::*;
-        let per_object: Vec<Vec<WorldTriangle>> = self
+        let per_object: Vec<(Vec<WorldTriangle>, usize)> = self
             .objects
             .par_iter()
             .enumerate()
             .filter(|(_, o)| o.visible)
-            .map(|(oi, o)| object_triangles(oi as u32, o))
+            .map(|(oi, o)| object_triangles(oi as u32, o, frame))
             .collect();
-        per_object.concat()
+        Flattened {
+            dropped: per_object.iter().map(|(_, d)| d).sum(),
+            triangles: per_object.into_iter().flat_map(|(t, _)| t).collect(),
+        }
     }
 
-    /// World-space bounds of the visible geometry.
+    /// Robust world-space bounds of the visible geometry (see [`robust_bounds`]): what
+    /// framing, the default light radius and the render frame use.
     pub fn bounds(&self) -> Bounds {
-        let mut b = Bounds::default();
-        for o in self.objects.iter().filter(|o| o.visible) {
-            for p in &o.mesh.positions {
-                b.grow(o.world_from_object.transform_point3(p.as_dvec3()));
-            }
-        }
-        b
+        use rayon::prelude::*;
+        let triangles: Vec<[DVec3; 3]> = self
+            .objects
+            .par_iter()
+            .filter(|o| o.visible)
+            .flat_map_iter(|o| {
+                let m = o.world_from_object;
+                o.mesh.indices.iter().map(move |t| {
+                    t.map(|i| m.transform_point3(o.mesh.positions[i as usize].as_dvec3()))
+                })
+            })
+            .collect();
+        robust_bounds(&triangles)
     }
 
     /// Number of triangles over all visible objects.
@@ -381,17 +410,29 @@ impl Scene {
     }
 }
 
-fn object_triangles(object: u32, o: &Object) -> Vec<WorldTriangle> {
+/// Triangles in render space, and how many were dropped.
+#[derive(Clone, Debug, Default)]
+pub struct Flattened {
+    /// The triangles kept.
+    pub triangles: Vec<WorldTriangle>,
+    /// Triangles with a non-finite or absurd vertex, left out.
+    pub dropped: usize,
+}
+
+fn object_triangles(object: u32, o: &Object, frame: &RenderFrame) -> (Vec<WorldTriangle>, usize) {
     let m = o.world_from_object;
     let normal_matrix = m.inverse().transpose();
     // A mirroring transform flips the winding; swap two vertices to keep front faces in front.
     let flip = m.determinant() < 0.0;
-    let world: Vec<Vec3> = o
+    let world: Vec<DVec3> = o
         .mesh
         .positions
         .iter()
-        .map(|p| m.transform_point3(p.as_dvec3()).as_vec3())
+        .map(|p| m.transform_point3(p.as_dvec3()))
         .collect();
+    let sane = |t: &[u32; 3]| t.iter().all(|&i| is_sane(world[i as usize]));
+    let dropped = o.mesh.indices.iter().filter(|t| !sane(t)).count();
+    let world: Vec<Vec3> = world.iter().map(|&p| frame.point(p)).collect();
     let normals: Vec<Vec3> = o
         .mesh
         .normals
@@ -403,11 +444,13 @@ fn object_triangles(object: u32, o: &Object) -> Vec<WorldTriangle> {
                 .as_vec3()
         })
         .collect();
-    o.mesh
+    let triangles = o
+        .mesh
         .indices
         .iter()
         .zip(&o.mesh.materials)
         .enumerate()
+        .filter(|(_, (t, _))| sane(t))
         .map(|(ti, (&[a, b, c], &material))| {
             let idx = if flip { [a, c, b] } else { [a, b, c] };
             let v = idx.map(|i| world[i as usize]);
@@ -453,5 +496,6 @@ fn object_triangles(object: u32, o: &Object) -> Vec<WorldTriangle> {
                 object,
             }
         })
-        .collect()
+        .collect();
+    (triangles, dropped)
 }

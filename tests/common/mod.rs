@@ -237,7 +237,7 @@ impl Gltf {
 
     /// GLB bytes, written by the library's GLB writer (the one `bench generate` uses).
     pub fn glb(&self) -> Vec<u8> {
-        penumbra::cli::bench::generate::glb(&self.json(None), &self.bin)
+        penumbra::bench::generate::glb(&self.json(None), &self.bin)
     }
 
     /// Writes `name.glb` into `dir`.
@@ -326,6 +326,20 @@ pub fn sphere(
         }
     }
     (pos, nrm, idx)
+}
+
+/// A unit quad in the z = 0 plane as two triangles with material 0.
+pub fn quad() -> Prim {
+    Prim::triangles(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ],
+        vec![0, 1, 2, 0, 2, 3],
+        0,
+    )
 }
 
 /// The device the tests use: `PENUMBRA_TEST_DEVICE` (e.g. `gpu` on the H100 machine), else

@@ -1,18 +1,23 @@
 //! `penumbra bench`: ray throughput of the traversal kernels (`trace`), where a frame's time
 //! goes (`frame`), error against run time (`converge`), and a generator of large test scenes
-//! (`generate`). What each measures, and the figures, are in `docs/benchmarks.md`.
+//! (`generate`), and the host BVH build and update (`bvh`). What each measures, and the figures,
+//! are in `docs/benchmarks.md`.
 
+mod bvh;
 mod converge;
 mod frame;
 pub mod generate;
 mod plot;
 mod rays;
 mod stats;
+pub mod stress;
 mod trace;
 
+pub use bvh::BvhArgs;
 pub use converge::ConvergeArgs;
 pub use frame::FrameArgs;
 pub use generate::GenerateArgs;
+pub use stress::StressArgs;
 pub use trace::TraceArgs;
 
 use crate::cl::Gpu;
@@ -24,14 +29,24 @@ use clap::Subcommand;
 pub enum BenchCommand {
     /// Rays per second of the traversal kernels alone (primary, diffuse-bounce and shadow
     /// rays), validated against the host traversal.
+    #[command(
+        mut_arg("width", |a| a.help("Width of the primary ray grid [default: 1280]")),
+        mut_arg("height", |a| a.help("Height of the primary ray grid [default: 720]"))
+    )]
     Trace(Box<TraceArgs>),
     /// Samples per second of the whole path tracer and the kernel time of each stage.
     Frame(Box<FrameArgs>),
     /// Error (RMSE, relMSE) against run time for several sampling settings, against a
     /// reference image; table, CSV/JSON and a log-log plot.
     Converge(Box<ConvergeArgs>),
+    /// Host time to build the scene's BVH and to update it when one instance moves.
+    Bvh(Box<BvhArgs>),
     /// Writes a large test scene (instanced spheres or copies of a mesh in a closed, lit room).
     Generate(Box<GenerateArgs>),
+    /// The same image at any position and scale: moved and scaled copies of the Cornell box
+    /// against the original, leaks from closed meshes, spawned-ray reintersection, grazing
+    /// shadow rays and acne; a Markdown table.
+    Stress(Box<StressArgs>),
 }
 
 /// Runs a benchmark.
@@ -41,6 +56,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Frame(a) => frame::run(&a),
         BenchCommand::Converge(a) => converge::run(&a),
         BenchCommand::Generate(a) => generate::run(&a),
+        BenchCommand::Bvh(a) => bvh::run(&a),
+        BenchCommand::Stress(a) => stress::run(&a),
     }
 }
 

@@ -10,13 +10,13 @@
 use super::rays::{self, LightTargets, MISS};
 use super::stats::median;
 use super::{device_json, device_line, thousands};
+use crate::args::{CameraArgs, DeviceArgs, ShadowArgs, SizeArgs, prepare};
 use crate::bvh::Bvh;
 use crate::cl::kernels::{Launch, SceneBuffers};
-use crate::cl::types::{GpuHit, GpuRay};
+use crate::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay};
 use crate::cl::{Buffer, Gpu, Program, call_err};
-use crate::cli::CommonArgs;
 use crate::date::today;
-use crate::render::{Renderer, gpu_camera};
+use crate::render::{RenderSettings, Renderer, gpu_camera};
 use crate::scene::LightKind;
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
@@ -30,19 +30,15 @@ use std::time::Instant;
 pub struct TraceArgs {
     /// glTF or GLB file; the bundled Cornell box when absent.
     pub scene: Option<PathBuf>,
-    /// OpenCL device: gpu, cpu or an index from `penumbra devices` (default: first GPU, else
-    /// first CPU; also PENUMBRA_DEVICE).
-    #[arg(long)]
-    pub device: Option<String>,
-    /// Width of the primary ray grid.
-    #[arg(long, default_value_t = 1280)]
-    pub width: u32,
-    /// Height of the primary ray grid.
-    #[arg(long, default_value_t = 720)]
-    pub height: u32,
-    /// Camera of the glTF file to use (index; the automatic camera when the file has none).
-    #[arg(long)]
-    pub camera: Option<usize>,
+    /// The device.
+    #[command(flatten)]
+    pub device: DeviceArgs,
+    /// Size of the primary ray grid (default 1280×720, see `BenchCommand::Trace`).
+    #[command(flatten)]
+    pub size: SizeArgs,
+    /// The camera the primary rays start from.
+    #[command(flatten)]
+    pub camera: CameraArgs,
     /// Seed of the diffuse and shadow ray directions.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
@@ -58,6 +54,10 @@ pub struct TraceArgs {
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Time the kernels of the 4-wide BVH (the megakernel's, CPU devices) instead of the
+    /// binary BVH's (the wavefront's).
+    #[arg(long)]
+    pub wide: bool,
 }
 
 /// Agreement of device results with the host traversal.
@@ -238,6 +238,7 @@ struct Tracer<'a> {
     counters: Buffer<u32>,
     warmup: usize,
     runs: usize,
+    wide: bool,
 }
 
 impl Tracer<'_> {
@@ -246,9 +247,12 @@ impl Tracer<'_> {
         let buf = Buffer::from_slice(self.gpu, rays)?;
         let hits = Buffer::<GpuHit>::new(self.gpu, rays.len())?;
         let times = time_launches(self.gpu, self.warmup, self.runs, || {
-            Ok(self
-                .program
-                .trace_closest(self.gpu, self.scene, &buf, &hits, &self.counters)?)
+            let (p, s, c) = (self.program, self.scene, &self.counters);
+            Ok(if self.wide {
+                p.trace_closest_wide(self.gpu, s, &buf, &hits, c)?
+            } else {
+                p.trace_closest(self.gpu, s, &buf, &hits, c)?
+            })
         })?;
         let mut out = hits.read(self.gpu)?;
         out.truncate(rays.len());
@@ -260,9 +264,12 @@ impl Tracer<'_> {
         let buf = Buffer::from_slice(self.gpu, rays)?;
         let occluded = Buffer::<u32>::new(self.gpu, rays.len())?;
         let times = time_launches(self.gpu, self.warmup, self.runs, || {
-            Ok(self
-                .program
-                .trace_any(self.gpu, self.scene, &buf, &occluded, &self.counters)?)
+            let (p, s, c) = (self.program, self.scene, &self.counters);
+            Ok(if self.wide {
+                p.trace_any_wide(self.gpu, s, &buf, &occluded, c)?
+            } else {
+                p.trace_any(self.gpu, s, &buf, &occluded, c)?
+            })
         })?;
         let mut out = occluded.read(self.gpu)?;
         out.truncate(rays.len());
@@ -275,23 +282,23 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     if args.runs == 0 {
         anyhow::bail!("--runs must be at least 1");
     }
-    let common = CommonArgs {
-        device: args.device.clone(),
-        width: Some(args.width),
-        height: Some(args.height),
-        spp: None,
-        bounces: 0,
-        seed: 0,
-        camera: args.camera,
+    let (width, height) = args.size.size((1280, 720))?;
+    args.camera.check()?;
+    // Hard shadows: the lights are only shadow ray targets here.
+    let hard = ShadowArgs {
         light_radius: None,
         hard_shadows: true,
-        sky: None,
-        ..CommonArgs::default()
     };
-    let settings = common.settings((args.width, args.height))?;
-    let prepared = common.prepare(args.scene.as_deref())?;
+    let settings = RenderSettings {
+        width,
+        height,
+        bounces: 0,
+        seed: 0,
+        ..RenderSettings::default()
+    };
+    let prepared = prepare(args.scene.as_deref(), &args.camera, &hard, false)?;
     let source = prepared.scene.source.clone();
-    let mut renderer = Renderer::new(&common.device_choice()?)?;
+    let mut renderer = Renderer::new(&args.device.device_choice()?)?;
     renderer.set_settings(&settings)?;
     let stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
@@ -304,7 +311,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     ) else {
         return Err(anyhow!("{source}: the scene did not load"));
     };
-    let mut counters = Buffer::<u32>::new(gpu, 8)?;
+    let mut counters = Buffer::<u32>::new(gpu, COUNTER_SLOTS)?;
     counters.clear(gpu)?;
     let tracer = Tracer {
         gpu,
@@ -313,13 +320,18 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         counters,
         warmup: args.warmup,
         runs: args.runs,
+        wide: args.wide,
     };
     let tris = &host.vertices;
     let bvh = &host.bvh;
 
     // Primary rays.
-    let camera = gpu_camera(&prepared.camera, settings.aspect());
-    let primary = rays::primary_rays(&camera, args.width, args.height);
+    // Rays are made in the render space the scene was uploaded in.
+    let camera = gpu_camera(
+        &renderer.space().camera(&prepared.camera),
+        settings.aspect(),
+    );
+    let primary = rays::primary_rays(&camera, width, height);
     let (primary_hits, times) = tracer.closest(&primary)?;
     let check = timed(|| check_closest(bvh, tris, &primary, &primary_hits, args.validate));
     let hit_count = primary_hits.iter().filter(|h| h.prim != MISS).count();
@@ -351,14 +363,19 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         ));
 
         // Shadow rays from the primary hits to the lights.
-        let targets = light_targets(&prepared.lights, host, tris);
+        let targets = light_targets(&host.space.lights(&prepared.lights), host, tris);
         let shadow = rays::shadow_rays(&points, primary.len(), &targets, args.seed);
         let (occluded, times) = tracer.any(&shadow)?;
         let check = timed(|| check_any(bvh, tris, &shadow, &occluded, args.validate));
         let n = occluded.iter().filter(|&&o| o != 0).count();
         results.push(set_result("shadow", "any", shadow.len(), n, &times, check));
     }
-    let overflows = tracer.counters.read(gpu)?.get(4).copied().unwrap_or(0);
+    let overflows = tracer
+        .counters
+        .read(gpu)?
+        .get(COUNT_OVERFLOW)
+        .copied()
+        .unwrap_or(0);
     let total = results
         .iter()
         .fold(Check::default(), |a, r| a.add(r.validation));
@@ -366,11 +383,12 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     if args.json {
         let summary = serde_json::json!({
             "benchmark": "trace",
+            "bvh": if args.wide { "wide" } else { "binary" },
             "date": today(),
             "scene": source,
             "device": device_json(gpu),
-            "width": args.width,
-            "height": args.height,
+            "width": width,
+            "height": height,
             "camera": prepared.camera.name,
             "triangles": stats.triangles,
             "bvh_nodes": stats.nodes,
@@ -405,9 +423,14 @@ pub fn run(args: &TraceArgs) -> Result<()> {
             stats.kernel_build_ms
         );
         println!(
-            "rays     {}×{} primary from camera '{}'; kernel time from profiling events, median \
-             of {} runs after {} warm-up",
-            args.width, args.height, prepared.camera.name, args.runs, args.warmup
+            "rays     {}×{} primary from camera '{}'; {} BVH kernels; kernel time from profiling \
+             events, median of {} runs after {} warm-up",
+            width,
+            height,
+            prepared.camera.name,
+            if args.wide { "4-wide" } else { "binary" },
+            args.runs,
+            args.warmup
         );
         println!();
         println!(

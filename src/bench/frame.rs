@@ -2,9 +2,8 @@
 //! time goes, stage by stage (kernel time from OpenCL profiling events).
 
 use super::{device_json, device_line, thousands};
-use crate::cli::{CommonArgs, SamplingArgs};
+use crate::args::{CommonArgs, StrategyArgs};
 use crate::date::today;
-use crate::render::Renderer;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -19,9 +18,9 @@ pub struct FrameArgs {
     /// 1920×1080).
     #[command(flatten)]
     pub common: CommonArgs,
-    /// Sampling options.
+    /// Direct-light strategy and Russian roulette.
     #[command(flatten)]
-    pub sampling: SamplingArgs,
+    pub strategy: StrategyArgs,
     /// Untimed samples per pixel rendered first (buffers, caches, clocks).
     #[arg(long, default_value_t = 1)]
     pub warmup: u32,
@@ -33,12 +32,11 @@ pub struct FrameArgs {
 /// Runs the benchmark.
 pub fn run(args: &FrameArgs) -> Result<()> {
     let mut settings = args.common.settings((1920, 1080))?;
-    args.sampling.apply(&mut settings);
-    let spp = args.common.spp.unwrap_or(16);
+    args.strategy.apply(&mut settings);
+    let spp = args.common.sampling.spp.unwrap_or(16);
     let prepared = args.common.prepare(args.scene.as_deref())?;
     let source = prepared.scene.source.clone();
-    let mut renderer = Renderer::new(&args.common.device_choice()?)?;
-    renderer.set_settings(&settings)?;
+    let mut renderer = args.common.open_renderer(&settings)?;
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| source.clone())?;
@@ -77,6 +75,7 @@ pub fn run(args: &FrameArgs) -> Result<()> {
             "date": today(),
             "scene": source,
             "device": device_json(&renderer.gpu),
+            "kernel": renderer.kernel(),
             "width": settings.width,
             "height": settings.height,
             "spp": spp,

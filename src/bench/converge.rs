@@ -8,10 +8,10 @@
 
 use super::stats::{ImageError, image_error, log_log_slope};
 use super::{device_json, device_line, plot};
-use crate::cli::CommonArgs;
+use crate::args::CommonArgs;
 use crate::date::today;
 use crate::image_io::read_exr;
-use crate::render::{Renderer, Strategy};
+use crate::render::Strategy;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -35,7 +35,7 @@ pub struct ConvergeArgs {
     #[arg(long, value_delimiter = ',', value_parser = parse_config)]
     pub configs: Vec<Config>,
     /// Stop a configuration after the step that passes this many seconds of rendering.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = crate::args::parse_seconds)]
     pub max_seconds: f64,
     /// Fit the slopes over the steps with at least this many samples per pixel.
     #[arg(long, default_value_t = 4)]
@@ -177,8 +177,8 @@ impl Curve {
 /// Runs the benchmark.
 pub fn run(args: &ConvergeArgs) -> Result<()> {
     let (ref_w, ref_h, reference) = read_exr(&args.reference)?;
-    if args.common.width.is_some_and(|w| w != ref_w)
-        || args.common.height.is_some_and(|h| h != ref_h)
+    if args.common.size.width.is_some_and(|w| w != ref_w)
+        || args.common.size.height.is_some_and(|h| h != ref_h)
     {
         bail!(
             "{}: the reference is {ref_w}×{ref_h}, not the --width/--height given",
@@ -186,7 +186,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let mut settings = args.common.settings((ref_w, ref_h))?;
-    let max_spp = args.common.spp.unwrap_or(1024);
+    let max_spp = args.common.sampling.spp.unwrap_or(1024);
     let configs = if args.configs.is_empty() {
         Config::ALL.to_vec()
     } else {
@@ -205,8 +205,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
 
-    let mut renderer = Renderer::new(&args.common.device_choice()?)?;
-    renderer.set_settings(&settings)?;
+    let mut renderer = args.common.open_renderer(&settings)?;
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| source.clone())?;

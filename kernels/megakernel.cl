@@ -1,0 +1,59 @@
+// The path tracer as one kernel, for CPU devices: a work item follows the paths of one pixel
+// from the camera to their end, `frame.samples_in_wave` samples one after the other, with the
+// path state in registers: no queues, no path buffers, one launch per pass. Each vertex is
+// shaded by path.h's shade_vertex, as the wavefront's `shade` does, and its light sample is
+// traced at once (the wavefront's `connect`), so both compute the same estimator from the
+// same random numbers. The samples of a pixel are summed in order and added to the film once.
+//
+// Rays are traced through the 4-wide BVH (traverse_wide.h), whose box tests use the CPU's
+// vector lanes.
+
+kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environment,
+                       global const GpuWideNode* nodes, global const GpuTriangle* tris,
+                       global const GpuTriShading* shading,
+                       global const GpuTriTangents* tangents,
+                       global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
+                       global const GpuTexture* textures, global const uint* texels,
+                       global const float* env_texels, global const float* env_marginal,
+                       global const float* env_conditional, global const GpuLight* lights,
+                       global const float* light_cdf, global float4* film,
+                       volatile global uint* counters) {
+    uint pixel = get_global_id(0);
+    uint pixels = frame.width * frame.height;
+    if (pixel >= pixels) return;
+    ShadeScene sc = {tris,
+                     {shading, tangents, materials, tex_refs, textures, texels},
+                     {environment, env_texels, env_marginal, env_conditional},
+                     lights,
+                     light_cdf};
+    volatile global uint* overflow = &counters[COUNT_OVERFLOW];
+    float3 sum = (float3)(0.0f);
+    uint extension_rays = 0;
+    uint shadow_rays = 0;
+    uint nonfinite = 0;
+    for (uint j = 0; j < frame.samples_in_wave; ++j) {
+        PathState s = camera_path(&frame, &camera, pixel, frame.first_sample + j);
+        for (uint bounce = 0; bounce <= frame.max_bounces + 1u; ++bounce) {
+            GpuHit hit = traverse_wide(nodes, tris, &sc.surf, s.origin, s.direction, 0.0f, INFINITY,
+                                  false, overflow);
+            ++extension_rays;
+            ShadowQuery q;
+            bool alive = shade_vertex(&frame, bounce, &sc, hit, &s, &q);
+            if (q.valid) {
+                ++shadow_rays;
+                s.radiance += shadow_test_wide(nodes, tris, &sc.surf, &q, overflow);
+            }
+            if (!alive) break;
+        }
+        if (all(isfinite(s.radiance))) {
+            sum += s.radiance;
+        } else {
+            ++nonfinite;
+        }
+    }
+    film[pixel] += (float4)(sum, (float)frame.samples_in_wave);
+    // One atomic per work item for the statistics; `advance` moves them into the totals.
+    atomic_add(&counters[COUNT_IN], extension_rays);
+    atomic_add(&counters[COUNT_SHADOW], shadow_rays);
+    if (nonfinite > 0u) atomic_add(&counters[COUNT_NONFINITE], nonfinite);
+}

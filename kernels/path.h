@@ -1,0 +1,362 @@
+// One path vertex at a time: the camera ray, and the shading of the vertex a ray found
+// (emission with MIS, one light sample, the BSDF sample and Russian roulette). Both execution
+// shapes call these, so they compute the same estimator with the same random numbers:
+//   - the wavefront (stages.cl) keeps the state in GpuPath slots between kernels and traces
+//     the light sample later in `connect`;
+//   - the megakernel (megakernel.cl) keeps it in registers and traces the light sample at once.
+
+inline float power_heuristic(float a, float b) {
+    float a2 = a * a;
+    float b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+// A path between two vertices.
+typedef struct {
+    float3 origin;      // of the next ray
+    float3 direction;   // of the next ray (unit)
+    float3 throughput;
+    float3 radiance;    // gathered so far
+    float prev_pdf;     // pdf of the BSDF sample that made the ray (0: camera ray)
+    uint flags;         // PATH_SPECULAR, PATH_THROUGH_WALL
+    uint rng;
+    float2 cone;        // ray cone (width, spread angle) for texture filtering
+} PathState;
+
+// A light sample to test for visibility: `contribution` is added to the path's radiance when
+// the segment (origin, direction, 0..tmax) is unoccluded, or only blocked by smooth thin walls
+// (then tinted by them and multiplied by `unweight`, the inverse of its MIS weight).
+typedef struct {
+    float3 origin;
+    float3 direction;
+    float tmax;
+    float3 contribution;
+    float unweight;
+    bool valid;
+} ShadowQuery;
+
+// What shading reads of the scene.
+typedef struct {
+    global const GpuTriangle* tris;
+    SceneSurfaces surf;
+    EnvMap env;
+    global const GpuLight* lights;
+    global const float* light_cdf;
+} ShadeScene;
+
+// The camera ray of sample `sample` of `pixel` (box filter, pinhole or thin lens), with the
+// random state seeded from (pixel, sample, seed).
+inline PathState camera_path(const GpuFrame* frame, const GpuCamera* camera, uint pixel,
+                             uint sample) {
+    uint rng = hash_u32(hash_u32(pixel ^ hash_u32(frame->seed)) ^
+                        hash_u32(sample * 0x9e3779b9u + 1u));
+    // Jitter within the pixel (box filter) and form the pinhole or thin-lens ray.
+    float fx = ((float)(pixel % frame->width) + rng_next(&rng)) / (float)frame->width;
+    float fy = ((float)(pixel / frame->width) + rng_next(&rng)) / (float)frame->height;
+    float3 dir = camera->forward.xyz + (2.0f * fx - 1.0f) * camera->right.xyz +
+                 (1.0f - 2.0f * fy) * camera->up.xyz;
+    float3 origin = camera->origin.xyz;
+    float u1 = rng_next(&rng);
+    float u2 = rng_next(&rng);
+    if (camera->origin.w > 0.0f) {
+        float3 focus = origin + dir * camera->forward.w;
+        float r = camera->origin.w * sqrt(u1);
+        float phi = 2.0f * PI_F * u2;
+        origin += r * cos(phi) * normalize(camera->right.xyz) +
+                  r * sin(phi) * normalize(camera->up.xyz);
+        dir = focus - origin;
+    }
+    PathState s;
+    s.origin = origin;
+    s.direction = normalize(dir);
+    s.throughput = (float3)(1.0f, 1.0f, 1.0f);
+    s.radiance = (float3)(0.0f, 0.0f, 0.0f);
+    s.prev_pdf = 0.0f;
+    s.flags = 0u;
+    s.rng = rng;
+    // The ray cone for texture filtering: no width at the eye, one pixel's angle of spread.
+    s.cone = (float2)(0.0f, 2.0f * length(camera->up.xyz) / (float)frame->height);
+    return s;
+}
+
+// Shades the vertex that the path's ray found at `bounce` (hit.prim == NO_HIT: it escaped).
+// Adds emission to s->radiance, fills *shadow with the light sample to test (valid = false
+// when there is none) and, when the path goes on, sets the next ray. Returns whether it does.
+inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* sc, GpuHit hit,
+                         PathState* s, ShadowQuery* shadow) {
+    shadow->valid = false;
+    float3 throughput = s->throughput;
+    float3 radiance = s->radiance;
+    uint rng = s->rng;
+    float3 wo = -s->direction;
+    float prev_pdf = s->prev_pdf;
+    bool prev_specular = (s->flags & PATH_SPECULAR) != 0u;
+    bool counts_emission = bounce == 0u || prev_specular || frame->strategy != STRATEGY_LIGHTS;
+    // Seen through a thin wall from a scattering vertex, a light is left to that vertex's light
+    // sample, whose shadow ray passes the wall unweighted (see `shadow_test`).
+    bool mis = bounce > 0u && !prev_specular && frame->strategy == STRATEGY_MIS;
+#ifdef HAS_THIN_WALLS
+    bool light_sampled_only = mis && (s->flags & PATH_THROUGH_WALL) != 0u;
+#else
+    bool light_sampled_only = false;
+#endif
+    const SceneSurfaces* surf = &sc->surf;
+    global const GpuMaterial* materials = surf->materials;
+
+    if (hit.prim == NO_HIT) {
+#ifdef HAS_ENV_MAP
+        // Escaped into the environment map, weighted against its sampling at the last vertex.
+        float env_pdf;
+        float3 le = env_radiance(&sc->env, -wo, &env_pdf);
+        float weight = 1.0f;
+        if (mis) weight = power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
+        if (light_sampled_only) weight = 0.0f;
+        if (counts_emission) radiance += throughput * le * weight;
+#else
+        // Escaped: the uniform sky, reached by BSDF sampling only.
+        if (counts_emission) radiance += throughput * frame->sky.xyz;
+#endif
+        s->radiance = radiance;
+        return false;
+    }
+
+    GpuTriangle tri = sc->tris[hit.prim];
+    float w0 = 1.0f - hit.u - hit.v;
+    float3 p_err;
+    float3 p = surface_point(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, hit.u, hit.v, &p_err);
+    float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
+    global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
+    bool front = dot(ng, wo) > 0.0f;
+    GpuTriShading sh = surf->shading[hit.prim];
+    TexCoords tc = texcoords_at(sh, hit.u, hit.v);
+#ifdef HAS_TEXTURES
+    // The ray cone's footprint picks the mip levels; it widens by the roughness at each bounce.
+    float2 cone = s->cone;
+    float cone_width = cone.x + cone.y * hit.t;
+    texcoords_footprint(&tc, sh, tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz, cone_width,
+                        fabs(dot(ng, wo)));
+    tc.xi = rng_next(&rng);
+#endif
+
+#ifdef HAS_TRIANGLE_LIGHTS
+    // Emission of a light hit by this ray, weighted against light sampling of the last vertex.
+    int light_index = as_int(tri.v1.w);
+    bool two_sided = (as_uint(mat->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
+    if (light_index >= 0 && (front || two_sided) && counts_emission) {
+        float weight = 1.0f;
+        if (mis) {
+            global const GpuLight* l = &sc->lights[light_index];
+            float cos_l = fabs(dot(ng, wo));
+            float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
+            weight = power_heuristic(prev_pdf, light_pdf);
+        }
+        if (light_sampled_only) weight = 0.0f;
+#ifdef HAS_TEXTURES
+        // Past the camera ray, emission is read at the finest level, as light sampling reads it.
+        TexCoords etc = bounce == 0u ? tc : texcoords_at(sh, hit.u, hit.v);
+        radiance += throughput * textured_emission(mat, surf, &etc) * weight;
+#else
+        radiance += throughput * mat->emission.xyz * weight;
+#endif
+    }
+#endif
+
+#ifdef HAS_UNLIT
+    // An unlit material shows its base color (textured) and scatters nothing; nothing else
+    // samples it, so it counts in full.
+    if ((as_uint(mat->emission.w) & MATERIAL_UNLIT) != 0u) {
+        float3 color = mat->base_color.xyz;
+#ifdef HAS_TEXTURES
+        if (mat->textures.x >= 0) color *= texture_sample(surf, mat->textures.x, &tc).xyz;
+#endif
+        s->radiance = radiance + throughput * color;
+        return false;
+    }
+#endif
+
+    // The last extension only looks for emitters (the MIS partner of the last light sample).
+    if (bounce > frame->max_bounces) {
+        s->radiance = radiance;
+        return false;
+    }
+
+    // Face the normals towards the side the ray came from.
+    if (!front) ng = -ng;
+    float3 ns = ng;
+    if (sh.n0.w > 0.0f) {
+        float3 n = w0 * sh.n0.xyz + hit.u * sh.n1.xyz + hit.v * sh.n2.xyz;
+        float len = length(n);
+        if (len > 0.0f) {
+            ns = n / len;
+            if (dot(ns, ng) < 0.0f) ns = -ns;
+        }
+    }
+#ifdef HAS_CLEARCOAT
+    // The coat has its own normal texture; without one it takes the interpolated normal.
+    float3 coat_normal = ns;
+#ifdef HAS_NORMAL_MAPS
+    if (mat->textures3.z >= 0) {
+        coat_normal = normal_map(surf, mat->textures3.z, mat->coat.z, &tc, hit.prim, hit.u, hit.v,
+                                 ns, ng, front);
+    }
+#endif
+#endif
+#ifdef HAS_NORMAL_MAPS
+    if (mat->textures.z >= 0) {
+        ns = normal_map(surf, mat->textures.z, mat->alpha.w, &tc, hit.prim, hit.u, hit.v, ns, ng,
+                        front);
+    }
+#endif
+    SurfaceMaterial m = surface_material(mat);
+#ifdef HAS_CLEARCOAT
+    m.coat_normal = coat_normal;
+#endif
+#ifdef HAS_TEXTURES
+    apply_textures(&m, mat, surf, &tc);
+    float alpha_r = m.roughness * m.roughness;
+    s->cone = (float2)(cone_width, cone.y + alpha_r);
+#endif
+
+    // Hit from behind, a transmissive volume was travelled through: attenuate the segment
+    // (Beer–Lambert) and see the interface from inside. Other back faces shade as front faces.
+    if (!front && m.transmission > 0.0f && m.thickness > 0.0f) {
+        throughput *= volume_transmittance(&m, hit.t);
+        material_from_inside(&m);
+    }
+
+    // Next-event estimation: one light sample, its visibility tested by the caller.
+    if (frame->strategy != STRATEGY_BSDF && frame->light_count > 0u) {
+        uint index = cdf_search(sc->light_cdf, frame->light_count, rng_next(&rng));
+        float u1 = rng_next(&rng);
+        float u2 = rng_next(&rng);
+        LightSample ls =
+            sample_light(sc->lights, sc->tris, materials, surf, &sc->env, index, p, u1, u2);
+        // A light behind the surface is reached through transmission when bsdf_eval says so;
+        // the geometric and shading normals must agree on the side. Transmissive surfaces
+        // block shadow rays (no caustics through next-event estimation), except smooth thin
+        // walls, which `shadow_test` passes with their tint and without the MIS weight.
+        float side = dot(ls.wi, ng);
+        if (side * dot(ls.wi, ns) > 0.0f &&
+            (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
+            float bsdf_pdf;
+            float3 f = bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
+            float weight = (frame->strategy == STRATEGY_MIS && ls.pdf > 0.0f)
+                               ? power_heuristic(ls.pdf, bsdf_pdf)
+                               : 1.0f;
+            float3 contribution = throughput * f * ls.radiance * weight;
+            if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
+                float3 from = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
+                float3 dir = ls.wi;
+                // Virtual lights (spheres, discs, the sky) are not geometry: trace to them.
+                float tmax = ls.distance;
+                if (ls.on_surface) {
+                    float3 seg = ls.target - from;
+                    tmax = length(seg);
+                    dir = seg / tmax;
+                }
+                shadow->origin = from;
+                shadow->direction = dir;
+                shadow->tmax = tmax;
+                shadow->contribution = contribution;
+                shadow->unweight = weight > 0.0f ? 1.0f / weight : 0.0f;
+                shadow->valid = true;
+            }
+        }
+    }
+
+    // Sample the BSDF for the next ray; Russian roulette after rr_depth bounces.
+    float3 wi;
+    float pdf;
+    bool specular;
+    float u1 = rng_next(&rng);
+    float u2 = rng_next(&rng);
+    float u3 = m.transmission > 0.0f ? rng_next(&rng) : 0.0f;
+    float3 weight = bsdf_sample(&m, ns, wo, (float3)(u1, u2, u3), &wi, &pdf, &specular);
+    throughput *= weight;
+    float side = dot(wi, ng);
+    bool alive = pdf > 0.0f && side * dot(wi, ns) > 0.0f &&
+                 (throughput.x > 0.0f || throughput.y > 0.0f || throughput.z > 0.0f);
+    if (alive && bounce >= frame->rr_depth) {
+        float q = fmin(fmax(throughput.x, fmax(throughput.y, throughput.z)), 0.95f);
+        if (rng_next(&rng) >= q) {
+            alive = false;
+        } else {
+            throughput /= q;
+        }
+    }
+    s->radiance = radiance;
+    s->rng = rng;
+    if (alive) {
+        uint flags = specular ? PATH_SPECULAR : 0u;
+#ifdef HAS_THIN_WALLS
+        // Straight through a thin wall the path keeps its last scattering vertex's pdf and
+        // flags, as the shadow rays of that vertex pass the wall (a camera ray stays direct).
+        if (specular && side < 0.0f && bsdf_passes_straight(&m)) {
+            pdf = prev_pdf;
+            flags = bounce == 0u ? PATH_SPECULAR : s->flags;
+            if (!prev_specular && bounce > 0u) flags |= PATH_THROUGH_WALL;
+        }
+#endif
+        s->origin = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
+        s->prev_pdf = pdf;
+        s->direction = wi;
+        s->flags = flags;
+        s->throughput = throughput;
+    }
+    return alive;
+}
+
+// Shadow rays pass at most this many thin walls.
+#define MAX_THIN_WALLS 8u
+
+// Whether the surface hit by a shadow ray along dir is a smooth thin wall; if so, multiplies
+// *tint by what it lets through. Without thin walls in the scene, nothing is.
+inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* surf, GpuHit hit,
+                           float3 dir, float3* tint) {
+#ifdef HAS_THIN_WALLS
+    GpuTriangle tri = tris[hit.prim];
+    global const GpuMaterial* mat = &surf->materials[as_uint(tri.v0.w)];
+    SurfaceMaterial m = surface_material(mat);
+#ifdef HAS_TEXTURES
+    TexCoords tc = texcoords_at(surf->shading[hit.prim], hit.u, hit.v);
+    apply_textures(&m, mat, surf, &tc);
+#endif
+    if (!bsdf_passes_straight(&m)) return false;
+    float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
+    *tint *= thin_wall_transmittance(&m, fabs(dot(ng, dir)));
+    return true;
+#else
+    return false;
+#endif
+}
+
+// The shadow test of a light sample, for a BVH of NODE traversed by TRAVERSE: what of
+// q->contribution reaches the path, or 0 when something other than smooth thin walls is in the
+// way. Through walls the light comes tinted by each wall and no longer shared with the BSDF
+// sample (the MIS weight undone: BSDF samples through walls leave such lights to light
+// sampling). The wavefront's `connect` and the megakernel use the same test this way.
+#define DEFINE_SHADOW_TEST(NAME, NODE, TRAVERSE)                                                \
+    inline float3 NAME(global const NODE* nodes, global const GpuTriangle* tris,               \
+                       const SceneSurfaces* surf, const ShadowQuery* q,                        \
+                       volatile global uint* overflow) {                                      \
+        GpuHit hit = TRAVERSE(nodes, tris, surf, q->origin, q->direction, 0.0f, q->tmax, true, \
+                              overflow);                                                       \
+        if (hit.prim == NO_HIT) return q->contribution;                                        \
+        float3 tint = (float3)(1.0f);                                                          \
+        if (!thin_wall_tint(tris, surf, hit, q->direction, &tint)) return (float3)(0.0f);      \
+        /* The walls in order, nearest first, each beyond the last. */                         \
+        tint = (float3)(q->unweight);                                                          \
+        hit = TRAVERSE(nodes, tris, surf, q->origin, q->direction, 0.0f, q->tmax, false,       \
+                       overflow);                                                              \
+        for (uint walls = 0u; hit.prim != NO_HIT; ++walls) {                                   \
+            if (walls == MAX_THIN_WALLS ||                                                     \
+                !thin_wall_tint(tris, surf, hit, q->direction, &tint)) {                       \
+                return (float3)(0.0f);                                                         \
+            }                                                                                  \
+            hit = TRAVERSE(nodes, tris, surf, q->origin, q->direction, hit.t, q->tmax, false,  \
+                           overflow);                                                          \
+        }                                                                                      \
+        return q->contribution * tint;                                                         \
+    }
+DEFINE_SHADOW_TEST(shadow_test, GpuBvhNode, traverse)
+DEFINE_SHADOW_TEST(shadow_test_wide, GpuWideNode, traverse_wide)

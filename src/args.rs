@@ -1,0 +1,669 @@
+//! The command-line option groups that `cli` and `bench` share (clap), each with its checks,
+//! and the loading of a scene with them (`prepare`).
+//!
+//! `CommonArgs` flattens every group a rendering command takes; a command that needs fewer
+//! (`bench trace`) flattens only those.
+
+use crate::cl::DeviceChoice;
+use crate::cli::first_image;
+use crate::render::exposure::ExposureMode;
+use crate::render::{KernelChoice, RenderSettings, Renderer, Strategy};
+use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
+use anyhow::{Result, bail};
+use clap::Args;
+use std::path::Path;
+
+/// The largest image side accepted.
+pub const MAX_SIDE: u32 = 16384;
+/// The most bounces accepted.
+pub const MAX_BOUNCES: u32 = 256;
+
+/// The OpenCL device.
+#[derive(Args, Debug, Clone, Default)]
+pub struct DeviceArgs {
+    /// OpenCL device: gpu, cpu or an index from `penumbra devices` (default: first GPU, else
+    /// first CPU; also PENUMBRA_DEVICE).
+    #[arg(long)]
+    pub device: Option<String>,
+}
+
+impl DeviceArgs {
+    /// The device choice from `--device` or `PENUMBRA_DEVICE`.
+    pub fn device_choice(&self) -> Result<DeviceChoice> {
+        DeviceChoice::from_arg_or_env(self.device.as_deref()).map_err(anyhow::Error::msg)
+    }
+}
+
+/// The image size.
+#[derive(Args, Debug, Clone, Default)]
+pub struct SizeArgs {
+    /// Image width in pixels.
+    #[arg(long, allow_negative_numbers = true)]
+    pub width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long, allow_negative_numbers = true)]
+    pub height: Option<u32>,
+}
+
+impl SizeArgs {
+    /// Width and height, `default` where not given; rejects absurd sizes.
+    pub fn size(&self, default: (u32, u32)) -> Result<(u32, u32)> {
+        let width = self.width.unwrap_or(default.0);
+        let height = self.height.unwrap_or(default.1);
+        for (name, v) in [("--width", width), ("--height", height)] {
+            if v == 0 || v > MAX_SIDE {
+                bail!("{name} {v} is out of range (1..={MAX_SIDE})");
+            }
+        }
+        Ok((width, height))
+    }
+}
+
+/// Which camera, or where the camera is.
+#[derive(Args, Debug, Clone, Default)]
+pub struct CameraArgs {
+    /// Camera of the glTF file to use (index; the automatic camera when the file has none).
+    #[arg(long, allow_negative_numbers = true)]
+    pub camera: Option<usize>,
+    /// Camera position X,Y,Z (replaces the file's camera; use with --look-at).
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "look_at")]
+    pub eye: Option<[f64; 3]>,
+    /// Point the camera looks at, X,Y,Z (use with --eye).
+    #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "eye")]
+    pub look_at: Option<[f64; 3]>,
+    /// Vertical field of view in degrees (default: the camera's).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_fov)]
+    pub fov: Option<f64>,
+}
+
+impl CameraArgs {
+    /// Rejects a field of view outside (0, 180) degrees.
+    pub fn check(&self) -> Result<()> {
+        if let Some(f) = self.fov
+            && !(f > 0.0 && f < 180.0)
+        {
+            bail!("--fov {f} is out of range (0..180 degrees)");
+        }
+        Ok(())
+    }
+
+    /// The camera of `scene` these options choose.
+    pub fn choose(&self, scene: &Scene) -> Result<Camera> {
+        let mut camera = match self.camera {
+            None => scene.cameras[0].clone(),
+            Some(i) => match scene.cameras.get(i) {
+                Some(c) => c.clone(),
+                None => bail!(
+                    "{}: --camera {i} is out of range (the scene has {} camera(s))",
+                    scene.source,
+                    scene.cameras.len()
+                ),
+            },
+        };
+        if let (Some(eye), Some(target)) = (self.eye, self.look_at) {
+            let (eye, target) = (glam::DVec3::from(eye), glam::DVec3::from(target));
+            if (target - eye).normalize_or_zero() == glam::DVec3::ZERO {
+                bail!("--eye and --look-at are the same point");
+            }
+            camera = Camera::look_at("command line", eye, target, camera.yfov);
+        }
+        if let Some(fov) = self.fov {
+            camera.yfov = fov.to_radians();
+        }
+        Ok(camera)
+    }
+}
+
+/// Depth of field.
+#[derive(Args, Debug, Clone)]
+pub struct LensArgs {
+    /// Depth of field: thin-lens radius in scene units (0 = pinhole, everything sharp).
+    #[arg(
+        long,
+        default_value_t = RenderSettings::default().lens_radius,
+        allow_negative_numbers = true,
+        value_parser = parse_non_negative
+    )]
+    pub aperture: f32,
+    /// Distance from the eye to the plane in focus, along the view axis, in scene units
+    /// (default: the distance to what the image centre sees).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_positive)]
+    pub focus_distance: Option<f32>,
+}
+
+/// Samples per pixel, bounces and the random sequence.
+#[derive(Args, Debug, Clone)]
+pub struct SamplingArgs {
+    /// Samples per pixel.
+    #[arg(long, allow_negative_numbers = true)]
+    pub spp: Option<u32>,
+    /// Bounces after the first hit (0 = direct light only).
+    #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().bounces)]
+    pub bounces: u32,
+    /// Seed of the random sequence.
+    #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().seed)]
+    pub seed: u32,
+}
+
+/// How large the lights are, which sets how soft their shadows are.
+#[derive(Args, Debug, Clone, Default)]
+pub struct ShadowArgs {
+    /// Radius of point and spot lights in scene units (soft shadows); default 2% of the
+    /// scene's diagonal. Directional lights get an angular radius of 2·R/diagonal radians.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_non_negative)]
+    pub light_radius: Option<f32>,
+    /// Hard shadows: every light radius 0.
+    #[arg(long, conflicts_with = "light_radius")]
+    pub hard_shadows: bool,
+}
+
+impl ShadowArgs {
+    /// Rejects a negative or non-finite light radius.
+    pub fn check(&self) -> Result<()> {
+        if let Some(r) = self.light_radius
+            && !(r.is_finite() && r >= 0.0)
+        {
+            bail!("--light-radius {r} must be a finite number >= 0");
+        }
+        Ok(())
+    }
+}
+
+/// The light from outside the scene.
+#[derive(Args, Debug, Clone)]
+pub struct EnvArgs {
+    /// Uniform sky radiance as R,G,B (or one value for gray); default black.
+    #[arg(long, value_parser = parse_color)]
+    pub sky: Option<[f32; 3]>,
+    /// Environment light: `studio` or `outdoor` (bundled), `none`, an equirectangular .hdr or
+    /// .exr image (importance-sampled), or a uniform color R,G,B / gray value (like --sky).
+    /// Default: `studio` when the scene's own lights do not light the view (docs/viewer.md).
+    /// Any environment replaces the default light rig.
+    #[arg(
+        long,
+        value_name = "studio|outdoor|none|FILE|COLOR",
+        conflicts_with = "sky"
+    )]
+    pub env: Option<String>,
+    /// Radiance scale of the --env image.
+    #[arg(
+        long,
+        default_value_t = RenderSettings::default().env_intensity,
+        allow_negative_numbers = true,
+        value_parser = parse_non_negative
+    )]
+    pub env_intensity: f32,
+    /// Rotation of the --env image about the up (+Y) axis in degrees, counter-clockwise seen
+    /// from above.
+    #[arg(
+        long,
+        default_value_t = RenderSettings::default().env_rotation,
+        allow_negative_numbers = true,
+        value_parser = parse_finite
+    )]
+    pub env_rotation: f32,
+}
+
+/// What `--env` asked for.
+pub enum EnvChoice {
+    /// A uniform radiance.
+    Color([f32; 3]),
+    /// An environment image.
+    Map(EnvMap),
+}
+
+impl EnvArgs {
+    /// The uniform sky radiance: an `--env` color, else `--sky`, else black.
+    pub fn sky(&self) -> [f32; 3] {
+        match self.env.as_deref().map(parse_color) {
+            Some(Ok(c)) => c,
+            _ => self.sky.unwrap_or([0.0; 3]),
+        }
+    }
+
+    /// What `--env` asks for: a color, or an image loaded now; `None` without `--env`.
+    pub fn environment(&self) -> Result<Option<EnvChoice>> {
+        let arg = match first_image::EnvArg::parse(self.env.as_deref()) {
+            first_image::EnvArg::Other(arg) => arg,
+            named => return Ok(first_image::environment(&named, None)),
+        };
+        let arg = arg.as_str();
+        if let Ok(c) = parse_color(arg) {
+            return Ok(Some(EnvChoice::Color(c)));
+        }
+        let path = Path::new(arg);
+        if !path.is_file() {
+            bail!("--env {arg}: neither a color (R,G,B) nor an existing .hdr/.exr file");
+        }
+        Ok(Some(EnvChoice::Map(
+            EnvMap::load(path).map_err(anyhow::Error::msg)?,
+        )))
+    }
+}
+
+/// The most stops `--exposure` may brighten or darken by.
+pub const MAX_EXPOSURE: f32 = 64.0;
+
+/// An exposure in stops within ±[`MAX_EXPOSURE`].
+fn parse_exposure(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v.abs() <= MAX_EXPOSURE => Ok(v),
+        _ => Err(format!(
+            "'{s}' is out of range (-{MAX_EXPOSURE}..={MAX_EXPOSURE} stops)"
+        )),
+    }
+}
+
+/// How bright the image is shown and written.
+#[derive(Args, Debug, Clone, Default)]
+pub struct ExposureArgs {
+    /// Exposure in stops (default: automatic, metered on the image as it converges).
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        conflicts_with = "ev100",
+        value_parser = parse_exposure
+    )]
+    pub exposure: Option<f32>,
+    /// Physical exposure: a camera at this EV100 (about 15 for a scene lit by a sun in lux).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_finite)]
+    pub ev100: Option<f32>,
+}
+
+impl ExposureArgs {
+    /// How the exposure is chosen: `--exposure`, `--ev100`, else automatically.
+    pub fn mode(&self) -> ExposureMode {
+        match (self.exposure, self.ev100) {
+            (Some(stops), _) => ExposureMode::Manual(stops),
+            (None, Some(ev)) => ExposureMode::Ev100(ev),
+            (None, None) => ExposureMode::Auto,
+        }
+    }
+}
+
+/// Options every rendering command shares.
+#[derive(Args, Debug, Clone)]
+pub struct CommonArgs {
+    /// The device.
+    #[command(flatten)]
+    pub device: DeviceArgs,
+    /// The image size.
+    #[command(flatten)]
+    pub size: SizeArgs,
+    /// Samples, bounces, seed.
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+    /// The camera.
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// Light radius and hard shadows.
+    #[command(flatten)]
+    pub shadows: ShadowArgs,
+    /// Sky and environment light.
+    #[command(flatten)]
+    pub env: EnvArgs,
+    /// Depth of field.
+    #[command(flatten)]
+    pub lens: LensArgs,
+    /// Exposure.
+    #[command(flatten)]
+    pub exposure: ExposureArgs,
+    /// Kernels: wavefront (queued stages per bounce), megakernel (whole paths per work item)
+    /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
+    #[arg(long, default_value = "auto", value_parser = parse_kernel)]
+    pub kernel: KernelChoice,
+}
+
+fn parse_kernel(s: &str) -> Result<KernelChoice, String> {
+    s.parse()
+}
+
+impl Default for CommonArgs {
+    /// The command line's defaults: what an empty command line gives.
+    fn default() -> Self {
+        #[derive(clap::Parser)]
+        struct Empty {
+            #[command(flatten)]
+            common: CommonArgs,
+        }
+        <Empty as clap::Parser>::parse_from(["penumbra"]).common
+    }
+}
+
+impl CommonArgs {
+    /// Opens the chosen device with the chosen kernel shape and `settings`.
+    pub fn open_renderer(&self, settings: &RenderSettings) -> Result<Renderer> {
+        let mut renderer = Renderer::new(&self.device_choice()?)?;
+        renderer.set_kernel(self.kernel)?;
+        renderer.set_settings(settings)?;
+        Ok(renderer)
+    }
+
+    /// The device choice from `--device` or `PENUMBRA_DEVICE`.
+    pub fn device_choice(&self) -> Result<DeviceChoice> {
+        self.device.device_choice()
+    }
+
+    /// Render settings for a default size; rejects absurd values.
+    pub fn settings(&self, default_size: (u32, u32)) -> Result<RenderSettings> {
+        let (width, height) = self.size.size(default_size)?;
+        let sampling = &self.sampling;
+        if sampling.bounces > MAX_BOUNCES {
+            bail!(
+                "--bounces {} is out of range (0..={MAX_BOUNCES})",
+                sampling.bounces
+            );
+        }
+        if sampling.spp == Some(0) {
+            bail!("--spp must be at least 1");
+        }
+        self.shadows.check()?;
+        let (env, lens) = (&self.env, &self.lens);
+        for (name, v) in [
+            ("--env-intensity", env.env_intensity),
+            ("--aperture", lens.aperture),
+            ("--focus-distance", lens.focus_distance.unwrap_or(1.0)),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                bail!("{name} {v} must be a finite number >= 0");
+            }
+        }
+        if lens.focus_distance == Some(0.0) {
+            bail!("--focus-distance must be greater than 0");
+        }
+        if !env.env_rotation.is_finite() {
+            bail!("--env-rotation {} must be finite", env.env_rotation);
+        }
+        self.camera.check()?;
+        Ok(RenderSettings {
+            width,
+            height,
+            bounces: sampling.bounces,
+            seed: sampling.seed,
+            sky: env.sky(),
+            env_intensity: env.env_intensity,
+            env_rotation: env.env_rotation,
+            lens_radius: lens.aperture,
+            focus_distance: lens.focus_distance.unwrap_or(1.0),
+            ..RenderSettings::default()
+        })
+    }
+
+    /// What `--env` asks for: a color, or an image loaded now; `None` without `--env`.
+    pub fn environment(&self) -> Result<Option<EnvChoice>> {
+        self.env.environment()
+    }
+
+    /// How the exposure is chosen: `--exposure`, `--ev100`, else automatically.
+    pub fn exposure_mode(&self) -> ExposureMode {
+        self.exposure.mode()
+    }
+
+    /// Loads the scene (or the bundled one), applies camera and light options and decides the
+    /// first image: the automatic camera gives way to the first view, and the rule "the
+    /// scene's lights light the view" decides the environment (`cli/first_image.rs`).
+    pub fn prepare(&self, path: Option<&Path>) -> Result<Prepared> {
+        let (mut scene, load_ms) = load(path)?;
+        let mut camera = self.camera.choose(&scene)?;
+        // `--sky` alone is an explicit choice of lighting too: no automatic environment.
+        let env_arg = match (&self.env.env, self.env.sky) {
+            (None, Some(_)) => first_image::EnvArg::Off,
+            (env, _) => first_image::EnvArg::parse(env.as_deref()),
+        };
+        let camera_chosen = self.camera.camera.is_some()
+            || self.camera.eye.is_some()
+            || scene.cameras[0].name != crate::scene::framing::AUTO_CAMERA;
+        let own_lights = if scene.default_rig {
+            Vec::new()
+        } else {
+            scene.lights.clone()
+        };
+        let aspect = match (self.size.width, self.size.height) {
+            (Some(w), Some(h)) if h > 0 => w as f64 / h as f64,
+            _ => 4.0 / 3.0,
+        };
+        let first = first_image::decide(
+            &scene,
+            &own_lights,
+            camera_chosen.then_some(&camera),
+            aspect,
+        );
+        if let Some(c) = &first.camera {
+            camera = c.clone();
+            if let Some(fov) = self.camera.fov {
+                camera.yfov = fov.to_radians();
+            }
+        }
+        let environment = match env_arg {
+            first_image::EnvArg::Auto => first_image::environment(&env_arg, first.environment),
+            _ => self.environment()?,
+        };
+        if environment.is_some() {
+            scene.light_by_environment();
+        }
+        if env_arg == first_image::EnvArg::Auto {
+            if let Some(preset) = first.environment {
+                eprintln!(
+                    "penumbra: {}: its own lights do not light the view; using the {} environment",
+                    scene.source,
+                    preset.name()
+                );
+            }
+            scene.lights.extend(first.lights.iter().cloned());
+        }
+        if scene.default_rig {
+            eprintln!(
+                "penumbra: {} has no lights; using the default light rig",
+                scene.source
+            );
+        }
+        let mut prepared = finish(scene, camera, &self.shadows, load_ms);
+        prepared.environment = environment;
+        prepared.first_view = Some(first);
+        Ok(prepared)
+    }
+}
+
+/// A scene ready to render: its lights with the chosen radii and the chosen camera.
+pub struct Prepared {
+    /// The scene.
+    pub scene: Scene,
+    /// Lights with radii applied.
+    pub lights: Vec<Light>,
+    /// The camera.
+    pub camera: Camera,
+    /// Loading time.
+    pub load_ms: f64,
+    /// The light radius rule applied to `lights`.
+    pub shadows: Shadows,
+    /// The environment: asked for with `--env`, or the one the first image needs
+    /// ([`CommonArgs::prepare`] only).
+    pub environment: Option<EnvChoice>,
+    /// What the first-view analysis found ([`CommonArgs::prepare`] only).
+    pub first_view: Option<first_image::FirstImage>,
+}
+
+/// Loads the scene at `path` (or the bundled one) and logs its warnings; the loading time in ms.
+fn load(path: Option<&Path>) -> Result<(Scene, f64)> {
+    let t = std::time::Instant::now();
+    let scene = load_or_bundled(path)?;
+    let load_ms = t.elapsed().as_secs_f64() * 1e3;
+    for w in &scene.warnings {
+        log::warn!("{}: {w}", scene.source);
+    }
+    Ok((scene, load_ms))
+}
+
+/// Sizes the lights of `scene` by the light radius rule.
+fn finish(scene: Scene, camera: Camera, shadows: &ShadowArgs, load_ms: f64) -> Prepared {
+    let bounds = scene.bounds();
+    let shadows = Shadows::new(shadows.light_radius, shadows.hard_shadows, &bounds);
+    let lights = shadows.apply(&scene.lights, bounds.diagonal());
+    Prepared {
+        scene,
+        lights,
+        camera,
+        load_ms,
+        shadows,
+        environment: None,
+        first_view: None,
+    }
+}
+
+/// Loads the scene at `path` (or the bundled one), chooses its camera and sizes its lights;
+/// `environment`: an environment light (`--env`) replaces the default light rig.
+pub fn prepare(
+    path: Option<&Path>,
+    camera: &CameraArgs,
+    shadows: &ShadowArgs,
+    environment: bool,
+) -> Result<Prepared> {
+    let (mut scene, load_ms) = load(path)?;
+    if scene.default_rig && !environment {
+        eprintln!(
+            "penumbra: {} has no lights; using the default light rig",
+            scene.source
+        );
+    }
+    let camera = camera.choose(&scene)?;
+    if environment {
+        scene.light_by_environment();
+    }
+    Ok(finish(scene, camera, shadows, load_ms))
+}
+
+/// How paths are sampled (`render`, `bench frame`).
+#[derive(Args, Debug, Clone)]
+pub struct StrategyArgs {
+    /// Direct-light strategy.
+    #[arg(long, value_enum, default_value_t = StrategyArg::Mis)]
+    pub strategy: StrategyArg,
+    /// Disable Russian roulette.
+    #[arg(long)]
+    pub no_russian_roulette: bool,
+}
+
+impl StrategyArgs {
+    /// Applies the strategy and Russian roulette choice to `settings`.
+    pub fn apply(&self, settings: &mut RenderSettings) {
+        settings.strategy = self.strategy.into();
+        if self.no_russian_roulette {
+            settings.russian_roulette = None;
+        }
+    }
+}
+
+/// `--strategy` values.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StrategyArg {
+    /// Light and BSDF sampling with multiple importance sampling.
+    Mis,
+    /// BSDF sampling only.
+    Bsdf,
+    /// Light sampling only.
+    Lights,
+}
+
+impl From<StrategyArg> for Strategy {
+    fn from(s: StrategyArg) -> Self {
+        match s {
+            StrategyArg::Mis => Strategy::Mis,
+            StrategyArg::Bsdf => Strategy::Bsdf,
+            StrategyArg::Lights => Strategy::Lights,
+        }
+    }
+}
+
+fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}' is not a point: use X,Y,Z"))?;
+    match parts.as_slice() {
+        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(format!("'{s}' is not a point: use X,Y,Z")),
+    }
+}
+
+fn parse_color(s: &str) -> Result<[f32; 3], String> {
+    let parts: Vec<f32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}' is not a color: use R,G,B or one number"))?;
+    let c = match parts.as_slice() {
+        [v] => [*v; 3],
+        [r, g, b] => [*r, *g, *b],
+        _ => return Err(format!("'{s}' is not a color: use R,G,B or one number")),
+    };
+    if c.iter().any(|v| !v.is_finite() || *v < 0.0) {
+        return Err(format!(
+            "'{s}': color values must be finite and not negative"
+        ));
+    }
+    Ok(c)
+}
+
+/// A finite number (NaN and ±inf are refused).
+pub(crate) fn parse_finite(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("'{s}' is not a finite number")),
+    }
+}
+
+/// A finite number ≥ 0.
+fn parse_non_negative(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v >= 0.0 => Ok(v),
+        _ => Err(format!("'{s}' must be a finite number >= 0")),
+    }
+}
+
+/// A finite number > 0.
+fn parse_positive(s: &str) -> Result<f32, String> {
+    match parse_finite(s)? {
+        v if v > 0.0 => Ok(v),
+        _ => Err(format!("'{s}' must be a finite number > 0")),
+    }
+}
+
+/// A vertical field of view in degrees, strictly between 0 and 180.
+fn parse_fov(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
+        _ => Err(format!("'{s}' is not a field of view in degrees (0..180)")),
+    }
+}
+
+/// A duration in seconds: finite and > 0.
+pub(crate) fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "'{s}' is not a duration in seconds (a finite number > 0)"
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vectors_parse() {
+        assert_eq!(parse_vec3("-278, 273,800"), Ok([-278.0, 273.0, 800.0]));
+        assert!(parse_vec3("1,2").is_err());
+        assert!(parse_vec3("1,nan,2").is_err());
+    }
+
+    #[test]
+    fn colors_parse_or_fail_clearly() {
+        assert_eq!(parse_color("0.5").unwrap(), [0.5; 3]);
+        assert_eq!(parse_color("1,2,3").unwrap(), [1.0, 2.0, 3.0]);
+        assert!(parse_color("1,2").is_err());
+        assert!(parse_color("-1").is_err());
+        assert!(parse_color("nan").is_err());
+    }
+}

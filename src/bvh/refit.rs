@@ -1,0 +1,208 @@
+//! Updating a built tree after its triangles moved (skins, morph targets): the boxes are
+//! recomputed bottom up with the topology kept, and the tree is rebuilt instead when that has
+//! made it too slow to traverse.
+
+use super::build::TRAVERSAL_COST;
+use super::{Aabb, Bvh, Child, build};
+use crate::cl::types::GpuBvhNode;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// A refit is kept while the SAH cost stays below this multiple of the cost right after the
+/// last full build; beyond it the tree is rebuilt.
+pub const REFIT_MAX_GROWTH: f32 = 2.0;
+
+/// What [`Bvh::refit_or_rebuild`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Update {
+    /// The boxes were refitted; the topology is unchanged.
+    Refitted,
+    /// The refitted tree had grown too costly and was built again.
+    Rebuilt,
+}
+
+impl Bvh {
+    /// The SAH cost (traversal cost 1, intersection cost 1 per triangle, relative to the root's
+    /// area) and the depth of the deepest leaf (root = 0), from the node array.
+    pub fn sah_and_depth(&self) -> (f32, u32) {
+        let Some(root) = self.nodes.first() else {
+            return (0.0, 0);
+        };
+        let root_leaf_only = matches!(self.child(0, 1).1, Child::Leaf { count: 0, .. });
+        let root_area = child_box(root, 0)
+            .union(child_box(root, 1))
+            .area()
+            .max(f32::MIN_POSITIVE) as f64;
+        // Children come after their parents, so one forward pass knows every node's depth.
+        let mut depths = vec![0u8; self.nodes.len()];
+        let mut cost = if root_leaf_only {
+            0.0
+        } else {
+            TRAVERSAL_COST as f64
+        };
+        let mut deepest = 0;
+        for index in 0..self.nodes.len() {
+            let depth = depths[index];
+            for side in 0..2 {
+                let (b, child) = self.child(index as u32, side);
+                let area = b.area() as f64 / root_area;
+                match child {
+                    Child::Node(c) => {
+                        depths[c as usize] = depth + 1;
+                        cost += area * TRAVERSAL_COST as f64;
+                    }
+                    Child::Leaf { count, .. } => {
+                        cost += area * count as f64;
+                        if count > 0 {
+                            deepest = deepest.max(depth as u32 + u32::from(!root_leaf_only));
+                        }
+                    }
+                }
+            }
+        }
+        (cost as f32, deepest)
+    }
+
+    /// Recomputes every box for `triangles` (in their original order, as given to
+    /// [`build`]), keeping the tree's topology; updates `sah_cost`.
+    ///
+    /// # Panics
+    /// When `triangles` is not as long as the list the tree was built over.
+    pub fn refit(&mut self, triangles: &[[Vec3; 3]]) {
+        assert_eq!(
+            triangles.len(),
+            self.tri_indices.len(),
+            "a refit needs the triangles the tree was built over"
+        );
+        // Leaf boxes first, all nodes at once.
+        let tri_indices = &self.tri_indices;
+        self.nodes.par_iter_mut().for_each(|node| {
+            for side in 0..2 {
+                let (lo, hi) = sides(node, side);
+                let index = lo[3].to_bits() as i32;
+                if index < 0 {
+                    let first = !index as usize;
+                    let count = hi[3].to_bits() as usize;
+                    let b = tri_indices[first..first + count]
+                        .iter()
+                        .flat_map(|&t| triangles[t as usize])
+                        .fold(Aabb::EMPTY, Aabb::grow);
+                    set_box(lo, hi, b);
+                }
+            }
+        });
+        // Then interior boxes from the back: a node's children come after it.
+        for index in (0..self.nodes.len()).rev() {
+            for side in 0..2 {
+                if let (_, Child::Node(c)) = self.child(index as u32, side) {
+                    let n = &self.nodes[c as usize];
+                    let b = child_box(n, 0).union(child_box(n, 1));
+                    let (lo, hi) = sides(&mut self.nodes[index], side);
+                    set_box(lo, hi, b);
+                }
+            }
+        }
+        self.sah_cost = self.sah_and_depth().0;
+    }
+
+    /// Refits for `triangles`, and builds the tree again when the refit left its SAH cost at
+    /// [`REFIT_MAX_GROWTH`] times the cost of the last full build or more.
+    pub fn refit_or_rebuild(&mut self, triangles: &[[Vec3; 3]]) -> Update {
+        self.refit(triangles);
+        if self.sah_cost < REFIT_MAX_GROWTH * self.built_sah_cost {
+            return Update::Refitted;
+        }
+        *self = build(triangles);
+        Update::Rebuilt
+    }
+}
+
+/// The box of child `side` of `node`.
+fn child_box(node: &GpuBvhNode, side: usize) -> Aabb {
+    let (lo, hi) = if side == 0 {
+        (node.left_min, node.left_max)
+    } else {
+        (node.right_min, node.right_max)
+    };
+    Aabb {
+        min: Vec3::new(lo[0], lo[1], lo[2]),
+        max: Vec3::new(hi[0], hi[1], hi[2]),
+    }
+}
+
+/// The min and max lanes of child `side`.
+fn sides(node: &mut GpuBvhNode, side: usize) -> (&mut [f32; 4], &mut [f32; 4]) {
+    if side == 0 {
+        (&mut node.left_min, &mut node.left_max)
+    } else {
+        (&mut node.right_min, &mut node.right_max)
+    }
+}
+
+/// Writes a box into a child's lanes, keeping the `.w` references.
+fn set_box(lo: &mut [f32; 4], hi: &mut [f32; 4], b: Aabb) {
+    lo[..3].copy_from_slice(&b.min.to_array());
+    hi[..3].copy_from_slice(&b.max.to_array());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::build::tests::random_triangles;
+    use super::*;
+
+    #[test]
+    fn refitting_an_unchanged_mesh_gives_the_built_tree() {
+        for n in [1, 2, 7, 5000, 70_000] {
+            let tris = random_triangles(n, 3);
+            let built = build(&tris);
+            let mut refitted = built.clone();
+            refitted.refit(&tris);
+            // Leaf references are NaN bits as floats: compare bytes.
+            let same = refitted
+                .nodes
+                .iter()
+                .zip(&built.nodes)
+                .position(|(a, b)| bytemuck::bytes_of(a) != bytemuck::bytes_of(b));
+            assert_eq!(same, None, "the first differing node of {n} triangles");
+            assert_eq!(refitted.sah_cost, built.sah_cost);
+            assert_eq!(refitted.tri_indices, built.tri_indices);
+        }
+    }
+
+    #[test]
+    fn a_refit_after_moving_vertices_holds_every_triangle() {
+        let tris = random_triangles(3000, 5);
+        let mut bvh = build(&tris);
+        // A wave that moves every vertex by up to 0.3 along y and z.
+        let moved: Vec<[Vec3; 3]> = tris
+            .iter()
+            .map(|t| t.map(|v| v + Vec3::new(0.0, (v.x * 1.7).sin(), (v.x * 0.9).cos()) * 0.3))
+            .collect();
+        assert_eq!(bvh.refit_or_rebuild(&moved), Update::Refitted);
+        super::super::build::tests::check_tree(&bvh, &moved);
+        // Closest hits through the refitted tree equal those of a fresh build.
+        let fresh = build(&moved);
+        let order = |b: &Bvh| -> Vec<[Vec3; 3]> {
+            b.tri_indices.iter().map(|&i| moved[i as usize]).collect()
+        };
+        let (a, b) = (order(&bvh), order(&fresh));
+        for ray in super::super::build::tests::random_rays(500, 17) {
+            let x = bvh.intersect(&ray, &a).map(|h| h.t);
+            let y = fresh.intersect(&ray, &b).map(|h| h.t);
+            assert_eq!(x, y, "{ray:?}");
+        }
+    }
+
+    #[test]
+    fn a_scrambled_mesh_is_rebuilt() {
+        let tris = random_triangles(4000, 9);
+        let mut bvh = build(&tris);
+        // Every triangle swaps places with one far away: the old topology no longer fits.
+        let scrambled: Vec<[Vec3; 3]> = (0..tris.len())
+            .map(|i| tris[(i * 2311 + 17) % tris.len()])
+            .collect();
+        assert_eq!(bvh.refit_or_rebuild(&scrambled), Update::Rebuilt);
+        assert!(bvh.sah_cost < 2.0 * build(&tris).sah_cost);
+        super::super::build::tests::check_tree(&bvh, &scrambled);
+    }
+}

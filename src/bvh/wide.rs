@@ -1,0 +1,284 @@
+//! The 4-wide BVH for SIMD traversal on CPU devices: the binary BVH collapsed so that each node
+//! holds up to four children whose boxes are laid out by coordinate (structure of arrays), one
+//! `float4` per box plane, so a kernel tests a ray against all four boxes with a few vector
+//! operations (kernels/traverse_wide.h). The boxes and leaves are the binary BVH's own, so the
+//! same triangles are found; only the order of the tests changes.
+
+use super::traverse::{box_entry, safe_inverse};
+use super::{Aabb, Bvh, Child, Hit, Ray, intersect_triangle};
+use crate::cl::types::GpuWideNode;
+use glam::Vec3;
+
+/// Children per wide node.
+pub const WIDTH: usize = 4;
+
+/// Entries of the wide traversal stack; the kernels use the same size. A visit pushes at most
+/// `WIDTH - 1` children and every wide level is at least one binary level, so a binary tree
+/// within the builder's depth limit needs at most 3 × 48 entries.
+pub const WIDE_STACK_SIZE: usize = (WIDTH - 1) * super::MAX_DEPTH as usize;
+
+/// A collapsed BVH: node 0 is the root; triangles are the binary BVH's, in its order.
+#[derive(Clone, Debug)]
+pub struct WideBvh {
+    /// Nodes. See [`GpuWideNode`] for the child encoding.
+    pub nodes: Vec<GpuWideNode>,
+}
+
+/// One child slot of a node under construction.
+#[derive(Clone, Copy)]
+struct Slot {
+    bounds: Aabb,
+    child: Child,
+}
+
+impl WideBvh {
+    /// Collapses `bvh`: each wide node takes its binary node's two children and keeps opening
+    /// the interior child with the largest surface area until it has four (or only leaves).
+    pub fn collapse(bvh: &Bvh) -> Self {
+        let mut nodes = vec![GpuWideNode::default()];
+        let mut work = vec![(0u32, 0usize)]; // (binary node, wide node)
+        while let Some((binary, wide)) = work.pop() {
+            let mut slots: Vec<Slot> = (0..2)
+                .map(|side| {
+                    let (bounds, child) = bvh.child(binary, side);
+                    Slot { bounds, child }
+                })
+                .collect();
+            while slots.len() < WIDTH {
+                let Some((i, node)) = slots
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, s)| match s.child {
+                        Child::Node(n) => Some((i, n, s.bounds.area())),
+                        Child::Leaf { .. } => None,
+                    })
+                    .max_by(|a, b| a.2.total_cmp(&b.2))
+                    .map(|(i, n, _)| (i, n))
+                else {
+                    break;
+                };
+                slots.swap_remove(i);
+                for side in 0..2 {
+                    let (bounds, child) = bvh.child(node, side);
+                    slots.push(Slot { bounds, child });
+                }
+            }
+            let mut out = GpuWideNode::default();
+            for (i, s) in slots.iter().enumerate() {
+                out.min_x[i] = s.bounds.min.x;
+                out.min_y[i] = s.bounds.min.y;
+                out.min_z[i] = s.bounds.min.z;
+                out.max_x[i] = s.bounds.max.x;
+                out.max_y[i] = s.bounds.max.y;
+                out.max_z[i] = s.bounds.max.z;
+                match s.child {
+                    Child::Leaf { first, count } => {
+                        out.child[i] = !(first as i32);
+                        out.count[i] = count;
+                    }
+                    Child::Node(n) => {
+                        let index = nodes.len();
+                        nodes.push(GpuWideNode::default());
+                        out.child[i] = index as i32;
+                        work.push((n, index));
+                    }
+                }
+            }
+            nodes[wide] = out;
+        }
+        Self { nodes }
+    }
+
+    /// The decoded children of `node` (empty slots left out).
+    pub fn children(&self, node: u32) -> impl Iterator<Item = (Aabb, Child)> + '_ {
+        let n = &self.nodes[node as usize];
+        (0..WIDTH).filter_map(move |i| {
+            let child = if n.count[i] > 0 {
+                Child::Leaf {
+                    first: !n.child[i] as u32,
+                    count: n.count[i],
+                }
+            } else if n.child[i] > 0 {
+                Child::Node(n.child[i] as u32)
+            } else {
+                return None;
+            };
+            let bounds = Aabb {
+                min: Vec3::new(n.min_x[i], n.min_y[i], n.min_z[i]),
+                max: Vec3::new(n.max_x[i], n.max_y[i], n.max_z[i]),
+            };
+            Some((bounds, child))
+        })
+    }
+
+    /// The closest hit along `ray` among `tris` (in BVH order), visiting children nearest
+    /// first as the kernels do: the host reference of kernels/traverse_wide.h.
+    pub fn intersect(&self, ray: &Ray, tris: &[[Vec3; 3]]) -> Option<Hit> {
+        let inv = safe_inverse(ray.direction);
+        let mut tmax = ray.tmax;
+        let mut best = None;
+        let mut stack = Vec::with_capacity(WIDE_STACK_SIZE);
+        let mut node = 0u32;
+        loop {
+            let mut hit: Vec<(f32, Child)> = self
+                .children(node)
+                .filter_map(|(b, c)| {
+                    box_entry(b.min, b.max, ray.origin, inv, ray.tmin, tmax).map(|d| (d, c))
+                })
+                .collect();
+            hit.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut interior = Vec::new();
+            for (d, child) in hit {
+                match child {
+                    Child::Leaf { first, count } if d < tmax => {
+                        for prim in first..first + count {
+                            let r = Ray { tmax, ..*ray };
+                            if let Some((t, u, v)) = intersect_triangle(&r, &tris[prim as usize]) {
+                                tmax = t;
+                                best = Some(Hit { t, u, v, prim });
+                            }
+                        }
+                    }
+                    Child::Node(n) => interior.push((d, n)),
+                    Child::Leaf { .. } => {}
+                }
+            }
+            interior.retain(|&(d, _)| d < tmax);
+            if let Some(&(_, nearest)) = interior.first() {
+                for &(_, n) in interior[1..].iter().rev() {
+                    stack.push(n);
+                }
+                assert!(stack.len() <= WIDE_STACK_SIZE, "wide stack overflow");
+                node = nearest;
+            } else {
+                match stack.pop() {
+                    Some(n) => node = n,
+                    None => return best,
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn random_triangles(n: usize, seed: u64) -> Vec<[Vec3; 3]> {
+        let mut s = seed;
+        let mut rnd = move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new(rnd(), rnd(), rnd()) * 10.0;
+                let mut v = || c + (Vec3::new(rnd(), rnd(), rnd()) - 0.5) * 0.8;
+                [v(), v(), v()]
+            })
+            .collect()
+    }
+
+    /// Triangles in BVH order.
+    fn ordered(bvh: &Bvh, tris: &[[Vec3; 3]]) -> Vec<[Vec3; 3]> {
+        bvh.tri_indices.iter().map(|&i| tris[i as usize]).collect()
+    }
+
+    #[test]
+    fn every_triangle_is_in_exactly_one_leaf_inside_its_box() {
+        let tris = random_triangles(5000, 3);
+        let bvh = crate::bvh::build(&tris);
+        let wide = WideBvh::collapse(&bvh);
+        let ordered = ordered(&bvh, &tris);
+        let mut seen = vec![0u32; tris.len()];
+        let mut reached = vec![false; wide.nodes.len()];
+        reached[0] = true;
+        for node in 0..wide.nodes.len() as u32 {
+            let children: Vec<_> = wide.children(node).collect();
+            assert!(
+                children.len() >= 2 && children.len() <= WIDTH,
+                "node {node}"
+            );
+            for (bounds, child) in children {
+                match child {
+                    Child::Leaf { first, count } => {
+                        for p in first..first + count {
+                            seen[p as usize] += 1;
+                            for v in ordered[p as usize] {
+                                assert!(bounds.contains(v), "triangle {p} outside its box");
+                            }
+                        }
+                    }
+                    Child::Node(n) => {
+                        assert!(!reached[n as usize], "node {n} has two parents");
+                        reached[n as usize] = true;
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1), "each triangle once");
+        assert!(reached.iter().all(|&r| r), "every node reachable");
+        // Four-wide nodes: about a third as many as the binary tree's.
+        assert!(
+            wide.nodes.len() * 2 < bvh.nodes.len(),
+            "{}",
+            wide.nodes.len()
+        );
+    }
+
+    #[test]
+    fn wide_traversal_finds_the_binary_traversals_hits() {
+        let tris = random_triangles(3000, 9);
+        let bvh = crate::bvh::build(&tris);
+        let wide = WideBvh::collapse(&bvh);
+        let ordered = ordered(&bvh, &tris);
+        let mut s = 5u64;
+        let mut rnd = move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut hits = 0;
+        for i in 0..4000 {
+            let origin = Vec3::new(rnd(), rnd(), rnd()) * 14.0 - 2.0;
+            let mut direction = (Vec3::new(rnd(), rnd(), rnd()) - 0.5).normalize();
+            if i % 10 == 0 {
+                direction = Vec3::Y; // axis-parallel
+            }
+            let ray = Ray {
+                origin,
+                direction,
+                tmin: 0.0,
+                tmax: if i % 7 == 0 { 2.0 } else { f32::INFINITY },
+            };
+            let a = bvh.intersect(&ray, &ordered);
+            let b = wide.intersect(&ray, &ordered);
+            assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "ray {i}");
+            hits += a.is_some() as usize;
+        }
+        assert!(hits > 400, "the rays hit something ({hits})");
+    }
+
+    #[test]
+    fn a_single_leaf_tree_collapses_to_one_node() {
+        let tris = random_triangles(2, 1);
+        let bvh = crate::bvh::build(&tris);
+        let wide = WideBvh::collapse(&bvh);
+        assert_eq!(wide.nodes.len(), 1);
+        let ordered = ordered(&bvh, &tris);
+        let c = (ordered[0][0] + ordered[0][1] + ordered[0][2]) / 3.0;
+        let ray = Ray {
+            origin: c + Vec3::Z * 20.0,
+            direction: -Vec3::Z,
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        };
+        assert_eq!(
+            wide.intersect(&ray, &ordered).map(|h| h.t),
+            bvh.intersect(&ray, &ordered).map(|h| h.t)
+        );
+    }
+}

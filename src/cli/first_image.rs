@@ -1,0 +1,93 @@
+//! The defaults that make the first image of any scene readable: the first view (a scene's own
+//! camera wins), an environment when the scene's own lights do not light that view, and lights
+//! inside an interior that nothing lights.
+
+use crate::args::EnvChoice;
+use crate::scene::framing::{self, FirstView};
+use crate::scene::{Camera, EnvPreset, Light, Scene};
+
+/// What `--env` names.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvArg {
+    /// No `--env`: decided per scene.
+    Auto,
+    /// `--env none`: no environment.
+    Off,
+    /// A bundled environment.
+    Preset(EnvPreset),
+    /// An image file or a colour (parsed later).
+    Other(String),
+}
+
+impl EnvArg {
+    /// Reads the `--env` value.
+    pub fn parse(arg: Option<&str>) -> Self {
+        match arg {
+            None => EnvArg::Auto,
+            Some("none") => EnvArg::Off,
+            Some(name) => EnvPreset::from_name(name)
+                .map(EnvArg::Preset)
+                .unwrap_or_else(|| EnvArg::Other(name.to_string())),
+        }
+    }
+}
+
+/// The defaults chosen for a scene.
+pub struct FirstImage {
+    /// The first-view analysis (from the chosen camera).
+    pub view: FirstView,
+    /// The camera to use when the scene has none of its own (and none was asked for).
+    pub camera: Option<Camera>,
+    /// The environment the rule asks for (`None`: the scene's lights light the view).
+    pub environment: Option<EnvPreset>,
+    /// Lights to add: an interior that neither its lights nor the environment reach.
+    pub lights: Vec<Light>,
+}
+
+/// Decides the first view of `scene` whose own lights are `lights` (without a default rig);
+/// `camera` is the camera in use when the scene (or the command line) chose one.
+pub fn decide(scene: &Scene, lights: &[Light], camera: Option<&Camera>, aspect: f64) -> FirstImage {
+    let view = framing::first_view(scene, lights, camera, aspect);
+    let environment = (!view.lit).then_some(EnvPreset::Studio);
+    // Inside a room, daylight through the windows is not enough: add a ceiling lamp and a light
+    // at the camera unless the scene's own lights reach the view.
+    let added = if view.interior && !view.lit {
+        framing::interior_lights(&view)
+    } else {
+        Vec::new()
+    };
+    FirstImage {
+        camera: camera.is_none().then(|| view.camera.clone()),
+        environment,
+        lights: added,
+        view,
+    }
+}
+
+/// The environment to use: the one asked for, else the one the first image needs.
+pub fn environment(arg: &EnvArg, needed: Option<EnvPreset>) -> Option<EnvChoice> {
+    match arg {
+        EnvArg::Auto => needed.map(|p| EnvChoice::Map(p.load())),
+        EnvArg::Preset(p) => Some(EnvChoice::Map(p.load())),
+        EnvArg::Off | EnvArg::Other(_) => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn env_names_parse() {
+        assert_eq!(EnvArg::parse(None), EnvArg::Auto);
+        assert_eq!(EnvArg::parse(Some("none")), EnvArg::Off);
+        assert_eq!(
+            EnvArg::parse(Some("outdoor")),
+            EnvArg::Preset(EnvPreset::Outdoor)
+        );
+        assert_eq!(
+            EnvArg::parse(Some("sky.hdr")),
+            EnvArg::Other("sky.hdr".into())
+        );
+    }
+}

@@ -1,0 +1,146 @@
+//! The megakernel: on CPU devices a frame is one kernel launch in which each work item traces
+//! whole paths for one pixel (kernels/megakernel.cl). It computes the wavefront's estimator
+//! (the same shading function, kernels/path.h) without its queues, path buffers and per-bounce
+//! launches, which cost more than they save where there are only a few cores.
+
+use super::Renderer;
+use crate::cl::kernels::Launch;
+use crate::cl::types::GpuFrame;
+use crate::cl::{ClError, Stage};
+use opencl3::device::CL_DEVICE_TYPE_CPU;
+use std::str::FromStr;
+use std::time::Instant;
+
+/// Which kernels render: the wavefront stages or the megakernel.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum KernelChoice {
+    /// The megakernel on CPU devices (CL_DEVICE_TYPE_CPU), the wavefront elsewhere.
+    #[default]
+    Auto,
+    /// Queued stages per bounce (what GPUs run best).
+    Wavefront,
+    /// One path per work item, all bounces in one kernel.
+    Megakernel,
+}
+
+impl FromStr for KernelChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "" | "auto" => Ok(Self::Auto),
+            "wavefront" => Ok(Self::Wavefront),
+            "megakernel" => Ok(Self::Megakernel),
+            _ => Err(format!(
+                "kernel '{s}' is not 'wavefront', 'megakernel' or 'auto'"
+            )),
+        }
+    }
+}
+
+/// Paths one megakernel launch may trace at most, so that its 32-bit ray counters cannot
+/// overflow (each path traces at most bounces + 2 extension rays and as many shadow rays).
+const MAX_RAYS_PER_LAUNCH: u64 = 1 << 31;
+
+impl Renderer {
+    /// Chooses the kernels (resolving `Auto` by the device type). Resets the film.
+    pub fn set_kernel(&mut self, choice: KernelChoice) -> Result<(), ClError> {
+        self.megakernel = match choice {
+            KernelChoice::Auto => self
+                .gpu
+                .device
+                .dev_type()
+                .is_ok_and(|t| t & CL_DEVICE_TYPE_CPU != 0),
+            KernelChoice::Wavefront => false,
+            KernelChoice::Megakernel => true,
+        };
+        self.reset()
+    }
+
+    /// The kernels in use (never `Auto`).
+    pub fn kernel(&self) -> KernelChoice {
+        if self.megakernel {
+            KernelChoice::Megakernel
+        } else {
+            KernelChoice::Wavefront
+        }
+    }
+
+    /// Launches the megakernel once over no pixels and waits, so that a driver which compiles
+    /// kernels at their first launch (PoCL does, per work-group size) does it now, in the
+    /// kernel build time, and not in the first frame. Returns the milliseconds it took.
+    pub(super) fn prime_megakernel(&mut self) -> Result<f64, ClError> {
+        if !self.megakernel || self.scene.is_none() {
+            return Ok(0.0);
+        }
+        let t = Instant::now();
+        self.ensure_frame()?;
+        let mut frame = self.settings.gpu_frame(self.light_count);
+        frame.width = 0;
+        frame.height = 0;
+        frame.samples_in_wave = 0;
+        self.launch_megakernel(&frame)?;
+        self.gpu
+            .queue
+            .finish()
+            .map_err(crate::cl::call_err("building the megakernel"))?;
+        Ok(t.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// One megakernel launch for `frame`, then `advance` to move its ray counts into the
+    /// totals.
+    fn launch_megakernel(&self, frame: &GpuFrame) -> Result<[(Stage, Launch); 2], ClError> {
+        let (Some(program), Some((scene, _)), Some(f)) = (
+            self.program.as_ref(),
+            self.scene.as_ref(),
+            self.frame.as_ref(),
+        ) else {
+            return Err(ClError::Device("no scene is loaded".into()));
+        };
+        let (gpu, counters) = (&self.gpu, &self.counters);
+        let l = program.megakernel(
+            gpu,
+            frame,
+            &self.camera,
+            &self.env,
+            scene,
+            &f.film,
+            counters,
+        )?;
+        let a = program.advance(gpu, counters, &self.stats_buffer)?;
+        Ok([(Stage::Megakernel, l), (Stage::Advance, a)])
+    }
+
+    /// Enqueues `spp` more samples per pixel as megakernel launches (as few as the ray
+    /// counters allow).
+    pub(super) fn enqueue_megakernel(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
+        self.ensure_frame()?;
+        let pixels = u64::from(self.settings.width * self.settings.height).max(1);
+        let rays_per_sample = 2 * (u64::from(self.settings.bounces) + 2);
+        let per_launch = (MAX_RAYS_PER_LAUNCH / (pixels * rays_per_sample)).clamp(1, 1 << 16);
+        let mut launches = Vec::new();
+        let mut done = 0;
+        while done < spp {
+            let n = (per_launch as u32).min(spp - done);
+            let mut frame = self.settings.gpu_frame(self.light_count);
+            frame.samples_in_wave = n;
+            frame.first_sample = self.samples + done;
+            launches.extend(self.launch_megakernel(&frame)?);
+            done += n;
+        }
+        self.samples += spp;
+        Ok(launches)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_kernel_choices() {
+        assert_eq!("auto".parse(), Ok(KernelChoice::Auto));
+        assert_eq!("Wavefront".parse(), Ok(KernelChoice::Wavefront));
+        assert_eq!("megakernel".parse(), Ok(KernelChoice::Megakernel));
+        assert!("fast".parse::<KernelChoice>().is_err());
+    }
+}

@@ -1,0 +1,988 @@
+//! The first view of a scene without a camera of its own: robust bounds of what is there, the
+//! side its lights illuminate, interiors seen from inside, and the rule that decides whether the
+//! scene's own lights light that view (else the viewer adds an environment).
+//!
+//! Everything here runs on the host with the reference BVH traversal ([`crate::bvh`]) and is
+//! deterministic: the same scene gives the same first view.
+//!
+//! # "The scene's own lights light the view"
+//!
+//! From the chosen camera a grid of [`PROBE_COLUMNS`] × [`PROBE_ROWS`] rays finds the subject
+//! points. At each point the direct irradiance E from the scene's punctual lights and emissive
+//! triangles is estimated (cosine at the point, inverse square, cone and emitter cosine, one
+//! visibility ray per light; the [`MAX_EMITTERS`] most powerful emissive triangles stand for
+//! all of them, scaled by their share of the emitted power). With L_s = median(E)/π (the
+//! radiance of a white diffuse surface at the median point) and L_e = the 90th percentile of
+//! the radiance of emitters the camera sees directly, the lights light the view when
+//! - at least [`MIN_LIT_FRACTION`] of the subject points get some direct light, and
+//! - L_s ≥ L_e · 2^−[`MAX_STOPS_BELOW_EMITTERS`] (the subject is within the tone curve's reach
+//!   once the visible lamps are exposed).
+//!
+//! Small glowing parts (a car's headlights, a lamp's filament behind glass) fail the first test;
+//! a sun or a lamp over the subject passes both.
+
+use super::{Bounds, Camera, Light, LightKind, Scene, WorldTriangle};
+use crate::bvh::{Bvh, Ray};
+use glam::{DVec3, Vec3};
+
+/// Columns of the probe grid of camera rays.
+pub const PROBE_COLUMNS: usize = 32;
+/// Rows of the probe grid of camera rays.
+pub const PROBE_ROWS: usize = 24;
+/// Emissive triangles evaluated at each subject point (the most powerful ones).
+pub const MAX_EMITTERS: usize = 64;
+/// The share of subject points that must receive direct light.
+pub const MIN_LIT_FRACTION: f64 = 0.25;
+/// How far (in stops) the lit subject may lie below the directly seen emitters.
+pub const MAX_STOPS_BELOW_EMITTERS: f64 = 10.0;
+/// Share of the rays from the middle of the bounds that must hit front faces for an interior.
+pub const INTERIOR_HIT_FRACTION: f64 = 0.6;
+/// Share of escaping rays from which a one-sided opening makes an open box (the Cornell box
+/// loses a sixth of its rays through its front; a room loses a few through its windows).
+pub const OPEN_SIDE_FRACTION: f64 = 0.08;
+/// Rays cast from the middle of the bounds to tell an interior from an object.
+pub const SHELL_RAYS: usize = 128;
+/// Eye height in metres (glTF's unit) inside a room; models in centimetres or millimetres are
+/// recognised by their floor-to-ceiling height.
+pub const EYE_HEIGHT: f64 = 1.6;
+/// Vertical field of view of an interior view (wider than [`super::AUTO_YFOV`]).
+pub const INTERIOR_YFOV: f64 = 1.15;
+/// Name of the cameras made here (and by [`Camera::framing`]).
+pub const AUTO_CAMERA: &str = "auto";
+
+/// The scene's triangles with a BVH for probe rays.
+pub struct Probe {
+    bvh: Bvh,
+    /// Triangles in BVH order.
+    tris: Vec<[Vec3; 3]>,
+    /// Emitted radiance luminance of each triangle, in BVH order (0 for most).
+    emission: Vec<f32>,
+    /// All triangles, glass included, with their BVH, when some are see-through (walls with
+    /// windows are still walls when telling an interior).
+    shell: Option<(Bvh, Vec<[Vec3; 3]>)>,
+    /// Up to [`FIT_POINTS`] vertices inside the robust bounds, for fitting the view.
+    points: Vec<Vec3>,
+    /// Robust bounds of the visible geometry.
+    pub bounds: Bounds,
+}
+
+/// Vertices kept for fitting the view to the subject's silhouette.
+pub const FIT_POINTS: usize = 8192;
+
+/// What the first-view analysis found (for messages, the JSON summary and tests).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FirstView {
+    /// The camera to start with.
+    pub camera: Camera,
+    /// Robust bounds of the visible geometry.
+    pub bounds: Bounds,
+    /// Whether the camera was put inside (the model is an interior).
+    pub interior: bool,
+    /// Whether the scene's own lights light the view (the rule in the module docs).
+    pub lit: bool,
+    /// The share of probe rays from the camera that hit geometry.
+    pub coverage: f64,
+    /// The share of subject points with direct light from the scene's lights.
+    pub lit_fraction: f64,
+    /// L_s: median direct irradiance over π at the subject points.
+    pub subject_radiance: f64,
+    /// L_e: 90th percentile radiance of the emitters seen directly (0 when none is).
+    pub emitter_radiance: f64,
+}
+
+fn luminance(c: [f32; 3]) -> f32 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}
+
+fn area(t: &[Vec3; 3]) -> f32 {
+    0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
+}
+
+/// The `q`-quantile of `values` weighted by `weights` (both non-empty, same length).
+fn weighted_quantile(values: &[(f32, f32)], q: f64) -> f32 {
+    let total: f64 = values.iter().map(|v| v.1 as f64).sum();
+    let target = q * total;
+    let mut acc = 0.0;
+    for &(v, w) in values {
+        acc += w as f64;
+        if acc >= target {
+            return v;
+        }
+    }
+    values.last().map_or(0.0, |v| v.0)
+}
+
+/// Bounds of the bulk of the geometry. Per axis, the 5th–95th percentile range of the triangle
+/// centroids weighted by √area (so that neither a huge ground plane nor a dense small part
+/// dominates), widened by half that range on each side, is the window; the bounds of the
+/// triangles whose centroids fall in the window, clipped to it, are the result. A stray object
+/// far away is left out; a lone object keeps its exact bounds.
+pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
+    let mut exact = Bounds::default();
+    for t in tris {
+        for v in t {
+            exact.grow(v.as_dvec3());
+        }
+    }
+    if tris.len() < 8 {
+        return exact;
+    }
+    let centroids: Vec<Vec3> = tris.iter().map(|t| (t[0] + t[1] + t[2]) / 3.0).collect();
+    let weights: Vec<f32> = tris.iter().map(|t| area(t).sqrt() + 1e-12).collect();
+    let mut lo = Vec3::ZERO;
+    let mut hi = Vec3::ZERO;
+    for axis in 0..3 {
+        let mut v: Vec<(f32, f32)> = centroids
+            .iter()
+            .zip(&weights)
+            .map(|(c, &w)| (c[axis], w))
+            .collect();
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (a, b) = (weighted_quantile(&v, 0.05), weighted_quantile(&v, 0.95));
+        let margin = 0.5 * (b - a);
+        lo[axis] = a - margin;
+        hi[axis] = b + margin;
+    }
+    let mut bounds = Bounds::default();
+    for (t, c) in tris.iter().zip(&centroids) {
+        if c.cmpge(lo).all() && c.cmple(hi).all() {
+            for v in t {
+                bounds.grow(v.clamp(lo, hi).as_dvec3());
+            }
+        }
+    }
+    if bounds.is_empty() { exact } else { bounds }
+}
+
+impl Probe {
+    /// Builds the probe for the visible geometry of `scene`. Glass and blended surfaces are left
+    /// out of the BVH (light passes them); they still count for the bounds.
+    pub fn new(scene: &Scene) -> Self {
+        let world = scene.world_triangles();
+        Self::from_triangles(&world, scene)
+    }
+
+    fn from_triangles(world: &[WorldTriangle], scene: &Scene) -> Self {
+        let all: Vec<[Vec3; 3]> = world.iter().map(|t| t.v).collect();
+        let bounds = robust_bounds(&all);
+        let (lo, hi) = (bounds.min.as_vec3(), bounds.max.as_vec3());
+        let inside: Vec<Vec3> = all
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|p| p.cmpge(lo).all() && p.cmple(hi).all())
+            .collect();
+        let step = inside.len().div_ceil(FIT_POINTS).max(1);
+        let points = inside.into_iter().step_by(step).collect();
+        let see_through = |t: &WorldTriangle| {
+            scene
+                .materials
+                .get(t.material as usize)
+                .is_some_and(|m| m.transmission > 0.0 || m.alpha == super::AlphaMode::Blend)
+        };
+        let kept: Vec<&WorldTriangle> = world.iter().filter(|t| !see_through(t)).collect();
+        let shell = (kept.len() < world.len()).then(|| {
+            let bvh = crate::bvh::build(&all);
+            let tris = bvh.tri_indices.iter().map(|&i| all[i as usize]).collect();
+            (bvh, tris)
+        });
+        let verts: Vec<[Vec3; 3]> = kept.iter().map(|t| t.v).collect();
+        let bvh = crate::bvh::build(&verts);
+        let tris = bvh.tri_indices.iter().map(|&i| verts[i as usize]).collect();
+        let emission = bvh
+            .tri_indices
+            .iter()
+            .map(|&i| {
+                scene
+                    .materials
+                    .get(kept[i as usize].material as usize)
+                    .map_or(0.0, |m| luminance(m.emission))
+            })
+            .collect();
+        Self {
+            bvh,
+            tris,
+            emission,
+            shell,
+            points,
+            bounds,
+        }
+    }
+
+    /// The triangles with glass, and their BVH.
+    fn shell(&self) -> (&Bvh, &[[Vec3; 3]]) {
+        match &self.shell {
+            Some((bvh, tris)) => (bvh, tris),
+            None => (&self.bvh, &self.tris),
+        }
+    }
+
+    /// The closest triangle along a ray, glass included (an index into [`Self::shell`]).
+    fn hit_all(&self, origin: DVec3, dir: DVec3) -> Option<usize> {
+        let (bvh, tris) = self.shell();
+        let ray = Ray {
+            origin: origin.as_vec3(),
+            direction: dir.as_vec3(),
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        };
+        bvh.intersect(&ray, tris).map(|h| h.prim as usize)
+    }
+
+    /// The unit geometric normal of a triangle of [`Self::shell`].
+    fn normal_all(&self, prim: usize) -> DVec3 {
+        let t = &self.shell().1[prim];
+        (t[1] - t[0])
+            .cross(t[2] - t[0])
+            .as_dvec3()
+            .normalize_or(DVec3::Y)
+    }
+
+    fn hit(&self, origin: DVec3, dir: DVec3, tmax: f64) -> Option<(f64, usize)> {
+        let ray = Ray {
+            origin: origin.as_vec3(),
+            direction: dir.as_vec3(),
+            tmin: 0.0,
+            tmax: tmax as f32,
+        };
+        self.bvh
+            .intersect(&ray, &self.tris)
+            .map(|h| (h.t as f64, h.prim as usize))
+    }
+
+    fn visible(&self, from: DVec3, to: DVec3) -> bool {
+        let d = to - from;
+        let ray = Ray {
+            origin: from.as_vec3(),
+            direction: d.as_vec3(),
+            tmin: 1e-4,
+            tmax: 0.999,
+        };
+        !self.bvh.occluded(&ray, &self.tris)
+    }
+
+    fn unobstructed(&self, from: DVec3, dir: DVec3) -> bool {
+        let ray = Ray {
+            origin: from.as_vec3(),
+            direction: dir.as_vec3(),
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        };
+        !self.bvh.occluded(&ray, &self.tris)
+    }
+
+    fn normal(&self, prim: usize) -> DVec3 {
+        let t = &self.tris[prim];
+        (t[1] - t[0])
+            .cross(t[2] - t[0])
+            .as_dvec3()
+            .normalize_or(DVec3::Y)
+    }
+
+    fn scale(&self) -> f64 {
+        self.bounds.diagonal().max(1e-6)
+    }
+}
+
+/// Unit directions spread evenly over the sphere (a Fibonacci lattice).
+fn sphere_directions(n: usize) -> impl Iterator<Item = DVec3> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n).map(move |i| {
+        let y = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+        let r = (1.0 - y * y).max(0.0).sqrt();
+        let phi = golden * i as f64;
+        DVec3::new(r * phi.cos(), y, r * phi.sin())
+    })
+}
+
+/// What the rays from the middle of the bounds say about the model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shell {
+    /// Most rays hit surfaces that face the middle (walls seen from inside) and the openings
+    /// are not all on one side: a room or a building, seen from inside.
+    Interior,
+    /// A box open on one side (a stage, the Cornell box): seen from that side, along this
+    /// unit direction (from the middle outwards).
+    OpenSide(DVec3),
+    /// Anything else: framed from outside.
+    Object,
+}
+
+/// Classifies the model by [`SHELL_RAYS`] rays from `point`. A surface seen from inside a room
+/// faces the point; the shell of a closed object seen from within faces away, so only hits on
+/// front faces count. At least [`INTERIOR_HIT_FRACTION`] of the rays must hit front faces; when
+/// the rays that escape leave mostly sideways through one side (their mean direction is long and
+/// near horizontal), the model is an open box instead.
+pub fn classify_shell(probe: &Probe, point: DVec3) -> Shell {
+    let (mut front, mut misses) = (0usize, 0usize);
+    let mut escape = DVec3::ZERO;
+    for d in sphere_directions(SHELL_RAYS) {
+        match probe.hit_all(point, d) {
+            Some(prim) if probe.normal_all(prim).dot(d) < 0.0 => front += 1,
+            Some(_) => {}
+            None => {
+                escape += d;
+                misses += 1;
+            }
+        }
+    }
+    if (front as f64) < INTERIOR_HIT_FRACTION * SHELL_RAYS as f64 {
+        return Shell::Object;
+    }
+    let mean = escape / misses.max(1) as f64;
+    let open = misses as f64 >= OPEN_SIDE_FRACTION * SHELL_RAYS as f64;
+    if open && mean.length() > 0.6 && mean.normalize().y.abs() < 0.5 {
+        Shell::OpenSide(mean.normalize())
+    } else {
+        Shell::Interior
+    }
+}
+
+/// A horizontal unit direction at `azimuth` radians (0 = −Z, growing towards +X).
+fn horizontal(azimuth: f64) -> DVec3 {
+    DVec3::new(azimuth.sin(), 0.0, -azimuth.cos())
+}
+
+/// The camera inside a room: among a grid of standing points, the one with the most open space
+/// around it at eye height; from there it looks along the longest open direction (averaged over
+/// neighbouring directions so that a door does not win), stepped back towards the wall behind.
+fn interior_camera(probe: &Probe) -> Option<Camera> {
+    const AZIMUTHS: usize = 32;
+    let b = probe.bounds;
+    let size = b.max - b.min;
+    let far = probe.scale();
+    // Standing points: where a vertical ray finds a floor (the top of the bounds stands in for
+    // a missing ceiling: models of flats are often open above).
+    let mut spots = Vec::new();
+    for i in 0..5 {
+        for k in 0..5 {
+            let fx = 0.2 + 0.15 * i as f64;
+            let fz = 0.2 + 0.15 * k as f64;
+            let top = DVec3::new(b.min.x + fx * size.x, b.center().y, b.min.z + fz * size.z);
+            if let Some((down, _)) = probe.hit(top, DVec3::NEG_Y, far) {
+                let up = probe
+                    .hit(top, DVec3::Y, far)
+                    .map_or(b.max.y - top.y, |h| h.0);
+                spots.push((top.x, top.y - down, top.y + up, top.z));
+            }
+        }
+    }
+    // Stand on the lowest floor, not on tables or beds.
+    let floor = spots.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
+    let mut best: Option<(f64, DVec3, Vec<f64>)> = None;
+    for &(x, bottom, ceiling, z) in &spots {
+        let height = ceiling - bottom;
+        if bottom > floor + 0.05 * height {
+            continue;
+        }
+        // Metres, centimetres or millimetres, whichever makes a room height of it; else 60%.
+        let eye_height = [1.0, 100.0, 1000.0]
+            .into_iter()
+            .find(|unit| (2.0..=5.0).contains(&(height / unit)))
+            .map_or(0.6 * height, |unit| EYE_HEIGHT * unit);
+        let eye = DVec3::new(x, bottom + eye_height, z);
+        let distances: Vec<f64> = (0..AZIMUTHS)
+            .map(|a| {
+                let d = horizontal(a as f64 / AZIMUTHS as f64 * std::f64::consts::TAU);
+                probe.hit(eye, d, far).map_or(far, |(t, _)| t)
+            })
+            .collect();
+        let nearest = distances.iter().copied().fold(f64::INFINITY, f64::min);
+        // Standing inside furniture or at a wall: skip.
+        if nearest < 0.08 * height {
+            continue;
+        }
+        let mean = distances.iter().sum::<f64>() / AZIMUTHS as f64;
+        let score = mean + nearest;
+        if best.as_ref().is_none_or(|(s, _, _)| score > *s) {
+            best = Some((score, eye, distances));
+        }
+    }
+    let (_, eye, distances) = best?;
+    let n = distances.len();
+    let smoothed =
+        |a: usize| (distances[(a + n - 1) % n] + 2.0 * distances[a] + distances[(a + 1) % n]) / 4.0;
+    let look = (0..n)
+        .max_by(|&a, &b| smoothed(a).total_cmp(&smoothed(b)))
+        .unwrap_or(0);
+    let forward = horizontal(look as f64 / n as f64 * std::f64::consts::TAU);
+    let behind = distances[(look + n / 2) % n];
+    let eye = eye - forward * (0.6 * behind).min(behind - 0.3).max(0.0);
+    // Look slightly down, at the floor's far half.
+    let target = eye + forward * 10.0 - DVec3::Y * 1.2;
+    Some(Camera::look_at(AUTO_CAMERA, eye, target, INTERIOR_YFOV))
+}
+
+/// Where each light comes from, seen from `point`, weighted by the irradiance it gives there
+/// (unoccluded): (unit direction towards the light, weight).
+fn light_directions(probe: &Probe, lights: &[Light], point: DVec3) -> Vec<(DVec3, f64)> {
+    let mut out = Vec::new();
+    for l in lights {
+        let power = l.intensity as f64 * luminance(l.color) as f64;
+        match l.kind {
+            LightKind::Directional => out.push((-l.direction, power)),
+            LightKind::Point | LightKind::Spot { .. } => {
+                let to = l.position - point;
+                let d2 = to.length_squared().max(1e-12);
+                out.push((to / d2.sqrt(), power / d2));
+            }
+        }
+    }
+    for (centre, normal, power) in emitters(probe) {
+        let to = centre - point;
+        let d2 = to.length_squared().max(1e-12);
+        let dir = to / d2.sqrt();
+        out.push((dir, power * normal.dot(-dir).abs() / d2));
+    }
+    out
+}
+
+/// The most powerful emissive triangles: (centroid, unit normal, radiance × area), at most
+/// [`MAX_EMITTERS`], the power scaled up by the share of all emitted power they leave out.
+fn emitters(probe: &Probe) -> Vec<(DVec3, DVec3, f64)> {
+    let mut all: Vec<(usize, f64)> = probe
+        .emission
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| **e > 0.0)
+        .map(|(i, &e)| (i, e as f64 * area(&probe.tris[i]) as f64))
+        .filter(|(_, p)| *p > 0.0)
+        .collect();
+    let total: f64 = all.iter().map(|e| e.1).sum();
+    all.sort_by(|a, b| b.1.total_cmp(&a.1));
+    all.truncate(MAX_EMITTERS);
+    let kept: f64 = all.iter().map(|e| e.1).sum();
+    let scale = if kept > 0.0 { total / kept } else { 1.0 };
+    all.into_iter()
+        .map(|(i, p)| {
+            let t = &probe.tris[i];
+            let centre = ((t[0] + t[1] + t[2]) / 3.0).as_dvec3();
+            (centre, probe.normal(i), p * scale)
+        })
+        .collect()
+}
+
+/// The view direction (from the subject towards the eye) from which the lights illuminate the
+/// visible side: among 16 azimuths × 2 elevations, the one that best faces the light-weighted
+/// directions, with smaller preferences for a broad side of the bounds (a fox from the side,
+/// not nose-on) and for the glTF front (+Z).
+pub fn lit_side(probe: &Probe, lights: &[Light]) -> DVec3 {
+    let centre = probe.bounds.center();
+    let e = (probe.bounds.max - probe.bounds.min).max(DVec3::ZERO);
+    let (side_x, side_z) = (e.y * e.z, e.x * e.y);
+    let largest = side_x.max(side_z).max(1e-30);
+    let sources = light_directions(probe, lights, centre);
+    let total: f64 = sources.iter().map(|s| s.1).sum();
+    let front = DVec3::new(0.35, 0.3, 1.0).normalize();
+    let mut best = (f64::NEG_INFINITY, front);
+    for a in 0..16 {
+        for elevation in [0.25f64, 0.5] {
+            let az = a as f64 / 16.0 * std::f64::consts::TAU;
+            let d = DVec3::new(
+                elevation.cos() * az.sin(),
+                elevation.sin(),
+                elevation.cos() * az.cos(),
+            );
+            let lit: f64 = if total > 0.0 {
+                sources
+                    .iter()
+                    .map(|(l, w)| w * d.dot(*l).max(0.0))
+                    .sum::<f64>()
+                    / total
+            } else {
+                0.0
+            };
+            // The projected area of the box's sides seen from d, relative to the larger side.
+            let broad = (d.x.abs() * side_x + d.z.abs() * side_z) / largest;
+            let score = lit + 0.3 * d.dot(front) + 0.4 * broad;
+            if score > best.0 {
+                best = (score, d);
+            }
+        }
+    }
+    best.1
+}
+
+/// A camera looking at the middle of `bounds` from direction `dir` (unit, subject to eye), at
+/// the distance where all `points` fit 90% of the frame of `aspect` (width/height). With the
+/// eight corners of the bounds as points the whole box fits; with the subject's vertices its
+/// silhouette does, which fills the frame better.
+pub fn fit(bounds: &Bounds, points: &[Vec3], dir: DVec3, yfov: f64, aspect: f64) -> Camera {
+    let centre = bounds.center();
+    let probe = Camera::look_at(AUTO_CAMERA, centre + dir, centre, yfov);
+    let right = probe.forward.cross(probe.up).normalize();
+    let tan_y = (yfov * 0.5).tan() * 0.9;
+    let tan_x = tan_y * aspect.max(1e-3);
+    let corners = (0..8).map(|i| {
+        DVec3::new(
+            if i & 1 == 0 {
+                bounds.min.x
+            } else {
+                bounds.max.x
+            },
+            if i & 2 == 0 {
+                bounds.min.y
+            } else {
+                bounds.max.y
+            },
+            if i & 4 == 0 {
+                bounds.min.z
+            } else {
+                bounds.max.z
+            },
+        )
+    });
+    let all: Vec<DVec3> = if points.is_empty() {
+        corners.collect()
+    } else {
+        points.iter().map(|p| p.as_dvec3()).collect()
+    };
+    let mut distance: f64 = 1e-6 * bounds.diagonal();
+    for corner in all {
+        let p = corner - centre;
+        let depth = p.dot(probe.forward);
+        distance = distance
+            .max(p.dot(right).abs() / tan_x - depth)
+            .max(p.dot(probe.up).abs() / tan_y - depth);
+    }
+    Camera::look_at(AUTO_CAMERA, centre + dir * distance, centre, yfov)
+}
+
+/// A primary ray through the pixel at fractions (fx, fy) of the image (0,0 = top left).
+fn camera_ray(camera: &Camera, aspect: f64, fx: f64, fy: f64) -> DVec3 {
+    let right = camera.forward.cross(camera.up).normalize();
+    let h = (camera.yfov * 0.5).tan();
+    (camera.forward + right * ((2.0 * fx - 1.0) * h * aspect) + camera.up * ((1.0 - 2.0 * fy) * h))
+        .normalize()
+}
+
+/// Direct irradiance at `point` (unit normal `n` facing the viewer) from the lights and the
+/// emitters, with visibility.
+fn irradiance(
+    probe: &Probe,
+    lights: &[Light],
+    emitters: &[(DVec3, DVec3, f64)],
+    point: DVec3,
+    n: DVec3,
+) -> f64 {
+    let eps = 1e-4 * probe.scale();
+    let origin = point + n * eps;
+    let mut e = 0.0;
+    for l in lights {
+        let power = l.intensity as f64 * luminance(l.color) as f64;
+        match l.kind {
+            LightKind::Directional => {
+                let wi = -l.direction;
+                let cos = n.dot(wi);
+                if cos > 0.0 && probe.unobstructed(origin, wi) {
+                    e += power * cos;
+                }
+            }
+            LightKind::Point | LightKind::Spot { .. } => {
+                let to = l.position - origin;
+                let d2 = to.length_squared().max(1e-12);
+                let wi = to / d2.sqrt();
+                let cos = n.dot(wi);
+                let cone = match l.kind {
+                    LightKind::Spot { inner, outer } => {
+                        let c = (-wi).dot(l.direction);
+                        let (ci, co) = ((inner as f64).cos(), (outer as f64).cos());
+                        ((c - co) / (ci - co).max(1e-6)).clamp(0.0, 1.0)
+                    }
+                    _ => 1.0,
+                };
+                if cos > 0.0 && cone > 0.0 && probe.visible(origin, l.position) {
+                    e += power * cone * cos / d2;
+                }
+            }
+        }
+    }
+    for &(centre, normal, power) in emitters {
+        let to = centre - origin;
+        let d2 = to.length_squared().max(1e-12);
+        let wi = to / d2.sqrt();
+        let cos = n.dot(wi);
+        // Emissive triangles glow on both sides when double-sided; take the facing cosine.
+        let cos_e = normal.dot(-wi).abs();
+        if cos > 0.0 && probe.visible(origin, centre - wi * eps) {
+            e += power * cos * cos_e / d2;
+        }
+    }
+    e
+}
+
+/// The rule of the module docs, evaluated from `camera`: (lit, coverage, lit fraction, L_s, L_e).
+fn light_test(
+    probe: &Probe,
+    lights: &[Light],
+    camera: &Camera,
+    aspect: f64,
+) -> (bool, f64, f64, f64, f64) {
+    use rayon::prelude::*;
+    let emitters = emitters(probe);
+    let far = probe.scale() * 100.0 + (camera.eye - probe.bounds.center()).length() * 4.0;
+    let samples: Vec<(Option<f64>, Option<f64>)> = (0..PROBE_COLUMNS * PROBE_ROWS)
+        .into_par_iter()
+        .map(|i| {
+            let fx = ((i % PROBE_COLUMNS) as f64 + 0.5) / PROBE_COLUMNS as f64;
+            let fy = ((i / PROBE_COLUMNS) as f64 + 0.5) / PROBE_ROWS as f64;
+            let d = camera_ray(camera, aspect, fx, fy);
+            let Some((t, prim)) = probe.hit(camera.eye, d, far) else {
+                return (None, None);
+            };
+            if probe.emission[prim] > 0.0 {
+                return (None, Some(probe.emission[prim] as f64));
+            }
+            let mut n = probe.normal(prim);
+            if n.dot(d) > 0.0 {
+                n = -n;
+            }
+            (
+                Some(irradiance(probe, lights, &emitters, camera.eye + d * t, n)),
+                None,
+            )
+        })
+        .collect();
+    let mut subject: Vec<f64> = samples.iter().filter_map(|s| s.0).collect();
+    let mut seen: Vec<f64> = samples.iter().filter_map(|s| s.1).collect();
+    let coverage = (subject.len() + seen.len()) as f64 / samples.len() as f64;
+    if subject.is_empty() {
+        return (false, coverage, 0.0, 0.0, 0.0);
+    }
+    let lit_fraction = subject.iter().filter(|&&e| e > 0.0).count() as f64 / subject.len() as f64;
+    subject.sort_by(f64::total_cmp);
+    seen.sort_by(f64::total_cmp);
+    let subject_radiance = subject[subject.len() / 2] / std::f64::consts::PI;
+    let emitter_radiance = if seen.is_empty() {
+        0.0
+    } else {
+        seen[(seen.len() * 9 / 10).min(seen.len() - 1)]
+    };
+    let lit = lit_fraction >= MIN_LIT_FRACTION
+        && subject_radiance > 0.0
+        && subject_radiance >= emitter_radiance * 2f64.powf(-MAX_STOPS_BELOW_EMITTERS);
+    (
+        lit,
+        coverage,
+        lit_fraction,
+        subject_radiance,
+        emitter_radiance,
+    )
+}
+
+/// The first view of `scene` lit by `lights` (the scene's own, without a default rig), for an
+/// image of `aspect` (width/height). `camera` is the scene's own camera when it has one: it is
+/// kept ("a scene's camera wins") and only the light rule is evaluated from it.
+pub fn first_view(
+    scene: &Scene,
+    lights: &[Light],
+    camera: Option<&Camera>,
+    aspect: f64,
+) -> FirstView {
+    let probe = Probe::new(scene);
+    first_view_with(&probe, lights, camera, aspect)
+}
+
+/// [`first_view`] with a probe already built.
+pub fn first_view_with(
+    probe: &Probe,
+    lights: &[Light],
+    camera: Option<&Camera>,
+    aspect: f64,
+) -> FirstView {
+    let bounds = probe.bounds;
+    let (camera, interior) = match camera {
+        Some(c) => (c.clone(), false),
+        None if probe.tris.is_empty() => (Camera::framing(&bounds, super::AUTO_YFOV), false),
+        None => {
+            let outside = |dir: DVec3| fit(&bounds, &probe.points, dir, super::AUTO_YFOV, aspect);
+            match classify_shell(probe, bounds.center()) {
+                Shell::Interior => match interior_camera(probe) {
+                    Some(c) => (c, true),
+                    None => (outside(lit_side(probe, lights)), false),
+                },
+                Shell::OpenSide(d) => {
+                    // Straight into the opening, a little from above.
+                    (outside((d + DVec3::Y * 0.15).normalize()), false)
+                }
+                Shell::Object => (outside(lit_side(probe, lights)), false),
+            }
+        }
+    };
+    let (lit, coverage, lit_fraction, subject_radiance, emitter_radiance) =
+        light_test(probe, lights, &camera, aspect);
+    FirstView {
+        camera,
+        bounds,
+        interior,
+        lit,
+        coverage,
+        lit_fraction,
+        subject_radiance,
+        emitter_radiance,
+    }
+}
+
+/// A light added by the user: a point light above and to the right of the camera, a third of
+/// the way to what it looks at, so that it shows in the view and lights the subject with an
+/// irradiance of about 1 (`distance` is the camera's distance to its subject).
+pub fn light_near_camera(camera: &Camera, distance: f64, name: &str) -> Light {
+    let distance = distance.max(1e-6);
+    let right = camera.forward.cross(camera.up).normalize_or(DVec3::X);
+    let position = camera.eye
+        + camera.forward * (0.3 * distance)
+        + camera.up * (0.12 * distance)
+        + right * (0.12 * distance);
+    let to_subject = camera.eye + camera.forward * distance - position;
+    let d = to_subject.length();
+    Light {
+        name: name.into(),
+        kind: LightKind::Point,
+        position,
+        direction: to_subject.normalize_or(DVec3::NEG_Y),
+        color: [1.0, 1.0, 1.0],
+        intensity: (d * d) as f32,
+        light_radius: (0.02 * distance) as f32,
+    }
+}
+
+/// Lights for an interior the scene's own lights leave dark: a lamp below the ceiling above the
+/// camera and a softer one at the camera, both scaled to the room.
+pub fn interior_lights(first: &FirstView) -> Vec<Light> {
+    let b = first.bounds;
+    let height = (b.max.y - b.min.y).max(1e-6);
+    let span = (b.max - b.min).length();
+    let ahead = first.camera.eye + first.camera.forward.with_y(0.0) * (0.15 * span);
+    let ceiling = ahead.with_y(b.max.y - 0.1 * height).clamp(b.min, b.max);
+    let mut lamp = light_near_camera(&first.camera, 0.25 * span, "room light");
+    lamp.position = ceiling;
+    lamp.direction = DVec3::NEG_Y;
+    lamp.intensity = (0.25 * span * 0.25 * span) as f32;
+    let fill = light_near_camera(&first.camera, 0.15 * span, "camera light");
+    vec![lamp, fill]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Material, Mesh, Object};
+    use glam::DMat4;
+
+    /// A box from `lo` to `hi` as 12 triangles; `inward` makes the faces look inside.
+    fn cuboid(lo: Vec3, hi: Vec3, inward: bool) -> Vec<[Vec3; 3]> {
+        let c = |i: usize| {
+            Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        };
+        // Quads as corner indices, counter-clockwise seen from outside.
+        let quads = [
+            [0, 2, 3, 1], // −Z
+            [4, 5, 7, 6], // +Z
+            [0, 4, 6, 2], // −X
+            [1, 3, 7, 5], // +X
+            [0, 1, 5, 4], // −Y
+            [2, 6, 7, 3], // +Y
+        ];
+        let mut out = Vec::new();
+        for q in quads {
+            let (a, b, cc, d) = (c(q[0]), c(q[1]), c(q[2]), c(q[3]));
+            if inward {
+                out.push([a, cc, b]);
+                out.push([a, d, cc]);
+            } else {
+                out.push([a, b, cc]);
+                out.push([a, cc, d]);
+            }
+        }
+        out
+    }
+
+    fn scene_of(parts: &[(Vec<[Vec3; 3]>, Material)]) -> Scene {
+        let mut scene = Scene::default();
+        for (i, (tris, material)) in parts.iter().enumerate() {
+            let mut mesh = Mesh::default();
+            for t in tris {
+                let base = mesh.positions.len() as u32;
+                mesh.positions.extend_from_slice(t);
+                mesh.indices.push([base, base + 1, base + 2]);
+                mesh.materials.push(i as u32);
+            }
+            scene.objects.push(Object {
+                name: format!("part {i}"),
+                world_from_object: DMat4::IDENTITY,
+                visible: true,
+                mesh,
+            });
+            scene.materials.push(material.clone());
+        }
+        scene
+    }
+
+    fn point(position: DVec3, intensity: f32) -> Light {
+        Light {
+            name: "lamp".into(),
+            kind: LightKind::Point,
+            position,
+            direction: DVec3::NEG_Y,
+            color: [1.0; 3],
+            intensity,
+            light_radius: 0.0,
+        }
+    }
+
+    /// A finely split unit cube (so percentiles see many triangles) at the origin.
+    fn subject() -> Vec<[Vec3; 3]> {
+        let mut tris = Vec::new();
+        for i in 0..4 {
+            for k in 0..4 {
+                let lo = Vec3::new(i as f32 * 0.25 - 0.5, -0.5, k as f32 * 0.25 - 0.5);
+                tris.extend(cuboid(lo, lo + Vec3::new(0.25, 1.0, 0.25), false));
+            }
+        }
+        tris
+    }
+
+    #[test]
+    fn robust_bounds_ignore_a_stray_far_object() {
+        let mut tris = subject();
+        tris.extend(cuboid(Vec3::splat(1000.0), Vec3::splat(1000.1), false));
+        let b = robust_bounds(&tris);
+        assert!((b.min - DVec3::splat(-0.5)).length() < 1e-6, "{b:?}");
+        assert!((b.max - DVec3::splat(0.5)).length() < 1e-6, "{b:?}");
+    }
+
+    #[test]
+    fn a_small_model_fills_the_frame() {
+        for size in [0.01f32, 1.0, 300.0] {
+            let tris: Vec<[Vec3; 3]> = subject().iter().map(|t| t.map(|v| v * size)).collect();
+            let b = robust_bounds(&tris);
+            let cam = fit(&b, &[], DVec3::new(0.3, 0.4, 1.0).normalize(), 0.8, 1.6);
+            // Project the corners: the widest one reaches 80–100% of the half-frame.
+            let right = cam.forward.cross(cam.up);
+            let tan_y = (cam.yfov * 0.5).tan();
+            let mut fill = 0.0f64;
+            for i in 0..8 {
+                let p = DVec3::new(
+                    if i & 1 == 0 { b.min.x } else { b.max.x },
+                    if i & 2 == 0 { b.min.y } else { b.max.y },
+                    if i & 4 == 0 { b.min.z } else { b.max.z },
+                ) - cam.eye;
+                let z = p.dot(cam.forward);
+                assert!(z > 0.0);
+                fill = fill
+                    .max(p.dot(cam.up).abs() / (z * tan_y))
+                    .max(p.dot(right).abs() / (z * tan_y * 1.6));
+            }
+            assert!((0.8..=0.901).contains(&fill), "size {size}: fill {fill}");
+        }
+    }
+
+    #[test]
+    fn the_view_faces_the_light() {
+        let scene = scene_of(&[(subject(), Material::default())]);
+        let probe = Probe::new(&scene);
+        for light_dir in [DVec3::X, DVec3::NEG_Z, DVec3::new(-1.0, 0.5, 0.2)] {
+            let lamp = point(light_dir.normalize() * 5.0, 25.0);
+            let d = lit_side(&probe, &[lamp]);
+            assert!(
+                d.dot(light_dir.normalize()) > 0.6,
+                "light from {light_dir}, view from {d}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_room_is_seen_from_inside_and_an_object_from_outside() {
+        // A 6 × 2.7 × 4 m room with a table in it.
+        let mut room = cuboid(Vec3::ZERO, Vec3::new(6.0, 2.7, 4.0), true);
+        room.extend(cuboid(
+            Vec3::new(2.5, 0.0, 1.5),
+            Vec3::new(3.5, 0.75, 2.5),
+            false,
+        ));
+        let scene = scene_of(&[(room, Material::default())]);
+        let view = first_view(&scene, &[], None, 1.6);
+        assert!(view.interior);
+        let eye = view.camera.eye;
+        assert!(
+            (eye.y - EYE_HEIGHT).abs() < 1e-6 && eye.x > 0.0 && eye.x < 6.0 && eye.z > 0.0,
+            "{eye} in {:?}",
+            view.bounds
+        );
+        // It looks along the long (x) side of the room.
+        assert!(
+            view.camera.forward.x.abs() > 0.9,
+            "{:?}",
+            view.camera.forward
+        );
+        // The same box with faces out is a closed object: framed from outside.
+        let closed = cuboid(Vec3::ZERO, Vec3::new(6.0, 2.7, 4.0), false);
+        let view = first_view(&scene_of(&[(closed, Material::default())]), &[], None, 1.6);
+        assert!(!view.interior);
+        assert!(view.camera.eye.z > 4.0, "{}", view.camera.eye);
+    }
+
+    #[test]
+    fn a_lamp_over_the_subject_lights_the_view_and_a_tiny_glow_does_not() {
+        let floor = vec![
+            [
+                Vec3::new(-5.0, -0.5, -5.0),
+                Vec3::new(-5.0, -0.5, 5.0),
+                Vec3::new(5.0, -0.5, 5.0),
+            ],
+            [
+                Vec3::new(-5.0, -0.5, -5.0),
+                Vec3::new(5.0, -0.5, 5.0),
+                Vec3::new(5.0, -0.5, -5.0),
+            ],
+        ];
+        let parts = [
+            (subject(), Material::default()),
+            (floor, Material::default()),
+        ];
+        let scene = scene_of(&parts);
+        let lamp = point(DVec3::new(1.0, 4.0, 2.0), 20.0);
+        let view = first_view(&scene, &[lamp], None, 1.5);
+        assert!(view.lit, "{view:?}");
+        assert!(view.coverage > 0.3, "{view:?}");
+        let view = first_view(&scene, &[], None, 1.5);
+        assert!(!view.lit && view.lit_fraction == 0.0, "{view:?}");
+
+        // A small, very bright glowing cube inside a closed housing lights nothing.
+        let glow_material = Material {
+            emission: [500.0; 3],
+            ..Material::default()
+        };
+        let glow = cuboid(Vec3::new(0.55, 0.2, 0.55), Vec3::new(0.6, 0.25, 0.6), false);
+        let housing = cuboid(
+            Vec3::new(0.52, 0.17, 0.52),
+            Vec3::new(0.63, 0.28, 0.63),
+            true,
+        );
+        let mut parts = parts.to_vec();
+        parts.push((glow, glow_material));
+        parts.push((
+            housing.iter().map(|t| [t[0], t[2], t[1]]).collect(),
+            Material::default(),
+        ));
+        let view = first_view(&scene_of(&parts), &[], None, 1.5);
+        assert!(!view.lit, "{view:?}");
+    }
+
+    #[test]
+    fn an_added_light_shows_in_view_near_the_camera() {
+        let cam = Camera::look_at("c", DVec3::new(0.0, 0.0, 10.0), DVec3::ZERO, 0.8);
+        let l = light_near_camera(&cam, 10.0, "added");
+        let p = l.position - cam.eye;
+        let z = p.dot(cam.forward);
+        assert!(z > 0.0 && z < 5.0, "{p}");
+        // Inside the field of view.
+        assert!(p.dot(cam.up).abs() / z < (0.4f64).tan(), "{p}");
+        // Irradiance about 1 at the subject.
+        let d2 = (l.position - DVec3::ZERO).length_squared();
+        assert!((l.intensity as f64 / d2 - 1.0).abs() < 1e-3);
+    }
+}

@@ -1,0 +1,211 @@
+//! The bytes a glTF file refers to: its buffers (the GLB chunk, `data:` URIs, files beside it)
+//! and its encoded images. URIs are resolved relative to the glTF file; only regular files are
+//! read, never more bytes than a buffer declares; images are checked against the size limits
+//! from their header before they are decoded.
+
+use super::limits;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// Loads every buffer of `document`: exactly `byteLength` bytes each.
+pub fn load_buffers(
+    document: &gltf::Document,
+    base: Option<&Path>,
+    blob: Option<Vec<u8>>,
+) -> Result<Vec<Vec<u8>>, String> {
+    let mut blob = blob;
+    let mut out = Vec::new();
+    for buffer in document.buffers() {
+        let i = buffer.index();
+        let length = buffer.length();
+        if super::compression::is_meshopt_fallback(document.as_json(), i) {
+            // A meshopt fallback buffer: no bytes in the file; its views are decoded from
+            // compressed data instead, never allocated from byteLength here.
+            out.push(Vec::new());
+            continue;
+        }
+        let mut data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob
+                .take()
+                .ok_or_else(|| format!("buffers[{i}]: no uri and no GLB binary chunk"))?,
+            gltf::buffer::Source::Uri(uri) => {
+                match resolve(uri, base).map_err(|e| format!("buffers[{i}].uri: {e}"))? {
+                    Resolved::Data(bytes) => bytes,
+                    Resolved::File(path) => read_regular(&path, Some(length))
+                        .map_err(|e| format!("buffers[{i}].uri: {}: {e}", path.display()))?,
+                }
+            }
+        };
+        if data.len() < length {
+            return Err(format!(
+                "buffers[{i}]: byteLength is {length} but only {} bytes exist",
+                data.len()
+            ));
+        }
+        data.truncate(length);
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// Where a URI points.
+enum Resolved {
+    /// The decoded bytes of a `data:` URI.
+    Data(Vec<u8>),
+    /// A file relative to the glTF file.
+    File(PathBuf),
+}
+
+/// Resolves a glTF URI: a base64 `data:` URI, or a relative path (percent-encoded) from
+/// `base`. Other schemes and absolute paths are refused.
+fn resolve(uri: &str, base: Option<&Path>) -> Result<Resolved, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let Some((_, payload)) = rest.split_once(";base64,") else {
+            return Err("only base64 data: URIs are supported".into());
+        };
+        return base64::decode(payload)
+            .map(Resolved::Data)
+            .map_err(|e| format!("bad base64 data: {e}"));
+    }
+    let scheme = uri
+        .split_once(':')
+        .is_some_and(|(s, _)| !s.is_empty() && !s.contains('/'));
+    if scheme {
+        return Err(format!(
+            "'{uri}': only relative paths and data: URIs are supported"
+        ));
+    }
+    let decoded = percent_encoding::percent_decode_str(uri)
+        .decode_utf8()
+        .map_err(|_| format!("'{uri}' is not valid UTF-8 once percent-decoded"))?;
+    let relative = Path::new(decoded.as_ref());
+    if relative.is_absolute() || decoded.starts_with('/') || decoded.starts_with('\\') {
+        return Err(format!("'{uri}' must be relative to the glTF file"));
+    }
+    let Some(base) = base else {
+        return Err(format!(
+            "'{uri}' names a file, but the glTF was not loaded from a folder"
+        ));
+    };
+    Ok(Resolved::File(base.join(relative)))
+}
+
+/// Reads a regular file: exactly `want` bytes from its start when given (an error when it is
+/// shorter), else the whole file up to [`limits::MAX_IMAGE_DECODE_BYTES`]. Devices, pipes and
+/// folders are refused before anything is read, so `/dev/zero` cannot fill memory.
+fn read_regular(path: &Path, want: Option<usize>) -> Result<Vec<u8>, String> {
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err("not a regular file".into());
+    }
+    let size = meta.len();
+    let want = match want {
+        Some(w) if (w as u64) > size => {
+            return Err(format!("{size} bytes, but {w} are declared"));
+        }
+        Some(w) => w as u64,
+        None if size > limits::MAX_IMAGE_DECODE_BYTES => {
+            return Err(format!(
+                "{size} bytes is more than the limit of {}",
+                limits::MAX_IMAGE_DECODE_BYTES
+            ));
+        }
+        None => size,
+    };
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut data = Vec::with_capacity(want as usize);
+    file.take(want)
+        .read_to_end(&mut data)
+        .map_err(|e| e.to_string())?;
+    if (data.len() as u64) < want {
+        return Err(format!("{} bytes, but {want} are declared", data.len()));
+    }
+    Ok(data)
+}
+
+/// Reads and decodes image `image` of the document (`images[i]`) with its size checked from
+/// the header first; `base` resolves relative URIs.
+pub fn decode_image(
+    image: &gltf::Image,
+    base: Option<&Path>,
+    buffers: &[Vec<u8>],
+) -> Result<gltf::image::Data, String> {
+    let bytes: std::borrow::Cow<[u8]> = match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let start = view.offset();
+            let slice = buffers
+                .get(view.buffer().index())
+                .and_then(|b| b.get(start..start.checked_add(view.length())?))
+                .ok_or_else(|| {
+                    format!(
+                        "bufferViews[{}] lies outside buffers[{}]",
+                        view.index(),
+                        view.buffer().index()
+                    )
+                })?;
+            slice.into()
+        }
+        gltf::image::Source::Uri { uri, .. } => match resolve(uri, base)? {
+            Resolved::Data(bytes) => bytes.into(),
+            Resolved::File(path) => read_regular(&path, None)
+                .map_err(|e| format!("{}: {e}", path.display()))?
+                .into(),
+        },
+    };
+    decode_bounded(&bytes)
+}
+
+/// Decodes an encoded PNG or JPEG after checking its header's size against the limits.
+pub fn decode_bounded(bytes: &[u8]) -> Result<gltf::image::Data, String> {
+    use gltf::image::Format as F;
+    use image::DynamicImage as D;
+    let format = image::guess_format(bytes).map_err(|e| e.to_string())?;
+    let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+    let (width, height) = reader().into_dimensions().map_err(|e| e.to_string())?;
+    check_size(
+        width,
+        height,
+        limits::MAX_IMAGE_SIDE,
+        limits::MAX_IMAGE_PIXELS,
+    )?;
+    let mut bounded = reader();
+    let mut caps = image::Limits::default();
+    caps.max_image_width = Some(limits::MAX_IMAGE_SIDE);
+    caps.max_image_height = Some(limits::MAX_IMAGE_SIDE);
+    caps.max_alloc = Some(limits::MAX_IMAGE_DECODE_BYTES);
+    bounded.limits(caps);
+    let decoded = bounded.decode().map_err(|e| e.to_string())?;
+    let format = match &decoded {
+        D::ImageLuma8(_) => F::R8,
+        D::ImageLumaA8(_) => F::R8G8,
+        D::ImageRgb8(_) => F::R8G8B8,
+        D::ImageRgba8(_) => F::R8G8B8A8,
+        D::ImageLuma16(_) => F::R16,
+        D::ImageLumaA16(_) => F::R16G16,
+        D::ImageRgb16(_) => F::R16G16B16,
+        D::ImageRgba16(_) => F::R16G16B16A16,
+        D::ImageRgb32F(_) => F::R32G32B32FLOAT,
+        D::ImageRgba32F(_) => F::R32G32B32A32FLOAT,
+        other => return Err(format!("pixel format {:?} is not supported", other.color())),
+    };
+    Ok(gltf::image::Data {
+        width: decoded.width(),
+        height: decoded.height(),
+        pixels: decoded.into_bytes(),
+        format,
+    })
+}
+
+/// Checks an image's header size against a side and pixel limit.
+pub fn check_size(width: u32, height: u32, max_side: u32, max_pixels: u64) -> Result<(), String> {
+    if width == 0 || height == 0 {
+        return Err(format!("the image is empty ({width}×{height})"));
+    }
+    if width > max_side || height > max_side || width as u64 * height as u64 > max_pixels {
+        return Err(format!(
+            "{width}×{height} pixels is more than the limit ({max_side} per side, \
+             {max_pixels} pixels)"
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,217 @@
+//! The megakernel (whole paths per work item, CPU devices) against the wavefront (queued
+//! stages, GPUs): both must compute the same estimator. Independent renders of the Cornell box
+//! (and of a clear-coated floor lit through a thin glass pane) with several seeds give
+//! per-block means and their standard errors for each kernel; the means must agree within noise.
+
+mod common;
+
+use common::{Gltf, Prim, render_exr};
+use serde_json::json;
+use std::path::Path;
+
+const SIZE: usize = 32;
+const BLOCK: usize = 8;
+const SEEDS: u32 = 8;
+
+/// Per 8×8 block and channel: the mean over seeds of the block mean, and its variance (of the
+/// mean over seeds), from `SEEDS` renders of `kernel`.
+fn block_stats(
+    kernel: &str,
+    scene: &Path,
+    extra: &[&str],
+    dir: &Path,
+    seed0: u32,
+) -> (Vec<f64>, Vec<f64>) {
+    let blocks = (SIZE / BLOCK) * (SIZE / BLOCK) * 3;
+    let mut sum = vec![0.0f64; blocks];
+    let mut sum2 = vec![0.0f64; blocks];
+    for s in 0..SEEDS {
+        let out = dir.join(format!("{kernel}-{s}.exr"));
+        let seed = (seed0 + s).to_string();
+        let size = SIZE.to_string();
+        let mut args = vec![
+            "--kernel",
+            kernel,
+            "--width",
+            &size,
+            "--height",
+            &size,
+            "--spp",
+            "16",
+            "--bounces",
+            "6",
+            "--seed",
+            &seed,
+        ];
+        args.extend_from_slice(extra);
+        let (summary, px) = render_exr(scene, &out, &args);
+        assert_eq!(
+            summary["kernel"],
+            if kernel == "megakernel" {
+                "Megakernel"
+            } else {
+                "Wavefront"
+            }
+        );
+        assert_eq!(summary["nonfinite_samples"], 0);
+        for (b, (s1, s2)) in sum.iter_mut().zip(sum2.iter_mut()).enumerate() {
+            let (c, blk) = (b % 3, b / 3);
+            let (bx, by) = (blk % (SIZE / BLOCK), blk / (SIZE / BLOCK));
+            let mut m = 0.0;
+            for y in by * BLOCK..(by + 1) * BLOCK {
+                for x in bx * BLOCK..(bx + 1) * BLOCK {
+                    m += px[y * SIZE + x][c] as f64;
+                }
+            }
+            m /= (BLOCK * BLOCK) as f64;
+            *s1 += m;
+            *s2 += m * m;
+        }
+    }
+    let n = SEEDS as f64;
+    let mean: Vec<f64> = sum.iter().map(|s| s / n).collect();
+    let var: Vec<f64> = sum2
+        .iter()
+        .zip(&mean)
+        .map(|(s2, m)| (s2 / n - m * m).max(0.0) * n / (n - 1.0) / n)
+        .collect();
+    (mean, var)
+}
+
+/// Asserts that both kernels render `scene` alike within noise, and that the comparison would
+/// see a 3% bias.
+fn assert_kernels_agree(scene: &Path, extra: &[&str], dir: &Path) {
+    let (mw, vw) = block_stats("wavefront", scene, extra, dir, 100);
+    let (mm, vm) = block_stats("megakernel", scene, extra, dir, 200);
+    let mut z2 = 0.0;
+    let mut worst = 0.0f64;
+    let mut n = 0;
+    for i in 0..mw.len() {
+        let se = (vw[i] + vm[i]).sqrt();
+        if mw[i] < 1e-4 && mm[i] < 1e-4 {
+            continue; // a black block in both
+        }
+        assert!(se > 0.0, "block {i}: no noise in {} / {}", mw[i], mm[i]);
+        let z = (mm[i] - mw[i]) / se;
+        worst = worst.max(z.abs());
+        z2 += z * z;
+        n += 1;
+    }
+    assert!(n >= 24, "enough lit blocks ({n})");
+    // With 8 seeds a side z is t-distributed with ~14 degrees of freedom: |z| > 5 has a
+    // probability below 1e-3 per block, and the mean of z² is about 1.2.
+    let mean_z2 = z2 / n as f64;
+    assert!(worst < 5.0, "a block differs by {worst:.2} standard errors");
+    assert!(mean_z2 < 2.5, "mean z² {mean_z2:.2} over {n} blocks");
+    // A real difference is seen: a 3% brighter image fails the same test.
+    let mut z2_biased = 0.0;
+    for i in 0..mw.len() {
+        let se = (vw[i] + vm[i]).sqrt();
+        if se > 0.0 {
+            let z = (mm[i] * 1.03 - mw[i]) / se;
+            z2_biased += z * z;
+        }
+    }
+    assert!(z2_biased / n as f64 > 2.5, "the test can see a 3% bias");
+}
+
+#[test]
+fn megakernel_and_wavefront_agree_within_noise() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell-box.glb");
+    let dir = tempfile::tempdir().unwrap();
+    assert_kernels_agree(&scene, &[], dir.path());
+}
+
+/// A clear-coated floor and sphere lit by an emissive panel through a smooth thin glass pane
+/// (`HAS_CLEARCOAT`, `HAS_THIN_WALLS`): shadow rays pass the pane in both kernels.
+fn coated_room_through_a_pane(dir: &Path) -> std::path::PathBuf {
+    let mut g = Gltf::default();
+    for e in [
+        "KHR_materials_clearcoat",
+        "KHR_materials_transmission",
+        "KHR_materials_volume",
+    ] {
+        g.use_ext(e);
+    }
+    let light = g.lambert([0.0; 3], [1.0; 3], 5.0, true);
+    g.materials.push(json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.3, 0.2, 1.0], "metallicFactor": 0.0,
+                                 "roughnessFactor": 0.6},
+        "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0,
+                                                   "clearcoatRoughnessFactor": 0.15}}
+    }));
+    let coated = g.materials.len() - 1;
+    g.materials.push(json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [0.9, 1.0, 0.8, 1.0], "metallicFactor": 0.0,
+                                 "roughnessFactor": 0.0},
+        "doubleSided": true,
+        "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                       "KHR_materials_volume": {"thicknessFactor": 0.0}}
+    }));
+    let pane = g.materials.len() - 1;
+    let quad = |y: f32, h: f32, up: bool, m: usize| {
+        let p = vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
+        let i = if up {
+            vec![0, 2, 1, 0, 3, 2]
+        } else {
+            vec![0, 1, 2, 0, 2, 3]
+        };
+        Prim::triangles(p, i, m)
+    };
+    let (sp, sn, si) = common::sphere(0.15, 12, 24, false);
+    let mut ball = Prim::triangles(
+        sp.iter().map(|p| [p[0], p[1] + 0.15, p[2]]).collect(),
+        si,
+        coated,
+    );
+    ball.normals = sn;
+    let mesh = g.mesh(vec![
+        quad(0.0, 1.0, true, coated),
+        quad(2.0, 0.5, false, light),
+        quad(1.0, 3.0, true, pane),
+        ball,
+    ]);
+    g.node(json!({"mesh": mesh}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 0.8, 0.4], "rotation": common::LOOK_DOWN}));
+    g.write_glb(dir, "coated-room")
+}
+
+#[test]
+fn kernels_agree_on_a_clear_coat_lit_through_a_thin_wall() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = coated_room_through_a_pane(dir.path());
+    assert_kernels_agree(&scene, &["--sky", "0,0,0"], dir.path());
+}
+
+#[test]
+fn the_same_seed_traces_the_same_paths_in_both_kernels() {
+    // Both kernels draw the same random numbers for the same (pixel, sample, seed) and shade
+    // with the same code, so they trace the same rays.
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell-box.glb");
+    let dir = tempfile::tempdir().unwrap();
+    let args = |k: &'static str| {
+        vec![
+            "--kernel",
+            k,
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--spp",
+            "4",
+            "--bounces",
+            "5",
+        ]
+    };
+    let (a, pa) = render_exr(&scene, &dir.path().join("w.exr"), &args("wavefront"));
+    let (b, pb) = render_exr(&scene, &dir.path().join("m.exr"), &args("megakernel"));
+    let rays = |v: &serde_json::Value| {
+        v["rays_per_second"].as_f64().unwrap() * v["seconds"].as_f64().unwrap()
+    };
+    let (ra, rb) = (rays(&a), rays(&b));
+    assert!((ra - rb).abs() <= 1e-6 * ra + 2.0, "{ra} rays against {rb}");
+    let (ma, mb) = (common::mean_gray(&pa), common::mean_gray(&pb));
+    assert!((ma - mb).abs() <= 1e-3 * ma, "mean {ma} against {mb}");
+}
