@@ -41,7 +41,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
             bool alive = shade_vertex(&frame, bounce, &sc, hit, &s, &q);
             if (q.valid) {
                 ++shadow_rays;
-                s.radiance += shadow_test_wide(nodes, tris, &sc.surf, &q, overflow);
+                s.radiance += shadow_pass_wide(nodes, tris, &sc.surf, &q, overflow);
             }
             if (!alive) break;
         }

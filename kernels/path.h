@@ -93,7 +93,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     bool prev_specular = (s->flags & PATH_SPECULAR) != 0u;
     bool counts_emission = bounce == 0u || prev_specular || frame->strategy != STRATEGY_LIGHTS;
     // Seen through a thin wall from a scattering vertex, a light is left to that vertex's light
-    // sample, whose shadow ray passes the wall unweighted (see `shadow_test`).
+    // sample, whose shadow ray passes the wall unweighted (see `shadow_pass`).
     bool mis = bounce > 0u && !prev_specular && frame->strategy == STRATEGY_MIS;
 #ifdef HAS_THIN_WALLS
     bool light_sampled_only = mis && (s->flags & PATH_THROUGH_WALL) != 0u;
@@ -234,7 +234,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
         // A light behind the surface is reached through transmission when bsdf_eval says so;
         // the geometric and shading normals must agree on the side. Transmissive surfaces
         // block shadow rays (no caustics through next-event estimation), except smooth thin
-        // walls, which `shadow_test` passes with their tint and without the MIS weight.
+        // walls, which `shadow_pass` passes with their tint and without the MIS weight.
         float side = dot(ls.wi, ng);
         if (side * dot(ls.wi, ns) > 0.0f &&
             (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
@@ -358,5 +358,5 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
         }                                                                                      \
         return q->contribution * tint;                                                         \
     }
-DEFINE_SHADOW_TEST(shadow_test, GpuBvhNode, traverse)
-DEFINE_SHADOW_TEST(shadow_test_wide, GpuWideNode, traverse_wide)
+DEFINE_SHADOW_TEST(shadow_pass, GpuBvhNode, traverse)
+DEFINE_SHADOW_TEST(shadow_pass_wide, GpuWideNode, traverse_wide)

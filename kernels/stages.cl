@@ -107,7 +107,7 @@ kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tr
     q.tmax = r.origin.w;
     q.contribution = r.contribution.xyz;
     q.unweight = r.contribution.w;
-    float3 c = shadow_test(nodes, tris, &surf, &q, &counters[COUNT_OVERFLOW]);
+    float3 c = shadow_pass(nodes, tris, &surf, &q, &counters[COUNT_OVERFLOW]);
     if (any(c != 0.0f)) paths[as_uint(r.direction.w)].radiance.xyz += c;
 }
 
