@@ -16,6 +16,11 @@
 //                 c A_c(mu) (A_c its directional albedo). The diffuse base sees coat and specular
 //                 layer as one layer of albedo A_c + (1 - A_c) A, scaled as above; the glossy lobes
 //                 are scaled by 1 - c max(A_c(mu_o), A_c(mu_i)) (reciprocal, never gains energy)
+//   sheen         (HAS_SHEEN, KHR_materials_sheen) the Charlie distribution (Estevez and Kulla
+//                 2017) with their fitted visibility, between the coat and the base: it reflects
+//                 sheenColor E_sh(mu) (E_sh tabulated); the diffuse base sees it as one more layer
+//                 of albedo s E_sh (s = max3(sheenColor)), the other base lobes are scaled by
+//                 1 - s max(E_sh(mu_o), E_sh(mu_i)), the spec's albedo scaling made reciprocal
 // Below BSDF_DELTA_ALPHA the glossy lobes are perfect mirror and refraction (delta) lobes.
 //
 // Contract: bsdf_eval returns f(wo, wi) * |cos(n, wi)| and its pdf (solid angle) for the non-delta
@@ -40,6 +45,10 @@ typedef struct {
     float coat_roughness;        // perceptual
     float3 coat_normal;          // the coat's shading normal (world); 0: the shading normal
 #endif
+#ifdef HAS_SHEEN
+    float3 sheen_color;          // KHR_materials_sheen sheenColorFactor; 0: no sheen
+    float sheen_roughness;       // perceptual
+#endif
 } SurfaceMaterial;
 
 // The untextured material.
@@ -60,6 +69,10 @@ inline SurfaceMaterial surface_material(global const GpuMaterial* m) {
     s.coat_roughness = m->coat.y;
     s.coat_normal = (float3)(0.0f);
 #endif
+#ifdef HAS_SHEEN
+    s.sheen_color = m->sheen.xyz;
+    s.sheen_roughness = m->sheen.w;
+#endif
     return s;
 }
 
@@ -69,6 +82,9 @@ inline void material_from_inside(SurfaceMaterial* m) {
     m->ior = 1.0f / m->ior;
 #ifdef HAS_CLEARCOAT
     m->clearcoat = 0.0f;
+#endif
+#ifdef HAS_SHEEN
+    m->sheen_color = (float3)(0.0f);
 #endif
 }
 
@@ -405,6 +421,12 @@ typedef struct {
     float coat;        // clamped clearcoat factor
     float coat_roughness;
 #endif
+#ifdef HAS_SHEEN
+    float3 sheen;           // clamped sheen color; 0: no sheen
+    float sheen_max;        // s = max3(sheen)
+    float sheen_roughness;  // clamped to [SHEEN_MIN_ROUGHNESS, 1]
+    float sheen_o;          // s E_sh(mu_o): what the sheen reflects at wo
+#endif
 } BsdfLobes;
 
 // A(mu): what the dielectric specular layer reflects at one cosine, single and multiple
@@ -412,6 +434,322 @@ typedef struct {
 inline float layer_albedo(const BsdfLobes* l, float2 e) {
     float f0 = l->f0_layer;
     return l->specular * (f0 * e.x + (1.0f - f0) * e.y + l->ms_layer * (1.0f - e.x));
+}
+
+// 8-point Gauss–Legendre quadrature on [0, 1] of the cosine-weighted means 2∫g(mu) mu dmu of
+// the layers' cross terms: sum GL_W[k >> 1] * mu * g(mu) over mu = gl_mu(k), k = 0..7.
+constant float GL_X[4] = {0.1834346425f, 0.5255324099f, 0.7966664774f, 0.9602898565f};
+constant float GL_W[4] = {0.3626837834f, 0.3137066459f, 0.2223810345f, 0.1012285363f};
+inline float gl_mu(int k) {
+    return 0.5f + ((k & 1) ? 0.5f : -0.5f) * GL_X[k >> 1];
+}
+
+#ifdef HAS_SHEEN
+// Sheen roughness below this is taken as this (narrower lobes are not tabulated).
+#define SHEEN_MIN_ROUGHNESS (3.0f / 32.0f)
+
+// Directional albedo of a white Charlie sheen lobe with the fitted visibility, which exceeds 1
+// at grazing angles (2.0 at cos 0 for the narrowest lobe): SHEEN_E_CHARLIE. The lobe used is
+// that one times k(mu_o) k(mu_i), k = 1 / max(1, E_charlie(mu)) (reciprocal, and never above 1);
+// SHEEN_E is its albedo E_sh, SHEEN_E_AVG its cosine-weighted mean 2∫E_sh mu dmu. Rows for
+// roughness 0, 1/32 .. 1 (those below SHEEN_MIN_ROUGHNESS repeat it), columns for cos(theta_o)
+// (0/32)², (1/32)² .. 1 (dense near grazing, where the lobe changes fastest). tests/bsdf.rs computes them by quadrature (print_sheen_tables) and checks them
+// (sheen_albedo_tables_match_quadrature).
+constant float SHEEN_E_CHARLIE[1089] = {
+    2.02299f, 2.22389f, 2.22580f, 2.05872f, 1.82416f, 1.56907f, 1.31747f, 1.08217f, 0.86989f, 0.68379f, 0.52484f,
+    0.39250f, 0.28525f, 0.20080f, 0.13641f, 0.08903f, 0.05553f, 0.03290f, 0.01839f, 0.00961f, 0.00465f, 0.00205f,
+    0.00082f, 0.00029f, 0.00009f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    2.02299f, 2.22389f, 2.22580f, 2.05872f, 1.82416f, 1.56907f, 1.31747f, 1.08217f, 0.86989f, 0.68379f, 0.52484f,
+    0.39250f, 0.28525f, 0.20080f, 0.13641f, 0.08903f, 0.05553f, 0.03290f, 0.01839f, 0.00961f, 0.00465f, 0.00205f,
+    0.00082f, 0.00029f, 0.00009f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    2.02299f, 2.22389f, 2.22580f, 2.05872f, 1.82416f, 1.56907f, 1.31747f, 1.08217f, 0.86989f, 0.68379f, 0.52484f,
+    0.39250f, 0.28525f, 0.20080f, 0.13641f, 0.08903f, 0.05553f, 0.03290f, 0.01839f, 0.00961f, 0.00465f, 0.00205f,
+    0.00082f, 0.00029f, 0.00009f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    2.02299f, 2.22389f, 2.22580f, 2.05872f, 1.82416f, 1.56907f, 1.31747f, 1.08217f, 0.86989f, 0.68379f, 0.52484f,
+    0.39250f, 0.28525f, 0.20080f, 0.13641f, 0.08903f, 0.05553f, 0.03290f, 0.01839f, 0.00961f, 0.00465f, 0.00205f,
+    0.00082f, 0.00029f, 0.00009f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    1.54484f, 1.71053f, 1.74171f, 1.64782f, 1.50047f, 1.33244f, 1.16063f, 0.99425f, 0.83846f, 0.69609f, 0.56856f,
+    0.45642f, 0.35958f, 0.27752f, 0.20937f, 0.15402f, 0.11016f, 0.07633f, 0.05103f, 0.03275f, 0.02007f, 0.01165f,
+    0.00636f, 0.00322f, 0.00150f, 0.00062f, 0.00023f, 0.00007f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    1.26395f, 1.40639f, 1.44820f, 1.39013f, 1.28793f, 1.16682f, 1.03980f, 0.91401f, 0.79352f, 0.68066f, 0.57675f,
+    0.48248f, 0.39813f, 0.32368f, 0.25891f, 0.20342f, 0.15667f, 0.11802f, 0.08672f, 0.06195f, 0.04286f, 0.02859f,
+    0.01827f, 0.01111f, 0.00638f, 0.00341f, 0.00167f, 0.00073f, 0.00027f, 0.00008f, 0.00002f, 0.00000f, 0.00000f,
+    1.08205f, 1.20850f, 1.25460f, 1.21670f, 1.14097f, 1.04813f, 0.94880f, 0.84884f, 0.75158f, 0.65899f, 0.57219f,
+    0.49186f, 0.41833f, 0.35174f, 0.29209f, 0.23927f, 0.19306f, 0.15318f, 0.11929f, 0.09096f, 0.06772f, 0.04906f,
+    0.03444f, 0.02331f, 0.01514f, 0.00935f, 0.00541f, 0.00289f, 0.00138f, 0.00056f, 0.00018f, 0.00003f, 0.00000f,
+    0.95699f, 1.07210f, 1.12006f, 1.09466f, 1.03583f, 0.96136f, 0.88035f, 0.79780f, 0.71656f, 0.63831f, 0.56404f,
+    0.49434f, 0.42954f, 0.36982f, 0.31524f, 0.26580f, 0.22144f, 0.18204f, 0.14745f, 0.11746f, 0.09183f, 0.07027f,
+    0.05246f, 0.03807f, 0.02678f, 0.01812f, 0.01169f, 0.00708f, 0.00394f, 0.00195f, 0.00080f, 0.00023f, 0.00002f,
+    0.86770f, 0.97463f, 1.02350f, 1.00642f, 0.95904f, 0.89719f, 0.82891f, 0.75861f, 0.68882f, 0.62102f, 0.55608f,
+    0.49451f, 0.43662f, 0.38259f, 0.33249f, 0.28638f, 0.24423f, 0.20603f, 0.17170f, 0.14115f, 0.11427f, 0.09090f,
+    0.07088f, 0.05401f, 0.04015f, 0.02897f, 0.02012f, 0.01330f, 0.00822f, 0.00463f, 0.00225f, 0.00083f, 0.00013f,
+    0.80250f, 0.90346f, 0.95292f, 0.94170f, 0.90246f, 0.84962f, 0.79050f, 0.72912f, 0.66775f, 0.60773f, 0.54985f,
+    0.49455f, 0.44213f, 0.39273f, 0.34644f, 0.30330f, 0.26334f, 0.22655f, 0.19292f, 0.16240f, 0.13496f, 0.11052f,
+    0.08900f, 0.07031f, 0.05445f, 0.04116f, 0.03016f, 0.02124f, 0.01416f, 0.00875f, 0.00480f, 0.00212f, 0.00051f,
+    0.75441f, 0.85100f, 0.90099f, 0.89412f, 0.86086f, 0.81466f, 0.76233f, 0.70758f, 0.65254f, 0.59842f, 0.54595f,
+    0.49554f, 0.44744f, 0.40179f, 0.35865f, 0.31809f, 0.28011f, 0.24472f, 0.21194f, 0.18175f, 0.15414f, 0.12910f,
+    0.10657f, 0.08656f, 0.06915f, 0.05416f, 0.04135f, 0.03053f, 0.02155f, 0.01428f, 0.00858f, 0.00433f, 0.00141f,
+    0.71899f, 0.81243f, 0.86302f, 0.85948f, 0.83074f, 0.78955f, 0.74234f, 0.69263f, 0.64240f, 0.59282f, 0.54454f,
+    0.49796f, 0.45329f, 0.41065f, 0.37011f, 0.33171f, 0.29546f, 0.26137f, 0.22945f, 0.19971f, 0.17215f, 0.14678f,
+    0.12358f, 0.10259f, 0.08401f, 0.06766f, 0.05333f, 0.04087f, 0.03015f, 0.02108f, 0.01359f, 0.00762f, 0.00307f,
+    0.69329f, 0.78451f, 0.83581f, 0.83494f, 0.80969f, 0.77233f, 0.72904f, 0.68318f, 0.63666f, 0.59058f, 0.54558f,
+    0.50200f, 0.46005f, 0.41984f, 0.38142f, 0.34481f, 0.31002f, 0.27707f, 0.24595f, 0.21668f, 0.18927f, 0.16374f,
+    0.14009f, 0.11837f, 0.09887f, 0.08143f, 0.06586f, 0.05199f, 0.03972f, 0.02900f, 0.01978f, 0.01202f, 0.00571f,
+    0.67530f, 0.76500f, 0.81715f, 0.81846f, 0.79596f, 0.76156f, 0.72129f, 0.67840f, 0.63475f, 0.59139f, 0.54893f,
+    0.50771f, 0.46792f, 0.42965f, 0.39293f, 0.35779f, 0.32422f, 0.29223f, 0.26182f, 0.23299f, 0.20577f, 0.18015f,
+    0.15618f, 0.13390f, 0.11368f, 0.09537f, 0.07875f, 0.06369f, 0.05008f, 0.03786f, 0.02702f, 0.01754f, 0.00942f,
+    0.66356f, 0.75230f, 0.80542f, 0.80857f, 0.78824f, 0.75615f, 0.71820f, 0.67760f, 0.63616f, 0.59490f, 0.55443f,
+    0.51506f, 0.47696f, 0.44022f, 0.40487f, 0.37091f, 0.33833f, 0.30714f, 0.27731f, 0.24887f, 0.22181f, 0.19616f,
+    0.17194f, 0.14922f, 0.12841f, 0.10938f, 0.09191f, 0.07583f, 0.06105f, 0.04752f, 0.03519f, 0.02410f, 0.01423f,
+    0.65700f, 0.74520f, 0.79941f, 0.80413f, 0.78554f, 0.75524f, 0.71908f, 0.68022f, 0.64047f, 0.60083f, 0.56188f,
+    0.52393f, 0.48715f, 0.45161f, 0.41733f, 0.38430f, 0.35252f, 0.32196f, 0.29261f, 0.26447f, 0.23756f, 0.21187f,
+    0.18744f, 0.16435f, 0.14305f, 0.12342f, 0.10522f, 0.08828f, 0.07250f, 0.05780f, 0.04417f, 0.03160f, 0.02012f,
+    0.65482f, 0.74278f, 0.79817f, 0.80426f, 0.78706f, 0.75814f, 0.72332f, 0.68578f, 0.64729f, 0.60887f, 0.57107f,
+    0.53420f, 0.49843f, 0.46380f, 0.43035f, 0.39804f, 0.36686f, 0.33679f, 0.30781f, 0.27990f, 0.25308f, 0.22735f,
+    0.20272f, 0.17930f, 0.15758f, 0.13743f, 0.11861f, 0.10094f, 0.08429f, 0.06859f, 0.05380f, 0.03993f, 0.02698f,
+    0.65636f, 0.74432f, 0.80095f, 0.80824f, 0.79214f, 0.76425f, 0.73043f, 0.69385f, 0.65628f, 0.61874f, 0.58178f,
+    0.54572f, 0.51068f, 0.47674f, 0.44389f, 0.41212f, 0.38139f, 0.35168f, 0.32295f, 0.29520f, 0.26842f, 0.24262f,
+    0.21780f, 0.19407f, 0.17197f, 0.15138f, 0.13202f, 0.11372f, 0.09632f, 0.07975f, 0.06396f, 0.04894f, 0.03471f,
+    0.66109f, 0.74918f, 0.80711f, 0.81543f, 0.80019f, 0.77306f, 0.73994f, 0.70402f, 0.66709f, 0.63016f, 0.59379f,
+    0.55828f, 0.52377f, 0.49031f, 0.45790f, 0.42650f, 0.39608f, 0.36661f, 0.33805f, 0.31037f, 0.28358f, 0.25768f,
+    0.23267f, 0.20864f, 0.18620f, 0.16520f, 0.14538f, 0.12652f, 0.10848f, 0.09116f, 0.07450f, 0.05850f, 0.04316f,
+    0.66854f, 0.75683f, 0.81606f, 0.82528f, 0.81070f, 0.78409f, 0.75142f, 0.71592f, 0.67939f, 0.64285f, 0.60685f,
+    0.57170f, 0.53753f, 0.50438f, 0.47225f, 0.44109f, 0.41086f, 0.38153f, 0.35304f, 0.32539f, 0.29854f, 0.27251f,
+    0.24729f, 0.22298f, 0.20021f, 0.17885f, 0.15860f, 0.13926f, 0.12066f, 0.10270f, 0.08530f, 0.06847f, 0.05219f,
+    0.67827f, 0.76677f, 0.82727f, 0.83728f, 0.82316f, 0.79688f, 0.76445f, 0.72916f, 0.69284f, 0.65649f, 0.62070f,
+    0.58574f, 0.55176f, 0.51878f, 0.48680f, 0.45577f, 0.42563f, 0.39635f, 0.36788f, 0.34018f, 0.31323f, 0.28704f,
+    0.26161f, 0.23702f, 0.21394f, 0.19225f, 0.17163f, 0.15186f, 0.13277f, 0.11425f, 0.09624f, 0.07870f, 0.06164f,
+    0.68984f, 0.77850f, 0.84023f, 0.85089f, 0.83710f, 0.81096f, 0.77861f, 0.74337f, 0.70708f, 0.67078f, 0.63504f,
+    0.60015f, 0.56623f, 0.53331f, 0.50138f, 0.47038f, 0.44026f, 0.41096f, 0.38244f, 0.35465f, 0.32758f, 0.30121f,
+    0.27555f, 0.25069f, 0.22733f, 0.20532f, 0.18437f, 0.16422f, 0.14472f, 0.12573f, 0.10719f, 0.08907f, 0.07137f,
+    0.70282f, 0.79154f, 0.85442f, 0.86561f, 0.85200f, 0.82587f, 0.79346f, 0.75813f, 0.72176f, 0.68539f, 0.64959f,
+    0.61465f, 0.58070f, 0.54776f, 0.51579f, 0.48476f, 0.45459f, 0.42522f, 0.39661f, 0.36870f, 0.34147f, 0.31491f,
+    0.28903f, 0.26391f, 0.24028f, 0.21799f, 0.19674f, 0.17627f, 0.15640f, 0.13702f, 0.11804f, 0.09944f, 0.08123f,
+    0.71671f, 0.80536f, 0.86928f, 0.88090f, 0.86736f, 0.84113f, 0.80855f, 0.77303f, 0.73647f, 0.69994f, 0.66400f,
+    0.62895f, 0.59490f, 0.56186f, 0.52982f, 0.49870f, 0.46843f, 0.43896f, 0.41023f, 0.38218f, 0.35479f, 0.32805f,
+    0.30195f, 0.27659f, 0.25271f, 0.23017f, 0.20865f, 0.18790f, 0.16773f, 0.14802f, 0.12869f, 0.10972f, 0.09111f,
+    0.73101f, 0.81943f, 0.88426f, 0.89620f, 0.88263f, 0.85622f, 0.82339f, 0.78761f, 0.75082f, 0.71407f, 0.67794f,
+    0.64272f, 0.60853f, 0.57537f, 0.54320f, 0.51197f, 0.48160f, 0.45201f, 0.42314f, 0.39495f, 0.36740f, 0.34048f,
+    0.31419f, 0.28861f, 0.26451f, 0.24176f, 0.22002f, 0.19904f, 0.17862f, 0.15865f, 0.13904f, 0.11978f, 0.10087f,
+    0.74512f, 0.83316f, 0.89874f, 0.91090f, 0.89724f, 0.87060f, 0.83748f, 0.80142f, 0.76435f, 0.72737f, 0.69103f,
+    0.65563f, 0.62128f, 0.58798f, 0.55570f, 0.52435f, 0.49386f, 0.46416f, 0.43517f, 0.40685f, 0.37917f, 0.35209f,
+    0.32563f, 0.29987f, 0.27560f, 0.25267f, 0.23075f, 0.20959f, 0.18898f, 0.16881f, 0.14900f, 0.12952f, 0.11042f,
+    0.75843f, 0.84592f, 0.91208f, 0.92437f, 0.91059f, 0.88369f, 0.85030f, 0.81395f, 0.77663f, 0.73941f, 0.70288f,
+    0.66732f, 0.63282f, 0.59941f, 0.56702f, 0.53557f, 0.50500f, 0.47520f, 0.44613f, 0.41771f, 0.38992f, 0.36273f,
+    0.33614f, 0.31025f, 0.28585f, 0.26280f, 0.24076f, 0.21947f, 0.19873f, 0.17843f, 0.15848f, 0.13887f, 0.11964f,
+    0.77025f, 0.85703f, 0.92360f, 0.93596f, 0.92204f, 0.89492f, 0.86127f, 0.82469f, 0.78716f, 0.74976f, 0.71309f,
+    0.67740f, 0.64282f, 0.60933f, 0.57688f, 0.54538f, 0.51476f, 0.48493f, 0.45581f, 0.42735f, 0.39950f, 0.37226f,
+    0.34560f, 0.31964f, 0.29516f, 0.27205f, 0.24994f, 0.22859f, 0.20779f, 0.18742f, 0.16740f, 0.14773f, 0.12846f,
+    0.77985f, 0.86580f, 0.93259f, 0.94498f, 0.93094f, 0.90366f, 0.86984f, 0.83311f, 0.79545f, 0.75797f, 0.72122f,
+    0.68551f, 0.65090f, 0.61741f, 0.58498f, 0.55351f, 0.52291f, 0.49311f, 0.46402f, 0.43558f, 0.40775f, 0.38052f,
+    0.35387f, 0.32790f, 0.30343f, 0.28031f, 0.25821f, 0.23686f, 0.21607f, 0.19570f, 0.17570f, 0.15604f, 0.13678f,
+    0.78647f, 0.87150f, 0.93833f, 0.95071f, 0.93663f, 0.90929f, 0.87542f, 0.83867f, 0.80102f, 0.76356f, 0.72687f,
+    0.69123f, 0.65672f, 0.62334f, 0.59101f, 0.55966f, 0.52919f, 0.49951f, 0.47054f, 0.44221f, 0.41449f, 0.38736f,
+    0.36080f, 0.33491f, 0.31052f, 0.28749f, 0.26547f, 0.24420f, 0.22349f, 0.20321f, 0.18328f, 0.16370f, 0.14454f,
+    0.78935f, 0.87343f, 0.94011f, 0.95249f, 0.93844f, 0.91118f, 0.87744f, 0.84083f, 0.80335f, 0.76608f, 0.72961f,
+    0.69419f, 0.65991f, 0.62676f, 0.59468f, 0.56358f, 0.53334f, 0.50390f, 0.47515f, 0.44705f, 0.41955f, 0.39261f,
+    0.36624f, 0.34054f, 0.31632f, 0.29347f, 0.27162f, 0.25053f, 0.22998f, 0.20986f, 0.19009f, 0.17067f, 0.15167f,
+    0.78778f, 0.87089f, 0.93722f, 0.94962f, 0.93575f, 0.90875f, 0.87533f, 0.83907f, 0.80196f, 0.76509f, 0.72901f,
+    0.69399f, 0.66011f, 0.62736f, 0.59568f, 0.56496f, 0.53511f, 0.50603f, 0.47765f, 0.44990f, 0.42273f, 0.39612f,
+    0.37006f, 0.34465f, 0.32072f, 0.29814f, 0.27657f, 0.25573f, 0.23545f, 0.21557f, 0.19604f, 0.17686f, 0.15810f,
+    0.78109f, 0.86325f, 0.92905f, 0.94149f, 0.92795f, 0.90144f, 0.86857f, 0.83290f, 0.79641f, 0.76014f, 0.72468f,
+    0.69026f, 0.65697f, 0.62481f, 0.59369f, 0.56353f, 0.53423f, 0.50568f, 0.47781f, 0.45056f, 0.42387f, 0.39772f,
+    0.37210f, 0.34710f, 0.32357f, 0.30139f, 0.28019f, 0.25973f, 0.23980f, 0.22027f, 0.20107f, 0.18221f, 0.16377f,
+};
+constant float SHEEN_E[1089] = {
+    0.86668f, 0.90101f, 0.91368f, 0.92507f, 0.93420f, 0.94120f, 0.94642f, 0.95022f, 0.82889f, 0.65276f, 0.50153f,
+    0.37520f, 0.27260f, 0.19174f, 0.13007f, 0.08473f, 0.05272f, 0.03114f, 0.01734f, 0.00902f, 0.00434f, 0.00191f,
+    0.00075f, 0.00026f, 0.00008f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    0.86668f, 0.90101f, 0.91368f, 0.92507f, 0.93420f, 0.94120f, 0.94642f, 0.95022f, 0.82889f, 0.65276f, 0.50153f,
+    0.37520f, 0.27260f, 0.19174f, 0.13007f, 0.08473f, 0.05272f, 0.03114f, 0.01734f, 0.00902f, 0.00434f, 0.00191f,
+    0.00075f, 0.00026f, 0.00008f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    0.86668f, 0.90101f, 0.91368f, 0.92507f, 0.93420f, 0.94120f, 0.94642f, 0.95022f, 0.82889f, 0.65276f, 0.50153f,
+    0.37520f, 0.27260f, 0.19174f, 0.13007f, 0.08473f, 0.05272f, 0.03114f, 0.01734f, 0.00902f, 0.00434f, 0.00191f,
+    0.00075f, 0.00026f, 0.00008f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    0.86668f, 0.90101f, 0.91368f, 0.92507f, 0.93420f, 0.94120f, 0.94642f, 0.95022f, 0.82889f, 0.65276f, 0.50153f,
+    0.37520f, 0.27260f, 0.19174f, 0.13007f, 0.08473f, 0.05272f, 0.03114f, 0.01734f, 0.00902f, 0.00434f, 0.00191f,
+    0.00075f, 0.00026f, 0.00008f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    0.91292f, 0.94847f, 0.95629f, 0.96319f, 0.96865f, 0.97280f, 0.97591f, 0.97260f, 0.82164f, 0.68299f, 0.55837f,
+    0.44851f, 0.35347f, 0.27284f, 0.20583f, 0.15138f, 0.10822f, 0.07494f, 0.05006f, 0.03210f, 0.01965f, 0.01139f,
+    0.00620f, 0.00314f, 0.00145f, 0.00061f, 0.00022f, 0.00007f, 0.00002f, 0.00000f, 0.00000f, 0.00000f, 0.00000f,
+    0.93868f, 0.97501f, 0.97952f, 0.98337f, 0.98630f, 0.98848f, 0.99008f, 0.90602f, 0.78727f, 0.67575f, 0.57287f,
+    0.47940f, 0.39569f, 0.32175f, 0.25739f, 0.20223f, 0.15576f, 0.11732f, 0.08619f, 0.06156f, 0.04258f, 0.02839f,
+    0.01814f, 0.01103f, 0.00633f, 0.00338f, 0.00166f, 0.00072f, 0.00027f, 0.00008f, 0.00002f, 0.00000f, 0.00000f,
+    0.95254f, 0.98945f, 0.99174f, 0.99359f, 0.99493f, 0.99588f, 0.94553f, 0.84632f, 0.74962f, 0.65744f, 0.57097f,
+    0.49088f, 0.41754f, 0.35111f, 0.29158f, 0.23886f, 0.19273f, 0.15293f, 0.11909f, 0.09080f, 0.06760f, 0.04897f,
+    0.03438f, 0.02326f, 0.01511f, 0.00932f, 0.00540f, 0.00288f, 0.00138f, 0.00056f, 0.00018f, 0.00003f, 0.00000f,
+    0.95342f, 0.99677f, 0.99762f, 0.99826f, 0.99869f, 0.96038f, 0.87962f, 0.79725f, 0.71613f, 0.63797f, 0.56378f,
+    0.49413f, 0.42937f, 0.36967f, 0.31512f, 0.26571f, 0.22136f, 0.18198f, 0.14740f, 0.11742f, 0.09180f, 0.07025f,
+    0.05245f, 0.03806f, 0.02677f, 0.01812f, 0.01168f, 0.00708f, 0.00394f, 0.00195f, 0.00080f, 0.00023f, 0.00002f,
+    0.86748f, 0.97442f, 0.99985f, 0.99990f, 0.95897f, 0.89714f, 0.82887f, 0.75858f, 0.68880f, 0.62100f, 0.55606f,
+    0.49450f, 0.43661f, 0.38258f, 0.33249f, 0.28637f, 0.24423f, 0.20603f, 0.17170f, 0.14115f, 0.11427f, 0.09090f,
+    0.07088f, 0.05401f, 0.04015f, 0.02897f, 0.02012f, 0.01330f, 0.00822f, 0.00463f, 0.00225f, 0.00083f, 0.00013f,
+    0.80250f, 0.90346f, 0.95292f, 0.94170f, 0.90246f, 0.84962f, 0.79050f, 0.72912f, 0.66775f, 0.60773f, 0.54985f,
+    0.49455f, 0.44213f, 0.39273f, 0.34644f, 0.30330f, 0.26334f, 0.22655f, 0.19292f, 0.16240f, 0.13496f, 0.11052f,
+    0.08900f, 0.07031f, 0.05445f, 0.04116f, 0.03016f, 0.02124f, 0.01416f, 0.00875f, 0.00480f, 0.00212f, 0.00051f,
+    0.75441f, 0.85100f, 0.90099f, 0.89412f, 0.86086f, 0.81466f, 0.76233f, 0.70758f, 0.65254f, 0.59842f, 0.54595f,
+    0.49554f, 0.44744f, 0.40179f, 0.35865f, 0.31809f, 0.28011f, 0.24472f, 0.21194f, 0.18175f, 0.15414f, 0.12910f,
+    0.10657f, 0.08656f, 0.06915f, 0.05416f, 0.04135f, 0.03053f, 0.02155f, 0.01428f, 0.00858f, 0.00433f, 0.00141f,
+    0.71899f, 0.81243f, 0.86302f, 0.85948f, 0.83074f, 0.78955f, 0.74234f, 0.69263f, 0.64240f, 0.59282f, 0.54454f,
+    0.49796f, 0.45329f, 0.41065f, 0.37011f, 0.33171f, 0.29546f, 0.26137f, 0.22945f, 0.19971f, 0.17215f, 0.14678f,
+    0.12358f, 0.10259f, 0.08401f, 0.06766f, 0.05333f, 0.04087f, 0.03015f, 0.02108f, 0.01359f, 0.00762f, 0.00307f,
+    0.69329f, 0.78451f, 0.83581f, 0.83494f, 0.80969f, 0.77233f, 0.72904f, 0.68318f, 0.63666f, 0.59058f, 0.54558f,
+    0.50200f, 0.46005f, 0.41984f, 0.38142f, 0.34481f, 0.31002f, 0.27707f, 0.24595f, 0.21668f, 0.18927f, 0.16374f,
+    0.14009f, 0.11837f, 0.09887f, 0.08143f, 0.06586f, 0.05199f, 0.03972f, 0.02900f, 0.01978f, 0.01202f, 0.00571f,
+    0.67530f, 0.76500f, 0.81715f, 0.81846f, 0.79596f, 0.76156f, 0.72129f, 0.67840f, 0.63475f, 0.59139f, 0.54893f,
+    0.50771f, 0.46792f, 0.42965f, 0.39293f, 0.35779f, 0.32422f, 0.29223f, 0.26182f, 0.23299f, 0.20577f, 0.18015f,
+    0.15618f, 0.13390f, 0.11368f, 0.09537f, 0.07875f, 0.06369f, 0.05008f, 0.03786f, 0.02702f, 0.01754f, 0.00942f,
+    0.66356f, 0.75230f, 0.80542f, 0.80857f, 0.78824f, 0.75615f, 0.71820f, 0.67760f, 0.63616f, 0.59490f, 0.55443f,
+    0.51506f, 0.47696f, 0.44022f, 0.40487f, 0.37091f, 0.33833f, 0.30714f, 0.27731f, 0.24887f, 0.22181f, 0.19616f,
+    0.17194f, 0.14922f, 0.12841f, 0.10938f, 0.09191f, 0.07583f, 0.06105f, 0.04752f, 0.03519f, 0.02410f, 0.01423f,
+    0.65700f, 0.74520f, 0.79941f, 0.80413f, 0.78554f, 0.75524f, 0.71908f, 0.68022f, 0.64047f, 0.60083f, 0.56188f,
+    0.52393f, 0.48715f, 0.45161f, 0.41733f, 0.38430f, 0.35252f, 0.32196f, 0.29261f, 0.26447f, 0.23756f, 0.21187f,
+    0.18744f, 0.16435f, 0.14305f, 0.12342f, 0.10522f, 0.08828f, 0.07250f, 0.05780f, 0.04417f, 0.03160f, 0.02012f,
+    0.65482f, 0.74278f, 0.79817f, 0.80426f, 0.78706f, 0.75814f, 0.72332f, 0.68578f, 0.64729f, 0.60887f, 0.57107f,
+    0.53420f, 0.49843f, 0.46380f, 0.43035f, 0.39804f, 0.36686f, 0.33679f, 0.30781f, 0.27990f, 0.25308f, 0.22735f,
+    0.20272f, 0.17930f, 0.15758f, 0.13743f, 0.11861f, 0.10094f, 0.08429f, 0.06859f, 0.05380f, 0.03993f, 0.02698f,
+    0.65636f, 0.74432f, 0.80095f, 0.80824f, 0.79214f, 0.76425f, 0.73043f, 0.69385f, 0.65628f, 0.61874f, 0.58178f,
+    0.54572f, 0.51068f, 0.47674f, 0.44389f, 0.41212f, 0.38139f, 0.35168f, 0.32295f, 0.29520f, 0.26842f, 0.24262f,
+    0.21780f, 0.19407f, 0.17197f, 0.15138f, 0.13202f, 0.11372f, 0.09632f, 0.07975f, 0.06396f, 0.04894f, 0.03471f,
+    0.66109f, 0.74918f, 0.80711f, 0.81543f, 0.80019f, 0.77306f, 0.73994f, 0.70402f, 0.66709f, 0.63016f, 0.59379f,
+    0.55828f, 0.52377f, 0.49031f, 0.45790f, 0.42650f, 0.39608f, 0.36661f, 0.33805f, 0.31037f, 0.28358f, 0.25768f,
+    0.23267f, 0.20864f, 0.18620f, 0.16520f, 0.14538f, 0.12652f, 0.10848f, 0.09116f, 0.07450f, 0.05850f, 0.04316f,
+    0.66854f, 0.75683f, 0.81606f, 0.82528f, 0.81070f, 0.78409f, 0.75142f, 0.71592f, 0.67939f, 0.64285f, 0.60685f,
+    0.57170f, 0.53753f, 0.50438f, 0.47225f, 0.44109f, 0.41086f, 0.38153f, 0.35304f, 0.32539f, 0.29854f, 0.27251f,
+    0.24729f, 0.22298f, 0.20021f, 0.17885f, 0.15860f, 0.13926f, 0.12066f, 0.10270f, 0.08530f, 0.06847f, 0.05219f,
+    0.67827f, 0.76677f, 0.82727f, 0.83728f, 0.82316f, 0.79688f, 0.76445f, 0.72916f, 0.69284f, 0.65649f, 0.62070f,
+    0.58574f, 0.55176f, 0.51878f, 0.48680f, 0.45577f, 0.42563f, 0.39635f, 0.36788f, 0.34018f, 0.31323f, 0.28704f,
+    0.26161f, 0.23702f, 0.21394f, 0.19225f, 0.17163f, 0.15186f, 0.13277f, 0.11425f, 0.09624f, 0.07870f, 0.06164f,
+    0.68984f, 0.77850f, 0.84023f, 0.85089f, 0.83710f, 0.81096f, 0.77861f, 0.74337f, 0.70708f, 0.67078f, 0.63504f,
+    0.60015f, 0.56623f, 0.53331f, 0.50138f, 0.47038f, 0.44026f, 0.41096f, 0.38244f, 0.35465f, 0.32758f, 0.30121f,
+    0.27555f, 0.25069f, 0.22733f, 0.20532f, 0.18437f, 0.16422f, 0.14472f, 0.12573f, 0.10719f, 0.08907f, 0.07137f,
+    0.70282f, 0.79154f, 0.85442f, 0.86561f, 0.85200f, 0.82587f, 0.79346f, 0.75813f, 0.72176f, 0.68539f, 0.64959f,
+    0.61465f, 0.58070f, 0.54776f, 0.51579f, 0.48476f, 0.45459f, 0.42522f, 0.39661f, 0.36870f, 0.34147f, 0.31491f,
+    0.28903f, 0.26391f, 0.24028f, 0.21799f, 0.19674f, 0.17627f, 0.15640f, 0.13702f, 0.11804f, 0.09944f, 0.08123f,
+    0.71671f, 0.80536f, 0.86928f, 0.88090f, 0.86736f, 0.84113f, 0.80855f, 0.77303f, 0.73647f, 0.69994f, 0.66400f,
+    0.62895f, 0.59490f, 0.56186f, 0.52982f, 0.49870f, 0.46843f, 0.43896f, 0.41023f, 0.38218f, 0.35479f, 0.32805f,
+    0.30195f, 0.27659f, 0.25271f, 0.23017f, 0.20865f, 0.18790f, 0.16773f, 0.14802f, 0.12869f, 0.10972f, 0.09111f,
+    0.73101f, 0.81943f, 0.88426f, 0.89620f, 0.88263f, 0.85622f, 0.82339f, 0.78761f, 0.75082f, 0.71407f, 0.67794f,
+    0.64272f, 0.60853f, 0.57537f, 0.54320f, 0.51197f, 0.48160f, 0.45201f, 0.42314f, 0.39495f, 0.36740f, 0.34048f,
+    0.31419f, 0.28861f, 0.26451f, 0.24176f, 0.22002f, 0.19904f, 0.17862f, 0.15865f, 0.13904f, 0.11978f, 0.10087f,
+    0.74512f, 0.83316f, 0.89874f, 0.91090f, 0.89724f, 0.87060f, 0.83748f, 0.80142f, 0.76435f, 0.72737f, 0.69103f,
+    0.65563f, 0.62128f, 0.58798f, 0.55570f, 0.52435f, 0.49386f, 0.46416f, 0.43517f, 0.40685f, 0.37917f, 0.35209f,
+    0.32563f, 0.29987f, 0.27560f, 0.25267f, 0.23075f, 0.20959f, 0.18898f, 0.16881f, 0.14900f, 0.12952f, 0.11042f,
+    0.75843f, 0.84592f, 0.91208f, 0.92437f, 0.91059f, 0.88369f, 0.85030f, 0.81395f, 0.77663f, 0.73941f, 0.70288f,
+    0.66732f, 0.63282f, 0.59941f, 0.56702f, 0.53557f, 0.50500f, 0.47520f, 0.44613f, 0.41771f, 0.38992f, 0.36273f,
+    0.33614f, 0.31025f, 0.28585f, 0.26280f, 0.24076f, 0.21947f, 0.19873f, 0.17843f, 0.15848f, 0.13887f, 0.11964f,
+    0.77025f, 0.85703f, 0.92360f, 0.93596f, 0.92204f, 0.89492f, 0.86127f, 0.82469f, 0.78716f, 0.74976f, 0.71309f,
+    0.67740f, 0.64282f, 0.60933f, 0.57688f, 0.54538f, 0.51476f, 0.48493f, 0.45581f, 0.42735f, 0.39950f, 0.37226f,
+    0.34560f, 0.31964f, 0.29516f, 0.27205f, 0.24994f, 0.22859f, 0.20779f, 0.18742f, 0.16740f, 0.14773f, 0.12846f,
+    0.77985f, 0.86580f, 0.93259f, 0.94498f, 0.93094f, 0.90366f, 0.86984f, 0.83311f, 0.79545f, 0.75797f, 0.72122f,
+    0.68551f, 0.65090f, 0.61741f, 0.58498f, 0.55351f, 0.52291f, 0.49311f, 0.46402f, 0.43558f, 0.40775f, 0.38052f,
+    0.35387f, 0.32790f, 0.30343f, 0.28031f, 0.25821f, 0.23686f, 0.21607f, 0.19570f, 0.17570f, 0.15604f, 0.13678f,
+    0.78647f, 0.87150f, 0.93833f, 0.95071f, 0.93663f, 0.90929f, 0.87542f, 0.83867f, 0.80102f, 0.76356f, 0.72687f,
+    0.69123f, 0.65672f, 0.62334f, 0.59101f, 0.55966f, 0.52919f, 0.49951f, 0.47054f, 0.44221f, 0.41449f, 0.38736f,
+    0.36080f, 0.33491f, 0.31052f, 0.28749f, 0.26547f, 0.24420f, 0.22349f, 0.20321f, 0.18328f, 0.16370f, 0.14454f,
+    0.78935f, 0.87343f, 0.94011f, 0.95249f, 0.93844f, 0.91118f, 0.87744f, 0.84083f, 0.80335f, 0.76608f, 0.72961f,
+    0.69419f, 0.65991f, 0.62676f, 0.59468f, 0.56358f, 0.53334f, 0.50390f, 0.47515f, 0.44705f, 0.41955f, 0.39261f,
+    0.36624f, 0.34054f, 0.31632f, 0.29347f, 0.27162f, 0.25053f, 0.22998f, 0.20986f, 0.19009f, 0.17067f, 0.15167f,
+    0.78778f, 0.87089f, 0.93722f, 0.94962f, 0.93575f, 0.90875f, 0.87533f, 0.83907f, 0.80196f, 0.76509f, 0.72901f,
+    0.69399f, 0.66011f, 0.62736f, 0.59568f, 0.56496f, 0.53511f, 0.50603f, 0.47765f, 0.44990f, 0.42273f, 0.39612f,
+    0.37006f, 0.34465f, 0.32072f, 0.29814f, 0.27657f, 0.25573f, 0.23545f, 0.21557f, 0.19604f, 0.17686f, 0.15810f,
+    0.78109f, 0.86325f, 0.92905f, 0.94149f, 0.92795f, 0.90144f, 0.86857f, 0.83290f, 0.79641f, 0.76014f, 0.72468f,
+    0.69026f, 0.65697f, 0.62481f, 0.59369f, 0.56353f, 0.53423f, 0.50568f, 0.47781f, 0.45056f, 0.42387f, 0.39772f,
+    0.37210f, 0.34710f, 0.32357f, 0.30139f, 0.28019f, 0.25973f, 0.23980f, 0.22027f, 0.20107f, 0.18221f, 0.16377f,
+};
+constant float SHEEN_E_AVG[33] = {
+    0.01823f, 0.01823f, 0.01823f, 0.01823f, 0.02611f, 0.03394f, 0.04183f, 0.04993f, 0.05836f, 0.06723f, 0.07659f,
+    0.08646f, 0.09683f, 0.10768f, 0.11897f, 0.13066f, 0.14268f, 0.15496f, 0.16742f, 0.17995f, 0.19247f, 0.20486f,
+    0.21700f, 0.22880f, 0.24012f, 0.25086f, 0.26090f, 0.27011f, 0.27837f, 0.28557f, 0.29160f, 0.29631f, 0.29960f,
+};
+
+// A sheen table at cos(theta_o) and perceptual roughness, bilinear in (sqrt(cos), roughness).
+inline float sheen_table(constant float* table, float cos_o, float roughness) {
+    float x = sqrt(clamp(cos_o, 0.0f, 1.0f)) * 32.0f;
+    float y = clamp(roughness, 0.0f, 1.0f) * 32.0f;
+    int i = min((int)x, 31);
+    int j = min((int)y, 31);
+    int k = j * 33 + i;
+    float fx = x - (float)i;
+    return mix(mix(table[k], table[k + 1], fx), mix(table[k + 33], table[k + 34], fx),
+               y - (float)j);
+}
+
+// What the sheen reflects at cos(theta) = mu, by its strongest channel: s E_sh(mu).
+inline float sheen_albedo(const BsdfLobes* l, float mu) {
+    return l->sheen_max * sheen_table(SHEEN_E, mu, l->sheen_roughness);
+}
+
+// Estevez and Kulla's fitted Lambda of the sheen visibility at cos(theta) = c.
+inline float sheen_lambda_fit(float x, float t) {
+    float a = mix(21.5473f, 25.3245f, t);
+    float b = mix(3.82987f, 3.32435f, t);
+    float c = mix(0.19823f, 0.16801f, t);
+    float d = mix(-1.97760f, -1.27393f, t);
+    float e = mix(-4.32054f, -4.85967f, t);
+    return a / (1.0f + b * pow(x, c)) + d * x + e;
+}
+inline float sheen_lambda(float c, float alpha) {
+    float t = (1.0f - alpha) * (1.0f - alpha);
+    return c < 0.5f ? exp(sheen_lambda_fit(c, t))
+                    : exp(2.0f * sheen_lambda_fit(0.5f, t) - sheen_lambda_fit(1.0f - c, t));
+}
+
+// The sheen lobe's f * cos at local wo, wi (both above the surface): sheenColor D V cos_i
+// k(mu_o) k(mu_i), D the Charlie distribution (2 + 1/alpha) sin^(1/alpha)(theta_h) / 2pi.
+inline float3 sheen_eval(const BsdfLobes* l, float3 wo, float3 wi) {
+    float alpha = l->sheen_roughness * l->sheen_roughness;
+    float inv = 1.0f / alpha;
+    float3 h = normalize(wo + wi);
+    float sin2 = h.x * h.x + h.y * h.y;
+    float d = (2.0f + inv) * pow(sin2, 0.5f * inv) * (0.5f * INV_PI_F);
+    // V cos_i = cos_i / ((1 + Lambda_o + Lambda_i) 4 cos_o cos_i).
+    float v = 1.0f / ((1.0f + sheen_lambda(wo.z, alpha) + sheen_lambda(wi.z, alpha)) * 4.0f * wo.z);
+    float k = 1.0f / (fmax(1.0f, sheen_table(SHEEN_E_CHARLIE, wo.z, l->sheen_roughness)) *
+                      fmax(1.0f, sheen_table(SHEEN_E_CHARLIE, wi.z, l->sheen_roughness)));
+    return l->sheen * (d * v * k);
+}
+
+// What the sheen leaves of the glossy base lobes between cosines mu_o and mu_i:
+// 1 - s max(E_sh(mu_o), E_sh(mu_i)).
+inline float sheen_gloss_scale(const BsdfLobes* l, float mu_i) {
+    if (!(l->sheen_max > 0.0f)) return 1.0f;
+    return 1.0f - fmax(l->sheen_o, sheen_albedo(l, mu_i));
+}
+
+// The probability of sampling the sheen (cosine-distributed) among the sheen and the base.
+inline float sheen_probability(const BsdfLobes* l) {
+    return l->sheen_o > 0.0f ? l->sheen_o / (l->sheen_o + (1.0f - l->sheen_o) * l->albedo) : 0.0f;
+}
+
+// The cosine-weighted mean of the sheen over the specular layer, a_avg being the specular
+// layer's: a_avg + s E_sh,avg - ∫ s E_sh A 2mu dmu (0 over a specularFactor 0 base).
+inline float sheen_layer_albedo_avg(const BsdfLobes* l, float a_avg) {
+    float cross = 0.0f;
+    if (l->specular > 0.0f) {
+        for (int k = 0; k < 8; ++k) {
+            float mu = gl_mu(k);
+            float a = layer_albedo(l, ggx_energy(mu, l->roughness));
+            cross += GL_W[k >> 1] * mu * sheen_albedo(l, mu) * a;
+        }
+    }
+    float y = l->sheen_roughness * 32.0f;
+    int j = min((int)y, 31);
+    float e_avg = mix(SHEEN_E_AVG[j], SHEEN_E_AVG[j + 1], y - (float)j);
+    return a_avg + l->sheen_max * e_avg - cross;
+}
+#endif
+
+// What the layers over the diffuse base but under the coat reflect at mu, a being the specular
+// layer's albedo there: the sheen over the specular layer.
+inline float under_coat_albedo(const BsdfLobes* l, float mu, float a) {
+#ifdef HAS_SHEEN
+    if (l->sheen_max > 0.0f) {
+        float as = sheen_albedo(l, mu);
+        return as + (1.0f - as) * a;
+    }
+#endif
+    return a;
 }
 
 #ifdef HAS_CLEARCOAT
@@ -435,8 +773,8 @@ inline float coated_layer_albedo(const BsdfLobes* l, float mu, float a) {
     return ac + (1.0f - ac) * a;
 }
 
-// Its cosine-weighted mean, a_avg being the specular layer's: a_avg + c A_c,avg - c ∫A_c A 2mu dmu,
-// the last term by 8-point Gauss–Legendre quadrature (it is 0 over a specularFactor 0 base).
+// Its cosine-weighted mean, a_avg being the mean of what lies under the coat: a_avg + c A_c,avg
+// - c ∫A_c A 2mu dmu, the last term by quadrature (0 over a specularFactor 0 base, no sheen).
 inline float coated_layer_albedo_avg(const BsdfLobes* l, float a_avg) {
     float ac_avg;
     if (l->coat_roughness * l->coat_roughness < BSDF_DELTA_ALPHA) {
@@ -446,13 +784,15 @@ inline float coated_layer_albedo_avg(const BsdfLobes* l, float a_avg) {
         ac_avg = COAT_F0 * e.x + (1.0f - COAT_F0) * e.y;
     }
     float cross = 0.0f;
-    if (l->specular > 0.0f) {
-        const float x[4] = {0.1834346425f, 0.5255324099f, 0.7966664774f, 0.9602898565f};
-        const float w[4] = {0.3626837834f, 0.3137066459f, 0.2223810345f, 0.1012285363f};
+    bool layered = l->specular > 0.0f;
+#ifdef HAS_SHEEN
+    layered = layered || l->sheen_max > 0.0f;
+#endif
+    if (layered) {
         for (int k = 0; k < 8; ++k) {
-            float mu = 0.5f + ((k & 1) ? 0.5f : -0.5f) * x[k >> 1];
-            float a = layer_albedo(l, ggx_energy(mu, l->roughness));
-            cross += w[k >> 1] * mu * coat_albedo(mu, l->coat_roughness) * a;
+            float mu = gl_mu(k);
+            float a = under_coat_albedo(l, mu, layer_albedo(l, ggx_energy(mu, l->roughness)));
+            cross += GL_W[k >> 1] * mu * coat_albedo(mu, l->coat_roughness) * a;
         }
     }
     return a_avg + l->coat * (ac_avg - cross);
@@ -466,7 +806,7 @@ inline float coated_layer_albedo_avg(const BsdfLobes* l, float a_avg) {
 // times the clear coat's scaling of the glossy lobes, gs.
 inline float3 cosine_lobes(const BsdfLobes* l, float wi_cos, float gs) {
     float2 e_i = ggx_energy(wi_cos, l->roughness);
-    float a_i = layer_albedo(l, e_i);
+    float a_i = under_coat_albedo(l, wi_cos, layer_albedo(l, e_i));
 #ifdef HAS_CLEARCOAT
     if (l->coat > 0.0f) a_i = coated_layer_albedo(l, wi_cos, a_i);
 #endif
@@ -502,6 +842,17 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
     }
     float a_o = layer_albedo(&l, e_o);
     float a_avg = layer_albedo(&l, e_avg);
+#ifdef HAS_SHEEN
+    l.sheen = clamp(m->sheen_color, 0.0f, 1.0f);
+    l.sheen_max = bsdf_max3(l.sheen);
+    l.sheen_roughness = clamp(m->sheen_roughness, SHEEN_MIN_ROUGHNESS, 1.0f);
+    l.sheen_o = 0.0f;
+    if (l.sheen_max > 0.0f) {
+        l.sheen_o = sheen_albedo(&l, cos_o);
+        a_avg = sheen_layer_albedo_avg(&l, a_avg);
+        a_o = l.sheen_o + (1.0f - l.sheen_o) * a_o;
+    }
+#endif
 #ifdef HAS_CLEARCOAT
     l.coat = clamp(m->clearcoat, 0.0f, 1.0f);
     l.coat_roughness = clamp(m->coat_roughness, 0.0f, 1.0f);
@@ -615,6 +966,9 @@ inline float3 thin_wall_transmittance(const SurfaceMaterial* m, float cos_o) {
 #ifdef HAS_CLEARCOAT
     trans *= 1.0f - l.coat * coat_albedo(cos_o, l.coat_roughness);
 #endif
+#ifdef HAS_SHEEN
+    trans *= sheen_gloss_scale(&l, cos_o);
+#endif
     return trans;
 }
 
@@ -694,14 +1048,42 @@ inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, flo
         return (float3)(0.0f);
     }
     BsdfLobes l = bsdf_lobes(m, wo.z);
+#if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN)
+    // The coat over the sheen over the base: each scales the glossy lobes under it and is
+    // sampled by its share.
+    float cs = 1.0f;
+    float q_coat = 0.0f;
+    float p_coat = 0.0f;
+    float3 f_coat = (float3)(0.0f);
+    bool layered = false;
 #ifdef HAS_CLEARCOAT
     if (l.coat > 0.0f) {
+        layered = true;
         CoatLobe c = coat_lobe(m, &l, n, wo_world);
+        cs = coat_gloss_scale(&c, wi_world);
+        f_coat = coat_eval(&c, wo_world, wi_world, &p_coat);
+        q_coat = c.p;
+    }
+#endif
+    float ss = 1.0f;
+    float q_sheen = 0.0f;
+    float p_sheen = 0.0f;
+    float3 f_sheen = (float3)(0.0f);
+#ifdef HAS_SHEEN
+    if (l.sheen_max > 0.0f) {
+        layered = true;
+        ss = sheen_gloss_scale(&l, fabs(wi.z));
+        q_sheen = sheen_probability(&l);
+        if (wi.z > 0.0f) {
+            f_sheen = sheen_eval(&l, wo, wi);
+            p_sheen = wi.z * INV_PI_F;
+        }
+    }
+#endif
+    if (layered) {
         float p_base;
-        float3 f = base_eval(m, &l, wo, wi, coat_gloss_scale(&c, wi_world), &p_base);
-        float p_coat;
-        f += coat_eval(&c, wo_world, wi_world, &p_coat);
-        *pdf = (1.0f - c.p) * p_base + c.p * p_coat;
+        float3 f = base_eval(m, &l, wo, wi, cs * ss, &p_base) + f_sheen * cs + f_coat;
+        *pdf = (1.0f - q_coat) * ((1.0f - q_sheen) * p_base + q_sheen * p_sheen) + q_coat * p_coat;
         return f;
     }
 #endif
@@ -750,6 +1132,25 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
         u.x = fmin((u.x - c.p) / p_base, 0x1.fffffep-1f);
     }
 #endif
+#ifdef HAS_SHEEN
+    // The sheen's share (of what the coat leaves), cosine-distributed.
+    float p_under_sheen = 1.0f;
+    if (l.sheen_max > 0.0f) {
+        float q = sheen_probability(&l);
+        if (u.x < q) {
+            wi = sample_cosine(fmin(u.x / q, 0x1.fffffep-1f), u.y);
+            *wi_world = normalize(wi.x * t + wi.y * b + wi.z * n);
+            float3 f = bsdf_eval(m, n, wo_world, *wi_world, pdf);
+            if (!(*pdf > 0.0f)) {
+                *pdf = 0.0f;
+                return (float3)(0.0f);
+            }
+            return f / *pdf;
+        }
+        p_under_sheen = 1.0f - q;
+        u.x = fmin((u.x - q) / p_under_sheen, 0x1.fffffep-1f);
+    }
+#endif
     if (u.x < l.p_diffuse) {
         wi = sample_cosine(u.x / l.p_diffuse, u.y);
     } else {
@@ -779,9 +1180,15 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
             *specular = true;
             float3 w = (reflect ? refl : trans) / chosen;
             w = reflect || l.thin ? w : w / (l.eta * l.eta);
+#ifdef HAS_SHEEN
+            if (l.sheen_max > 0.0f) {
+                *pdf *= p_under_sheen;
+                w *= sheen_gloss_scale(&l, fabs(wi.z)) / p_under_sheen;
+            }
+#endif
 #ifdef HAS_CLEARCOAT
             if (c.c > 0.0f) {
-                *pdf = chosen * p_base;
+                *pdf *= p_base;
                 w *= coat_gloss_scale(&c, *wi_world) / p_base;
             }
 #endif

@@ -18,6 +18,10 @@ inline void apply_textures(SurfaceMaterial* m, global const GpuMaterial* mat,
     if (mat->textures3.x >= 0) m->clearcoat *= texture_sample(s, mat->textures3.x, tc).x;
     if (mat->textures3.y >= 0) m->coat_roughness *= texture_sample(s, mat->textures3.y, tc).y;
 #endif
+#ifdef HAS_SHEEN
+    if (mat->textures2.z >= 0) m->sheen_color *= texture_sample(s, mat->textures2.z, tc).xyz;
+    if (mat->textures2.w >= 0) m->sheen_roughness *= texture_sample(s, mat->textures2.w, tc).w;
+#endif
 }
 
 // Emitted radiance at the hit: the factor times the emissive texture.

@@ -75,6 +75,7 @@ typedef struct {
     int4 textures2;     // texture refs: .x transmission, .y thickness; -1 none
     float4 coat;        // clearcoat: .x factor, .y roughness, .z normal texture scale
     int4 textures3;     // texture refs: .x clearcoat, .y clearcoat roughness, .z clearcoat normal
+    float4 sheen;       // sheen: .xyz color, .w roughness
 } GpuMaterial;
 
 typedef struct {

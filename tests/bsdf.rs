@@ -35,6 +35,8 @@ struct Mat {
     thickness: f32,
     clearcoat: f32,
     coat_roughness: f32,
+    sheen: [f32; 3],
+    sheen_roughness: f32,
 }
 
 impl Mat {
@@ -50,6 +52,17 @@ impl Mat {
             thickness: 0.0,
             clearcoat: 0.0,
             coat_roughness: 0.0,
+            sheen: [0.0; 3],
+            sheen_roughness: 0.0,
+        }
+    }
+
+    /// This material under a sheen (`KHR_materials_sheen`).
+    fn sheened(self, sheen: [f32; 3], sheen_roughness: f32) -> Self {
+        Self {
+            sheen,
+            sheen_roughness,
+            ..self
         }
     }
 
@@ -99,6 +112,12 @@ impl Mat {
             textures2: [-1; 4],
             coat: [self.clearcoat, self.coat_roughness, 1.0, 0.0],
             textures3: [-1; 4],
+            sheen: [
+                self.sheen[0],
+                self.sheen[1],
+                self.sheen[2],
+                self.sheen_roughness,
+            ],
         }
     }
 }
@@ -115,6 +134,7 @@ impl Device {
         // Every lobe compiled in; a material without them reduces to the plain BSDF.
         let features = KernelFeatures {
             clearcoat: true,
+            sheen: true,
             ..KernelFeatures::default()
         };
         let program = Program::build(&gpu, features).expect("kernels build");
@@ -559,6 +579,29 @@ fn sampling_matches_pdf_chi_square() {
         60.0,
         false,
     ));
+    // Sheen: over diffuse (narrow and wide), over a glossy dielectric, under a coat.
+    for t in [10.0, 45.0, 80.0] {
+        cases.push(case(
+            "sheen 0.3 over diffuse",
+            Mat::lambert([0.3, 0.3, 0.6]).sheened([1.0, 0.8, 0.6], 0.3),
+            t,
+            false,
+        ));
+    }
+    cases.push(case(
+        "sheen 0.8 over dielectric 0.4",
+        Mat::dielectric([0.6, 0.2, 0.2], 0.4).sheened([0.5, 0.9, 0.7], 0.8),
+        60.0,
+        false,
+    ));
+    cases.push(case(
+        "coat 0.3 over sheen 0.5 over metal 0.5",
+        Mat::metal([0.9, 0.6, 0.3], 0.5)
+            .sheened([0.6; 3], 0.5)
+            .coated(0.8, 0.3),
+        30.0,
+        false,
+    ));
     // Any normal: the kernels' frame must not matter.
     let n = norm([1.0, -2.0, 3.0]);
     cases.push(Case {
@@ -775,6 +818,34 @@ fn directional_albedo_never_exceeds_one() {
             false,
         ));
     }
+    for r in [0.0, 0.3, 1.0] {
+        let sheen = |m: Mat| m.sheened([1.0; 3], r);
+        materials.push((
+            format!("sheen {r} over white"),
+            sheen(Mat::lambert(white)),
+            false,
+        ));
+        materials.push((
+            format!("sheen {r} over dielectric 0.3"),
+            sheen(Mat::dielectric(white, 0.3)),
+            false,
+        ));
+        materials.push((
+            format!("sheen {r} over metal 1"),
+            sheen(Mat::metal(white, 1.0)),
+            false,
+        ));
+        materials.push((
+            format!("coat 0.2 over sheen {r} over white"),
+            sheen(Mat::lambert(white)).coated(1.0, 0.2),
+            false,
+        ));
+        materials.push((
+            format!("sheen {r} over thin glass"),
+            sheen(Mat::glass(0.0, 0.0)),
+            false,
+        ));
+    }
 
     let count = 1 << 16;
     let mut worst = (f64::MIN, String::new());
@@ -848,6 +919,49 @@ fn white_under_a_clear_coat_loses_at_most_what_the_spec_loses() {
             }
         }
     }
+}
+
+/// A white Lambertian base under a sheen reflects what the glTF spec's layering says,
+/// `sheenColor E(mu) + (1 - max3(sheenColor) E(mu))` per channel (E the bounded sheen lobe's
+/// albedo, by quadrature here), within noise (and 2% below cos 0.1, the tables' interpolation
+/// error there): it neither loses more nor gains.
+#[test]
+fn white_under_a_sheen_keeps_what_the_spec_keeps() {
+    let d = Device::new();
+    let charlie = kernel_table("SHEEN_E_CHARLIE");
+    let n = [0.0, 0.0, 1.0];
+    let count = 1 << 17;
+    let mut worst = 0.0f64;
+    for color in [[1.0f32; 3], [0.9, 0.4, 0.1]] {
+        for r in [0.1f32, 0.4, 1.0] {
+            let m = Mat::lambert([1.0; 3]).sheened(color, r);
+            let s_max = color.iter().cloned().fold(0.0f32, f32::max) as f64;
+            for (k, mu) in [0.05f64, 0.2, 0.5, 0.8, 1.0].iter().enumerate() {
+                let wo = direction_at(n, mu.acos().to_degrees());
+                let s = d.sample(&m, wo, n, false, count, 500 + k as u32);
+                let e = sheen_albedo(*mu, r as f64, 256, Some(&charlie));
+                for ch in 0..3 {
+                    let w: Vec<f64> = s.w.iter().map(|w| w[ch] as f64).collect();
+                    let mean = w.iter().sum::<f64>() / count as f64;
+                    let var = w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / count as f64;
+                    // Near grazing the tables' bilinear interpolation errs by up to 2%.
+                    let table = if *mu < 0.1 { 0.02 } else { 3e-3 };
+                    let noise = 4.0 * (var / count as f64).sqrt() + table;
+                    let spec = color[ch] as f64 * e + 1.0 - s_max * e;
+                    worst = worst.max((mean - spec).abs());
+                    assert!(
+                        mean <= 1.0 + noise,
+                        "sheen {color:?} {r} at cos {mu} gains: {mean}"
+                    );
+                    assert!(
+                        (mean - spec).abs() <= noise,
+                        "sheen {color:?} {r} at cos {mu}, channel {ch}: albedo {mean:.4}, spec {spec:.4}"
+                    );
+                }
+            }
+        }
+    }
+    eprintln!("largest difference from the spec's layering: {worst:.4}");
 }
 
 /// The directional albedo of a GGX reflection lobe (alpha) at cos(theta_o) = mu: with Fresnel 1
@@ -1002,21 +1116,201 @@ fn ggx_energy_tables_match_monte_carlo() {
 #[ignore]
 fn print_energy_tables() {
     let rows: Vec<_> = (0..=32).map(energy_table_row).collect();
-    let print = |name: &str, values: Vec<f64>| {
-        println!("constant float {name}[{}] = {{", values.len());
-        for line in values.chunks(11) {
-            let s: Vec<String> = line.iter().map(|v| format!("{v:.5}f")).collect();
-            println!("    {},", s.join(", "));
-        }
-        println!("}};");
-    };
-    print("GGX_E", rows.iter().flat_map(|r| r.0.clone()).collect());
-    print(
+    print_table("GGX_E", rows.iter().flat_map(|r| r.0.clone()).collect());
+    print_table(
         "GGX_E_SCHLICK",
         rows.iter().flat_map(|r| r.1.clone()).collect(),
     );
-    print("GGX_E_AVG", rows.iter().map(|r| r.2).collect());
-    print("GGX_E_SCHLICK_AVG", rows.iter().map(|r| r.3).collect());
+    print_table("GGX_E_AVG", rows.iter().map(|r| r.2).collect());
+    print_table("GGX_E_SCHLICK_AVG", rows.iter().map(|r| r.3).collect());
+}
+
+/// Prints a table as kernels/bsdf.h declares it.
+fn print_table(name: &str, values: Vec<f64>) {
+    println!("constant float {name}[{}] = {{", values.len());
+    for line in values.chunks(11) {
+        let s: Vec<String> = line.iter().map(|v| format!("{v:.5}f")).collect();
+        println!("    {},", s.join(", "));
+    }
+    println!("}};");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sheen (KHR_materials_sheen): the Charlie distribution's albedo table
+
+/// Charlie sheen: D(h) for cos(theta_h) = `cos_h` and alpha = roughness², as kernels/bsdf.h.
+fn charlie_d(cos_h: f64, alpha: f64) -> f64 {
+    let inv = 1.0 / alpha;
+    let sin2 = (1.0 - cos_h * cos_h).max(0.0);
+    (2.0 + inv) * sin2.powf(0.5 * inv) / (2.0 * PI)
+}
+
+/// Estevez and Kulla's fitted Lambda of the sheen visibility.
+fn sheen_lambda(cos: f64, alpha: f64) -> f64 {
+    let t = (1.0 - alpha) * (1.0 - alpha);
+    let mix = |a: f64, b: f64| a + (b - a) * t;
+    let l = |x: f64| {
+        mix(21.5473, 25.3245) / (1.0 + mix(3.82987, 3.32435) * x.powf(mix(0.19823, 0.16801)))
+            + mix(-1.97760, -1.27393) * x
+            + mix(-4.32054, -4.85967)
+    };
+    if cos < 0.5 {
+        l(cos).exp()
+    } else {
+        (2.0 * l(0.5) - l(1.0 - cos)).exp()
+    }
+}
+
+/// The sheen roughness the kernels use: at least 3/32 (narrower lobes are not tabulated).
+fn sheen_roughness(r: f64) -> f64 {
+    r.clamp(3.0 / 32.0, 1.0)
+}
+
+/// f·cos of a white Charlie sheen lobe (unbounded) at local wo, wi.
+fn sheen_f_cos(wo: V, wi: V, roughness: f64) -> f64 {
+    if wo[2] <= 0.0 || wi[2] <= 0.0 {
+        return 0.0;
+    }
+    let alpha = sheen_roughness(roughness).powi(2);
+    let h = norm(add(wo, wi));
+    let v = 1.0
+        / ((1.0 + sheen_lambda(wo[2], alpha) + sheen_lambda(wi[2], alpha)) * 4.0 * wo[2] * wi[2]);
+    charlie_d(h[2], alpha) * v * wi[2]
+}
+
+/// A sheen table (rows roughness 0, 1/32 .. 1, columns cos (0/32)², (1/32)² .. 1) at
+/// (mu, roughness), bilinear in (sqrt(mu), roughness) as kernels/bsdf.h reads it.
+fn table_at(table: &[f64], mu: f64, roughness: f64) -> f64 {
+    let x = mu.clamp(0.0, 1.0).sqrt() * 32.0;
+    let y = roughness.clamp(0.0, 1.0) * 32.0;
+    let (i, j) = ((x as usize).min(31), (y as usize).min(31));
+    let k = j * 33 + i;
+    let (fx, fy) = (x - i as f64, y - j as f64);
+    let a = table[k] + (table[k + 1] - table[k]) * fx;
+    let b = table[k + 33] + (table[k + 34] - table[k + 33]) * fx;
+    a + (b - a) * fy
+}
+
+/// The directional albedo of a white sheen lobe at cos(theta_o) = mu: midpoint quadrature over
+/// (cos theta_i, phi) with n × n points (phi over half the circle, by symmetry). With
+/// `charlie` (the unbounded lobe's albedo table) the lobe is the bounded one, times
+/// k(mu_o) k(mu_i), k = 1 / max(1, E_charlie).
+fn sheen_albedo(mu: f64, roughness: f64, n: usize, charlie: Option<&[f64]>) -> f64 {
+    let mu = mu.max(1e-4);
+    let r = sheen_roughness(roughness);
+    let k = |m: f64| charlie.map_or(1.0, |t| 1.0 / table_at(t, m, r).max(1.0));
+    let wo = [(1.0 - mu * mu).sqrt(), 0.0, mu];
+    let mut sum = 0.0;
+    for i in 0..n {
+        let z = (i as f64 + 0.5) / n as f64;
+        let s = (1.0 - z * z).sqrt();
+        let mut ring = 0.0;
+        for j in 0..n {
+            let phi = PI * (j as f64 + 0.5) / n as f64;
+            let wi = [s * phi.cos(), s * phi.sin(), z];
+            ring += sheen_f_cos(wo, wi, roughness);
+        }
+        sum += ring * k(z);
+    }
+    sum * k(mu) * 2.0 * PI / (n * n) as f64
+}
+
+/// Rounds as the printed tables do.
+fn round5(v: f64) -> f64 {
+    (v * 1e5).round() / 1e5
+}
+
+/// The sheen tables: the unbounded lobe's albedo (33 × 33), the bounded lobe's, and the bounded
+/// lobe's cosine-weighted means per roughness row.
+fn sheen_tables() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let cell = |m: usize, r: usize| ((m as f64 / 32.0).powi(2), (r as f64 / 32.0));
+    let charlie: Vec<f64> = (0..33 * 33)
+        .map(|k| {
+            let (mu, r) = cell(k % 33, k / 33);
+            round5(sheen_albedo(mu, r, 512, None))
+        })
+        .collect();
+    let bounded: Vec<f64> = (0..33 * 33)
+        .map(|k| {
+            let (mu, r) = cell(k % 33, k / 33);
+            round5(sheen_albedo(mu, r, 512, Some(&charlie)))
+        })
+        .collect();
+    let steps = 128;
+    let avg = (0..=32)
+        .map(|r| {
+            let roughness = r as f64 / 32.0;
+            round5(
+                (0..steps)
+                    .map(|m| {
+                        let mu = (m as f64 + 0.5) / steps as f64;
+                        let e = sheen_albedo(mu, roughness, 192, Some(&charlie));
+                        2.0 * e * mu / steps as f64
+                    })
+                    .sum(),
+            )
+        })
+        .collect();
+    (charlie, bounded, avg)
+}
+
+/// Prints the sheen tables for kernels/bsdf.h:
+/// `cargo test --release --test bsdf print_sheen_tables -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn print_sheen_tables() {
+    let (charlie, bounded, avg) = sheen_tables();
+    print_table("SHEEN_E_CHARLIE", charlie);
+    print_table("SHEEN_E", bounded);
+    print_table("SHEEN_E_AVG", avg);
+}
+
+/// The sheen tables against quadrature done afresh (with other points).
+#[test]
+fn sheen_albedo_tables_match_quadrature() {
+    let charlie = kernel_table("SHEEN_E_CHARLIE");
+    let e = kernel_table("SHEEN_E");
+    let avg = kernel_table("SHEEN_E_AVG");
+    assert_eq!((charlie.len(), e.len(), avg.len()), (33 * 33, 33 * 33, 33));
+    for r in [3usize, 6, 12, 20, 32] {
+        for m in [1usize, 4, 12, 20, 32] {
+            let (mu, roughness) = ((m as f64 / 32.0).powi(2), r as f64 / 32.0);
+            let k = r * 33 + m;
+            for (name, table, q) in [
+                ("Charlie", &charlie, sheen_albedo(mu, roughness, 400, None)),
+                (
+                    "bounded",
+                    &e,
+                    sheen_albedo(mu, roughness, 400, Some(&charlie)),
+                ),
+            ] {
+                assert!(
+                    (table[k] - q).abs() < 2e-3 + 5e-3 * q,
+                    "sheen {name} E(roughness {r}/32, cos {m}/32): table {} vs quadrature {q}",
+                    table[k]
+                );
+            }
+        }
+        let row = &e[r * 33..r * 33 + 33];
+        let trap: f64 = (0..32)
+            .map(|i| {
+                let (m0, m1) = ((i as f64 / 32.0).powi(2), ((i + 1) as f64 / 32.0).powi(2));
+                (row[i] * m0 + row[i + 1] * m1) * (m1 - m0)
+            })
+            .sum();
+        assert!(
+            (avg[r] - trap).abs() < 3e-3,
+            "sheen E_avg(roughness {r}/32): table {} vs the E column's {trap}",
+            avg[r]
+        );
+    }
+    // The Charlie lobe reflects more than it receives at grazing angles; the bounded one never.
+    assert!(charlie[3 * 33] > 1.5, "{}", charlie[3 * 33]);
+    assert_eq!(e[..33], e[3 * 33..4 * 33]);
+    assert!(
+        e.iter().all(|&v| (0.0..=1.0).contains(&v)),
+        "sheen albedo in [0, 1]"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1034,6 +1328,7 @@ fn material_json(g: &mut Gltf, m: &Mat, attenuation: Option<([f32; 3], f32)>) ->
         g.use_ext(e);
     }
     g.use_ext("KHR_materials_clearcoat");
+    g.use_ext("KHR_materials_sheen");
     let mut volume = json!({"thicknessFactor": m.thickness});
     if let Some((color, distance)) = attenuation {
         volume["attenuationColor"] = json!(color);
@@ -1057,6 +1352,10 @@ fn material_json(g: &mut Gltf, m: &Mat, attenuation: Option<([f32; 3], f32)>) ->
             "KHR_materials_clearcoat": {
                 "clearcoatFactor": m.clearcoat,
                 "clearcoatRoughnessFactor": m.coat_roughness
+            },
+            "KHR_materials_sheen": {
+                "sheenColorFactor": m.sheen,
+                "sheenRoughnessFactor": m.sheen_roughness
             }
         }
     }));
@@ -1219,6 +1518,16 @@ fn white_furnace_spheres_keep_their_energy() {
             Mat::dielectric(white, 0.2).coated(0.8, 0.3),
             0.95,
         ),
+        (
+            "white, white sheen",
+            Mat::lambert(white).sheened(white, 0.5),
+            0.98,
+        ),
+        (
+            "rough metal, sheen 0.3",
+            Mat::metal(white, 0.7).sheened([0.8; 3], 0.3),
+            0.9,
+        ),
     ];
     // Render first: a GPU in exclusive-process mode serves one process, so the renderer (a
     // child process) must run before this process opens the device.
@@ -1322,6 +1631,11 @@ fn reflection_is_reciprocal() {
         ("glossy metal", Mat::metal([0.9; 3], 0.2)),
         ("rough coat over plastic", plastic.coated(0.8, 0.4)),
         ("rough coat over half metal", half.coated(1.0, 0.1)),
+        ("sheen over plastic", plastic.sheened([0.9, 0.5, 0.7], 0.4)),
+        (
+            "coat over sheen over half metal",
+            half.sheened([0.6; 3], 0.8).coated(0.5, 0.3),
+        ),
     ];
     let angles = [5.0, 30.0, 55.0, 80.0];
     for (name, m) in &materials {

@@ -63,6 +63,8 @@ pub struct KernelFeatures {
     pub unlit: bool,
     /// Some material has a clear coat (`HAS_CLEARCOAT`, `KHR_materials_clearcoat`).
     pub clearcoat: bool,
+    /// Some material has a sheen (`HAS_SHEEN`, `KHR_materials_sheen`).
+    pub sheen: bool,
 }
 
 impl KernelFeatures {
@@ -79,6 +81,7 @@ impl KernelFeatures {
             (self.thin_walls, "HAS_THIN_WALLS"),
             (self.unlit, "HAS_UNLIT"),
             (self.clearcoat, "HAS_CLEARCOAT"),
+            (self.sheen, "HAS_SHEEN"),
         ] {
             if on {
                 d.push_str(" -D");

@@ -267,7 +267,7 @@ pub struct GpuEnvironment {
 }
 const _: () = assert!(size_of::<GpuEnvironment>() == 48);
 
-/// A glTF material as the kernels see it (160 bytes).
+/// A glTF material as the kernels see it (176 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuMaterial {
@@ -286,7 +286,8 @@ pub struct GpuMaterial {
     pub alpha: [f32; 4],
     /// Texture references (base color, metallic-roughness, normal, emissive); -1 when absent.
     pub textures: [i32; 4],
-    /// More texture references (`.x` transmission, `.y` thickness, `.zw` spare); -1 when absent.
+    /// More texture references (`.x` transmission, `.y` thickness, `.z` sheen color, `.w` sheen
+    /// roughness (A)); -1 when absent.
     pub textures2: [i32; 4],
     /// `KHR_materials_clearcoat`: `.x` clearcoatFactor, `.y` clearcoatRoughnessFactor, `.z`
     /// clearcoat normal texture scale; `.w` spare.
@@ -294,8 +295,10 @@ pub struct GpuMaterial {
     /// Texture references of the extensions: `.x` clearcoat (R), `.y` clearcoat roughness (G),
     /// `.z` clearcoat normal; `.w` spare; -1 when absent.
     pub textures3: [i32; 4],
+    /// `KHR_materials_sheen`: `.xyz` sheenColorFactor, `.w` sheenRoughnessFactor.
+    pub sheen: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuMaterial>() == 160);
+const _: () = assert!(size_of::<GpuMaterial>() == 176);
 
 /// One light for next-event estimation (64 bytes).
 #[repr(C)]
@@ -445,7 +448,8 @@ pub fn layouts() -> Vec<StructLayout> {
             textures,
             textures2,
             coat,
-            textures3
+            textures3,
+            sheen
         ),
         layout!(GpuLight, position, intensity, spot, extra),
         layout!(GpuCamera, origin, forward, right, up),

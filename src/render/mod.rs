@@ -158,6 +158,7 @@ impl Renderer {
             thin_walls: used(&|m| m.transmission > 0.0 && m.thickness <= 0.0),
             unlit: used(&|m| m.unlit),
             clearcoat: used(&|m| m.clearcoat > 0.0),
+            sheen: used(&|m| m.sheen_color.iter().any(|&c| c > 0.0)),
         };
         let budget = self
             .gpu

@@ -83,7 +83,12 @@ pub fn gpu_material(m: &Material) -> GpuMaterial {
             slot(m.textures.normal),
             slot(m.textures.emissive),
         ],
-        textures2: [slot(m.textures.transmission), -1, -1, -1],
+        textures2: [
+            slot(m.textures.transmission),
+            -1,
+            slot(m.textures.sheen_color),
+            slot(m.textures.sheen_roughness),
+        ],
         coat: [
             m.clearcoat,
             m.clearcoat_roughness,
@@ -95,6 +100,12 @@ pub fn gpu_material(m: &Material) -> GpuMaterial {
             slot(m.textures.clearcoat_roughness),
             slot(m.textures.clearcoat_normal),
             -1,
+        ],
+        sheen: [
+            m.sheen_color[0],
+            m.sheen_color[1],
+            m.sheen_color[2],
+            m.sheen_roughness,
         ],
     }
 }

@@ -427,6 +427,8 @@ impl TextureTable {
             &mut slots.clearcoat,
             &mut slots.clearcoat_roughness,
             &mut slots.clearcoat_normal,
+            &mut slots.sheen_color,
+            &mut slots.sheen_roughness,
         ] {
             if let Some(r) = *slot
                 && self.failed[self.refs[r as usize].image as usize]

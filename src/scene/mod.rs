@@ -151,6 +151,10 @@ pub struct Material {
     pub clearcoat_roughness: f32,
     /// Scale of the clearcoat normal texture.
     pub clearcoat_normal_scale: f32,
+    /// `KHR_materials_sheen` sheenColorFactor (linear; 0: no sheen).
+    pub sheen_color: [f32; 3],
+    /// `KHR_materials_sheen` sheenRoughnessFactor.
+    pub sheen_roughness: f32,
 }
 
 impl Default for Material {
@@ -176,6 +180,8 @@ impl Default for Material {
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
             clearcoat_normal_scale: 1.0,
+            sheen_color: [0.0; 3],
+            sheen_roughness: 0.0,
         }
     }
 }

@@ -130,6 +130,10 @@ pub struct MaterialTextures {
     pub clearcoat_roughness: Option<u32>,
     /// `KHR_materials_clearcoat` clearcoatNormalTexture.
     pub clearcoat_normal: Option<u32>,
+    /// `KHR_materials_sheen` sheenColorTexture (sRGB RGB).
+    pub sheen_color: Option<u32>,
+    /// `KHR_materials_sheen` sheenRoughnessTexture (A).
+    pub sheen_roughness: Option<u32>,
 }
 
 impl MaterialTextures {
@@ -143,6 +147,8 @@ impl MaterialTextures {
             || self.clearcoat.is_some()
             || self.clearcoat_roughness.is_some()
             || self.clearcoat_normal.is_some()
+            || self.sheen_color.is_some()
+            || self.sheen_roughness.is_some()
     }
 
     /// Whether a slot holds a tangent-space normal map (the base's or the clearcoat's).

@@ -1,5 +1,5 @@
 //! Material extensions the gltf crate does not parse, read from the material's raw
-//! `extensions` JSON: `KHR_materials_clearcoat`.
+//! `extensions` JSON: `KHR_materials_clearcoat` and `KHR_materials_sheen`.
 
 use super::TextureTable;
 use crate::scene::Material;
@@ -23,6 +23,9 @@ pub(super) fn read_extensions(
     };
     if let Some(x) = m.extension_value("KHR_materials_clearcoat") {
         reader.clearcoat(x, material);
+    }
+    if let Some(x) = m.extension_value("KHR_materials_sheen") {
+        reader.sheen(x, material);
     }
 }
 
@@ -76,5 +79,19 @@ impl Reader<'_> {
         t.clearcoat = self.texture(x, "clearcoatTexture", false);
         t.clearcoat_roughness = self.texture(x, "clearcoatRoughnessTexture", false);
         t.clearcoat_normal = self.texture(x, "clearcoatNormalTexture", false);
+    }
+
+    fn sheen(&mut self, x: &Value, material: &mut Material) {
+        let color = x.get("sheenColorFactor").and_then(Value::as_array);
+        material.sheen_color = std::array::from_fn(|i| {
+            color
+                .and_then(|c| c.get(i))
+                .and_then(Value::as_f64)
+                .map_or(0.0, |v| (v as f32).clamp(0.0, 1.0))
+        });
+        material.sheen_roughness = Self::unit(x, "sheenRoughnessFactor", 0.0);
+        let t: &mut MaterialTextures = &mut material.textures;
+        t.sheen_color = self.texture(x, "sheenColorTexture", true);
+        t.sheen_roughness = self.texture(x, "sheenRoughnessTexture", false);
     }
 }
