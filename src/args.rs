@@ -312,6 +312,10 @@ pub struct CommonArgs {
     /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
     #[arg(long, default_value = "auto", value_parser = parse_kernel)]
     pub kernel: KernelChoice,
+    /// The `KHR_materials_variants` variant to show (by name); without it, the default
+    /// materials.
+    #[arg(long, value_name = "NAME")]
+    pub variant: Option<String>,
 }
 
 fn parse_kernel(s: &str) -> Result<KernelChoice, String> {
@@ -404,6 +408,10 @@ impl CommonArgs {
     /// scene's lights light the view" decides the environment (`cli/first_image.rs`).
     pub fn prepare(&self, path: Option<&Path>) -> Result<Prepared> {
         let (mut scene, load_ms) = load(path)?;
+        if let Some(name) = &self.variant {
+            let v = scene.variant_named(name).map_err(anyhow::Error::msg)?;
+            scene.select_variant(Some(v));
+        }
         let mut camera = self.camera.choose(&scene)?;
         // `--sky` alone is an explicit choice of lighting too: no automatic environment.
         let env_arg = match (&self.env.env, self.env.sky) {

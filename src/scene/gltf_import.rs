@@ -4,6 +4,7 @@ use super::accessor::{self, Attributes, BufferData};
 use super::compression;
 use super::pose::{Pose, apply_morph_targets, apply_skin, node_pose, rest_worlds};
 use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
+use super::variants::{self, VariantRange};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
     default_light_rig, limits, sources, validate,
@@ -80,6 +81,8 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         ..Scene::default()
     };
     scene.materials.push(Material::default());
+    scene.variants = variants::names(document.extension_value("KHR_materials_variants"));
+    let variant_count = scene.variants.len();
 
     let roots: Vec<gltf::Node> = match document
         .default_scene()
@@ -146,7 +149,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
             let m = match meshes.get(&mesh.index()).filter(|_| !posed) {
                 Some(m) => m.clone(),
                 None => {
-                    let m = import_mesh(
+                    let mut m = import_mesh(
                         &mesh,
                         root,
                         &buffer_data,
@@ -155,6 +158,11 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
                         &normal_sets,
                         &mut warnings,
                     )?;
+                    m.keep_variants(
+                        variant_count,
+                        &format!("meshes[{}]", mesh.index()),
+                        &mut warnings,
+                    );
                     if !posed {
                         meshes.insert(mesh.index(), m.clone());
                     }
@@ -920,6 +928,14 @@ fn import_mesh(
         out.positions.extend_from_slice(&positions);
         out.indices
             .extend(triangles.iter().map(|t| t.map(|i| i + base)));
+        if let Some(x) = prim.extension_value("KHR_materials_variants") {
+            let start = out.materials.len() as u32;
+            out.variants.push(VariantRange {
+                triangles: start..start + triangles.len() as u32,
+                default: material,
+                materials: variants::mappings(x, default_material as usize, &what, warnings),
+            });
+        }
         out.materials
             .extend(std::iter::repeat_n(material, triangles.len()));
     }

@@ -17,6 +17,7 @@ mod sources;
 mod tangents;
 mod textures;
 mod validate;
+mod variants;
 
 pub use bounds::{ABSURD_COORDINATE, RenderFrame, is_sane, robust_bounds};
 pub use env_presets::EnvPreset;
@@ -28,6 +29,7 @@ pub use textures::{
     linear_to_srgb, mip_chain, srgb_to_linear,
 };
 pub use validate::SUPPORTED_EXTENSIONS;
+pub use variants::VariantRange;
 
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -81,6 +83,8 @@ pub struct Mesh {
     /// `TANGENT` or generated (MikkTSpace) for normal-mapped primitives; empty when no
     /// primitive of the mesh is normal-mapped. Zero where unknown.
     pub tangents: Vec<[Vec4; 3]>,
+    /// The triangles whose material a `KHR_materials_variants` variant changes.
+    pub variants: Vec<VariantRange>,
 }
 
 /// One placed mesh: a glTF node's mesh with its world transform.
@@ -360,6 +364,10 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// Decoded images used by the materials (only those).
     pub images: Vec<Arc<Image>>,
+    /// `KHR_materials_variants` variant names (empty: none).
+    pub variants: Vec<String>,
+    /// The selected variant (`None`: the default materials).
+    pub variant: Option<usize>,
     /// Texture uses, indexed by `MaterialTextures`.
     pub texture_refs: Vec<TextureRef>,
 }
