@@ -38,6 +38,29 @@ inline RayPrep prepare_ray(float3 o, float3 d) {
     return r;
 }
 
+// gamma(n) of Higham's error analysis for single precision: n u / (1 - n u), u = 2^-24.
+inline float gamma_f32(float n) {
+    return (n * 5.96046448e-8f) / (1.0f - n * 5.96046448e-8f);
+}
+
+// The bound on the rounding error of a watertight hit's t (pbrt-v4, Triangle::Intersect),
+// from the sheared vertices (x, y relative to the origin; z already scaled by shear.z), the
+// edge functions and their sum; src/bvh/traverse.rs computes the same.
+inline float triangle_t_error(float ax, float ay, float bx, float by, float cx, float cy,
+                              float az, float bz, float cz, float u, float v, float w,
+                              float det) {
+    float max_z = fmax(fmax(fabs(az), fabs(bz)), fabs(cz));
+    float delta_z = gamma_f32(3.0f) * max_z;
+    float max_x = fmax(fmax(fabs(ax), fabs(bx)), fabs(cx));
+    float max_y = fmax(fmax(fabs(ay), fabs(by)), fabs(cy));
+    float delta_x = gamma_f32(5.0f) * (max_x + max_z);
+    float delta_y = gamma_f32(5.0f) * (max_y + max_z);
+    float delta_e = 2.0f * (gamma_f32(2.0f) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    float max_e = fmax(fmax(fabs(u), fabs(v)), fabs(w));
+    return 3.0f * (gamma_f32(3.0f) * max_e * max_z + delta_e * max_z + delta_z * max_e) /
+           fabs(det);
+}
+
 // Returns true on a hit in (tmin, *tmax), updating *tmax and the barycentrics.
 inline bool intersect_triangle(const RayPrep* r, float4 v0, float4 v1, float4 v2, float tmin,
                                float* tmax, float* bu, float* bv) {
@@ -64,8 +87,12 @@ inline bool intersect_triangle(const RayPrep* r, float4 v0, float4 v1, float4 v2
     if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
     float det = u + v + w;
     if (det == 0.0f) return false;
-    float t = (u * (r->shear.z * a.z) + v * (r->shear.z * b.z) + w * (r->shear.z * c.z)) / det;
+    float az = r->shear.z * a.z, bz = r->shear.z * b.z, cz = r->shear.z * c.z;
+    float t = (u * az + v * bz + w * cz) / det;
     if (!(t > tmin && t < *tmax)) return false;
+    // pbrt-v4's conservative bound on t's rounding error: a hit closer than its own error
+    // could lie behind the origin, as it does for a ray leaving this very triangle.
+    if (t <= triangle_t_error(ax, ay, bx, by, cx, cy, az, bz, cz, u, v, w, det)) return false;
     *tmax = t;
     *bu = v / det;
     *bv = w / det;

@@ -49,6 +49,30 @@ fn node_hierarchy_composes_transforms() {
 }
 
 #[test]
+fn node_transforms_keep_f64_precision_at_survey_coordinates() {
+    // Two quads 0.25 apart at x ≈ 1.2e7, where f32 steps by 1: read as f32 both would land on
+    // the same point. One is placed by TRS, the other by a matrix.
+    let mut g = Gltf::default();
+    g.lambert([0.5; 3], [0.0; 3], 1.0, false);
+    let m = g.mesh(vec![quad()]);
+    g.node(json!({"mesh": m, "translation": [12345678.25, 0.0, 0.0]}));
+    let mut matrix = [0.0f64; 16];
+    for i in 0..4 {
+        matrix[5 * i] = 1.0;
+    }
+    matrix[12] = 12345678.5;
+    g.node(json!({"mesh": m, "matrix": matrix}));
+    let dir = tempfile::tempdir().unwrap();
+    let s = load(&g.write_glb(dir.path(), "survey")).unwrap();
+    let x: Vec<f64> = s
+        .objects
+        .iter()
+        .map(|o| o.world_from_object.w_axis.x)
+        .collect();
+    assert_eq!(x, [12345678.25, 12345678.5]);
+}
+
+#[test]
 fn non_indexed_and_unsupported_modes() {
     let mut g = Gltf::default();
     g.lambert([0.5; 3], [0.0; 3], 1.0, false);

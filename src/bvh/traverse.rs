@@ -95,8 +95,26 @@ fn intersect_sheared(ray: &Ray, sh: &Shear, tri: &[Vec3; 3]) -> Option<(f32, f32
     if det == 0.0 {
         return None;
     }
-    let t = (u * (sh.s.z * a[kz]) + v * (sh.s.z * b[kz]) + w * (sh.s.z * c[kz])) / det;
+    let (az, bz, cz) = (sh.s.z * a[kz], sh.s.z * b[kz], sh.s.z * c[kz]);
+    let t = (u * az + v * bz + w * cz) / det;
     if !(t > ray.tmin && t < ray.tmax) {
+        return None;
+    }
+    // pbrt-v4's conservative bound on t's rounding error (as `triangle_t_error` in
+    // kernels/traverse.h): a hit closer than its own error could lie behind the origin.
+    let t_error = {
+        let gamma = |n: f32| (n * 5.960_464_5e-8) / (1.0 - n * 5.960_464_5e-8);
+        let max_z = az.abs().max(bz.abs()).max(cz.abs());
+        let delta_z = gamma(3.0) * max_z;
+        let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_y = ay.abs().max(by.abs()).max(cy.abs());
+        let delta_x = gamma(5.0) * (max_x + max_z);
+        let delta_y = gamma(5.0) * (max_y + max_z);
+        let delta_e = 2.0 * (gamma(2.0) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = u.abs().max(v.abs()).max(w.abs());
+        3.0 * (gamma(3.0) * max_e * max_z + delta_e * max_z + delta_z * max_e) / det.abs()
+    };
+    if t <= t_error {
         return None;
     }
     Some((t, v / det, w / det))

@@ -122,6 +122,7 @@ pub struct Gpu {
 impl Gpu {
     /// Opens the device the choice names.
     pub fn open(choice: &DeviceChoice) -> Result<Self, ClError> {
+        let _setup = super::CL_SETUP.lock().unwrap_or_else(|e| e.into_inner());
         let devices = list_devices()?;
         let info = match choice {
             DeviceChoice::Auto => devices

@@ -7,6 +7,10 @@ pub mod kernels;
 mod program;
 pub mod types;
 
+/// Serialises device opening and program builds within a process: PoCL (3.x, Debian 12) can
+/// crash when two threads create contexts or compile at the same time, as test binaries do.
+pub(crate) static CL_SETUP: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 pub use device::{DeviceChoice, DeviceInfo, Gpu, list_devices};
 pub use kernels::{Buffer, Program, Stage};
 pub use program::{KernelFeatures, build_program, build_test_program};

@@ -155,6 +155,7 @@ pub(crate) fn build_source(
         options.push_str("-cl-fp32-correctly-rounded-divide-sqrt");
     }
     options.push_str(&features.defines());
+    let _setup = super::CL_SETUP.lock().unwrap_or_else(|e| e.into_inner());
     let mut program = opencl3::program::Program::create_from_source(&gpu.context, source)
         .map_err(|e| ClError::Build(format!("cannot create the program: {e}")))?;
     if program.build(&[gpu.device.id()], &options).is_err() {

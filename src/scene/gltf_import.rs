@@ -4,6 +4,7 @@ use super::accessor::{self, Attributes, BufferData};
 use super::compression;
 use super::pose::{Pose, apply_morph_targets, apply_skin, node_pose, rest_worlds};
 use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
+use super::validate::PreciseNode;
 use super::variants::{self, VariantRange};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
@@ -48,7 +49,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         decoded_views: HashMap::new(),
     };
     buffer_data.decoded_views = compression::decode_meshopt_views(root, &buffer_data.buffers)?;
-    let rest = rest_worlds(&document);
+    let rest = rest_worlds(&document, &parsed.precise_nodes);
 
     let mut table = TextureTable {
         sources: texture_sources(root),
@@ -116,7 +117,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
             ));
         }
         // A node whose transform is not usable is left out with everything below it.
-        let world = match node_matrix(&node) {
+        let world = match node_matrix(&node, parsed.precise_nodes.get(node.index())) {
             Ok(local) => parent * local,
             Err(why) => {
                 warn_once(
@@ -248,21 +249,34 @@ fn warn_once(warnings: &mut Vec<String>, warning: String) {
 }
 
 /// The node's local transform, or why it cannot be used: a non-finite value, a zero
-/// quaternion or a singular matrix.
-pub(super) fn node_matrix(node: &gltf::Node) -> Result<DMat4, &'static str> {
-    if let gltf::scene::Transform::Matrix { matrix } = node.transform() {
-        let m = DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)));
+/// quaternion or a singular matrix. `precise` holds the values as written, in f64, when the
+/// file could be read that way; otherwise gltf-json's f32 values are used.
+pub(super) fn node_matrix(
+    node: &gltf::Node,
+    precise: Option<&PreciseNode>,
+) -> Result<DMat4, &'static str> {
+    let f32_matrix = match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => Some(matrix.map(|c| c.map(f64::from))),
+        _ => None,
+    };
+    if let Some(matrix) = f32_matrix {
+        let m = match precise.and_then(|p| p.matrix) {
+            Some(m) => DMat4::from_cols_array(&m),
+            None => DMat4::from_cols_array_2d(&matrix),
+        };
         if !m.is_finite() {
             return Err("matrix is not finite");
         }
         if !m.inverse().is_finite() || m.determinant() == 0.0 {
             return Err("matrix is singular");
         }
+        return Ok(m);
     }
     let (t, r, s) = node.transform().decomposed();
-    let t = DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64);
-    let r = DQuat::from_xyzw(r[0] as f64, r[1] as f64, r[2] as f64, r[3] as f64);
-    let s = DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64);
+    let p = precise.cloned().unwrap_or_default();
+    let t = DVec3::from(p.translation.unwrap_or(t.map(f64::from)));
+    let r = DQuat::from_array(p.rotation.unwrap_or(r.map(f64::from)));
+    let s = DVec3::from(p.scale.unwrap_or(s.map(f64::from)));
     if !(t.is_finite() && r.is_finite() && s.is_finite()) {
         return Err("translation, rotation or scale is not finite");
     }

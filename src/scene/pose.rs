@@ -4,6 +4,7 @@
 
 use super::accessor::{self, Attributes, BufferData};
 use super::gltf_import::node_matrix;
+use super::validate::PreciseNode;
 use glam::{DMat4, Vec3, Vec4};
 
 /// The pose a mesh is drawn in: morph target weights and skin joint matrices.
@@ -18,7 +19,7 @@ pub struct Pose {
 
 /// World transforms of every node at its rest transform, as the scene graph nests them
 /// (a node no scene reaches is placed by its own transform). Used for skin joints.
-pub fn rest_worlds(document: &gltf::Document) -> Vec<DMat4> {
+pub fn rest_worlds(document: &gltf::Document, precise: &[PreciseNode]) -> Vec<DMat4> {
     let count = document.nodes().len();
     let mut parent: Vec<Option<usize>> = vec![None; count];
     for node in document.nodes() {
@@ -30,7 +31,7 @@ pub fn rest_worlds(document: &gltf::Document) -> Vec<DMat4> {
     }
     let local: Vec<DMat4> = document
         .nodes()
-        .map(|n| node_matrix(&n).unwrap_or(DMat4::IDENTITY))
+        .map(|n| node_matrix(&n, precise.get(n.index())).unwrap_or(DMat4::IDENTITY))
         .collect();
     (0..count)
         .map(|mut i| {

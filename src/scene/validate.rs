@@ -37,6 +37,35 @@ pub struct Parsed {
     pub document: gltf::Document,
     /// The GLB `BIN` chunk.
     pub blob: Option<Vec<u8>>,
+    /// Node transforms as written, in f64 (gltf-json reads them as f32).
+    pub precise_nodes: Vec<PreciseNode>,
+}
+
+/// A node's transform read from the JSON text in f64, so that a scene placed at survey
+/// coordinates keeps the relative placement of its nodes (f32 keeps only about half a unit at
+/// 10⁷). Empty when the text cannot be read this way; the f32 values are used then.
+#[derive(serde::Deserialize, Default, Clone, Debug)]
+pub struct PreciseNode {
+    /// `translation`.
+    pub translation: Option<[f64; 3]>,
+    /// `rotation` (x, y, z, w).
+    pub rotation: Option<[f64; 4]>,
+    /// `scale`.
+    pub scale: Option<[f64; 3]>,
+    /// `matrix`, column-major.
+    pub matrix: Option<[f64; 16]>,
+}
+
+/// The nodes' transforms in f64, or none when any of them does not read as numbers.
+fn precise_nodes(json: &[u8]) -> Vec<PreciseNode> {
+    #[derive(serde::Deserialize)]
+    struct Nodes {
+        #[serde(default)]
+        nodes: Vec<PreciseNode>,
+    }
+    serde_json::from_slice::<Nodes>(json)
+        .map(|n| n.nodes)
+        .unwrap_or_default()
 }
 
 /// Parses `.gltf` JSON or `.glb` bytes and validates the document. Warnings (unsupported
@@ -59,9 +88,11 @@ pub fn parse(bytes: &[u8], warnings: &mut Vec<String>) -> Result<Parsed, String>
         };
         return Err(format!("{first}{more}"));
     }
+    let precise_nodes = precise_nodes(&json_bytes);
     Ok(Parsed {
         document: gltf::Document::from_json_without_validation(root),
         blob,
+        precise_nodes,
     })
 }
 
