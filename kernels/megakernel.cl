@@ -10,6 +10,8 @@
 
 kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environment,
                        global const GpuWideNode* nodes, global const GpuTriangle* tris,
+                       global const GpuInstance* instances,
+                       global const GpuTriangle* object_tris,
                        global const GpuTriShading* shading,
                        global const GpuTriTangents* tangents,
                        global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
@@ -34,14 +36,15 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
     for (uint j = 0; j < frame.samples_in_wave; ++j) {
         PathState s = camera_path(&frame, &camera, pixel, frame.first_sample + j);
         for (uint bounce = 0; bounce <= frame.max_bounces + 1u; ++bounce) {
-            GpuHit hit = traverse_wide(nodes, tris, &sc.surf, s.origin, s.direction, 0.0f, INFINITY,
-                                  false, overflow);
+            GpuHit hit = trace_scene_wide(nodes, tris, instances, object_tris, &sc.surf, s.origin,
+                                          s.direction, 0.0f, INFINITY, false, overflow);
             ++extension_rays;
             ShadowQuery q;
             bool alive = shade_vertex(&frame, bounce, &sc, hit, &s, &q);
             if (q.valid) {
                 ++shadow_rays;
-                s.radiance += shadow_pass_wide(nodes, tris, &sc.surf, &q, overflow);
+                s.radiance += shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, &q,
+                                               overflow);
             }
             if (!alive) break;
         }

@@ -330,33 +330,34 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
 #endif
 }
 
-// The shadow test of a light sample, for a BVH of NODE traversed by TRAVERSE: what of
+// The shadow test of a light sample, for a BVH of NODE traced by TRACE (flat or two-level): what of
 // q->contribution reaches the path, or 0 when something other than smooth thin walls is in the
 // way. Through walls the light comes tinted by each wall and no longer shared with the BSDF
 // sample (the MIS weight undone: BSDF samples through walls leave such lights to light
 // sampling). The wavefront's `connect` and the megakernel use the same test this way.
-#define DEFINE_SHADOW_TEST(NAME, NODE, TRAVERSE)                                                \
+#define DEFINE_SHADOW_TEST(NAME, NODE, TRACE)                                                \
     inline float3 NAME(global const NODE* nodes, global const GpuTriangle* tris,               \
-                       const SceneSurfaces* surf, const ShadowQuery* q,                        \
-                       volatile global uint* overflow) {                                      \
-        GpuHit hit = TRAVERSE(nodes, tris, surf, q->origin, q->direction, 0.0f, q->tmax, true, \
-                              overflow);                                                       \
+                       global const GpuInstance* instances,                                    \
+                       global const GpuTriangle* object_tris, const SceneSurfaces* surf,        \
+                       const ShadowQuery* q, volatile global uint* overflow) {                 \
+        GpuHit hit = TRACE(nodes, tris, instances, object_tris, surf, q->origin, q->direction, \
+                           0.0f, q->tmax, true, overflow);                                     \
         if (hit.prim == NO_HIT) return q->contribution;                                        \
         float3 tint = (float3)(1.0f);                                                          \
         if (!thin_wall_tint(tris, surf, hit, q->direction, &tint)) return (float3)(0.0f);      \
         /* The walls in order, nearest first, each beyond the last. */                         \
         tint = (float3)(q->unweight);                                                          \
-        hit = TRAVERSE(nodes, tris, surf, q->origin, q->direction, 0.0f, q->tmax, false,       \
-                       overflow);                                                              \
+        hit = TRACE(nodes, tris, instances, object_tris, surf, q->origin, q->direction, 0.0f,  \
+                    q->tmax, false, overflow);                                                 \
         for (uint walls = 0u; hit.prim != NO_HIT; ++walls) {                                   \
             if (walls == MAX_THIN_WALLS ||                                                     \
                 !thin_wall_tint(tris, surf, hit, q->direction, &tint)) {                       \
                 return (float3)(0.0f);                                                         \
             }                                                                                  \
-            hit = TRAVERSE(nodes, tris, surf, q->origin, q->direction, hit.t, q->tmax, false,  \
-                           overflow);                                                          \
+            hit = TRACE(nodes, tris, instances, object_tris, surf, q->origin, q->direction,    \
+                        hit.t, q->tmax, false, overflow);                                      \
         }                                                                                      \
         return q->contribution * tint;                                                         \
     }
-DEFINE_SHADOW_TEST(shadow_pass, GpuBvhNode, traverse)
-DEFINE_SHADOW_TEST(shadow_pass_wide, GpuWideNode, traverse_wide)
+DEFINE_SHADOW_TEST(shadow_pass, GpuBvhNode, trace_scene)
+DEFINE_SHADOW_TEST(shadow_pass_wide, GpuWideNode, trace_scene_wide)

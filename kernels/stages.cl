@@ -26,6 +26,7 @@ kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, gl
 }
 
 kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                   global const GpuInstance* instances, global const GpuTriangle* object_tris,
                    global const GpuTriShading* shading, global const GpuTriTangents* tangents,
                    global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
                    global const GpuTexture* textures, global const uint* texels,
@@ -35,8 +36,8 @@ kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tri
     if (i >= counters[COUNT_IN]) return;
     SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
     global const GpuPath* p = &paths[queue[i]];
-    hits[i] = traverse(nodes, tris, &surf, p->origin.xyz, p->direction.xyz, 0.0f, INFINITY,
-                       false, &counters[COUNT_OVERFLOW]);
+    hits[i] = trace_scene(nodes, tris, instances, object_tris, &surf, p->origin.xyz,
+                          p->direction.xyz, 0.0f, INFINITY, false, &counters[COUNT_OVERFLOW]);
 }
 
 kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTriangle* tris,
@@ -92,6 +93,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
 }
 
 kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                    global const GpuInstance* instances, global const GpuTriangle* object_tris,
                     global const GpuTriShading* shading, global const GpuTriTangents* tangents,
                     global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
                     global const GpuTexture* textures, global const uint* texels,
@@ -107,7 +109,8 @@ kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tr
     q.tmax = r.origin.w;
     q.contribution = r.contribution.xyz;
     q.unweight = r.contribution.w;
-    float3 c = shadow_pass(nodes, tris, &surf, &q, &counters[COUNT_OVERFLOW]);
+    float3 c = shadow_pass(nodes, tris, instances, object_tris, &surf, &q,
+                           &counters[COUNT_OVERFLOW]);
     if (any(c != 0.0f)) paths[as_uint(r.direction.w)].radiance.xyz += c;
 }
 

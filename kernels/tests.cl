@@ -13,6 +13,11 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuBvhNode, right_min); PROBE_FIELD(GpuBvhNode, right_max);
     PROBE_SIZE(GpuTriangle);
     PROBE_FIELD(GpuTriangle, v0); PROBE_FIELD(GpuTriangle, v1); PROBE_FIELD(GpuTriangle, v2);
+    PROBE_SIZE(GpuInstance);
+    PROBE_FIELD(GpuInstance, row0); PROBE_FIELD(GpuInstance, row1);
+    PROBE_FIELD(GpuInstance, row2);
+    PROBE_FIELD(GpuInstance, root); PROBE_FIELD(GpuInstance, wide_root);
+    PROBE_FIELD(GpuInstance, prim_offset); PROBE_FIELD(GpuInstance, flags);
     PROBE_SIZE(GpuTriShading);
     PROBE_FIELD(GpuTriShading, n0); PROBE_FIELD(GpuTriShading, n1);
     PROBE_FIELD(GpuTriShading, n2); PROBE_FIELD(GpuTriShading, uv01);

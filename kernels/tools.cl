@@ -5,6 +5,7 @@
 #define TRACE_KERNELS(SUFFIX, NODE, TRAVERSE)                                                   \
     kernel void trace_closest##SUFFIX(                                                           \
         global const NODE* nodes, global const GpuTriangle* tris,                                \
+        global const GpuInstance* instances, global const GpuTriangle* object_tris,              \
         global const GpuTriShading* shading, global const GpuTriTangents* tangents,              \
         global const GpuMaterial* materials, global const GpuTexRef* tex_refs,                   \
         global const GpuTexture* textures, global const uint* texels, global const GpuRay* rays, \
@@ -13,11 +14,13 @@
         if (i >= count) return;                                                                  \
         SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};         \
         GpuRay r = rays[i];                                                                      \
-        hits[i] = TRAVERSE(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, r.origin.w,        \
-                           r.direction.w, false, &counters[COUNT_OVERFLOW]);                     \
+        hits[i] = TRAVERSE(nodes, tris, instances, object_tris, &surf, r.origin.xyz,             \
+                           r.direction.xyz, r.origin.w, r.direction.w, false,                    \
+                           &counters[COUNT_OVERFLOW]);                                           \
     }                                                                                            \
     kernel void trace_any##SUFFIX(                                                               \
         global const NODE* nodes, global const GpuTriangle* tris,                                \
+        global const GpuInstance* instances, global const GpuTriangle* object_tris,              \
         global const GpuTriShading* shading, global const GpuTriTangents* tangents,              \
         global const GpuMaterial* materials, global const GpuTexRef* tex_refs,                   \
         global const GpuTexture* textures, global const uint* texels, global const GpuRay* rays, \
@@ -26,10 +29,11 @@
         if (i >= count) return;                                                                  \
         SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};         \
         GpuRay r = rays[i];                                                                      \
-        GpuHit h = TRAVERSE(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, r.origin.w,       \
-                            r.direction.w, true, &counters[COUNT_OVERFLOW]);                     \
+        GpuHit h = TRAVERSE(nodes, tris, instances, object_tris, &surf, r.origin.xyz,            \
+                            r.direction.xyz, r.origin.w, r.direction.w, true,                    \
+                            &counters[COUNT_OVERFLOW]);                                          \
         occluded[i] = h.prim != NO_HIT ? 1u : 0u;                                                \
     }
 
-TRACE_KERNELS(, GpuBvhNode, traverse)
-TRACE_KERNELS(_wide, GpuWideNode, traverse_wide)
+TRACE_KERNELS(, GpuBvhNode, trace_scene)
+TRACE_KERNELS(_wide, GpuWideNode, trace_scene_wide)

@@ -113,88 +113,278 @@ inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float
 
 // Tests the triangles first .. first + count - 1 of a leaf, keeping the closest hit in *hit
 // (with HAS_ALPHA, hits the material's alpha cuts out or lets through are skipped). Returns
-// true when any_hit and a hit was found: the traversal can stop.
+// true when any_hit and a hit was found: the traversal can stop. A hit on triangle p is
+// reported as p + prim_offset (an instance's triangles in the scene's shading order), with u
+// and v swapped when `swap_uv` (a mirrored instance, whose shading triangle lists vertices 1 and
+// 2 the other way round). `o` and `d` are the ray in world space (the alpha hash reads them).
 inline bool intersect_leaf(const RayPrep* r, global const GpuTriangle* tris,
                            const SceneSurfaces* surf, uint first, uint count, float tmin,
-                           float3 o, float3 d, bool any_hit, GpuHit* hit) {
+                           float3 o, float3 d, bool any_hit, uint prim_offset, bool swap_uv,
+                           GpuHit* hit) {
     for (uint p = first; p < first + count; ++p) {
         GpuTriangle t = tris[p];
-#ifdef HAS_ALPHA
         float t_hit = hit->t;
         float bu, bv;
-        if (intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv) &&
-            !alpha_passes(surf, p, as_uint(t.v0.w), bu, bv, o, d)) {
-            hit->t = t_hit;
-            hit->u = bu;
-            hit->v = bv;
-            hit->prim = p;
-            if (any_hit) return true;
+        if (!intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv)) continue;
+        if (swap_uv) {
+            float tmp = bu;
+            bu = bv;
+            bv = tmp;
         }
-#else
-        if (intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &hit->t, &hit->u, &hit->v)) {
-            hit->prim = p;
-            if (any_hit) return true;
-        }
+#ifdef HAS_ALPHA
+        if (alpha_passes(surf, p + prim_offset, as_uint(t.v0.w), bu, bv, o, d)) continue;
 #endif
+        hit->t = t_hit;
+        hit->u = bu;
+        hit->v = bv;
+        hit->prim = p + prim_offset;
+        if (any_hit) return true;
     }
     return false;
 }
 
-// Closest hit (any_hit = false) or first hit (any_hit = true). On a stack overflow, which the
-// builder's depth limit rules out, the overflow counter is raised instead of failing silently.
-// With HAS_ALPHA, hits that the material's alpha cuts out (MASK) or lets through (BLEND, at
-// random) are skipped; `surf` is read only then.
-inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
-                       const SceneSurfaces* surf, float3 o, float3 d, float tmin, float tmax,
-                       bool any_hit, volatile global uint* overflow) {
-    RayPrep r = prepare_ray(o, d);
-    GpuHit hit;
-    hit.t = tmax;
-    hit.u = 0.0f;
-    hit.v = 0.0f;
-    hit.prim = NO_HIT;
+#define WALK_ON 0u
+#define WALK_DONE 1u
+#define WALK_OVERFLOW 2u
+
+// After a node's two children were tested (child[side] >= 0: an interior child the ray
+// reaches, at entry distance dist[side]): goes on to the nearer one, pushing the other, to the
+// only one, or to the next node on the stack. Returns WALK_DONE when the stack is empty, and
+// WALK_OVERFLOW (raising the counter) when it is full, which the builder's depth limit rules out.
+inline uint next_node(const int* child, const float* dist, uint* stack, uint* sp, uint* node,
+                      volatile global uint* overflow) {
+    if (child[0] >= 0 && child[1] >= 0) {
+        uint first = dist[0] <= dist[1] ? (uint)child[0] : (uint)child[1];
+        uint second = dist[0] <= dist[1] ? (uint)child[1] : (uint)child[0];
+        if (*sp == STACK_SIZE) {
+            atomic_inc(overflow);
+            return WALK_OVERFLOW;
+        }
+        stack[(*sp)++] = second;
+        *node = first;
+    } else if (child[0] >= 0) {
+        *node = (uint)child[0];
+    } else if (child[1] >= 0) {
+        *node = (uint)child[1];
+    } else {
+        if (*sp == 0u) return WALK_DONE;
+        *node = stack[--(*sp)];
+    }
+    return WALK_ON;
+}
+
+// Tests child `side` (0 left, 1 right) of node n: returns its entry distance (INFINITY when
+// the ray misses it before tmax). *child is the node index of an interior child reached, else
+// -1; *first and *count the triangles of a leaf reached (count 0 otherwise).
+inline float child_entry(const GpuBvhNode* n, int side, const RayPrep* r, float tmin,
+                         float tmax, int* child, uint* first, uint* count) {
+    float4 lo = side == 0 ? n->left_min : n->right_min;
+    float4 hi = side == 0 ? n->left_max : n->right_max;
+    *child = -1;
+    *first = 0u;
+    *count = 0u;
+    float dist = box_entry(lo, hi, r, tmin, tmax);
+    if (dist == INFINITY) return dist;
+    int ref = as_int(lo.w);
+    if (ref >= 0) {
+        *child = ref;
+    } else {
+        *first = (uint)(~ref);
+        *count = as_uint(hi.w);
+    }
+    return dist;
+}
+
+// Walks the binary BVH below node `root` along the prepared ray, keeping the closest hit (or
+// with any_hit the first) in *hit; leaves index `tris`. Returns true when the walk must end
+// the whole traversal: an any-hit was found, or the stack overflowed (which the builder's depth
+// limit rules out; the overflow counter is raised instead of failing silently).
+inline bool traverse_bvh(global const GpuBvhNode* nodes, uint root,
+                         global const GpuTriangle* tris, const SceneSurfaces* surf,
+                         const RayPrep* r, float3 o, float3 d, float tmin, bool any_hit,
+                         uint prim_offset, bool swap_uv, GpuHit* hit,
+                         volatile global uint* overflow) {
     uint stack[STACK_SIZE];
     uint sp = 0;
-    uint node = 0;
+    uint node = root;
     for (;;) {
         GpuBvhNode n = nodes[node];
         float dist[2];
         int child[2];
         for (int side = 0; side < 2; ++side) {
-            float4 lo = side == 0 ? n.left_min : n.right_min;
-            float4 hi = side == 0 ? n.left_max : n.right_max;
-            child[side] = -1;
-            dist[side] = box_entry(lo, hi, &r, tmin, hit.t);
-            if (dist[side] == INFINITY) continue;
-            int ref = as_int(lo.w);
-            if (ref >= 0) {
-                child[side] = ref;
-                continue;
-            }
-            uint first = (uint)(~ref);
-            uint count = as_uint(hi.w);
-            if (intersect_leaf(&r, tris, surf, first, count, tmin, o, d, any_hit, &hit)) {
-                return hit;
+            uint first, count;
+            dist[side] = child_entry(&n, side, r, tmin, hit->t, &child[side], &first, &count);
+            if (count > 0u && intersect_leaf(r, tris, surf, first, count, tmin, o, d, any_hit,
+                                             prim_offset, swap_uv, hit)) {
+                return true;
             }
         }
-        if (child[0] >= 0 && child[1] >= 0) {
-            uint first = dist[0] <= dist[1] ? (uint)child[0] : (uint)child[1];
-            uint second = dist[0] <= dist[1] ? (uint)child[1] : (uint)child[0];
-            if (sp == STACK_SIZE) {
-                atomic_inc(overflow);
-                return hit;
-            }
-            stack[sp++] = second;
-            node = first;
-        } else if (child[0] >= 0) {
-            node = (uint)child[0];
-        } else if (child[1] >= 0) {
-            node = (uint)child[1];
-        } else {
-            if (sp == 0) return hit;
-            node = stack[--sp];
+        uint next = next_node(child, dist, stack, &sp, &node, overflow);
+        if (next != WALK_ON) return next == WALK_OVERFLOW;
+    }
+}
+
+inline GpuHit no_hit(float tmax) {
+    GpuHit hit;
+    hit.t = tmax;
+    hit.u = 0.0f;
+    hit.v = 0.0f;
+    hit.prim = NO_HIT;
+    return hit;
+}
+
+// Closest hit (any_hit = false) or first hit (any_hit = true) in the flat BVH. With HAS_ALPHA,
+// hits that the material's alpha cuts out (MASK) or lets through (BLEND, at random) are
+// skipped; `surf` is read only then.
+inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                       const SceneSurfaces* surf, float3 o, float3 d, float tmin, float tmax,
+                       bool any_hit, volatile global uint* overflow) {
+    RayPrep r = prepare_ray(o, d);
+    GpuHit hit = no_hit(tmax);
+    traverse_bvh(nodes, 0u, tris, surf, &r, o, d, tmin, any_hit, 0u, false, &hit, overflow);
+    return hit;
+}
+
+// Two levels (src/bvh/instances.rs is the host reference). A ray reaching an instance in the
+// top level is carried into object space, o' = L (o - T) and d' = L d, its direction not
+// renormalised, so t stays the world ray's parameter and the watertight test runs unchanged on
+// the object-space triangles. Subtracting T (the world position of the object's origin) first
+// keeps the error relative to the distance from the object, not from the render origin: o' is
+// off by at most err = gamma(8) |L| |o - T| per coordinate, and as pbrt-v4 does, hits closer
+// than that error along the ray are ignored (tmin grows by dot(|d'|, err) / |d'|^2). The f32
+// rounding of T and of the world-space shading triangles (half an ulp each) stays below the
+// offset_ray bound a spawned ray leaves its surface by (gamma(7) |p|, over three ulps), so a
+// ray cannot find its own surface again in object space.
+inline float3 instance_point(const GpuInstance* inst, float3 p) {
+    float3 q = p - (float3)(inst->row0.w, inst->row1.w, inst->row2.w);
+    return (float3)(inst->row0.x * q.x + inst->row0.y * q.y + inst->row0.z * q.z,
+                    inst->row1.x * q.x + inst->row1.y * q.y + inst->row1.z * q.z,
+                    inst->row2.x * q.x + inst->row2.y * q.y + inst->row2.z * q.z);
+}
+
+inline float3 instance_vector(const GpuInstance* inst, float3 v) {
+    return (float3)(inst->row0.x * v.x + inst->row0.y * v.y + inst->row0.z * v.z,
+                    inst->row1.x * v.x + inst->row1.y * v.y + inst->row1.z * v.z,
+                    inst->row2.x * v.x + inst->row2.y * v.y + inst->row2.z * v.z);
+}
+
+// The tmin of the object-space ray (o', d') of world ray origin o (see above).
+inline float instance_tmin(const GpuInstance* inst, float3 o, float3 od, float tmin) {
+    const float gamma8 = 8.0f * 0x1p-24f / (1.0f - 8.0f * 0x1p-24f);
+    float3 a = fabs(o - (float3)(inst->row0.w, inst->row1.w, inst->row2.w));
+    float3 m0 = fabs(inst->row0.xyz), m1 = fabs(inst->row1.xyz), m2 = fabs(inst->row2.xyz);
+    float3 err = gamma8 * (float3)(m0.x * a.x + m0.y * a.y + m0.z * a.z,
+                                   m1.x * a.x + m1.y * a.y + m1.z * a.z,
+                                   m2.x * a.x + m2.y * a.y + m2.z * a.z);
+    float3 ad = fabs(od);
+    float len2 = od.x * od.x + od.y * od.y + od.z * od.z;
+    float dt = len2 > 0.0f ? (ad.x * err.x + ad.y * err.y + ad.z * err.z) / len2 : 0.0f;
+    return fmax(tmin, dt);
+}
+
+// The top levels' traversal stack: children still to visit, each an interior node (count 0)
+// or a leaf's instances first .. first + count - 1, with the distance its box starts at.
+typedef struct {
+    uint ref[STACK_SIZE * 3];
+    uint count[STACK_SIZE * 3];
+    float dist[STACK_SIZE * 3];
+    uint sp;
+} TopStack;
+
+inline bool top_push(TopStack* s, uint ref, uint count, float dist,
+                     volatile global uint* overflow) {
+    if (s->sp == STACK_SIZE * 3) {
+        atomic_inc(overflow);
+        return false;
+    }
+    s->ref[s->sp] = ref;
+    s->count[s->sp] = count;
+    s->dist[s->sp++] = dist;
+    return true;
+}
+
+// Pops the next entry that starts before tmax into *ref and *count; false when none is left.
+inline bool top_pop(TopStack* s, float tmax, uint* ref, uint* count) {
+    while (s->sp > 0u) {
+        --s->sp;
+        if (s->dist[s->sp] < tmax) {
+            *ref = s->ref[s->sp];
+            *count = s->count[s->sp];
+            return true;
         }
     }
+    return false;
+}
+
+// Enters the instances first .. first + count - 1 of a top-level leaf: carries the ray into
+// each one's object space and walks its bottom level (binary, or 4-wide with WIDE). Returns
+// true when the traversal must end (an any-hit, or an overflow).
+#define ENTER_INSTANCES(WALK, ROOT)                                                            \
+    for (uint i = first; i < first + count; ++i) {                                             \
+        GpuInstance inst = instances[i];                                                       \
+        float3 od = instance_vector(&inst, d);                                                 \
+        RayPrep lr = prepare_ray(instance_point(&inst, o), od);                                \
+        float ltmin = instance_tmin(&inst, o, od, tmin);                                       \
+        if (WALK(nodes, inst.ROOT, object_tris, surf, &lr, o, d, ltmin, any_hit,               \
+                 inst.prim_offset, inst.flags != 0u, &hit, overflow)) {                        \
+            return hit;                                                                        \
+        }                                                                                      \
+    }
+
+// Closest or first hit through the top level (`nodes` from 0, leaves index `instances`) and
+// the instances' bottom levels (in the same node array, from each instance's root; leaves
+// index `object_tris`). Hits are reported in the shading order of the scene's triangles.
+// Unlike a bottom level's leaves, whose few triangles are tested on the spot, a top-level leaf
+// (a whole mesh) waits on the stack with its children's order: nearest first, and skipped once
+// a hit closer than its box is found.
+inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
+                                 global const GpuInstance* instances,
+                                 global const GpuTriangle* object_tris,
+                                 const SceneSurfaces* surf, float3 o, float3 d, float tmin,
+                                 float tmax, bool any_hit, volatile global uint* overflow) {
+    RayPrep r = prepare_ray(o, d);
+    GpuHit hit = no_hit(tmax);
+    TopStack s;
+    s.sp = 0;
+    top_push(&s, 0u, 0u, tmin, overflow);
+    uint first, count;
+    while (top_pop(&s, hit.t, &first, &count)) {
+        if (count > 0u) {
+            ENTER_INSTANCES(traverse_bvh, root)
+            continue;
+        }
+        GpuBvhNode n = nodes[first];
+        float dist[2];
+        int child[2];
+        uint firsts[2], counts[2];
+        for (int side = 0; side < 2; ++side) {
+            dist[side] = child_entry(&n, side, &r, tmin, hit.t, &child[side], &firsts[side],
+                                     &counts[side]);
+        }
+        // The farther child first, so that the nearer is popped first.
+        int far = dist[0] <= dist[1] ? 1 : 0;
+        for (int k = 0; k < 2; ++k) {
+            int side = k == 0 ? far : 1 - far;
+            bool reached = child[side] >= 0 || counts[side] > 0u;
+            uint ref = child[side] >= 0 ? (uint)child[side] : firsts[side];
+            if (reached && !top_push(&s, ref, counts[side], dist[side], overflow)) return hit;
+        }
+    }
+    return hit;
+}
+
+// The scene's traversal: the flat BVH, or with TWO_LEVEL the instances' two levels.
+inline GpuHit trace_scene(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+                          global const GpuInstance* instances,
+                          global const GpuTriangle* object_tris, const SceneSurfaces* surf,
+                          float3 o, float3 d, float tmin, float tmax, bool any_hit,
+                          volatile global uint* overflow) {
+#ifdef TWO_LEVEL
+    return traverse_two_level(nodes, instances, object_tris, surf, o, d, tmin, tmax, any_hit,
+                              overflow);
+#else
+    return traverse(nodes, tris, surf, o, d, tmin, tmax, any_hit, overflow);
+#endif
 }
 
 // The point at barycentrics (u, v) of a triangle and a bound on how far a spawned ray's origin

@@ -21,6 +21,20 @@ typedef struct {
     uint4 count;
 } GpuWideNode;
 
+// One placed mesh of a two-level scene (src/bvh/instances.rs): object_from_world as
+// p_object = L (p_world - T), the rows of L with T in .w (T: the world position of the object's
+// origin), its bottom-level roots in the binary and the wide node arrays, and the offset from
+// its bottom level's triangle indices to the scene's shading order.
+typedef struct {
+    float4 row0;       // first row of L; .w = T.x
+    float4 row1;       // .w = T.y
+    float4 row2;       // .w = T.z
+    uint root;         // bottom-level root in the binary nodes
+    uint wide_root;    // bottom-level root in the wide nodes
+    uint prim_offset;  // shading index = triangle index + prim_offset (wrapping)
+    uint flags;        // 1: mirrored (the shading triangle swaps vertices 1 and 2)
+} GpuInstance;
+
 typedef struct {
     float4 v0;  // .w = material index (uint bits)
     float4 v1;  // .w = emissive light index (int bits), -1 when not emissive

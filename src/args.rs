@@ -7,7 +7,7 @@
 use crate::cl::DeviceChoice;
 use crate::cli::first_image;
 use crate::render::exposure::ExposureMode;
-use crate::render::{KernelChoice, RenderSettings, Renderer, Strategy};
+use crate::render::{BvhChoice, KernelChoice, RenderSettings, Renderer, Strategy};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
 use anyhow::{Result, bail};
 use clap::Args;
@@ -246,10 +246,20 @@ pub const MAX_EXPOSURE: f32 = 64.0;
 
 /// An exposure in stops within ±[`MAX_EXPOSURE`].
 fn parse_exposure(s: &str) -> Result<f32, String> {
+    within_max_exposure(s, " stops")
+}
+
+/// An EV100 within ±[`MAX_EXPOSURE`] (the exposure it sets is within a stop of that).
+fn parse_ev100(s: &str) -> Result<f32, String> {
+    within_max_exposure(s, "")
+}
+
+/// A finite number within ±[`MAX_EXPOSURE`]; `unit` follows the range in the message.
+fn within_max_exposure(s: &str, unit: &str) -> Result<f32, String> {
     match parse_finite(s)? {
         v if v.abs() <= MAX_EXPOSURE => Ok(v),
         _ => Err(format!(
-            "'{s}' is out of range (-{MAX_EXPOSURE}..={MAX_EXPOSURE} stops)"
+            "'{s}' is out of range (-{MAX_EXPOSURE}..={MAX_EXPOSURE}{unit})"
         )),
     }
 }
@@ -266,7 +276,7 @@ pub struct ExposureArgs {
     )]
     pub exposure: Option<f32>,
     /// Physical exposure: a camera at this EV100 (about 15 for a scene lit by a sun in lux).
-    #[arg(long, allow_negative_numbers = true, value_parser = parse_finite)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_ev100)]
     pub ev100: Option<f32>,
 }
 
@@ -316,6 +326,11 @@ pub struct CommonArgs {
     /// materials.
     #[arg(long, value_name = "NAME")]
     pub variant: Option<String>,
+    /// Acceleration structure: flat (one BVH over every triangle), two-level (a BLAS per
+    /// distinct mesh under a TLAS of instances) or auto (two levels for scenes of at least 4 M
+    /// triangles that instancing shrinks eightfold).
+    #[arg(long, default_value = "auto")]
+    pub bvh: BvhChoice,
 }
 
 fn parse_kernel(s: &str) -> Result<KernelChoice, String> {
@@ -339,6 +354,7 @@ impl CommonArgs {
     pub fn open_renderer(&self, settings: &RenderSettings) -> Result<Renderer> {
         let mut renderer = Renderer::new(&self.device_choice()?)?;
         renderer.set_kernel(self.kernel)?;
+        renderer.set_bvh_choice(self.bvh);
         renderer.set_settings(settings)?;
         Ok(renderer)
     }

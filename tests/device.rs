@@ -168,7 +168,7 @@ fn kernel_traversal_equals_host_traversal() {
             tmin: *tmin,
             tmax: *tmax,
         };
-        let expect = host.bvh.intersect(&ray, &host.vertices);
+        let expect = host.intersect(&ray);
         hit_count += expect.is_some() as usize;
         for (got, occluded) in [(hits[i], occluded[i]), (wide_hits[i], wide_occluded[i])] {
             match expect {

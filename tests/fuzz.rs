@@ -8,10 +8,20 @@
 //! finite light). Each failing input is saved in `tests/fuzz-corpus/` and replayed by
 //! `the_corpus_replays_cleanly` from then on.
 //!
+//! An input that hangs (one load past [`HANG`]) is saved by a watchdog thread, which then ends
+//! the process. One that kills the process (a crash in a C/C++ decoder, memory exhausted) is
+//! left in `target/tmp/fuzz-last-input`; the next run saves it as `died-….glb` in the corpus.
+//!
 //! `PENUMBRA_FUZZ_SECONDS` sets the run time (default 60), `PENUMBRA_FUZZ_SEED` the seed
-//! (default: from the clock, printed). Seeds: the bundled Cornell box, and with
+//! (default: from the clock, printed). Long runs print progress every five minutes; every run
+//! ends with a summary line (`fuzz summary: …`: executions, inputs per second, distinct
+//! failures, new corpus entries). Seeds: the bundled Cornell box, textured quads whose texture
+//! is KTX2 (ETC1S and UASTC, `KHR_texture_basisu`), WebP (`EXT_texture_webp`) and PNG, and with
 //! `PENUMBRA_SCENES` set, the shared Cubes, CornellBox and Fox.
 
+mod common;
+
+use common::{ktx2_fixture, textured_quad};
 use penumbra::scene::{BUNDLED_SCENE, LightKind, Scene, limits, load_from_bytes};
 use serde_json::{Value, json};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -20,6 +30,9 @@ use std::time::{Duration, Instant};
 
 /// A load slower than this counts as a failure (a hang in the making).
 const SLOW: Duration = Duration::from_secs(20);
+
+/// A load still running after this is a hang: the watchdog saves the input and ends the run.
+const HANG: Duration = Duration::from_secs(120);
 
 /// splitmix64: small, fast and good enough to pick mutations.
 struct Rng(u64);
@@ -81,6 +94,39 @@ fn as_gltf(glb: &Glb) -> Vec<u8> {
 /// The seed inputs: (name, GLB bytes).
 fn seeds() -> Vec<(String, Vec<u8>)> {
     let mut out = vec![("cornell-box.glb".to_string(), BUNDLED_SCENE.to_vec())];
+    let rgba = ktx2_fixture("rgba.png");
+    let webp = {
+        let image = image::load_from_memory(&rgba).unwrap();
+        let mut bytes = Vec::new();
+        image
+            .write_to(
+                &mut std::io::Cursor::new(&mut bytes),
+                image::ImageFormat::WebP,
+            )
+            .unwrap();
+        bytes
+    };
+    for (name, image, mime, extension) in [
+        (
+            "ktx2-etc1s.glb",
+            ktx2_fixture("etc1s-alpha.ktx2"),
+            "image/ktx2",
+            Some("KHR_texture_basisu"),
+        ),
+        (
+            "ktx2-uastc.glb",
+            ktx2_fixture("uastc.ktx2"),
+            "image/ktx2",
+            Some("KHR_texture_basisu"),
+        ),
+        ("webp.glb", webp, "image/webp", Some("EXT_texture_webp")),
+        ("png.glb", rgba, "image/png", None),
+    ] {
+        out.push((
+            name.to_string(),
+            textured_quad(&image, mime, extension).glb(),
+        ));
+    }
     if let Some(dir) = std::env::var_os("PENUMBRA_SCENES").map(PathBuf::from) {
         for f in [
             "Cubes/Cubes.glb",
@@ -157,6 +203,10 @@ fn interesting(rng: &mut Rng, doc_len: usize) -> Value {
         json!("orthographic"),
         json!("perspective"),
         json!("image/png"),
+        json!("image/ktx2"),
+        json!("image/webp"),
+        json!("KHR_texture_basisu"),
+        json!("EXT_texture_webp"),
         json!("KHR_materials_sheen"),
         json!("EXT_meshopt_compression"),
     ];
@@ -300,10 +350,12 @@ fn mutate_json(doc: &mut Value, rng: &mut Rng) {
                     "KHR_materials_ior",
                     "KHR_materials_volume",
                     "KHR_lights_punctual",
-                ][rng.below(4)];
+                    "KHR_texture_basisu",
+                    "EXT_texture_webp",
+                ][rng.below(6)];
                 o.insert(
                     "extensions".into(),
-                    json!({ext: {"ior": 0.0, "offset": [1e39, 0], "thicknessFactor": -1, "light": 7}}),
+                    json!({ext: {"ior": 0.0, "offset": [1e39, 0], "thicknessFactor": -1, "light": 7, "source": rng.below(3)}}),
                 );
             } else if let Some(o) = doc.as_object_mut() {
                 o.insert(
@@ -565,6 +617,51 @@ fn fnv(bytes: &[u8]) -> u64 {
     })
 }
 
+/// Saves a failing input in the corpus, named by its kind and content; returns the path.
+fn save(kind: &str, input: &[u8]) -> PathBuf {
+    let ext = if input.starts_with(b"glTF") {
+        "glb"
+    } else {
+        "gltf"
+    };
+    let file = corpus_dir().join(format!("{kind}-{:016x}.{ext}", fnv(input)));
+    std::fs::create_dir_all(corpus_dir()).unwrap();
+    std::fs::write(&file, input).unwrap();
+    file
+}
+
+/// Milliseconds since the Unix epoch.
+fn now_ms() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_millis() as u64)
+}
+
+/// When the load in progress started (ms since the epoch; 0 between loads), for the watchdog.
+static LOAD_STARTED: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Watches for a load that runs past [`HANG`]: saves the input being run (`last`) in the
+/// corpus and ends the process with a failure.
+fn watchdog(last: PathBuf) {
+    std::thread::spawn(move || {
+        loop {
+            std::thread::sleep(Duration::from_secs(1));
+            let started = LOAD_STARTED.load(std::sync::atomic::Ordering::Relaxed);
+            if started != 0 && now_ms().saturating_sub(started) > HANG.as_millis() as u64 {
+                let input = std::fs::read(&last).unwrap_or_default();
+                let file = save("hang", &input);
+                let _ = std::fs::remove_file(&last);
+                eprintln!(
+                    "fuzz: a load ran past {HANG:?} (a hang); saved as {}\n\
+                     fuzz summary: stopped by the hang",
+                    file.display()
+                );
+                std::process::exit(101);
+            }
+        }
+    });
+}
+
 #[test]
 fn fuzz_the_loader() {
     let seconds: u64 = std::env::var("PENUMBRA_FUZZ_SECONDS")
@@ -583,8 +680,24 @@ fn fuzz_the_loader() {
     let mut rng = Rng(seed);
     let seeds = seeds();
     let base = uri_folder();
-    // The input being run, so that one which kills the process (out of memory) is not lost.
+    // The input being run, so that one which kills the process (a crash, out of memory) is
+    // not lost: a run that ends normally removes it, so one found here killed its run.
     let last = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fuzz-last-input");
+    let (mut runs, mut failures, mut new_entries) = (0u64, Vec::new(), Vec::new());
+    let mut seen = std::collections::HashSet::new();
+    if let Ok(input) = std::fs::read(&last) {
+        seen.insert("died".to_string());
+        let file = save("died", &input);
+        eprintln!(
+            "fuzz: the previous run died while loading {} (a crash, memory exhausted, or it \
+             was stopped); saved as {}",
+            last.display(),
+            file.display()
+        );
+        failures.push(format!("{}: the previous run died on it", file.display()));
+        new_entries.push(file);
+    }
+    watchdog(last.clone());
     let quiet = std::env::var_os("PENUMBRA_FUZZ_VERBOSE").is_none();
     if quiet {
         let report = std::panic::take_hook();
@@ -594,15 +707,20 @@ fn fuzz_the_loader() {
             }
         }));
     }
-    let deadline = Instant::now() + Duration::from_secs(seconds);
-    let (mut runs, mut failures) = (0u64, Vec::new());
-    let mut seen = std::collections::HashSet::new();
+    let start = Instant::now();
+    let deadline = start + Duration::from_secs(seconds);
+    let mut next_progress = start + Duration::from_secs(300);
+    let mut kinds = std::collections::BTreeMap::<&str, u64>::new();
     while Instant::now() < deadline {
         let (name, seed_bytes) = &seeds[rng.below(seeds.len())];
         let (kind, input) = make_input(seed_bytes, &mut rng);
         let _ = std::fs::write(&last, &input);
         runs += 1;
-        if let Err(why) = run_one(&input, base.path()) {
+        *kinds.entry(kind).or_default() += 1;
+        LOAD_STARTED.store(now_ms(), std::sync::atomic::Ordering::Relaxed);
+        let outcome = run_one(&input, base.path());
+        LOAD_STARTED.store(0, std::sync::atomic::Ordering::Relaxed);
+        if let Err(why) = outcome {
             // One saved input per kind of failure (the message without its numbers).
             let class: String = why
                 .chars()
@@ -613,25 +731,45 @@ fn fuzz_the_loader() {
                 failures.push(format!("(not saved, like one above) {why}"));
                 continue;
             }
-            let ext = if input.starts_with(b"glTF") {
-                "glb"
-            } else {
-                "gltf"
-            };
-            let file = corpus_dir().join(format!("{kind}-{:016x}.{ext}", fnv(&input)));
-            std::fs::create_dir_all(corpus_dir()).unwrap();
-            std::fs::write(&file, &input).unwrap();
+            let file = save(kind, &input);
             eprintln!(
                 "fuzz: {name} ({kind}) fails: {why}\n      saved as {}",
                 file.display()
             );
             failures.push(format!("{}: {why}", file.display()));
+            new_entries.push(file);
+        }
+        if Instant::now() >= next_progress {
+            next_progress += Duration::from_secs(300);
+            eprintln!(
+                "fuzz: {:.0} s, {runs} inputs, {} distinct failures",
+                start.elapsed().as_secs_f64(),
+                seen.len()
+            );
         }
     }
+    let _ = std::fs::remove_file(&last);
     if quiet {
         let _ = std::panic::take_hook();
     }
-    eprintln!("fuzz: {runs} inputs, {} failures", failures.len());
+    let elapsed = start.elapsed().as_secs_f64();
+    eprintln!(
+        "fuzz summary: seed {seed}, {runs} executions in {elapsed:.0} s ({:.1} inputs/s; {}), \
+         {} failing inputs, {} distinct failures, {} new corpus entries{}",
+        runs as f64 / elapsed.max(1e-9),
+        kinds
+            .iter()
+            .map(|(k, n)| format!("{k} {n}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        failures.len(),
+        seen.len(),
+        new_entries.len(),
+        new_entries
+            .iter()
+            .map(|f| format!("\n  {}", f.display()))
+            .collect::<String>()
+    );
     assert!(runs > 0);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -256,7 +256,20 @@ impl FrameLoop {
         }
         // Rebase the render space around the eye when the camera travelled far from its origin.
         let far = self.loaded && self.renderer.space().is_far(world.camera.eye);
-        if pending.scene || !self.loaded || far {
+        // Objects moved in a two-level scene (a scene change alone: a new file comes with new
+        // lights and settings too): new instance transforms and a new TLAS, written in place.
+        // Anything else (hidden or shown objects, a flat BVH) reloads the scene.
+        let moved = if pending.scene && self.loaded && !far && !pending.lights && !pending.settings
+        {
+            self.renderer.move_instances(world.scene)?
+        } else {
+            None
+        };
+        if let Some(update) = moved {
+            if let Some(stats) = self.scene_stats.as_mut() {
+                stats.bvh_build_ms = update.ms;
+            }
+        } else if pending.scene || !self.loaded || far {
             let mut space = RenderFrame::around(&world.scene.bounds());
             if far || space.is_far(world.camera.eye) {
                 space = RenderFrame::new(&world.scene.bounds(), world.camera.eye);

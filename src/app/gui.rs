@@ -585,6 +585,10 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
         .show(ui, |ui| {
             let p = info.progress;
             ui.label(format!("device: {}", info.device));
+            if let Some(s) = info.scene_stats {
+                let mb = s.device_bytes as f64 / 1e6;
+                ui.label(format!("device memory {mb:.1} MB · {} BVH", s.bvh));
+            }
             let moving = if info.film.divisor > 1 {
                 format!(" (1/{} while moving)", info.film.divisor)
             } else {

@@ -90,6 +90,8 @@ pub struct ViewerConfig {
     pub device: DeviceChoice,
     /// The kernels (`--kernel`).
     pub kernel: crate::render::KernelChoice,
+    /// The acceleration structure (`--bvh`).
+    pub bvh: crate::render::BvhChoice,
     /// The environment map, if one lights the scene.
     pub env_map: Option<EnvMap>,
     /// An environment (map or color) lights the scene: files opened later without lights get
@@ -134,6 +136,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
     let mut renderer = Renderer::new(&config.device)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
     renderer.set_kernel(config.kernel)?;
+    renderer.set_bvh_choice(config.bvh);
     let env_name = config.env_map.as_ref().map(|m| m.name.clone());
     if let Some(map) = config.env_map {
         renderer

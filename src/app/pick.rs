@@ -20,7 +20,7 @@ pub struct Pick {
 /// scene's render space.
 pub fn pick(host: &HostScene, camera: &Camera, aspect: f32, fx: f32, fy: f32) -> Option<Pick> {
     let ray = primary_ray(&gpu_camera(&host.space.camera(camera), aspect), fx, fy);
-    let hit = host.bvh.intersect(&ray, &host.vertices)?;
+    let hit = host.intersect(&ray)?;
     let point = ray.origin + ray.direction * hit.t;
     Some(Pick {
         object: host.object_of(hit.prim) as usize,

@@ -284,7 +284,7 @@ pub fn leaks(
                 tmin: 0.0,
                 tmax: f32::INFINITY,
             };
-            host.bvh.intersect(&ray, &host.vertices).is_none()
+            host.intersect(&ray).is_none()
         })
         .count();
     let gpu = &renderer.gpu;

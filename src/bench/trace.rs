@@ -11,12 +11,13 @@ use super::rays::{self, LightTargets, MISS};
 use super::stats::median;
 use super::{device_json, device_line, thousands};
 use crate::args::{CameraArgs, DeviceArgs, ShadowArgs, SizeArgs, prepare};
-use crate::bvh::Bvh;
 use crate::cl::kernels::{Launch, SceneBuffers};
 use crate::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay};
 use crate::cl::{Buffer, Gpu, Program, call_err};
 use crate::date::today;
-use crate::render::{RenderSettings, Renderer, gpu_camera};
+use crate::render::{
+    Accel, BvhChoice, HostScene, InstanceUpdate, RenderSettings, Renderer, gpu_camera,
+};
 use crate::scene::LightKind;
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
@@ -58,6 +59,11 @@ pub struct TraceArgs {
     /// binary BVH's (the wavefront's).
     #[arg(long)]
     pub wide: bool,
+    /// The acceleration structure: flat, two-level (a BLAS per distinct mesh under a TLAS of
+    /// instances) or auto (two levels for scenes of at least 4 M triangles that instancing
+    /// shrinks eightfold).
+    #[arg(long, default_value = "auto")]
+    pub bvh: BvhChoice,
 }
 
 /// Agreement of device results with the host traversal.
@@ -121,17 +127,11 @@ fn same_t(a: f32, b: f32) -> bool {
 }
 
 /// Compares closest hits with the host traversal.
-fn check_closest(
-    bvh: &Bvh,
-    tris: &[[Vec3; 3]],
-    rays: &[GpuRay],
-    hits: &[GpuHit],
-    want: usize,
-) -> Check {
+fn check_closest(host: &HostScene, rays: &[GpuRay], hits: &[GpuHit], want: usize) -> Check {
     sample_indices(rays.len(), want)
         .into_par_iter()
         .map(|i| {
-            let host = bvh.intersect(&rays::to_host(&rays[i]), tris);
+            let host = host.intersect(&rays::to_host(&rays[i]));
             let dev = hits[i];
             let mut c = Check {
                 checked: 1,
@@ -154,17 +154,11 @@ fn check_closest(
 }
 
 /// Compares occlusion with the host traversal.
-fn check_any(
-    bvh: &Bvh,
-    tris: &[[Vec3; 3]],
-    rays: &[GpuRay],
-    occluded: &[u32],
-    want: usize,
-) -> Check {
+fn check_any(host: &HostScene, rays: &[GpuRay], occluded: &[u32], want: usize) -> Check {
     sample_indices(rays.len(), want)
         .into_par_iter()
         .map(|i| {
-            let host = bvh.occluded(&rays::to_host(&rays[i]), tris);
+            let host = host.occluded(&rays::to_host(&rays[i]));
             let agree = host == (occluded[i] != 0);
             Check {
                 checked: 1,
@@ -300,9 +294,11 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     let source = prepared.scene.source.clone();
     let mut renderer = Renderer::new(&args.device.device_choice()?)?;
     renderer.set_settings(&settings)?;
+    renderer.set_bvh_choice(args.bvh);
     let stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| source.clone())?;
+    let instance_move = time_instance_move(&mut renderer, &prepared.scene)?;
     let gpu = &renderer.gpu;
     let (Some(program), Some(scene), Some(host)) = (
         renderer.program(),
@@ -323,7 +319,6 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         wide: args.wide,
     };
     let tris = &host.vertices;
-    let bvh = &host.bvh;
 
     // Primary rays.
     // Rays are made in the render space the scene was uploaded in.
@@ -333,7 +328,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     );
     let primary = rays::primary_rays(&camera, width, height);
     let (primary_hits, times) = tracer.closest(&primary)?;
-    let check = timed(|| check_closest(bvh, tris, &primary, &primary_hits, args.validate));
+    let check = timed(|| check_closest(host, &primary, &primary_hits, args.validate));
     let hit_count = primary_hits.iter().filter(|h| h.prim != MISS).count();
     let mut results = vec![set_result(
         "primary",
@@ -351,7 +346,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     } else {
         let diffuse = rays::diffuse_rays(&points, primary.len(), args.seed);
         let (hits, times) = tracer.closest(&diffuse)?;
-        let check = timed(|| check_closest(bvh, tris, &diffuse, &hits, args.validate));
+        let check = timed(|| check_closest(host, &diffuse, &hits, args.validate));
         let n = hits.iter().filter(|h| h.prim != MISS).count();
         results.push(set_result(
             "diffuse",
@@ -366,7 +361,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         let targets = light_targets(&host.space.lights(&prepared.lights), host, tris);
         let shadow = rays::shadow_rays(&points, primary.len(), &targets, args.seed);
         let (occluded, times) = tracer.any(&shadow)?;
-        let check = timed(|| check_any(bvh, tris, &shadow, &occluded, args.validate));
+        let check = timed(|| check_any(host, &shadow, &occluded, args.validate));
         let n = occluded.iter().filter(|&&o| o != 0).count();
         results.push(set_result("shadow", "any", shadow.len(), n, &times, check));
     }
@@ -392,7 +387,11 @@ pub fn run(args: &TraceArgs) -> Result<()> {
             "camera": prepared.camera.name,
             "triangles": stats.triangles,
             "bvh_nodes": stats.nodes,
-            "bvh_depth": bvh.depth,
+            "bvh_depth": host.accel.depth(),
+            "bvh_levels": stats.bvh,
+            "meshes": stats.meshes,
+            "instances": stats.instances,
+            "device_bytes": stats.device_bytes,
             "sah_cost": stats.sah_cost,
             "load_ms": prepared.load_ms,
             "bvh_build_ms": stats.bvh_build_ms,
@@ -406,17 +405,22 @@ pub fn run(args: &TraceArgs) -> Result<()> {
             "ties": total.ties,
             "mismatches": total.mismatches,
             "stack_overflows": overflows,
+            "instance_move_ms": instance_move.map(|u| u.ms),
+            "instance_move_bytes": instance_move.map(|u| u.bytes),
         });
         println!("{summary}");
     } else {
         println!("penumbra bench trace — {source} — {}", today());
         println!("device   {}", device_line(gpu));
         println!(
-            "scene    {} triangles, {} BVH nodes (depth {}), SAH cost {:.2}; load {:.0} ms, \
-             BVH build {:.0} ms, kernel build {:.0} ms",
+            "scene    {} triangles, {} BVH ({} meshes, {} instances), {} nodes (depth {}), SAH \
+             cost {:.2}; load {:.0} ms, BVH build {:.0} ms, kernel build {:.0} ms",
             thousands(stats.triangles as u64),
+            stats.bvh,
+            stats.meshes,
+            stats.instances,
             thousands(stats.nodes as u64),
-            bvh.depth,
+            host.accel.depth(),
             stats.sah_cost,
             prepared.load_ms,
             stats.bvh_build_ms,
@@ -476,6 +480,14 @@ pub fn run(args: &TraceArgs) -> Result<()> {
             overflows
         );
     }
+    if let Some(u) = instance_move
+        && !args.json
+    {
+        println!(
+            "instance move: {:.3} ms (new transform, TLAS rebuild, {} bytes written in place)",
+            u.ms, u.bytes
+        );
+    }
     if total.mismatches > 0 || overflows > 0 {
         anyhow::bail!(
             "{source}: the device traversal disagrees with the host on {} of {} rays \
@@ -485,6 +497,40 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// With two levels: moves the object with the most triangles by a thousandth of the scene's
+/// size and back, three times, through [`Renderer::move_instances`] (new transform, TLAS
+/// rebuild, in-place upload); returns the fastest move. The scene ends where it started.
+fn time_instance_move(
+    renderer: &mut Renderer,
+    scene: &crate::scene::Scene,
+) -> Result<Option<InstanceUpdate>> {
+    if !matches!(renderer.accel(), Some(Accel::TwoLevel(_))) {
+        return Ok(None);
+    }
+    let Some(i) = (0..scene.objects.len())
+        .filter(|&i| scene.objects[i].visible)
+        .max_by_key(|&i| scene.objects[i].mesh.indices.len())
+    else {
+        return Ok(None);
+    };
+    let mut moved = scene.clone();
+    let shift = glam::DMat4::from_translation(glam::DVec3::X * scene.bounds().diagonal() * 1e-3);
+    let mut best: Option<InstanceUpdate> = None;
+    for run in 0..6 {
+        moved.objects[i].world_from_object = if run % 2 == 0 {
+            shift * scene.objects[i].world_from_object
+        } else {
+            scene.objects[i].world_from_object
+        };
+        if let Some(u) = renderer.move_instances(&moved)?
+            && best.is_none_or(|b| u.ms < b.ms)
+        {
+            best = Some(u);
+        }
+    }
+    Ok(best)
 }
 
 /// Shadow ray targets: the emissive triangles and the punctual lights of the scene.

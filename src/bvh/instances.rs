@@ -1,13 +1,19 @@
-//! Two levels (host side): one bottom-level BVH (BLAS) per mesh, built once and shared by every
-//! instance of it, and a top-level BVH (TLAS) over the instances' world boxes, rebuilt when an
-//! instance moves. A ray reaching an instance is carried into object space by the instance's
+//! Two levels: one bottom-level BVH (BLAS) per mesh, built once and shared by every instance
+//! of it, and a top-level BVH (TLAS) over the instances' world boxes, rebuilt when an instance
+//! moves. A ray reaching an instance is carried into object space by the instance's
 //! `object_from_world` without renormalising its direction, so distances stay in world units and
 //! the watertight triangle test runs unchanged on the object-space vertices: a scaled or
-//! mirrored instance is as watertight as an identity one. The kernels still traverse one flat
-//! BVH; this is the host model and reference the device form will be tested against.
+//! mirrored instance is as watertight as an identity one. The carried origin's rounding error
+//! is bounded and hits closer than it along the ray are ignored (pbrt-v4's rule), so a ray
+//! spawned off a surface cannot find that surface again in object space.
+//!
+//! This is also the host reference of the device's two-level traversal
+//! (`traverse_two_level` in kernels/traverse.h): the transform and its error bound are computed
+//! here with the kernels' f32 operations in the kernels' order.
 
-use super::{Aabb, Bvh, Hit, Ray, build, build_boxes};
-use glam::{Mat4, Vec3};
+use super::{Aabb, Bvh, Hit, Ray, WideBvh, build, build_boxes};
+use crate::cl::types::{GpuBvhNode, GpuWideNode};
+use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
 
 /// A mesh's BVH and its object-space triangles in BVH order.
@@ -42,10 +48,83 @@ impl Blas {
 pub struct Instance {
     /// Index of its BLAS.
     pub blas: u32,
-    /// World from object transform.
-    pub world_from_object: Mat4,
-    /// Its inverse.
-    pub object_from_world: Mat4,
+    /// World from object transform (f64, as the scene composes it).
+    pub world_from_object: DMat4,
+    /// Object from world as the device applies it, `p_object = L (p_world - T)`: the rows of L
+    /// in f32 with T (the world position of the object's origin) in `.w`.
+    pub rows: [[f32; 4]; 3],
+    /// Whether the transform mirrors (negative determinant).
+    pub mirrored: bool,
+    /// Index of its first triangle in the shading order (instances one after the other in
+    /// their given order, each in its BLAS's order).
+    pub prim_offset: u32,
+}
+
+impl Instance {
+    fn new(blas: u32, world_from_object: DMat4, prim_offset: u32) -> Self {
+        let linear = glam::DMat3::from_mat4(world_from_object).inverse();
+        let origin = world_from_object.w_axis;
+        let row = |i: usize| {
+            let r = linear.row(i);
+            [r.x as f32, r.y as f32, r.z as f32, origin[i] as f32]
+        };
+        Self {
+            blas,
+            world_from_object,
+            rows: [row(0), row(1), row(2)],
+            mirrored: world_from_object.determinant() < 0.0,
+            prim_offset,
+        }
+    }
+
+    /// `ray` in object space, with its tmin raised past the transform's rounding error: the
+    /// kernels' `instance_point`, `instance_vector` and `instance_tmin`, operation for operation.
+    pub fn to_object(&self, ray: &Ray) -> Ray {
+        let [r0, r1, r2] = self.rows;
+        let (o, d) = (ray.origin, ray.direction);
+        let q = o - Vec3::new(r0[3], r1[3], r2[3]);
+        let apply = |r: [f32; 4], v: Vec3| r[0] * v.x + r[1] * v.y + r[2] * v.z;
+        let od = Vec3::new(apply(r0, d), apply(r1, d), apply(r2, d));
+        let gamma8 = 8.0 * f32::EPSILON * 0.5 / (1.0 - 8.0 * f32::EPSILON * 0.5);
+        let a = q.abs();
+        let bound = |r: [f32; 4]| r[0].abs() * a.x + r[1].abs() * a.y + r[2].abs() * a.z;
+        let err = Vec3::new(bound(r0), bound(r1), bound(r2)) * gamma8;
+        let ad = od.abs();
+        let len2 = od.x * od.x + od.y * od.y + od.z * od.z;
+        let dt = if len2 > 0.0 {
+            (ad.x * err.x + ad.y * err.y + ad.z * err.z) / len2
+        } else {
+            0.0
+        };
+        Ray {
+            origin: Vec3::new(apply(r0, q), apply(r1, q), apply(r2, q)),
+            direction: od,
+            tmin: ray.tmin.max(dt),
+            tmax: ray.tmax,
+        }
+    }
+
+    /// The world box of a BLAS box under this instance, computed in f64 and padded by 2^-20
+    /// of its coordinates' magnitude, so that it holds the f32 world triangles and whatever
+    /// the device finds through the rounded transform.
+    fn world_box(&self, b: Aabb) -> Aabb {
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for corner in 0..8 {
+            let p = DVec3::new(
+                if corner & 1 != 0 { b.max.x } else { b.min.x } as f64,
+                if corner & 2 != 0 { b.max.y } else { b.min.y } as f64,
+                if corner & 4 != 0 { b.max.z } else { b.min.z } as f64,
+            );
+            let w = self.world_from_object.transform_point3(p);
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+        let pad = lo.abs().max(hi.abs()) * (1.0 / (1u64 << 20) as f64);
+        Aabb {
+            min: (lo - pad).as_vec3(),
+            max: (hi + pad).as_vec3(),
+        }
+    }
 }
 
 /// A hit in a two-level scene.
@@ -71,14 +150,20 @@ pub struct TwoLevel {
 impl TwoLevel {
     /// Builds every BLAS (in parallel) and the TLAS over `instances` (mesh index, world from
     /// object).
-    pub fn new(meshes: &[Vec<[Vec3; 3]>], instances: &[(u32, Mat4)]) -> Self {
+    pub fn new(meshes: &[Vec<[Vec3; 3]>], instances: &[(u32, DMat4)]) -> Self {
         let blases = meshes.par_iter().map(|m| Blas::new(m)).collect();
+        Self::from_blases(blases, instances)
+    }
+
+    /// The TLAS over `instances` of prebuilt BLASes.
+    pub fn from_blases(blases: Vec<Blas>, instances: &[(u32, DMat4)]) -> Self {
+        let mut offset = 0u32;
         let instances = instances
             .iter()
-            .map(|&(blas, m)| Instance {
-                blas,
-                world_from_object: m,
-                object_from_world: m.inverse(),
+            .map(|&(blas, m)| {
+                let inst = Instance::new(blas, m, offset);
+                offset += blases[blas as usize].triangles.len() as u32;
+                inst
             })
             .collect();
         let mut two = Self {
@@ -90,11 +175,25 @@ impl TwoLevel {
         two
     }
 
+    /// Triangles over all instances.
+    pub fn triangle_count(&self) -> usize {
+        self.instances
+            .iter()
+            .map(|i| self.blases[i.blas as usize].triangles.len())
+            .sum()
+    }
+
     /// Moves instance `i` and rebuilds the TLAS.
-    pub fn set_transform(&mut self, i: usize, world_from_object: Mat4) {
-        self.instances[i].world_from_object = world_from_object;
-        self.instances[i].object_from_world = world_from_object.inverse();
+    pub fn set_transform(&mut self, i: usize, world_from_object: DMat4) {
+        self.place(i, world_from_object);
         self.rebuild_tlas();
+    }
+
+    /// Moves instance `i` without rebuilding the TLAS (call [`TwoLevel::rebuild_tlas`] after
+    /// the last move).
+    pub fn place(&mut self, i: usize, world_from_object: DMat4) {
+        let inst = &mut self.instances[i];
+        *inst = Instance::new(inst.blas, world_from_object, inst.prim_offset);
     }
 
     /// Builds the TLAS over the instances' current world boxes.
@@ -102,17 +201,7 @@ impl TwoLevel {
         let boxes: Vec<Aabb> = self
             .instances
             .iter()
-            .map(|inst| {
-                let b = self.blases[inst.blas as usize].bounds();
-                (0..8).fold(Aabb::EMPTY, |acc, corner| {
-                    let p = Vec3::select(
-                        glam::BVec3::new(corner & 1 != 0, corner & 2 != 0, corner & 4 != 0),
-                        b.max,
-                        b.min,
-                    );
-                    acc.grow(inst.world_from_object.transform_point3(p))
-                })
-            })
+            .map(|inst| inst.world_box(self.blases[inst.blas as usize].bounds()))
             .collect();
         self.tlas = build_boxes(&boxes);
     }
@@ -127,17 +216,32 @@ impl TwoLevel {
         self.trace(ray, true).is_some()
     }
 
+    /// The closest hit as the device reports it: `prim` in the shading order, and the
+    /// barycentrics of the shading triangle (whose vertices 1 and 2 trade places in a mirrored
+    /// instance).
+    pub fn shading_hit(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect(ray).map(|h| {
+            let inst = &self.instances[h.instance as usize];
+            let (u, v) = if inst.mirrored {
+                (h.hit.v, h.hit.u)
+            } else {
+                (h.hit.u, h.hit.v)
+            };
+            Hit {
+                prim: inst.prim_offset + h.hit.prim,
+                u,
+                v,
+                ..h.hit
+            }
+        })
+    }
+
     fn trace(&self, ray: &Ray, any: bool) -> Option<InstanceHit> {
         self.tlas.walk(ray, any, |leaf, r| {
             let instance = self.tlas.tri_indices[leaf as usize];
             let inst = &self.instances[instance as usize];
             let blas = &self.blases[inst.blas as usize];
-            // Into object space; the direction keeps its scale so `t` stays a world distance.
-            let local = Ray {
-                origin: inst.object_from_world.transform_point3(r.origin),
-                direction: inst.object_from_world.transform_vector3(r.direction),
-                ..*r
-            };
+            let local = inst.to_object(r);
             let hit = if any {
                 blas.bvh.occluded(&local, &blas.triangles).then_some(Hit {
                     t: r.tmax,
@@ -151,6 +255,101 @@ impl TwoLevel {
             hit.map(|hit| (hit.t, InstanceHit { instance, hit }))
         })
     }
+
+    /// Nodes the device reserves for the TLAS at the front of its node arrays (binary and
+    /// wide): as many as a TLAS over these instances can take, so that a rebuilt TLAS is
+    /// written over the old one in place and the BLASes behind it stay where they are.
+    pub fn tlas_slots(&self) -> usize {
+        self.instances.len().saturating_sub(1).max(1)
+    }
+
+    /// The device form: the TLAS's nodes (padded to [`TwoLevel::tlas_slots`]) followed by every
+    /// BLAS's (child indices and leaf triangles rebased: BLAS leaves index the object triangles
+    /// of all meshes one after the other, TLAS leaves the instances in TLAS order), each BLAS's
+    /// root, and each mesh's first object triangle.
+    pub fn device_nodes(&self) -> (Vec<GpuBvhNode>, Vec<u32>, Vec<u32>) {
+        let mut nodes = self.tlas.nodes.clone();
+        nodes.resize(self.tlas_slots(), GpuBvhNode::default());
+        let (mut roots, mut firsts) = (vec![], vec![]);
+        let mut tri_base = 0u32;
+        for b in &self.blases {
+            roots.push(nodes.len() as u32);
+            firsts.push(tri_base);
+            let base = nodes.len() as i32;
+            nodes.extend(b.bvh.nodes.iter().map(|n| {
+                let mut n = *n;
+                for (lo, hi) in [
+                    (&mut n.left_min, n.left_max),
+                    (&mut n.right_min, n.right_max),
+                ] {
+                    let r = lo[3].to_bits() as i32;
+                    let r = if r >= 0 {
+                        r + base
+                    } else if hi[3].to_bits() > 0 {
+                        !((!r) + tri_base as i32)
+                    } else {
+                        r
+                    };
+                    lo[3] = f32::from_bits(r as u32);
+                }
+                n
+            }));
+            tri_base += b.triangles.len() as u32;
+        }
+        (nodes, roots, firsts)
+    }
+
+    /// [`TwoLevel::device_nodes`] for the 4-wide form: the collapsed TLAS, then every
+    /// collapsed BLAS, rebased alike; and each BLAS's root.
+    pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>) {
+        let mut nodes = WideBvh::collapse(&self.tlas).nodes;
+        nodes.resize(self.tlas_slots(), GpuWideNode::default());
+        let mut roots = vec![];
+        let mut tri_base = 0i32;
+        for b in &self.blases {
+            let base = nodes.len() as i32;
+            roots.push(base as u32);
+            nodes.extend(WideBvh::collapse(&b.bvh).nodes.into_iter().map(|mut n| {
+                for i in 0..super::WIDTH {
+                    if n.count[i] > 0 {
+                        n.child[i] = !((!n.child[i]) + tri_base);
+                    } else if n.child[i] > 0 {
+                        n.child[i] += base;
+                    }
+                }
+                n
+            }));
+            tri_base += b.triangles.len() as i32;
+        }
+        (nodes, roots)
+    }
+}
+
+/// A closed cube [-1, 1]³, each face an n×n grid of quads (two triangles each), with shared
+/// corners computed the same way on every face so that edges match exactly: the mesh of the
+/// leak tests (a ray from inside must hit it, whatever the instance's transform).
+pub fn closed_cube(n: usize) -> Vec<[Vec3; 3]> {
+    let c = |i: usize| i as f32 / n as f32 * 2.0 - 1.0;
+    let mut tris = vec![];
+    for axis in 0..3 {
+        for side in [-1.0f32, 1.0] {
+            let p = |i: usize, j: usize| {
+                let mut v = Vec3::ZERO;
+                v[axis] = side;
+                v[(axis + 1) % 3] = c(i);
+                v[(axis + 2) % 3] = c(j);
+                v
+            };
+            for i in 0..n {
+                for j in 0..n {
+                    let (a, b, d, e) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
+                    tris.push([a, b, d]);
+                    tris.push([a, d, e]);
+                }
+            }
+        }
+    }
+    tris
 }
 
 #[cfg(test)]
@@ -158,33 +357,7 @@ mod tests {
     use super::super::build::tests::{lcg, random_triangles};
     use super::super::intersect_triangle;
     use super::*;
-    use glam::Quat;
-
-    /// A closed cube [-1, 1]³, each face an n×n grid of quads (two triangles each), with shared
-    /// corners computed the same way on every face so that edges match exactly.
-    fn closed_cube(n: usize) -> Vec<[Vec3; 3]> {
-        let c = |i: usize| i as f32 / n as f32 * 2.0 - 1.0;
-        let mut tris = vec![];
-        for axis in 0..3 {
-            for side in [-1.0f32, 1.0] {
-                let p = |i: usize, j: usize| {
-                    let mut v = Vec3::ZERO;
-                    v[axis] = side;
-                    v[(axis + 1) % 3] = c(i);
-                    v[(axis + 2) % 3] = c(j);
-                    v
-                };
-                for i in 0..n {
-                    for j in 0..n {
-                        let (a, b, d, e) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
-                        tris.push([a, b, d]);
-                        tris.push([a, d, e]);
-                    }
-                }
-            }
-        }
-        tris
-    }
+    use glam::{Mat4, Quat};
 
     /// Identity, moved, non-uniformly scaled, mirrored, and rotated-and-mirrored placements.
     fn placements() -> Vec<Mat4> {
@@ -219,12 +392,15 @@ mod tests {
         let cube = closed_cube(6);
         let two = TwoLevel::new(
             std::slice::from_ref(&cube),
-            &placements().iter().map(|&m| (0, m)).collect::<Vec<_>>(),
+            &placements()
+                .iter()
+                .map(|&m| (0, m.as_dmat4()))
+                .collect::<Vec<_>>(),
         );
         let mut leaks = 0;
         let mut rays = 0;
         for (i, inst) in two.instances.iter().enumerate() {
-            let m = inst.world_from_object;
+            let m = inst.world_from_object.as_mat4();
             let centre = m.transform_point3(Vec3::ZERO);
             // Aim at every vertex and edge midpoint (in world space), the hardest directions.
             for t in &cube {
@@ -258,7 +434,13 @@ mod tests {
                 )
             })
             .collect();
-        let two = TwoLevel::new(&meshes, &placed);
+        let two = TwoLevel::new(
+            &meshes,
+            &placed
+                .iter()
+                .map(|&(mesh, m)| (mesh, m.as_dmat4()))
+                .collect::<Vec<_>>(),
+        );
         let world: Vec<[Vec3; 3]> = placed
             .iter()
             .flat_map(|&(mesh, m)| {
@@ -300,12 +482,18 @@ mod tests {
 
     #[test]
     fn moving_an_instance_moves_its_hits() {
-        let mut two = TwoLevel::new(&[closed_cube(2)], &[(0, Mat4::IDENTITY)]);
+        let mut two = TwoLevel::new(&[closed_cube(2)], &[(0, glam::DMat4::IDENTITY)]);
         let r = ray(Vec3::new(0.0, 0.0, -10.0), Vec3::Z);
         assert_eq!(two.intersect(&r).map(|h| h.hit.t), Some(9.0));
-        two.set_transform(0, Mat4::from_translation(Vec3::new(0.0, 0.0, 4.0)));
+        two.set_transform(
+            0,
+            glam::DMat4::from_translation(glam::DVec3::new(0.0, 0.0, 4.0)),
+        );
         assert_eq!(two.intersect(&r).map(|h| h.hit.t), Some(13.0));
-        two.set_transform(0, Mat4::from_translation(Vec3::new(5.0, 0.0, 0.0)));
+        two.set_transform(
+            0,
+            glam::DMat4::from_translation(glam::DVec3::new(5.0, 0.0, 0.0)),
+        );
         assert!(two.intersect(&r).is_none());
     }
 }

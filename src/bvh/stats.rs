@@ -3,10 +3,8 @@
 
 use super::{TwoLevel, build};
 use crate::scene::{Object, Scene};
-use glam::{Mat4, Vec3};
+use glam::{DMat4, DVec3, Vec3};
 use serde::Serialize;
-use std::collections::HashMap;
-use std::hash::{Hash, Hasher};
 use std::time::Instant;
 
 /// Build and update figures of one scene (times are the minimum over the runs).
@@ -126,7 +124,7 @@ pub fn report(scene: &Scene, runs: usize) -> BvhReport {
         for run in 0..runs {
             let d = if run % 2 == 0 { extent * 0.1 } else { 0.0 };
             let t = Instant::now();
-            two.set_transform(i, Mat4::from_translation(Vec3::X * d) * home);
+            two.set_transform(i, DMat4::from_translation(DVec3::X * d as f64) * home);
             instance_move_ms = instance_move_ms.min(ms(t));
         }
     }
@@ -154,29 +152,23 @@ type Triangles = Vec<[Vec3; 3]>;
 /// The distinct meshes among `objects` (object-space triangles) and each object's mesh index
 /// and transform. The importer gives each node its own copy of the mesh, so meshes are told
 /// apart by their content.
-fn instances(objects: &[(usize, &Object)]) -> (Vec<Triangles>, Vec<(u32, Mat4)>) {
-    let mut index: HashMap<u64, u32> = HashMap::new();
-    let mut meshes = vec![];
+fn instances(objects: &[(usize, &Object)]) -> (Vec<Triangles>, Vec<(u32, DMat4)>) {
+    let objects: Vec<&Object> = objects.iter().map(|(_, o)| *o).collect();
+    let (first, mesh_of) = crate::scene::distinct_meshes(&objects);
+    let meshes = first
+        .iter()
+        .map(|&o| {
+            let m = &objects[o].mesh;
+            m.indices
+                .iter()
+                .map(|t| t.map(|i| m.positions[i as usize]))
+                .collect()
+        })
+        .collect();
     let placed = objects
         .iter()
-        .map(|(_, o)| {
-            let mut h = std::collections::hash_map::DefaultHasher::new();
-            let m = &o.mesh;
-            m.indices.hash(&mut h);
-            for p in &m.positions {
-                p.to_array().map(f32::to_bits).hash(&mut h);
-            }
-            let mesh = *index.entry(h.finish()).or_insert_with(|| {
-                meshes.push(
-                    m.indices
-                        .iter()
-                        .map(|t| t.map(|i| m.positions[i as usize]))
-                        .collect(),
-                );
-                meshes.len() as u32 - 1
-            });
-            (mesh, o.world_from_object.as_mat4())
-        })
+        .zip(mesh_of)
+        .map(|(o, mesh)| (mesh, o.world_from_object))
         .collect();
     (meshes, placed)
 }

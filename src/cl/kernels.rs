@@ -63,17 +63,24 @@ impl<T: Pod> Buffer<T> {
 
     /// Copies `data` to the start of the buffer (blocking).
     pub fn write(&mut self, gpu: &Gpu, data: &[T]) -> Result<(), ClError> {
+        self.write_at(gpu, 0, data)
+    }
+
+    /// Copies `data` into the buffer from element `at` on (blocking): an update in place, no
+    /// new allocation.
+    pub fn write_at(&mut self, gpu: &Gpu, at: usize, data: &[T]) -> Result<(), ClError> {
         assert!(
-            data.len() <= self.len.max(1),
+            at + data.len() <= self.len.max(1),
             "write past the end of a buffer"
         );
         if data.is_empty() {
             return Ok(());
         }
-        // SAFETY: the slice fits the buffer (checked above); the write is blocking.
+        let offset = at * std::mem::size_of::<T>();
+        // SAFETY: the slice fits the buffer from `at` on (checked above); the write is blocking.
         unsafe {
             gpu.queue
-                .enqueue_write_buffer(&mut self.inner, CL_BLOCKING, 0, data, &[])
+                .enqueue_write_buffer(&mut self.inner, CL_BLOCKING, offset, data, &[])
                 .map_err(call_err("uploading a buffer"))?;
         }
         Ok(())
@@ -332,8 +339,7 @@ impl Program {
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(gpu, Stage::Extend.name(), &self.extend, slots, |e| unsafe {
-            e.set_arg(&scene.nodes.mem())
-                .set_arg(&scene.triangles.mem());
+            set_geometry(e, scene.nodes.mem(), scene);
             set_surfaces(e, scene);
             e.set_arg(&paths.mem())
                 .set_arg(&queue.mem())
@@ -395,8 +401,7 @@ impl Program {
             &self.connect,
             slots,
             |e| unsafe {
-                e.set_arg(&scene.nodes.mem())
-                    .set_arg(&scene.triangles.mem());
+                set_geometry(e, scene.nodes.mem(), scene);
                 set_surfaces(e, scene);
                 e.set_arg(&shadow_rays.mem())
                     .set_arg(&counters.mem())
@@ -545,7 +550,7 @@ impl Program {
     ) -> Result<Launch, ClError> {
         let count = rays.len() as u32;
         self.run(gpu, stage, kernel, rays.len(), |e| unsafe {
-            e.set_arg(&nodes).set_arg(&bvh.triangles.mem());
+            set_geometry(e, nodes, bvh);
             set_surfaces(e, bvh);
             e.set_arg(&rays.mem())
                 .set_arg(&count)
@@ -576,11 +581,8 @@ impl Program {
             pixels,
             local,
             |e| unsafe {
-                e.set_arg(frame)
-                    .set_arg(camera)
-                    .set_arg(&env.info)
-                    .set_arg(&scene.wide_nodes.mem())
-                    .set_arg(&scene.triangles.mem());
+                e.set_arg(frame).set_arg(camera).set_arg(&env.info);
+                set_geometry(e, scene.wide_nodes.mem(), scene);
                 set_surfaces(e, scene);
                 e.set_arg(&env.texels.mem())
                     .set_arg(&env.marginal.mem())
@@ -786,6 +788,22 @@ fn megakernel_local_size() -> usize {
         .unwrap_or(64)
 }
 
+/// Sets the four geometry arguments every traversing kernel takes first: the nodes (binary or
+/// wide), the shading-order triangles, the instances and the object-space triangles (the last
+/// two are read with `TWO_LEVEL` only).
+///
+/// # Safety
+/// Only for kernels whose next four parameters are exactly those.
+unsafe fn set_geometry(e: &mut ExecuteKernel, nodes: opencl3::types::cl_mem, scene: &SceneBuffers) {
+    // SAFETY: the caller's kernel declares these four buffers next, in this order.
+    unsafe {
+        e.set_arg(&nodes)
+            .set_arg(&scene.triangles.mem())
+            .set_arg(&scene.instances.mem())
+            .set_arg(&scene.object_triangles.mem());
+    }
+}
+
 /// Sets the six surface arguments every traversing kernel takes after the triangles, in the
 /// order of `SceneSurfaces` (kernels/textures.h).
 ///
@@ -821,8 +839,13 @@ pub struct SceneBuffers {
     pub nodes: Buffer<GpuBvhNode>,
     /// The same BVH collapsed to 4-wide nodes (the megakernel's).
     pub wide_nodes: Buffer<GpuWideNode>,
-    /// Triangles in BVH order.
+    /// Triangles in shading order (the flat BVH's order, or instance by instance).
     pub triangles: Buffer<GpuTriangle>,
+    /// Two levels: the instances in top-level order (one placeholder when flat).
+    pub instances: Buffer<GpuInstance>,
+    /// Two levels: every distinct mesh's object-space triangles in its bottom level's order
+    /// (one placeholder when flat).
+    pub object_triangles: Buffer<GpuTriangle>,
     /// Shading data in BVH order.
     pub shading: Buffer<GpuTriShading>,
     /// Tangents in BVH order (one placeholder element without normal maps).
@@ -839,4 +862,23 @@ pub struct SceneBuffers {
     pub lights: Buffer<GpuLight>,
     /// Cumulative selection probabilities of the lights.
     pub light_cdf: Buffer<f32>,
+}
+
+impl SceneBuffers {
+    /// Bytes of every buffer: what the scene takes on the device.
+    pub fn bytes(&self) -> usize {
+        self.nodes.bytes()
+            + self.wide_nodes.bytes()
+            + self.triangles.bytes()
+            + self.instances.bytes()
+            + self.object_triangles.bytes()
+            + self.shading.bytes()
+            + self.tangents.bytes()
+            + self.tex_refs.bytes()
+            + self.textures.bytes()
+            + self.texels.bytes()
+            + self.materials.bytes()
+            + self.lights.bytes()
+            + self.light_cdf.bytes()
+    }
 }

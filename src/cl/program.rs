@@ -65,6 +65,8 @@ pub struct KernelFeatures {
     pub clearcoat: bool,
     /// Some material has a sheen (`HAS_SHEEN`, `KHR_materials_sheen`).
     pub sheen: bool,
+    /// Rays descend a top level over instances, then their meshes' bottom levels (`TWO_LEVEL`).
+    pub two_level: bool,
 }
 
 impl KernelFeatures {
@@ -82,6 +84,7 @@ impl KernelFeatures {
             (self.unlit, "HAS_UNLIT"),
             (self.clearcoat, "HAS_CLEARCOAT"),
             (self.sheen, "HAS_SHEEN"),
+            (self.two_level, "TWO_LEVEL"),
         ] {
             if on {
                 d.push_str(" -D");

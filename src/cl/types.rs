@@ -170,6 +170,29 @@ pub struct GpuWideNode {
 }
 const _: () = assert!(size_of::<GpuWideNode>() == 128);
 
+/// One placed mesh of a two-level scene (64 bytes): object from world as
+/// `p_object = L (p_world - T)`, bottom-level roots and shading-order offset; see
+/// `kernels/types.h` and `bvh::instances`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuInstance {
+    /// First row of L; `.w` = T.x, the world position of the object's origin.
+    pub row0: [f32; 4],
+    /// Second row of L; `.w` = T.y.
+    pub row1: [f32; 4],
+    /// Third row of L; `.w` = T.z.
+    pub row2: [f32; 4],
+    /// Bottom-level root in the binary node array.
+    pub root: u32,
+    /// Bottom-level root in the wide node array.
+    pub wide_root: u32,
+    /// Shading index = bottom-level triangle index + `prim_offset` (wrapping).
+    pub prim_offset: u32,
+    /// 1 when mirrored (negative determinant).
+    pub flags: u32,
+}
+const _: () = assert!(size_of::<GpuInstance>() == 64);
+
 /// A triangle's vertices in world space, in BVH order (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
@@ -432,6 +455,16 @@ pub fn layouts() -> Vec<StructLayout> {
     vec![
         layout!(GpuBvhNode, left_min, left_max, right_min, right_max),
         layout!(GpuTriangle, v0, v1, v2),
+        layout!(
+            GpuInstance,
+            row0,
+            row1,
+            row2,
+            root,
+            wide_root,
+            prim_offset,
+            flags
+        ),
         layout!(GpuTriShading, n0, n1, n2, uv01, uv2, uv1_12),
         layout!(GpuTriTangents, t0, t1, t2),
         layout!(GpuTexture, offset, width, height, flags),

@@ -123,6 +123,7 @@ fn view(args: ViewArgs) -> Result<()> {
         device,
         env_lights: environment.is_some(),
         kernel: common.kernel,
+        bvh: common.bvh,
         env_map: match environment {
             Some(EnvChoice::Map(map)) => Some(map),
             _ => None,

@@ -103,7 +103,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let samples = settings.width as f64 * settings.height as f64 * spp as f64;
     let rays = (stats.extension_rays + stats.shadow_rays) as f64;
-    let summary = serde_json::json!({
+    let mut summary = serde_json::json!({
         "scene": args.scene.display().to_string(),
         "output": args.output.display().to_string(),
         "device": renderer.gpu.description(),
@@ -152,6 +152,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "focus_distance": renderer.settings().focus_distance,
         "kernel_ms": stats.stage_ms,
     });
+    // Added after the literal, which is at serde_json's macro recursion limit.
+    for (key, value) in [
+        ("bvh", serde_json::json!(scene_stats.bvh)),
+        ("meshes", serde_json::json!(scene_stats.meshes)),
+        ("instances", serde_json::json!(scene_stats.instances)),
+        ("device_bytes", serde_json::json!(scene_stats.device_bytes)),
+    ] {
+        summary[key] = value;
+    }
     println!("{summary}");
     Ok(())
 }

@@ -3,22 +3,26 @@
 
 pub mod camera;
 pub mod exposure;
+pub mod instancing;
 mod lights;
 mod megakernel;
 mod settings;
 mod textures;
 pub mod tonemap;
+mod update;
 mod upload;
 mod wavefront;
 
+pub use instancing::BvhChoice;
 pub use lights::gpu_lights;
 pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
-pub use upload::{HostScene, gpu_camera};
+pub use update::InstanceUpdate;
+pub use upload::{Accel, HostScene, gpu_camera};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
-use crate::bvh::{Bvh, Ray, WideBvh};
+use crate::bvh::{Ray, WideBvh};
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
@@ -54,6 +58,14 @@ pub struct SceneStats {
     pub texture_max_side: u32,
     /// Triangles left out for a non-finite or absurd vertex.
     pub dropped_triangles: usize,
+    /// The acceleration structure: "flat" or "two-level".
+    pub bvh: &'static str,
+    /// Distinct meshes with a BLAS (two levels; 1 when flat).
+    pub meshes: usize,
+    /// Instances in the TLAS (two levels; 0 when flat).
+    pub instances: usize,
+    /// Bytes of every scene buffer on the device (textures included).
+    pub device_bytes: usize,
 }
 
 /// The path tracer on one OpenCL device.
@@ -81,6 +93,8 @@ pub struct Renderer {
     pending: Vec<(Stage, Launch)>,
     /// Whether frames run as the megakernel (else the wavefront); see [`KernelChoice`].
     megakernel: bool,
+    /// The acceleration structure the next scene load builds.
+    bvh_choice: BvhChoice,
 }
 
 impl Renderer {
@@ -114,6 +128,7 @@ impl Renderer {
             stats: RenderStats::default(),
             pending: Vec::new(),
             megakernel: false,
+            bvh_choice: BvhChoice::Auto,
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -137,14 +152,33 @@ impl Renderer {
     ) -> Result<SceneStats, ClError> {
         let t = Instant::now();
         let flat = scene.flatten(&space);
+        let dropped = flat.dropped;
         let world = flat.triangles;
-        let verts: Vec<[glam::Vec3; 3]> = world.iter().map(|t| t.v).collect();
-        let bvh = crate::bvh::build(&verts);
+        let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
+        let (mut host, object_tris) =
+            match instancing::plan(scene, &space, dropped, self.bvh_choice) {
+                Some(plan) => {
+                    let object_tris = object_triangles(&plan);
+                    let mut host = HostScene::ordered(
+                        &world,
+                        &plan.order,
+                        Accel::TwoLevel(plan.two),
+                        &materials,
+                    );
+                    host.layout.objects = plan.objects;
+                    (host, object_tris)
+                }
+                None => {
+                    let verts: Vec<[glam::Vec3; 3]> = world.iter().map(|t| t.v).collect();
+                    let bvh = crate::bvh::build(&verts);
+                    drop(verts);
+                    (HostScene::new(&world, bvh, &materials), vec![])
+                }
+            };
+        drop(world);
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
 
         let t = Instant::now();
-        let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
-        let mut host = HostScene::new(&world, bvh, &materials);
         host.space = space;
         host.scale_emitter_power(&lights::emissive_texture_means(scene));
         let used = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
@@ -159,6 +193,7 @@ impl Renderer {
             unlit: used(&|m| m.unlit),
             clearcoat: used(&|m| m.clearcoat > 0.0),
             sheen: used(&|m| m.sheen_color.iter().any(|&c| c > 0.0)),
+            two_level: matches!(host.accel, Accel::TwoLevel(_)),
         };
         let budget = self
             .gpu
@@ -171,16 +206,49 @@ impl Renderer {
         let kernel_build_ms = self.ensure_program()?;
         self.lights = lights.to_vec();
         let (glights, cdf) = self.light_table(&host);
+        let (nodes, wide_nodes, instances) = device_accel(&mut host);
         let placeholder = [GpuTriTangents::default()];
         let tangents: &[GpuTriTangents] = if host.tangents.is_empty() {
             &placeholder
         } else {
             &host.tangents
         };
+        let object_tris = if object_tris.is_empty() {
+            vec![GpuTriangle::default()]
+        } else {
+            object_tris
+        };
+        let bytes = |n: usize, size: usize| n.max(1) * size;
+        fits_device(
+            &[
+                ("BVH nodes", std::mem::size_of_val(nodes.as_slice())),
+                (
+                    "wide BVH nodes",
+                    std::mem::size_of_val(wide_nodes.as_slice()),
+                ),
+                (
+                    "triangles",
+                    std::mem::size_of_val(host.triangles.as_slice()),
+                ),
+                (
+                    "object triangles",
+                    std::mem::size_of_val(object_tris.as_slice()),
+                ),
+                ("instances", std::mem::size_of_val(instances.as_slice())),
+                ("shading", std::mem::size_of_val(host.shading.as_slice())),
+                ("tangents", std::mem::size_of_val(tangents)),
+                ("texels", bytes(pack.texels.len(), 4)),
+            ],
+            self.gpu.device.global_mem_size().ok(),
+            self.gpu.device.max_mem_alloc_size().ok(),
+        )
+        .map_err(ClError::Device)?;
         let buffers = SceneBuffers {
-            nodes: Buffer::from_slice(&self.gpu, &host.bvh.nodes)?,
-            wide_nodes: Buffer::from_slice(&self.gpu, &WideBvh::collapse(&host.bvh).nodes)?,
+            nodes: Buffer::from_slice(&self.gpu, &nodes)?,
+            wide_nodes: Buffer::from_slice(&self.gpu, &wide_nodes)?,
             triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
+            instances: Buffer::from_slice(&self.gpu, &instances)?,
+            object_triangles: Buffer::from_slice(&self.gpu, &object_tris)?,
             shading: Buffer::from_slice(&self.gpu, &host.shading)?,
             tangents: Buffer::from_slice(&self.gpu, tangents)?,
             tex_refs: Buffer::from_slice(&self.gpu, &pack.refs)?,
@@ -190,19 +258,25 @@ impl Renderer {
             lights: Buffer::from_slice(&self.gpu, &glights)?,
             light_cdf: Buffer::from_slice(&self.gpu, &cdf)?,
         };
+        drop((nodes, wide_nodes, instances, object_tris));
         self.light_count = glights.len() as u32;
         self.update_env_info(&glights);
+        let (meshes, instances) = host.accel.instancing();
         let stats = SceneStats {
             triangles: host.triangles.len(),
-            nodes: host.bvh.nodes.len(),
-            sah_cost: host.bvh.sah_cost,
+            nodes: host.accel.node_count(),
+            sah_cost: host.accel.sah_cost(),
             bvh_build_ms,
             kernel_build_ms,
             upload_ms: t.elapsed().as_secs_f64() * 1e3 - kernel_build_ms,
             textures: pack.textures.len(),
             texture_bytes: pack.bytes(),
             texture_max_side: pack.max_side,
-            dropped_triangles: flat.dropped,
+            dropped_triangles: dropped,
+            bvh: host.accel.name(),
+            meshes,
+            instances,
+            device_bytes: buffers.bytes(),
         };
         self.scene = Some((buffers, host));
         if let Some(c) = self.world_camera.clone() {
@@ -304,7 +378,7 @@ impl Renderer {
             direction: unit,
             ..ray
         };
-        let hit = host.bvh.intersect(&ray, &host.vertices)?;
+        let hit = host.intersect(&ray)?;
         Some((hit.t * unit.dot(forward.normalize())) / host.space.scale as f32)
     }
 
@@ -399,9 +473,14 @@ impl Renderer {
         self.scene.as_ref().map(|(b, _)| b)
     }
 
-    /// The BVH on the host.
-    pub fn bvh(&self) -> Option<&Bvh> {
-        self.scene.as_ref().map(|(_, h)| &h.bvh)
+    /// The acceleration structure on the host.
+    pub fn accel(&self) -> Option<&Accel> {
+        self.scene.as_ref().map(|(_, h)| &h.accel)
+    }
+
+    /// Chooses the acceleration structure of the scenes loaded from now on.
+    pub fn set_bvh_choice(&mut self, choice: BvhChoice) {
+        self.bvh_choice = choice;
     }
 
     /// The film as linear RGB (the mean of the samples), row by row from the top.
@@ -421,5 +500,91 @@ impl Renderer {
                 [p[0] / n, p[1] / n, p[2] / n]
             })
             .collect())
+    }
+}
+
+/// The device's node arrays (binary and wide) and instances for `host`'s acceleration
+/// structure (the instances are a placeholder when flat); fills `host.layout` for two levels.
+fn device_accel(host: &mut HostScene) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec<GpuInstance>) {
+    match &host.accel {
+        Accel::Flat(bvh) => (
+            bvh.nodes.clone(),
+            WideBvh::collapse(bvh).nodes,
+            vec![GpuInstance::default()],
+        ),
+        Accel::TwoLevel(two) => {
+            let (nodes, roots, firsts) = two.device_nodes();
+            let (wide, wide_roots) = two.device_wide_nodes();
+            host.layout.roots = roots;
+            host.layout.wide_roots = wide_roots;
+            host.layout.firsts = firsts;
+            let instances = host.layout.gpu_instances(two);
+            (nodes, wide, instances)
+        }
+    }
+}
+
+/// Every distinct mesh's object-space triangles in BLAS order, mesh after mesh, with the
+/// material in `v0.w`.
+fn object_triangles(plan: &instancing::Instancing) -> Vec<GpuTriangle> {
+    plan.two
+        .blases
+        .iter()
+        .flat_map(|b| &b.triangles)
+        .zip(&plan.object_materials)
+        .map(|(t, &m)| GpuTriangle {
+            v0: upload::f4(t[0], f32::from_bits(m)),
+            v1: upload::f4(t[1], 0.0),
+            v2: upload::f4(t[2], 0.0),
+        })
+        .collect()
+}
+
+/// Checks before any allocation that the scene's buffers fit the device: their sum against
+/// `CL_DEVICE_GLOBAL_MEM_SIZE` (`global`) and each against `CL_DEVICE_MAX_MEM_ALLOC_SIZE`
+/// (`max_alloc`), so that a scene too large fails with one clear line instead of an allocation
+/// error halfway through the upload.
+fn fits_device(
+    buffers: &[(&str, usize)],
+    global: Option<u64>,
+    max_alloc: Option<u64>,
+) -> Result<(), String> {
+    let gb = |b: u64| b as f64 / 1e9;
+    let total: usize = buffers.iter().map(|(_, b)| b).sum();
+    if let Some(global) = global
+        && total as u64 > global
+    {
+        return Err(format!(
+            "the scene needs {:.2} GB of device memory and the device has {:.2} GB \
+             (an instanced scene takes less with --bvh two-level)",
+            gb(total as u64),
+            gb(global)
+        ));
+    }
+    if let Some(max) = max_alloc
+        && let Some((name, b)) = buffers.iter().find(|(_, b)| *b as u64 > max)
+    {
+        return Err(format!(
+            "the scene's {name} need a {:.2} GB buffer and the device allows {:.2} GB in one",
+            gb(*b as u64),
+            gb(max)
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod fit_tests {
+    use super::fits_device;
+
+    #[test]
+    fn scenes_too_large_for_the_device_are_refused_with_a_reason() {
+        let buffers = [("triangles", 600), ("shading", 500)];
+        assert!(fits_device(&buffers, Some(2000), Some(1000)).is_ok());
+        assert!(fits_device(&buffers, None, None).is_ok());
+        let total = fits_device(&buffers, Some(1000), Some(1000)).unwrap_err();
+        assert!(total.contains("device memory"), "{total}");
+        let one = fits_device(&buffers, Some(2000), Some(550)).unwrap_err();
+        assert!(one.contains("triangles need"), "{one}");
     }
 }

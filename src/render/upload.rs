@@ -1,16 +1,109 @@
 //! Turning the host scene into the device's structs: triangles and shading data in BVH order,
 //! materials and the camera. The light list is built in `lights`, the textures in `textures`.
 
-use crate::bvh::Bvh;
+use crate::bvh::{Bvh, Hit, Ray, TwoLevel};
 use crate::cl::types::*;
 use crate::scene::{AlphaMode, Camera, Material, RenderFrame, WorldTriangle, robust_bounds};
 use glam::Vec3;
 
+/// The acceleration structure of the scene on the device, with its host reference.
+#[derive(Clone, Debug)]
+pub enum Accel {
+    /// One BVH over the world-space triangles.
+    Flat(Bvh),
+    /// A BLAS per distinct mesh and a TLAS over the instances (render space).
+    TwoLevel(TwoLevel),
+}
+
+impl Accel {
+    /// "flat" or "two-level".
+    pub fn name(&self) -> &'static str {
+        match self {
+            Accel::Flat(_) => "flat",
+            Accel::TwoLevel(_) => "two-level",
+        }
+    }
+
+    /// Nodes over both levels.
+    pub fn node_count(&self) -> usize {
+        match self {
+            Accel::Flat(b) => b.nodes.len(),
+            Accel::TwoLevel(t) => {
+                t.tlas.nodes.len() + t.blases.iter().map(|b| b.bvh.nodes.len()).sum::<usize>()
+            }
+        }
+    }
+
+    /// The SAH cost of the flat BVH, or of the TLAS.
+    pub fn sah_cost(&self) -> f32 {
+        match self {
+            Accel::Flat(b) => b.sah_cost,
+            Accel::TwoLevel(t) => t.tlas.sah_cost,
+        }
+    }
+
+    /// The deepest leaf: of the flat BVH, or the TLAS's depth plus the deepest BLAS's.
+    pub fn depth(&self) -> u32 {
+        match self {
+            Accel::Flat(b) => b.depth,
+            Accel::TwoLevel(t) => {
+                t.tlas.depth + 1 + t.blases.iter().map(|b| b.bvh.depth).max().unwrap_or(0)
+            }
+        }
+    }
+
+    /// Distinct meshes and instances (1 and 0 for the flat BVH).
+    pub fn instancing(&self) -> (usize, usize) {
+        match self {
+            Accel::Flat(_) => (1, 0),
+            Accel::TwoLevel(t) => (t.blases.len(), t.instances.len()),
+        }
+    }
+}
+
+/// Where a two-level scene's parts sit on the device, to update instances in place.
+#[derive(Clone, Debug, Default)]
+pub struct InstanceLayout {
+    /// The object each instance places (index in `Scene::objects`).
+    pub objects: Vec<u32>,
+    /// Each BLAS's root in the binary node array.
+    pub roots: Vec<u32>,
+    /// Each BLAS's root in the wide node array.
+    pub wide_roots: Vec<u32>,
+    /// Each BLAS's first object-space triangle.
+    pub firsts: Vec<u32>,
+}
+
+impl InstanceLayout {
+    /// The device instances of `two` in TLAS order.
+    pub fn gpu_instances(&self, two: &TwoLevel) -> Vec<GpuInstance> {
+        two.tlas
+            .tri_indices
+            .iter()
+            .map(|&i| {
+                let inst = &two.instances[i as usize];
+                let b = inst.blas as usize;
+                GpuInstance {
+                    row0: inst.rows[0],
+                    row1: inst.rows[1],
+                    row2: inst.rows[2],
+                    root: self.roots[b],
+                    wide_root: self.wide_roots[b],
+                    prim_offset: inst.prim_offset.wrapping_sub(self.firsts[b]),
+                    flags: inst.mirrored as u32,
+                }
+            })
+            .collect()
+    }
+}
+
 /// The scene as uploaded, kept on the host for picking and for tests.
 pub struct HostScene {
-    /// The BVH.
-    pub bvh: Bvh,
-    /// Triangles in BVH order.
+    /// The acceleration structure.
+    pub accel: Accel,
+    /// Two levels: where the instances' parts sit on the device (empty when flat).
+    pub layout: InstanceLayout,
+    /// Triangles in shading order: the flat BVH's, or instance by instance in BLAS order.
     pub triangles: Vec<GpuTriangle>,
     /// Vertices in BVH order (for the host traversal).
     pub vertices: Vec<[Vec3; 3]>,
@@ -117,13 +210,25 @@ fn slot(r: Option<u32>) -> i32 {
 impl HostScene {
     /// Orders the triangles as the BVH wants them and fills the device structs.
     pub fn new(world: &[WorldTriangle], bvh: Bvh, materials: &[Material]) -> Self {
+        let order = bvh.tri_indices.clone();
+        Self::ordered(world, &order, Accel::Flat(bvh), materials)
+    }
+
+    /// Fills the device structs from `world` taken in `order` (indices into `world`), for
+    /// traversal by `accel`.
+    pub fn ordered(
+        world: &[WorldTriangle],
+        order: &[u32],
+        accel: Accel,
+        materials: &[Material],
+    ) -> Self {
         let mut emissive = Vec::new();
         let mut triangles = Vec::with_capacity(world.len());
         let mut shading = Vec::with_capacity(world.len());
         let mut vertices = Vec::with_capacity(world.len());
         let normal_mapped = world.iter().any(|t| t.tangents.is_some());
         let mut tangents = Vec::new();
-        for (order, &index) in bvh.tri_indices.iter().enumerate() {
+        for (order, &index) in order.iter().enumerate() {
             let t = &world[index as usize];
             let m = &materials[t.material as usize];
             let mut light = -1i32;
@@ -134,27 +239,11 @@ impl HostScene {
                 light = emissive.len() as i32;
                 emissive.push((order as u32, area, power));
             }
-            triangles.push(GpuTriangle {
-                v0: f4(t.v[0], f32::from_bits(t.material)),
-                v1: f4(t.v[1], f32::from_bits(light as u32)),
-                v2: f4(t.v[2], f32::from_bits(t.object)),
-            });
-            let smooth = if t.smooth { 1.0 } else { 0.0 };
-            shading.push(GpuTriShading {
-                n0: f4(t.n[0], smooth),
-                n1: f4(t.n[1], 0.0),
-                n2: f4(t.n[2], 0.0),
-                uv01: [t.uv[0].x, t.uv[0].y, t.uv[1].x, t.uv[1].y],
-                uv2: [t.uv[2].x, t.uv[2].y, t.uv1[0].x, t.uv1[0].y],
-                uv1_12: [t.uv1[1].x, t.uv1[1].y, t.uv1[2].x, t.uv1[2].y],
-            });
+            let (tri, sh, tan) = device_triangle(t, light);
+            triangles.push(tri);
+            shading.push(sh);
             if normal_mapped {
-                let c = t.tangents.unwrap_or_default().map(|v| v.to_array());
-                tangents.push(GpuTriTangents {
-                    t0: c[0],
-                    t1: c[1],
-                    t2: c[2],
-                });
+                tangents.push(tan);
             }
             vertices.push(t.v);
         }
@@ -167,7 +256,8 @@ impl HostScene {
             (b.center().as_vec3(), b.diagonal() as f32)
         };
         Self {
-            bvh,
+            accel,
+            layout: InstanceLayout::default(),
             triangles,
             vertices,
             shading,
@@ -194,10 +284,69 @@ impl HostScene {
         self.middle
     }
 
+    /// Replaces the triangles from shading position `at` on with `world` (the same triangles
+    /// moved, in the same order: their light indices stay); returns the range written.
+    pub fn rewrite(&mut self, at: usize, world: &[WorldTriangle]) -> std::ops::Range<usize> {
+        for (k, t) in world.iter().enumerate() {
+            let light = self.triangles[at + k].v1[3].to_bits() as i32;
+            let (tri, sh, tan) = device_triangle(t, light);
+            self.triangles[at + k] = tri;
+            self.shading[at + k] = sh;
+            if !self.tangents.is_empty() {
+                self.tangents[at + k] = tan;
+            }
+            self.vertices[at + k] = t.v;
+        }
+        at..at + world.len()
+    }
+
+    /// The closest hit along `ray` (render space): `prim` in shading order, as the device
+    /// reports it.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        match &self.accel {
+            Accel::Flat(b) => b.intersect(ray, &self.vertices),
+            Accel::TwoLevel(t) => t.shading_hit(ray),
+        }
+    }
+
+    /// Whether anything blocks `ray` within its interval.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        match &self.accel {
+            Accel::Flat(b) => b.occluded(ray, &self.vertices),
+            Accel::TwoLevel(t) => t.occluded(ray),
+        }
+    }
+
     /// The object index of a triangle in BVH order.
     pub fn object_of(&self, prim: u32) -> u32 {
         self.triangles[prim as usize].v2[3].to_bits()
     }
+}
+
+/// A triangle's device structs; `light` is its index among the emissive triangles (-1: none).
+fn device_triangle(t: &WorldTriangle, light: i32) -> (GpuTriangle, GpuTriShading, GpuTriTangents) {
+    let smooth = if t.smooth { 1.0 } else { 0.0 };
+    let c = t.tangents.unwrap_or_default().map(|v| v.to_array());
+    (
+        GpuTriangle {
+            v0: f4(t.v[0], f32::from_bits(t.material)),
+            v1: f4(t.v[1], f32::from_bits(light as u32)),
+            v2: f4(t.v[2], f32::from_bits(t.object)),
+        },
+        GpuTriShading {
+            n0: f4(t.n[0], smooth),
+            n1: f4(t.n[1], 0.0),
+            n2: f4(t.n[2], 0.0),
+            uv01: [t.uv[0].x, t.uv[0].y, t.uv[1].x, t.uv[1].y],
+            uv2: [t.uv[2].x, t.uv[2].y, t.uv1[0].x, t.uv1[0].y],
+            uv1_12: [t.uv1[1].x, t.uv1[1].y, t.uv1[2].x, t.uv1[2].y],
+        },
+        GpuTriTangents {
+            t0: c[0],
+            t1: c[1],
+            t2: c[2],
+        },
+    )
 }
 
 /// The device camera for an aspect ratio (width / height).

@@ -322,26 +322,32 @@ struct TextureTable {
     order: Vec<usize>,
     /// Scene images that could not be decoded.
     failed: Vec<bool>,
-    /// The image each glTF texture shows (its `EXT_texture_webp` source, else its plain
-    /// source), if any.
+    /// The image each glTF texture shows (its `KHR_texture_basisu` or `EXT_texture_webp`
+    /// source, else its plain source), if any.
     sources: Vec<Option<usize>>,
 }
 
-/// The image each texture shows: the `EXT_texture_webp` source where present, else the
-/// core `source` (a `KHR_texture_basisu` image is not decoded, so only its fallback counts).
+/// The image each texture shows: the first source in range of its `KHR_texture_basisu`
+/// source, its `EXT_texture_webp` source and its core `source` (a PNG/JPEG fallback).
 fn texture_sources(root: &gltf::json::Root) -> Vec<Option<usize>> {
     root.textures
         .iter()
         .map(|t| {
-            let webp = t
-                .extensions
-                .as_ref()
-                .and_then(|e| e.others.get("EXT_texture_webp"))
-                .and_then(|w| w.get("source"))
-                .and_then(serde_json::Value::as_u64)
-                .map(|i| i as usize);
+            let extension = |name: &str| {
+                t.extensions
+                    .as_ref()
+                    .and_then(|e| e.others.get(name))
+                    .and_then(|w| w.get("source"))
+                    .and_then(serde_json::Value::as_u64)
+                    .map(|i| i as usize)
+            };
             let core = Some(t.source.value()).filter(|&i| i != u32::MAX as usize);
-            webp.or(core).filter(|&i| i < root.images.len())
+            super::validate::IMAGE_SOURCE_EXTENSIONS
+                .iter()
+                .map(|e| extension(e))
+                .chain([core])
+                .flatten()
+                .find(|&i| i < root.images.len())
         })
         .collect()
 }

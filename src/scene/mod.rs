@@ -4,6 +4,7 @@
 //! into world-space triangles (f32) whenever the scene changes.
 
 mod accessor;
+mod basisu;
 mod bounds;
 mod compression;
 mod env_presets;
@@ -396,6 +397,13 @@ impl Scene {
         }
     }
 
+    /// Object `i`'s triangles in the render space of `frame`, in its mesh's order, as
+    /// [`Scene::flatten`] gives them (whether or not the object is visible).
+    pub fn flatten_object(&self, i: usize, frame: &RenderFrame) -> Flattened {
+        let (triangles, dropped) = object_triangles(i as u32, &self.objects[i], frame);
+        Flattened { triangles, dropped }
+    }
+
     /// Robust world-space bounds of the visible geometry (see [`robust_bounds`]): what
     /// framing, the default light radius and the render frame use.
     pub fn bounds(&self) -> Bounds {
@@ -422,6 +430,33 @@ impl Scene {
             .map(|o| o.mesh.indices.len())
             .sum()
     }
+}
+
+/// The distinct meshes among `objects` (the index of the first object using each) and each
+/// object's mesh. The importer gives every node its own copy of its mesh, so meshes are told
+/// apart by content: triangles, positions and materials.
+pub fn distinct_meshes(objects: &[&Object]) -> (Vec<usize>, Vec<u32>) {
+    let mut index = std::collections::HashMap::<u64, u32>::new();
+    let mut first = vec![];
+    let mesh_of = objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            let m = &o.mesh;
+            m.indices.hash(&mut h);
+            m.materials.hash(&mut h);
+            for p in &m.positions {
+                p.to_array().map(f32::to_bits).hash(&mut h);
+            }
+            *index.entry(h.finish()).or_insert_with(|| {
+                first.push(i);
+                first.len() as u32 - 1
+            })
+        })
+        .collect();
+    (first, mesh_of)
 }
 
 /// Triangles in render space, and how many were dropped.

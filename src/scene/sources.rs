@@ -155,19 +155,18 @@ pub fn decode_image(
     decode_bounded(&bytes)
 }
 
-/// Decodes an encoded PNG or JPEG after checking its header's size against the limits.
+/// Decodes an encoded PNG, JPEG, WebP or KTX2 (Basis Universal) image after checking its
+/// header's size against the limits.
 pub fn decode_bounded(bytes: &[u8]) -> Result<gltf::image::Data, String> {
     use gltf::image::Format as F;
     use image::DynamicImage as D;
+    if super::basisu::is_ktx2(bytes) {
+        return super::basisu::decode(bytes);
+    }
     let format = image::guess_format(bytes).map_err(|e| e.to_string())?;
     let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
     let (width, height) = reader().into_dimensions().map_err(|e| e.to_string())?;
-    check_size(
-        width,
-        height,
-        limits::MAX_IMAGE_SIDE,
-        limits::MAX_IMAGE_PIXELS,
-    )?;
+    check_image_size(width, height)?;
     let mut bounded = reader();
     let mut caps = image::Limits::default();
     caps.max_image_width = Some(limits::MAX_IMAGE_SIDE);
@@ -194,6 +193,17 @@ pub fn decode_bounded(bytes: &[u8]) -> Result<gltf::image::Data, String> {
         pixels: decoded.into_bytes(),
         format,
     })
+}
+
+/// Checks a texture image's header size against [`limits::MAX_IMAGE_SIDE`] and
+/// [`limits::MAX_IMAGE_PIXELS`].
+pub fn check_image_size(width: u32, height: u32) -> Result<(), String> {
+    check_size(
+        width,
+        height,
+        limits::MAX_IMAGE_SIDE,
+        limits::MAX_IMAGE_PIXELS,
+    )
 }
 
 /// Checks an image's header size against a side and pixel limit.

@@ -31,6 +31,10 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_texture_basisu",
 ];
 
+/// Texture extensions that name an image by their `source` (instead of the core `source`), in
+/// the order the importer prefers them.
+pub const IMAGE_SOURCE_EXTENSIONS: &[&str] = &["KHR_texture_basisu", "EXT_texture_webp"];
+
 /// A parsed document that passed validation, with the GLB binary chunk if there was one.
 pub struct Parsed {
     /// The document; every index in it is in range and every enum valid.
@@ -270,6 +274,24 @@ fn beyond_gltf_json(root: &json::Root) -> Vec<String> {
             }
             (None, None) => out.push(format!("images[{i}]: neither uri nor bufferView")),
             _ => {}
+        }
+    }
+    // The image sources the texture extensions name (read as raw JSON by the importer).
+    for (i, t) in root.textures.iter().enumerate() {
+        for ext in IMAGE_SOURCE_EXTENSIONS {
+            let Some(object) = t.extensions.as_ref().and_then(|e| e.others.get(*ext)) else {
+                continue;
+            };
+            let at = format!("textures[{i}].extensions.{ext}");
+            match object.get("source") {
+                None if object.is_object() => out.push(format!("{at}.source: missing")),
+                None => out.push(format!("{at}: invalid value")),
+                Some(s) => match s.as_u64() {
+                    Some(n) if n < root.images.len() as u64 => {}
+                    Some(_) => out.push(format!("{at}.source: index out of range")),
+                    None => out.push(format!("{at}.source: invalid value")),
+                },
+            }
         }
     }
     let quantized = root

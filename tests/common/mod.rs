@@ -379,6 +379,44 @@ pub fn render_exr(scene: &Path, out: &Path, extra: &[&str]) -> (Value, Vec<[f32;
     (summary, px)
 }
 
+/// A quad (with texture coordinates) whose material shows `image` (encoded bytes of type
+/// `mime`) as its base color texture; the texture names the image through `extension`
+/// (`KHR_texture_basisu`, `EXT_texture_webp`) when given, else through its `source`.
+pub fn textured_quad(image: &[u8], mime: &str, extension: Option<&str>) -> Gltf {
+    let mut g = Gltf::default();
+    g.lambert([1.0; 3], [0.0; 3], 1.0, false);
+    let view = g.bytes_view(image);
+    g.extra.insert(
+        "images".into(),
+        json!([{"bufferView": view, "mimeType": mime}]),
+    );
+    let texture = match extension {
+        Some(ext) => {
+            g.use_ext(ext);
+            g.required.push(ext.to_string());
+            json!({"extensions": {ext: {"source": 0}}})
+        }
+        None => json!({"source": 0}),
+    };
+    g.extra.insert("textures".into(), json!([texture]));
+    g.materials[0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": 0});
+    let uv = g.float_accessor(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+    let m = g.mesh(vec![quad()]);
+    g.meshes[m]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv);
+    g.node(json!({"mesh": m}));
+    g
+}
+
+/// A file of the KTX2 fixtures (tests/ktx2, made by scripts/ktx2_fixtures.sh).
+pub fn ktx2_fixture(name: &str) -> Vec<u8> {
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/ktx2")
+            .join(name),
+    )
+    .unwrap()
+}
+
 /// The scenes folder, if set.
 pub fn scenes_dir() -> Option<PathBuf> {
     std::env::var_os("PENUMBRA_SCENES")

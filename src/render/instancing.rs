@@ -1,0 +1,164 @@
+//! Which acceleration structure a scene goes to the device in: one flat BVH over every
+//! world-space triangle, or two levels (a BLAS per distinct mesh, shared by the nodes that
+//! place it, and a TLAS over the instances; see `bvh::instances`).
+//!
+//! Shading reads the triangles in world space either way (one copy per instance, in the order
+//! the traversal reports them), so images agree; two levels store each distinct mesh's BVH and
+//! object-space triangles once and make moving an object a TLAS rebuild written in place
+//! (`Renderer::move_instances`).
+//!
+//! The automatic choice (`--bvh auto`): two levels when the scene is large and instancing
+//! saves most of the flat BVH (at least 4 M triangles over all instances and at least 8 times
+//! the triangles of the distinct meshes), else the flat BVH. With PoCL's default work-group
+//! method the two-level kernels trace 1.0–3.7 times slower than the flat BVH (within −14 …
+//! +29 % with `POCL_WORK_GROUP_METHOD=cbs`; docs/benchmarks.md, 2026-11-30), so a scene that
+//! fits a flat BVH gets one; `--bvh two-level` trades that for moving objects in milliseconds
+//! in the viewer.
+
+use crate::bvh::{Blas, TwoLevel};
+use crate::scene::{Object, RenderFrame, Scene, distinct_meshes};
+use glam::{DMat4, Vec3};
+use rayon::prelude::*;
+use std::str::FromStr;
+
+/// Triangles over all instances from which `--bvh auto` considers two levels.
+pub const AUTO_MIN_TRIANGLES: usize = 4_000_000;
+
+/// How many times the distinct meshes' triangles the instances must hold for `--bvh auto` to
+/// take two levels.
+pub const AUTO_MIN_SAVING: usize = 8;
+
+/// `--bvh`: which acceleration structure the device traverses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum BvhChoice {
+    /// Two levels for large, heavily instanced scenes (see the module's rule), else flat.
+    #[default]
+    Auto,
+    /// One BVH over every world-space triangle.
+    Flat,
+    /// A BLAS per distinct mesh and a TLAS over the instances.
+    TwoLevel,
+}
+
+impl FromStr for BvhChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "" | "auto" => Ok(Self::Auto),
+            "flat" => Ok(Self::Flat),
+            "two-level" | "two_level" => Ok(Self::TwoLevel),
+            _ => Err(format!("bvh '{s}' is not 'flat', 'two-level' or 'auto'")),
+        }
+    }
+}
+
+/// A scene's instances: each visible object with triangles, the distinct meshes they use.
+pub struct Instancing {
+    /// The two levels (render space).
+    pub two: TwoLevel,
+    /// Index in the flattened triangle list of each triangle in shading order.
+    pub order: Vec<u32>,
+    /// Material of each object-space triangle, mesh after mesh, in BLAS order.
+    pub object_materials: Vec<u32>,
+    /// The object each instance places (index in `Scene::objects`).
+    pub objects: Vec<u32>,
+}
+
+/// The two levels of `scene` in render space `space`, or `None` when the flat BVH is chosen
+/// (or must be: flattening `dropped` triangles with absurd vertices, which the instances would
+/// keep).
+pub fn plan(
+    scene: &Scene,
+    space: &RenderFrame,
+    dropped: usize,
+    choice: BvhChoice,
+) -> Option<Instancing> {
+    if choice == BvhChoice::Flat || dropped > 0 {
+        return None;
+    }
+    let objects = placed_objects(scene);
+    let placed: Vec<&Object> = objects
+        .iter()
+        .map(|&i| &scene.objects[i as usize])
+        .collect();
+    let (meshes, mesh_of) = distinct_meshes(&placed);
+    let unique: usize = meshes.iter().map(|&o| placed[o].mesh.indices.len()).sum();
+    let total: usize = placed.iter().map(|o| o.mesh.indices.len()).sum();
+    let auto_flat = total < AUTO_MIN_TRIANGLES || total < AUTO_MIN_SAVING * unique;
+    if total == 0 || (choice == BvhChoice::Auto && auto_flat) {
+        return None;
+    }
+    let blases: Vec<Blas> = meshes
+        .par_iter()
+        .map(|&o| {
+            let m = &placed[o].mesh;
+            let tris: Vec<[Vec3; 3]> = m
+                .indices
+                .iter()
+                .map(|t| t.map(|i| m.positions[i as usize]))
+                .collect();
+            Blas::new(&tris)
+        })
+        .collect();
+    let object_materials = meshes
+        .iter()
+        .zip(&blases)
+        .flat_map(|(&o, b)| {
+            let m = &placed[o].mesh;
+            b.bvh.tri_indices.iter().map(|&k| m.materials[k as usize])
+        })
+        .collect();
+    // Render from object: the render frame's (p - origin) * scale after the node's transform.
+    let frame =
+        DMat4::from_scale(glam::DVec3::splat(space.scale)) * DMat4::from_translation(-space.origin);
+    let instances: Vec<(u32, DMat4)> = placed
+        .iter()
+        .zip(&mesh_of)
+        .map(|(o, &m)| (m, frame * o.world_from_object))
+        .collect();
+    let two = TwoLevel::from_blases(blases, &instances);
+    // Shading order: instance after instance, each in its BLAS's order, as indices into the
+    // flattened list (which holds the visible objects' triangles in object order).
+    let mut order = Vec::with_capacity(total);
+    let mut base = 0u32;
+    for (o, inst) in placed.iter().zip(&two.instances) {
+        let blas = &two.blases[inst.blas as usize];
+        order.extend(blas.bvh.tri_indices.iter().map(|&k| base + k));
+        base += o.mesh.indices.len() as u32;
+    }
+    Some(Instancing {
+        two,
+        order,
+        object_materials,
+        objects,
+    })
+}
+
+/// The render frame's map, (p - origin) * scale, as a matrix: render from object is this times
+/// the node's world from object.
+pub fn render_from_world(space: &RenderFrame) -> DMat4 {
+    DMat4::from_scale(glam::DVec3::splat(space.scale)) * DMat4::from_translation(-space.origin)
+}
+
+/// The indices of the visible objects that have triangles: the instances, in object order.
+pub fn placed_objects(scene: &Scene) -> Vec<u32> {
+    (0..scene.objects.len() as u32)
+        .filter(|&i| {
+            let o = &scene.objects[i as usize];
+            o.visible && !o.mesh.indices.is_empty()
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn choices_parse() {
+        assert_eq!("auto".parse(), Ok(BvhChoice::Auto));
+        assert_eq!("Two-Level".parse(), Ok(BvhChoice::TwoLevel));
+        assert_eq!("flat".parse(), Ok(BvhChoice::Flat));
+        assert!("deep".parse::<BvhChoice>().is_err());
+    }
+}

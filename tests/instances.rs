@@ -1,0 +1,358 @@
+//! Two-level traversal on the device: instances of one mesh placed with identity, scaled,
+//! mirrored and rotated-and-mirrored transforms are as leak-free as the flat BVH, the device
+//! finds the host reference's hits, and a scene of instances renders the same image with
+//! `--bvh flat` and `--bvh two-level`.
+
+mod common;
+
+use common::{Gltf, Prim, render_exr, sphere};
+use glam::{DMat4, DQuat, DVec3, Vec3};
+use penumbra::bvh::Ray;
+use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay};
+use penumbra::cl::{Buffer, DeviceChoice};
+use penumbra::render::{BvhChoice, Renderer};
+use penumbra::scene::{Material, Mesh, Object, RenderFrame, Scene};
+use serde_json::json;
+use std::f32::consts::FRAC_1_SQRT_2;
+
+fn renderer() -> Renderer {
+    let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
+    Renderer::new(&choice).expect("the test's OpenCL device is available")
+}
+
+/// The leak tests' closed cube as a mesh.
+fn closed_cube(n: usize) -> Mesh {
+    let tris = penumbra::bvh::closed_cube(n);
+    Mesh {
+        positions: tris.iter().flatten().copied().collect(),
+        indices: (0..tris.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect(),
+        materials: vec![0; tris.len()],
+        ..Mesh::default()
+    }
+}
+
+/// Identity, moved, non-uniformly scaled, mirrored, rotated-and-mirrored, and far away.
+fn placements() -> Vec<DMat4> {
+    vec![
+        DMat4::IDENTITY,
+        DMat4::from_translation(DVec3::new(5.0, -2.0, 3.0)),
+        DMat4::from_scale_rotation_translation(
+            DVec3::new(0.3, 2.0, 5.0),
+            DQuat::IDENTITY,
+            DVec3::new(-6.0, 1.0, 0.5),
+        ),
+        DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)) * DMat4::from_translation(DVec3::X * 3.0),
+        DMat4::from_scale_rotation_translation(
+            DVec3::new(-0.5, 1.5, 0.75),
+            DQuat::from_euler(glam::EulerRot::XYZ, 0.3, 1.1, -0.7),
+            DVec3::new(0.0, 7.0, -4.0),
+        ),
+        DMat4::from_scale_rotation_translation(
+            DVec3::new(1e-3, 1e-3, 2e-3),
+            DQuat::from_euler(glam::EulerRot::XYZ, -0.9, 0.2, 0.4),
+            DVec3::new(3e3, -1e3, 2e3),
+        ),
+    ]
+}
+
+fn cube_scene(n: usize) -> Scene {
+    Scene {
+        source: "cubes".into(),
+        objects: placements()
+            .into_iter()
+            .enumerate()
+            .map(|(i, m)| Object {
+                name: format!("cube {i}"),
+                world_from_object: m,
+                visible: true,
+                mesh: closed_cube(n),
+            })
+            .collect(),
+        materials: vec![Material::default()],
+        ..Scene::default()
+    }
+}
+
+/// Traces `rays` with the four tracing kernels: (closest binary, any binary, closest wide,
+/// any wide), and the overflow count.
+fn trace_all(r: &Renderer, rays: &[GpuRay]) -> ([Vec<GpuHit>; 2], [Vec<u32>; 2], u32) {
+    let ray_buf = Buffer::from_slice(&r.gpu, rays).unwrap();
+    let mut counters = Buffer::<u32>::new(&r.gpu, COUNTER_SLOTS).unwrap();
+    counters.clear(&r.gpu).unwrap();
+    let program = r.program().unwrap();
+    let scene = r.scene_buffers().unwrap();
+    let hits = [(); 2].map(|_| Buffer::<GpuHit>::new(&r.gpu, rays.len()).unwrap());
+    let occluded = [(); 2].map(|_| Buffer::<u32>::new(&r.gpu, rays.len()).unwrap());
+    program
+        .trace_closest(&r.gpu, scene, &ray_buf, &hits[0], &counters)
+        .unwrap();
+    program
+        .trace_any(&r.gpu, scene, &ray_buf, &occluded[0], &counters)
+        .unwrap();
+    program
+        .trace_closest_wide(&r.gpu, scene, &ray_buf, &hits[1], &counters)
+        .unwrap();
+    program
+        .trace_any_wide(&r.gpu, scene, &ray_buf, &occluded[1], &counters)
+        .unwrap();
+    let overflow = counters.read(&r.gpu).unwrap()[COUNT_OVERFLOW];
+    (
+        hits.map(|h| h.read(&r.gpu).unwrap()),
+        occluded.map(|o| o.read(&r.gpu).unwrap()),
+        overflow,
+    )
+}
+
+/// Rays from each instance's centre towards every vertex and edge midpoint of its cube (in
+/// world space), the hardest directions for a watertight test: each must hit its own cube,
+/// through all four tracing kernels, and the binary ones must find the host reference's hits.
+fn assert_no_leaks(r: &Renderer, placements: &[DMat4], n: usize) {
+    let host = r.host_scene().unwrap();
+    let cube = closed_cube(n);
+    let mut rays = vec![];
+    let mut owner = vec![];
+    for (i, m) in placements.iter().enumerate() {
+        let centre = m.transform_point3(DVec3::ZERO);
+        for t in &cube.indices {
+            for k in 0..3 {
+                let a = cube.positions[t[k] as usize].as_dvec3();
+                let b = cube.positions[t[(k + 1) % 3] as usize].as_dvec3();
+                for target in [a, (a + b) * 0.5] {
+                    let d = (m.transform_point3(target) - centre).as_vec3();
+                    let o = centre.as_vec3();
+                    rays.push(GpuRay {
+                        origin: [o.x, o.y, o.z, 0.0],
+                        direction: [d.x, d.y, d.z, f32::INFINITY],
+                    });
+                    owner.push(i as u32);
+                }
+            }
+        }
+    }
+    let ([hits, wide_hits], [occluded, wide_occluded], overflow) = trace_all(r, &rays);
+    assert_eq!(overflow, 0, "no stack overflow");
+    let mut leaks = 0;
+    for (i, ray) in rays.iter().enumerate() {
+        for (h, occ) in [(hits[i], occluded[i]), (wide_hits[i], wide_occluded[i])] {
+            let inside = h.prim != u32::MAX && host.object_of(h.prim) == owner[i];
+            if !inside || occ != 1 {
+                leaks += 1;
+            }
+        }
+        let host_ray = Ray {
+            origin: Vec3::from_slice(&ray.origin[..3]),
+            direction: Vec3::from_slice(&ray.direction[..3]),
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        };
+        let expect = host.intersect(&host_ray).expect("the host finds the cube");
+        assert_eq!(
+            (hits[i].prim, hits[i].t),
+            (expect.prim, expect.t),
+            "ray {i}"
+        );
+        assert_eq!(wide_hits[i].t, expect.t, "ray {i} (wide)");
+    }
+    assert!(rays.len() > 5000);
+    assert_eq!(leaks, 0, "rays leaked out of {} (twice each)", rays.len());
+}
+
+#[test]
+fn no_ray_leaks_out_of_scaled_or_mirrored_instances_on_the_device() {
+    let mut r = renderer();
+    r.set_bvh_choice(BvhChoice::TwoLevel);
+    let scene = cube_scene(6);
+    // World coordinates: the rays are made in world space.
+    let stats = r
+        .load_scene_in(&scene, &[], RenderFrame::default())
+        .unwrap();
+    assert_eq!(stats.bvh, "two-level");
+    assert_eq!((stats.meshes, stats.instances), (1, placements().len()));
+    assert_no_leaks(&r, &placements(), 6);
+}
+
+#[test]
+fn moving_instances_updates_the_device_in_place() {
+    let mut r = renderer();
+    r.set_bvh_choice(BvhChoice::TwoLevel);
+    let mut scene = cube_scene(6);
+    let stats = r
+        .load_scene_in(&scene, &[], RenderFrame::default())
+        .unwrap();
+    // Move every other cube, one of them also rescaled and mirrored the other way.
+    let mut moved = placements();
+    for (i, m) in moved.iter_mut().enumerate().filter(|(i, _)| i % 2 == 1) {
+        *m = DMat4::from_translation(DVec3::new(0.5, -20.0 * i as f64, 2.0)) * *m;
+        if i == 3 {
+            *m *= DMat4::from_scale(DVec3::new(-2.0, 0.5, 1.0));
+        }
+        scene.objects[i].world_from_object = *m;
+    }
+    let update = r
+        .move_instances(&scene)
+        .unwrap()
+        .expect("moving instances of a two-level scene needs no reload");
+    assert_eq!(update.moved, 3);
+    let buffers = r.scene_buffers().unwrap();
+    assert_eq!(buffers.bytes(), stats.device_bytes, "no buffer grew");
+    // Written: the TLAS's slots (binary and wide nodes, 64 and 128 bytes), the instances (64
+    // bytes each) and the moved cubes' shading triangles (48 + 96 bytes each), nothing else.
+    let n = placements().len();
+    let tlas = (n - 1) * (64 + 128) + n * 64;
+    let moved_triangles = 3 * 6 * 6 * 6 * 2;
+    assert_eq!(
+        update.bytes,
+        tlas + moved_triangles * (48 + 96),
+        "{update:?}"
+    );
+    assert_no_leaks(&r, &moved, 6);
+    // Hiding a cube changes the instances: that needs a reload.
+    scene.objects[0].visible = false;
+    assert_eq!(r.move_instances(&scene).unwrap(), None);
+}
+
+#[test]
+fn two_levels_find_the_flat_bvhs_hits() {
+    // The same scene both ways: every hit at the same distance on the same object (the
+    // shading order differs, so triangles are compared by object and distance).
+    let scene = cube_scene(4);
+    let mut rays = vec![];
+    let mut s = 3u64;
+    let mut rnd = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    };
+    for _ in 0..20000 {
+        let o = Vec3::new(rnd(), rnd(), rnd()) * 24.0 - 12.0;
+        let d = (Vec3::new(rnd(), rnd(), rnd()) - 0.5).normalize();
+        rays.push(GpuRay {
+            origin: [o.x, o.y, o.z, 0.0],
+            direction: [d.x, d.y, d.z, f32::INFINITY],
+        });
+    }
+    let mut results = vec![];
+    for choice in [BvhChoice::Flat, BvhChoice::TwoLevel] {
+        let mut r = renderer();
+        r.set_bvh_choice(choice);
+        r.load_scene_in(&scene, &[], RenderFrame::default())
+            .unwrap();
+        let ([hits, _], [occluded, _], _) = trace_all(&r, &rays);
+        let host = r.host_scene().unwrap();
+        let objects: Vec<Option<u32>> = hits
+            .iter()
+            .map(|h| (h.prim != u32::MAX).then(|| host.object_of(h.prim)))
+            .collect();
+        results.push((hits, objects, occluded));
+    }
+    let (flat, two) = (&results[0], &results[1]);
+    let mut hit = 0;
+    for i in 0..rays.len() {
+        assert_eq!(flat.1[i], two.1[i], "ray {i}: object");
+        assert_eq!(flat.2[i], two.2[i], "ray {i}: occlusion");
+        if flat.1[i].is_some() {
+            hit += 1;
+            let (a, b) = (flat.0[i].t, two.0[i].t);
+            assert!(
+                (a - b).abs() <= 1e-5 * a.abs().max(1.0),
+                "ray {i}: {a} vs {b}"
+            );
+        }
+    }
+    assert!(hit > 500, "the rays hit the cubes ({hit})");
+}
+
+#[test]
+fn instances_render_the_same_image_both_ways() {
+    // A sphere mesh placed five times (scaled, squashed, mirrored) and a floor, lit by an
+    // emissive quad: the flat BVH and two levels must render the same image.
+    let dir = common::output_dir("instances_render_the_same_image_both_ways");
+    let mut g = Gltf::default();
+    let grey = g.lambert([0.7, 0.7, 0.7], [0.0; 3], 0.0, false);
+    let lamp = g.lambert([0.0; 3], [1.0; 3], 20.0, true);
+    let (pos, nrm, idx) = sphere(1.0, 16, 24, false);
+    let ball = g.mesh(vec![Prim {
+        positions: pos,
+        normals: nrm,
+        indices: idx,
+        material: Some(grey),
+        mode: 4,
+    }]);
+    let mut floor = common::quad();
+    floor.material = Some(grey);
+    let floor = g.mesh(vec![floor]);
+    let mut light = common::quad();
+    light.material = Some(lamp);
+    let light = g.mesh(vec![light]);
+    g.node(
+        json!({"mesh": floor, "scale": [20.0, 20.0, 1.0], "translation": [-10.0, 0.0, 10.0],
+                  "rotation": common::LOOK_DOWN}),
+    );
+    g.node(
+        json!({"mesh": light, "scale": [3.0, 3.0, 1.0], "translation": [-1.5, 8.0, -1.5],
+                  "rotation": [FRAC_1_SQRT_2, 0.0, 0.0, FRAC_1_SQRT_2]}),
+    );
+    for (i, (s, x)) in [
+        ([1.0, 1.0, 1.0], -4.0),
+        ([0.5, 2.0, 0.5], -1.5),
+        ([-1.0, 1.0, 1.0], 1.0),
+        ([1.5, 0.5, -1.0], 4.0),
+        ([0.7, 0.7, 0.7], 6.5),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        g.node(json!({"mesh": ball, "scale": s, "translation": [x, 1.2, i as f32 * 0.3]}));
+    }
+    let scene = g.write_glb(&dir, "balls.glb");
+    let args = |bvh: &'static str| {
+        vec![
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--spp",
+            "16",
+            "--bounces",
+            "3",
+            "--bvh",
+            bvh,
+        ]
+    };
+    let (flat_summary, flat) = render_exr(&scene, &dir.join("flat.exr"), &args("flat"));
+    let (two_summary, two) = render_exr(&scene, &dir.join("two.exr"), &args("two-level"));
+    assert_eq!(flat_summary["bvh"], "flat");
+    assert_eq!(two_summary["bvh"], "two-level");
+    assert_eq!(two_summary["instances"], 7);
+    assert_eq!(two_summary["meshes"], 3);
+    assert_eq!(flat_summary["triangles"], two_summary["triangles"]);
+    assert!(two_summary["device_bytes"].as_u64().unwrap() > 0);
+    // The hit points differ by rounding only (barycentrics found in object space), so paths
+    // may part after many bounces in a rare pixel; the images agree to within noise.
+    let diff: f64 = flat
+        .iter()
+        .zip(&two)
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs() as f64).sum::<f64>() / 3.0)
+        .sum::<f64>()
+        / flat.len() as f64;
+    let mean = common::mean_gray(&flat);
+    assert!(mean > 0.01, "the scene is lit ({mean})");
+    assert!(
+        diff <= 0.01 * mean,
+        "mean absolute difference {diff} against a mean of {mean}"
+    );
+    let close = |a: f32, b: f32| (a - b).abs() <= 1e-3 * a.abs().max(b.abs()).max(1e-3);
+    let same = flat
+        .iter()
+        .zip(&two)
+        .filter(|(a, b)| (0..3).all(|c| close(a[c], b[c])))
+        .count();
+    assert!(
+        same * 10 >= flat.len() * 9,
+        "{same} of {} pixels agree to 1e-3",
+        flat.len()
+    );
+}
