@@ -12,8 +12,8 @@ typedef struct {
 
 #ifdef HAS_ENV_MAP
 
-// Radiance arriving from world direction d (unit), and the solid-angle pdf of sampling it.
-inline float3 env_radiance(const EnvMap* e, float3 d, float* pdf) {
+// The map coordinates (u, v in [0, 1]) of world direction d (unit), and its cos(theta).
+inline float3 env_uv(const EnvMap* e, float3 d) {
     float c = e->info.rotation.x;
     float s = e->info.rotation.y;
     // Into the map's frame: undo the rotation about +Y.
@@ -21,6 +21,15 @@ inline float3 env_radiance(const EnvMap* e, float3 d, float* pdf) {
     float u = atan2(m.x, -m.z) * (0.5f * INV_PI_F) + 0.5f;
     float cos_theta = clamp(m.y, -1.0f, 1.0f);
     float v = acos(cos_theta) * INV_PI_F;
+    return (float3)(u, v, cos_theta);
+}
+
+// Radiance arriving from world direction d (unit), and the solid-angle pdf of sampling it.
+inline float3 env_radiance(const EnvMap* e, float3 d, float* pdf) {
+    float3 uv = env_uv(e, d);
+    float u = uv.x;
+    float v = uv.y;
+    float cos_theta = uv.z;
     uint w = e->info.width;
     uint h = e->info.height;
     uint x = min((uint)(fmax(u, 0.0f) * (float)w), w - 1u);
@@ -33,6 +42,33 @@ inline float3 env_radiance(const EnvMap* e, float3 d, float* pdf) {
                ? luminance(radiance) * sin_centre * e->info.scale.y / sin_theta
                : 0.0f;
     return radiance * e->info.scale.x;
+}
+
+inline float3 env_texel(const EnvMap* e, uint x, uint y) {
+    uint i = 3u * (y * e->info.width + x);
+    return (float3)(e->texels[i], e->texels[i + 1u], e->texels[i + 2u]);
+}
+
+// The map seen directly (by a camera ray): bilinearly filtered, so that a small map does not
+// show its texels as blocks. Lighting reads it unfiltered (env_radiance), as it samples it.
+inline float3 env_background(const EnvMap* e, float3 d) {
+    float3 uv = env_uv(e, d);
+    int w = (int)e->info.width;
+    int h = (int)e->info.height;
+    float fx = uv.x * (float)w - 0.5f;
+    float fy = uv.y * (float)h - 0.5f;
+    float x0f = floor(fx);
+    float y0f = floor(fy);
+    float tx = fx - x0f;
+    float ty = fy - y0f;
+    int x0 = (((int)x0f % w) + w) % w;
+    uint xa = (uint)x0;
+    uint xb = (uint)((x0 + 1) % w);
+    uint ya = (uint)clamp((int)y0f, 0, h - 1);
+    uint yb = (uint)clamp((int)y0f + 1, 0, h - 1);
+    float3 top = mix(env_texel(e, xa, ya), env_texel(e, xb, ya), tx);
+    float3 bottom = mix(env_texel(e, xa, yb), env_texel(e, xb, yb), tx);
+    return mix(top, bottom, ty) * e->info.scale.x;
 }
 
 // Samples a world direction in proportion to luminance x sin(theta); returns it with its

@@ -33,6 +33,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
     uint extension_rays = 0;
     uint shadow_rays = 0;
     uint nonfinite = 0;
+    uint counted = 0;  // samples whose camera ray hit (the film's .w with the background cut out)
     for (uint j = 0; j < frame.samples_in_wave; ++j) {
         PathState s = camera_path(&frame, &camera, pixel, frame.first_sample + j);
         for (uint bounce = 0; bounce <= frame.max_bounces + 1u; ++bounce) {
@@ -48,13 +49,15 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
             }
             if (!alive) break;
         }
+        counted += (s.flags & PATH_ESCAPED) == 0u;
         if (all(isfinite(s.radiance))) {
             sum += s.radiance;
         } else {
             ++nonfinite;
         }
     }
-    film[pixel] += (float4)(sum, (float)frame.samples_in_wave);
+    if (frame.background == BACKGROUND_ENV) counted = frame.samples_in_wave;
+    film[pixel] += (float4)(sum, (float)counted);
     // One atomic per work item for the statistics; `advance` moves them into the totals.
     atomic_add(&counters[COUNT_IN], extension_rays);
     atomic_add(&counters[COUNT_SHADOW], shadow_rays);

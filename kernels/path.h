@@ -18,7 +18,7 @@ typedef struct {
     float3 throughput;
     float3 radiance;    // gathered so far
     float prev_pdf;     // pdf of the BSDF sample that made the ray (0: camera ray)
-    uint flags;         // PATH_SPECULAR, PATH_THROUGH_WALL
+    uint flags;         // PATH_SPECULAR, PATH_ESCAPED, PATH_THROUGH_WALL
     uint rng;
     float2 cone;        // ray cone (width, spread angle) for texture filtering
 } PathState;
@@ -104,10 +104,17 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     global const GpuMaterial* materials = surf->materials;
 
     if (hit.prim == NO_HIT) {
+        // An escaped camera ray is marked for the film's coverage count (the film's .w then
+        // counts the samples whose camera ray hit); with the background cut out it adds nothing.
+        if (bounce == 0u && frame->background != BACKGROUND_ENV) {
+            s->flags |= PATH_ESCAPED;
+            if (frame->background == BACKGROUND_CUTOUT) return false;
+        }
 #ifdef HAS_ENV_MAP
         // Escaped into the environment map, weighted against its sampling at the last vertex.
         float env_pdf;
         float3 le = env_radiance(&sc->env, -wo, &env_pdf);
+        if (bounce == 0u) le = env_background(&sc->env, -wo);  // seen directly: filtered
         float weight = 1.0f;
         if (mis) weight = power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
         if (light_sampled_only) weight = 0.0f;

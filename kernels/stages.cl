@@ -88,6 +88,8 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
         path.direction = (float4)(s.direction, as_float(s.flags));
         path.throughput.xyz = s.throughput;
         queue_out[atomic_inc(&counters[COUNT_OUT])] = slot;
+    } else if (frame.background != BACKGROUND_ENV) {
+        path.direction.w = as_float(s.flags);  // PATH_ESCAPED for `accumulate`
     }
     paths[slot] = path;
 }
@@ -124,9 +126,9 @@ kernel void advance(global uint* counters, global ulong* stats) {
     counters[COUNT_SHADOW] = 0;
 }
 
-// Adds every finished sample of the wave to the film (.xyz radiance sum, .w sample count), in a
-// fixed order per pixel so the result does not depend on the queues' order. Non-finite samples
-// are counted and dropped.
+// Adds every finished sample of the wave to the film (.xyz radiance sum, .w sample count; with
+// coverage counted, .w counts the samples whose camera ray hit), in a fixed order per pixel
+// so the result does not depend on the queues' order. Non-finite samples are counted and dropped.
 kernel void accumulate(GpuFrame frame, global const GpuPath* paths, global float4* film,
                        volatile global uint* counters) {
     uint pixel = get_global_id(0);
@@ -141,5 +143,12 @@ kernel void accumulate(GpuFrame frame, global const GpuPath* paths, global float
             atomic_inc(&counters[COUNT_NONFINITE]);
         }
     }
-    film[pixel] += (float4)(sum, (float)frame.samples_in_wave);
+    uint counted = frame.samples_in_wave;
+    if (frame.background != BACKGROUND_ENV) {
+        counted = 0u;
+        for (uint j = 0; j < frame.samples_in_wave; ++j) {
+            counted += (as_uint(paths[pixel + j * pixels].direction.w) & PATH_ESCAPED) == 0u;
+        }
+    }
+    film[pixel] += (float4)(sum, (float)counted);
 }

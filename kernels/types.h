@@ -118,12 +118,13 @@ typedef struct {
     float4 sky;     // uniform environment radiance
     uint light_count;
     uint bounce;
-    uint pad[2];
+    uint background;  // BACKGROUND_*: what an escaped camera ray adds
+    uint pad;
 } GpuFrame;
 
 typedef struct {
     float4 origin;      // .w = pdf of the BSDF sample that made this ray (0: camera ray)
-    float4 direction;   // .w = flags (uint bits): PATH_SPECULAR, PATH_THROUGH_WALL
+    float4 direction;   // .w = flags (uint bits): PATH_SPECULAR, PATH_ESCAPED, PATH_THROUGH_WALL
     float4 throughput;  // .w = slot (uint bits): pixel + sample_in_wave * pixels
     float4 radiance;    // .w = random state (uint bits)
 } GpuPath;

@@ -6,6 +6,7 @@
 
 use crate::cl::DeviceChoice;
 use crate::cli::first_image;
+use crate::render::background::Background;
 use crate::render::exposure::ExposureMode;
 use crate::render::{BvhChoice, KernelChoice, RenderSettings, Renderer, Strategy};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
@@ -318,6 +319,16 @@ pub struct CommonArgs {
     /// Exposure.
     #[command(flatten)]
     pub exposure: ExposureArgs,
+    /// What escaped camera rays show: `env` (the environment), `transparent` (alpha 0 in the
+    /// PNG, an A channel in the EXR) or a flat color R,G,B in 0..1 (sRGB, like #RRGGBB / 255).
+    /// Lighting is the same either way.
+    #[arg(
+        long,
+        default_value = "env",
+        value_name = "env|transparent|COLOR",
+        value_parser = parse_background
+    )]
+    pub background: Background,
     /// Kernels: wavefront (queued stages per bounce), megakernel (whole paths per work item)
     /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
     #[arg(long, default_value = "auto", value_parser = parse_kernel)]
@@ -331,6 +342,10 @@ pub struct CommonArgs {
     /// triangles that instancing shrinks eightfold).
     #[arg(long, default_value = "auto")]
     pub bvh: BvhChoice,
+}
+
+fn parse_background(s: &str) -> Result<Background, String> {
+    s.parse()
 }
 
 fn parse_kernel(s: &str) -> Result<KernelChoice, String> {
@@ -405,6 +420,8 @@ impl CommonArgs {
             env_rotation: env.env_rotation,
             lens_radius: lens.aperture,
             focus_distance: lens.focus_distance.unwrap_or(1.0),
+            cutout: self.background.cutout(),
+            count_coverage: true,
             ..RenderSettings::default()
         })
     }
@@ -423,6 +440,16 @@ impl CommonArgs {
     /// first image: the automatic camera gives way to the first view, and the rule "the
     /// scene's lights light the view" decides the environment (`cli/first_image.rs`).
     pub fn prepare(&self, path: Option<&Path>) -> Result<Prepared> {
+        let aspect = match (self.size.width, self.size.height) {
+            (Some(w), Some(h)) if h > 0 => w as f64 / h as f64,
+            _ => 4.0 / 3.0,
+        };
+        self.prepare_for(path, aspect)
+    }
+
+    /// [`CommonArgs::prepare`] for an image of this width over height (the viewer's image is
+    /// the window less the overlay's panel).
+    pub fn prepare_for(&self, path: Option<&Path>, aspect: f64) -> Result<Prepared> {
         let (mut scene, load_ms) = load(path)?;
         if let Some(name) = &self.variant {
             let v = scene.variant_named(name).map_err(anyhow::Error::msg)?;
@@ -441,10 +468,6 @@ impl CommonArgs {
             Vec::new()
         } else {
             scene.lights.clone()
-        };
-        let aspect = match (self.size.width, self.size.height) {
-            (Some(w), Some(h)) if h > 0 => w as f64 / h as f64,
-            _ => 4.0 / 3.0,
         };
         let first = first_image::decide(
             &scene,

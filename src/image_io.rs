@@ -39,6 +39,22 @@ pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Resu
     .with_context(|| format!("{}: cannot write EXR", path.display()))
 }
 
+/// Writes premultiplied linear RGB with `alpha` as a float RGBA EXR.
+pub fn write_exr_rgba(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    alpha: &[f32],
+) -> Result<()> {
+    let w = width as usize;
+    exr::prelude::write_rgba_file(path, w, height as usize, |x, y| {
+        let p = rgb[y * w + x];
+        (p[0], p[1], p[2], alpha[y * w + x])
+    })
+    .with_context(|| format!("{}: cannot write EXR", path.display()))
+}
+
 /// The size of each layer of an EXR file and its chunk count, from the header alone (no pixel
 /// is read): `(width, height, chunks)` per layer.
 pub fn exr_layer_sizes(path: &Path) -> Result<Vec<(u64, u64, u64)>> {

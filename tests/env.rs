@@ -5,7 +5,7 @@
 mod common;
 
 use common::stats::chi2;
-use common::{Gltf, Prim, render_exr, sphere};
+use common::{Gltf, Prim, render_exr, white_sphere};
 use glam::Vec3;
 use penumbra::cl::DeviceChoice;
 use penumbra::render::Renderer;
@@ -161,40 +161,6 @@ fn write_env(
     let path = dir.join(format!("{name}.exr"));
     penumbra::image_io::write_exr(&path, w, h, &px).unwrap();
     path
-}
-
-/// A white (albedo 1) Lambertian sphere of radius 1 at the origin seen from z = 4; a floor
-/// below it when `floor`.
-fn white_sphere(dir: &Path, floor: bool) -> PathBuf {
-    let mut g = Gltf::default();
-    let m = g.lambert([1.0; 3], [0.0; 3], 1.0, false);
-    let (positions, normals, indices) = sphere(1.0, 32, 64, false);
-    let mut prims = vec![Prim {
-        positions,
-        normals,
-        indices,
-        material: Some(m),
-        mode: 4,
-    }];
-    if floor {
-        let gray = g.lambert([0.5; 3], [0.0; 3], 1.0, false);
-        prims.push(Prim::triangles(
-            vec![
-                [-5.0, -1.0, -5.0],
-                [5.0, -1.0, -5.0],
-                [5.0, -1.0, 5.0],
-                [-5.0, -1.0, 5.0],
-            ],
-            vec![0, 2, 1, 0, 3, 2],
-            gray,
-        ));
-    }
-    let mesh = g.mesh(prims);
-    g.node(json!({"mesh": mesh}));
-    g.cameras
-        .push(json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.01}}));
-    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 4.0]}));
-    g.write_glb(dir, if floor { "sphere-floor" } else { "sphere" })
 }
 
 #[test]

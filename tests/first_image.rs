@@ -1,5 +1,6 @@
 //! The first image of every shared scene, rendered with no options (small, few samples): not
-//! black, not blown out, the subject covering the frame, interiors seen from inside. Skipped
+//! black, not blown out, the subject covering the frame and itself well exposed (measured on the
+//! same render with the background cut out), interiors seen from inside. Skipped
 //! (with a note) when PENUMBRA_SCENES is not set.
 
 mod common;
@@ -7,7 +8,8 @@ mod common;
 use common::{output_dir, penumbra, scenes_dir};
 use std::path::PathBuf;
 
-/// The scenes, without the meshopt copy (it must fail; tests/scenes.rs checks that).
+/// The scenes, without the meshopt copy (the same model as lamborghini.glb; tests/scenes.rs
+/// renders it).
 fn scene_files() -> Vec<PathBuf> {
     let Some(dir) = scenes_dir() else {
         eprintln!("PENUMBRA_SCENES is not set: skipping the first images");
@@ -50,6 +52,27 @@ fn png_stats(path: &std::path::Path) -> (f64, f64, f64) {
     (median, clipped, black)
 }
 
+/// Statistics of the subject of a PNG rendered with `--background transparent`: the pixels
+/// with alpha ≥ 128 (camera rays mostly hit): (their share of the image, their median luma,
+/// the share of them with a channel at 255).
+fn subject_stats(path: &std::path::Path) -> (f64, f64, f64) {
+    let img = image::open(path).unwrap().into_rgba8();
+    let n = (img.width() * img.height()) as f64;
+    let subject: Vec<_> = img.pixels().filter(|p| p[3] >= 128).collect();
+    let mut luma: Vec<f64> = subject
+        .iter()
+        .map(|p| (0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64) / 255.0)
+        .collect();
+    luma.sort_by(f64::total_cmp);
+    let median = luma.get(luma.len() / 2).copied().unwrap_or(0.0);
+    let clipped = subject.iter().filter(|p| p.0[..3].contains(&255)).count() as f64;
+    (
+        subject.len() as f64 / n,
+        median,
+        clipped / subject.len().max(1) as f64,
+    )
+}
+
 #[test]
 fn every_shared_scene_opens_readable() {
     let out = output_dir("first_image");
@@ -77,15 +100,62 @@ fn every_shared_scene_opens_readable() {
         let view = &summary["first_view"];
         let coverage = view["coverage"].as_f64().unwrap();
         let (median, clipped, black) = png_stats(&png);
+        // The same render with the background cut out shows the subject alone.
+        let cut = out.join(format!("{name}-subject.png"));
+        let o = penumbra(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            cut.to_str().unwrap(),
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--spp",
+            "4",
+            "--bounces",
+            "2",
+            "--background",
+            "transparent",
+        ]);
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let (share, subject_median, subject_clipped) = subject_stats(&cut);
         eprintln!(
             "{name}: median luma {median:.2}, clipped {:.0}%, black {:.0}%, coverage {:.0}%, \
-             interior {}, env {}",
+             interior {}, env {}; subject {:.0}% of the frame, median luma {subject_median:.2}, \
+             clipped {:.0}%",
             clipped * 100.0,
             black * 100.0,
             coverage * 100.0,
             view["interior"],
-            summary["environment"]
+            summary["environment"],
+            share * 100.0,
+            subject_clipped * 100.0,
         );
+        // The subject itself is exposed: neither dark nor washed out, little of it clipped. (At
+        // 4 spp dark noise pulls the metered key down, so bright subjects (a lime car, an
+        // emitting ball) show a median up to about 0.85; clipping is what marks blown out.)
+        if !(0.12..=0.88).contains(&subject_median) {
+            failures.push(format!(
+                "{name}: the subject's median luma is {subject_median:.2}"
+            ));
+        }
+        if subject_clipped > 0.12 {
+            failures.push(format!(
+                "{name}: {:.0}% of the subject clips",
+                subject_clipped * 100.0
+            ));
+        }
+        if share < 0.12 {
+            failures.push(format!(
+                "{name}: the subject fills {:.0}% of the frame",
+                share * 100.0
+            ));
+        }
         if !(0.05..=0.85).contains(&median) {
             failures.push(format!(
                 "{name}: median luma {median:.2} (too dark or too bright)"

@@ -96,6 +96,22 @@ impl Xvfb {
         panic!("no free X display number in {base}..{}", base + 40);
     }
 
+    /// What the window `wid` shows, grabbed from the X server with ImageMagick's `import`.
+    fn window_image(&self, wid: &str, dir: &Path) -> Gray {
+        let png = dir.join(format!("window-{wid}.png"));
+        let o = Command::new("import")
+            .args(["-window", wid, png.to_str().unwrap()])
+            .env("DISPLAY", &self.display)
+            .output()
+            .expect("ImageMagick's import runs");
+        assert!(
+            o.status.success(),
+            "import failed: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        load(&png)
+    }
+
     /// Runs xdotool on this display; returns its stdout.
     fn xdotool(&self, args: &[&str]) -> String {
         let o = Command::new("xdotool")
@@ -363,6 +379,37 @@ fn picture_difference(a: &Gray, b: &Gray) -> f32 {
     a.iter().zip(&b).map(|(p, q)| (p - q).abs()).sum::<f32>() / a.len() as f32
 }
 
+/// A PNG's width and height.
+fn png_size(path: &Path) -> (u32, u32) {
+    image::image_dimensions(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+impl Gray {
+    /// The `w`×`h` part at (`x`, `y`).
+    fn crop(&self, x: usize, y: usize, w: usize, h: usize) -> Gray {
+        let pixels = (y..y + h)
+            .flat_map(|r| self.pixels[r * self.width + x..][..w].iter().copied())
+            .collect();
+        Gray {
+            width: w,
+            height: h,
+            pixels,
+        }
+    }
+
+    /// Mean absolute difference per pixel.
+    fn mean_abs_difference(&self, other: &Gray) -> f32 {
+        assert_eq!((self.width, self.height), (other.width, other.height));
+        let sum: f32 = self
+            .pixels
+            .iter()
+            .zip(&other.pixels)
+            .map(|(a, b)| (a - b).abs())
+            .sum();
+        sum / self.pixels.len() as f32
+    }
+}
+
 /// Whether two PNGs hold the same pixels.
 fn same_pixels(a: &Path, b: &Path) -> bool {
     let load = |p: &Path| image::open(p).expect("a PNG").to_rgba8().into_raw();
@@ -398,6 +445,7 @@ fn frames_and_screenshot_save_the_final_frame_and_hard_shadows_are_sharper() {
     let _serial = serial();
     let Some(x) = Xvfb::start() else { return };
     let dir = tempfile::tempdir().unwrap();
+    // Without the overlay the image is the whole window.
     let common = [
         "--width",
         "320",
@@ -409,6 +457,7 @@ fn frames_and_screenshot_save_the_final_frame_and_hard_shadows_are_sharper() {
         "48",
         "--frames",
         "2",
+        "--no-overlay",
     ];
     let mut shots = Vec::new();
     for (name, extra) in [("soft", None), ("hard", Some("--hard-shadows"))] {
@@ -425,7 +474,7 @@ fn frames_and_screenshot_save_the_final_frame_and_hard_shadows_are_sharper() {
             String::from_utf8_lossy(&o.stderr)
         );
         assert!(
-            stdout.contains("(48 spp)"),
+            stdout.contains("(320×240, 48 spp)"),
             "{name}: not converged: {stdout}"
         );
         println!("{name}: {:.1} s", t.elapsed().as_secs_f64());
@@ -447,8 +496,8 @@ fn frames_and_screenshot_save_the_final_frame_and_hard_shadows_are_sharper() {
 #[test]
 fn keys_and_mouse_drive_the_window() {
     let _serial = serial();
-    if !have("xdotool") {
-        skip("xdotool is not installed (apt-get install xdotool)");
+    if !have("xdotool") || !have("import") {
+        skip("xdotool or ImageMagick is not installed (apt-get install xdotool imagemagick)");
         return;
     }
     let Some(x) = Xvfb::start() else { return };
@@ -463,6 +512,7 @@ fn keys_and_mouse_drive_the_window() {
         "1",
         "--spp",
         "48",
+        "--no-overlay",
         "--screenshot",
         last.to_str().unwrap(),
     ];
@@ -479,11 +529,11 @@ fn keys_and_mouse_drive_the_window() {
         t.elapsed().as_secs_f64()
     );
 
-    // Hide the overlay so the mouse reaches the image; F12 saves what is on screen.
-    x.xdotool(&["key", "Tab"]);
+    // The overlay is hidden (--no-overlay): the image fills the window; F12 saves exactly it.
     x.xdotool(&["key", "F12"]);
     let soft = v.screenshot_path(dir.path());
     load(&soft).assert_not_blank("the first screenshot");
+    assert_eq!(png_size(&soft), (320, 240));
 
     // H switches to hard shadows: the accumulation restarts and the edges sharpen.
     x.xdotool(&["key", "h"]);
@@ -525,15 +575,33 @@ fn keys_and_mouse_drive_the_window() {
     assert!(turn > 0.02, "the mouse drag did not turn the view ({turn})");
     load(&turned).assert_not_blank("the turned view");
 
-    // Show the overlay again and click its Screenshot button (top left of the top bar): the
-    // PNG holds the image without the overlay, so it equals the last one.
+    // Tab shows the overlay: a side panel of fixed width, the image laid out beside it (the
+    // film is re-rendered at the size of the rest of the window, so nothing is letterboxed).
     x.xdotool(&["key", "Tab"]);
-    std::thread::sleep(Duration::from_millis(300));
+    v.wait_for("reached 48 spp");
+    // Its Screenshot button (top left of the panel) saves the image without the panel.
     x.xdotool(&["mousemove", "--window", &wid, "40", "11", "click", "1"]);
     let button = v.screenshot_path(dir.path());
-    assert_ne!(button, turned);
+    let (w, h) = png_size(&button);
+    assert_eq!(h, 240);
     assert!(
-        same_pixels(&button, &turned),
+        (100..240).contains(&w),
+        "the image beside the panel is {w} wide"
+    );
+    // The window shows that image, unscaled and uncovered, right of the panel.
+    let window = x.window_image(&wid, dir.path());
+    let shown = window.crop(320 - w as usize, 0, w as usize, h as usize);
+    let on_screen = shown.mean_abs_difference(&load(&button));
+    println!("image beside the panel: {w}×{h}, differs from the PNG by {on_screen:.4}");
+    assert!(
+        on_screen < 0.01,
+        "the window does not show the saved image beside the panel ({on_screen})"
+    );
+    x.xdotool(&["key", "F12"]);
+    let key = v.screenshot_path(dir.path());
+    assert_ne!(button, key, "screenshots must not overwrite each other");
+    assert!(
+        same_pixels(&button, &key),
         "the button's screenshot differs from F12's (overlay in the image?)"
     );
 
@@ -542,6 +610,6 @@ fn keys_and_mouse_drive_the_window() {
     let status = v.wait_exit();
     assert!(status.success(), "exit status {status}");
     assert!(last.exists() && last.with_extension("exr").exists());
-    assert!(same_pixels(&last, &turned), "the final frame differs");
+    assert!(same_pixels(&last, &key), "the final frame differs");
     println!("total {:.1} s", t.elapsed().as_secs_f64());
 }

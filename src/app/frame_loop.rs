@@ -75,6 +75,11 @@ pub struct Film {
     pub height: u32,
     /// Linear radiance, rows from the top.
     pub pixels: Vec<[f32; 3]>,
+    /// Each pixel's coverage (`Renderer::coverage`) when the renderer counts it; else empty.
+    pub coverage: Vec<f32>,
+    /// The background is cut out (`RenderSettings::cutout`): `pixels` is premultiplied by
+    /// `coverage`.
+    pub cutout: bool,
     /// Samples per pixel in it.
     pub spp: u32,
     /// Resolution divisor it was rendered at.
@@ -145,6 +150,12 @@ impl FrameLoop {
         }
     }
 
+    /// Whether the next step builds kernels: the first load, or a scene change that needs a
+    /// kernel variant not built yet (a prediction from the scene's materials).
+    pub fn builds_next(&self, scene: &Scene) -> bool {
+        !self.loaded || self.pending.scene && self.renderer.would_build_for(scene)
+    }
+
     /// Records changes to apply before the next batch.
     pub fn invalidate(&mut self, changes: Changes) {
         self.pending.merge(changes);
@@ -204,7 +215,7 @@ impl FrameLoop {
         };
         self.renderer.finish()?;
         let ms = batch.started.elapsed().as_secs_f64() * 1e3;
-        let settings = self.renderer.settings();
+        let settings = self.renderer.settings().clone();
         let size = (settings.width, settings.height);
         self.budget
             .record(batch.plan.divisor, pixel_count(size), batch.plan.spp, ms);
@@ -213,6 +224,12 @@ impl FrameLoop {
             width: size.0,
             height: size.1,
             pixels: self.renderer.image()?,
+            coverage: if settings.cutout || settings.count_coverage {
+                self.renderer.coverage()?
+            } else {
+                Vec::new()
+            },
+            cutout: settings.cutout,
             spp,
             divisor: batch.plan.divisor,
         };

@@ -61,6 +61,11 @@ impl Framework {
         self.state.on_window_event(window, event).consumed
     }
 
+    /// Physical pixels per point.
+    pub fn pixels_per_point(&self) -> f32 {
+        self.screen.pixels_per_point
+    }
+
     /// Follows a window resize.
     pub fn resize(&mut self, width: u32, height: u32) {
         if width > 0 && height > 0 {

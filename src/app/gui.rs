@@ -6,6 +6,7 @@ use super::camera::{CameraController, Mode};
 use super::frame_loop::{Changes, Film, Progress};
 use super::state::ViewState;
 use crate::render::SceneStats;
+use crate::render::background::Background;
 use crate::render::exposure::AutoExposure;
 use crate::render::tonemap::ToneMapper;
 use crate::scene::{EnvPreset, LightPreset, Scene};
@@ -78,9 +79,12 @@ pub struct Actions {
 }
 
 /// A line in the middle of the window (e.g. while the kernels build).
-pub fn notice(ctx: &egui::Context, text: &str) {
+pub fn notice(ctx: &egui::Context, text: &str, panel_width: f32) {
     egui::Area::new(egui::Id::new("notice"))
-        .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+        .anchor(
+            egui::Align2::CENTER_CENTER,
+            egui::vec2(0.5 * panel_width, 0.0),
+        )
         .interactable(false)
         .show(ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| {
@@ -163,25 +167,29 @@ impl Gui {
         }
     }
 
-    /// Draws the overlay; returns what the user asked for.
+    /// Draws the overlay, a side panel of fixed width ([`super::layout::panel_points`]) left of
+    /// the image; returns what the user asked for.
     pub fn ui(&mut self, ui: &mut Ui, m: &mut Model, info: &Info) -> Actions {
         let mut actions = Actions::default();
-        egui::Panel::top("penumbra-bar").show(ui, |ui| {
-            self.bar(ui, m, info, &mut actions);
-        });
-        let height = ui.ctx().content_rect().height();
-        egui::Window::new("Controls")
-            .default_pos([8.0, 44.0])
-            .default_width(290.0)
-            .default_height((height - 60.0).max(120.0))
-            .vscroll(true)
-            .show(ui.ctx(), |ui| {
-                self.render_section(ui, m, &mut actions);
-                self.camera_section(ui, m, &mut actions);
-                self.lights_section(ui, m, &mut actions);
-                self.scene_section(ui, m, info, &mut actions);
-                stats_section(ui, m, info);
-                controls_section(ui);
+        let width = super::layout::panel_points(ui.ctx().content_rect().width());
+        egui::Panel::left("penumbra-panel")
+            .resizable(false)
+            .exact_size(width)
+            .show(ui, |ui| {
+                self.bar(ui, m, info, &mut actions);
+                ui.separator();
+                egui::ScrollArea::vertical()
+                    .id_salt("panel")
+                    .auto_shrink([false, false])
+                    .show(ui, |ui| {
+                        // Statistics first: visible without scrolling in a 600 px window.
+                        stats_section(ui, m, info);
+                        self.render_section(ui, m, &mut actions);
+                        self.camera_section(ui, m, &mut actions);
+                        self.lights_section(ui, m, &mut actions);
+                        self.scene_section(ui, m, info, &mut actions);
+                        controls_section(ui);
+                    });
             });
         actions
     }
@@ -191,37 +199,23 @@ impl Gui {
             if ui.button("📷 Screenshot (F12)").clicked() {
                 actions.screenshot = true;
             }
-            if ui
-                .checkbox(&mut m.view.shadows.hard, "Hard shadows (H)")
-                .changed()
-            {
-                actions.changes.lights = true;
-            }
-            for mode in [Mode::Fly, Mode::Orbit] {
-                if ui
-                    .selectable_label(m.camera.mode == mode, mode.name())
-                    .clicked()
-                {
-                    m.camera.set_mode(mode);
-                }
-            }
             if ui.button("Hide (Tab)").clicked() {
                 actions.hide_overlay = true;
             }
-            let target = m
-                .view
-                .spp_target
-                .map_or_else(|| "∞".to_string(), |t| t.to_string());
-            ui.label(format!(
-                "{} / {target} spp · {:.2} MS/s · {:.0} fps",
-                info.progress.spp,
-                info.progress.samples_per_second * 1e-6,
-                info.fps
-            ));
-            if let Some(e) = info.device_error {
-                ui.label(RichText::new(format!("device error: {e}")).color(Color32::LIGHT_RED));
-            }
         });
+        let target = m
+            .view
+            .spp_target
+            .map_or_else(|| "∞".to_string(), |t| t.to_string());
+        ui.label(format!(
+            "{} / {target} spp · {:.2} MS/s · {:.0} fps",
+            info.progress.spp,
+            info.progress.samples_per_second * 1e-6,
+            info.fps
+        ));
+        if let Some(e) = info.device_error {
+            ui.label(RichText::new(format!("device error: {e}")).color(Color32::LIGHT_RED));
+        }
     }
 
     fn render_section(&mut self, ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
@@ -235,7 +229,7 @@ impl Gui {
                 {
                     actions.changes.settings = true;
                 }
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     let mut endless = v.spp_target.is_none();
                     if ui.checkbox(&mut endless, "endless").changed() {
                         v.spp_target = if endless { None } else { Some(256) };
@@ -249,7 +243,7 @@ impl Gui {
                         );
                     }
                 });
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     ui.label("sky");
                     if ui.color_edit_button_rgb(&mut v.sky).changed() {
                         actions.changes.settings = true;
@@ -273,7 +267,7 @@ impl Gui {
                         actions.changes.settings = true;
                     }
                 });
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     ui.label("environment");
                     for p in EnvPreset::ALL {
                         let on = self.env_name.as_deref() == Some(p.name());
@@ -286,7 +280,7 @@ impl Gui {
                         actions.environment = Some(EnvSource::None);
                     }
                 });
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     ui.label("file");
                     let field = ui.add(
                         egui::TextEdit::singleline(&mut self.env_text)
@@ -308,50 +302,74 @@ impl Gui {
                     ui.label(RichText::new(e).color(Color32::LIGHT_RED));
                 }
                 if self.env_name.is_some() {
-                    ui.horizontal(|ui| {
-                        let i = ui.add(
-                            egui::DragValue::new(&mut v.env_intensity)
-                                .range(0.0..=1.0e6)
-                                .speed(0.01)
-                                .prefix("intensity × "),
-                        );
-                        let r = ui.add(
-                            egui::Slider::new(&mut v.env_rotation, -180.0..=180.0)
-                                .text("rotation (°)"),
-                        );
-                        if i.changed() || r.changed() {
-                            actions.changes.settings = true;
-                        }
-                    });
+                    let i = ui.add(
+                        egui::DragValue::new(&mut v.env_intensity)
+                            .range(0.0..=1.0e6)
+                            .speed(0.01)
+                            .prefix("environment intensity × "),
+                    );
+                    let r = ui.add(
+                        egui::Slider::new(&mut v.env_rotation, -180.0..=180.0).text("rotation °"),
+                    );
+                    if i.changed() || r.changed() {
+                        actions.changes.settings = true;
+                    }
                 }
                 ui.horizontal(|ui| {
                     let mut auto = v.auto_exposure.is_some();
                     if ui.checkbox(&mut auto, "auto").changed() {
                         v.auto_exposure = auto.then(AutoExposure::default);
                     }
-                    let s = ui.add(
-                        egui::Slider::new(&mut v.exposure, -24.0..=24.0).text("exposure (stops)"),
-                    );
+                    let s = ui.add(egui::Slider::new(&mut v.exposure, -24.0..=24.0).text("stops"));
                     if s.changed() {
                         v.auto_exposure = None;
                     }
+                })
+                .response
+                .on_hover_text("exposure: automatic (metered on the image) or in stops");
+                ui.horizontal_wrapped(|ui| {
+                    ui.label("tone mapper");
+                    for t in ToneMapper::ALL {
+                        ui.selectable_value(&mut v.tone_mapper, t, t.name());
+                    }
                 });
-                egui::ComboBox::from_label("tone mapper")
-                    .selected_text(v.tone_mapper.name())
-                    .show_ui(ui, |ui| {
-                        for t in ToneMapper::ALL {
-                            ui.selectable_value(&mut v.tone_mapper, t, t.name());
-                        }
-                    });
+                ui.horizontal_wrapped(|ui| {
+                    ui.label("background");
+                    let b = &mut v.background;
+                    let before = *b;
+                    if ui.selectable_label(*b == Background::Env, "env").clicked() {
+                        *b = Background::Env;
+                    }
+                    if ui
+                        .selectable_label(*b == Background::Transparent, "transparent")
+                        .clicked()
+                    {
+                        *b = Background::Transparent;
+                    }
+                    let mut color = match *b {
+                        Background::Color(c) => c,
+                        _ => [1.0; 3],
+                    };
+                    let is_color = matches!(*b, Background::Color(_));
+                    if ui.selectable_label(is_color, "color").clicked() {
+                        *b = Background::Color(color);
+                    }
+                    if is_color && ui.color_edit_button_rgb(&mut color).changed() {
+                        *b = Background::Color(color);
+                    }
+                    if b.cutout() != before.cutout() {
+                        actions.changes.settings = true;
+                    }
+                });
             });
     }
 
     fn camera_section(&mut self, ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
         egui::CollapsingHeader::new("Camera")
-            .default_open(true)
+            .default_open(false)
             .show(ui, |ui| {
                 let c: &mut CameraController = &mut m.camera;
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     ui.label("mode (O)");
                     for mode in [Mode::Fly, Mode::Orbit] {
                         if ui.radio(c.mode == mode, mode.name()).clicked() {
@@ -373,14 +391,14 @@ impl Gui {
                 }
                 let mut fov = c.camera.yfov.to_degrees();
                 if ui
-                    .add(egui::Slider::new(&mut fov, 5.0..=150.0).text("field of view (°)"))
+                    .add(egui::Slider::new(&mut fov, 5.0..=150.0).text("fov °"))
                     .changed()
                 {
                     c.camera.yfov = fov.to_radians();
                     actions.changes.camera = true;
                 }
                 let v = &mut m.view;
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     ui.label("lens");
                     let size = v.diagonal() as f32;
                     let a = ui
@@ -405,7 +423,7 @@ impl Gui {
                     }
                 });
                 let c: &mut CameraController = &mut m.camera;
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     ui.label("fly speed");
                     let speed = c.speed;
                     ui.add(
@@ -427,14 +445,15 @@ impl Gui {
     }
 
     fn lights_section(&mut self, ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
-        if super::light_editor::lights_section(ui, &mut self.preset, &mut m.view) {
+        if super::light_editor::lights_section(ui, &mut self.preset, &mut m.view, &m.camera.camera)
+        {
             actions.changes.lights = true;
         }
     }
 
     fn scene_section(&mut self, ui: &mut Ui, m: &mut Model, info: &Info, actions: &mut Actions) {
         egui::CollapsingHeader::new("Scene")
-            .default_open(true)
+            .default_open(false)
             .show(ui, |ui| {
                 ui.add(egui::Label::new(m.scene.source.as_str()).truncate());
                 ui.horizontal(|ui| {
@@ -629,7 +648,8 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
                     ui.label("ms / spp");
                     ui.end_row();
                     let spp = p.spp.max(1) as f64;
-                    for (stage, ms) in &p.stats.stage_ms {
+                    // Stages that did not run (the other kernel shape's) are left out.
+                    for (stage, ms) in p.stats.stage_ms.iter().filter(|(_, ms)| *ms > 0.0) {
                         ui.label(*stage);
                         ui.label(format!("{ms:.1}"));
                         ui.label(format!("{:.2}", ms / spp));

@@ -162,14 +162,11 @@ impl App {
         let Some(host) = self.frame_loop.renderer.host_scene() else {
             return;
         };
-        let (w, h) = (self.size.0 as f32, self.size.1 as f32);
-        let hit = pick::pick(
-            host,
-            &self.model.camera.camera,
-            w / h,
-            x as f32 / w,
-            y as f32 / h,
-        );
+        let area = self.image_area();
+        let Some((u, v)) = area.image_position(x, y) else {
+            return;
+        };
+        let hit = pick::pick(host, &self.model.camera.camera, area.aspect(), u, v);
         log::debug!("pick at ({x:.0}, {y:.0}): {hit:?}");
         match hit {
             Some(hit) => {

@@ -2,16 +2,21 @@
 //! position, direction, cone, color, intensity and radius of each light of the rig.
 
 use super::state::{NewLight, RigLight, ViewState};
-use crate::scene::{LightKind, LightPreset};
+use crate::scene::{Camera, LightKind, LightPreset};
 use egui::Ui;
 use glam::DVec3;
 
 /// The "Shadows & lights" section: hard shadows, the light radius, presets, and one editor per
 /// light of the rig; returns whether the rendered lights changed.
-pub fn lights_section(ui: &mut Ui, preset: &mut LightPreset, v: &mut ViewState) -> bool {
+pub fn lights_section(
+    ui: &mut Ui,
+    preset: &mut LightPreset,
+    v: &mut ViewState,
+    camera: &Camera,
+) -> bool {
     let mut changed = false;
     egui::CollapsingHeader::new("Shadows & lights")
-        .default_open(true)
+        .default_open(false)
         .show(ui, |ui| {
             if ui
                 .checkbox(&mut v.shadows.hard, "hard shadows (H)")
@@ -31,15 +36,15 @@ pub fn lights_section(ui: &mut Ui, preset: &mut LightPreset, v: &mut ViewState) 
             {
                 changed = true;
             }
+            // The presets as a list in place (a drop-down would cover the controls below).
+            ui.horizontal_wrapped(|ui| {
+                ui.label("preset");
+                for p in LightPreset::ALL {
+                    ui.selectable_value(preset, p, p.name());
+                }
+            });
             ui.horizontal(|ui| {
-                egui::ComboBox::from_id_salt("preset")
-                    .selected_text(preset.name())
-                    .show_ui(ui, |ui| {
-                        for p in LightPreset::ALL {
-                            ui.selectable_value(preset, p, p.name());
-                        }
-                    });
-                if ui.button("replace").clicked() {
+                if ui.button("replace the lights").clicked() {
                     v.apply_preset(*preset, true);
                     changed = true;
                 }
@@ -52,7 +57,7 @@ pub fn lights_section(ui: &mut Ui, preset: &mut LightPreset, v: &mut ViewState) 
                 ui.label("add");
                 for kind in NewLight::ALL {
                     if ui.button(kind.name()).clicked() {
-                        v.add_light(kind);
+                        v.add_light(kind, camera);
                         changed = true;
                     }
                 }
@@ -105,7 +110,7 @@ fn light_editor(ui: &mut Ui, l: &mut RigLight, radius: f32, hard: bool, size: f6
     let mut changed = false;
     let light = &mut l.light;
     if light.kind != LightKind::Directional {
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label("position");
             for c in [
                 &mut light.position.x,
@@ -123,7 +128,7 @@ fn light_editor(ui: &mut Ui, l: &mut RigLight, radius: f32, hard: bool, size: f6
         let d = light.direction.normalize_or(DVec3::NEG_Y);
         let mut elevation = d.y.clamp(-1.0, 1.0).asin().to_degrees();
         let mut azimuth = d.x.atan2(d.z).to_degrees();
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label("direction");
             let a = ui.add(
                 egui::DragValue::new(&mut azimuth)
@@ -148,7 +153,7 @@ fn light_editor(ui: &mut Ui, l: &mut RigLight, radius: f32, hard: bool, size: f6
     }
     if let LightKind::Spot { inner, outer } = &mut light.kind {
         let mut deg = [inner.to_degrees(), outer.to_degrees()];
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label("cone");
             let a = ui.add(
                 egui::DragValue::new(&mut deg[0])
@@ -169,7 +174,7 @@ fn light_editor(ui: &mut Ui, l: &mut RigLight, radius: f32, hard: bool, size: f6
             }
         });
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("color");
         changed |= ui.color_edit_button_rgb(&mut light.color).changed();
         let speed = (light.intensity.abs() * 0.01).max(1e-3);
@@ -182,7 +187,7 @@ fn light_editor(ui: &mut Ui, l: &mut RigLight, radius: f32, hard: bool, size: f6
             )
             .changed();
     });
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         let unit = if light.kind == LightKind::Directional {
             " rad"
         } else {

@@ -120,7 +120,7 @@ impl App {
             return;
         };
         self.autofocus = false;
-        let aspect = self.size.0 as f32 / self.size.1.max(1) as f32;
+        let aspect = self.image_area().aspect();
         if let Some(hit) = pick::pick(host, &self.model.camera.camera, aspect, 0.5, 0.5) {
             self.focus_at(hit.point);
         }

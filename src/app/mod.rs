@@ -8,6 +8,7 @@ mod frame_loop;
 mod framework;
 mod gui;
 mod input;
+mod layout;
 mod light_editor;
 mod loading;
 mod pick;
@@ -15,7 +16,8 @@ mod screenshot;
 mod state;
 
 use crate::cl::DeviceChoice;
-use crate::render::exposure::{ExposureMode, meter};
+use crate::render::background::{Background, unpremultiply};
+use crate::render::exposure::{ExposureMode, meter_subject};
 use crate::render::tonemap::{ToneMapper, to_rgba8};
 use crate::render::{RenderSettings, Renderer};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows};
@@ -99,6 +101,8 @@ pub struct ViewerConfig {
     pub env_lights: bool,
     /// How the exposure is chosen: metered on the film, or fixed.
     pub exposure: ExposureMode,
+    /// What escaped camera rays show (`--background`).
+    pub background: Background,
     /// Focus the lens on what the image centre sees once the scene is on the device (a lens
     /// without a focus distance).
     pub autofocus: bool,
@@ -106,6 +110,19 @@ pub struct ViewerConfig {
     pub frames: Option<u64>,
     /// Save the final frame to this PNG path on exit (for tests), an EXR beside it.
     pub screenshot: Option<PathBuf>,
+    /// Show the overlay at the start.
+    pub overlay: bool,
+}
+
+/// The image's width over height in a window of `size` pixels, beside the overlay's panel
+/// when `overlay` (at one pixel per point), for framing the first view.
+pub fn image_aspect(size: (u32, u32), overlay: bool) -> f64 {
+    let panel = if overlay {
+        layout::panel_points(size.0 as f32) as u32
+    } else {
+        0
+    };
+    layout::ImageArea::new(size, panel).aspect() as f64
 }
 
 /// Checks what needs no scene before one is loaded: that there is a display to open a window
@@ -152,6 +169,8 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         &config.lights,
         bounds,
     );
+    let mut view = view;
+    view.background = config.background;
     let camera = CameraController::new(config.camera, &bounds);
     let path_text = config
         .path
@@ -170,7 +189,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         screenshot_on_exit: config.screenshot,
         gfx: None,
         input: Input::default(),
-        overlay: true,
+        overlay: config.overlay,
         last_motion: None,
         last_redraw: Instant::now(),
         wake: None,
@@ -179,6 +198,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         fps: 0.0,
         display: Vec::new(),
         display_key: None,
+        display_generation: 0,
         loader: None,
         device_error: None,
         fatal: None,
@@ -188,6 +208,8 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         autofocus: config.autofocus,
         env_lights: config.env_lights,
         notice_frames: 0,
+        deferred_env: None,
+        frame_key: None,
     };
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.fatal.take() {
@@ -262,8 +284,10 @@ struct App {
     fps: f64,
     /// The film tone-mapped (RGBA8), as on screen.
     display: Vec<u8>,
-    /// Exposure, tone mapper and samples of `display`.
-    display_key: Option<(f32, ToneMapper, u32, usize)>,
+    /// Exposure, tone mapper, samples, size and background of `display`.
+    display_key: Option<(f32, ToneMapper, u32, usize, u64)>,
+    /// Counts the changes of `display`.
+    display_generation: u64,
     /// The scene file being loaded in the background.
     loader: Option<Loader>,
     device_error: Option<String>,
@@ -277,9 +301,13 @@ struct App {
     autofocus: bool,
     /// `--env` lights the scene: files without lights get no default rig.
     env_lights: bool,
-    /// Frames saying "Compiling kernels…" shown before the first scene's (blocking) upload and
-    /// kernel build: egui lays a new area out unseen in its first frame, so it takes two.
+    /// Frames drawn saying "Compiling kernels…" before a (blocking) kernel build: egui lays a
+    /// new area out unseen in its first frame, so the build waits until one was shown.
     notice_frames: u8,
+    /// An environment the overlay asked for whose kernels build after the notice is shown.
+    deferred_env: Option<gui::EnvSource>,
+    /// The display generation, image area and window size the frame buffer was composed for.
+    frame_key: Option<(u64, layout::ImageArea, (u32, u32))>,
 }
 
 impl ApplicationHandler for App {
@@ -422,7 +450,8 @@ impl App {
             || self.last_motion.is_some_and(|t| now - t < MOVING_FOR)
     }
 
-    /// Saves the frame on screen (PNG) and the film (EXR) into `screenshots/`.
+    /// Saves the image on screen (PNG, exactly the film: the panel and nothing else around it)
+    /// and the film (EXR) into `screenshots/` under a new name.
     fn screenshot(&mut self) {
         let film = &self.frame_loop.film;
         if film.pixels.is_empty() || self.display.len() != film.pixels.len() * 4 {
@@ -434,13 +463,16 @@ impl App {
             height: film.height,
             rgba: &self.display,
             linear: &film.pixels,
+            coverage: film.cutout.then_some(film.coverage.as_slice()),
         };
         match screenshot::save_timestamped(Path::new(screenshot::FOLDER), &shot) {
             Ok(png) => {
                 println!(
-                    "penumbra: saved {} and {}",
+                    "penumbra: saved {} and {} ({}×{})",
                     png.display(),
-                    png.with_extension("exr").display()
+                    png.with_extension("exr").display(),
+                    film.width,
+                    film.height
                 );
                 self.last_screenshot = Some(png);
             }
@@ -457,22 +489,22 @@ impl App {
         if film.pixels.is_empty() {
             bail!("--screenshot {}: no frame was rendered", path.display());
         }
-        let rgba = to_rgba8(
-            &film.pixels,
-            self.model.view.exposure,
-            self.model.view.tone_mapper,
-        );
+        let v = &self.model.view;
+        let rgba = display_rgba(film, v.exposure, v.tone_mapper, v.background);
         let shot = screenshot::Shot {
             width: film.width,
             height: film.height,
             rgba: &rgba,
             linear: &film.pixels,
+            coverage: film.cutout.then_some(film.coverage.as_slice()),
         };
         let exr = screenshot::save_at(path, &shot)?;
         println!(
-            "penumbra: saved {} and {} ({} spp)",
+            "penumbra: saved {} and {} ({}×{}, {} spp)",
             path.display(),
             exr.display(),
+            film.width,
+            film.height,
             film.spp
         );
         Ok(())
@@ -497,15 +529,21 @@ impl App {
         let screenshot = actions.screenshot;
         self.apply(actions, now);
 
-        // Collect a finished batch and start the next one before showing this image. The first
-        // step builds the kernels and blocks for seconds with a cold cache: show a frame that
-        // says so first.
-        let new_image = if self.frame_loop.first_load() && self.notice_frames < 2 {
-            self.notice_frames += 1;
+        // Collect a finished batch and start the next one before showing this image. A step (or
+        // an environment change) that builds kernels blocks for seconds with a cold cache: show
+        // two frames that say so first.
+        let new_image = if self.builds_next() && self.notice_frames <= 2 {
             self.wake = Some(now);
             false
         } else {
-            self.step_frame_loop(now)
+            if let Some(env) = self.deferred_env.take() {
+                self.set_environment(env);
+            }
+            let new = self.step_frame_loop(now);
+            if !self.builds_next() {
+                self.notice_frames = 0;
+            }
+            new
         };
         self.autofocus_once();
         self.update_display(new_image);
@@ -526,6 +564,7 @@ impl App {
     /// Runs the overlay (it edits the model) and a mouse press held back for it; `None` without
     /// a window.
     fn overlay_pass(&mut self, now: Instant) -> Option<gui::Actions> {
+        let compiling = self.device_error.is_none() && self.builds_next();
         let gfx = self.gfx.as_mut()?;
         let info = Info {
             device: &self.device,
@@ -540,15 +579,22 @@ impl App {
         };
         let mut actions = gui::Actions::default();
         let (overlay, gui, model) = (self.overlay, &mut self.gui, &mut self.model);
-        let compiling = self.frame_loop.first_load() && self.device_error.is_none();
+        let panel = if overlay {
+            layout::panel_points(self.size.0 as f32 / gfx.framework.pixels_per_point())
+        } else {
+            0.0
+        };
         let repaint = gfx.framework.prepare(&gfx.window, |ui| {
             if overlay {
                 actions = gui.ui(ui, model, &info);
             }
             if compiling {
-                gui::notice(ui.ctx(), "Compiling kernels…");
+                gui::notice(ui.ctx(), "Compiling kernels…", panel);
             }
         });
+        if compiling {
+            self.notice_frames = self.notice_frames.saturating_add(1);
+        }
         self.wake = now.checked_add(repaint);
         if let Some(button) = self.input.press.take()
             && !(overlay && gfx.framework.context().is_pointer_over_egui())
@@ -576,7 +622,14 @@ impl App {
             self.open(path);
         }
         if let Some(env) = actions.environment {
-            self.set_environment(env);
+            // Applied in `redraw` once the "Compiling kernels…" notice is on screen if the
+            // change builds kernels, else at once.
+            let on = env != gui::EnvSource::None;
+            if self.frame_loop.renderer.would_build_for_env(on) {
+                self.deferred_env = Some(env);
+            } else {
+                self.set_environment(env);
+            }
         }
     }
 
@@ -590,7 +643,7 @@ impl App {
             scene: &self.model.scene,
             lights: &self.lights,
             camera: &self.model.camera.camera,
-            settings: self.model.view.render_settings(self.size),
+            settings: self.model.view.render_settings(self.image_area().size()),
             spp_target: self.model.view.spp_target,
             moving: self.moving(now),
         };
@@ -646,9 +699,33 @@ impl App {
         }
     }
 
-    /// Tone-maps the film into the window's frame when the film, the exposure or the tone
-    /// mapper changed.
+    /// Whether the next frame-loop step (or a deferred environment) builds kernels.
+    fn builds_next(&self) -> bool {
+        self.frame_loop.builds_next(&self.model.scene)
+            || self.deferred_env.as_ref().is_some_and(|e| {
+                self.frame_loop
+                    .renderer
+                    .would_build_for_env(*e != gui::EnvSource::None)
+            })
+    }
+
+    /// Where the image goes in the window: right of the overlay's panel (all of it without).
+    fn image_area(&self) -> layout::ImageArea {
+        let panel = match (&self.gfx, self.overlay) {
+            (Some(gfx), true) => {
+                let ppp = gfx.framework.pixels_per_point();
+                (layout::panel_points(self.size.0 as f32 / ppp) * ppp).round() as u32
+            }
+            _ => 0,
+        };
+        layout::ImageArea::new(self.size, panel)
+    }
+
+    /// Tone-maps the film when the film, the exposure, the tone mapper or the background
+    /// changed, and composes the window's frame (the image beside the panel) when that or the
+    /// layout changed.
     fn update_display(&mut self, new_image: bool) {
+        let area = self.image_area();
         let Some(gfx) = self.gfx.as_mut() else {
             return;
         };
@@ -657,29 +734,75 @@ impl App {
             return;
         }
         if new_image && let Some(auto) = self.model.view.auto_exposure.as_mut() {
-            self.model.view.exposure = auto.update(meter(&film.pixels).as_ref());
+            // The subject without the background (the straight color when it is cut out).
+            let coverage = (!film.coverage.is_empty()).then_some(film.coverage.as_slice());
+            let metering = match coverage.filter(|_| film.cutout) {
+                Some(c) => meter_subject(&unpremultiply(&film.pixels, c), coverage),
+                None => meter_subject(&film.pixels, coverage),
+            };
+            self.model.view.exposure = auto.update(metering.as_ref());
         }
         let v = &self.model.view;
-        let key = (v.exposure, v.tone_mapper, film.spp, film.pixels.len());
-        if self.display_key == Some(key) && !new_image {
+        // A color background is painted into the display: its value is part of the key.
+        let background = match v.background {
+            Background::Env => 0,
+            Background::Transparent => 1,
+            Background::Color(c) => c.iter().fold(2u64, |h, x| h * 31 + x.to_bits() as u64),
+        };
+        let key = (
+            v.exposure,
+            v.tone_mapper,
+            film.spp,
+            film.pixels.len(),
+            background,
+        );
+        if self.display_key != Some(key) || new_image {
+            self.display_key = Some(key);
+            self.display = display_rgba(film, v.exposure, v.tone_mapper, v.background);
+            self.display_generation += 1;
+        }
+        let frame_key = (self.display_generation, area, self.size);
+        if self.frame_key == Some(frame_key) {
             return;
         }
-        self.display_key = Some(key);
-        self.display = to_rgba8(&film.pixels, v.exposure, v.tone_mapper);
         let texture = gfx.pixels.texture();
-        if (texture.width(), texture.height()) != (film.width, film.height)
-            && let Err(e) = gfx.pixels.resize_buffer(film.width, film.height)
+        if (texture.width(), texture.height()) != self.size
+            && let Err(e) = gfx.pixels.resize_buffer(self.size.0, self.size.1)
         {
             log::warn!(
                 "cannot resize the frame to {}×{}: {e}",
-                film.width,
-                film.height
+                self.size.0,
+                self.size.1
             );
             return;
         }
-        let frame = gfx.pixels.frame_mut();
-        if frame.len() == self.display.len() {
-            frame.copy_from_slice(&self.display);
-        }
+        layout::compose(
+            gfx.pixels.frame_mut(),
+            self.size,
+            area,
+            &self.display,
+            (film.width, film.height),
+        );
+        self.frame_key = Some(frame_key);
     }
+}
+
+/// The film as shown: exposed and tone-mapped RGBA8, with the background applied when it is
+/// cut out (alpha for transparent, the color painted behind).
+fn display_rgba(
+    film: &frame_loop::Film,
+    exposure: f32,
+    mapper: ToneMapper,
+    background: Background,
+) -> Vec<u8> {
+    if !film.cutout {
+        return to_rgba8(&film.pixels, exposure, mapper);
+    }
+    let mut rgba = to_rgba8(
+        &unpremultiply(&film.pixels, &film.coverage),
+        exposure,
+        mapper,
+    );
+    crate::render::background::apply(&mut rgba, &film.coverage, background);
+    rgba
 }

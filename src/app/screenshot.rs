@@ -1,7 +1,7 @@
 //! Screenshots: the displayed frame as PNG (exposure, tone curve and sRGB, without the overlay)
 //! and the film as EXR (linear radiance), side by side with the same name.
 
-use crate::image_io::{unique_path, write_exr};
+use crate::image_io::{unique_path, write_exr, write_exr_rgba};
 use crate::render::tonemap::write_rgba_png;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
@@ -18,8 +18,10 @@ pub struct Shot<'a> {
     pub height: u32,
     /// What is on screen: RGBA8, sRGB.
     pub rgba: &'a [u8],
-    /// The film: linear RGB.
+    /// The film: linear RGB (premultiplied by `coverage` when there is one).
     pub linear: &'a [[f32; 3]],
+    /// With the background cut out, each pixel's coverage: the EXR's A channel.
+    pub coverage: Option<&'a [f32]>,
 }
 
 /// `YYYYMMDD-HHMMSS` in UTC.
@@ -54,7 +56,10 @@ pub fn save_timestamped(dir: &Path, shot: &Shot) -> Result<PathBuf> {
 pub fn save_at(png: &Path, shot: &Shot) -> Result<PathBuf> {
     write_rgba_png(png, shot.width, shot.height, shot.rgba)?;
     let exr = png.with_extension("exr");
-    write_exr(&exr, shot.width, shot.height, shot.linear)?;
+    match shot.coverage {
+        Some(a) => write_exr_rgba(&exr, shot.width, shot.height, shot.linear, a)?,
+        None => write_exr(&exr, shot.width, shot.height, shot.linear)?,
+    }
     Ok(exr)
 }
 
@@ -80,6 +85,7 @@ mod tests {
             height: 1,
             rgba: &[255, 0, 0, 255, 0, 255, 0, 255],
             linear: &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            coverage: None,
         };
         let a = save_timestamped(&folder, &shot).unwrap();
         let b = save_timestamped(&folder, &shot).unwrap();

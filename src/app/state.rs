@@ -2,12 +2,26 @@
 //! with its light radius, exposure and tone mapping.
 
 use crate::render::RenderSettings;
+use crate::render::background::Background;
 use crate::render::exposure::{AutoExposure, ExposureMode};
 use crate::render::tonemap::ToneMapper;
+use crate::scene::framing::light_near_camera;
 use crate::scene::{
-    Bounds, Light, LightKind, LightPreset, Shadows, default_light_radius, preset_lights,
+    Bounds, Camera, Light, LightKind, LightPreset, Shadows, default_light_radius, preset_lights,
 };
 use glam::DVec3;
+
+/// How far the camera's subject is: the bounds' middle along the view, or a quarter of the
+/// scene's diagonal when that is behind or very near (inside a room).
+pub fn subject_distance(camera: &Camera, bounds: &Bounds) -> f64 {
+    let size = bounds.diagonal().max(1e-6);
+    let along = (bounds.center() - camera.eye).dot(camera.forward);
+    if along > 0.1 * size {
+        along.min(2.0 * size)
+    } else {
+        0.25 * size
+    }
+}
 
 /// Kinds of light the user can add.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,6 +96,8 @@ pub struct ViewState {
     pub auto_exposure: Option<AutoExposure>,
     /// Tone curve.
     pub tone_mapper: ToneMapper,
+    /// What escaped camera rays show.
+    pub background: Background,
     /// The lights: the scene's, presets' and the user's.
     pub rig: Vec<RigLight>,
     /// The scene's bounds, which size new lights and the light radius range.
@@ -114,6 +130,11 @@ impl ViewState {
             exposure: exposure.stops(None),
             auto_exposure: (exposure == ExposureMode::Auto).then(AutoExposure::default),
             tone_mapper: ToneMapper::default(),
+            background: if base.cutout {
+                Background::Transparent
+            } else {
+                Background::Env
+            },
             rig: Vec::new(),
             bounds,
             base,
@@ -156,6 +177,7 @@ impl ViewState {
             env_rotation: self.env_rotation,
             lens_radius: self.aperture.max(0.0),
             focus_distance: self.focus_distance.max(1e-6),
+            cutout: self.background.cutout(),
             ..self.base.clone()
         }
     }
@@ -188,40 +210,40 @@ impl ViewState {
         self.shadows.hard = !self.shadows.hard;
     }
 
-    /// Adds a light of `kind` sized and placed for the scene.
-    pub fn add_light(&mut self, kind: NewLight) {
-        let center = self.bounds.center();
-        let size = self.diagonal();
+    /// Adds a light of `kind` where it shows: near `camera`, above and to the right, aimed at
+    /// what the camera looks at and scaled to its distance (see [`light_near_camera`]).
+    pub fn add_light(&mut self, kind: NewLight, camera: &Camera) {
+        let distance = subject_distance(camera, &self.bounds);
         let count = self.rig.len() + 1;
-        let above = center + DVec3::new(0.0, 0.35 * size, 0.0);
-        let (light_kind, follows, radius, intensity) = match kind {
-            NewLight::Point => (LightKind::Point, true, 0.0, 0.3 * size * size),
-            NewLight::Spot => (
-                LightKind::Spot {
+        let mut light = light_near_camera(camera, distance, &format!("{} {count}", kind.name()));
+        // Halfway from the middle of the view to its top right corner, whatever the field of
+        // view, aimed at the subject with an irradiance of about 1 there.
+        let up = camera.up.normalize_or(DVec3::Y);
+        let right = camera.forward.cross(up).normalize_or(DVec3::X);
+        let ahead = 0.3 * distance;
+        let t = (0.5 * camera.yfov).tan();
+        light.position = camera.eye + camera.forward * ahead + (up + right) * (0.5 * t * ahead);
+        let to_subject = camera.eye + camera.forward * distance - light.position;
+        light.direction = to_subject.normalize_or(DVec3::NEG_Y);
+        light.intensity = to_subject.length_squared() as f32;
+        let follows = kind != NewLight::Sphere;
+        match kind {
+            NewLight::Point => {}
+            NewLight::Spot => {
+                light.kind = LightKind::Spot {
                     inner: 0.3,
                     outer: 0.6,
-                },
-                true,
-                0.0,
-                0.6 * size * size,
-            ),
-            NewLight::Directional => (LightKind::Directional, true, 0.0, 2.0),
-            NewLight::Sphere => (LightKind::Point, false, 0.05 * size, 0.3 * size * size),
-        };
+                }
+            }
+            // A sun from the same side, with an irradiance of about 1 like the others.
+            NewLight::Directional => {
+                light.kind = LightKind::Directional;
+                light.intensity = 1.0;
+            }
+            NewLight::Sphere => light.light_radius = (0.05 * distance) as f32,
+        }
         self.rig.push(RigLight {
-            light: Light {
-                name: format!("{} {count}", kind.name()),
-                kind: light_kind,
-                position: above,
-                direction: if kind == NewLight::Directional {
-                    DVec3::new(-0.3, -1.0, -0.4).normalize()
-                } else {
-                    DVec3::NEG_Y
-                },
-                color: [1.0; 3],
-                intensity: intensity as f32,
-                light_radius: radius as f32,
-            },
+            light,
             enabled: true,
             follows_light_radius: follows,
         });
@@ -255,6 +277,11 @@ mod tests {
     use super::*;
     use crate::args::CommonArgs;
     use clap::Parser;
+
+    /// A camera looking at the test bounds from outside.
+    fn camera() -> Camera {
+        Camera::look_at("c", DVec3::new(0.5, 1.0, 6.0), bounds().center(), 0.8)
+    }
 
     fn state(extra: &[&str], lights: &[Light]) -> ViewState {
         let a = args(extra);
@@ -362,7 +389,7 @@ mod tests {
     #[test]
     fn the_hard_toggle_gives_radius_zero_and_restores_the_light_radius() {
         let mut s = state(&["--light-radius", "0.1"], &[point()]);
-        s.add_light(NewLight::Sphere);
+        s.add_light(NewLight::Sphere, &camera());
         let soft = s.lights();
         assert_eq!(soft[0].light_radius, 0.1);
         assert!(soft[1].light_radius > 0.0);
@@ -399,9 +426,57 @@ mod tests {
         // The softbox keeps its large radius.
         assert!(s.lights()[0].light_radius > s.shadows.light_radius);
         for kind in NewLight::ALL {
-            s.add_light(kind);
+            s.add_light(kind, &camera());
         }
         assert_eq!(s.lights().len(), 5);
         assert!(s.lights().iter().all(|l| l.intensity > 0.0));
+    }
+
+    #[test]
+    fn added_lights_are_in_view_near_the_camera_and_scaled_to_the_scene() {
+        for cam in [
+            camera(),
+            // Inside the bounds (an interior), looking along +X.
+            Camera::look_at(
+                "in",
+                DVec3::new(0.2, 1.0, 1.0),
+                DVec3::new(1.0, 1.0, 1.0),
+                1.0,
+            ),
+        ] {
+            let mut s = state(&[], &[]);
+            let distance = subject_distance(&cam, &bounds());
+            for kind in NewLight::ALL {
+                s.add_light(kind, &cam);
+            }
+            for l in s.lights() {
+                let to = l.position - cam.eye;
+                // In front of the camera and inside its field of view.
+                let ahead = to.dot(cam.forward);
+                assert!(ahead > 0.0, "{}: behind the camera", l.name);
+                // Within the vertical field of view (and so the wider horizontal one).
+                let half = (cam.yfov * 0.5).tan() * ahead;
+                let right = cam.forward.cross(cam.up).normalize();
+                let (x, y) = (to.dot(right), to.dot(cam.up.normalize()));
+                assert!(
+                    x.abs() < half && y.abs() < half,
+                    "{}: outside the view",
+                    l.name
+                );
+                // Nearer than the subject, not at the top of the bounds.
+                assert!(to.length() < distance, "{}: {to:?}", l.name);
+                // Spots aim at the subject; about unit irradiance there for every kind.
+                if let LightKind::Spot { .. } = l.kind {
+                    let aim = (cam.eye + cam.forward * distance - l.position).normalize();
+                    assert!(l.direction.dot(aim) > 0.999, "{}", l.name);
+                }
+                let subject = cam.eye + cam.forward * distance;
+                let e = match l.kind {
+                    LightKind::Directional => l.intensity as f64,
+                    _ => l.intensity as f64 / (subject - l.position).length_squared(),
+                };
+                assert!((0.5..2.0).contains(&e), "{}: irradiance {e}", l.name);
+            }
+        }
     }
 }

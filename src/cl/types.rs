@@ -101,9 +101,18 @@ kernel_constants! {
 
     /// `GpuPath::direction.w` flag: the last bounce was specular.
     PATH_SPECULAR: u32 = 1;
+    /// `GpuPath::direction.w` flag: the camera ray escaped (with coverage counted).
+    PATH_ESCAPED: u32 = 2;
+
+    /// `GpuFrame::background`: escaped camera rays see the environment.
+    BACKGROUND_ENV: u32 = 0;
+    /// Escaped camera rays add nothing and the film's `.w` counts the samples that hit.
+    BACKGROUND_CUTOUT: u32 = 1;
+    /// Escaped camera rays see the environment and the film's `.w` counts the samples that hit.
+    BACKGROUND_COUNT: u32 = 2;
     /// `GpuPath::direction.w` flag: went straight through a thin wall since the last
     /// scattering vertex.
-    PATH_THROUGH_WALL: u32 = 2;
+    PATH_THROUGH_WALL: u32 = 4;
 
     /// Slot of the counters buffer (u32): paths in this bounce's input queue.
     COUNT_IN: usize = 0;
@@ -383,8 +392,10 @@ pub struct GpuFrame {
     pub light_count: u32,
     /// Current bounce (set per launch by the host).
     pub bounce: u32,
+    /// What an escaped camera ray adds (`BACKGROUND_*`).
+    pub background: u32,
     /// Padding.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 const _: () = assert!(size_of::<GpuFrame>() == 64);
 
@@ -499,6 +510,7 @@ pub fn layouts() -> Vec<StructLayout> {
             sky,
             light_count,
             bounce,
+            background,
             pad
         ),
         layout!(GpuPath, origin, direction, throughput, radiance),

@@ -50,6 +50,9 @@ pub struct ViewArgs {
     /// Save the final frame to this PNG path on exit (for tests); an EXR beside it.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+    /// Start with the overlay hidden: the image fills the window (Tab shows the overlay).
+    #[arg(long)]
+    pub no_overlay: bool,
 }
 
 /// Options of `render`.
@@ -106,7 +109,8 @@ fn view(args: ViewArgs) -> Result<()> {
     crate::app::preflight(args.screenshot.as_deref())?;
     let common = &args.common;
     let settings = common.settings(DEFAULT_SIZE)?;
-    let mut prepared = common.prepare(args.scene.as_deref())?;
+    let aspect = crate::app::image_aspect((settings.width, settings.height), !args.no_overlay);
+    let mut prepared = common.prepare_for(args.scene.as_deref(), aspect)?;
     let environment = prepared.environment.take();
     let device = common.device_choice()?;
     // With a lens but no focus distance, focus on what the image centre sees once loaded.
@@ -129,9 +133,11 @@ fn view(args: ViewArgs) -> Result<()> {
             _ => None,
         },
         exposure: common.exposure_mode(),
+        background: common.background,
         autofocus,
         frames: args.frames,
         screenshot: args.screenshot,
+        overlay: !args.no_overlay,
     })
 }
 

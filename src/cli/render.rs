@@ -2,10 +2,10 @@
 
 use super::RenderArgs;
 use crate::args::EnvChoice;
-use crate::image_io::{Format, write_exr};
+use crate::image_io::{Format, write_exr, write_exr_rgba};
+use crate::render::background::{self, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
-use crate::render::tonemap::ToneMapper;
-use crate::render::tonemap::write_png;
+use crate::render::tonemap::{ToneMapper, to_rgba8, write_rgba_png};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -79,19 +79,28 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     bar.finish_and_clear();
 
     let image = renderer.image()?;
+    let background = args.common.background;
+    // Each pixel's coverage: the subject is metered without the background. With the background
+    // cut out, the straight color is metered and tone-mapped.
+    let coverage = renderer.coverage()?;
+    let straight = background
+        .cutout()
+        .then(|| unpremultiply(&image, &coverage));
+    let shown = straight.as_deref().unwrap_or(&image);
     let mode = args.common.exposure_mode();
-    let metering = exposure::meter(&image);
+    let metering = exposure::meter_subject(shown, Some(&coverage));
     let exposure = mode.stops(metering.as_ref());
+    let (w, h) = (settings.width, settings.height);
     match format {
-        Format::Exr => write_exr(&args.output, settings.width, settings.height, &image)?,
-        Format::Png => write_png(
-            &args.output,
-            settings.width,
-            settings.height,
-            &image,
-            exposure,
-            ToneMapper::default(),
-        )?,
+        Format::Exr if background.cutout() => {
+            write_exr_rgba(&args.output, w, h, &image, &coverage)?
+        }
+        Format::Exr => write_exr(&args.output, w, h, &image)?,
+        Format::Png => {
+            let mut rgba = to_rgba8(shown, exposure, ToneMapper::default());
+            background::apply(&mut rgba, &coverage, background);
+            write_rgba_png(&args.output, w, h, &rgba)?;
+        }
     }
     let stats = renderer.stats();
     if stats.stack_overflows > 0 {
@@ -135,6 +144,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "textures": scene_stats.textures,
         "texture_bytes": scene_stats.texture_bytes,
         "environment": renderer.environment().map(|m| m.name.clone()),
+        "background": background.name(),
         "exposure": exposure,
         "auto_exposure": mode == ExposureMode::Auto,
         "camera": {

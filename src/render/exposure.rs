@@ -76,6 +76,31 @@ pub fn meter(image: &[[f32; 3]]) -> Option<Metering> {
     })
 }
 
+/// Pixels at least this much covered by the scene count as the subject.
+pub const SUBJECT_COVERAGE: f32 = 0.5;
+/// The subject is metered alone when it covers at least this share of the image.
+pub const MIN_SUBJECT_SHARE: f32 = 0.02;
+
+/// Meters the subject of `image`: the pixels whose camera rays mostly hit the scene
+/// (`coverage` ≥ [`SUBJECT_COVERAGE`], see `Renderer::coverage`), so that a dark or bright
+/// background (the environment seen past the model) does not set the exposure. The whole image
+/// is metered without a coverage, or when the subject is under [`MIN_SUBJECT_SHARE`] of it.
+pub fn meter_subject(image: &[[f32; 3]], coverage: Option<&[f32]>) -> Option<Metering> {
+    let Some(coverage) = coverage.filter(|c| c.len() == image.len()) else {
+        return meter(image);
+    };
+    let subject: Vec<[f32; 3]> = image
+        .iter()
+        .zip(coverage)
+        .filter(|(_, a)| **a >= SUBJECT_COVERAGE)
+        .map(|(p, _)| *p)
+        .collect();
+    if (subject.len() as f32) < MIN_SUBJECT_SHARE * image.len() as f32 {
+        return meter(image);
+    }
+    meter(&subject)
+}
+
 /// The exposure in stops that the metering asks for: the key to middle grey, lowered where the
 /// 90th percentile would go past [`BRIGHT_LIMIT`].
 pub fn auto_stops(m: &Metering) -> f32 {
@@ -240,6 +265,24 @@ mod tests {
                 [truth * mean; 3]
             })
             .collect()
+    }
+
+    #[test]
+    fn the_subject_is_metered_without_its_background() {
+        // A mid-grey subject on half the image before a dark curtain: the whole image's key is
+        // pulled down (overexposing the subject); the subject's is not.
+        let image: Vec<[f32; 3]> = (0..1000)
+            .map(|i| if i < 500 { [0.18; 3] } else { [0.002; 3] })
+            .collect();
+        let coverage: Vec<f32> = (0..1000).map(|i| if i < 500 { 1.0 } else { 0.0 }).collect();
+        let whole = auto_stops(&meter(&image).unwrap());
+        let subject = auto_stops(&meter_subject(&image, Some(&coverage)).unwrap());
+        assert!(whole > 2.0, "{whole}");
+        assert!(subject.abs() < 0.05, "{subject}");
+        // A subject of a few pixels is not metered alone.
+        let speck: Vec<f32> = (0..1000).map(|i| if i < 5 { 1.0 } else { 0.0 }).collect();
+        assert_eq!(meter_subject(&image, Some(&speck)), meter(&image));
+        assert_eq!(meter_subject(&image, None), meter(&image));
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! The renderer: owns the OpenCL device, the scene on it and the film, and runs the wavefront
 //! stages. It knows nothing of windows; the viewer and the command line drive it alike.
 
+pub mod background;
 pub mod camera;
 pub mod exposure;
 pub mod instancing;
@@ -66,6 +67,25 @@ pub struct SceneStats {
     pub instances: usize,
     /// Bytes of every scene buffer on the device (textures included).
     pub device_bytes: usize,
+}
+
+/// The kernel features a scene needs; `triangle_lights` and `tangents` come from its upload
+/// (emissive triangles with an area, tangents for normal maps).
+fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> KernelFeatures {
+    let used = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
+    KernelFeatures {
+        triangle_lights,
+        textures: used(&|m| m.textures.any()),
+        normal_maps: used(&|m| m.textures.normal_mapped()) && tangents,
+        alpha: used(&|m| m.alpha != AlphaMode::Opaque),
+        transmission: used(&|m| m.transmission > 0.0),
+        env_map: false,
+        two_level: false,
+        thin_walls: used(&|m| m.transmission > 0.0 && m.thickness <= 0.0),
+        unlit: used(&|m| m.unlit),
+        clearcoat: used(&|m| m.clearcoat > 0.0),
+        sheen: used(&|m| m.sheen_color.iter().any(|&c| c > 0.0)),
+    }
 }
 
 /// The path tracer on one OpenCL device.
@@ -181,19 +201,9 @@ impl Renderer {
         let t = Instant::now();
         host.space = space;
         host.scale_emitter_power(&lights::emissive_texture_means(scene));
-        let used = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
         self.scene_features = KernelFeatures {
-            triangle_lights: !host.emissive.is_empty(),
-            textures: used(&|m| m.textures.any()),
-            normal_maps: used(&|m| m.textures.normal_mapped()) && !host.tangents.is_empty(),
-            alpha: used(&|m| m.alpha != AlphaMode::Opaque),
-            transmission: used(&|m| m.transmission > 0.0),
-            env_map: false,
-            thin_walls: used(&|m| m.transmission > 0.0 && m.thickness <= 0.0),
-            unlit: used(&|m| m.unlit),
-            clearcoat: used(&|m| m.clearcoat > 0.0),
-            sheen: used(&|m| m.sheen_color.iter().any(|&c| c > 0.0)),
             two_level: matches!(host.accel, Accel::TwoLevel(_)),
+            ..scene_features(scene, !host.emissive.is_empty(), !host.tangents.is_empty())
         };
         let budget = self
             .gpu
@@ -286,6 +296,27 @@ impl Renderer {
         stats.kernel_build_ms += self.prime_megakernel()?;
         self.reset()?;
         Ok(stats)
+    }
+
+    /// Whether loading `scene` would build kernels (its features differ from the built ones'),
+    /// predicted from its materials before the upload: for a "Compiling kernels…" notice.
+    pub fn would_build_for(&self, scene: &Scene) -> bool {
+        let any = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
+        let features = KernelFeatures {
+            env_map: self.environment.is_some(),
+            two_level: self.scene_features.two_level,
+            ..scene_features(scene, any(&|m| m.is_emissive()), true)
+        };
+        self.program.as_ref().is_none_or(|p| p.features != features)
+    }
+
+    /// Whether setting (`on`) or removing the environment map would build kernels.
+    pub fn would_build_for_env(&self, on: bool) -> bool {
+        self.scene.is_some()
+            && self
+                .program
+                .as_ref()
+                .is_some_and(|p| p.features.env_map != on)
     }
 
     /// Builds the kernels when the scene's features (with the environment's) changed; returns
@@ -493,12 +524,39 @@ impl Renderer {
             return Ok(vec![[0.0; 3]; n]);
         };
         let film = f.film.read(&self.gpu)?;
+        if self.settings.cutout || self.settings.count_coverage {
+            // `.w` counts the samples whose camera ray hit: the mean is over all samples.
+            let n = self.samples.max(1) as f32;
+            return Ok(film
+                .iter()
+                .map(|p| [p[0] / n, p[1] / n, p[2] / n])
+                .collect());
+        }
         Ok(film
             .iter()
             .map(|p| {
                 let n = p[3].max(1.0);
                 [p[0] / n, p[1] / n, p[2] / n]
             })
+            .collect())
+    }
+
+    /// Each pixel's coverage: the share of its samples whose camera ray hit the scene, with
+    /// [`RenderSettings::cutout`] or [`RenderSettings::count_coverage`] (else all 1).
+    pub fn coverage(&mut self) -> Result<Vec<f32>, ClError> {
+        if !self.pending.is_empty() {
+            self.finish()?;
+        }
+        let n = (self.settings.width * self.settings.height) as usize;
+        let counted = self.settings.cutout || self.settings.count_coverage;
+        let Some(f) = self.frame.as_ref().filter(|_| counted) else {
+            return Ok(vec![1.0; n]);
+        };
+        let total = self.samples.max(1) as f32;
+        Ok(f.film
+            .read(&self.gpu)?
+            .iter()
+            .map(|p| (p[3] / total).clamp(0.0, 1.0))
             .collect())
     }
 }

@@ -1,6 +1,9 @@
 //! What the user controls about a render.
 
-use crate::cl::types::{GpuFrame, STRATEGY_BSDF, STRATEGY_LIGHTS, STRATEGY_MIS};
+use crate::cl::types::{
+    BACKGROUND_COUNT, BACKGROUND_CUTOUT, BACKGROUND_ENV, GpuFrame, STRATEGY_BSDF, STRATEGY_LIGHTS,
+    STRATEGY_MIS,
+};
 
 /// Which estimator feeds direct light.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -40,6 +43,13 @@ pub struct RenderSettings {
     pub lens_radius: f32,
     /// Distance from the eye to the plane in focus, along the view axis, in scene units.
     pub focus_distance: f32,
+    /// Escaped camera rays add nothing (the environment still lights the scene) and the film
+    /// keeps each pixel's coverage (`Renderer::coverage`): for `--background transparent` and
+    /// `--background COLOR`.
+    pub cutout: bool,
+    /// The film keeps each pixel's coverage with the background shown too (for metering the
+    /// subject); the image is the same.
+    pub count_coverage: bool,
 }
 
 impl Default for RenderSettings {
@@ -56,6 +66,8 @@ impl Default for RenderSettings {
             env_rotation: 0.0,
             lens_radius: 0.0,
             focus_distance: 1.0,
+            cutout: false,
+            count_coverage: false,
         }
     }
 }
@@ -84,7 +96,12 @@ impl RenderSettings {
             sky: [self.sky[0], self.sky[1], self.sky[2], 0.0],
             light_count,
             bounce: 0,
-            pad: [0; 2],
+            background: match (self.cutout, self.count_coverage) {
+                (true, _) => BACKGROUND_CUTOUT,
+                (false, true) => BACKGROUND_COUNT,
+                (false, false) => BACKGROUND_ENV,
+            },
+            pad: 0,
         }
     }
 }

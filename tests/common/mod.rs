@@ -438,3 +438,37 @@ pub fn mean_gray(px: &[[f32; 3]]) -> f64 {
         .sum::<f64>()
         / px.len() as f64
 }
+
+/// A white (albedo 1) Lambertian sphere of radius 1 at the origin seen from z = 4; a floor
+/// below it when `floor`.
+pub fn white_sphere(dir: &Path, floor: bool) -> PathBuf {
+    let mut g = Gltf::default();
+    let m = g.lambert([1.0; 3], [0.0; 3], 1.0, false);
+    let (positions, normals, indices) = sphere(1.0, 32, 64, false);
+    let mut prims = vec![Prim {
+        positions,
+        normals,
+        indices,
+        material: Some(m),
+        mode: 4,
+    }];
+    if floor {
+        let gray = g.lambert([0.5; 3], [0.0; 3], 1.0, false);
+        prims.push(Prim::triangles(
+            vec![
+                [-5.0, -1.0, -5.0],
+                [5.0, -1.0, -5.0],
+                [5.0, -1.0, 5.0],
+                [-5.0, -1.0, 5.0],
+            ],
+            vec![0, 2, 1, 0, 3, 2],
+            gray,
+        ));
+    }
+    let mesh = g.mesh(prims);
+    g.node(json!({"mesh": mesh}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 4.0]}));
+    g.write_glb(dir, if floor { "sphere-floor" } else { "sphere" })
+}
