@@ -44,10 +44,8 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
             bool alive = shade_vertex(&frame, bounce, &sc, hit, &s, &q);
             if (q.valid) {
                 ++shadow_rays;
-                GpuHit blocker = trace_scene_wide(nodes, tris, instances, object_tris, &sc.surf,
-                                                  q.origin, q.direction, 0.0f, q.tmax, true,
-                                                  overflow);
-                if (blocker.prim == NO_HIT) s.radiance += q.contribution;
+                s.radiance += shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, &q,
+                                               overflow);
             }
             if (!alive) break;
         }

@@ -18,18 +18,20 @@ typedef struct {
     float3 throughput;
     float3 radiance;    // gathered so far
     float prev_pdf;     // pdf of the BSDF sample that made the ray (0: camera ray)
-    uint flags;         // PATH_SPECULAR, PATH_ESCAPED
+    uint flags;         // PATH_SPECULAR, PATH_ESCAPED, PATH_THROUGH_WALL
     uint rng;
     float2 cone;        // ray cone (width, spread angle) for texture filtering
 } PathState;
 
 // A light sample to test for visibility: `contribution` is added to the path's radiance when
-// the segment (origin, direction, 0..tmax) is unoccluded.
+// the segment (origin, direction, 0..tmax) is unoccluded, or only blocked by smooth thin walls
+// (then tinted by them and multiplied by `unweight`, the inverse of its MIS weight).
 typedef struct {
     float3 origin;
     float3 direction;
     float tmax;
     float3 contribution;
+    float unweight;
     bool valid;
 } ShadowQuery;
 
@@ -90,6 +92,14 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     float prev_pdf = s->prev_pdf;
     bool prev_specular = (s->flags & PATH_SPECULAR) != 0u;
     bool counts_emission = bounce == 0u || prev_specular || frame->strategy != STRATEGY_LIGHTS;
+    // Seen through a thin wall from a scattering vertex, a light is left to that vertex's light
+    // sample, whose shadow ray passes the wall unweighted (see `shadow_pass`).
+    bool mis = bounce > 0u && !prev_specular && frame->strategy == STRATEGY_MIS;
+#ifdef HAS_THIN_WALLS
+    bool light_sampled_only = mis && (s->flags & PATH_THROUGH_WALL) != 0u;
+#else
+    bool light_sampled_only = false;
+#endif
     const SceneSurfaces* surf = &sc->surf;
     global const GpuMaterial* materials = surf->materials;
 
@@ -106,9 +116,8 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
         float3 le = env_radiance(&sc->env, -wo, &env_pdf);
         if (bounce == 0u) le = env_background(&sc->env, -wo);  // seen directly: filtered
         float weight = 1.0f;
-        if (bounce > 0u && !prev_specular && frame->strategy == STRATEGY_MIS) {
-            weight = power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
-        }
+        if (mis) weight = power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
+        if (light_sampled_only) weight = 0.0f;
         if (counts_emission) radiance += throughput * le * weight;
 #else
         // Escaped: the uniform sky, reached by BSDF sampling only.
@@ -142,12 +151,13 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     bool two_sided = (as_uint(mat->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
     if (light_index >= 0 && (front || two_sided) && counts_emission) {
         float weight = 1.0f;
-        if (bounce > 0u && !prev_specular && frame->strategy == STRATEGY_MIS) {
+        if (mis) {
             global const GpuLight* l = &sc->lights[light_index];
             float cos_l = fabs(dot(ng, wo));
             float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
             weight = power_heuristic(prev_pdf, light_pdf);
         }
+        if (light_sampled_only) weight = 0.0f;
 #ifdef HAS_TEXTURES
         // Past the camera ray, emission is read at the finest level, as light sampling reads it.
         TexCoords etc = bounce == 0u ? tc : texcoords_at(sh, hit.u, hit.v);
@@ -155,6 +165,19 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
 #else
         radiance += throughput * mat->emission.xyz * weight;
 #endif
+    }
+#endif
+
+#ifdef HAS_UNLIT
+    // An unlit material shows its base color (textured) and scatters nothing; nothing else
+    // samples it, so it counts in full.
+    if ((as_uint(mat->emission.w) & MATERIAL_UNLIT) != 0u) {
+        float3 color = mat->base_color.xyz;
+#ifdef HAS_TEXTURES
+        if (mat->textures.x >= 0) color *= texture_sample(surf, mat->textures.x, &tc).xyz;
+#endif
+        s->radiance = radiance + throughput * color;
+        return false;
     }
 #endif
 
@@ -175,10 +198,26 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
             if (dot(ns, ng) < 0.0f) ns = -ns;
         }
     }
+#ifdef HAS_CLEARCOAT
+    // The coat has its own normal texture; without one it takes the interpolated normal.
+    float3 coat_normal = ns;
 #ifdef HAS_NORMAL_MAPS
-    if (mat->textures.z >= 0) ns = normal_map(surf, mat, &tc, hit.prim, hit.u, hit.v, ns, ng, front);
+    if (mat->textures3.z >= 0) {
+        coat_normal = normal_map(surf, mat->textures3.z, mat->coat.z, &tc, hit.prim, hit.u, hit.v,
+                                 ns, ng, front);
+    }
+#endif
+#endif
+#ifdef HAS_NORMAL_MAPS
+    if (mat->textures.z >= 0) {
+        ns = normal_map(surf, mat->textures.z, mat->alpha.w, &tc, hit.prim, hit.u, hit.v, ns, ng,
+                        front);
+    }
 #endif
     SurfaceMaterial m = surface_material(mat);
+#ifdef HAS_CLEARCOAT
+    m.coat_normal = coat_normal;
+#endif
 #ifdef HAS_TEXTURES
     apply_textures(&m, mat, surf, &tc);
     float alpha_r = m.roughness * m.roughness;
@@ -201,7 +240,8 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
             sample_light(sc->lights, sc->tris, materials, surf, &sc->env, index, p, u1, u2);
         // A light behind the surface is reached through transmission when bsdf_eval says so;
         // the geometric and shading normals must agree on the side. Transmissive surfaces
-        // block shadow rays (no caustics through next-event estimation).
+        // block shadow rays (no caustics through next-event estimation), except smooth thin
+        // walls, which `shadow_pass` passes with their tint and without the MIS weight.
         float side = dot(ls.wi, ng);
         if (side * dot(ls.wi, ns) > 0.0f &&
             (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
@@ -225,6 +265,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
                 shadow->direction = dir;
                 shadow->tmax = tmax;
                 shadow->contribution = contribution;
+                shadow->unweight = weight > 0.0f ? 1.0f / weight : 0.0f;
                 shadow->valid = true;
             }
         }
@@ -253,11 +294,77 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     s->radiance = radiance;
     s->rng = rng;
     if (alive) {
+        uint flags = specular ? PATH_SPECULAR : 0u;
+#ifdef HAS_THIN_WALLS
+        // Straight through a thin wall the path keeps its last scattering vertex's pdf and
+        // flags, as the shadow rays of that vertex pass the wall (a camera ray stays direct).
+        if (specular && side < 0.0f && bsdf_passes_straight(&m)) {
+            pdf = prev_pdf;
+            flags = bounce == 0u ? PATH_SPECULAR : s->flags;
+            if (!prev_specular && bounce > 0u) flags |= PATH_THROUGH_WALL;
+        }
+#endif
         s->origin = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
         s->prev_pdf = pdf;
         s->direction = wi;
-        s->flags = specular ? PATH_SPECULAR : 0u;
+        s->flags = flags;
         s->throughput = throughput;
     }
     return alive;
 }
+
+// Shadow rays pass at most this many thin walls.
+#define MAX_THIN_WALLS 8u
+
+// Whether the surface hit by a shadow ray along dir is a smooth thin wall; if so, multiplies
+// *tint by what it lets through. Without thin walls in the scene, nothing is.
+inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* surf, GpuHit hit,
+                           float3 dir, float3* tint) {
+#ifdef HAS_THIN_WALLS
+    GpuTriangle tri = tris[hit.prim];
+    global const GpuMaterial* mat = &surf->materials[as_uint(tri.v0.w)];
+    SurfaceMaterial m = surface_material(mat);
+#ifdef HAS_TEXTURES
+    TexCoords tc = texcoords_at(surf->shading[hit.prim], hit.u, hit.v);
+    apply_textures(&m, mat, surf, &tc);
+#endif
+    if (!bsdf_passes_straight(&m)) return false;
+    float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
+    *tint *= thin_wall_transmittance(&m, fabs(dot(ng, dir)));
+    return true;
+#else
+    return false;
+#endif
+}
+
+// The shadow test of a light sample, for a BVH of NODE traced by TRACE (flat or two-level): what of
+// q->contribution reaches the path, or 0 when something other than smooth thin walls is in the
+// way. Through walls the light comes tinted by each wall and no longer shared with the BSDF
+// sample (the MIS weight undone: BSDF samples through walls leave such lights to light
+// sampling). The wavefront's `connect` and the megakernel use the same test this way.
+#define DEFINE_SHADOW_TEST(NAME, NODE, TRACE)                                                \
+    inline float3 NAME(global const NODE* nodes, global const GpuTriangle* tris,               \
+                       global const GpuInstance* instances,                                    \
+                       global const GpuTriangle* object_tris, const SceneSurfaces* surf,        \
+                       const ShadowQuery* q, volatile global uint* overflow) {                 \
+        GpuHit hit = TRACE(nodes, tris, instances, object_tris, surf, q->origin, q->direction, \
+                           0.0f, q->tmax, true, overflow);                                     \
+        if (hit.prim == NO_HIT) return q->contribution;                                        \
+        float3 tint = (float3)(1.0f);                                                          \
+        if (!thin_wall_tint(tris, surf, hit, q->direction, &tint)) return (float3)(0.0f);      \
+        /* The walls in order, nearest first, each beyond the last. */                         \
+        tint = (float3)(q->unweight);                                                          \
+        hit = TRACE(nodes, tris, instances, object_tris, surf, q->origin, q->direction, 0.0f,  \
+                    q->tmax, false, overflow);                                                 \
+        for (uint walls = 0u; hit.prim != NO_HIT; ++walls) {                                   \
+            if (walls == MAX_THIN_WALLS ||                                                     \
+                !thin_wall_tint(tris, surf, hit, q->direction, &tint)) {                       \
+                return (float3)(0.0f);                                                         \
+            }                                                                                  \
+            hit = TRACE(nodes, tris, instances, object_tris, surf, q->origin, q->direction,    \
+                        hit.t, q->tmax, false, overflow);                                      \
+        }                                                                                      \
+        return q->contribution * tint;                                                         \
+    }
+DEFINE_SHADOW_TEST(shadow_pass, GpuBvhNode, trace_scene)
+DEFINE_SHADOW_TEST(shadow_pass_wide, GpuWideNode, trace_scene_wide)

@@ -76,7 +76,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
         GpuShadowRay ray;
         ray.origin = (float4)(q.origin, q.tmax);
         ray.direction = (float4)(q.direction, as_float(slot));
-        ray.contribution = (float4)(q.contribution, 0.0f);
+        ray.contribution = (float4)(q.contribution, q.unweight);
         shadow_rays[atomic_inc(&counters[COUNT_SHADOW])] = ray;
     }
 #ifdef HAS_TEXTURES
@@ -105,9 +105,15 @@ kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tr
     if (i >= counters[COUNT_SHADOW]) return;
     SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};
     GpuShadowRay r = shadow_rays[i];
-    GpuHit hit = trace_scene(nodes, tris, instances, object_tris, &surf, r.origin.xyz,
-                             r.direction.xyz, 0.0f, r.origin.w, true, &counters[COUNT_OVERFLOW]);
-    if (hit.prim == NO_HIT) paths[as_uint(r.direction.w)].radiance.xyz += r.contribution.xyz;
+    ShadowQuery q;
+    q.origin = r.origin.xyz;
+    q.direction = r.direction.xyz;
+    q.tmax = r.origin.w;
+    q.contribution = r.contribution.xyz;
+    q.unweight = r.contribution.w;
+    float3 c = shadow_pass(nodes, tris, instances, object_tris, &surf, &q,
+                           &counters[COUNT_OVERFLOW]);
+    if (any(c != 0.0f)) paths[as_uint(r.direction.w)].radiance.xyz += c;
 }
 
 // One work item: counts the rays of this bounce and makes the output queue the next input.

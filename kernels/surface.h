@@ -14,6 +14,14 @@ inline void apply_textures(SurfaceMaterial* m, global const GpuMaterial* mat,
 #ifdef HAS_TRANSMISSION
     if (mat->textures2.x >= 0) m->transmission *= texture_sample(s, mat->textures2.x, tc).x;
 #endif
+#ifdef HAS_CLEARCOAT
+    if (mat->textures3.x >= 0) m->clearcoat *= texture_sample(s, mat->textures3.x, tc).x;
+    if (mat->textures3.y >= 0) m->coat_roughness *= texture_sample(s, mat->textures3.y, tc).y;
+#endif
+#ifdef HAS_SHEEN
+    if (mat->textures2.z >= 0) m->sheen_color *= texture_sample(s, mat->textures2.z, tc).xyz;
+    if (mat->textures2.w >= 0) m->sheen_roughness *= texture_sample(s, mat->textures2.w, tc).w;
+#endif
 }
 
 // Emitted radiance at the hit: the factor times the emissive texture.
@@ -26,13 +34,13 @@ inline float3 textured_emission(global const GpuMaterial* mat, const SceneSurfac
 #endif
 
 #ifdef HAS_NORMAL_MAPS
-// The shading normal from the normal map. ns and ng face the side the ray came from; `front`
+// The shading normal from the normal map `tex` scaled by `scale` (the material's normal
+// texture, or its clearcoat normal texture). ns and ng face the side the ray came from; `front`
 // says whether that is the triangle's front, in which case the tangent frame is the file's,
 // else every axis of it is reversed (glTF reverses back-face normals of double-sided
 // materials). The result is bent to stay above the geometric surface.
-inline float3 normal_map(const SceneSurfaces* s, global const GpuMaterial* mat,
-                         const TexCoords* tc, uint prim, float u, float v, float3 ns, float3 ng,
-                         bool front) {
+inline float3 normal_map(const SceneSurfaces* s, int tex, float scale, const TexCoords* tc,
+                         uint prim, float u, float v, float3 ns, float3 ng, bool front) {
     GpuTriTangents tt = s->tangents[prim];
     float w0 = 1.0f - u - v;
     float3 t = w0 * tt.t0.xyz + u * tt.t1.xyz + v * tt.t2.xyz;
@@ -42,8 +50,7 @@ inline float3 normal_map(const SceneSurfaces* s, global const GpuMaterial* mat,
     if (!(len > 1e-8f)) return ns;
     t /= len;
     float3 b = cross(n, t) * (tt.t0.w < 0.0f ? -1.0f : 1.0f);
-    float3 c = texture_sample(s, mat->textures.z, tc).xyz * 2.0f - 1.0f;
-    float scale = mat->alpha.w;
+    float3 c = texture_sample(s, tex, tc).xyz * 2.0f - 1.0f;
     float3 mapped = normalize(c.x * scale * t + c.y * scale * b + c.z * n);
     if (!all(isfinite(mapped))) return ns;
     if (!front) mapped = -mapped;

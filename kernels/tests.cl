@@ -39,6 +39,8 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuMaterial, params); PROBE_FIELD(GpuMaterial, specular);
     PROBE_FIELD(GpuMaterial, volume); PROBE_FIELD(GpuMaterial, alpha);
     PROBE_FIELD(GpuMaterial, textures); PROBE_FIELD(GpuMaterial, textures2);
+    PROBE_FIELD(GpuMaterial, coat); PROBE_FIELD(GpuMaterial, textures3);
+    PROBE_FIELD(GpuMaterial, sheen);
     PROBE_SIZE(GpuLight);
     PROBE_FIELD(GpuLight, position); PROBE_FIELD(GpuLight, intensity);
     PROBE_FIELD(GpuLight, spot); PROBE_FIELD(GpuLight, extra);

@@ -87,6 +87,9 @@ typedef struct {
     float4 alpha;       // .x alphaCutoff, .y mode (uint bits, ALPHA_*), .z thickness, .w normal scale
     int4 textures;      // texture refs: base color, metallic-roughness, normal, emissive; -1 none
     int4 textures2;     // texture refs: .x transmission, .y thickness; -1 none
+    float4 coat;        // clearcoat: .x factor, .y roughness, .z normal texture scale
+    int4 textures3;     // texture refs: .x clearcoat, .y clearcoat roughness, .z clearcoat normal
+    float4 sheen;       // sheen: .xyz color, .w roughness
 } GpuMaterial;
 
 typedef struct {
@@ -121,7 +124,7 @@ typedef struct {
 
 typedef struct {
     float4 origin;      // .w = pdf of the BSDF sample that made this ray (0: camera ray)
-    float4 direction;   // .w = flags (uint bits): PATH_SPECULAR, PATH_ESCAPED
+    float4 direction;   // .w = flags (uint bits): PATH_SPECULAR, PATH_ESCAPED, PATH_THROUGH_WALL
     float4 throughput;  // .w = slot (uint bits): pixel + sample_in_wave * pixels
     float4 radiance;    // .w = random state (uint bits)
 } GpuPath;

@@ -334,6 +334,10 @@ pub struct CommonArgs {
     /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
     #[arg(long, default_value = "auto", value_parser = parse_kernel)]
     pub kernel: KernelChoice,
+    /// The `KHR_materials_variants` variant to show (by name); without it, the default
+    /// materials.
+    #[arg(long, value_name = "NAME")]
+    pub variant: Option<String>,
     /// Acceleration structure: flat (one BVH over every triangle), two-level (a BLAS per
     /// distinct mesh under a TLAS of instances) or auto (two levels for scenes of at least 4 M
     /// triangles that instancing shrinks eightfold).
@@ -448,6 +452,10 @@ impl CommonArgs {
     /// the window less the overlay's panel).
     pub fn prepare_for(&self, path: Option<&Path>, aspect: f64) -> Result<Prepared> {
         let (mut scene, load_ms) = load(path)?;
+        if let Some(name) = &self.variant {
+            let v = scene.variant_named(name).map_err(anyhow::Error::msg)?;
+            scene.select_variant(Some(v));
+        }
         let mut camera = self.camera.choose(&scene)?;
         // `--sky` alone is an explicit choice of lighting too: no automatic environment.
         let env_arg = match (&self.env.env, self.env.sky) {

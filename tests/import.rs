@@ -155,10 +155,14 @@ fn a_scene_without_camera_or_lights_is_framed_and_lit_by_the_default_rig() {
 #[test]
 fn unsupported_optional_extensions_only_warn() {
     let mut g = one_quad_scene();
-    g.use_ext("KHR_materials_sheen");
+    g.use_ext("KHR_materials_iridescence");
     let dir = tempfile::tempdir().unwrap();
     let s = load(&g.write_glb(dir.path(), "opt")).unwrap();
-    assert!(s.warnings.iter().any(|w| w.contains("KHR_materials_sheen")));
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("KHR_materials_iridescence"))
+    );
 }
 
 /// Runs `penumbra render` on a bad file: exit code non-zero, one line on stderr naming the
@@ -273,4 +277,104 @@ fn absurd_options_fail_with_one_clear_line() {
             "{args:?}: {err}"
         );
     }
+}
+
+/// A quad whose material `KHR_materials_variants` switches: red by default, blue in "Blue",
+/// green in "Green"; one mapping names a material and one a variant that do not exist.
+fn variant_scene(dir: &Path) -> std::path::PathBuf {
+    let mut g = Gltf::default();
+    g.lambert([0.8, 0.1, 0.1], [0.0; 3], 1.0, true);
+    let blue = g.lambert([0.1, 0.1, 0.8], [0.0; 3], 1.0, true);
+    let green = g.lambert([0.1, 0.8, 0.1], [0.0; 3], 1.0, true);
+    let m = g.mesh(vec![quad()]);
+    g.meshes[m]["primitives"][0]["extensions"] = json!({"KHR_materials_variants": {"mappings": [
+        {"material": blue, "variants": [0]},
+        {"material": green, "variants": [1, 7]},
+        {"material": 99, "variants": [0]}
+    ]}});
+    g.use_ext("KHR_materials_variants");
+    g.extra.insert(
+        "extensions".into(),
+        json!({"KHR_materials_variants": {"variants": [{"name": "Blue"}, {"name": "Green"}]}}),
+    );
+    g.node(json!({"mesh": m}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.5, 0.5, 2.0]}));
+    g.write_glb(dir, "variants")
+}
+
+#[test]
+fn material_variants_switch_the_materials() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = load(&variant_scene(dir.path())).unwrap();
+    assert_eq!(s.variants, ["Blue", "Green"]);
+    let all =
+        |s: &penumbra::scene::Scene, m: u32| s.objects[0].mesh.materials.iter().all(|&x| x == m);
+    assert!(all(&s, 0), "the default material");
+    assert!(
+        !s.warnings.iter().any(|w| w.contains("not supported")),
+        "{:?}",
+        s.warnings
+    );
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("mappings[2]: no such material"))
+    );
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("variants that do not exist"))
+    );
+    let green = s.variant_named("Green").unwrap();
+    s.select_variant(Some(green));
+    assert!(all(&s, 2));
+    s.select_variant(Some(0));
+    assert!(all(&s, 1));
+    s.select_variant(None);
+    assert!(all(&s, 0));
+    let e = s.variant_named("Pink").unwrap_err();
+    assert!(
+        e.contains("no variant \"Pink\"") && e.contains("\"Blue\", \"Green\""),
+        "{e}"
+    );
+}
+
+#[test]
+fn variant_on_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = variant_scene(dir.path());
+    let args = [
+        "--width", "8", "--height", "8", "--spp", "2", "--sky", "1,1,1",
+    ];
+    let (summary, px) = common::render_exr(
+        &scene,
+        &dir.path().join("green.exr"),
+        &[&args[..], &["--variant", "Green"]].concat(),
+    );
+    assert_eq!(summary["variant"], "Green");
+    assert_eq!(summary["variants"], json!(["Blue", "Green"]));
+    let (r, g) = px.iter().fold((0.0, 0.0), |(r, g), p| (r + p[0], g + p[1]));
+    assert!(g > 3.0 * r, "green {g} against red {r}");
+    let (summary, _) = common::render_exr(&scene, &dir.path().join("default.exr"), &args);
+    assert_eq!(summary["variant"], json!(null));
+    let out = dir.path().join("x.exr");
+    let o = penumbra(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--variant",
+        "Pink",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    // The file's own warnings come first; the error is one line.
+    let errors: Vec<&str> = err.lines().filter(|l| l.contains("error")).collect();
+    assert_eq!(errors.len(), 1, "{err}");
+    assert!(
+        errors[0].starts_with("penumbra: error: ") && errors[0].contains("\"Blue\", \"Green\""),
+        "{err}"
+    );
 }

@@ -828,3 +828,59 @@ fn a_texture_can_read_texcoord_1() {
         assert!(row[6][1] < 0.01 && row[7][1] < 0.01, "{row:?}");
     }
 }
+
+/// `KHR_materials_clearcoat` is read from the material's extension object: its factors, its
+/// three textures with their texCoord, `KHR_texture_transform` and normal scale, and tangents
+/// are made for its normal texture; nothing warns.
+#[test]
+fn clearcoat_factors_textures_and_transforms_are_read() {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let image = t.embedded(&mut g, &png(4, 4, &test_texels()));
+    let coat = t.texture(image, REPEAT);
+    let rough = t.texture(image, CLAMP);
+    let normal = t.texture(image, MIRROR);
+    g.use_ext("KHR_materials_clearcoat");
+    g.use_ext("KHR_texture_transform");
+    let m = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"extensions": {"KHR_materials_clearcoat": {
+            "clearcoatFactor": 0.75,
+            "clearcoatTexture": {"index": coat, "texCoord": 1},
+            "clearcoatRoughnessFactor": 0.25,
+            "clearcoatRoughnessTexture": {"index": rough, "extensions": {"KHR_texture_transform":
+                {"offset": [0.5, 0.25], "rotation": 0.3, "scale": [2.0, 3.0]}}},
+            "clearcoatNormalTexture": {"index": normal, "scale": 0.5}
+        }}}),
+    );
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, false, false);
+    g.node(json!({"mesh": mesh}));
+    let dir = tempfile::tempdir().unwrap();
+    let s = penumbra::scene::load(&g.write_glb(dir.path(), "coat")).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let mat = &s.materials[m];
+    assert_eq!(
+        (
+            mat.clearcoat,
+            mat.clearcoat_roughness,
+            mat.clearcoat_normal_scale
+        ),
+        (0.75, 0.25, 0.5)
+    );
+    let refs = |slot: Option<u32>| &s.texture_refs[slot.expect("a texture") as usize];
+    assert_eq!(refs(mat.textures.clearcoat).tex_coord, 1);
+    let r = refs(mat.textures.clearcoat_roughness);
+    assert_eq!(
+        (r.transform.offset, r.transform.rotation, r.transform.scale),
+        ([0.5, 0.25], 0.3, [2.0, 3.0])
+    );
+    assert!(!r.srgb);
+    assert!(mat.textures.clearcoat_normal.is_some() && mat.textures.normal.is_none());
+    let world = s.world_triangles();
+    assert!(
+        world.iter().all(|t| t.tangents.is_some()),
+        "tangents for the coat's normals"
+    );
+}

@@ -489,6 +489,7 @@ impl Gui {
                         s.triangles, info.load_ms, s.bvh_build_ms, s.kernel_build_ms
                     ));
                 }
+                variant_picker(ui, m, actions);
                 ui.label("objects (click one in the image to pick it):");
                 egui::ScrollArea::vertical()
                     .id_salt("objects")
@@ -572,6 +573,28 @@ impl Gui {
             self.edit = Some(TransformEdit::of(i, t));
             actions.changes.scene = true;
         }
+    }
+}
+
+/// The `KHR_materials_variants` picker (only for scenes with variants): choosing one gives the
+/// triangles its materials and re-uploads the scene.
+fn variant_picker(ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
+    if m.scene.variants.is_empty() {
+        return;
+    }
+    let name = |v: Option<usize>| v.map_or("default".to_string(), |v| m.scene.variants[v].clone());
+    let mut chosen = m.scene.variant;
+    egui::ComboBox::from_label("material variant")
+        .selected_text(name(chosen))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut chosen, None, "default");
+            for (i, v) in m.scene.variants.iter().enumerate() {
+                ui.selectable_value(&mut chosen, Some(i), v);
+            }
+        });
+    if chosen != m.scene.variant {
+        m.scene.select_variant(chosen);
+        actions.changes.scene = true;
     }
 }
 

@@ -56,6 +56,15 @@ pub struct KernelFeatures {
     pub transmission: bool,
     /// An environment map lights the scene (`HAS_ENV_MAP`).
     pub env_map: bool,
+    /// Some material is a transmissive thin wall (`HAS_THIN_WALLS`: shadow rays pass the smooth
+    /// ones).
+    pub thin_walls: bool,
+    /// Some material is unlit (`HAS_UNLIT`, `KHR_materials_unlit`).
+    pub unlit: bool,
+    /// Some material has a clear coat (`HAS_CLEARCOAT`, `KHR_materials_clearcoat`).
+    pub clearcoat: bool,
+    /// Some material has a sheen (`HAS_SHEEN`, `KHR_materials_sheen`).
+    pub sheen: bool,
     /// Rays descend a top level over instances, then their meshes' bottom levels (`TWO_LEVEL`).
     pub two_level: bool,
 }
@@ -71,6 +80,10 @@ impl KernelFeatures {
             (self.alpha, "HAS_ALPHA"),
             (self.transmission, "HAS_TRANSMISSION"),
             (self.env_map, "HAS_ENV_MAP"),
+            (self.thin_walls, "HAS_THIN_WALLS"),
+            (self.unlit, "HAS_UNLIT"),
+            (self.clearcoat, "HAS_CLEARCOAT"),
+            (self.sheen, "HAS_SHEEN"),
             (self.two_level, "TWO_LEVEL"),
         ] {
             if on {

@@ -71,6 +71,8 @@ kernel_constants! {
 
     /// Material flags in `GpuMaterial::emission.w`: both sides are front faces.
     MATERIAL_DOUBLE_SIDED: u32 = 1;
+    /// `KHR_materials_unlit`: the surface shows its base color and ends the path.
+    MATERIAL_UNLIT: u32 = 2;
 
     /// Alpha modes in `GpuMaterial::alpha.y`: opaque.
     ALPHA_OPAQUE: u32 = 0;
@@ -108,6 +110,9 @@ kernel_constants! {
     BACKGROUND_CUTOUT: u32 = 1;
     /// Escaped camera rays see the environment and the film's `.w` counts the samples that hit.
     BACKGROUND_COUNT: u32 = 2;
+    /// `GpuPath::direction.w` flag: went straight through a thin wall since the last
+    /// scattering vertex.
+    PATH_THROUGH_WALL: u32 = 4;
 
     /// Slot of the counters buffer (u32): paths in this bounce's input queue.
     COUNT_IN: usize = 0;
@@ -294,7 +299,7 @@ pub struct GpuEnvironment {
 }
 const _: () = assert!(size_of::<GpuEnvironment>() == 48);
 
-/// A glTF material as the kernels see it (128 bytes).
+/// A glTF material as the kernels see it (176 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuMaterial {
@@ -313,10 +318,19 @@ pub struct GpuMaterial {
     pub alpha: [f32; 4],
     /// Texture references (base color, metallic-roughness, normal, emissive); -1 when absent.
     pub textures: [i32; 4],
-    /// More texture references (`.x` transmission, `.y` thickness, `.zw` spare); -1 when absent.
+    /// More texture references (`.x` transmission, `.y` thickness, `.z` sheen color, `.w` sheen
+    /// roughness (A)); -1 when absent.
     pub textures2: [i32; 4],
+    /// `KHR_materials_clearcoat`: `.x` clearcoatFactor, `.y` clearcoatRoughnessFactor, `.z`
+    /// clearcoat normal texture scale; `.w` spare.
+    pub coat: [f32; 4],
+    /// Texture references of the extensions: `.x` clearcoat (R), `.y` clearcoat roughness (G),
+    /// `.z` clearcoat normal; `.w` spare; -1 when absent.
+    pub textures3: [i32; 4],
+    /// `KHR_materials_sheen`: `.xyz` sheenColorFactor, `.w` sheenRoughnessFactor.
+    pub sheen: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuMaterial>() == 128);
+const _: () = assert!(size_of::<GpuMaterial>() == 176);
 
 /// One light for next-event estimation (64 bytes).
 #[repr(C)]
@@ -476,7 +490,10 @@ pub fn layouts() -> Vec<StructLayout> {
             volume,
             alpha,
             textures,
-            textures2
+            textures2,
+            coat,
+            textures3,
+            sheen
         ),
         layout!(GpuLight, position, intensity, spot, extra),
         layout!(GpuCamera, origin, forward, right, up),

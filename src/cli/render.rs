@@ -138,6 +138,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "bvh_nodes": scene_stats.nodes,
         "lights": prepared.lights.len(),
         "default_light_rig": prepared.scene.default_rig,
+        "variants": prepared.scene.variants,
+        "variant": prepared.scene.variant.map(|v| prepared.scene.variants[v].clone()),
         "nonfinite_samples": stats.nonfinite_samples,
         "textures": scene_stats.textures,
         "texture_bytes": scene_stats.texture_bytes,

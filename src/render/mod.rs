@@ -76,11 +76,15 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
     KernelFeatures {
         triangle_lights,
         textures: used(&|m| m.textures.any()),
-        normal_maps: used(&|m| m.textures.normal.is_some()) && tangents,
+        normal_maps: used(&|m| m.textures.normal_mapped()) && tangents,
         alpha: used(&|m| m.alpha != AlphaMode::Opaque),
         transmission: used(&|m| m.transmission > 0.0),
         env_map: false,
         two_level: false,
+        thin_walls: used(&|m| m.transmission > 0.0 && m.thickness <= 0.0),
+        unlit: used(&|m| m.unlit),
+        clearcoat: used(&|m| m.clearcoat > 0.0),
+        sheen: used(&|m| m.sheen_color.iter().any(|&c| c > 0.0)),
     }
 }
 

@@ -135,7 +135,7 @@ pub fn gpu_material(m: &Material) -> GpuMaterial {
         MATERIAL_DOUBLE_SIDED
     } else {
         0
-    };
+    } | if m.unlit { MATERIAL_UNLIT } else { 0 };
     GpuMaterial {
         base_color: m.base_color,
         emission: [
@@ -176,7 +176,30 @@ pub fn gpu_material(m: &Material) -> GpuMaterial {
             slot(m.textures.normal),
             slot(m.textures.emissive),
         ],
-        textures2: [slot(m.textures.transmission), -1, -1, -1],
+        textures2: [
+            slot(m.textures.transmission),
+            -1,
+            slot(m.textures.sheen_color),
+            slot(m.textures.sheen_roughness),
+        ],
+        coat: [
+            m.clearcoat,
+            m.clearcoat_roughness,
+            m.clearcoat_normal_scale,
+            0.0,
+        ],
+        textures3: [
+            slot(m.textures.clearcoat),
+            slot(m.textures.clearcoat_roughness),
+            slot(m.textures.clearcoat_normal),
+            -1,
+        ],
+        sheen: [
+            m.sheen_color[0],
+            m.sheen_color[1],
+            m.sheen_color[2],
+            m.sheen_roughness,
+        ],
     }
 }
 

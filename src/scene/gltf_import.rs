@@ -5,6 +5,7 @@ use super::compression;
 use super::pose::{Pose, apply_morph_targets, apply_skin, node_pose, rest_worlds};
 use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
 use super::validate::PreciseNode;
+use super::variants::{self, VariantRange};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
     default_light_rig, limits, sources, validate,
@@ -16,6 +17,8 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
+
+mod materials;
 
 /// Vertical field of view of the automatic camera.
 pub const AUTO_YFOV: f64 = 0.8;
@@ -54,7 +57,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
     };
     let mut materials = document
         .materials()
-        .map(|m| import_material(m, &mut table, &mut warnings))
+        .map(|m| import_material(m, &document, &mut table, &mut warnings))
         .collect::<Vec<_>>();
     let images = decode_images(&document, base, &buffers, &mut table, &mut warnings);
     for m in &mut materials {
@@ -64,7 +67,11 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
     // The texture coordinate set of each material's normal map (tangents are made for it).
     let normal_sets: Vec<Option<u32>> = materials
         .iter()
-        .map(|m| m.textures.normal.map(|r| table.refs[r as usize].tex_coord))
+        .map(|m| {
+            (m.textures.normal)
+                .or(m.textures.clearcoat_normal)
+                .map(|r| table.refs[r as usize].tex_coord)
+        })
         .collect();
 
     let mut scene = Scene {
@@ -75,6 +82,8 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         ..Scene::default()
     };
     scene.materials.push(Material::default());
+    scene.variants = variants::names(document.extension_value("KHR_materials_variants"));
+    let variant_count = scene.variants.len();
 
     let roots: Vec<gltf::Node> = match document
         .default_scene()
@@ -141,7 +150,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
             let m = match meshes.get(&mesh.index()).filter(|_| !posed) {
                 Some(m) => m.clone(),
                 None => {
-                    let m = import_mesh(
+                    let mut m = import_mesh(
                         &mesh,
                         root,
                         &buffer_data,
@@ -150,6 +159,11 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
                         &normal_sets,
                         &mut warnings,
                     )?;
+                    m.keep_variants(
+                        variant_count,
+                        &format!("meshes[{}]", mesh.index()),
+                        &mut warnings,
+                    );
                     if !posed {
                         meshes.insert(mesh.index(), m.clone());
                     }
@@ -438,6 +452,11 @@ impl TextureTable {
             &mut slots.normal,
             &mut slots.emissive,
             &mut slots.transmission,
+            &mut slots.clearcoat,
+            &mut slots.clearcoat_roughness,
+            &mut slots.clearcoat_normal,
+            &mut slots.sheen_color,
+            &mut slots.sheen_roughness,
         ] {
             if let Some(r) = *slot
                 && self.failed[self.refs[r as usize].image as usize]
@@ -502,6 +521,7 @@ fn decode_images(
 
 fn import_material(
     m: gltf::Material,
+    document: &gltf::Document,
     table: &mut TextureTable,
     warnings: &mut Vec<String>,
 ) -> Material {
@@ -546,9 +566,10 @@ fn import_material(
         transmission: m
             .transmission()
             .and_then(|t| table.info(t.transmission_texture(), false, &what, warnings)),
+        ..MaterialTextures::default()
     };
     let volume = m.volume();
-    let material = Material {
+    let mut material = Material {
         name: m
             .name()
             .map(str::to_string)
@@ -605,7 +626,10 @@ fn import_material(
             f32::MAX,
             1.0,
         ),
+        unlit: m.unlit(),
+        ..Material::default()
     };
+    materials::read_extensions(&m, document, table, &mut material, warnings);
     if !fix.0.is_empty() {
         warnings.push(format!(
             "materials[{}]: {}",
@@ -924,6 +948,14 @@ fn import_mesh(
         out.positions.extend_from_slice(&positions);
         out.indices
             .extend(triangles.iter().map(|t| t.map(|i| i + base)));
+        if let Some(x) = prim.extension_value("KHR_materials_variants") {
+            let start = out.materials.len() as u32;
+            out.variants.push(VariantRange {
+                triangles: start..start + triangles.len() as u32,
+                default: material,
+                materials: variants::mappings(x, default_material as usize, &what, warnings),
+            });
+        }
         out.materials
             .extend(std::iter::repeat_n(material, triangles.len()));
     }

@@ -18,6 +18,7 @@ mod sources;
 mod tangents;
 mod textures;
 mod validate;
+mod variants;
 
 pub use bounds::{ABSURD_COORDINATE, RenderFrame, is_sane, robust_bounds};
 pub use env_presets::EnvPreset;
@@ -29,6 +30,7 @@ pub use textures::{
     linear_to_srgb, mip_chain, srgb_to_linear,
 };
 pub use validate::SUPPORTED_EXTENSIONS;
+pub use variants::VariantRange;
 
 use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -82,6 +84,8 @@ pub struct Mesh {
     /// `TANGENT` or generated (MikkTSpace) for normal-mapped primitives; empty when no
     /// primitive of the mesh is normal-mapped. Zero where unknown.
     pub tangents: Vec<[Vec4; 3]>,
+    /// The triangles whose material a `KHR_materials_variants` variant changes.
+    pub variants: Vec<VariantRange>,
 }
 
 /// One placed mesh: a glTF node's mesh with its world transform.
@@ -144,6 +148,18 @@ pub struct Material {
     pub textures: MaterialTextures,
     /// Normal texture scale (x and y of the tangent-space normal).
     pub normal_scale: f32,
+    /// `KHR_materials_unlit`: shows its base color and scatters nothing.
+    pub unlit: bool,
+    /// `KHR_materials_clearcoat` clearcoatFactor (0: no coat).
+    pub clearcoat: f32,
+    /// `KHR_materials_clearcoat` clearcoatRoughnessFactor.
+    pub clearcoat_roughness: f32,
+    /// Scale of the clearcoat normal texture.
+    pub clearcoat_normal_scale: f32,
+    /// `KHR_materials_sheen` sheenColorFactor (linear; 0: no sheen).
+    pub sheen_color: [f32; 3],
+    /// `KHR_materials_sheen` sheenRoughnessFactor.
+    pub sheen_roughness: f32,
 }
 
 impl Default for Material {
@@ -165,6 +181,12 @@ impl Default for Material {
             alpha: AlphaMode::Opaque,
             textures: MaterialTextures::default(),
             normal_scale: 1.0,
+            unlit: false,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            clearcoat_normal_scale: 1.0,
+            sheen_color: [0.0; 3],
+            sheen_roughness: 0.0,
         }
     }
 }
@@ -343,6 +365,10 @@ pub struct Scene {
     pub warnings: Vec<String>,
     /// Decoded images used by the materials (only those).
     pub images: Vec<Arc<Image>>,
+    /// `KHR_materials_variants` variant names (empty: none).
+    pub variants: Vec<String>,
+    /// The selected variant (`None`: the default materials).
+    pub variant: Option<usize>,
     /// Texture uses, indexed by `MaterialTextures`.
     pub texture_refs: Vec<TextureRef>,
 }

@@ -124,6 +124,16 @@ pub struct MaterialTextures {
     pub emissive: Option<u32>,
     /// `KHR_materials_transmission` texture (R).
     pub transmission: Option<u32>,
+    /// `KHR_materials_clearcoat` clearcoatTexture (R).
+    pub clearcoat: Option<u32>,
+    /// `KHR_materials_clearcoat` clearcoatRoughnessTexture (G).
+    pub clearcoat_roughness: Option<u32>,
+    /// `KHR_materials_clearcoat` clearcoatNormalTexture.
+    pub clearcoat_normal: Option<u32>,
+    /// `KHR_materials_sheen` sheenColorTexture (sRGB RGB).
+    pub sheen_color: Option<u32>,
+    /// `KHR_materials_sheen` sheenRoughnessTexture (A).
+    pub sheen_roughness: Option<u32>,
 }
 
 impl MaterialTextures {
@@ -134,6 +144,16 @@ impl MaterialTextures {
             || self.normal.is_some()
             || self.emissive.is_some()
             || self.transmission.is_some()
+            || self.clearcoat.is_some()
+            || self.clearcoat_roughness.is_some()
+            || self.clearcoat_normal.is_some()
+            || self.sheen_color.is_some()
+            || self.sheen_roughness.is_some()
+    }
+
+    /// Whether a slot holds a tangent-space normal map (the base's or the clearcoat's).
+    pub fn normal_mapped(&self) -> bool {
+        self.normal.is_some() || self.clearcoat_normal.is_some()
     }
 }
 
