@@ -270,7 +270,10 @@ fn absurd_options_fail_with_one_clear_line() {
         assert!(err.contains(expect), "{args:?}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
         // A number outside an option's range is a usage error (2); the rest is bad input (1).
-        let usage = matches!(args[0], "--width" | "--bounces" | "--spp");
+        let usage = matches!(
+            args[0],
+            "--width" | "--bounces" | "--spp" | "--light-radius"
+        );
         assert_eq!(
             o.status.code(),
             Some(if usage { 2 } else { 1 }),

@@ -29,27 +29,35 @@ pub fn robust_bounds(triangles: &[[DVec3; 3]]) -> Bounds {
     if sane.is_empty() {
         return b;
     }
-    let median = |mut v: Vec<f64>, q: f64| {
-        v.sort_unstable_by(f64::total_cmp);
-        v[((v.len() - 1) as f64 * q).round() as usize]
+    // Quartiles and the median extent from a regular sample of at most 2^16 triangles:
+    // they only place the outlier box, which is 64 scene sizes wide on each side, and a
+    // full sort of every coordinate cost ~0.3 s per call on a 1 M-triangle scene.
+    let step = sane.len().div_ceil(1 << 16);
+    let sample: Vec<&[DVec3; 3]> = sane.iter().step_by(step).copied().collect();
+    let quantile = |mut v: Vec<f64>, q: f64| {
+        let k = ((v.len() - 1) as f64 * q).round() as usize;
+        *v.select_nth_unstable_by(k, f64::total_cmp).1
     };
-    let centroids: Vec<DVec3> = sane.iter().map(|t| (t[0] + t[1] + t[2]) / 3.0).collect();
+    let centroid = |t: &[DVec3; 3]| (t[0] + t[1] + t[2]) / 3.0;
     let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ZERO);
     for axis in 0..3 {
-        let c: Vec<f64> = centroids.iter().map(|p| p[axis]).collect();
-        lo[axis] = median(c.clone(), 0.25);
-        hi[axis] = median(c, 0.75);
+        let c: Vec<f64> = sample.iter().map(|t| centroid(t)[axis]).collect();
+        lo[axis] = quantile(c.clone(), 0.25);
+        hi[axis] = quantile(c, 0.75);
     }
-    let extents = sane.iter().map(|t| {
+    let extents = sample.iter().map(|t| {
         let (a, b) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
         (b - a).max_element()
     });
-    let size = (hi - lo).max_element().max(median(extents.collect(), 0.5));
+    let size = (hi - lo)
+        .max_element()
+        .max(quantile(extents.collect(), 0.5));
     let (lo, hi) = (
         lo - DVec3::splat(64.0 * size),
         hi + DVec3::splat(64.0 * size),
     );
-    for (t, c) in sane.iter().zip(&centroids) {
+    for t in &sane {
+        let c = centroid(t);
         if c.cmpge(lo).all() && c.cmple(hi).all() {
             t.iter().for_each(|&p| b.grow(p));
         }
