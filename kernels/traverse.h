@@ -92,7 +92,11 @@ inline bool intersect_triangle(const RayPrep* r, float4 v0, float4 v1, float4 v2
     if (!(t > tmin && t < *tmax)) return false;
     // pbrt-v4's conservative bound on t's rounding error: a hit closer than its own error
     // could lie behind the origin, as it does for a ray leaving this very triangle.
-    if (t <= triangle_t_error(ax, ay, bx, by, cx, cy, az, bz, cz, u, v, w, det)) return false;
+    // Only a hit much closer than the triangle's farthest vertex can be that close to its own
+    // error; the bound is evaluated for those alone (it is cheap, but not free on a GPU).
+    if (t < 0.00390625f * fmax(fmax(fabs(az), fabs(bz)), fabs(cz)) &&
+        t <= triangle_t_error(ax, ay, bx, by, cx, cy, az, bz, cz, u, v, w, det))
+        return false;
     *tmax = t;
     *bu = v / det;
     *bv = w / det;

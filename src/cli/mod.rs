@@ -155,10 +155,13 @@ mod tests {
 
     #[test]
     fn absurd_settings_are_rejected() {
-        let cli = Cli::parse_from(["penumbra", "render", "a.glb", "-o", "x.exr", "--width", "0"]);
-        let Some(Command::Render(r)) = cli.command else {
-            panic!("not a render command")
-        };
-        assert!(r.common.settings((64, 64)).is_err());
+        // Out-of-range sizes and counts are usage errors from clap itself (exit 2).
+        for args in [["--width", "0"], ["--spp", "0"], ["--bounces", "100000"]] {
+            let line = [
+                "penumbra", "render", "a.glb", "-o", "x.exr", args[0], args[1],
+            ];
+            let e = Cli::try_parse_from(line).expect_err("out of range");
+            assert_eq!(e.exit_code(), 2, "{args:?}");
+        }
     }
 }
