@@ -73,6 +73,30 @@ fn subject_stats(path: &std::path::Path) -> (f64, f64, f64) {
     )
 }
 
+/// The small default render each scene gets here (96×72, 4 spp, 2 bounces), plus `extra`.
+fn render_small(
+    scene: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> std::process::Output {
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "96",
+        "--height",
+        "72",
+        "--spp",
+        "4",
+        "--bounces",
+        "2",
+    ];
+    args.extend_from_slice(extra);
+    penumbra(&args)
+}
+
 #[test]
 fn every_shared_scene_opens_readable() {
     let out = output_dir("first_image");
@@ -80,20 +104,7 @@ fn every_shared_scene_opens_readable() {
     for scene in scene_files() {
         let name = scene.file_stem().unwrap().to_string_lossy().to_string();
         let png = out.join(format!("{name}.png"));
-        let o = penumbra(&[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            png.to_str().unwrap(),
-            "--width",
-            "96",
-            "--height",
-            "72",
-            "--spp",
-            "4",
-            "--bounces",
-            "2",
-        ]);
+        let o = render_small(&scene, &png, &[]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(o.status.success(), "{name}: {err}");
         let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -102,22 +113,7 @@ fn every_shared_scene_opens_readable() {
         let (median, clipped, black) = png_stats(&png);
         // The same render with the background cut out shows the subject alone.
         let cut = out.join(format!("{name}-subject.png"));
-        let o = penumbra(&[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            cut.to_str().unwrap(),
-            "--width",
-            "96",
-            "--height",
-            "72",
-            "--spp",
-            "4",
-            "--bounces",
-            "2",
-            "--background",
-            "transparent",
-        ]);
+        let o = render_small(&scene, &cut, &["--background", "transparent"]);
         assert!(
             o.status.success(),
             "{name}: {}",
