@@ -1,9 +1,10 @@
 //! Host-side costs a user waits for when a scene opens: the binned-SAH BVH build (triangles per
 //! second on generated soups of 100k and 1M triangles and, when PENUMBRA_BVH_SCENE names a glTF
 //! file such as the room of `penumbra bench generate`, on that scene's world triangles), the
-//! refit of the 1M soup, and glTF loading (the bundled Cornell box and, when PENUMBRA_SCENES is
-//! set, StanfordBunny). Sample sizes are small so that `cargo bench --bench bvh` finishes in a
-//! few minutes on two cores.
+//! same builds timed in process CPU time (all threads; on a machine shared with other work the
+//! wall time says little), the refit of the 1M soup, and glTF loading (the bundled Cornell box
+//! and, when PENUMBRA_SCENES is set, StanfordBunny). Sample sizes are small so that
+//! `cargo bench --bench bvh` finishes in a few minutes on two cores.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
@@ -31,28 +32,65 @@ fn soup(n: usize) -> Vec<[Vec3; 3]> {
         .collect()
 }
 
+/// CPU time this process has used, all threads together (Linux: the scheduler's per-thread
+/// run time in nanoseconds, `/proc/self/task/*/schedstat`); `None` elsewhere.
+fn process_cpu_time() -> Option<Duration> {
+    let mut ns = 0u64;
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let stat = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+        ns += stat.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
+    Some(Duration::from_nanos(ns))
+}
+
 fn bvh_build(c: &mut Criterion) {
+    let mut inputs: Vec<(String, Vec<[Vec3; 3]>)> = [100_000usize, 1_000_000]
+        .into_iter()
+        .map(|n| (n.to_string(), soup(n)))
+        .collect();
+    if let Some(path) = std::env::var_os("PENUMBRA_BVH_SCENE") {
+        let scene = penumbra::scene::load(&PathBuf::from(path)).expect("PENUMBRA_BVH_SCENE loads");
+        inputs.push((
+            "scene".into(),
+            scene.world_triangles().iter().map(|t| t.v).collect(),
+        ));
+    }
     let mut group = c.benchmark_group("bvh_build");
     group
         .sample_size(10)
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(5));
-    for n in [100_000usize, 1_000_000] {
-        let tris = soup(n);
-        group.throughput(Throughput::Elements(n as u64));
-        group.bench_with_input(BenchmarkId::from_parameter(n), &tris, |b, tris| {
+    for (name, tris) in &inputs {
+        group.throughput(Throughput::Elements(tris.len() as u64));
+        group.bench_with_input(BenchmarkId::from_parameter(name), tris, |b, tris| {
             b.iter(|| black_box(penumbra::bvh::build(black_box(tris))))
         });
     }
-    if let Some(path) = std::env::var_os("PENUMBRA_BVH_SCENE") {
-        let scene = penumbra::scene::load(&PathBuf::from(path)).expect("PENUMBRA_BVH_SCENE loads");
-        let tris: Vec<[Vec3; 3]> = scene.world_triangles().iter().map(|t| t.v).collect();
-        group.throughput(Throughput::Elements(tris.len() as u64));
-        group.bench_function("scene", |b| {
-            b.iter(|| black_box(penumbra::bvh::build(black_box(&tris))))
-        });
-    }
     group.finish();
+
+    // The same builds in CPU time: criterion's "time" is the CPU time of every thread, so
+    // RAYON_NUM_THREADS=1 and =2 give the builder's parallel overhead on a loaded machine.
+    if process_cpu_time().is_some() {
+        let mut group = c.benchmark_group("bvh_build_cpu");
+        group
+            .sample_size(10)
+            .warm_up_time(Duration::from_secs(1))
+            .measurement_time(Duration::from_secs(5));
+        for (name, tris) in &inputs {
+            group.throughput(Throughput::Elements(tris.len() as u64));
+            group.bench_with_input(BenchmarkId::from_parameter(name), tris, |b, tris| {
+                b.iter_custom(|iters| {
+                    let cpu = || process_cpu_time().unwrap_or_default();
+                    let start = cpu();
+                    for _ in 0..iters {
+                        black_box(penumbra::bvh::build(black_box(tris)));
+                    }
+                    cpu().saturating_sub(start)
+                })
+            });
+        }
+        group.finish();
+    }
 
     // Refit after every vertex moved a little (the topology stays, the boxes change).
     let mut group = c.benchmark_group("bvh_refit");

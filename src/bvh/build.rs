@@ -19,6 +19,8 @@ const BINS: usize = 16;
 const FEW_BINS: usize = 8;
 /// Largest node binned with [`FEW_BINS`].
 const FEW_BINS_MAX: usize = 256;
+/// Nodes binned with two sets of bins (see [`Binning::bin`]) have at least this many primitives.
+const TWO_BIN_SETS_MIN: usize = 256;
 /// Nodes of at most this many primitives are split by a full SAH sweep over their sorted
 /// centroids instead of bins.
 const SWEEP_MAX: usize = 4;
@@ -268,8 +270,11 @@ fn build_subtree(prims: &mut [Prim], first: u32, depth: u32, info: NodeInfo) -> 
         };
     };
     if prims.len() <= PARALLEL_THRESHOLD {
-        let mut nodes = vec![GpuBvhNode::default()];
+        // A binary tree over n primitives has at most n - 1 interior nodes: no regrowth.
+        let mut nodes = Vec::with_capacity(prims.len() - 1);
+        nodes.push(GpuBvhNode::default());
         emit(prims, first, depth, split, 0, &mut nodes);
+        nodes.shrink_to_fit();
         return Built::Tree { bounds, nodes };
     }
     let (left, right) = prims.split_at_mut(split.at);
@@ -438,6 +443,30 @@ fn keep_as_leaf(cost: f32, n: usize) -> bool {
 fn split_sweep(prims: &mut [Prim], info: NodeInfo) -> Found {
     let n = prims.len();
     let extent = info.centroids.max - info.centroids.min;
+    if n == 2 {
+        // The only split: one primitive a side (the most common node near the leaves).
+        if !extent.cmpgt(Vec4::ZERO).any() {
+            return Found::Flat;
+        }
+        let one = |p: &Prim| Bounds4 {
+            min: p.min,
+            max: p.max,
+        };
+        let weighted = half_area(one(&prims[0])) + half_area(one(&prims[1]));
+        if keep_as_leaf(relative_cost(weighted, info), n) {
+            return Found::Leaf;
+        }
+        let side = |p: &Prim| {
+            let mut i = NodeInfo::EMPTY;
+            i.add(p);
+            i
+        };
+        return Found::Split(Split {
+            at: 1,
+            left: side(&prims[0]),
+            right: side(&prims[1]),
+        });
+    }
     let mut centroids = [Vec4::ZERO; SWEEP_MAX];
     for (c, p) in centroids.iter_mut().zip(prims.iter()) {
         *c = p.centroid2();
@@ -521,12 +550,13 @@ impl<const B: usize> Bins<B> {
     }
 }
 
-/// Where a primitive falls in the bins: `(centroid2 - origin) * scale`, whose integer part
-/// (clamped to the last bin) is the bin on each axis.
+/// Where a primitive falls in the bins: `centroid2 * scale - bias` (that is,
+/// `(centroid2 - origin) * scale - 0.5`), rounded to the nearest integer and clamped to the bins,
+/// is its bin on each axis.
 #[derive(Clone, Copy)]
 struct Binning {
-    origin: Vec4,
     scale: Vec4,
+    bias: Vec4,
 }
 
 impl Binning {
@@ -535,19 +565,22 @@ impl Binning {
         let extent = info.centroids.max - info.centroids.min;
         let scale = Vec4::splat(B as f32) / extent;
         let usable = extent.cmpgt(Vec4::ZERO) & scale.cmplt(Vec4::splat(f32::INFINITY));
+        let scale = Vec4::select(usable, scale, Vec4::ZERO);
         Binning {
-            origin: info.centroids.min,
-            scale: Vec4::select(usable, scale, Vec4::ZERO),
+            scale,
+            bias: info.centroids.min * scale + 0.5,
         }
     }
 
     /// The bins, one a lane, of a primitive with [`Prim::centroid2`] `c`. Adding 2^23 (whose
-    /// float has no fraction bits left) rounds `t - 0.5` to the nearest integer and leaves it
-    /// in the low bits: that vectorises where a float-to-integer conversion does not. The bins
-    /// are monotonic in the centroid, which is all the SAH sweep and the partition need.
+    /// float has no fraction bits left) rounds to the nearest integer and leaves it in the low
+    /// bits: that vectorises where a float-to-integer conversion does not. The bins are
+    /// monotonic in the centroid, which is all the SAH sweep and the partition need.
     fn bins_of<const B: usize>(self, c: Vec4) -> [u32; 4] {
-        let t = (c - self.origin) * self.scale;
-        let t = (t - 0.5).max(Vec4::ZERO).min(Vec4::splat((B - 1) as f32)) + MAGIC;
+        let t = (c * self.scale - self.bias)
+            .max(Vec4::ZERO)
+            .min(Vec4::splat((B - 1) as f32))
+            + MAGIC;
         t.to_array().map(|x| x.to_bits() - MAGIC_BITS)
     }
 
@@ -556,7 +589,6 @@ impl Binning {
         // Two sets of bins, for even and odd primitives: neighbours often fall in the same
         // bin, and one set would make each update wait for the last one's store.
         let mut even = Bins::<B>::EMPTY;
-        let mut odd = Bins::<B>::EMPTY;
         let add = |bins: &mut Bins<B>, p: &Prim| {
             let b = self.bins_of::<B>(p.centroid2());
             for (axis, &i) in b[..3].iter().enumerate() {
@@ -564,6 +596,13 @@ impl Binning {
                 bins.counts[axis][i as usize] += 1;
             }
         };
+        if prims.len() < TWO_BIN_SETS_MIN {
+            for p in prims {
+                add(&mut even, p);
+            }
+            return even;
+        }
+        let mut odd = Bins::<B>::EMPTY;
         let mut pairs = prims.chunks_exact(2);
         for pair in &mut pairs {
             add(&mut even, &pair[0]);
