@@ -55,23 +55,19 @@ fn bvh_build(c: &mut Criterion) {
             scene.world_triangles().iter().map(|t| t.v).collect(),
         ));
     }
-    let mut group = c.benchmark_group("bvh_build");
-    group
-        .sample_size(10)
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(5));
-    for (name, tris) in &inputs {
-        group.throughput(Throughput::Elements(tris.len() as u64));
-        group.bench_with_input(BenchmarkId::from_parameter(name), tris, |b, tris| {
-            b.iter(|| black_box(penumbra::bvh::build(black_box(tris))))
-        });
-    }
-    group.finish();
-
-    // The same builds in CPU time: criterion's "time" is the CPU time of every thread, so
-    // RAYON_NUM_THREADS=1 and =2 give the builder's parallel overhead on a loaded machine.
-    if process_cpu_time().is_some() {
-        let mut group = c.benchmark_group("bvh_build_cpu");
+    // The builds in wall time, then in CPU time: criterion's "time" of `bvh_build_cpu` is the
+    // CPU time of every thread, so RAYON_NUM_THREADS=1 and =2 give the builder's parallel
+    // overhead, and a loaded machine distorts it far less than the wall time.
+    for cpu_time in [false, true] {
+        if cpu_time && process_cpu_time().is_none() {
+            continue;
+        }
+        let name = if cpu_time {
+            "bvh_build_cpu"
+        } else {
+            "bvh_build"
+        };
+        let mut group = c.benchmark_group(name);
         group
             .sample_size(10)
             .warm_up_time(Duration::from_secs(1))
@@ -79,11 +75,15 @@ fn bvh_build(c: &mut Criterion) {
         for (name, tris) in &inputs {
             group.throughput(Throughput::Elements(tris.len() as u64));
             group.bench_with_input(BenchmarkId::from_parameter(name), tris, |b, tris| {
+                let build = || black_box(penumbra::bvh::build(black_box(tris)));
+                if !cpu_time {
+                    return b.iter(build);
+                }
                 b.iter_custom(|iters| {
                     let cpu = || process_cpu_time().unwrap_or_default();
                     let start = cpu();
                     for _ in 0..iters {
-                        black_box(penumbra::bvh::build(black_box(tris)));
+                        build();
                     }
                     cpu().saturating_sub(start)
                 })

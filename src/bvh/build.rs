@@ -186,12 +186,7 @@ fn build_prims(mut prims: Vec<Prim>) -> Bvh {
     drop(prims);
     let nodes = match root {
         Built::Tree { nodes, .. } => nodes,
-        Built::Top { .. } => {
-            let mut nodes = Vec::with_capacity(root.node_count());
-            nodes.push(GpuBvhNode::default());
-            assemble(root, 0, &mut nodes);
-            nodes
-        }
+        Built::Top { .. } => assemble(root),
         Built::Leaf {
             bounds,
             first,
@@ -325,12 +320,70 @@ fn emit(
     }
 }
 
-/// Writes the parallel levels below the interior node at `slot` into `nodes`, in the layout
-/// [`emit`] gives: interior children next to each other, then the left subtree, then the right.
-/// Each task's block is freed as soon as it is copied.
-fn assemble(node: Built, slot: usize, nodes: &mut Vec<GpuBvhNode>) {
+/// The node array of a tree whose top levels were split in parallel, in the layout [`emit`]
+/// gives: interior children next to each other, then the left subtree, then the right. The
+/// split levels are placed first (a few nodes a task); then every task's block is copied into
+/// its own range of the array in parallel.
+fn assemble(root: Built) -> Vec<GpuBvhNode> {
+    let mut nodes = vec![GpuBvhNode::default(); root.node_count()];
+    let mut blocks = Vec::new();
+    let mut end = 1;
+    place(root, 0, &mut end, &mut nodes, &mut blocks);
+    // The blocks, less their roots, in ascending disjoint ranges from `start`.
+    let mut jobs = Vec::with_capacity(blocks.len());
+    let mut rest = &mut nodes[..];
+    let mut base = 0;
+    for block in &blocks {
+        let (_, tail) = std::mem::take(&mut rest).split_at_mut(block.start - base);
+        let (range, tail) = tail.split_at_mut(block.nodes.len() - 1);
+        jobs.push((range, block));
+        rest = tail;
+        base = block.start + block.nodes.len() - 1;
+    }
+    let roots: Vec<(usize, GpuBvhNode)> = jobs
+        .into_par_iter()
+        .map(|(range, block)| {
+            // The block's root takes the reserved slot, the rest follows: local index i >= 1
+            // lands at start + i - 1.
+            let offset = block.start as u32 - 1;
+            let shift = |mut n: GpuBvhNode| {
+                for lo in [&mut n.left_min, &mut n.right_min] {
+                    if (lo[3].to_bits() as i32) >= 0 {
+                        lo[3] = f32::from_bits(lo[3].to_bits() + offset);
+                    }
+                }
+                n
+            };
+            for (to, &from) in range.iter_mut().zip(&block.nodes[1..]) {
+                *to = shift(from);
+            }
+            (block.slot, shift(block.nodes[0]))
+        })
+        .collect();
+    for (slot, node) in roots {
+        nodes[slot] = node;
+    }
+    nodes
+}
+
+/// A task's block of nodes and where it goes: its root at `slot`, the rest from `start` on.
+struct Block {
+    slot: usize,
+    start: usize,
+    nodes: Vec<GpuBvhNode>,
+}
+
+/// Writes the split node `node` at `slot`, reserving slots from `end` for its interior
+/// children, and notes where the blocks below it go.
+fn place(
+    node: Built,
+    slot: usize,
+    end: &mut usize,
+    nodes: &mut [GpuBvhNode],
+    blocks: &mut Vec<Block>,
+) {
     let Built::Top { children, .. } = node else {
-        unreachable!("assemble is only called on split nodes")
+        unreachable!("place is only called on split nodes")
     };
     let mut gpu = GpuBvhNode::default();
     let mut pending = [None, None];
@@ -342,10 +395,9 @@ fn assemble(node: Built, slot: usize, nodes: &mut Vec<GpuBvhNode>) {
                 count,
             } => write_leaf(&mut gpu, side, *bounds, *first, *count),
             Built::Tree { .. } | Built::Top { .. } => {
-                nodes.push(GpuBvhNode::default());
-                let index = nodes.len() - 1;
-                write_interior(&mut gpu, side, child.bounds(), index as u32);
-                pending[side] = Some(index);
+                write_interior(&mut gpu, side, child.bounds(), *end as u32);
+                pending[side] = Some(*end);
+                *end += 1;
             }
         }
     }
@@ -354,21 +406,14 @@ fn assemble(node: Built, slot: usize, nodes: &mut Vec<GpuBvhNode>) {
     for (child, index) in [left, right].into_iter().zip(pending) {
         let Some(index) = index else { continue };
         match child {
-            Built::Top { .. } => assemble(child, index, nodes),
+            Built::Top { .. } => place(child, index, end, nodes, blocks),
             Built::Tree { nodes: block, .. } => {
-                // The block's root takes the reserved slot, the rest follows: local index i >= 1
-                // lands at start + i - 1.
-                let offset = (nodes.len() - 1) as u32;
-                let shift = |mut n: GpuBvhNode| {
-                    for lo in [&mut n.left_min, &mut n.right_min] {
-                        if (lo[3].to_bits() as i32) >= 0 {
-                            lo[3] = f32::from_bits(lo[3].to_bits() + offset);
-                        }
-                    }
-                    n
-                };
-                nodes[index] = shift(block[0]);
-                nodes.extend(block[1..].iter().map(|&n| shift(n)));
+                blocks.push(Block {
+                    slot: index,
+                    start: *end,
+                    nodes: block,
+                });
+                *end += blocks.last().map_or(0, |b| b.nodes.len() - 1);
             }
             Built::Leaf { .. } => unreachable!("leaves reserve no slot"),
         }

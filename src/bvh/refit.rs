@@ -25,42 +25,66 @@ impl Bvh {
     /// The SAH cost (traversal cost 1, intersection cost 1 per triangle, relative to the root's
     /// area) and the depth of the deepest leaf (root = 0), from the node array.
     pub fn sah_and_depth(&self) -> (f32, u32) {
+        (self.sah(), self.deepest_leaf())
+    }
+
+    /// The SAH cost of [`Bvh::sah_and_depth`]. Summed in parallel over fixed chunks of nodes, so
+    /// the sum is the same at any thread count.
+    fn sah(&self) -> f32 {
         let Some(root) = self.nodes.first() else {
-            return (0.0, 0);
+            return 0.0;
         };
         let root_leaf_only = matches!(self.child(0, 1).1, Child::Leaf { count: 0, .. });
         let root_area = child_box(root, 0)
             .union(child_box(root, 1))
             .area()
             .max(f32::MIN_POSITIVE) as f64;
+        let chunk_sums: Vec<f64> = self
+            .nodes
+            .par_chunks(1 << 14)
+            .map(|chunk| {
+                let mut sum = 0.0;
+                for node in chunk {
+                    for side in 0..2 {
+                        let (lo, hi) = lanes(node, side);
+                        // A leaf's cost is its triangle count, an interior node's one step.
+                        let weight = if (lo[3].to_bits() as i32) < 0 {
+                            hi[3].to_bits() as f64
+                        } else {
+                            TRAVERSAL_COST as f64
+                        };
+                        sum += child_box(node, side).area() as f64 * weight;
+                    }
+                }
+                sum
+            })
+            .collect();
+        let step = if root_leaf_only { 0.0 } else { TRAVERSAL_COST };
+        (step as f64 + chunk_sums.iter().sum::<f64>() / root_area) as f32
+    }
+
+    /// The depth of the deepest leaf of [`Bvh::sah_and_depth`].
+    fn deepest_leaf(&self) -> u32 {
+        if self.nodes.is_empty() {
+            return 0;
+        }
+        let root_leaf_only = matches!(self.child(0, 1).1, Child::Leaf { count: 0, .. });
         // Children come after their parents, so one forward pass knows every node's depth.
         let mut depths = vec![0u8; self.nodes.len()];
-        let mut cost = if root_leaf_only {
-            0.0
-        } else {
-            TRAVERSAL_COST as f64
-        };
         let mut deepest = 0;
-        for index in 0..self.nodes.len() {
+        for (index, node) in self.nodes.iter().enumerate() {
             let depth = depths[index];
             for side in 0..2 {
-                let (b, child) = self.child(index as u32, side);
-                let area = b.area() as f64 / root_area;
-                match child {
-                    Child::Node(c) => {
-                        depths[c as usize] = depth + 1;
-                        cost += area * TRAVERSAL_COST as f64;
-                    }
-                    Child::Leaf { count, .. } => {
-                        cost += area * count as f64;
-                        if count > 0 {
-                            deepest = deepest.max(depth as u32 + u32::from(!root_leaf_only));
-                        }
-                    }
+                let (lo, hi) = lanes(node, side);
+                let child = lo[3].to_bits() as i32;
+                if child >= 0 {
+                    depths[child as usize] = depth + 1;
+                } else if hi[3].to_bits() > 0 {
+                    deepest = deepest.max(depth as u32 + u32::from(!root_leaf_only));
                 }
             }
         }
-        (cost as f32, deepest)
+        deepest
     }
 
     /// Recomputes every box for `triangles` (in their original order, as given to
@@ -102,7 +126,7 @@ impl Bvh {
                 }
             }
         }
-        self.sah_cost = self.sah_and_depth().0;
+        self.sah_cost = self.sah();
     }
 
     /// Refits for `triangles`, and builds the tree again when the refit left its SAH cost at
@@ -131,6 +155,15 @@ fn child_box(node: &GpuBvhNode, side: usize) -> Aabb {
 }
 
 /// The min and max lanes of child `side`.
+fn lanes(node: &GpuBvhNode, side: usize) -> (&[f32; 4], &[f32; 4]) {
+    if side == 0 {
+        (&node.left_min, &node.left_max)
+    } else {
+        (&node.right_min, &node.right_max)
+    }
+}
+
+/// The min and max lanes of child `side`, to write.
 fn sides(node: &mut GpuBvhNode, side: usize) -> (&mut [f32; 4], &mut [f32; 4]) {
     if side == 0 {
         (&mut node.left_min, &mut node.left_max)
