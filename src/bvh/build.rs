@@ -4,7 +4,9 @@
 //! per triangle). Large nodes at the top of the tree bin and partition their primitives in
 //! parallel (rayon chunks, binned per chunk and reduced; partitioned per chunk and the misplaced
 //! runs swapped in parallel), so the top levels scale with cores; below that every subtree is a
-//! task that writes its nodes straight into the final layout. The layout is depth first with the
+//! task that writes its nodes in the final layout into its own block, and the blocks are copied
+//! into the node array in parallel. Small nodes use fewer bins, the smallest an exact sweep
+//! (docs/architecture.md gives the measured reasons). The layout is depth first with the
 //! two children of a node either leaves or next to each other: node 0 is the root, a node's
 //! interior children come after it, and each subtree (less its root) is contiguous.
 
@@ -15,7 +17,8 @@ use rayon::prelude::*;
 
 /// Bins per axis of large nodes.
 const BINS: usize = 16;
-/// Bins per axis of nodes of at most [`FEW_BINS_MAX`] primitives.
+/// Bins per axis of nodes of at most [`FEW_BINS_MAX`] primitives: 8 there cost 0.2 % of SAH on
+/// the 1 M-triangle room and save ~10 % of the build; up to 512 primitives they cost 2.8 %.
 const FEW_BINS: usize = 8;
 /// Largest node binned with [`FEW_BINS`].
 const FEW_BINS_MAX: usize = 256;
@@ -33,8 +36,7 @@ pub(super) const TRAVERSAL_COST: f32 = 1.0;
 pub const MAX_DEPTH: u32 = 48;
 /// Subtrees with more primitives than this are built on another rayon task.
 const PARALLEL_THRESHOLD: usize = 4096;
-/// Nodes with at least this many primitives bin and partition them in parallel chunks. Smaller
-/// nodes use the serial partition, whose order the trees of small scenes have always had.
+/// Nodes with at least this many primitives bin and partition them in parallel chunks.
 const PARALLEL_SPLIT_THRESHOLD: usize = 1 << 16;
 /// Smallest chunk of a parallel binning or partition.
 const MIN_CHUNK: usize = 1 << 14;
