@@ -66,13 +66,18 @@ pub fn gpu_lights(
     let disc = std::f32::consts::PI * (0.5 * diagonal) * (0.5 * diagonal);
     let near = (0.05 * diagonal).max(1e-12);
     let inverse_square = |p: Vec3| 1.0 / (p - center).length_squared().max(near * near);
-    for &(prim, area, power) in &host.emissive {
-        let v = &host.vertices[prim as usize];
-        let centroid = (v[0] + v[1] + v[2]) / 3.0;
+    // Two levels: a triangle light names its instance's slot in the (TLAS-ordered) instances.
+    let slots = match &host.accel {
+        crate::render::Accel::TwoLevel(two) if !host.emissive.is_empty() => two.slots(),
+        _ => vec![],
+    };
+    for e in &host.emissive {
+        let (area, power, centroid) = (e.area, e.power, e.centroid);
+        let slot = slots.get(e.instance as usize).copied().unwrap_or(0);
         out.push(GpuLight {
             position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_TRIANGLE)],
             intensity: [0.0; 4],
-            spot: [f32::from_bits(prim), area, 0.0, 0.0],
+            spot: [f32::from_bits(e.prim), area, f32::from_bits(slot), 0.0],
             extra: [0.0; 4],
         });
         // `power` is π L A (× 2 when double-sided), so power / π is the intensity scale L A.

@@ -21,19 +21,23 @@ pub fn is_sane(p: DVec3) -> bool {
 /// out (it is still rendered, but framing, the light radius and the light table ignore it).
 /// Triangles with absurd vertices never count.
 pub fn robust_bounds(triangles: &[[DVec3; 3]]) -> Bounds {
-    let sane: Vec<&[DVec3; 3]> = triangles
-        .iter()
-        .filter(|t| t.iter().all(|&p| is_sane(p)))
-        .collect();
+    robust_bounds_of(&|| triangles.iter().copied())
+}
+
+/// [`robust_bounds`] of the triangles `triangles()` yields (called three times), without
+/// keeping them: scenes pass their placed triangles transformed on the fly.
+pub fn robust_bounds_of<I: Iterator<Item = [DVec3; 3]>>(triangles: &dyn Fn() -> I) -> Bounds {
+    let sane = || triangles().filter(|t| t.iter().all(|&p| is_sane(p)));
+    let count = sane().count();
     let mut b = Bounds::default();
-    if sane.is_empty() {
+    if count == 0 {
         return b;
     }
     // Quartiles and the median extent from a regular sample of at most 2^16 triangles:
     // they only place the outlier box, which is 64 scene sizes wide on each side, and a
     // full sort of every coordinate cost ~0.3 s per call on a 1 M-triangle scene.
-    let step = sane.len().div_ceil(1 << 16);
-    let sample: Vec<&[DVec3; 3]> = sane.iter().step_by(step).copied().collect();
+    let step = count.div_ceil(1 << 16);
+    let sample: Vec<[DVec3; 3]> = sane().step_by(step).collect();
     let quantile = |mut v: Vec<f64>, q: f64| {
         let k = ((v.len() - 1) as f64 * q).round() as usize;
         *v.select_nth_unstable_by(k, f64::total_cmp).1
@@ -56,8 +60,8 @@ pub fn robust_bounds(triangles: &[[DVec3; 3]]) -> Bounds {
         lo - DVec3::splat(64.0 * size),
         hi + DVec3::splat(64.0 * size),
     );
-    for t in &sane {
-        let c = centroid(t);
+    for t in sane() {
+        let c = centroid(&t);
         if c.cmpge(lo).all() && c.cmple(hi).all() {
             t.iter().for_each(|&p| b.grow(p));
         }
