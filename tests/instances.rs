@@ -205,8 +205,40 @@ fn moving_instances_updates_the_device_in_place() {
     let tlas = (n - 1) * (64 + 128) + n * 112;
     assert_eq!(update.bytes, tlas, "{update:?}");
     assert_no_leaks(&r, &moved, 6);
-    // Hiding a cube changes the instances: that needs a reload.
+    // Hiding a cube is an update too: it leaves the TLAS (no buffer grows), and a ray from its
+    // centre finds nothing, on the device and on the host; shown again, it is whole.
     scene.objects[0].visible = false;
+    let hidden = r
+        .move_instances(&scene)
+        .unwrap()
+        .expect("hiding an instance needs no reload");
+    assert_eq!(hidden.moved, 1);
+    assert_eq!(r.scene_buffers().unwrap().bytes(), stats.device_bytes);
+    let ray = GpuRay {
+        origin: [0.0; 4],
+        direction: [1.0, 0.0, 0.0, f32::INFINITY],
+    };
+    let ([hits, wide_hits], [occluded, _], _) = trace_all(&r, &[ray]);
+    assert_eq!(
+        (hits[0].prim, wide_hits[0].prim, occluded[0]),
+        (u32::MAX, u32::MAX, 0)
+    );
+    let host_ray = Ray {
+        origin: Vec3::ZERO,
+        direction: Vec3::X,
+        tmin: 0.0,
+        tmax: f32::INFINITY,
+    };
+    assert_eq!(r.host_scene().unwrap().intersect(&host_ray), None);
+    scene.objects[0].visible = true;
+    r.move_instances(&scene)
+        .unwrap()
+        .expect("showing an instance needs no reload");
+    assert_no_leaks(&r, &moved, 6);
+    // Other geometry is a reload.
+    std::sync::Arc::make_mut(&mut scene.objects[1].mesh)
+        .indices
+        .pop();
     assert_eq!(r.move_instances(&scene).unwrap(), None);
 }
 

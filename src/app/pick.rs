@@ -66,10 +66,7 @@ mod tests {
     }
 
     fn host(scene: &Scene) -> HostScene {
-        let world = scene.world_triangles();
-        let verts: Vec<[Vec3; 3]> = world.iter().map(|t| t.v).collect();
-        let bvh = crate::bvh::build(&verts);
-        HostScene::new(&world, bvh, &scene.materials)
+        HostScene::flat(scene.world_triangles(), &scene.materials)
     }
 
     #[test]

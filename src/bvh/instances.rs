@@ -175,6 +175,8 @@ pub struct TwoLevel {
     pub tlas: Bvh,
     /// Each BLAS's first triangle among the meshes' triangles one after the other.
     pub firsts: Vec<u32>,
+    /// Hidden instances are left out of the TLAS (they keep their place among the instances).
+    pub hidden: Vec<bool>,
 }
 
 impl TwoLevel {
@@ -187,6 +189,12 @@ impl TwoLevel {
 
     /// The TLAS over `instances` of prebuilt BLASes.
     pub fn from_blases(blases: Vec<Blas>, instances: &[(u32, DMat4)]) -> Self {
+        let shown = vec![false; instances.len()];
+        Self::with_hidden(blases, instances, shown)
+    }
+
+    /// [`TwoLevel::from_blases`] with `hidden` instances left out of the TLAS.
+    pub fn with_hidden(blases: Vec<Blas>, instances: &[(u32, DMat4)], hidden: Vec<bool>) -> Self {
         let instances = instances
             .iter()
             .map(|&(blas, m)| Instance::new(blas, m))
@@ -200,6 +208,7 @@ impl TwoLevel {
             })
             .collect();
         let mut two = Self {
+            hidden,
             blases,
             instances,
             tlas: build_boxes(&[]),
@@ -213,7 +222,9 @@ impl TwoLevel {
     pub fn triangle_count(&self) -> usize {
         self.instances
             .iter()
-            .map(|i| self.blases[i.blas as usize].triangles.len())
+            .zip(&self.hidden)
+            .filter(|(_, hidden)| !**hidden)
+            .map(|(i, _)| self.blases[i.blas as usize].triangles.len())
             .sum()
     }
 
@@ -232,12 +243,20 @@ impl TwoLevel {
 
     /// Builds the TLAS over the instances' current world boxes.
     pub fn rebuild_tlas(&mut self) {
-        let boxes: Vec<Aabb> = self
-            .instances
+        let shown: Vec<u32> = (0..self.instances.len() as u32)
+            .filter(|&i| !self.hidden[i as usize])
+            .collect();
+        let boxes: Vec<Aabb> = shown
             .iter()
-            .map(|inst| inst.world_box(self.blases[inst.blas as usize].bounds()))
+            .map(|&i| {
+                let inst = &self.instances[i as usize];
+                inst.world_box(self.blases[inst.blas as usize].bounds())
+            })
             .collect();
         self.tlas = build_boxes(&boxes);
+        for i in &mut self.tlas.tri_indices {
+            *i = shown[*i as usize];
+        }
     }
 
     /// The closest hit along `ray`.
@@ -265,9 +284,10 @@ impl TwoLevel {
         })
     }
 
-    /// Each instance's TLAS slot (the inverse of the TLAS's `tri_indices`).
+    /// Each instance's TLAS slot (the inverse of the TLAS's `tri_indices`; `u32::MAX` for a
+    /// hidden one).
     pub fn slots(&self) -> Vec<u32> {
-        let mut slots = vec![0; self.instances.len()];
+        let mut slots = vec![u32::MAX; self.instances.len()];
         for (slot, &i) in self.tlas.tri_indices.iter().enumerate() {
             slots[i as usize] = slot as u32;
         }

@@ -53,7 +53,8 @@ impl FromStr for BvhChoice {
     }
 }
 
-/// A scene's instances: each visible object with triangles, the distinct meshes they use.
+/// A scene's instances: each object with triangles (hidden ones left out of the TLAS), the
+/// distinct meshes they use.
 pub struct Instancing {
     /// The two levels (render space).
     pub two: TwoLevel,
@@ -70,14 +71,18 @@ pub fn plan(scene: &Scene, space: &RenderFrame, choice: BvhChoice) -> Option<Ins
     if choice == BvhChoice::Flat {
         return None;
     }
-    let objects = placed_objects(scene);
+    let objects = instanced_objects(scene);
     let placed: Vec<&Object> = objects
         .iter()
         .map(|&i| &scene.objects[i as usize])
         .collect();
     let (meshes, mesh_of) = distinct_meshes(&placed);
     let unique: usize = meshes.iter().map(|&o| placed[o].mesh.indices.len()).sum();
-    let total: usize = placed.iter().map(|o| o.mesh.indices.len()).sum();
+    let total: usize = placed
+        .iter()
+        .filter(|o| o.visible)
+        .map(|o| o.mesh.indices.len())
+        .sum();
     let auto_flat = total < AUTO_MIN_TRIANGLES || total < AUTO_MIN_SAVING * unique;
     if total == 0 || (choice == BvhChoice::Auto && auto_flat) || scene.absurd_triangles() > 0 {
         return None;
@@ -92,8 +97,9 @@ pub fn plan(scene: &Scene, space: &RenderFrame, choice: BvhChoice) -> Option<Ins
         .zip(&mesh_of)
         .map(|(o, &m)| (m, frame * o.world_from_object))
         .collect();
+    let hidden = placed.iter().map(|o| !o.visible).collect();
     Some(Instancing {
-        two: TwoLevel::from_blases(blases, &instances),
+        two: TwoLevel::with_hidden(blases, &instances, hidden),
         mesh_objects: meshes.iter().map(|&o| objects[o]).collect(),
         objects,
     })
@@ -105,13 +111,11 @@ pub fn render_from_world(space: &RenderFrame) -> DMat4 {
     DMat4::from_scale(glam::DVec3::splat(space.scale)) * DMat4::from_translation(-space.origin)
 }
 
-/// The indices of the visible objects that have triangles: the instances, in object order.
-pub fn placed_objects(scene: &Scene) -> Vec<u32> {
+/// The indices of the objects that have triangles, visible or hidden: the instances, in object
+/// order (hidden ones are left out of the TLAS, so that hiding or showing one is an update).
+pub fn instanced_objects(scene: &Scene) -> Vec<u32> {
     (0..scene.objects.len() as u32)
-        .filter(|&i| {
-            let o = &scene.objects[i as usize];
-            o.visible && !o.mesh.indices.is_empty()
-        })
+        .filter(|&i| !scene.objects[i as usize].mesh.indices.is_empty())
         .collect()
 }
 

@@ -186,13 +186,7 @@ impl Renderer {
             }
             None => {
                 let flat = scene.flatten(&space);
-                let verts: Vec<[glam::Vec3; 3]> = flat.triangles.iter().map(|t| t.v).collect();
-                let bvh = crate::bvh::build(&verts);
-                drop(verts);
-                (
-                    HostScene::new(&flat.triangles, bvh, &materials),
-                    flat.dropped,
-                )
+                (HostScene::flat(flat.triangles, &materials), flat.dropped)
             }
         };
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;

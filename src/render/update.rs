@@ -3,7 +3,7 @@
 //! build). The meshes' triangles and shading data stay in object space on the device, so
 //! nothing else is written (a moved light also rewrites the small light table).
 
-use super::instancing::{placed_objects, render_from_world};
+use super::instancing::{instanced_objects, render_from_world};
 use super::{Accel, Renderer};
 use crate::bvh::WideBvh;
 use crate::cl::ClError;
@@ -25,12 +25,12 @@ pub struct InstanceUpdate {
 impl Renderer {
     /// Brings a two-level scene on the device up to date with the transforms of `scene`'s
     /// objects: the moved instances get their new transforms, the TLAS is rebuilt, and both
-    /// are written over the old ones in place (the meshes stay as they are, in object space).
+    /// are written over the old ones in place (the meshes stay as they are, in object space);
+    /// a hidden object's instance is left out of the TLAS, a shown one taken back.
     /// With emissive triangles the (small) light table is written anew too: moved lights'
     /// areas and powers, and the instances' new TLAS slots. Returns `None`, changing nothing, when that cannot be done and the scene must
-    /// be loaded again: the scene on the device is flat, an object was hidden, shown or given
-    /// other geometry, or a moved object has an absurd vertex. Resets the film when anything
-    /// moved.
+    /// be loaded again: the scene on the device is flat, an object was given other geometry,
+    /// or a moved or shown object has an absurd vertex. Resets the film when anything changed.
     pub fn move_instances(&mut self, scene: &Scene) -> Result<Option<InstanceUpdate>, ClError> {
         let t = Instant::now();
         let Some((buffers, host)) = self.scene.as_mut() else {
@@ -39,7 +39,7 @@ impl Renderer {
         let Accel::TwoLevel(two) = &host.accel else {
             return Ok(None);
         };
-        let objects = placed_objects(scene);
+        let objects = instanced_objects(scene);
         if objects != host.layout.objects {
             return Ok(None);
         }
@@ -53,7 +53,11 @@ impl Renderer {
                 return Ok(None);
             }
             let m = frame * object.world_from_object;
-            if m == inst.world_from_object {
+            if m == inst.world_from_object && object.visible != two.hidden[i] {
+                continue;
+            }
+            if !object.visible {
+                moved.push((i, m, false));
                 continue;
             }
             let world = object.world_from_object;
@@ -65,7 +69,7 @@ impl Renderer {
             {
                 return Ok(None);
             }
-            moved.push((i, m));
+            moved.push((i, m, true));
         }
         if moved.is_empty() {
             return Ok(Some(InstanceUpdate::default()));
@@ -73,8 +77,9 @@ impl Renderer {
         let Accel::TwoLevel(two) = &mut host.accel else {
             return Ok(None);
         };
-        for &(i, m) in &moved {
+        for &(i, m, visible) in &moved {
             two.place(i, m);
+            two.hidden[i] = !visible;
         }
         two.rebuild_tlas();
         let slots = two.tlas_slots();
@@ -90,7 +95,7 @@ impl Renderer {
         let bytes = std::mem::size_of_val(nodes.as_slice())
             + std::mem::size_of_val(wide.as_slice())
             + std::mem::size_of_val(instances.as_slice());
-        for &(i, _) in &moved {
+        for &(i, _, _) in &moved {
             host.replace_emitters(i as u32);
         }
         // Triangle lights name their instances' TLAS slots, which the new TLAS reorders.

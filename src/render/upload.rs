@@ -80,9 +80,11 @@ pub struct InstanceLayout {
 }
 
 impl InstanceLayout {
-    /// The device instances of `two` in TLAS order.
+    /// The device instances of `two` in TLAS order, padded to all of them (hidden ones are
+    /// not in the TLAS), so that the buffer holds any later TLAS's.
     pub fn gpu_instances(&self, two: &TwoLevel) -> Vec<GpuInstance> {
-        two.tlas
+        let mut out: Vec<GpuInstance> = two
+            .tlas
             .tri_indices
             .iter()
             .map(|&i| {
@@ -103,7 +105,9 @@ impl InstanceLayout {
                     flags: inst.mirrored as u32,
                 }
             })
-            .collect()
+            .collect();
+        out.resize(two.instances.len().max(1), GpuInstance::default());
+        out
     }
 }
 
@@ -235,26 +239,19 @@ fn slot(r: Option<u32>) -> i32 {
 }
 
 impl HostScene {
-    /// Orders the world triangles as the flat BVH wants them and fills the device structs.
-    pub fn new(world: &[WorldTriangle], bvh: Bvh, materials: &[Material]) -> Self {
-        let mut emissive = Vec::new();
+    /// The flat form of `world` (render space, in object order): converted to the device
+    /// structs and dropped before the BVH is built, then the structs are put in BVH order one
+    /// array at a time, so that the large intermediate triangles and two orders of the same
+    /// data are never held together.
+    pub fn flat(world: Vec<WorldTriangle>, materials: &[Material]) -> Self {
+        let middle = middle_of(&|| world.iter().map(|t| t.v.map(Vec3::as_dvec3)));
+        let normal_mapped = world.iter().any(|t| t.tangents.is_some());
         let mut triangles = Vec::with_capacity(world.len());
         let mut shading = Vec::with_capacity(world.len());
+        let mut tangents = Vec::with_capacity(if normal_mapped { world.len() } else { 0 });
         let mut vertices = Vec::with_capacity(world.len());
-        let normal_mapped = world.iter().any(|t| t.tangents.is_some());
-        let mut tangents = Vec::new();
-        for (order, &index) in bvh.tri_indices.iter().enumerate() {
-            let t = &world[index as usize];
-            let m = &materials[t.material as usize];
-            let mut light = -1i32;
-            let area = 0.5 * (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).length();
-            if m.is_emissive() && area > 0.0 {
-                let sides = if m.double_sided { 2.0 } else { 1.0 };
-                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
-                light = emissive.len() as i32;
-                emissive.push((order as u32, area, power));
-            }
-            let (tri, sh, tan) = device_triangle(t, light);
+        for t in &world {
+            let (tri, sh, tan) = device_triangle(t, -1);
             triangles.push(tri);
             shading.push(sh);
             if normal_mapped {
@@ -262,17 +259,36 @@ impl HostScene {
             }
             vertices.push(t.v);
         }
-        let emissive = emissive
-            .into_iter()
-            .map(|(prim, area, power)| Emitter {
-                prim,
-                instance: 0,
-                area,
-                power,
-                centroid: vertices[prim as usize].iter().sum::<Vec3>() / 3.0,
-            })
-            .collect();
-        let middle = middle_of(&|| world.iter().map(|t| t.v.map(Vec3::as_dvec3)));
+        drop(world);
+        let bvh = crate::bvh::build(&vertices);
+        fn gather<T: Copy + Send + Sync>(v: Vec<T>, order: &[u32]) -> Vec<T> {
+            order.par_iter().map(|&i| v[i as usize]).collect()
+        }
+        let vertices = gather(vertices, &bvh.tri_indices);
+        let mut triangles = gather(triangles, &bvh.tri_indices);
+        let shading = gather(shading, &bvh.tri_indices);
+        let tangents = if normal_mapped {
+            gather(tangents, &bvh.tri_indices)
+        } else {
+            tangents
+        };
+        let mut emissive = Vec::new();
+        for (order, (tri, v)) in triangles.iter_mut().zip(&vertices).enumerate() {
+            let m = &materials[tri.v0[3].to_bits() as usize];
+            let area = triangle_area(v);
+            if m.is_emissive() && area > 0.0 {
+                let sides = if m.double_sided { 2.0 } else { 1.0 };
+                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
+                tri.v1[3] = f32::from_bits(emissive.len() as u32);
+                emissive.push(Emitter {
+                    prim: order as u32,
+                    instance: 0,
+                    area,
+                    power,
+                    centroid: v.iter().sum::<Vec3>() / 3.0,
+                });
+            }
+        }
         Self {
             vertices,
             ..Self::assemble(
@@ -596,13 +612,12 @@ mod tests {
             Vec3::new(5.0, 0.0, 5.0),
             Vec3::new(5.0, 0.0, -5.0),
         ];
-        let world = [WorldTriangle {
+        let world = vec![WorldTriangle {
             v,
             n: [Vec3::Y; 3],
             ..WorldTriangle::default()
         }];
-        let bvh = crate::bvh::build(&[v]);
-        HostScene::new(&world, bvh, &[Material::default()])
+        HostScene::flat(world, &[Material::default()])
     }
 
     fn light(kind: LightKind, position: glam::DVec3, intensity: f32) -> Light {

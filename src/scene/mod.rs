@@ -392,10 +392,14 @@ impl Scene {
             .filter(|(_, o)| o.visible)
             .map(|(oi, o)| object_triangles(oi as u32, o, frame))
             .collect();
-        Flattened {
-            dropped: per_object.iter().map(|(_, d)| d).sum(),
-            triangles: per_object.into_iter().flat_map(|(t, _)| t).collect(),
+        // Each object's triangles are moved over and freed in turn, so the two lists are not
+        // held in full at once.
+        let dropped = per_object.iter().map(|(_, d)| d).sum();
+        let mut triangles = Vec::with_capacity(per_object.iter().map(|(t, _)| t.len()).sum());
+        for (t, _) in per_object {
+            triangles.extend(t);
         }
+        Flattened { dropped, triangles }
     }
 
     /// Object `i`'s triangles in the render space of `frame`, in its mesh's order, as
