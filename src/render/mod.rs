@@ -210,12 +210,14 @@ impl Renderer {
         self.lights = lights.to_vec();
         let (glights, cdf) = self.light_table(&host);
         let (nodes, wide_nodes, instances) = device_accel(&mut host);
-        let placeholder = [GpuTriTangents::default()];
-        let tangents: &[GpuTriTangents] = if host.tangents.is_empty() {
-            &placeholder
-        } else {
-            &host.tangents
-        };
+        // Shading data is the device's alone: it leaves the host scene, and each large host
+        // array is freed as soon as its buffer is made, so that the two copies (host memory
+        // either way with a CPU device) are not all held at once.
+        let shading = std::mem::take(&mut host.shading);
+        let mut tangents = std::mem::take(&mut host.tangents);
+        if tangents.is_empty() {
+            tangents.push(GpuTriTangents::default());
+        }
         // Two levels trace the meshes' object-space triangles in `triangles`: the separate
         // object-triangle buffer is a placeholder either way.
         let object_tris = [GpuTriangle::default()];
@@ -232,22 +234,30 @@ impl Renderer {
                     std::mem::size_of_val(host.triangles.as_slice()),
                 ),
                 ("instances", std::mem::size_of_val(instances.as_slice())),
-                ("shading", std::mem::size_of_val(host.shading.as_slice())),
-                ("tangents", std::mem::size_of_val(tangents)),
+                ("shading", std::mem::size_of_val(shading.as_slice())),
+                ("tangents", std::mem::size_of_val(tangents.as_slice())),
                 ("texels", bytes(pack.texels.len(), 4)),
             ],
             self.gpu.device.global_mem_size().ok(),
             self.gpu.device.max_mem_alloc_size().ok(),
         )
         .map_err(ClError::Device)?;
+        let nodes_buffer = Buffer::from_slice(&self.gpu, &nodes)?;
+        drop(nodes);
+        let wide_buffer = Buffer::from_slice(&self.gpu, &wide_nodes)?;
+        drop(wide_nodes);
+        let shading_buffer = Buffer::from_slice(&self.gpu, &shading)?;
+        drop(shading);
+        let tangents_buffer = Buffer::from_slice(&self.gpu, &tangents)?;
+        drop(tangents);
         let buffers = SceneBuffers {
-            nodes: Buffer::from_slice(&self.gpu, &nodes)?,
-            wide_nodes: Buffer::from_slice(&self.gpu, &wide_nodes)?,
+            nodes: nodes_buffer,
+            wide_nodes: wide_buffer,
             triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
             instances: Buffer::from_slice(&self.gpu, &instances)?,
             object_triangles: Buffer::from_slice(&self.gpu, &object_tris)?,
-            shading: Buffer::from_slice(&self.gpu, &host.shading)?,
-            tangents: Buffer::from_slice(&self.gpu, tangents)?,
+            shading: shading_buffer,
+            tangents: tangents_buffer,
             tex_refs: Buffer::from_slice(&self.gpu, &pack.refs)?,
             textures: Buffer::from_slice(&self.gpu, &pack.textures)?,
             texels: Buffer::from_slice(&self.gpu, &pack.texels)?,
@@ -255,7 +265,7 @@ impl Renderer {
             lights: Buffer::from_slice(&self.gpu, &glights)?,
             light_cdf: Buffer::from_slice(&self.gpu, &cdf)?,
         };
-        drop((nodes, wide_nodes, instances));
+        drop(instances);
         self.light_count = glights.len() as u32;
         self.update_env_info(&glights);
         let (meshes, instances) = host.accel.instancing();

@@ -138,9 +138,11 @@ pub struct HostScene {
     /// Flat: world vertices in BVH order (for the host traversal); empty with two levels,
     /// whose BLASes hold their triangles.
     pub vertices: Vec<[Vec3; 3]>,
-    /// Shading data, indexed as `triangles` (two levels: object-space normals).
+    /// Shading data, indexed as `triangles` (two levels: object-space normals); moved to the
+    /// device by `Renderer::load_scene` (empty after).
     pub shading: Vec<GpuTriShading>,
-    /// Tangents, indexed as `triangles`; empty when no triangle is normal-mapped.
+    /// Tangents, indexed as `triangles`; empty when no triangle is normal-mapped, and after
+    /// `Renderer::load_scene` moved them to the device.
     pub tangents: Vec<GpuTriTangents>,
     /// Materials.
     pub materials: Vec<GpuMaterial>,
@@ -244,7 +246,7 @@ impl HostScene {
     /// array at a time, so that the large intermediate triangles and two orders of the same
     /// data are never held together.
     pub fn flat(world: Vec<WorldTriangle>, materials: &[Material]) -> Self {
-        let middle = middle_of(&|| world.iter().map(|t| t.v.map(Vec3::as_dvec3)));
+        let middle = middle_of(1, &|_| world.iter().map(|t| t.v.map(Vec3::as_dvec3)));
         let normal_mapped = world.iter().any(|t| t.tangents.is_some());
         let mut triangles = Vec::with_capacity(world.len());
         let mut shading = Vec::with_capacity(world.len());
@@ -363,14 +365,16 @@ impl HostScene {
                 emissive.push(emitter(prim, i as u32, &v, &materials[material as usize]));
             }
         }
-        let middle = middle_of(&|| {
-            two.instances.iter().flat_map(|inst| {
-                let m = inst.world_from_object;
-                two.blases[inst.blas as usize]
-                    .triangles
-                    .iter()
-                    .map(move |t| t.map(|v| m.transform_point3(v.as_dvec3())))
-            })
+        let shown: Vec<usize> = (0..two.instances.len())
+            .filter(|&k| !two.hidden[k])
+            .collect();
+        let middle = middle_of(shown.len(), &|k| {
+            let inst = &two.instances[shown[k]];
+            let m = inst.world_from_object;
+            two.blases[inst.blas as usize]
+                .triangles
+                .iter()
+                .map(move |t| t.map(|v| m.transform_point3(v.as_dvec3())))
         });
         Self::assemble(
             Accel::TwoLevel(two),
@@ -487,9 +491,13 @@ fn emitter(prim: u32, instance: u32, v: &[Vec3; 3], m: &Material) -> Emitter {
     }
 }
 
-/// The middle and the diagonal of the robust bounds of the triangles `triangles()` yields.
-fn middle_of<I: Iterator<Item = [DVec3; 3]>>(triangles: &dyn Fn() -> I) -> (Vec3, f32) {
-    let b = robust_bounds_of(triangles);
+/// The middle and the diagonal of the robust bounds of the parts' triangles (see
+/// [`robust_bounds_of`]).
+fn middle_of<I: Iterator<Item = [DVec3; 3]>>(
+    parts: usize,
+    part: &(dyn Fn(usize) -> I + Sync),
+) -> (Vec3, f32) {
+    let b = robust_bounds_of(parts, part);
     if b.is_empty() {
         (Vec3::ZERO, 1.0)
     } else {

@@ -412,12 +412,12 @@ impl Scene {
     /// Robust world-space bounds of the visible geometry (see [`robust_bounds`]): what
     /// framing, the default light radius and the render frame use.
     pub fn bounds(&self) -> Bounds {
-        robust_bounds_of(&|| {
-            self.objects.iter().filter(|o| o.visible).flat_map(|o| {
-                let m = o.world_from_object;
-                o.mesh.indices.iter().map(move |t| {
-                    t.map(|i| m.transform_point3(o.mesh.positions[i as usize].as_dvec3()))
-                })
+        let visible: Vec<&Object> = self.objects.iter().filter(|o| o.visible).collect();
+        robust_bounds_of(visible.len(), &|k| {
+            let o = visible[k];
+            let m = o.world_from_object;
+            o.mesh.indices.iter().map(move |t| {
+                t.map(|i| m.transform_point3(o.mesh.positions[i as usize].as_dvec3()))
             })
         })
     }
