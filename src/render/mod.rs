@@ -641,7 +641,7 @@ mod fit_tests {
             name: "o".into(),
             world_from_object: DMat4::IDENTITY,
             visible: true,
-            mesh,
+            mesh: mesh.into(),
         };
         Scene {
             materials,
