@@ -74,10 +74,20 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
         uint prim = as_uint(l->spot.x);
         float area = l->spot.y;
         GpuTriangle t = tris[prim];
+#ifdef TWO_LEVEL
+        // Two levels: the mesh's object-space triangle, placed by the light's instance.
+        GpuInstance inst = surf->instances[as_uint(l->spot.z)];
+        float3 world_err;
+        t = instance_triangle(&inst, t, &world_err);
+#endif
         float2 b = sample_triangle(u1, u2);
         float3 q_err;
         float3 q = surface_point(t.v0.xyz, t.v1.xyz, t.v2.xyz, b.x, b.y, &q_err);
         float3 ng = triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz);
+#ifdef TWO_LEVEL
+        q_err += world_err;
+        ng *= instance_normal_sign(&inst);
+#endif
         float3 d = q - p;
         float dist2 = dot(d, d);
         if (dist2 <= 0.0f) return s;

@@ -24,7 +24,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels) return;
     ShadeScene sc = {tris,
-                     {shading, tangents, materials, tex_refs, textures, texels},
+                     {shading, tangents, materials, tex_refs, textures, texels, instances},
                      {environment, env_texels, env_marginal, env_conditional},
                      lights,
                      light_cdf};

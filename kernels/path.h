@@ -128,10 +128,20 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     }
 
     GpuTriangle tri = sc->tris[hit.prim];
+#ifdef TWO_LEVEL
+    // The mesh's object-space triangle, carried to world space by the hit's instance.
+    GpuInstance inst = surf->instances[hit.instance];
+    float3 world_err;
+    tri = instance_triangle(&inst, tri, &world_err);
+#endif
     float w0 = 1.0f - hit.u - hit.v;
     float3 p_err;
     float3 p = surface_point(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, hit.u, hit.v, &p_err);
     float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
+#ifdef TWO_LEVEL
+    p_err += world_err;
+    ng *= instance_normal_sign(&inst);
+#endif
     global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
     bool front = dot(ng, wo) > 0.0f;
     GpuTriShading sh = surf->shading[hit.prim];
@@ -148,6 +158,9 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
 #ifdef HAS_TRIANGLE_LIGHTS
     // Emission of a light hit by this ray, weighted against light sampling of the last vertex.
     int light_index = as_int(tri.v1.w);
+#ifdef TWO_LEVEL
+    if (light_index >= 0) light_index += as_int(inst.world0.w);
+#endif
     bool two_sided = (as_uint(mat->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
     if (light_index >= 0 && (front || two_sided) && counts_emission) {
         float weight = 1.0f;
@@ -192,6 +205,9 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     float3 ns = ng;
     if (sh.n0.w > 0.0f) {
         float3 n = w0 * sh.n0.xyz + hit.u * sh.n1.xyz + hit.v * sh.n2.xyz;
+#ifdef TWO_LEVEL
+        n = instance_normal(&inst, n);
+#endif
         float len = length(n);
         if (len > 0.0f) {
             ns = n / len;
@@ -203,15 +219,15 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     float3 coat_normal = ns;
 #ifdef HAS_NORMAL_MAPS
     if (mat->textures3.z >= 0) {
-        coat_normal = normal_map(surf, mat->textures3.z, mat->coat.z, &tc, hit.prim, hit.u, hit.v,
-                                 ns, ng, front);
+        coat_normal = normal_map(surf, mat->textures3.z, mat->coat.z, &tc,
+                                 hit_tangents(surf, hit), hit.u, hit.v, ns, ng, front);
     }
 #endif
 #endif
 #ifdef HAS_NORMAL_MAPS
     if (mat->textures.z >= 0) {
-        ns = normal_map(surf, mat->textures.z, mat->alpha.w, &tc, hit.prim, hit.u, hit.v, ns, ng,
-                        front);
+        ns = normal_map(surf, mat->textures.z, mat->alpha.w, &tc, hit_tangents(surf, hit), hit.u,
+                        hit.v, ns, ng, front);
     }
 #endif
     SurfaceMaterial m = surface_material(mat);
@@ -330,6 +346,10 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
 #endif
     if (!bsdf_passes_straight(&m)) return false;
     float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
+#ifdef TWO_LEVEL
+    GpuInstance inst = surf->instances[hit.instance];
+    ng = instance_normal(&inst, ng);  // object-space triangle: its normal to world space
+#endif
     *tint *= thin_wall_transmittance(&m, fabs(dot(ng, dir)));
     return true;
 #else

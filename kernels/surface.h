@@ -1,5 +1,63 @@
 // What a hit's textures do to its material: base color, metallic-roughness, transmission and
-// emission, and the shading normal from a tangent-space normal map.
+// emission, and the shading normal from a tangent-space normal map; with two levels, the hit's
+// object-space triangle and shading data carried to world space by its instance.
+
+#ifdef TWO_LEVEL
+// M v: a vector to world space (src/bvh/instances.rs keeps M's rows in world0..2).
+inline float3 instance_vector_to_world(const GpuInstance* inst, float3 v) {
+    return (float3)(inst->world0.x * v.x + inst->world0.y * v.y + inst->world0.z * v.z,
+                    inst->world1.x * v.x + inst->world1.y * v.y + inst->world1.z * v.z,
+                    inst->world2.x * v.x + inst->world2.y * v.y + inst->world2.z * v.z);
+}
+
+// p_world = M p + T (T in row0..2.w).
+inline float3 instance_to_world(const GpuInstance* inst, float3 p) {
+    return instance_vector_to_world(inst, p) + (float3)(inst->row0.w, inst->row1.w, inst->row2.w);
+}
+
+// An object-space triangle in world space (payloads in .w kept), and in *err a bound on the
+// rounding of its world vertices: gamma(4) (|M| |v| + |T|) for the largest |v| per coordinate.
+// Vertices keep their order, so a mirrored instance's triangle winds the other way: callers
+// flip its geometric normal (`instance_normal_sign`).
+inline GpuTriangle instance_triangle(const GpuInstance* inst, GpuTriangle t, float3* err) {
+    const float gamma4 = 4.0f * 0x1p-24f / (1.0f - 4.0f * 0x1p-24f);
+    float3 a = fmax(fmax(fabs(t.v0.xyz), fabs(t.v1.xyz)), fabs(t.v2.xyz));
+    float3 m0 = fabs(inst->world0.xyz), m1 = fabs(inst->world1.xyz), m2 = fabs(inst->world2.xyz);
+    float3 origin = fabs((float3)(inst->row0.w, inst->row1.w, inst->row2.w));
+    *err = gamma4 * ((float3)(dot(m0, a), dot(m1, a), dot(m2, a)) + origin);
+    GpuTriangle w;
+    w.v0 = (float4)(instance_to_world(inst, t.v0.xyz), t.v0.w);
+    w.v1 = (float4)(instance_to_world(inst, t.v1.xyz), t.v1.w);
+    w.v2 = (float4)(instance_to_world(inst, t.v2.xyz), t.v2.w);
+    return w;
+}
+
+// -1 for a mirrored instance (its world triangles wind the other way), else 1.
+inline float instance_normal_sign(const GpuInstance* inst) {
+    return (inst->flags & 1u) != 0u ? -1.0f : 1.0f;
+}
+
+// A normal to world space: L^T n (the inverse transpose of M), unit; 0 stays 0.
+inline float3 instance_normal(const GpuInstance* inst, float3 n) {
+    float3 w = inst->row0.xyz * n.x + inst->row1.xyz * n.y + inst->row2.xyz * n.z;
+    float len = length(w);
+    return len > 0.0f ? w / len : w;
+}
+#endif
+
+// The tangents at the corners of a hit's triangle in world space (w: bitangent sign). With two
+// levels they are the mesh's, carried by M and with the sign flipped in a mirrored instance.
+inline GpuTriTangents hit_tangents(const SceneSurfaces* s, GpuHit hit) {
+    GpuTriTangents tt = s->tangents[hit.prim];
+#ifdef TWO_LEVEL
+    GpuInstance inst = s->instances[hit.instance];
+    float sign = instance_normal_sign(&inst);
+    tt.t0 = (float4)(instance_vector_to_world(&inst, tt.t0.xyz), tt.t0.w * sign);
+    tt.t1 = (float4)(instance_vector_to_world(&inst, tt.t1.xyz), tt.t1.w * sign);
+    tt.t2 = (float4)(instance_vector_to_world(&inst, tt.t2.xyz), tt.t2.w * sign);
+#endif
+    return tt;
+}
 
 #ifdef HAS_TEXTURES
 // Multiplies the material's factors by its textures at the hit.
@@ -38,10 +96,10 @@ inline float3 textured_emission(global const GpuMaterial* mat, const SceneSurfac
 // texture, or its clearcoat normal texture). ns and ng face the side the ray came from; `front`
 // says whether that is the triangle's front, in which case the tangent frame is the file's,
 // else every axis of it is reversed (glTF reverses back-face normals of double-sided
-// materials). The result is bent to stay above the geometric surface.
+// materials); `tt` are the triangle's world-space tangents (`hit_tangents`). The result is
+// bent to stay above the geometric surface.
 inline float3 normal_map(const SceneSurfaces* s, int tex, float scale, const TexCoords* tc,
-                         uint prim, float u, float v, float3 ns, float3 ng, bool front) {
-    GpuTriTangents tt = s->tangents[prim];
+                         GpuTriTangents tt, float u, float v, float3 ns, float3 ng, bool front) {
     float w0 = 1.0f - u - v;
     float3 t = w0 * tt.t0.xyz + u * tt.t1.xyz + v * tt.t2.xyz;
     float3 n = front ? ns : -ns;

@@ -15,9 +15,10 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuTriangle, v0); PROBE_FIELD(GpuTriangle, v1); PROBE_FIELD(GpuTriangle, v2);
     PROBE_SIZE(GpuInstance);
     PROBE_FIELD(GpuInstance, row0); PROBE_FIELD(GpuInstance, row1);
-    PROBE_FIELD(GpuInstance, row2);
+    PROBE_FIELD(GpuInstance, row2); PROBE_FIELD(GpuInstance, world0);
+    PROBE_FIELD(GpuInstance, world1); PROBE_FIELD(GpuInstance, world2);
     PROBE_FIELD(GpuInstance, root); PROBE_FIELD(GpuInstance, wide_root);
-    PROBE_FIELD(GpuInstance, prim_offset); PROBE_FIELD(GpuInstance, flags);
+    PROBE_FIELD(GpuInstance, id); PROBE_FIELD(GpuInstance, flags);
     PROBE_SIZE(GpuTriShading);
     PROBE_FIELD(GpuTriShading, n0); PROBE_FIELD(GpuTriShading, n1);
     PROBE_FIELD(GpuTriShading, n2); PROBE_FIELD(GpuTriShading, uv01);
@@ -60,6 +61,7 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuPath, throughput); PROBE_FIELD(GpuPath, radiance);
     PROBE_SIZE(GpuHit);
     PROBE_FIELD(GpuHit, t); PROBE_FIELD(GpuHit, u); PROBE_FIELD(GpuHit, v); PROBE_FIELD(GpuHit, prim);
+    PROBE_FIELD(GpuHit, instance);
     PROBE_SIZE(GpuShadowRay);
     PROBE_FIELD(GpuShadowRay, origin); PROBE_FIELD(GpuShadowRay, direction);
     PROBE_FIELD(GpuShadowRay, contribution);

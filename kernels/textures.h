@@ -12,6 +12,9 @@ typedef struct {
     global const GpuTexRef* refs;
     global const GpuTexture* textures;
     global const uint* texels;
+    // Two levels: the instances, whose transforms carry object-space hits to world space for
+    // shading (unused with the flat BVH; kernels that only trace may leave it out).
+    global const GpuInstance* instances;
 } SceneSurfaces;
 
 // Texture coordinates at a hit and the mip level of one texel per unit of UV area per set:

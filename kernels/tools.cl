@@ -12,7 +12,7 @@
         uint count, global GpuHit* hits, volatile global uint* counters) {                       \
         uint i = get_global_id(0);                                                               \
         if (i >= count) return;                                                                  \
-        SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};         \
+        SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels, instances};\
         GpuRay r = rays[i];                                                                      \
         hits[i] = TRAVERSE(nodes, tris, instances, object_tris, &surf, r.origin.xyz,             \
                            r.direction.xyz, r.origin.w, r.direction.w, false,                    \
@@ -27,7 +27,7 @@
         uint count, global uint* occluded, volatile global uint* counters) {                     \
         uint i = get_global_id(0);                                                               \
         if (i >= count) return;                                                                  \
-        SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels};         \
+        SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels, instances};\
         GpuRay r = rays[i];                                                                      \
         GpuHit h = TRAVERSE(nodes, tris, instances, object_tris, &surf, r.origin.xyz,            \
                             r.direction.xyz, r.origin.w, r.direction.w, true,                    \

@@ -231,6 +231,7 @@ inline GpuHit no_hit(float tmax) {
     hit.u = 0.0f;
     hit.v = 0.0f;
     hit.prim = NO_HIT;
+    hit.instance = 0u;
     return hit;
 }
 
@@ -252,10 +253,11 @@ inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle*
 // the object-space triangles. Subtracting T (the world position of the object's origin) first
 // keeps the error relative to the distance from the object, not from the render origin: o' is
 // off by at most err = gamma(8) |L| |o - T| per coordinate, and as pbrt-v4 does, hits closer
-// than that error along the ray are ignored (tmin grows by dot(|d'|, err) / |d'|^2). The f32
-// rounding of T and of the world-space shading triangles (half an ulp each) stays below the
-// offset_ray bound a spawned ray leaves its surface by (gamma(7) |p|, over three ulps), so a
-// ray cannot find its own surface again in object space.
+// than that error along the ray are ignored (tmin grows by dot(|d'|, err) / |d'|^2). Shading
+// carries the hit's object-space triangle back to world space (M v + T in f32) and adds that
+// rounding's bound to the hit point's error (`instance_triangle` in surface.h), so the
+// offset_ray a spawned ray leaves its surface by covers it: a ray cannot find its own surface
+// again in object space.
 inline float3 instance_point(const GpuInstance* inst, float3 p) {
     float3 q = p - (float3)(inst->row0.w, inst->row1.w, inst->row2.w);
     return (float3)(inst->row0.x * q.x + inst->row0.y * q.y + inst->row0.z * q.z,
@@ -318,23 +320,31 @@ inline bool top_pop(TopStack* s, float tmax, uint* ref, uint* count) {
 }
 
 // Enters the instances first .. first + count - 1 of a top-level leaf: carries the ray into
-// each one's object space and walks its bottom level (binary, or 4-wide with WIDE). Returns
-// true when the traversal must end (an any-hit, or an overflow).
+// each one's object space and walks its bottom level (binary, or 4-wide with WIDE). A hit keeps
+// the object-space triangle's index and barycentrics and names the instance by its slot in
+// `instances` (TLAS order), where shading finds its transforms. Returns true when
+// the traversal must end (an any-hit, or an overflow).
 #define ENTER_INSTANCES(WALK, ROOT)                                                            \
     for (uint i = first; i < first + count; ++i) {                                             \
         GpuInstance inst = instances[i];                                                       \
         float3 od = instance_vector(&inst, d);                                                 \
         RayPrep lr = prepare_ray(instance_point(&inst, o), od);                                \
         float ltmin = instance_tmin(&inst, o, od, tmin);                                       \
-        if (WALK(nodes, inst.ROOT, object_tris, surf, &lr, o, d, ltmin, any_hit,               \
-                 inst.prim_offset, inst.flags != 0u, &hit, overflow)) {                        \
-            return hit;                                                                        \
+        GpuHit found = hit;                                                                    \
+        found.prim = NO_HIT;                                                                   \
+        bool stop = WALK(nodes, inst.ROOT, object_tris, surf, &lr, o, d, ltmin, any_hit, 0u,   \
+                         false, &found, overflow);                                             \
+        if (found.prim != NO_HIT) {                                                            \
+            hit = found;                                                                       \
+            hit.instance = i;                                                                  \
         }                                                                                      \
+        if (stop) return hit;                                                                  \
     }
 
 // Closest or first hit through the top level (`nodes` from 0, leaves index `instances`) and
 // the instances' bottom levels (in the same node array, from each instance's root; leaves
-// index `object_tris`). Hits are reported in the shading order of the scene's triangles.
+// index `object_tris`, the meshes' object-space triangles). Hits name the object-space
+// triangle and the instance.
 // Unlike a bottom level's leaves, whose few triangles are tested on the spot, a top-level leaf
 // (a whole mesh) waits on the stack with its children's order: nearest first, and skipped once
 // a hit closer than its box is found.
@@ -381,7 +391,8 @@ inline GpuHit trace_scene(global const GpuBvhNode* nodes, global const GpuTriang
                           float3 o, float3 d, float tmin, float tmax, bool any_hit,
                           volatile global uint* overflow) {
 #ifdef TWO_LEVEL
-    return traverse_two_level(nodes, instances, object_tris, surf, o, d, tmin, tmax, any_hit,
+    // With two levels `tris` holds the meshes' object-space triangles (object_tris is unused).
+    return traverse_two_level(nodes, instances, tris, surf, o, d, tmin, tmax, any_hit,
                               overflow);
 #else
     return traverse(nodes, tris, surf, o, d, tmin, tmax, any_hit, overflow);

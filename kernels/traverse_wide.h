@@ -196,7 +196,8 @@ inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const Gpu
                                float3 o, float3 d, float tmin, float tmax, bool any_hit,
                                volatile global uint* overflow) {
 #ifdef TWO_LEVEL
-    return traverse_wide_two_level(nodes, instances, object_tris, surf, o, d, tmin, tmax,
+    // With two levels `tris` holds the meshes' object-space triangles (object_tris is unused).
+    return traverse_wide_two_level(nodes, instances, tris, surf, o, d, tmin, tmax,
                                    any_hit, overflow);
 #else
     return traverse_wide(nodes, tris, surf, o, d, tmin, tmax, any_hit, overflow);

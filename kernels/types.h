@@ -23,18 +23,24 @@ typedef struct {
 
 // One placed mesh of a two-level scene (src/bvh/instances.rs): object_from_world as
 // p_object = L (p_world - T), the rows of L with T in .w (T: the world position of the object's
-// origin), its bottom-level roots in the binary and the wide node arrays, and the offset from
-// its bottom level's triangle indices to the scene's shading order.
+// origin), for traversal; world_from_object as p_world = M p_object + T, the rows of M, for
+// shading (triangles and shading data stay in object space, once per mesh); its bottom-level
+// roots in the binary and the wide node arrays; its index and its first light.
 typedef struct {
     float4 row0;       // first row of L; .w = T.x
     float4 row1;       // .w = T.y
     float4 row2;       // .w = T.z
+    float4 world0;     // first row of M; .w = light index of its first emissive triangle (int bits)
+    float4 world1;
+    float4 world2;
     uint root;         // bottom-level root in the binary nodes
     uint wide_root;    // bottom-level root in the wide nodes
-    uint prim_offset;  // shading index = triangle index + prim_offset (wrapping)
-    uint flags;        // 1: mirrored (the shading triangle swaps vertices 1 and 2)
+    uint id;           // the instance's index in the scene (host bookkeeping)
+    uint flags;        // 1: mirrored (negative determinant)
 } GpuInstance;
 
+// World space in BVH order; with TWO_LEVEL object space, once per mesh (then v1.w counts the
+// mesh's emissive triangles from the instance's first light, and v2.w is 0).
 typedef struct {
     float4 v0;  // .w = material index (uint bits)
     float4 v1;  // .w = emissive light index (int bits), -1 when not emissive
@@ -95,7 +101,8 @@ typedef struct {
 typedef struct {
     float4 position;   // position, or travel direction (directional); .w = kind (uint bits)
     float4 intensity;  // intensity (point/spot) or irradiance (directional); .w = light radius
-    float4 spot;       // spot axis; .w = cos outer angle. Triangle: .x = index bits, .y = area
+    float4 spot;       // spot axis; .w = cos outer angle. Triangle: .x = index bits, .y = area,
+                       // .z = instance slot (uint bits, two levels)
     float4 extra;      // .x = cos inner angle, .y = selection probability
 } GpuLight;
 
@@ -133,7 +140,8 @@ typedef struct {
     float t;
     float u;      // weight of vertex 1
     float v;      // weight of vertex 2
-    uint prim;    // triangle in BVH order, 0xffffffff on a miss
+    uint prim;    // triangle in BVH order (two levels: object-space triangle), 0xffffffff on a miss
+    uint instance;  // the instance hit: its slot in the instance buffer (two levels; 0 when flat)
 } GpuHit;
 
 typedef struct {

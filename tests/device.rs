@@ -52,7 +52,7 @@ fn random_scene(n: usize) -> Scene {
             name: "random".into(),
             world_from_object: DMat4::IDENTITY,
             visible: true,
-            mesh,
+            mesh: mesh.into(),
         }],
         materials: vec![Material::default()],
         ..Scene::default()

@@ -36,7 +36,7 @@ fn speck() -> Scene {
             name: "speck".into(),
             world_from_object: glam::DMat4::IDENTITY,
             visible: true,
-            mesh,
+            mesh: mesh.into(),
         }],
         materials: vec![Material::default()],
         ..Scene::default()

@@ -58,6 +58,8 @@ fn placements() -> Vec<DMat4> {
 }
 
 fn cube_scene(n: usize) -> Scene {
+    // One mesh shared by every node, as the importer shares a glTF mesh.
+    let mesh = std::sync::Arc::new(closed_cube(n));
     Scene {
         source: "cubes".into(),
         objects: placements()
@@ -67,7 +69,7 @@ fn cube_scene(n: usize) -> Scene {
                 name: format!("cube {i}"),
                 world_from_object: m,
                 visible: true,
-                mesh: closed_cube(n),
+                mesh: mesh.clone(),
             })
             .collect(),
         materials: vec![Material::default()],
@@ -136,7 +138,7 @@ fn assert_no_leaks(r: &Renderer, placements: &[DMat4], n: usize) {
     let mut leaks = 0;
     for (i, ray) in rays.iter().enumerate() {
         for (h, occ) in [(hits[i], occluded[i]), (wide_hits[i], wide_occluded[i])] {
-            let inside = h.prim != u32::MAX && host.object_of(h.prim) == owner[i];
+            let inside = h.prim != u32::MAX && host.object_of(&h) == owner[i];
             if !inside || occ != 1 {
                 leaks += 1;
             }
@@ -149,8 +151,8 @@ fn assert_no_leaks(r: &Renderer, placements: &[DMat4], n: usize) {
         };
         let expect = host.intersect(&host_ray).expect("the host finds the cube");
         assert_eq!(
-            (hits[i].prim, hits[i].t),
-            (expect.prim, expect.t),
+            (hits[i].prim, hits[i].instance, hits[i].t),
+            (expect.prim, expect.instance, expect.t),
             "ray {i}"
         );
         assert_eq!(wide_hits[i].t, expect.t, "ray {i} (wide)");
@@ -197,19 +199,46 @@ fn moving_instances_updates_the_device_in_place() {
     assert_eq!(update.moved, 3);
     let buffers = r.scene_buffers().unwrap();
     assert_eq!(buffers.bytes(), stats.device_bytes, "no buffer grew");
-    // Written: the TLAS's slots (binary and wide nodes, 64 and 128 bytes), the instances (64
-    // bytes each) and the moved cubes' shading triangles (48 + 96 bytes each), nothing else.
+    // Written: the TLAS's slots (binary and wide nodes, 64 and 128 bytes) and the instances
+    // (112 bytes each), nothing else: the cube's triangles stay in object space.
     let n = placements().len();
-    let tlas = (n - 1) * (64 + 128) + n * 64;
-    let moved_triangles = 3 * 6 * 6 * 6 * 2;
-    assert_eq!(
-        update.bytes,
-        tlas + moved_triangles * (48 + 96),
-        "{update:?}"
-    );
+    let tlas = (n - 1) * (64 + 128) + n * 112;
+    assert_eq!(update.bytes, tlas, "{update:?}");
     assert_no_leaks(&r, &moved, 6);
-    // Hiding a cube changes the instances: that needs a reload.
+    // Hiding a cube is an update too: it leaves the TLAS (no buffer grows), and a ray from its
+    // centre finds nothing, on the device and on the host; shown again, it is whole.
     scene.objects[0].visible = false;
+    let hidden = r
+        .move_instances(&scene)
+        .unwrap()
+        .expect("hiding an instance needs no reload");
+    assert_eq!(hidden.moved, 1);
+    assert_eq!(r.scene_buffers().unwrap().bytes(), stats.device_bytes);
+    let ray = GpuRay {
+        origin: [0.0; 4],
+        direction: [1.0, 0.0, 0.0, f32::INFINITY],
+    };
+    let ([hits, wide_hits], [occluded, _], _) = trace_all(&r, &[ray]);
+    assert_eq!(
+        (hits[0].prim, wide_hits[0].prim, occluded[0]),
+        (u32::MAX, u32::MAX, 0)
+    );
+    let host_ray = Ray {
+        origin: Vec3::ZERO,
+        direction: Vec3::X,
+        tmin: 0.0,
+        tmax: f32::INFINITY,
+    };
+    assert_eq!(r.host_scene().unwrap().intersect(&host_ray), None);
+    scene.objects[0].visible = true;
+    r.move_instances(&scene)
+        .unwrap()
+        .expect("showing an instance needs no reload");
+    assert_no_leaks(&r, &moved, 6);
+    // Other geometry is a reload.
+    std::sync::Arc::make_mut(&mut scene.objects[1].mesh)
+        .indices
+        .pop();
     assert_eq!(r.move_instances(&scene).unwrap(), None);
 }
 
@@ -244,7 +273,7 @@ fn two_levels_find_the_flat_bvhs_hits() {
         let host = r.host_scene().unwrap();
         let objects: Vec<Option<u32>> = hits
             .iter()
-            .map(|h| (h.prim != u32::MAX).then(|| host.object_of(h.prim)))
+            .map(|h| (h.prim != u32::MAX).then(|| host.object_of(h)))
             .collect();
         results.push((hits, objects, occluded));
     }

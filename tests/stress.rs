@@ -123,7 +123,7 @@ fn absurd_triangles_are_dropped_and_a_far_object_does_not_move_the_bounds() {
         name: name.into(),
         world_from_object: glam::DMat4::IDENTITY,
         visible: true,
-        mesh,
+        mesh: mesh.into(),
     };
     let mut scene = Scene {
         objects: (0..10).map(|i| object("near", quad(i as f32))).collect(),

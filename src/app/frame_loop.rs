@@ -273,9 +273,10 @@ impl FrameLoop {
         }
         // Rebase the render space around the eye when the camera travelled far from its origin.
         let far = self.loaded && self.renderer.space().is_far(world.camera.eye);
-        // Objects moved in a two-level scene (a scene change alone: a new file comes with new
-        // lights and settings too): new instance transforms and a new TLAS, written in place.
-        // Anything else (hidden or shown objects, a flat BVH) reloads the scene.
+        // Objects moved, hidden or shown in a two-level scene (a scene change alone: a new file
+        // comes with new lights and settings too): new instance transforms and a new TLAS,
+        // written in place; the overlay's "BVH rebuild" shows that update's time. Anything else
+        // (other geometry, a flat BVH) reloads the scene.
         let moved = if pending.scene && self.loaded && !far && !pending.lights && !pending.settings
         {
             self.renderer.move_instances(world.scene)?

@@ -23,7 +23,7 @@ pub fn pick(host: &HostScene, camera: &Camera, aspect: f32, fx: f32, fy: f32) ->
     let hit = host.intersect(&ray)?;
     let point = ray.origin + ray.direction * hit.t;
     Some(Pick {
-        object: host.object_of(hit.prim) as usize,
+        object: host.object_of(&hit) as usize,
         point: host.space.world_point(point),
     })
 }
@@ -52,7 +52,7 @@ mod tests {
             name: name.into(),
             world_from_object: DMat4::from_translation(DVec3::new(x, 0.0, z)),
             visible,
-            mesh: quad.clone(),
+            mesh: quad.clone().into(),
         };
         Scene {
             objects: vec![
@@ -66,10 +66,7 @@ mod tests {
     }
 
     fn host(scene: &Scene) -> HostScene {
-        let world = scene.world_triangles();
-        let verts: Vec<[Vec3; 3]> = world.iter().map(|t| t.v).collect();
-        let bvh = crate::bvh::build(&verts);
-        HostScene::new(&world, bvh, &scene.materials)
+        HostScene::flat(scene.world_triangles(), &scene.materials)
     }
 
     #[test]

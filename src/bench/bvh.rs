@@ -17,17 +17,39 @@ pub struct BvhArgs {
     /// Timed runs of each measurement (the fastest is reported).
     #[arg(long, default_value_t = 5)]
     pub runs: usize,
+    /// Leave out the flat form (flattening every instance): the figures, and the peak memory,
+    /// are then the two-level form's alone.
+    #[arg(long)]
+    pub two_level_only: bool,
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
 }
 
+/// The process's peak resident memory so far (`VmHWM` of /proc/self/status), where known.
+pub fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
 /// Runs the benchmark.
 pub fn run(args: &BvhArgs) -> Result<()> {
+    let before = peak_rss_bytes();
     let t = Instant::now();
     let scene = load(&args.scene)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
-    let r = crate::bvh::report(&scene, args.runs);
+    let loaded = peak_rss_bytes();
+    let r = crate::bvh::report(&scene, args.runs, !args.two_level_only);
+    let peak = peak_rss_bytes();
+    // What loading and building added to the process's peak, per distinct triangle.
+    let per_unique = match (before, peak) {
+        (Some(b), Some(p)) if r.unique_triangles > 0 => {
+            Some(p.saturating_sub(b) as f64 / r.unique_triangles as f64)
+        }
+        _ => None,
+    };
     let threads = rayon::current_num_threads();
     if args.json {
         let mut json = serde_json::json!({
@@ -36,6 +58,10 @@ pub fn run(args: &BvhArgs) -> Result<()> {
             "scene": scene.source,
             "threads": threads,
             "load_ms": load_ms,
+            "peak_rss_bytes": peak,
+            "load_peak_rss_bytes": loaded,
+            "start_rss_bytes": before,
+            "added_bytes_per_unique_triangle": per_unique,
         });
         if let (Some(o), serde_json::Value::Object(m)) =
             (json.as_object_mut(), serde_json::to_value(&r)?)
@@ -58,30 +84,49 @@ pub fn run(args: &BvhArgs) -> Result<()> {
         thousands(r.unique_triangles as u64)
     );
     println!("  instances          {:>12}", thousands(r.instances as u64));
-    println!(
-        "  nodes, depth       {:>12}, {}",
-        thousands(r.nodes as u64),
-        r.depth
-    );
     println!("  load               {:>12.1} ms", load_ms);
-    println!("  gather triangles   {:>12.1} ms", r.gather_ms);
-    println!("  full build         {:>12.1} ms", r.full_build_ms);
+    if let (Some(nodes), Some(depth), Some(gather), Some(full), Some(moved), Some(refit)) = (
+        r.nodes,
+        r.depth,
+        r.gather_ms,
+        r.full_build_ms,
+        r.flat_move_ms,
+        r.refit_ms,
+    ) {
+        println!(
+            "  nodes, depth       {:>12}, {}",
+            thousands(nodes as u64),
+            depth
+        );
+        println!("  gather triangles   {:>12.1} ms", gather);
+        println!("  full build         {:>12.1} ms", full);
+        println!(
+            "  flat move          {:>12.1} ms (move one instance, rebuild the flat BVH)",
+            moved
+        );
+        println!("  refit              {:>12.1} ms", refit);
+        println!(
+            "  SAH cost           {:>12.2} (after the refit {:.2})",
+            r.sah_cost.unwrap_or(0.0),
+            r.refit_sah_cost.unwrap_or(0.0)
+        );
+    }
     println!(
-        "  flat move          {:>12.1} ms (move one instance, rebuild the flat BVH)",
-        r.flat_move_ms
-    );
-    println!(
-        "  two-level build    {:>12.1} ms (every BLAS and the TLAS, host only)",
-        r.two_level_build_ms
+        "  two-level build    {:>12.1} ms (every BLAS and the TLAS, host only; {} nodes)",
+        r.two_level_build_ms,
+        thousands(r.two_level_nodes as u64)
     );
     println!(
         "  instance move      {:>12.3} ms (new TLAS, host only)",
         r.instance_move_ms
     );
-    println!("  refit              {:>12.1} ms", r.refit_ms);
-    println!(
-        "  SAH cost           {:>12.2} (after the refit {:.2})",
-        r.sah_cost, r.refit_sah_cost
-    );
+    if let (Some(peak), Some(per), Some(loaded)) = (peak, per_unique, loaded) {
+        println!(
+            "  peak memory        {:>12.1} MB ({per:.0} bytes a distinct triangle above the start; \
+             {:.1} MB after loading)",
+            peak as f64 / 1e6,
+            loaded as f64 / 1e6
+        );
+    }
     Ok(())
 }

@@ -21,6 +21,10 @@ pub struct GenerateArgs {
     /// of a subdivided sphere (20,480 triangles).
     #[arg(long)]
     pub from: Option<PathBuf>,
+    /// Give every copy its own glTF mesh (the same triangles written once per copy), so that
+    /// no mesh is shared: a scene of unique meshes, for memory and opening time.
+    #[arg(long)]
+    pub unique: bool,
     /// Output .glb file (overwritten).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -28,7 +32,7 @@ pub struct GenerateArgs {
 
 /// One mesh to instance with the transform that places it in its source.
 struct Part {
-    mesh: Mesh,
+    mesh: std::sync::Arc<Mesh>,
     world_from_object: DMat4,
 }
 
@@ -296,7 +300,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     }
     let parts = match &args.from {
         None => vec![Part {
-            mesh: icosphere(5),
+            mesh: icosphere(5).into(),
             world_from_object: DMat4::IDENTITY,
         }],
         Some(path) => {
@@ -350,6 +354,12 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         meshes.push(w.mesh(&format!("part{i}"), &p.mesh, 0));
     }
     for c in 0..copies {
+        if args.unique && c > 0 {
+            for (i, p) in parts.iter().enumerate() {
+                meshes.push(w.mesh(&format!("part{i}.{c}"), &p.mesh, 0));
+            }
+        }
+        let first_mesh = if args.unique { c * parts.len() } else { 0 };
         let (col, row) = ((c % cols) as f64, (c / cols) as f64);
         let at = DVec3::new(
             (col - 0.5 * (cols - 1) as f64) * spacing,
@@ -360,7 +370,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         let turn = DMat4::from_rotation_y(c as f64 * 2.399_963);
         for (i, p) in parts.iter().enumerate() {
             let m = DMat4::from_translation(at) * turn * normalize * p.world_from_object;
-            nodes.push(json!({"name": format!("copy{c}.{i}"), "mesh": i, "matrix": matrix(m)}));
+            nodes.push(json!({"name": format!("copy{c}.{i}"), "mesh": first_mesh + i, "matrix": matrix(m)}));
         }
     }
     meshes.push(w.mesh("room", &room(room_lo, room_hi), 1));

@@ -52,12 +52,16 @@ pub struct SurfacePoint {
 }
 
 /// The surface points of every hit (misses are left out), offset as the `shade` kernel does.
-pub fn surface_points(rays: &[GpuRay], hits: &[GpuHit], tris: &[[Vec3; 3]]) -> Vec<SurfacePoint> {
+pub fn surface_points(
+    rays: &[GpuRay],
+    hits: &[GpuHit],
+    triangle: &(dyn Fn(&GpuHit) -> [Vec3; 3] + Sync),
+) -> Vec<SurfacePoint> {
     rays.par_iter()
         .zip(hits)
         .filter(|(_, h)| h.prim != MISS)
         .map(|(r, h)| {
-            let t = &tris[h.prim as usize];
+            let t = &triangle(h);
             let p = (1.0 - h.u - h.v) * t[0] + h.u * t[1] + h.v * t[2];
             let mut n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or(Vec3::Y);
             if n.dot(to_host(r).direction) > 0.0 {

@@ -232,7 +232,7 @@ fn one_object(name: &str, mesh: Mesh, world_from_object: DMat4, material: Materi
             name: name.into(),
             world_from_object,
             visible: true,
-            mesh,
+            mesh: mesh.into(),
         }],
         materials: vec![material],
         ..Scene::default()

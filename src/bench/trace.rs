@@ -318,7 +318,6 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         runs: args.runs,
         wide: args.wide,
     };
-    let tris = &host.vertices;
 
     // Primary rays.
     // Rays are made in the render space the scene was uploaded in.
@@ -340,7 +339,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     )];
 
     // Diffuse first-bounce rays from the primary hits.
-    let points = rays::surface_points(&primary, &primary_hits, tris);
+    let points = rays::surface_points(&primary, &primary_hits, &|h| host.hit_triangle(h));
     if points.is_empty() {
         eprintln!("penumbra: {source}: no primary ray hit anything; only primary rays timed");
     } else {
@@ -358,7 +357,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         ));
 
         // Shadow rays from the primary hits to the lights.
-        let targets = light_targets(&host.space.lights(&prepared.lights), host, tris);
+        let targets = light_targets(&host.space.lights(&prepared.lights), host);
         let shadow = rays::shadow_rays(&points, primary.len(), &targets, args.seed);
         let (occluded, times) = tracer.any(&shadow)?;
         let check = timed(|| check_any(host, &shadow, &occluded, args.validate));
@@ -534,16 +533,18 @@ fn time_instance_move(
 }
 
 /// Shadow ray targets: the emissive triangles and the punctual lights of the scene.
-fn light_targets(
-    lights: &[crate::scene::Light],
-    host: &crate::render::HostScene,
-    tris: &[[Vec3; 3]],
-) -> LightTargets {
+fn light_targets(lights: &[crate::scene::Light], host: &crate::render::HostScene) -> LightTargets {
     let mut t = LightTargets {
         triangles: host
             .emissive
             .iter()
-            .map(|&(prim, _, _)| tris[prim as usize])
+            .map(|e| {
+                host.hit_triangle(&GpuHit {
+                    prim: e.prim,
+                    instance: e.instance,
+                    ..GpuHit::default()
+                })
+            })
             .collect(),
         ..LightTargets::default()
     };
@@ -555,10 +556,16 @@ fn light_targets(
             _ => t.points.push(l.position.as_vec3()),
         }
     }
-    let (lo, hi) = tris.iter().flatten().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    );
+    let (lo, hi) = match &host.accel {
+        crate::render::Accel::Flat(_) => host.vertices.iter().flatten().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        ),
+        crate::render::Accel::TwoLevel(two) => {
+            let b = two.tlas.child(0, 0).0.union(two.tlas.child(0, 1).0);
+            (b.min, b.max)
+        }
+    };
     t.bounds = (lo, hi);
     t
 }

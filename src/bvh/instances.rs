@@ -9,10 +9,13 @@
 //!
 //! This is also the host reference of the device's two-level traversal
 //! (`traverse_two_level` in kernels/traverse.h): the transform and its error bound are computed
-//! here with the kernels' f32 operations in the kernels' order.
+//! here with the kernels' f32 operations in the kernels' order. Hits name the object-space
+//! triangle (meshes one after the other, each in its BLAS's order) and the instance, as the
+//! device reports them: the device keeps each mesh's triangles and shading data once, in
+//! object space, and shading carries a hit to world space through the instance's transform.
 
 use super::{Aabb, Bvh, Hit, Ray, WideBvh, build, build_boxes};
-use crate::cl::types::{GpuBvhNode, GpuWideNode};
+use crate::cl::types::{GpuBvhNode, GpuHit, GpuWideNode};
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -37,6 +40,16 @@ impl Blas {
         Self { bvh, triangles }
     }
 
+    /// Builds the BLAS of an indexed mesh (object space); the copy of its triangles the build
+    /// needs lives only as long as the build.
+    pub fn of_mesh(positions: &[Vec3], indices: &[[u32; 3]]) -> Self {
+        let tris: Vec<[Vec3; 3]> = indices
+            .iter()
+            .map(|t| t.map(|i| positions[i as usize]))
+            .collect();
+        Self::new(&tris)
+    }
+
     /// The object-space box of the whole mesh.
     pub fn bounds(&self) -> Aabb {
         self.bvh.child(0, 0).0.union(self.bvh.child(0, 1).0)
@@ -55,13 +68,10 @@ pub struct Instance {
     pub rows: [[f32; 4]; 3],
     /// Whether the transform mirrors (negative determinant).
     pub mirrored: bool,
-    /// Index of its first triangle in the shading order (instances one after the other in
-    /// their given order, each in its BLAS's order).
-    pub prim_offset: u32,
 }
 
 impl Instance {
-    fn new(blas: u32, world_from_object: DMat4, prim_offset: u32) -> Self {
+    fn new(blas: u32, world_from_object: DMat4) -> Self {
         let linear = glam::DMat3::from_mat4(world_from_object).inverse();
         let origin = world_from_object.w_axis;
         let row = |i: usize| {
@@ -73,8 +83,24 @@ impl Instance {
             world_from_object,
             rows: [row(0), row(1), row(2)],
             mirrored: world_from_object.determinant() < 0.0,
-            prim_offset,
         }
+    }
+
+    /// World from object as the device applies it for shading, `p_world = M p_object + T`:
+    /// the rows of M in f32 (T is in `rows`' `.w`).
+    pub fn world_rows(&self) -> [[f32; 4]; 3] {
+        let m = self.world_from_object;
+        [0, 1, 2].map(|i| {
+            let r = m.row(i);
+            [r.x as f32, r.y as f32, r.z as f32, 0.0]
+        })
+    }
+
+    /// An object-space point in world space (f64).
+    pub fn to_world(&self, p: Vec3) -> Vec3 {
+        self.world_from_object
+            .transform_point3(p.as_dvec3())
+            .as_vec3()
     }
 
     /// `ray` in object space, with its tmin raised past the transform's rounding error: the
@@ -132,6 +158,8 @@ impl Instance {
 pub struct InstanceHit {
     /// The instance hit.
     pub instance: u32,
+    /// Its TLAS leaf slot (where the device keeps it).
+    pub slot: u32,
     /// The hit in that instance's BLAS (`prim` in its BVH order; `t` in world units).
     pub hit: Hit,
 }
@@ -145,6 +173,10 @@ pub struct TwoLevel {
     pub instances: Vec<Instance>,
     /// Over the instances' world boxes; its `tri_indices` are instance indices.
     pub tlas: Bvh,
+    /// Each BLAS's first triangle among the meshes' triangles one after the other.
+    pub firsts: Vec<u32>,
+    /// Hidden instances are left out of the TLAS (they keep their place among the instances).
+    pub hidden: Vec<bool>,
 }
 
 impl TwoLevel {
@@ -157,19 +189,30 @@ impl TwoLevel {
 
     /// The TLAS over `instances` of prebuilt BLASes.
     pub fn from_blases(blases: Vec<Blas>, instances: &[(u32, DMat4)]) -> Self {
-        let mut offset = 0u32;
+        let shown = vec![false; instances.len()];
+        Self::with_hidden(blases, instances, shown)
+    }
+
+    /// [`TwoLevel::from_blases`] with `hidden` instances left out of the TLAS.
+    pub fn with_hidden(blases: Vec<Blas>, instances: &[(u32, DMat4)], hidden: Vec<bool>) -> Self {
         let instances = instances
             .iter()
-            .map(|&(blas, m)| {
-                let inst = Instance::new(blas, m, offset);
-                offset += blases[blas as usize].triangles.len() as u32;
-                inst
+            .map(|&(blas, m)| Instance::new(blas, m))
+            .collect();
+        let mut first = 0u32;
+        let firsts = blases
+            .iter()
+            .map(|b| {
+                first += b.triangles.len() as u32;
+                first - b.triangles.len() as u32
             })
             .collect();
         let mut two = Self {
+            hidden,
             blases,
             instances,
             tlas: build_boxes(&[]),
+            firsts,
         };
         two.rebuild_tlas();
         two
@@ -179,7 +222,9 @@ impl TwoLevel {
     pub fn triangle_count(&self) -> usize {
         self.instances
             .iter()
-            .map(|i| self.blases[i.blas as usize].triangles.len())
+            .zip(&self.hidden)
+            .filter(|(_, hidden)| !**hidden)
+            .map(|(i, _)| self.blases[i.blas as usize].triangles.len())
             .sum()
     }
 
@@ -193,17 +238,25 @@ impl TwoLevel {
     /// the last move).
     pub fn place(&mut self, i: usize, world_from_object: DMat4) {
         let inst = &mut self.instances[i];
-        *inst = Instance::new(inst.blas, world_from_object, inst.prim_offset);
+        *inst = Instance::new(inst.blas, world_from_object);
     }
 
     /// Builds the TLAS over the instances' current world boxes.
     pub fn rebuild_tlas(&mut self) {
-        let boxes: Vec<Aabb> = self
-            .instances
+        let shown: Vec<u32> = (0..self.instances.len() as u32)
+            .filter(|&i| !self.hidden[i as usize])
+            .collect();
+        let boxes: Vec<Aabb> = shown
             .iter()
-            .map(|inst| inst.world_box(self.blases[inst.blas as usize].bounds()))
+            .map(|&i| {
+                let inst = &self.instances[i as usize];
+                inst.world_box(self.blases[inst.blas as usize].bounds())
+            })
             .collect();
         self.tlas = build_boxes(&boxes);
+        for i in &mut self.tlas.tri_indices {
+            *i = shown[*i as usize];
+        }
     }
 
     /// The closest hit along `ray`.
@@ -216,24 +269,38 @@ impl TwoLevel {
         self.trace(ray, true).is_some()
     }
 
-    /// The closest hit as the device reports it: `prim` in the shading order, and the
-    /// barycentrics of the shading triangle (whose vertices 1 and 2 trade places in a mirrored
-    /// instance).
-    pub fn shading_hit(&self, ray: &Ray) -> Option<Hit> {
+    /// The closest hit as the device reports it: `prim` among the meshes' triangles one after
+    /// the other (see [`TwoLevel::firsts`]) and the instance's TLAS slot.
+    pub fn device_hit(&self, ray: &Ray) -> Option<GpuHit> {
         self.intersect(ray).map(|h| {
             let inst = &self.instances[h.instance as usize];
-            let (u, v) = if inst.mirrored {
-                (h.hit.v, h.hit.u)
-            } else {
-                (h.hit.u, h.hit.v)
-            };
-            Hit {
-                prim: inst.prim_offset + h.hit.prim,
-                u,
-                v,
-                ..h.hit
+            GpuHit {
+                t: h.hit.t,
+                u: h.hit.u,
+                v: h.hit.v,
+                prim: self.firsts[inst.blas as usize] + h.hit.prim,
+                instance: h.slot,
             }
         })
+    }
+
+    /// Each instance's TLAS slot (the inverse of the TLAS's `tri_indices`; `u32::MAX` for a
+    /// hidden one).
+    pub fn slots(&self) -> Vec<u32> {
+        let mut slots = vec![u32::MAX; self.instances.len()];
+        for (slot, &i) in self.tlas.tri_indices.iter().enumerate() {
+            slots[i as usize] = slot as u32;
+        }
+        slots
+    }
+
+    /// The world-space vertices of triangle `prim` (among the meshes' triangles one after the
+    /// other) placed by instance `instance` (its index, not its slot).
+    pub fn hit_triangle(&self, prim: u32, instance: u32) -> [Vec3; 3] {
+        let inst = &self.instances[instance as usize];
+        let b = inst.blas as usize;
+        let t = self.blases[b].triangles[(prim - self.firsts[b]) as usize];
+        t.map(|v| inst.to_world(v))
     }
 
     fn trace(&self, ray: &Ray, any: bool) -> Option<InstanceHit> {
@@ -252,7 +319,16 @@ impl TwoLevel {
             } else {
                 blas.bvh.intersect(&local, &blas.triangles)
             };
-            hit.map(|hit| (hit.t, InstanceHit { instance, hit }))
+            hit.map(|hit| {
+                (
+                    hit.t,
+                    InstanceHit {
+                        instance,
+                        slot: leaf,
+                        hit,
+                    },
+                )
+            })
         })
     }
 

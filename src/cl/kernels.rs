@@ -368,7 +368,8 @@ impl Program {
         self.run(gpu, Stage::Shade.name(), &self.shade, slots, |e| unsafe {
             e.set_arg(frame)
                 .set_arg(&env.info)
-                .set_arg(&scene.triangles.mem());
+                .set_arg(&scene.triangles.mem())
+                .set_arg(&scene.instances.mem());
             set_surfaces(e, scene);
             e.set_arg(&env.texels.mem())
                 .set_arg(&env.marginal.mem())

@@ -179,9 +179,11 @@ pub struct GpuWideNode {
 }
 const _: () = assert!(size_of::<GpuWideNode>() == 128);
 
-/// One placed mesh of a two-level scene (64 bytes): object from world as
-/// `p_object = L (p_world - T)`, bottom-level roots and shading-order offset; see
-/// `kernels/types.h` and `bvh::instances`.
+/// One placed mesh of a two-level scene (112 bytes): object from world as
+/// `p_object = L (p_world - T)` for traversal, world from object as `p_world = M p_object + T`
+/// for shading (the mesh's triangles and shading data stay in object space on the device),
+/// bottom-level roots, and the instance's index and first light; see `kernels/types.h` and
+/// `bvh::instances`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuInstance {
@@ -191,26 +193,35 @@ pub struct GpuInstance {
     pub row1: [f32; 4],
     /// Third row of L; `.w` = T.z.
     pub row2: [f32; 4],
+    /// First row of M = L⁻¹ (world from object); `.w` = the light index of the instance's
+    /// first emissive triangle (i32 bits; an emissive triangle's `v1.w` counts from it).
+    pub world0: [f32; 4],
+    /// Second row of M.
+    pub world1: [f32; 4],
+    /// Third row of M.
+    pub world2: [f32; 4],
     /// Bottom-level root in the binary node array.
     pub root: u32,
     /// Bottom-level root in the wide node array.
     pub wide_root: u32,
-    /// Shading index = bottom-level triangle index + `prim_offset` (wrapping).
-    pub prim_offset: u32,
+    /// The instance's index in the scene (host bookkeeping; hits name the slot).
+    pub id: u32,
     /// 1 when mirrored (negative determinant).
     pub flags: u32,
 }
-const _: () = assert!(size_of::<GpuInstance>() == 64);
+const _: () = assert!(size_of::<GpuInstance>() == 112);
 
-/// A triangle's vertices in world space, in BVH order (48 bytes).
+/// A triangle's vertices in world space, in BVH order (48 bytes); with two levels, in object
+/// space, once per mesh (mesh after mesh, each in its BLAS's order).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuTriangle {
     /// Vertex 0; `.w` = material index (u32 bits).
     pub v0: [f32; 4],
-    /// Vertex 1; `.w` = emissive light index (i32 bits, -1 when not emissive).
+    /// Vertex 1; `.w` = emissive light index (i32 bits, -1 when not emissive; two levels: the
+    /// index among its mesh's emissive triangles, added to the instance's first light).
     pub v1: [f32; 4],
-    /// Vertex 2; `.w` = object index (u32 bits).
+    /// Vertex 2; `.w` = object index (u32 bits; two levels: 0, the instance tells).
     pub v2: [f32; 4],
 }
 const _: () = assert!(size_of::<GpuTriangle>() == 48);
@@ -343,7 +354,8 @@ pub struct GpuLight {
     /// directional light).
     pub intensity: [f32; 4],
     /// Spot axis (direction light travels); `.w` = cos of the outer cone angle.
-    /// For a triangle light: `.x` = triangle index (u32 bits), `.y` = area.
+    /// For a triangle light: `.x` = triangle index (u32 bits), `.y` = area, `.z` = the
+    /// instance's slot in the instance buffer (u32 bits; two levels).
     pub spot: [f32; 4],
     /// `.x` = cos of the inner cone angle; `.y` = selection probability; `.zw` unused.
     pub extra: [f32; 4],
@@ -414,7 +426,7 @@ pub struct GpuPath {
 }
 const _: () = assert!(size_of::<GpuPath>() == 64);
 
-/// The closest hit of an extension ray (16 bytes). `prim` is `u32::MAX` on a miss.
+/// The closest hit of an extension ray (20 bytes). `prim` is `u32::MAX` on a miss.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuHit {
@@ -424,10 +436,14 @@ pub struct GpuHit {
     pub u: f32,
     /// Barycentric coordinate of vertex 2.
     pub v: f32,
-    /// Triangle index in BVH order, or `u32::MAX` for a miss.
+    /// Triangle index in BVH order (two levels: the object-space triangle, mesh after mesh,
+    /// each in its BLAS's order), or `u32::MAX` for a miss.
     pub prim: u32,
+    /// The instance hit: its slot in the instance buffer, which is in TLAS order (two levels; 0
+    /// with the flat BVH).
+    pub instance: u32,
 }
-const _: () = assert!(size_of::<GpuHit>() == 16);
+const _: () = assert!(size_of::<GpuHit>() == 20);
 
 /// A shadow ray with the radiance it carries if unoccluded (48 bytes).
 #[repr(C)]
@@ -471,9 +487,12 @@ pub fn layouts() -> Vec<StructLayout> {
             row0,
             row1,
             row2,
+            world0,
+            world1,
+            world2,
             root,
             wide_root,
-            prim_offset,
+            id,
             flags
         ),
         layout!(GpuTriShading, n0, n1, n2, uv01, uv2, uv1_12),
@@ -514,7 +533,7 @@ pub fn layouts() -> Vec<StructLayout> {
             pad
         ),
         layout!(GpuPath, origin, direction, throughput, radiance),
-        layout!(GpuHit, t, u, v, prim),
+        layout!(GpuHit, t, u, v, prim, instance),
         layout!(GpuShadowRay, origin, direction, contribution),
         layout!(GpuRay, origin, direction),
         layout!(

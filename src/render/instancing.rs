@@ -2,9 +2,10 @@
 //! world-space triangle, or two levels (a BLAS per distinct mesh, shared by the nodes that
 //! place it, and a TLAS over the instances; see `bvh::instances`).
 //!
-//! Shading reads the triangles in world space either way (one copy per instance, in the order
-//! the traversal reports them), so images agree; two levels store each distinct mesh's BVH and
-//! object-space triangles once and make moving an object a TLAS rebuild written in place
+//! The flat BVH's triangles and shading data are in world space, one copy per placed triangle;
+//! two levels keep each distinct mesh's BVH, triangles and shading data once, in object space,
+//! and shading carries a hit to world space through its instance's transform, so moving an
+//! object is a TLAS rebuild and a few transforms written in place
 //! (`Renderer::move_instances`).
 //!
 //! The automatic choice (`--bvh auto`): two levels when the scene is large and instancing
@@ -17,7 +18,7 @@
 
 use crate::bvh::{Blas, TwoLevel};
 use crate::scene::{Object, RenderFrame, Scene, distinct_meshes};
-use glam::{DMat4, Vec3};
+use glam::DMat4;
 use rayon::prelude::*;
 use std::str::FromStr;
 
@@ -52,84 +53,54 @@ impl FromStr for BvhChoice {
     }
 }
 
-/// A scene's instances: each visible object with triangles, the distinct meshes they use.
+/// A scene's instances: each object with triangles (hidden ones left out of the TLAS), the
+/// distinct meshes they use.
 pub struct Instancing {
     /// The two levels (render space).
     pub two: TwoLevel,
-    /// Index in the flattened triangle list of each triangle in shading order.
-    pub order: Vec<u32>,
-    /// Material of each object-space triangle, mesh after mesh, in BLAS order.
-    pub object_materials: Vec<u32>,
     /// The object each instance places (index in `Scene::objects`).
     pub objects: Vec<u32>,
+    /// An object placing each BLAS's mesh (index in `Scene::objects`).
+    pub mesh_objects: Vec<u32>,
 }
 
 /// The two levels of `scene` in render space `space`, or `None` when the flat BVH is chosen
-/// (or must be: flattening `dropped` triangles with absurd vertices, which the instances would
-/// keep).
-pub fn plan(
-    scene: &Scene,
-    space: &RenderFrame,
-    dropped: usize,
-    choice: BvhChoice,
-) -> Option<Instancing> {
-    if choice == BvhChoice::Flat || dropped > 0 {
+/// (or must be: flattening drops triangles with absurd world vertices, which the instances
+/// would keep).
+pub fn plan(scene: &Scene, space: &RenderFrame, choice: BvhChoice) -> Option<Instancing> {
+    if choice == BvhChoice::Flat {
         return None;
     }
-    let objects = placed_objects(scene);
+    let objects = instanced_objects(scene);
     let placed: Vec<&Object> = objects
         .iter()
         .map(|&i| &scene.objects[i as usize])
         .collect();
     let (meshes, mesh_of) = distinct_meshes(&placed);
     let unique: usize = meshes.iter().map(|&o| placed[o].mesh.indices.len()).sum();
-    let total: usize = placed.iter().map(|o| o.mesh.indices.len()).sum();
+    let total: usize = placed
+        .iter()
+        .filter(|o| o.visible)
+        .map(|o| o.mesh.indices.len())
+        .sum();
     let auto_flat = total < AUTO_MIN_TRIANGLES || total < AUTO_MIN_SAVING * unique;
-    if total == 0 || (choice == BvhChoice::Auto && auto_flat) {
+    if total == 0 || (choice == BvhChoice::Auto && auto_flat) || scene.absurd_triangles() > 0 {
         return None;
     }
     let blases: Vec<Blas> = meshes
         .par_iter()
-        .map(|&o| {
-            let m = &placed[o].mesh;
-            let tris: Vec<[Vec3; 3]> = m
-                .indices
-                .iter()
-                .map(|t| t.map(|i| m.positions[i as usize]))
-                .collect();
-            Blas::new(&tris)
-        })
+        .map(|&o| Blas::of_mesh(&placed[o].mesh.positions, &placed[o].mesh.indices))
         .collect();
-    let object_materials = meshes
-        .iter()
-        .zip(&blases)
-        .flat_map(|(&o, b)| {
-            let m = &placed[o].mesh;
-            b.bvh.tri_indices.iter().map(|&k| m.materials[k as usize])
-        })
-        .collect();
-    // Render from object: the render frame's (p - origin) * scale after the node's transform.
-    let frame =
-        DMat4::from_scale(glam::DVec3::splat(space.scale)) * DMat4::from_translation(-space.origin);
+    let frame = render_from_world(space);
     let instances: Vec<(u32, DMat4)> = placed
         .iter()
         .zip(&mesh_of)
         .map(|(o, &m)| (m, frame * o.world_from_object))
         .collect();
-    let two = TwoLevel::from_blases(blases, &instances);
-    // Shading order: instance after instance, each in its BLAS's order, as indices into the
-    // flattened list (which holds the visible objects' triangles in object order).
-    let mut order = Vec::with_capacity(total);
-    let mut base = 0u32;
-    for (o, inst) in placed.iter().zip(&two.instances) {
-        let blas = &two.blases[inst.blas as usize];
-        order.extend(blas.bvh.tri_indices.iter().map(|&k| base + k));
-        base += o.mesh.indices.len() as u32;
-    }
+    let hidden = placed.iter().map(|o| !o.visible).collect();
     Some(Instancing {
-        two,
-        order,
-        object_materials,
+        two: TwoLevel::with_hidden(blases, &instances, hidden),
+        mesh_objects: meshes.iter().map(|&o| objects[o]).collect(),
         objects,
     })
 }
@@ -140,13 +111,11 @@ pub fn render_from_world(space: &RenderFrame) -> DMat4 {
     DMat4::from_scale(glam::DVec3::splat(space.scale)) * DMat4::from_translation(-space.origin)
 }
 
-/// The indices of the visible objects that have triangles: the instances, in object order.
-pub fn placed_objects(scene: &Scene) -> Vec<u32> {
+/// The indices of the objects that have triangles, visible or hidden: the instances, in object
+/// order (hidden ones are left out of the TLAS, so that hiding or showing one is an update).
+pub fn instanced_objects(scene: &Scene) -> Vec<u32> {
     (0..scene.objects.len() as u32)
-        .filter(|&i| {
-            let o = &scene.objects[i as usize];
-            o.visible && !o.mesh.indices.is_empty()
-        })
+        .filter(|&i| !scene.objects[i as usize].mesh.indices.is_empty())
         .collect()
 }
 

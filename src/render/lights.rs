@@ -66,13 +66,20 @@ pub fn gpu_lights(
     let disc = std::f32::consts::PI * (0.5 * diagonal) * (0.5 * diagonal);
     let near = (0.05 * diagonal).max(1e-12);
     let inverse_square = |p: Vec3| 1.0 / (p - center).length_squared().max(near * near);
-    for &(prim, area, power) in &host.emissive {
-        let v = &host.vertices[prim as usize];
-        let centroid = (v[0] + v[1] + v[2]) / 3.0;
+    // Two levels: a triangle light names its instance's slot in the (TLAS-ordered) instances;
+    // a hidden instance's lights keep their places in the list but are never chosen.
+    let slots = match &host.accel {
+        crate::render::Accel::TwoLevel(two) if !host.emissive.is_empty() => two.slots(),
+        _ => vec![],
+    };
+    for e in &host.emissive {
+        let (area, centroid) = (e.area, e.centroid);
+        let slot = slots.get(e.instance as usize).copied().unwrap_or(0);
+        let power = if slot == u32::MAX { 0.0 } else { e.power };
         out.push(GpuLight {
             position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_TRIANGLE)],
             intensity: [0.0; 4],
-            spot: [f32::from_bits(prim), area, 0.0, 0.0],
+            spot: [f32::from_bits(e.prim), area, f32::from_bits(slot), 0.0],
             extra: [0.0; 4],
         });
         // `power` is π L A (× 2 when double-sided), so power / π is the intensity scale L A.
@@ -128,6 +135,10 @@ pub fn gpu_lights(
     }
     let total_irradiance: f32 = weights.iter().map(|w| w.0).sum();
     let total_power: f32 = weights.iter().map(|w| w.1).sum();
+    if !(total_irradiance > 0.0 && total_power > 0.0) {
+        // Nothing lights the scene (every emitter hidden): no light is sampled.
+        return (vec![], vec![]);
+    }
     let mut cdf = Vec::with_capacity(weights.len());
     let mut acc = 0.0;
     for (l, w) in out.iter_mut().zip(&weights) {

@@ -182,31 +182,24 @@ impl Renderer {
         space: RenderFrame,
     ) -> Result<SceneStats, ClError> {
         let t = Instant::now();
-        let flat = scene.flatten(&space);
-        let dropped = flat.dropped;
-        let world = flat.triangles;
         let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
-        let (mut host, object_tris) =
-            match instancing::plan(scene, &space, dropped, self.bvh_choice) {
-                Some(plan) => {
-                    let object_tris = object_triangles(&plan);
-                    let mut host = HostScene::ordered(
-                        &world,
-                        &plan.order,
-                        Accel::TwoLevel(plan.two),
-                        &materials,
-                    );
-                    host.layout.objects = plan.objects;
-                    (host, object_tris)
-                }
-                None => {
-                    let verts: Vec<[glam::Vec3; 3]> = world.iter().map(|t| t.v).collect();
-                    let bvh = crate::bvh::build(&verts);
-                    drop(verts);
-                    (HostScene::new(&world, bvh, &materials), vec![])
-                }
-            };
-        drop(world);
+        let (mut host, dropped) = match instancing::plan(scene, &space, self.bvh_choice) {
+            Some(plan) => {
+                // Two levels: nothing is flattened; each mesh goes to the device once.
+                let meshes: Vec<&crate::scene::Mesh> = plan
+                    .mesh_objects
+                    .iter()
+                    .map(|&o| scene.objects[o as usize].mesh.as_ref())
+                    .collect();
+                let mut host = HostScene::two_level(plan.two, &meshes, &materials);
+                host.layout.objects = plan.objects;
+                (host, 0)
+            }
+            None => {
+                let flat = scene.flatten(&space);
+                (HostScene::flat(flat.triangles, &materials), flat.dropped)
+            }
+        };
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
 
         let t = Instant::now();
@@ -228,17 +221,17 @@ impl Renderer {
         self.lights = lights.to_vec();
         let (glights, cdf) = self.light_table(&host);
         let (nodes, wide_nodes, instances) = device_accel(&mut host);
-        let placeholder = [GpuTriTangents::default()];
-        let tangents: &[GpuTriTangents] = if host.tangents.is_empty() {
-            &placeholder
-        } else {
-            &host.tangents
-        };
-        let object_tris = if object_tris.is_empty() {
-            vec![GpuTriangle::default()]
-        } else {
-            object_tris
-        };
+        // Shading data is the device's alone: it leaves the host scene, and each large host
+        // array is freed as soon as its buffer is made, so that the two copies (host memory
+        // either way with a CPU device) are not all held at once.
+        let shading = std::mem::take(&mut host.shading);
+        let mut tangents = std::mem::take(&mut host.tangents);
+        if tangents.is_empty() {
+            tangents.push(GpuTriTangents::default());
+        }
+        // Two levels trace the meshes' object-space triangles in `triangles`: the separate
+        // object-triangle buffer is a placeholder either way.
+        let object_tris = [GpuTriangle::default()];
         let bytes = |n: usize, size: usize| n.max(1) * size;
         fits_device(
             &[
@@ -251,27 +244,31 @@ impl Renderer {
                     "triangles",
                     std::mem::size_of_val(host.triangles.as_slice()),
                 ),
-                (
-                    "object triangles",
-                    std::mem::size_of_val(object_tris.as_slice()),
-                ),
                 ("instances", std::mem::size_of_val(instances.as_slice())),
-                ("shading", std::mem::size_of_val(host.shading.as_slice())),
-                ("tangents", std::mem::size_of_val(tangents)),
+                ("shading", std::mem::size_of_val(shading.as_slice())),
+                ("tangents", std::mem::size_of_val(tangents.as_slice())),
                 ("texels", bytes(pack.texels.len(), 4)),
             ],
             self.gpu.device.global_mem_size().ok(),
             self.gpu.device.max_mem_alloc_size().ok(),
         )
         .map_err(ClError::Device)?;
+        let nodes_buffer = Buffer::from_slice(&self.gpu, &nodes)?;
+        drop(nodes);
+        let wide_buffer = Buffer::from_slice(&self.gpu, &wide_nodes)?;
+        drop(wide_nodes);
+        let shading_buffer = Buffer::from_slice(&self.gpu, &shading)?;
+        drop(shading);
+        let tangents_buffer = Buffer::from_slice(&self.gpu, &tangents)?;
+        drop(tangents);
         let buffers = SceneBuffers {
-            nodes: Buffer::from_slice(&self.gpu, &nodes)?,
-            wide_nodes: Buffer::from_slice(&self.gpu, &wide_nodes)?,
+            nodes: nodes_buffer,
+            wide_nodes: wide_buffer,
             triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
             instances: Buffer::from_slice(&self.gpu, &instances)?,
             object_triangles: Buffer::from_slice(&self.gpu, &object_tris)?,
-            shading: Buffer::from_slice(&self.gpu, &host.shading)?,
-            tangents: Buffer::from_slice(&self.gpu, tangents)?,
+            shading: shading_buffer,
+            tangents: tangents_buffer,
             tex_refs: Buffer::from_slice(&self.gpu, &pack.refs)?,
             textures: Buffer::from_slice(&self.gpu, &pack.textures)?,
             texels: Buffer::from_slice(&self.gpu, &pack.texels)?,
@@ -279,12 +276,12 @@ impl Renderer {
             lights: Buffer::from_slice(&self.gpu, &glights)?,
             light_cdf: Buffer::from_slice(&self.gpu, &cdf)?,
         };
-        drop((nodes, wide_nodes, instances, object_tris));
+        drop(instances);
         self.light_count = glights.len() as u32;
         self.update_env_info(&glights);
         let (meshes, instances) = host.accel.instancing();
         let stats = SceneStats {
-            triangles: host.triangles.len(),
+            triangles: host.triangle_count(),
             nodes: host.accel.node_count(),
             sah_cost: host.accel.sah_cost(),
             bvh_build_ms,
@@ -582,31 +579,14 @@ fn device_accel(host: &mut HostScene) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec
             vec![GpuInstance::default()],
         ),
         Accel::TwoLevel(two) => {
-            let (nodes, roots, firsts) = two.device_nodes();
+            let (nodes, roots, _) = two.device_nodes();
             let (wide, wide_roots) = two.device_wide_nodes();
             host.layout.roots = roots;
             host.layout.wide_roots = wide_roots;
-            host.layout.firsts = firsts;
             let instances = host.layout.gpu_instances(two);
             (nodes, wide, instances)
         }
     }
-}
-
-/// Every distinct mesh's object-space triangles in BLAS order, mesh after mesh, with the
-/// material in `v0.w`.
-fn object_triangles(plan: &instancing::Instancing) -> Vec<GpuTriangle> {
-    plan.two
-        .blases
-        .iter()
-        .flat_map(|b| &b.triangles)
-        .zip(&plan.object_materials)
-        .map(|(t, &m)| GpuTriangle {
-            v0: upload::f4(t[0], f32::from_bits(m)),
-            v1: upload::f4(t[1], 0.0),
-            v2: upload::f4(t[2], 0.0),
-        })
-        .collect()
 }
 
 /// Checks before any allocation that the scene's buffers fit the device: their sum against
@@ -661,7 +641,7 @@ mod fit_tests {
             name: "o".into(),
             world_from_object: DMat4::IDENTITY,
             visible: true,
-            mesh,
+            mesh: mesh.into(),
         };
         Scene {
             materials,

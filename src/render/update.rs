@@ -1,14 +1,14 @@
 //! Moving instances of a two-level scene without rebuilding it: the moved instances' transforms
 //! and a new TLAS, written over the old ones in the device buffers (no reallocation, no BLAS
-//! build). Shading reads world-space triangles, so the moved instances' triangles are
-//! rewritten in place too (their range of the shading buffers, nothing else).
+//! build). The meshes' triangles and shading data stay in object space on the device, so
+//! nothing else is written (a moved light also rewrites the small light table).
 
-use super::instancing::{placed_objects, render_from_world};
+use super::instancing::{instanced_objects, render_from_world};
 use super::{Accel, Renderer};
 use crate::bvh::WideBvh;
 use crate::cl::ClError;
 use crate::cl::types::{GpuBvhNode, GpuWideNode};
-use crate::scene::Scene;
+use crate::scene::{Scene, is_sane};
 use std::time::Instant;
 
 /// What [`Renderer::move_instances`] did.
@@ -25,11 +25,12 @@ pub struct InstanceUpdate {
 impl Renderer {
     /// Brings a two-level scene on the device up to date with the transforms of `scene`'s
     /// objects: the moved instances get their new transforms, the TLAS is rebuilt, and both
-    /// are written over the old ones in place. Returns `None`, changing nothing, when that
-    /// cannot be done and the scene must be loaded again: the scene on the device is flat, an
-    /// object was hidden, shown or given other geometry, or a moved object emits light (the
-    /// light table holds its triangles' areas) or has an absurd vertex. Resets the film when
-    /// anything moved.
+    /// are written over the old ones in place (the meshes stay as they are, in object space);
+    /// a hidden object's instance is left out of the TLAS, a shown one taken back.
+    /// With emissive triangles the (small) light table is written anew too: moved lights'
+    /// areas and powers, and the instances' new TLAS slots. Returns `None`, changing nothing, when that cannot be done and the scene must
+    /// be loaded again: the scene on the device is flat, an object was given other geometry,
+    /// or a moved or shown object has an absurd vertex. Resets the film when anything changed.
     pub fn move_instances(&mut self, scene: &Scene) -> Result<Option<InstanceUpdate>, ClError> {
         let t = Instant::now();
         let Some((buffers, host)) = self.scene.as_mut() else {
@@ -38,7 +39,7 @@ impl Renderer {
         let Accel::TwoLevel(two) = &host.accel else {
             return Ok(None);
         };
-        let objects = placed_objects(scene);
+        let objects = instanced_objects(scene);
         if objects != host.layout.objects {
             return Ok(None);
         }
@@ -52,25 +53,23 @@ impl Renderer {
                 return Ok(None);
             }
             let m = frame * object.world_from_object;
-            if m == inst.world_from_object {
+            if m == inst.world_from_object && object.visible != two.hidden[i] {
                 continue;
             }
-            let range = inst.prim_offset..inst.prim_offset + blas.triangles.len() as u32;
-            if host.emissive.iter().any(|(p, _, _)| range.contains(p)) {
-                return Ok(None);
+            if !object.visible {
+                moved.push((i, m, false));
+                continue;
             }
-            let world = scene.flatten_object(o as usize, &host.space);
-            if world.dropped > 0 {
-                return Ok(None);
-            }
-            // The object's triangles in the instance's shading order (its BLAS's).
-            let ordered: Vec<_> = blas
-                .bvh
-                .tri_indices
+            let world = object.world_from_object;
+            if object
+                .mesh
+                .positions
                 .iter()
-                .map(|&k| world.triangles[k as usize])
-                .collect();
-            moved.push((i, m, ordered));
+                .any(|p| !is_sane(world.transform_point3(p.as_dvec3())))
+            {
+                return Ok(None);
+            }
+            moved.push((i, m, true));
         }
         if moved.is_empty() {
             return Ok(Some(InstanceUpdate::default()));
@@ -78,8 +77,9 @@ impl Renderer {
         let Accel::TwoLevel(two) = &mut host.accel else {
             return Ok(None);
         };
-        for (i, m, _) in &moved {
-            two.place(*i, *m);
+        for &(i, m, visible) in &moved {
+            two.place(i, m);
+            two.hidden[i] = !visible;
         }
         two.rebuild_tlas();
         let slots = two.tlas_slots();
@@ -88,33 +88,19 @@ impl Renderer {
         let mut wide = WideBvh::collapse(&two.tlas).nodes;
         wide.resize(slots, GpuWideNode::default());
         let instances = host.layout.gpu_instances(two);
-        let offsets: Vec<usize> = moved
-            .iter()
-            .map(|(i, _, _)| two.instances[*i].prim_offset as usize)
-            .collect();
         let gpu = &self.gpu;
         buffers.nodes.write_at(gpu, 0, &nodes)?;
         buffers.wide_nodes.write_at(gpu, 0, &wide)?;
         buffers.instances.write_at(gpu, 0, &instances)?;
-        let mut bytes = std::mem::size_of_val(nodes.as_slice())
+        let bytes = std::mem::size_of_val(nodes.as_slice())
             + std::mem::size_of_val(wide.as_slice())
             + std::mem::size_of_val(instances.as_slice());
-        for ((_, _, ordered), at) in moved.iter().zip(offsets) {
-            let r = host.rewrite(at, ordered);
-            buffers
-                .triangles
-                .write_at(gpu, at, &host.triangles[r.clone()])?;
-            buffers
-                .shading
-                .write_at(gpu, at, &host.shading[r.clone()])?;
-            bytes += std::mem::size_of_val(&host.triangles[r.clone()])
-                + std::mem::size_of_val(&host.shading[r.clone()]);
-            if !host.tangents.is_empty() {
-                buffers
-                    .tangents
-                    .write_at(gpu, at, &host.tangents[r.clone()])?;
-                bytes += std::mem::size_of_val(&host.tangents[r]);
-            }
+        for &(i, _, _) in &moved {
+            host.replace_emitters(i as u32);
+        }
+        // Triangle lights name their instances' TLAS slots, which the new TLAS reorders.
+        if !host.emissive.is_empty() {
+            self.upload_lights()?;
         }
         let update = InstanceUpdate {
             moved: moved.len(),

@@ -1,10 +1,15 @@
-//! Turning the host scene into the device's structs: triangles and shading data in BVH order,
-//! materials and the camera. The light list is built in `lights`, the textures in `textures`.
+//! Turning the host scene into the device's structs: triangles and shading data in BVH order
+//! (flat: world space, one per placed triangle; two levels: object space, one per mesh
+//! triangle), materials and the camera. The light list is built in `lights`, the textures in
+//! `textures`.
 
-use crate::bvh::{Bvh, Hit, Ray, TwoLevel};
+use crate::bvh::{Bvh, Ray, TwoLevel};
 use crate::cl::types::*;
-use crate::scene::{AlphaMode, Camera, Material, RenderFrame, WorldTriangle, robust_bounds};
-use glam::Vec3;
+use crate::scene::{
+    AlphaMode, Camera, Material, Mesh, RenderFrame, WorldTriangle, robust_bounds_of,
+};
+use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
 
 /// The acceleration structure of the scene on the device, with its host reference.
 #[derive(Clone, Debug)]
@@ -70,31 +75,55 @@ pub struct InstanceLayout {
     pub roots: Vec<u32>,
     /// Each BLAS's root in the wide node array.
     pub wide_roots: Vec<u32>,
-    /// Each BLAS's first object-space triangle.
-    pub firsts: Vec<u32>,
+    /// Each instance's first light (the light index of its first emissive triangle).
+    pub light_bases: Vec<i32>,
 }
 
 impl InstanceLayout {
-    /// The device instances of `two` in TLAS order.
+    /// The device instances of `two` in TLAS order, padded to all of them (hidden ones are
+    /// not in the TLAS), so that the buffer holds any later TLAS's.
     pub fn gpu_instances(&self, two: &TwoLevel) -> Vec<GpuInstance> {
-        two.tlas
+        let mut out: Vec<GpuInstance> = two
+            .tlas
             .tri_indices
             .iter()
             .map(|&i| {
                 let inst = &two.instances[i as usize];
                 let b = inst.blas as usize;
+                let mut world = inst.world_rows();
+                world[0][3] = f32::from_bits(self.light_bases[i as usize] as u32);
                 GpuInstance {
                     row0: inst.rows[0],
                     row1: inst.rows[1],
                     row2: inst.rows[2],
+                    world0: world[0],
+                    world1: world[1],
+                    world2: world[2],
                     root: self.roots[b],
                     wide_root: self.wide_roots[b],
-                    prim_offset: inst.prim_offset.wrapping_sub(self.firsts[b]),
+                    id: i,
                     flags: inst.mirrored as u32,
                 }
             })
-            .collect()
+            .collect();
+        out.resize(two.instances.len().max(1), GpuInstance::default());
+        out
     }
+}
+
+/// An emissive triangle of the light table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emitter {
+    /// Its index in the device triangles (flat: BVH order; two levels: the mesh triangle).
+    pub prim: u32,
+    /// Its instance's index (two levels; 0 when flat).
+    pub instance: u32,
+    /// World (render space) area.
+    pub area: f32,
+    /// Emitted power, for light selection.
+    pub power: f32,
+    /// Centroid in render space.
+    pub centroid: Vec3,
 }
 
 /// The scene as uploaded, kept on the host for picking and for tests.
@@ -103,18 +132,22 @@ pub struct HostScene {
     pub accel: Accel,
     /// Two levels: where the instances' parts sit on the device (empty when flat).
     pub layout: InstanceLayout,
-    /// Triangles in shading order: the flat BVH's, or instance by instance in BLAS order.
+    /// Triangles as the device has them: the flat BVH's world triangles in BVH order, or
+    /// (two levels) every mesh's object-space triangles, mesh after mesh in BLAS order.
     pub triangles: Vec<GpuTriangle>,
-    /// Vertices in BVH order (for the host traversal).
+    /// Flat: world vertices in BVH order (for the host traversal); empty with two levels,
+    /// whose BLASes hold their triangles.
     pub vertices: Vec<[Vec3; 3]>,
-    /// Shading data in BVH order.
+    /// Shading data, indexed as `triangles` (two levels: object-space normals); moved to the
+    /// device by `Renderer::load_scene` (empty after).
     pub shading: Vec<GpuTriShading>,
-    /// Tangents in BVH order; empty when no triangle is normal-mapped.
+    /// Tangents, indexed as `triangles`; empty when no triangle is normal-mapped, and after
+    /// `Renderer::load_scene` moved them to the device.
     pub tangents: Vec<GpuTriTangents>,
     /// Materials.
     pub materials: Vec<GpuMaterial>,
-    /// Emissive triangles (BVH order index, area, emitted power for selection).
-    pub emissive: Vec<(u32, f32, f32)>,
+    /// Emissive triangles, in light-table order.
+    pub emissive: Vec<Emitter>,
     /// The map from world space to the render space the triangles are in.
     pub space: RenderFrame,
     /// The middle and the diagonal of the robust bounds of the triangles.
@@ -208,38 +241,19 @@ fn slot(r: Option<u32>) -> i32 {
 }
 
 impl HostScene {
-    /// Orders the triangles as the BVH wants them and fills the device structs.
-    pub fn new(world: &[WorldTriangle], bvh: Bvh, materials: &[Material]) -> Self {
-        let order = bvh.tri_indices.clone();
-        Self::ordered(world, &order, Accel::Flat(bvh), materials)
-    }
-
-    /// Fills the device structs from `world` taken in `order` (indices into `world`), for
-    /// traversal by `accel`.
-    pub fn ordered(
-        world: &[WorldTriangle],
-        order: &[u32],
-        accel: Accel,
-        materials: &[Material],
-    ) -> Self {
-        let mut emissive = Vec::new();
+    /// The flat form of `world` (render space, in object order): converted to the device
+    /// structs and dropped before the BVH is built, then the structs are put in BVH order one
+    /// array at a time, so that the large intermediate triangles and two orders of the same
+    /// data are never held together.
+    pub fn flat(world: Vec<WorldTriangle>, materials: &[Material]) -> Self {
+        let middle = middle_of(1, &|_| world.iter().map(|t| t.v.map(Vec3::as_dvec3)));
+        let normal_mapped = world.iter().any(|t| t.tangents.is_some());
         let mut triangles = Vec::with_capacity(world.len());
         let mut shading = Vec::with_capacity(world.len());
+        let mut tangents = Vec::with_capacity(if normal_mapped { world.len() } else { 0 });
         let mut vertices = Vec::with_capacity(world.len());
-        let normal_mapped = world.iter().any(|t| t.tangents.is_some());
-        let mut tangents = Vec::new();
-        for (order, &index) in order.iter().enumerate() {
-            let t = &world[index as usize];
-            let m = &materials[t.material as usize];
-            let mut light = -1i32;
-            let area = 0.5 * (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).length();
-            if m.is_emissive() && area > 0.0 {
-                let sides = if m.double_sided { 2.0 } else { 1.0 };
-                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
-                light = emissive.len() as i32;
-                emissive.push((order as u32, area, power));
-            }
-            let (tri, sh, tan) = device_triangle(t, light);
+        for t in &world {
+            let (tri, sh, tan) = device_triangle(t, -1);
             triangles.push(tri);
             shading.push(sh);
             if normal_mapped {
@@ -247,19 +261,63 @@ impl HostScene {
             }
             vertices.push(t.v);
         }
-        let corners: Vec<[glam::DVec3; 3]> =
-            world.iter().map(|t| t.v.map(Vec3::as_dvec3)).collect();
-        let b = robust_bounds(&corners);
-        let middle = if b.is_empty() {
-            (Vec3::ZERO, 1.0)
+        drop(world);
+        let bvh = crate::bvh::build(&vertices);
+        fn gather<T: Copy + Send + Sync>(v: Vec<T>, order: &[u32]) -> Vec<T> {
+            order.par_iter().map(|&i| v[i as usize]).collect()
+        }
+        let vertices = gather(vertices, &bvh.tri_indices);
+        let mut triangles = gather(triangles, &bvh.tri_indices);
+        let shading = gather(shading, &bvh.tri_indices);
+        let tangents = if normal_mapped {
+            gather(tangents, &bvh.tri_indices)
         } else {
-            (b.center().as_vec3(), b.diagonal() as f32)
+            tangents
         };
+        let mut emissive = Vec::new();
+        for (order, (tri, v)) in triangles.iter_mut().zip(&vertices).enumerate() {
+            let m = &materials[tri.v0[3].to_bits() as usize];
+            let area = triangle_area(v);
+            if m.is_emissive() && area > 0.0 {
+                let sides = if m.double_sided { 2.0 } else { 1.0 };
+                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
+                tri.v1[3] = f32::from_bits(emissive.len() as u32);
+                emissive.push(Emitter {
+                    prim: order as u32,
+                    instance: 0,
+                    area,
+                    power,
+                    centroid: v.iter().sum::<Vec3>() / 3.0,
+                });
+            }
+        }
+        Self {
+            vertices,
+            ..Self::assemble(
+                Accel::Flat(bvh),
+                InstanceLayout::default(),
+                (triangles, shading, tangents),
+                materials,
+                emissive,
+                middle,
+            )
+        }
+    }
+
+    /// The scene of `accel` with its device structs, in render space yet to be set.
+    fn assemble(
+        accel: Accel,
+        layout: InstanceLayout,
+        (triangles, shading, tangents): (Vec<GpuTriangle>, Vec<GpuTriShading>, Vec<GpuTriTangents>),
+        materials: &[Material],
+        emissive: Vec<Emitter>,
+        middle: (Vec3, f32),
+    ) -> Self {
         Self {
             accel,
-            layout: InstanceLayout::default(),
+            layout,
             triangles,
-            vertices,
+            vertices: vec![],
             shading,
             tangents,
             materials: materials.iter().map(gpu_material).collect(),
@@ -269,12 +327,82 @@ impl HostScene {
         }
     }
 
+    /// Fills the device structs of a two-level scene: every mesh's triangles and shading data
+    /// once, in object space and BLAS order (`meshes[b]` is BLAS b's mesh), and the light
+    /// table's emissive triangles instance by instance (each instance's first light is kept in
+    /// `layout.light_bases`). `two`'s instances are in render space.
+    pub fn two_level(two: TwoLevel, meshes: &[&Mesh], materials: &[Material]) -> Self {
+        let normal_mapped = meshes.iter().any(|m| !m.tangents.is_empty());
+        let per_mesh: Vec<_> = meshes
+            .par_iter()
+            .zip(&two.blases)
+            .map(|(m, b)| object_triangles(m, &b.bvh.tri_indices, materials, normal_mapped))
+            .collect();
+        let n = two.firsts.last().copied().unwrap_or(0) as usize
+            + two.blases.last().map_or(0, |b| b.triangles.len());
+        let mut triangles = Vec::with_capacity(n);
+        let mut shading = Vec::with_capacity(n);
+        let mut tangents = Vec::with_capacity(if normal_mapped { n } else { 0 });
+        // Each mesh's emissive triangles (index among the meshes' triangles, material).
+        let mut mesh_emitters = vec![];
+        for (b, (tri, sh, tan, emitters)) in per_mesh.into_iter().enumerate() {
+            triangles.extend(tri);
+            shading.extend(sh);
+            tangents.extend(tan);
+            mesh_emitters.push(
+                emitters
+                    .into_iter()
+                    .map(|(k, material)| (two.firsts[b] + k, material))
+                    .collect::<Vec<_>>(),
+            );
+        }
+        let mut emissive = vec![];
+        let mut light_bases = vec![];
+        for (i, inst) in two.instances.iter().enumerate() {
+            light_bases.push(emissive.len() as i32);
+            for &(prim, material) in &mesh_emitters[inst.blas as usize] {
+                let v = two.hit_triangle(prim, i as u32);
+                emissive.push(emitter(prim, i as u32, &v, &materials[material as usize]));
+            }
+        }
+        let shown: Vec<usize> = (0..two.instances.len())
+            .filter(|&k| !two.hidden[k])
+            .collect();
+        let middle = middle_of(shown.len(), &|k| {
+            let inst = &two.instances[shown[k]];
+            let m = inst.world_from_object;
+            two.blases[inst.blas as usize]
+                .triangles
+                .iter()
+                .map(move |t| t.map(|v| m.transform_point3(v.as_dvec3())))
+        });
+        Self::assemble(
+            Accel::TwoLevel(two),
+            InstanceLayout {
+                light_bases,
+                ..InstanceLayout::default()
+            },
+            (triangles, shading, tangents),
+            materials,
+            emissive,
+            middle,
+        )
+    }
+
+    /// Triangles over all placed meshes.
+    pub fn triangle_count(&self) -> usize {
+        match &self.accel {
+            Accel::Flat(_) => self.triangles.len(),
+            Accel::TwoLevel(t) => t.triangle_count(),
+        }
+    }
+
     /// Scales each emissive triangle's selection power by its material's factor in
     /// `per_material` (see [`emissive_texture_means`]).
     pub fn scale_emitter_power(&mut self, per_material: &[f32]) {
-        for (prim, _, power) in &mut self.emissive {
-            let material = self.triangles[*prim as usize].v0[3].to_bits() as usize;
-            *power *= per_material.get(material).copied().unwrap_or(1.0);
+        for e in &mut self.emissive {
+            let material = self.triangles[e.prim as usize].v0[3].to_bits() as usize;
+            e.power *= per_material.get(material).copied().unwrap_or(1.0);
         }
     }
 
@@ -284,28 +412,36 @@ impl HostScene {
         self.middle
     }
 
-    /// Replaces the triangles from shading position `at` on with `world` (the same triangles
-    /// moved, in the same order: their light indices stay); returns the range written.
-    pub fn rewrite(&mut self, at: usize, world: &[WorldTriangle]) -> std::ops::Range<usize> {
-        for (k, t) in world.iter().enumerate() {
-            let light = self.triangles[at + k].v1[3].to_bits() as i32;
-            let (tri, sh, tan) = device_triangle(t, light);
-            self.triangles[at + k] = tri;
-            self.shading[at + k] = sh;
-            if !self.tangents.is_empty() {
-                self.tangents[at + k] = tan;
-            }
-            self.vertices[at + k] = t.v;
+    /// Two levels: recomputes the emissive triangles of instance `i` after it moved (area,
+    /// power and centroid).
+    pub fn replace_emitters(&mut self, i: u32) {
+        let Accel::TwoLevel(two) = &self.accel else {
+            return;
+        };
+        for e in self.emissive.iter_mut().filter(|e| e.instance == i) {
+            let v = two.hit_triangle(e.prim, i);
+            let area = triangle_area(&v);
+            e.power = if e.area > 0.0 {
+                e.power * area / e.area
+            } else {
+                0.0
+            };
+            e.area = area;
+            e.centroid = v.iter().sum::<Vec3>() / 3.0;
         }
-        at..at + world.len()
     }
 
-    /// The closest hit along `ray` (render space): `prim` in shading order, as the device
-    /// reports it.
-    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+    /// The closest hit along `ray` (render space), as the device reports it.
+    pub fn intersect(&self, ray: &Ray) -> Option<GpuHit> {
         match &self.accel {
-            Accel::Flat(b) => b.intersect(ray, &self.vertices),
-            Accel::TwoLevel(t) => t.shading_hit(ray),
+            Accel::Flat(b) => b.intersect(ray, &self.vertices).map(|h| GpuHit {
+                t: h.t,
+                u: h.u,
+                v: h.v,
+                prim: h.prim,
+                instance: 0,
+            }),
+            Accel::TwoLevel(t) => t.device_hit(ray),
         }
     }
 
@@ -317,10 +453,115 @@ impl HostScene {
         }
     }
 
-    /// The object index of a triangle in BVH order.
-    pub fn object_of(&self, prim: u32) -> u32 {
-        self.triangles[prim as usize].v2[3].to_bits()
+    /// The object (index in `Scene::objects`) a device hit is on.
+    pub fn object_of(&self, hit: &GpuHit) -> u32 {
+        match &self.accel {
+            Accel::Flat(_) => self.triangles[hit.prim as usize].v2[3].to_bits(),
+            Accel::TwoLevel(t) => {
+                self.layout.objects[t.tlas.tri_indices[hit.instance as usize] as usize]
+            }
+        }
     }
+
+    /// The world (render space) vertices of a device hit's triangle.
+    pub fn hit_triangle(&self, hit: &GpuHit) -> [Vec3; 3] {
+        match &self.accel {
+            Accel::Flat(_) => self.vertices[hit.prim as usize],
+            Accel::TwoLevel(t) => {
+                t.hit_triangle(hit.prim, t.tlas.tri_indices[hit.instance as usize])
+            }
+        }
+    }
+}
+
+fn triangle_area(v: &[Vec3; 3]) -> f32 {
+    0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length()
+}
+
+/// The light-table entry of an emissive triangle with world vertices `v`.
+fn emitter(prim: u32, instance: u32, v: &[Vec3; 3], m: &Material) -> Emitter {
+    let area = triangle_area(v);
+    let sides = if m.double_sided { 2.0 } else { 1.0 };
+    Emitter {
+        prim,
+        instance,
+        area,
+        power: luminance(m.emission) * area * std::f32::consts::PI * sides,
+        centroid: v.iter().sum::<Vec3>() / 3.0,
+    }
+}
+
+/// The middle and the diagonal of the robust bounds of the parts' triangles (see
+/// [`robust_bounds_of`]).
+fn middle_of<I: Iterator<Item = [DVec3; 3]>>(
+    parts: usize,
+    part: &(dyn Fn(usize) -> I + Sync),
+) -> (Vec3, f32) {
+    let b = robust_bounds_of(parts, part);
+    if b.is_empty() {
+        (Vec3::ZERO, 1.0)
+    } else {
+        (b.center().as_vec3(), b.diagonal() as f32)
+    }
+}
+
+/// Device structs of one mesh's triangles in object space, in the order `order`, and its
+/// emissive triangles (index in that order, material): emissive materials with a nonzero
+/// object-space area, whose `v1.w` counts them.
+#[allow(clippy::type_complexity)]
+fn object_triangles(
+    m: &Mesh,
+    order: &[u32],
+    materials: &[Material],
+    normal_mapped: bool,
+) -> (
+    Vec<GpuTriangle>,
+    Vec<GpuTriShading>,
+    Vec<GpuTriTangents>,
+    Vec<(u32, u32)>,
+) {
+    let mut tris = Vec::with_capacity(order.len());
+    let mut shading = Vec::with_capacity(order.len());
+    let mut tangents = Vec::with_capacity(if normal_mapped { order.len() } else { 0 });
+    let mut emitters = vec![];
+    let corner = |a: &[Vec2], i: u32| a.get(i as usize).copied().unwrap_or(Vec2::ZERO);
+    for (k, &ti) in order.iter().enumerate() {
+        let idx = m.indices[ti as usize];
+        let material = m.materials[ti as usize];
+        let v = idx.map(|i| m.positions[i as usize]);
+        let mut light = -1i32;
+        if materials[material as usize].is_emissive() && triangle_area(&v) > 0.0 {
+            light = emitters.len() as i32;
+            emitters.push((k as u32, material));
+        }
+        let geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+        let smooth = !m.normals.is_empty();
+        let n = if smooth {
+            idx.map(|i| {
+                let n = m.normals[i as usize].normalize_or_zero();
+                if n == Vec3::ZERO { geometric } else { n }
+            })
+        } else {
+            [geometric; 3]
+        };
+        let t = WorldTriangle {
+            v,
+            n,
+            smooth,
+            uv: idx.map(|i| corner(&m.uvs, i)),
+            uv1: idx.map(|i| corner(&m.uvs1, i)),
+            tangents: m.tangents.get(ti as usize).copied(),
+            material,
+            object: 0,
+        };
+        let (tri, sh, tan) = device_triangle(&t, light);
+        tris.push(tri);
+        shading.push(sh);
+        if normal_mapped {
+            tangents.push(tan);
+        }
+    }
+    (tris, shading, tangents, emitters)
 }
 
 /// A triangle's device structs; `light` is its index among the emissive triangles (-1: none).
@@ -379,13 +620,12 @@ mod tests {
             Vec3::new(5.0, 0.0, 5.0),
             Vec3::new(5.0, 0.0, -5.0),
         ];
-        let world = [WorldTriangle {
+        let world = vec![WorldTriangle {
             v,
             n: [Vec3::Y; 3],
             ..WorldTriangle::default()
         }];
-        let bvh = crate::bvh::build(&[v]);
-        HostScene::new(&world, bvh, &[Material::default()])
+        HostScene::flat(world, &[Material::default()])
     }
 
     fn light(kind: LightKind, position: glam::DVec3, intensity: f32) -> Light {

@@ -814,7 +814,7 @@ mod tests {
                 name: format!("part {i}"),
                 world_from_object: DMat4::IDENTITY,
                 visible: true,
-                mesh,
+                mesh: mesh.into(),
             });
             scene.materials.push(material.clone());
         }

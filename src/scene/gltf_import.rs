@@ -98,7 +98,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         .rev()
         .map(|n| (n, DMat4::IDENTITY, 0))
         .collect();
-    let mut meshes: HashMap<usize, Mesh> = HashMap::new();
+    let mut meshes: HashMap<usize, Arc<Mesh>> = HashMap::new();
     let mut placed = 0usize;
     let mut triangles = 0usize;
     while let Some((node, parent, depth)) = stack.pop() {
@@ -148,7 +148,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
             let pose = node_pose(&node, &mesh, root, &buffer_data, &rest)?;
             let posed = node.skin().is_some() || node.weights().is_some();
             let m = match meshes.get(&mesh.index()).filter(|_| !posed) {
-                Some(m) => m.clone(),
+                Some(m) => Arc::clone(m),
                 None => {
                     let mut m = import_mesh(
                         &mesh,
@@ -164,8 +164,9 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
                         &format!("meshes[{}]", mesh.index()),
                         &mut warnings,
                     );
+                    let m = Arc::new(m);
                     if !posed {
-                        meshes.insert(mesh.index(), m.clone());
+                        meshes.insert(mesh.index(), Arc::clone(&m));
                     }
                     m
                 }

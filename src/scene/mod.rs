@@ -20,7 +20,7 @@ mod textures;
 mod validate;
 mod variants;
 
-pub use bounds::{ABSURD_COORDINATE, RenderFrame, is_sane, robust_bounds};
+pub use bounds::{ABSURD_COORDINATE, RenderFrame, is_sane, robust_bounds, robust_bounds_of};
 pub use env_presets::EnvPreset;
 pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
 pub use gltf_import::{AUTO_YFOV, load, load_from_bytes};
@@ -97,8 +97,9 @@ pub struct Object {
     pub world_from_object: DMat4,
     /// Hidden objects are left out of the BVH.
     pub visible: bool,
-    /// The geometry.
-    pub mesh: Mesh,
+    /// The geometry, shared by every object that places the same glTF mesh (the importer
+    /// reads each mesh once; a skinned or morphed node gets its own posed copy).
+    pub mesh: Arc<Mesh>,
 }
 
 /// How a material's alpha is used (glTF `alphaMode`).
@@ -423,10 +424,14 @@ impl Scene {
             .filter(|(_, o)| o.visible)
             .map(|(oi, o)| object_triangles(oi as u32, o, frame))
             .collect();
-        Flattened {
-            dropped: per_object.iter().map(|(_, d)| d).sum(),
-            triangles: per_object.into_iter().flat_map(|(t, _)| t).collect(),
+        // Each object's triangles are moved over and freed in turn, so the two lists are not
+        // held in full at once.
+        let dropped = per_object.iter().map(|(_, d)| d).sum();
+        let mut triangles = Vec::with_capacity(per_object.iter().map(|(t, _)| t.len()).sum());
+        for (t, _) in per_object {
+            triangles.extend(t);
         }
+        Flattened { dropped, triangles }
     }
 
     /// Object `i`'s triangles in the render space of `frame`, in its mesh's order, as
@@ -439,19 +444,38 @@ impl Scene {
     /// Robust world-space bounds of the visible geometry (see [`robust_bounds`]): what
     /// framing, the default light radius and the render frame use.
     pub fn bounds(&self) -> Bounds {
+        let visible: Vec<&Object> = self.objects.iter().filter(|o| o.visible).collect();
+        robust_bounds_of(visible.len(), &|k| {
+            let o = visible[k];
+            let m = o.world_from_object;
+            o.mesh.indices.iter().map(move |t| {
+                t.map(|i| m.transform_point3(o.mesh.positions[i as usize].as_dvec3()))
+            })
+        })
+    }
+
+    /// Triangles of the visible objects with a non-finite or absurd world vertex (those that
+    /// [`Scene::flatten`] drops), counted without flattening.
+    pub fn absurd_triangles(&self) -> usize {
         use rayon::prelude::*;
-        let triangles: Vec<[DVec3; 3]> = self
-            .objects
+        self.objects
             .par_iter()
             .filter(|o| o.visible)
-            .flat_map_iter(|o| {
+            .map(|o| {
                 let m = o.world_from_object;
-                o.mesh.indices.iter().map(move |t| {
-                    t.map(|i| m.transform_point3(o.mesh.positions[i as usize].as_dvec3()))
-                })
+                let sane: Vec<bool> = o
+                    .mesh
+                    .positions
+                    .iter()
+                    .map(|p| is_sane(m.transform_point3(p.as_dvec3())))
+                    .collect();
+                o.mesh
+                    .indices
+                    .iter()
+                    .filter(|t| !t.iter().all(|&i| sane[i as usize]))
+                    .count()
             })
-            .collect();
-        robust_bounds(&triangles)
+            .sum()
     }
 
     /// Number of triangles over all visible objects.
@@ -465,24 +489,16 @@ impl Scene {
 }
 
 /// The distinct meshes among `objects` (the index of the first object using each) and each
-/// object's mesh. The importer gives every node its own copy of its mesh, so meshes are told
-/// apart by content: triangles, positions and materials.
+/// object's mesh. The importer reads each glTF mesh once and the nodes placing it share it
+/// (`Object::mesh` is an `Arc`), so meshes are told apart by identity.
 pub fn distinct_meshes(objects: &[&Object]) -> (Vec<usize>, Vec<u32>) {
-    let mut index = std::collections::HashMap::<u64, u32>::new();
+    let mut index = std::collections::HashMap::<*const Mesh, u32>::new();
     let mut first = vec![];
     let mesh_of = objects
         .iter()
         .enumerate()
         .map(|(i, o)| {
-            use std::hash::{Hash, Hasher};
-            let mut h = std::collections::hash_map::DefaultHasher::new();
-            let m = &o.mesh;
-            m.indices.hash(&mut h);
-            m.materials.hash(&mut h);
-            for p in &m.positions {
-                p.to_array().map(f32::to_bits).hash(&mut h);
-            }
-            *index.entry(h.finish()).or_insert_with(|| {
+            *index.entry(Arc::as_ptr(&o.mesh)).or_insert_with(|| {
                 first.push(i);
                 first.len() as u32 - 1
             })

@@ -92,14 +92,27 @@ impl Scene {
     /// Gives the triangles the materials of `variant` (an index into `variants`; `None`: the
     /// default materials).
     pub fn select_variant(&mut self, variant: Option<usize>) {
+        // A mesh shared by several objects is rewritten once and stays shared.
+        let mut done = std::collections::HashMap::new();
         for o in &mut self.objects {
-            let mesh = &mut o.mesh;
+            if o.mesh.variants.is_empty() {
+                continue;
+            }
+            let key = std::sync::Arc::as_ptr(&o.mesh);
+            if let Some((_, m)) = done.get(&key) {
+                o.mesh = std::sync::Arc::clone(m);
+                continue;
+            }
+            let mut mesh = (*o.mesh).clone();
             for r in &mesh.variants {
                 let material = variant
                     .and_then(|v| r.materials.iter().find(|(x, _)| *x as usize == v))
                     .map_or(r.default, |&(_, m)| m);
                 mesh.materials[r.triangles.start as usize..r.triangles.end as usize].fill(material);
             }
+            // The old mesh is kept in `done` so that its address cannot be reused meanwhile.
+            let old = std::mem::replace(&mut o.mesh, std::sync::Arc::new(mesh));
+            done.insert(key, (old, std::sync::Arc::clone(&o.mesh)));
         }
         self.variant = variant;
     }
