@@ -117,31 +117,23 @@ inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float
 
 // Tests the triangles first .. first + count - 1 of a leaf, keeping the closest hit in *hit
 // (with HAS_ALPHA, hits the material's alpha cuts out or lets through are skipped). Returns
-// true when any_hit and a hit was found: the traversal can stop. A hit on triangle p is
-// reported as p + prim_offset (an instance's triangles in the scene's shading order), with u
-// and v swapped when `swap_uv` (a mirrored instance, whose shading triangle lists vertices 1 and
-// 2 the other way round). `o` and `d` are the ray in world space (the alpha hash reads them).
+// true when any_hit and a hit was found: the traversal can stop. `o` and `d` are the ray in
+// world space (the alpha hash reads them).
 inline bool intersect_leaf(const RayPrep* r, global const GpuTriangle* tris,
                            const SceneSurfaces* surf, uint first, uint count, float tmin,
-                           float3 o, float3 d, bool any_hit, uint prim_offset, bool swap_uv,
-                           GpuHit* hit) {
+                           float3 o, float3 d, bool any_hit, GpuHit* hit) {
     for (uint p = first; p < first + count; ++p) {
         GpuTriangle t = tris[p];
         float t_hit = hit->t;
         float bu, bv;
         if (!intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv)) continue;
-        if (swap_uv) {
-            float tmp = bu;
-            bu = bv;
-            bv = tmp;
-        }
 #ifdef HAS_ALPHA
-        if (alpha_passes(surf, p + prim_offset, as_uint(t.v0.w), bu, bv, o, d)) continue;
+        if (alpha_passes(surf, p, as_uint(t.v0.w), bu, bv, o, d)) continue;
 #endif
         hit->t = t_hit;
         hit->u = bu;
         hit->v = bv;
-        hit->prim = p + prim_offset;
+        hit->prim = p;
         if (any_hit) return true;
     }
     return false;
@@ -176,7 +168,7 @@ inline float child_entry(const GpuBvhNode* n, int side, const RayPrep* r, float 
 inline bool traverse_bvh(global const GpuBvhNode* nodes, uint root,
                          global const GpuTriangle* tris, const SceneSurfaces* surf,
                          const RayPrep* r, float3 o, float3 d, float tmin, bool any_hit,
-                         uint prim_offset, bool swap_uv, GpuHit* hit,
+                         GpuHit* hit,
                          volatile global uint* overflow) {
     // Written out in one loop, without helper functions taking pointers: compilers keep this
     // form's state in registers (the flat BVH's rays on an H200 lost 8 % to a version through
@@ -200,7 +192,7 @@ inline bool traverse_bvh(global const GpuBvhNode* nodes, uint root,
                 continue;
             }
             if (intersect_leaf(r, tris, surf, (uint)(~ref), as_uint(hi.w), tmin, o, d, any_hit,
-                               prim_offset, swap_uv, hit)) {
+                               hit)) {
                 return true;
             }
         }
@@ -243,7 +235,7 @@ inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle*
                        bool any_hit, volatile global uint* overflow) {
     RayPrep r = prepare_ray(o, d);
     GpuHit hit = no_hit(tmax);
-    traverse_bvh(nodes, 0u, tris, surf, &r, o, d, tmin, any_hit, 0u, false, &hit, overflow);
+    traverse_bvh(nodes, 0u, tris, surf, &r, o, d, tmin, any_hit, &hit, overflow);
     return hit;
 }
 
@@ -332,8 +324,8 @@ inline bool top_pop(TopStack* s, float tmax, uint* ref, uint* count) {
         float ltmin = instance_tmin(&inst, o, od, tmin);                                       \
         GpuHit found = hit;                                                                    \
         found.prim = NO_HIT;                                                                   \
-        bool stop = WALK(nodes, inst.ROOT, object_tris, surf, &lr, o, d, ltmin, any_hit, 0u,   \
-                         false, &found, overflow);                                             \
+        bool stop =                                                                            \
+            WALK(nodes, inst.ROOT, object_tris, surf, &lr, o, d, ltmin, any_hit, &found, overflow); \
         if (found.prim != NO_HIT) {                                                            \
             hit = found;                                                                       \
             hit.instance = i;                                                                  \

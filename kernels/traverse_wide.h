@@ -76,7 +76,7 @@ inline uint wide_children(global const GpuWideNode* n, const RayPrep* r, float t
 #define WIDE_LEAF(D, S)                                                                     \
     if (D < hit->t && counts[S] > 0u &&                                                     \
         intersect_leaf(r, tris, surf, (uint)(~children[S]), counts[S], tmin, o, d, any_hit, \
-                       prim_offset, swap_uv, hit)) {                                        \
+                       hit)) {                                                              \
         return true;                                                                        \
     }
 
@@ -95,7 +95,7 @@ inline uint wide_children(global const GpuWideNode* n, const RayPrep* r, float t
 inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
                               global const GpuTriangle* tris, const SceneSurfaces* surf,
                               const RayPrep* r, float3 o, float3 d, float tmin, bool any_hit,
-                              uint prim_offset, bool swap_uv, GpuHit* hit,
+                              GpuHit* hit,
                               volatile global uint* overflow) {
     uint stack[WIDE_STACK_SIZE + 1];
     float stack_d[WIDE_STACK_SIZE + 1];
@@ -149,8 +149,7 @@ inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTri
                             float tmax, bool any_hit, volatile global uint* overflow) {
     RayPrep r = prepare_ray(o, d);
     GpuHit hit = no_hit(tmax);
-    traverse_wide_bvh(nodes, 0u, tris, surf, &r, o, d, tmin, any_hit, 0u, false, &hit,
-                      overflow);
+    traverse_wide_bvh(nodes, 0u, tris, surf, &r, o, d, tmin, any_hit, &hit, overflow);
     return hit;
 }
 
