@@ -21,6 +21,10 @@
 //                 sheenColor E_sh(mu) (E_sh tabulated); the diffuse base sees it as one more layer
 //                 of albedo s E_sh (s = max3(sheenColor)), the other base lobes are scaled by
 //                 1 - s max(E_sh(mu_o), E_sh(mu_i)), the spec's albedo scaling made reciprocal
+//   anisotropy    (HAS_ANISOTROPY, KHR_materials_anisotropy) the reflection and transmission
+//                 microfacets are anisotropic GGX, alpha_t = mix(alpha, 1, strength^2) along the
+//                 anisotropy direction and alpha_b = alpha across it, in the frame of that
+//                 direction; the energy tables are read at the geometric mean sqrt(alpha_t alpha_b)
 // Below BSDF_DELTA_ALPHA the glossy lobes are perfect mirror and refraction (delta) lobes.
 //
 // Contract: bsdf_eval returns f(wo, wi) * |cos(n, wi)| and its pdf (solid angle) for the non-delta
@@ -49,6 +53,12 @@ typedef struct {
     float3 sheen_color;          // KHR_materials_sheen sheenColorFactor; 0: no sheen
     float sheen_roughness;       // perceptual
 #endif
+#ifdef HAS_ANISOTROPY
+    float anisotropy;            // KHR_materials_anisotropy strength; 0: isotropic
+    float2 aniso_rotation;       // cos, sin of the direction's angle from onb(n)'s t, when
+                                 // aniso_dir is 0 (no tangent frame: the BSDF tests)
+    float3 aniso_dir;            // the anisotropy direction (world), from the tangent frame
+#endif
 } SurfaceMaterial;
 
 // The untextured material.
@@ -72,6 +82,11 @@ inline SurfaceMaterial surface_material(global const GpuMaterial* m) {
 #ifdef HAS_SHEEN
     s.sheen_color = m->sheen.xyz;
     s.sheen_roughness = m->sheen.w;
+#endif
+#ifdef HAS_ANISOTROPY
+    s.anisotropy = m->aniso.x;
+    s.aniso_rotation = m->aniso.yz;
+    s.aniso_dir = (float3)(0.0f);
 #endif
     return s;
 }
@@ -400,6 +415,57 @@ inline float3 ggx_sample_vndf(float3 wo, float alpha, float u1, float u2) {
     return len2 > 0.0f ? h * rsqrt(len2) : (float3)(0.0f, 0.0f, 1.0f);
 }
 
+#ifdef HAS_ANISOTROPY
+// Anisotropic GGX (alpha_x along the frame's t, alpha_y along b): the distribution, Smith's
+// Lambda and the visible normals as above, with the axes stretched.
+inline float ggx_d_aniso(float3 h, float ax, float ay) {
+    float x = h.x / ax;
+    float y = h.y / ay;
+    float d = x * x + y * y + h.z * h.z;
+    return 1.0f / (PI_F * ax * ay * d * d);
+}
+
+inline float ggx_lambda_aniso(float3 w, float ax, float ay) {
+    float x = (ax * ax * w.x * w.x + ay * ay * w.y * w.y) / (w.z * w.z);
+    return x < INFINITY ? x / (2.0f * (sqrt(1.0f + x) + 1.0f)) : INFINITY;
+}
+
+inline float3 ggx_sample_vndf_aniso(float3 wo, float ax, float ay, float u1, float u2) {
+    float3 v = normalize((float3)(ax * wo.x, ay * wo.y, wo.z));
+    float phi = 2.0f * PI_F * u1;
+    float z = (1.0f - u2) * (1.0f + v.z) - v.z;
+    float s = sqrt(clamp(1.0f - z * z, 0.0f, 1.0f));
+    float3 h = (float3)(s * cos(phi), s * sin(phi), z) + v;
+    h = (float3)(ax * h.x, ay * h.y, fmax(h.z, 0.0f));
+    float len2 = dot(h, h);
+    return len2 > 0.0f ? h * rsqrt(len2) : (float3)(0.0f, 0.0f, 1.0f);
+}
+#endif
+
+// The lobes' frame about n: onb's, or (anisotropic) t along the anisotropy direction.
+inline void bsdf_frame(const SurfaceMaterial* m, float3 n, float3* t, float3* b) {
+    onb(n, t, b);
+#ifdef HAS_ANISOTROPY
+    if (m->anisotropy > 0.0f) {
+        float3 d = m->aniso_dir - n * dot(n, m->aniso_dir);
+        float len = length(d);
+        d = len > 1e-6f ? d / len : m->aniso_rotation.x * *t + m->aniso_rotation.y * *b;
+        *t = d;
+        *b = cross(n, d);
+    }
+#endif
+}
+
+// The largest GGX alpha of the glossy lobes (anisotropy stretches one axis).
+inline float bsdf_alpha_max(const SurfaceMaterial* m) {
+    float alpha = m->roughness * m->roughness;
+#ifdef HAS_ANISOTROPY
+    float s = clamp(m->anisotropy, 0.0f, 1.0f);
+    if (s > 0.0f) alpha = mix(alpha, 1.0f, s * s);
+#endif
+    return alpha;
+}
+
 // The material's lobes as seen from one wo.
 typedef struct {
     float roughness;   // clamped perceptual roughness (the energy tables' row)
@@ -427,7 +493,36 @@ typedef struct {
     float sheen_roughness;  // clamped to [SHEEN_MIN_ROUGHNESS, 1]
     float sheen_o;          // s E_sh(mu_o): what the sheen reflects at wo
 #endif
+#ifdef HAS_ANISOTROPY
+    float alpha_x;     // along the anisotropy direction (the frame's t)
+    float alpha_y;     // across it
+#endif
 } BsdfLobes;
+
+// The GGX distribution, Smith's Lambda and visible-normal sampling of the glossy lobes.
+inline float lobe_d(const BsdfLobes* l, float3 h) {
+#ifdef HAS_ANISOTROPY
+    return ggx_d_aniso(h, l->alpha_x, l->alpha_y);
+#else
+    return ggx_d(h, l->alpha * l->alpha);
+#endif
+}
+
+inline float lobe_lambda(const BsdfLobes* l, float3 w) {
+#ifdef HAS_ANISOTROPY
+    return ggx_lambda_aniso(w, l->alpha_x, l->alpha_y);
+#else
+    return ggx_lambda(w, l->alpha * l->alpha);
+#endif
+}
+
+inline float3 lobe_sample_vndf(const BsdfLobes* l, float3 wo, float u1, float u2) {
+#ifdef HAS_ANISOTROPY
+    return ggx_sample_vndf_aniso(wo, l->alpha_x, l->alpha_y, u1, u2);
+#else
+    return ggx_sample_vndf(wo, l->alpha, u1, u2);
+#endif
+}
 
 // A(mu): what the dielectric specular layer reflects at one cosine, single and multiple
 // scattering (e = (E, E_s) there), times specularFactor.
@@ -818,6 +913,19 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
     l.roughness = clamp(m->roughness, 0.0f, 1.0f);
     l.alpha = l.roughness * l.roughness;
     l.delta = l.alpha < BSDF_DELTA_ALPHA;
+#ifdef HAS_ANISOTROPY
+    // Anisotropy stretches the lobe along its direction; the tables are read at the geometric
+    // mean alpha (the isotropic lobe of the same peak density).
+    float s = clamp(m->anisotropy, 0.0f, 1.0f);
+    l.alpha_x = mix(l.alpha, 1.0f, s * s);
+    l.delta = l.alpha_x < BSDF_DELTA_ALPHA;
+    l.alpha_y = fmax(l.alpha, BSDF_DELTA_ALPHA);
+    l.alpha_x = fmax(l.alpha_x, BSDF_DELTA_ALPHA);
+    if (s > 0.0f && !l.delta) {
+        l.alpha = sqrt(l.alpha_x * l.alpha_y);
+        l.roughness = sqrt(l.alpha);
+    }
+#endif
     l.eta = fmax(m->ior, 1e-3f);
     l.metallic = clamp(m->metallic, 0.0f, 1.0f);
     l.transmission = clamp(m->transmission, 0.0f, 1.0f);
@@ -954,7 +1062,7 @@ inline void bsdf_gloss(const SurfaceMaterial* m, const BsdfLobes* l, float cos_o
 // shadow rays pass it, tinted by thin_wall_transmittance.
 inline bool bsdf_passes_straight(const SurfaceMaterial* m) {
     return m->transmission > 0.0f && m->thickness <= 0.0f && m->metallic < 1.0f &&
-           m->roughness * m->roughness < BSDF_DELTA_ALPHA;
+           bsdf_alpha_max(m) < BSDF_DELTA_ALPHA;
 }
 
 // What a smooth thin wall lets straight through at cos(theta) = cos_o: the expected weight of
@@ -994,8 +1102,7 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
         *pdf = p;
         return f;
     }
-    float a2 = l->alpha * l->alpha;
-    float lambda_o = ggx_lambda(wo, a2);
+    float lambda_o = lobe_lambda(l, wo);
     float g1 = 1.0f / (1.0f + lambda_o);
     float inv_cos_o = 1.0f / fmax(wo.z, 1e-20f);
     float3 refl, trans;
@@ -1004,8 +1111,8 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
         float3 wr = (float3)(wi.x, wi.y, fabs(wi.z));
         float3 h = normalize(wo + wr);
         bsdf_gloss(m, l, dot(wo, h), &refl, &trans);
-        float d = ggx_d(h, a2);
-        float g2 = 1.0f / (1.0f + lambda_o + ggx_lambda(wr, a2));
+        float d = lobe_d(l, h);
+        float g2 = 1.0f / (1.0f + lambda_o + lobe_lambda(l, wr));
         float pr = reflect_probability(refl, trans);
         float3 c = wi.z > 0.0f ? refl : trans;
         f += c * (0.25f * d * g2 * inv_cos_o) * gs;
@@ -1023,8 +1130,8 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
         float cos_ih = dot(wi, h);
         if (cos_oh > 0.0f && cos_ih < 0.0f) {
             bsdf_gloss(m, l, cos_oh, &refl, &trans);
-            float d = ggx_d(h, a2);
-            float g2 = 1.0f / (1.0f + lambda_o + ggx_lambda(wi, a2));
+            float d = lobe_d(l, h);
+            float g2 = 1.0f / (1.0f + lambda_o + lobe_lambda(l, wi));
             // dwh/dwi; |wo.h + eta wi.h| = len.
             float jacobian = l->eta * l->eta * -cos_ih / (len * len);
             float vndf = g1 * d * cos_oh * inv_cos_o;
@@ -1041,7 +1148,7 @@ inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, flo
                         float* pdf) {
     *pdf = 0.0f;
     float3 t, b;
-    onb(n, &t, &b);
+    bsdf_frame(m, n, &t, &b);
     float3 wo = (float3)(dot(wo_world, t), dot(wo_world, b), dot(wo_world, n));
     float3 wi = (float3)(dot(wi_world, t), dot(wi_world, b), dot(wi_world, n));
     if (wo.z <= 0.0f || wi.z == 0.0f || (wi.z < 0.0f && !(m->transmission > 0.0f))) {
@@ -1096,7 +1203,7 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
     *specular = false;
     *wi_world = n;
     float3 t, b;
-    onb(n, &t, &b);
+    bsdf_frame(m, n, &t, &b);
     float3 wo = (float3)(dot(wo_world, t), dot(wo_world, b), dot(wo_world, n));
     if (wo.z <= 0.0f) return (float3)(0.0f);
     BsdfLobes l = bsdf_lobes(m, wo.z);
@@ -1156,7 +1263,7 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
     } else {
         // A visible microfacet, then reflection or transmission by their share at it.
         float ug = fmin((u.x - l.p_diffuse) / (1.0f - l.p_diffuse), 0x1.fffffep-1f);
-        float3 h = l.delta ? (float3)(0.0f, 0.0f, 1.0f) : ggx_sample_vndf(wo, l.alpha, ug, u.y);
+        float3 h = l.delta ? (float3)(0.0f, 0.0f, 1.0f) : lobe_sample_vndf(&l, wo, ug, u.y);
         float cos_oh = dot(wo, h);
         float3 refl, trans;
         bsdf_gloss(m, &l, cos_oh, &refl, &trans);

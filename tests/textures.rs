@@ -884,3 +884,52 @@ fn clearcoat_factors_textures_and_transforms_are_read() {
         "tangents for the coat's normals"
     );
 }
+
+/// `KHR_materials_anisotropy` is read: strength, rotation and the texture with its texCoord
+/// and `KHR_texture_transform`; tangents are made for the anisotropic material (it has no
+/// normal map) and nothing warns.
+#[test]
+fn anisotropy_strength_rotation_and_texture_are_read() {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let image = t.embedded(&mut g, &png(4, 4, &test_texels()));
+    let tex = t.texture(image, REPEAT);
+    g.use_ext("KHR_materials_anisotropy");
+    g.use_ext("KHR_texture_transform");
+    let m = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"extensions": {"KHR_materials_anisotropy": {
+            "anisotropyStrength": 0.6,
+            "anisotropyRotation": 1.25,
+            "anisotropyTexture": {"index": tex, "extensions": {"KHR_texture_transform":
+                {"offset": [0.25, 0.5], "rotation": 0.2, "scale": [3.0, 2.0]}}}
+        }}}),
+    );
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, false, false);
+    g.node(json!({"mesh": mesh}));
+    let dir = tempfile::tempdir().unwrap();
+    let s = penumbra::scene::load(&g.write_glb(dir.path(), "aniso")).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let mat = &s.materials[m];
+    assert_eq!((mat.anisotropy, mat.anisotropy_rotation), (0.6, 1.25));
+    let r = &s.texture_refs[mat.textures.anisotropy.expect("a texture") as usize];
+    assert_eq!(r.tex_coord, 0);
+    assert_eq!(
+        (r.transform.offset, r.transform.rotation, r.transform.scale),
+        ([0.25, 0.5], 0.2, [3.0, 2.0])
+    );
+    assert!(!r.srgb, "the direction is data, not color");
+    let world = s.world_triangles();
+    assert!(
+        world.iter().all(|t| t.tangents.is_some()),
+        "tangents for the anisotropy direction"
+    );
+    let gpu = penumbra::render::gpu_material(mat);
+    assert_eq!(gpu.aniso[0], 0.6);
+    assert!(
+        (gpu.aniso[1] - 1.25f32.cos()).abs() < 1e-6 && (gpu.aniso[2] - 1.25f32.sin()).abs() < 1e-6
+    );
+    assert_eq!(gpu.textures4[0], mat.textures.anisotropy.unwrap() as i32);
+}

@@ -65,6 +65,11 @@ pub struct KernelFeatures {
     pub clearcoat: bool,
     /// Some material has a sheen (`HAS_SHEEN`, `KHR_materials_sheen`).
     pub sheen: bool,
+    /// Some material is anisotropic (`HAS_ANISOTROPY`, `KHR_materials_anisotropy`).
+    pub anisotropy: bool,
+    /// Tangents are uploaded for the anisotropic materials' frames (`HAS_TANGENTS`; only set
+    /// with `anisotropy`).
+    pub tangents: bool,
     /// Rays descend a top level over instances, then their meshes' bottom levels (`TWO_LEVEL`).
     pub two_level: bool,
 }
@@ -84,6 +89,8 @@ impl KernelFeatures {
             (self.unlit, "HAS_UNLIT"),
             (self.clearcoat, "HAS_CLEARCOAT"),
             (self.sheen, "HAS_SHEEN"),
+            (self.anisotropy, "HAS_ANISOTROPY"),
+            (self.tangents, "HAS_TANGENTS"),
             (self.two_level, "TWO_LEVEL"),
         ] {
             if on {

@@ -20,7 +20,7 @@ pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
 pub use update::InstanceUpdate;
-pub use upload::{Accel, HostScene, gpu_camera};
+pub use upload::{Accel, HostScene, gpu_camera, gpu_material};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
 use crate::bvh::{Ray, WideBvh};
@@ -85,6 +85,8 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         unlit: used(&|m| m.unlit),
         clearcoat: used(&|m| m.clearcoat > 0.0),
         sheen: used(&|m| m.sheen_color.iter().any(|&c| c > 0.0)),
+        anisotropy: used(&|m| m.anisotropy > 0.0),
+        tangents: used(&|m| m.anisotropy > 0.0) && tangents,
     }
 }
 

@@ -1,5 +1,6 @@
 //! Material extensions the gltf crate does not parse, read from the material's raw
-//! `extensions` JSON: `KHR_materials_clearcoat` and `KHR_materials_sheen`.
+//! `extensions` JSON: `KHR_materials_clearcoat`, `KHR_materials_sheen` and
+//! `KHR_materials_anisotropy`.
 
 use super::TextureTable;
 use crate::scene::Material;
@@ -26,6 +27,9 @@ pub(super) fn read_extensions(
     }
     if let Some(x) = m.extension_value("KHR_materials_sheen") {
         reader.sheen(x, material);
+    }
+    if let Some(x) = m.extension_value("KHR_materials_anisotropy") {
+        reader.anisotropy(x, material);
     }
 }
 
@@ -93,5 +97,15 @@ impl Reader<'_> {
         let t: &mut MaterialTextures = &mut material.textures;
         t.sheen_color = self.texture(x, "sheenColorTexture", true);
         t.sheen_roughness = self.texture(x, "sheenRoughnessTexture", false);
+    }
+
+    fn anisotropy(&mut self, x: &Value, material: &mut Material) {
+        material.anisotropy = Self::unit(x, "anisotropyStrength", 0.0);
+        material.anisotropy_rotation = x
+            .get("anisotropyRotation")
+            .and_then(Value::as_f64)
+            .filter(|r| r.is_finite())
+            .map_or(0.0, |r| r as f32);
+        material.textures.anisotropy = self.texture(x, "anisotropyTexture", false);
     }
 }
