@@ -494,6 +494,7 @@ typedef struct {
     float sheen_o;          // s E_sh(mu_o): what the sheen reflects at wo
 #endif
 #ifdef HAS_ANISOTROPY
+    bool anisotropic;  // alpha_x > alpha_y, the lobe not a delta
     float alpha_x;     // along the anisotropy direction (the frame's t)
     float alpha_y;     // across it
 #endif
@@ -538,6 +539,38 @@ constant float GL_W[4] = {0.3626837834f, 0.3137066459f, 0.2223810345f, 0.1012285
 inline float gl_mu(int k) {
     return 0.5f + ((k & 1) ? 0.5f : -0.5f) * GL_X[k >> 1];
 }
+
+#ifdef HAS_ANISOTROPY
+// The perceptual roughness at which the isotropic energy tables stand for the anisotropic lobe
+// seen along local w: towards the horizon the projected alpha Smith's Lambda sees there,
+// sqrt(ax² cos²φ + ay² sin²φ), towards the normal the geometric mean sqrt(ax ay), mixed by
+// sin²θ. E(w) at it is a function of the direction alone, so the lobes built on it stay
+// reciprocal.
+inline float aniso_table_roughness(const BsdfLobes* l, float3 w) {
+    float x2 = w.x * w.x;
+    float y2 = w.y * w.y;
+    float s2 = x2 + y2;
+    float a2 = (1.0f - s2) * l->alpha_x * l->alpha_y +
+               (l->alpha_x * l->alpha_x * x2 + l->alpha_y * l->alpha_y * y2);
+    return sqrt(sqrt(fmax(a2, 0.0f)));
+}
+
+// The cosine-weighted mean of (E, E_s) at aniso_table_roughness over the hemisphere: 8-point
+// Gauss–Legendre in cos θ times 4 azimuths of a quadrant (E is symmetric about both axes).
+inline float2 aniso_energy_avg(const BsdfLobes* l) {
+    float2 sum = (float2)(0.0f);
+    for (int k = 0; k < 8; ++k) {
+        float mu = gl_mu(k);
+        float s = sqrt(1.0f - mu * mu);
+        for (int j = 0; j < 4; ++j) {
+            float phi = ((float)j + 0.5f) * (0.125f * PI_F);
+            float3 w = (float3)(s * cos(phi), s * sin(phi), mu);
+            sum += (GL_W[k >> 1] * mu) * ggx_energy(mu, aniso_table_roughness(l, w));
+        }
+    }
+    return sum * 0.25f;
+}
+#endif
 
 #ifdef HAS_SHEEN
 // Sheen roughness below this is taken as this (narrower lobes are not tabulated).
@@ -899,8 +932,13 @@ inline float coated_layer_albedo_avg(const BsdfLobes* l, float a_avg) {
 // appendix, made reciprocal: it integrates to exactly 1 - A(mu_o)), and the Kulla–Conty
 // multiple-scattering lobe (1 - E(mu_o)) (1 - E(mu_i)) / (1 - E_avg) of the GGX reflection,
 // times the clear coat's scaling of the glossy lobes, gs.
-inline float3 cosine_lobes(const BsdfLobes* l, float wi_cos, float gs) {
+inline float3 cosine_lobes(const BsdfLobes* l, float3 wi, float gs) {
+    float wi_cos = wi.z;
+#ifdef HAS_ANISOTROPY
+    float2 e_i = ggx_energy(wi_cos, l->anisotropic ? aniso_table_roughness(l, wi) : l->roughness);
+#else
     float2 e_i = ggx_energy(wi_cos, l->roughness);
+#endif
     float a_i = under_coat_albedo(l, wi_cos, layer_albedo(l, e_i));
 #ifdef HAS_CLEARCOAT
     if (l->coat > 0.0f) a_i = coated_layer_albedo(l, wi_cos, a_i);
@@ -908,7 +946,9 @@ inline float3 cosine_lobes(const BsdfLobes* l, float wi_cos, float gs) {
     return (l->diffuse * (1.0f - a_i) + l->ms * ((1.0f - e_i.x) * gs)) * (wi_cos * INV_PI_F);
 }
 
-inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
+// The lobes at local wo (in the frame of bsdf_frame).
+inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float3 wo) {
+    float cos_o = wo.z;
     BsdfLobes l;
     l.roughness = clamp(m->roughness, 0.0f, 1.0f);
     l.alpha = l.roughness * l.roughness;
@@ -921,7 +961,8 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
     l.delta = l.alpha_x < BSDF_DELTA_ALPHA;
     l.alpha_y = fmax(l.alpha, BSDF_DELTA_ALPHA);
     l.alpha_x = fmax(l.alpha_x, BSDF_DELTA_ALPHA);
-    if (s > 0.0f && !l.delta) {
+    l.anisotropic = s > 0.0f && !l.delta;
+    if (l.anisotropic) {
         l.alpha = sqrt(l.alpha_x * l.alpha_y);
         l.roughness = sqrt(l.alpha);
     }
@@ -938,6 +979,12 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
     float opaque = dielectric * (1.0f - l.transmission);
     float2 e_o = ggx_energy(cos_o, l.roughness);
     float2 e_avg = ggx_energy_avg(l.roughness);
+#ifdef HAS_ANISOTROPY
+    if (l.anisotropic) {
+        e_o = ggx_energy(cos_o, aniso_table_roughness(&l, wo));
+        e_avg = aniso_energy_avg(&l);
+    }
+#endif
     // Multiple scattering of the metal and of the opaque dielectric's reflection (transmitting
     // interfaces are single-scattering only); a delta lobe loses nothing.
     l.ms_layer = 0.0f;
@@ -1068,7 +1115,7 @@ inline bool bsdf_passes_straight(const SurfaceMaterial* m) {
 // What a smooth thin wall lets straight through at cos(theta) = cos_o: the expected weight of
 // bsdf_sample's straight-through lobe.
 inline float3 thin_wall_transmittance(const SurfaceMaterial* m, float cos_o) {
-    BsdfLobes l = bsdf_lobes(m, cos_o);
+    BsdfLobes l = bsdf_lobes(m, (float3)(sqrt(fmax(1.0f - cos_o * cos_o, 0.0f)), 0.0f, cos_o));
     float3 refl, trans;
     bsdf_gloss(m, &l, cos_o, &refl, &trans);
 #ifdef HAS_CLEARCOAT
@@ -1094,7 +1141,7 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
     float3 f = (float3)(0.0f);
     float p = 0.0f;
     if (wi.z > 0.0f) {
-        f = cosine_lobes(l, wi.z, gs);
+        f = cosine_lobes(l, wi, gs);
         p = l->p_diffuse * (wi.z * INV_PI_F);
     }
     float p_gloss = 1.0f - l->p_diffuse;
@@ -1154,7 +1201,7 @@ inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, flo
     if (wo.z <= 0.0f || wi.z == 0.0f || (wi.z < 0.0f && !(m->transmission > 0.0f))) {
         return (float3)(0.0f);
     }
-    BsdfLobes l = bsdf_lobes(m, wo.z);
+    BsdfLobes l = bsdf_lobes(m, wo);
 #if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN)
     // The coat over the sheen over the base: each scales the glossy lobes under it and is
     // sampled by its share.
@@ -1206,7 +1253,7 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
     bsdf_frame(m, n, &t, &b);
     float3 wo = (float3)(dot(wo_world, t), dot(wo_world, b), dot(wo_world, n));
     if (wo.z <= 0.0f) return (float3)(0.0f);
-    BsdfLobes l = bsdf_lobes(m, wo.z);
+    BsdfLobes l = bsdf_lobes(m, wo);
     float3 wi;
 #ifdef HAS_CLEARCOAT
     // The share of the base lobes (all but the coat).

@@ -643,15 +643,25 @@ fn sampling_matches_pdf_chi_square() {
         45.0,
         false,
     ));
+    for (r, s, rot) in [
+        (0.3, 0.0, 0.0),
+        (0.3, 0.6, 0.0),
+        (0.3, 0.6, 0.4),
+        (0.5, 0.6, 0.4),
+        (0.3, 0.6, 1.5707964),
+    ] {
+        let mut c = case(
+            &format!("anisotropic rough glass {r}, strength {s}, rotation {rot}"),
+            Mat::glass(r, 1.0).anisotropic(s, rot),
+            30.0,
+            false,
+        );
+        c.grid = Grid::sphere(c.n, 0.005);
+        cases.push(c);
+    }
     cases.push(case(
-        "anisotropic rough glass 0.3, strength 0.6",
-        Mat::glass(0.3, 1.0).anisotropic(0.6, 0.4),
-        30.0,
-        false,
-    ));
-    cases.push(case(
-        "anisotropic metal 0, strength 1, under a coat",
-        Mat::metal(white, 0.0)
+        "anisotropic metal 0.2, strength 1, under a coat",
+        Mat::metal(white, 0.2)
             .anisotropic(1.0, 0.3)
             .coated(0.5, 0.2),
         60.0,
@@ -668,6 +678,10 @@ fn sampling_matches_pdf_chi_square() {
         grid: Grid::sphere(n, 0.02),
     });
 
+    // PENUMBRA_CHI2_ONLY=TEXT runs only the cases whose name contains TEXT (while debugging).
+    if let Ok(only) = std::env::var("PENUMBRA_CHI2_ONLY") {
+        cases.retain(|c| c.name.contains(&only));
+    }
     let count = 1 << 20;
     // Šidák correction: overall significance 1% over all cases.
     let alpha = 1.0 - (1.0f64 - 0.01).powf(1.0 / cases.len() as f64);
@@ -957,7 +971,11 @@ fn directional_albedo_never_exceeds_one() {
                 );
                 let mean = w.iter().sum::<f64>() / count as f64;
                 let var = w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / count as f64;
-                let bound = 1.0 + 4.0 * (var / count as f64).sqrt() + 1e-4;
+                // Anisotropic lobes are compensated from the isotropic tables at an approximate
+                // roughness (docs/materials.md): they may reflect up to 1% too much near the
+                // horizon.
+                let slack = if m.anisotropy > 0.0 { 0.01 } else { 1e-4 };
+                let bound = 1.0 + 4.0 * (var / count as f64).sqrt() + slack;
                 let excess = mean - bound + 1.0;
                 if excess > worst.0 {
                     worst = (excess, format!("{name} at cos {mu}: albedo {mean:.5}"));
