@@ -24,7 +24,11 @@
 //   anisotropy    (HAS_ANISOTROPY, KHR_materials_anisotropy) the reflection and transmission
 //                 microfacets are anisotropic GGX, alpha_t = mix(alpha, 1, strength^2) along the
 //                 anisotropy direction and alpha_b = alpha across it, in the frame of that
-//                 direction; the energy tables are read at the geometric mean sqrt(alpha_t alpha_b)
+//                 direction; the energy tables are read at a projected roughness per direction
+//   iridescence   (HAS_IRIDESCENCE, KHR_materials_iridescence) a thin film over the specular
+//                 layer: the Fresnel of the dielectric and the metal is mixed by iridescenceFactor
+//                 with the film's (Belcour and Barla 2017, as the Khronos sample viewer does it);
+//                 the diffuse base is layered under it at the film's largest reflectance
 // Below BSDF_DELTA_ALPHA the glossy lobes are perfect mirror and refraction (delta) lobes.
 //
 // Contract: bsdf_eval returns f(wo, wi) * |cos(n, wi)| and its pdf (solid angle) for the non-delta
@@ -52,6 +56,11 @@ typedef struct {
 #ifdef HAS_SHEEN
     float3 sheen_color;          // KHR_materials_sheen sheenColorFactor; 0: no sheen
     float sheen_roughness;       // perceptual
+#endif
+#ifdef HAS_IRIDESCENCE
+    float iridescence;           // KHR_materials_iridescence factor; 0: no film
+    float iridescence_ior;       // the film's index of refraction
+    float iridescence_thickness; // the film's thickness in nanometres
 #endif
 #ifdef HAS_ANISOTROPY
     float anisotropy;            // KHR_materials_anisotropy strength; 0: isotropic
@@ -83,6 +92,11 @@ inline SurfaceMaterial surface_material(global const GpuMaterial* m) {
     s.sheen_color = m->sheen.xyz;
     s.sheen_roughness = m->sheen.w;
 #endif
+#ifdef HAS_IRIDESCENCE
+    s.iridescence = m->iridescence.x;
+    s.iridescence_ior = m->iridescence.y;
+    s.iridescence_thickness = m->iridescence.w;
+#endif
 #ifdef HAS_ANISOTROPY
     s.anisotropy = m->aniso.x;
     s.aniso_rotation = m->aniso.yz;
@@ -100,6 +114,9 @@ inline void material_from_inside(SurfaceMaterial* m) {
 #endif
 #ifdef HAS_SHEEN
     m->sheen_color = (float3)(0.0f);
+#endif
+#ifdef HAS_IRIDESCENCE
+    m->iridescence = 0.0f;
 #endif
 }
 
@@ -466,6 +483,78 @@ inline float bsdf_alpha_max(const SurfaceMaterial* m) {
     return alpha;
 }
 
+#ifdef HAS_IRIDESCENCE
+// Thin-film interference (Belcour and Barla 2017, "A Practical Extension to Microfacet Theory for
+// the Modeling of Varying Iridescence"), as the Khronos glTF sample viewer evaluates it for
+// KHR_materials_iridescence: air over a film of index film_ior and thickness d (nm) over a base
+// of normal reflectance f0, seen at cos_1; Schlick's Fresnel at both interfaces, the spectral
+// integral of the first two orders against the CIE XYZ curves in Fourier form, then linear sRGB.
+
+// The XYZ sensitivity (Fourier form) at optical path difference opd (nm) and phase shift.
+inline float3 film_sensitivity(float opd, float3 shift) {
+    float phase = 2.0f * PI_F * opd * 1.0e-9f;
+    float3 val = (float3)(5.4856e-13f, 4.4201e-13f, 5.2481e-13f);
+    float3 pos = (float3)(1.6810e+06f, 1.7953e+06f, 2.2084e+06f);
+    float3 var = (float3)(4.3278e+09f, 9.3046e+09f, 6.6121e+09f);
+    float3 xyz = val * sqrt(2.0f * PI_F * var) * cos(pos * phase + shift) * exp(-phase * phase * var);
+    xyz.x += 9.7470e-14f * sqrt(2.0f * PI_F * 4.5282e+09f) * cos(2.2399e+06f * phase + shift.x) *
+             exp(-4.5282e+09f * phase * phase);
+    xyz /= 1.0685e-7f;
+    return (float3)(3.2404542f * xyz.x - 1.5371385f * xyz.y - 0.4985314f * xyz.z,
+                    -0.9692660f * xyz.x + 1.8760108f * xyz.y + 0.0415560f * xyz.z,
+                    0.0556434f * xyz.x - 0.2040259f * xyz.y + 1.0572252f * xyz.z);
+}
+
+inline float film_sq(float x) {
+    return x * x;
+}
+
+// The film's reflectance (RGB, in [0, 1]) at cos_1 over a base of normal reflectance f0.
+inline float3 film_fresnel(float cos_1, float film_ior, float d, float3 f0) {
+    // A vanishing film is no film (its index goes to the outside's).
+    float n2 = mix(1.0f, film_ior, smoothstep(0.0f, 0.03f, d));
+    float sin2_2 = film_sq(1.0f / n2) * (1.0f - cos_1 * cos_1);
+    float cos2_2 = 1.0f - sin2_2;
+    if (cos2_2 < 0.0f) return (float3)(1.0f);
+    float cos_2 = sqrt(cos2_2);
+    // First interface (air to film).
+    float r0 = film_sq((n2 - 1.0f) / (n2 + 1.0f));
+    float r12 = r0 + (1.0f - r0) * schlick_weight(cos_1);
+    float t121 = 1.0f - r12;
+    float phi12 = n2 < 1.0f ? PI_F : 0.0f;
+    float phi21 = PI_F - phi12;
+    // Second interface (film to base); the base's index from its reflectance.
+    float3 sf0 = sqrt(clamp(f0, 0.0f, 0.9999f));
+    float3 n3 = (1.0f + sf0) / (1.0f - sf0);
+    float3 r1 = (n3 - n2) / (n3 + n2);
+    r1 *= r1;
+    float3 r23 = r1 + (1.0f - r1) * schlick_weight(cos_2);
+    float3 phi23 = (float3)(n3.x < n2 ? PI_F : 0.0f, n3.y < n2 ? PI_F : 0.0f, n3.z < n2 ? PI_F : 0.0f);
+    float opd = 2.0f * n2 * d * cos_2;
+    float3 phi = phi21 + phi23;
+    float3 r123 = clamp(r12 * r23, 1e-5f, 0.9999f);
+    float3 s123 = sqrt(r123);
+    float3 rs = t121 * t121 * r23 / (1.0f - r123);
+    float3 color = r12 + rs;
+    float3 cm = rs - t121;
+    for (int m = 1; m <= 2; ++m) {
+        cm *= s123;
+        color += cm * 2.0f * film_sensitivity((float)m * opd, (float)m * phi);
+    }
+    return clamp(color, 0.0f, 1.0f);
+}
+
+// The largest normal-incidence reflectance of a film of index n2 over a base of reflectance f0
+// (its thickness a quarter or a half wave): (|r12| + |r23|)² / (1 + |r12 r23|)².
+inline float film_max_reflectance(float n2, float f0) {
+    float sf0 = sqrt(clamp(f0, 0.0f, 0.9999f));
+    float n3 = (1.0f + sf0) / (1.0f - sf0);
+    float a = fabs((n2 - 1.0f) / (n2 + 1.0f));
+    float b = fabs((n3 - n2) / (n3 + n2));
+    return film_sq((a + b) / (1.0f + a * b));
+}
+#endif
+
 // The material's lobes as seen from one wo.
 typedef struct {
     float roughness;   // clamped perceptual roughness (the energy tables' row)
@@ -492,6 +581,11 @@ typedef struct {
     float sheen_max;        // s = max3(sheen)
     float sheen_roughness;  // clamped to [SHEEN_MIN_ROUGHNESS, 1]
     float sheen_o;          // s E_sh(mu_o): what the sheen reflects at wo
+#endif
+#ifdef HAS_IRIDESCENCE
+    float iridescence;  // clamped factor; 0: no film
+    float film_ior;
+    float film_thickness;  // nanometres
 #endif
 #ifdef HAS_ANISOTROPY
     bool anisotropic;  // alpha_x > alpha_y, the lobe not a delta
@@ -975,6 +1069,17 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float3 wo) {
     float r = (l.eta - 1.0f) / (l.eta + 1.0f);
     l.f0 = fmin(r * r * m->specular_color, 1.0f);
     l.f0_layer = bsdf_max3(l.f0);
+#ifdef HAS_IRIDESCENCE
+    // The diffuse base lies under the film at its largest reflectance (any thickness), so it
+    // never takes light the film reflects.
+    l.iridescence = clamp(m->iridescence, 0.0f, 1.0f);
+    l.film_ior = fmax(m->iridescence_ior, 1.0f);
+    l.film_thickness = fmax(m->iridescence_thickness, 0.0f);
+    if (l.iridescence > 0.0f) {
+        float f_max = fmax(l.f0_layer, film_max_reflectance(l.film_ior, l.f0_layer));
+        l.f0_layer = mix(l.f0_layer, f_max, l.iridescence);
+    }
+#endif
     float dielectric = 1.0f - l.metallic;
     float opaque = dielectric * (1.0f - l.transmission);
     float2 e_o = ggx_energy(cos_o, l.roughness);
@@ -1090,6 +1195,12 @@ inline void bsdf_gloss(const SurfaceMaterial* m, const BsdfLobes* l, float cos_o
                        float3* trans) {
     float sw = l->thin ? schlick_weight(cos_oh) : dielectric_schlick(cos_oh, l->eta);
     float3 fr = l->f0 + (1.0f - l->f0) * sw;
+#ifdef HAS_IRIDESCENCE
+    // The film over the dielectric (its f0 with the specular color), seen from outside.
+    if (l->iridescence > 0.0f) {
+        fr = mix(fr, film_fresnel(cos_oh, l->film_ior, l->film_thickness, l->f0), l->iridescence);
+    }
+#endif
     float3 fr_trans = fr;
     float3 fr_refl = fr;
     if (l->thin && l->transmission > 0.0f) {
@@ -1097,6 +1208,13 @@ inline void bsdf_gloss(const SurfaceMaterial* m, const BsdfLobes* l, float cos_o
         fr_refl = mix(fr, fr_trans, l->transmission);
     }
     float3 metal = m->base_color + (1.0f - m->base_color) * schlick_weight(cos_oh);
+#ifdef HAS_IRIDESCENCE
+    // The film over the metal (its f0 the base color).
+    if (l->iridescence > 0.0f && l->metallic > 0.0f) {
+        metal = mix(metal, film_fresnel(cos_oh, l->film_ior, l->film_thickness, m->base_color),
+                    l->iridescence);
+    }
+#endif
     float dielectric = 1.0f - l->metallic;
     *refl = (dielectric * l->specular) * fr_refl + l->metallic * metal;
     bool tir = !l->thin && refracted_cos2(cos_oh, l->eta) <= 0.0f;

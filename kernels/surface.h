@@ -22,6 +22,14 @@ inline void apply_textures(SurfaceMaterial* m, global const GpuMaterial* mat,
     if (mat->textures2.z >= 0) m->sheen_color *= texture_sample(s, mat->textures2.z, tc).xyz;
     if (mat->textures2.w >= 0) m->sheen_roughness *= texture_sample(s, mat->textures2.w, tc).w;
 #endif
+#ifdef HAS_IRIDESCENCE
+    // R: the factor; G: the thickness between the minimum and the maximum (else the maximum).
+    if (mat->textures4.y >= 0) m->iridescence *= texture_sample(s, mat->textures4.y, tc).x;
+    if (mat->textures4.z >= 0) {
+        m->iridescence_thickness =
+            mix(mat->iridescence.z, mat->iridescence.w, texture_sample(s, mat->textures4.z, tc).y);
+    }
+#endif
 #ifdef HAS_ANISOTROPY
     // RG: the direction in tangent space (then turned by the rotation), B: the strength.
     if (mat->textures4.x >= 0) {

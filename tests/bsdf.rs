@@ -39,6 +39,8 @@ struct Mat {
     sheen_roughness: f32,
     anisotropy: f32,
     anisotropy_rotation: f32,
+    /// iridescenceFactor, iridescenceIor, thickness (nm).
+    iridescence: [f32; 3],
 }
 
 impl Mat {
@@ -58,6 +60,15 @@ impl Mat {
             sheen_roughness: 0.0,
             anisotropy: 0.0,
             anisotropy_rotation: 0.0,
+            iridescence: [0.0, 1.3, 400.0],
+        }
+    }
+
+    /// This material under a thin film (`KHR_materials_iridescence`).
+    fn iridescent(self, factor: f32, ior: f32, thickness: f32) -> Self {
+        Self {
+            iridescence: [factor, ior, thickness],
+            ..self
         }
     }
 
@@ -138,7 +149,12 @@ impl Mat {
                 self.anisotropy_rotation.sin(),
                 0.0,
             ],
-            iridescence: [0.0, 1.3, 100.0, 400.0],
+            iridescence: [
+                self.iridescence[0],
+                self.iridescence[1],
+                100.0,
+                self.iridescence[2],
+            ],
             diffuse_transmission: [1.0, 1.0, 1.0, 0.0],
             textures4: [-1; 4],
             textures5: [-1; 4],
@@ -160,6 +176,7 @@ impl Device {
             clearcoat: true,
             sheen: true,
             anisotropy: true,
+            iridescence: true,
             ..KernelFeatures::default()
         };
         let program = Program::build(&gpu, features).expect("kernels build");
@@ -678,6 +695,25 @@ fn sampling_matches_pdf_chi_square() {
         grid: Grid::sphere(n, 0.02),
     });
 
+    // Iridescence: the film's Fresnel decides reflection against transmission per microfacet.
+    cases.push(case(
+        "iridescent dielectric 0.4, film 1.8 / 300 nm",
+        plastic.iridescent(1.0, 1.8, 300.0),
+        30.0,
+        false,
+    ));
+    cases.push(case(
+        "iridescent metal 0.3, film 1.3 / 500 nm",
+        Mat::metal([0.9, 0.6, 0.3], 0.3).iridescent(0.7, 1.3, 500.0),
+        60.0,
+        false,
+    ));
+    cases.push(case(
+        "iridescent rough glass 0.4, film 1.5 / 250 nm",
+        Mat::glass(0.4, 1.0).iridescent(1.0, 1.5, 250.0),
+        45.0,
+        false,
+    ));
     // PENUMBRA_CHI2_ONLY=TEXT runs only the cases whose name contains TEXT (while debugging).
     if let Ok(only) = std::env::var("PENUMBRA_CHI2_ONLY") {
         cases.retain(|c| c.name.contains(&only));
@@ -945,6 +981,35 @@ fn directional_albedo_never_exceeds_one() {
                 false,
             ));
         }
+    }
+
+    for (ior, d) in [(1.3, 200.0), (1.8, 350.0), (2.5, 600.0), (1.5, 0.0)] {
+        let film = |m: Mat| m.iridescent(1.0, ior, d);
+        materials.push((
+            format!("film {ior} / {d} nm over white"),
+            film(Mat::dielectric(white, 0.3)),
+            false,
+        ));
+        materials.push((
+            format!("film {ior} / {d} nm over metal 0.5"),
+            film(Mat::metal(white, 0.5)),
+            false,
+        ));
+        materials.push((
+            format!("film {ior} / {d} nm over smooth white"),
+            film(Mat::dielectric(white, 0.0)),
+            false,
+        ));
+        materials.push((
+            format!("film {ior} / {d} nm over thin glass"),
+            film(Mat::glass(0.0, 0.0)),
+            false,
+        ));
+        materials.push((
+            format!("film {ior} / {d} nm over glass 0.3"),
+            film(Mat::glass(0.3, 1.0)),
+            false,
+        ));
     }
 
     let count = 1 << 16;
@@ -1456,6 +1521,14 @@ fn material_json(g: &mut Gltf, m: &Mat, attenuation: Option<([f32; 3], f32)>) ->
             "sheenRoughnessFactor": m.sheen_roughness
         }
     });
+    if m.iridescence[0] > 0.0 {
+        g.use_ext("KHR_materials_iridescence");
+        extensions["KHR_materials_iridescence"] = json!({
+            "iridescenceFactor": m.iridescence[0],
+            "iridescenceIor": m.iridescence[1],
+            "iridescenceThicknessMaximum": m.iridescence[2]
+        });
+    }
     if m.anisotropy > 0.0 {
         g.use_ext("KHR_materials_anisotropy");
         extensions["KHR_materials_anisotropy"] = json!({
@@ -1775,6 +1848,54 @@ fn white_furnace_anisotropic_spheres() {
     eprintln!("{}", report.join("\n"));
 }
 
+/// Iridescent spheres in the white furnace: a white dielectric under a film keeps at most all
+/// the light (the base is layered under the film's largest reflectance, so it loses a little),
+/// a white metal under a film keeps what the film reflects.
+#[test]
+fn white_furnace_iridescent_spheres() {
+    let dir = tempfile::tempdir().unwrap();
+    let white = [1.0f32; 3];
+    let pixels = sphere_pixels();
+    let cases = [
+        (
+            "white dielectric 0.3, film 1.3 / 400 nm",
+            Mat::dielectric(white, 0.3).iridescent(1.0, 1.3, 400.0),
+            0.97,
+        ),
+        (
+            "white dielectric 0, film 1.8 / 300 nm",
+            Mat::dielectric(white, 0.0).iridescent(1.0, 1.8, 300.0),
+            0.9,
+        ),
+        (
+            "white metal 0.4, film 1.5 / 250 nm",
+            Mat::metal(white, 0.4).iridescent(1.0, 1.5, 250.0),
+            0.9,
+        ),
+    ];
+    let mut report = vec![];
+    let out = output_dir("bsdf");
+    for (k, (name, m, low)) in cases.iter().enumerate() {
+        let scene = furnace_scene(dir.path(), &format!("film{k}"), m);
+        let warnings = penumbra::scene::load(&scene).unwrap().warnings;
+        assert!(warnings.is_empty(), "{name}: {warnings:?}");
+        let (summary, px) = furnace_render(&scene, 64, 8);
+        assert_eq!(summary["nonfinite_samples"], 0, "{name}");
+        let _ = std::fs::copy(
+            scene.with_extension("exr"),
+            out.join(format!("film{k}.exr")),
+        );
+        let (mean, err) = sphere_mean(&px, &pixels);
+        report.push(format!("{name}: mean {mean:.4} ± {err:.4}"));
+        assert!(
+            mean <= 1.0 + 4.0 * err + 1e-3,
+            "{name} gains energy: {mean}"
+        );
+        assert!(mean >= low - 4.0 * err, "{name} loses energy: {mean:.4}");
+    }
+    eprintln!("{}", report.join("\n"));
+}
+
 #[test]
 fn white_furnace_glass_spheres_conserve_energy() {
     let dir = tempfile::tempdir().unwrap();
@@ -1831,6 +1952,8 @@ fn reflection_is_reciprocal() {
             Mat::metal([0.9, 0.5, 0.2], 0.3).anisotropic(0.9, 0.5),
         ),
         ("anisotropic plastic", plastic.anisotropic(0.6, 2.0)),
+        ("iridescent plastic", plastic.iridescent(1.0, 1.8, 320.0)),
+        ("iridescent half metal", half.iridescent(0.6, 1.4, 450.0)),
         (
             "anisotropic smooth metal under a coat",
             Mat::metal([0.9; 3], 0.0)

@@ -933,3 +933,69 @@ fn anisotropy_strength_rotation_and_texture_are_read() {
     );
     assert_eq!(gpu.textures4[0], mat.textures.anisotropy.unwrap() as i32);
 }
+
+/// `KHR_materials_iridescence` is read: factor, film IOR, thickness range and both textures
+/// (the thickness texture with its `KHR_texture_transform`); nothing warns.
+#[test]
+fn iridescence_factors_and_textures_are_read() {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let image = t.embedded(&mut g, &png(4, 4, &test_texels()));
+    let factor = t.texture(image, REPEAT);
+    let thickness = t.texture(image, CLAMP);
+    g.use_ext("KHR_materials_iridescence");
+    g.use_ext("KHR_texture_transform");
+    let m = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"extensions": {"KHR_materials_iridescence": {
+            "iridescenceFactor": 0.8,
+            "iridescenceTexture": {"index": factor},
+            "iridescenceIor": 1.6,
+            "iridescenceThicknessMinimum": 150.0,
+            "iridescenceThicknessMaximum": 650.0,
+            "iridescenceThicknessTexture": {"index": thickness, "extensions": {"KHR_texture_transform":
+                {"scale": [2.0, 2.0]}}}
+        }}}),
+    );
+    // Defaults: a film of 1.3 and 100..400 nm.
+    let d = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 1.0}}}),
+    );
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, false, false);
+    g.node(json!({"mesh": mesh}));
+    let dir = tempfile::tempdir().unwrap();
+    let s = penumbra::scene::load(&g.write_glb(dir.path(), "film")).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let mat = &s.materials[m];
+    assert_eq!(
+        (
+            mat.iridescence,
+            mat.iridescence_ior,
+            mat.iridescence_thickness
+        ),
+        (0.8, 1.6, [150.0, 650.0])
+    );
+    assert!(mat.textures.iridescence.is_some());
+    let r = &s.texture_refs[mat.textures.iridescence_thickness.expect("a texture") as usize];
+    assert_eq!(r.transform.scale, [2.0, 2.0]);
+    let def = &s.materials[d];
+    assert_eq!(
+        (
+            def.iridescence,
+            def.iridescence_ior,
+            def.iridescence_thickness
+        ),
+        (1.0, 1.3, [100.0, 400.0])
+    );
+    let gpu = penumbra::render::gpu_material(mat);
+    assert_eq!(gpu.iridescence, [0.8, 1.6, 150.0, 650.0]);
+    assert_eq!(gpu.textures4[1], mat.textures.iridescence.unwrap() as i32);
+    assert_eq!(
+        gpu.textures4[2],
+        mat.textures.iridescence_thickness.unwrap() as i32
+    );
+}

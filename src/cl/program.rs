@@ -65,6 +65,8 @@ pub struct KernelFeatures {
     pub clearcoat: bool,
     /// Some material has a sheen (`HAS_SHEEN`, `KHR_materials_sheen`).
     pub sheen: bool,
+    /// Some material is iridescent (`HAS_IRIDESCENCE`, `KHR_materials_iridescence`).
+    pub iridescence: bool,
     /// Some material is anisotropic (`HAS_ANISOTROPY`, `KHR_materials_anisotropy`).
     pub anisotropy: bool,
     /// Tangents are uploaded for the anisotropic materials' frames (`HAS_TANGENTS`; only set
@@ -89,6 +91,7 @@ impl KernelFeatures {
             (self.unlit, "HAS_UNLIT"),
             (self.clearcoat, "HAS_CLEARCOAT"),
             (self.sheen, "HAS_SHEEN"),
+            (self.iridescence, "HAS_IRIDESCENCE"),
             (self.anisotropy, "HAS_ANISOTROPY"),
             (self.tangents, "HAS_TANGENTS"),
             (self.two_level, "TWO_LEVEL"),

@@ -1,6 +1,6 @@
 //! Material extensions the gltf crate does not parse, read from the material's raw
-//! `extensions` JSON: `KHR_materials_clearcoat`, `KHR_materials_sheen` and
-//! `KHR_materials_anisotropy`.
+//! `extensions` JSON: `KHR_materials_clearcoat`, `KHR_materials_sheen`,
+//! `KHR_materials_anisotropy` and `KHR_materials_iridescence`.
 
 use super::TextureTable;
 use crate::scene::Material;
@@ -30,6 +30,9 @@ pub(super) fn read_extensions(
     }
     if let Some(x) = m.extension_value("KHR_materials_anisotropy") {
         reader.anisotropy(x, material);
+    }
+    if let Some(x) = m.extension_value("KHR_materials_iridescence") {
+        reader.iridescence(x, material);
     }
 }
 
@@ -107,5 +110,25 @@ impl Reader<'_> {
             .filter(|r| r.is_finite())
             .map_or(0.0, |r| r as f32);
         material.textures.anisotropy = self.texture(x, "anisotropyTexture", false);
+    }
+
+    /// A non-negative finite number of the extension object; `default` otherwise.
+    fn non_negative(x: &Value, key: &str, default: f32) -> f32 {
+        x.get(key)
+            .and_then(Value::as_f64)
+            .filter(|v| v.is_finite() && *v >= 0.0)
+            .map_or(default, |v| v as f32)
+    }
+
+    fn iridescence(&mut self, x: &Value, material: &mut Material) {
+        material.iridescence = Self::unit(x, "iridescenceFactor", 0.0);
+        material.iridescence_ior = Self::non_negative(x, "iridescenceIor", 1.3).max(1.0);
+        material.iridescence_thickness = [
+            Self::non_negative(x, "iridescenceThicknessMinimum", 100.0),
+            Self::non_negative(x, "iridescenceThicknessMaximum", 400.0),
+        ];
+        let t: &mut MaterialTextures = &mut material.textures;
+        t.iridescence = self.texture(x, "iridescenceTexture", false);
+        t.iridescence_thickness = self.texture(x, "iridescenceThicknessTexture", false);
     }
 }
