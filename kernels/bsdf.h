@@ -29,6 +29,9 @@
 //                 layer: the Fresnel of the dielectric and the metal is mixed by iridescenceFactor
 //                 with the film's (Belcour and Barla 2017, as the Khronos sample viewer does it);
 //                 the diffuse base is layered under it at the film's largest reflectance
+//   diffuse transmission (HAS_DIFFUSE_TRANSMISSION, KHR_materials_diffuse_transmission) that
+//                 share of the diffuse base leaves through the back, Lambertian and tinted, under
+//                 the same albedo scaling (a thin sheet: no volume)
 // Below BSDF_DELTA_ALPHA the glossy lobes are perfect mirror and refraction (delta) lobes.
 //
 // Contract: bsdf_eval returns f(wo, wi) * |cos(n, wi)| and its pdf (solid angle) for the non-delta
@@ -56,6 +59,10 @@ typedef struct {
 #ifdef HAS_SHEEN
     float3 sheen_color;          // KHR_materials_sheen sheenColorFactor; 0: no sheen
     float sheen_roughness;       // perceptual
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    float diffuse_transmission;        // KHR_materials_diffuse_transmission factor; 0: none
+    float3 diffuse_transmission_color;
 #endif
 #ifdef HAS_IRIDESCENCE
     float iridescence;           // KHR_materials_iridescence factor; 0: no film
@@ -91,6 +98,10 @@ inline SurfaceMaterial surface_material(global const GpuMaterial* m) {
 #ifdef HAS_SHEEN
     s.sheen_color = m->sheen.xyz;
     s.sheen_roughness = m->sheen.w;
+#endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    s.diffuse_transmission = m->diffuse_transmission.w;
+    s.diffuse_transmission_color = m->diffuse_transmission.xyz;
 #endif
 #ifdef HAS_IRIDESCENCE
     s.iridescence = m->iridescence.x;
@@ -571,6 +582,10 @@ typedef struct {
     float3 diffuse;    // Lambertian lobe: base color x its share x (1 - A(mu_o)) / (1 - A_avg)
     float3 ms;         // multiple scattering: its colour x (1 - E(mu_o)) / (1 - E_avg)
     float p_diffuse;   // probability of the cosine-sampled lobes (diffuse and multiple scattering)
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    float3 dtrans;     // diffuse transmission: its color x its share x (1 - A(mu_o)) / (1 - A_avg)
+    float p_dtrans;    // probability of sampling it (cosine-distributed, below the surface)
+#endif
     float albedo;      // estimated albedo at wo of all lobes (luminance)
 #ifdef HAS_CLEARCOAT
     float coat;        // clamped clearcoat factor
@@ -1026,7 +1041,8 @@ inline float coated_layer_albedo_avg(const BsdfLobes* l, float a_avg) {
 // appendix, made reciprocal: it integrates to exactly 1 - A(mu_o)), and the Kulla–Conty
 // multiple-scattering lobe (1 - E(mu_o)) (1 - E(mu_i)) / (1 - E_avg) of the GGX reflection,
 // times the clear coat's scaling of the glossy lobes, gs.
-inline float3 cosine_lobes(const BsdfLobes* l, float3 wi, float gs) {
+// What all layers over the diffuse base reflect towards local wi (wi.z > 0), and E there.
+inline float layers_albedo_at(const BsdfLobes* l, float3 wi, float* e) {
     float wi_cos = wi.z;
 #ifdef HAS_ANISOTROPY
     float2 e_i = ggx_energy(wi_cos, l->anisotropic ? aniso_table_roughness(l, wi) : l->roughness);
@@ -1037,8 +1053,26 @@ inline float3 cosine_lobes(const BsdfLobes* l, float3 wi, float gs) {
 #ifdef HAS_CLEARCOAT
     if (l->coat > 0.0f) a_i = coated_layer_albedo(l, wi_cos, a_i);
 #endif
-    return (l->diffuse * (1.0f - a_i) + l->ms * ((1.0f - e_i.x) * gs)) * (wi_cos * INV_PI_F);
+    *e = e_i.x;
+    return a_i;
 }
+
+inline float3 cosine_lobes(const BsdfLobes* l, float3 wi, float gs) {
+    float e_i;
+    float a_i = layers_albedo_at(l, wi, &e_i);
+    return (l->diffuse * (1.0f - a_i) + l->ms * ((1.0f - e_i) * gs)) * (wi.z * INV_PI_F);
+}
+
+#ifdef HAS_DIFFUSE_TRANSMISSION
+// The diffuse transmission lobe at local wi below the surface (wi.z < 0), f * |cos|: the diffuse
+// base's transmitted share under the same layering as its reflection, seen from the mirrored
+// direction (reciprocal, and integrating to exactly its share of 1 - A(mu_o)).
+inline float3 diffuse_transmission_lobe(const BsdfLobes* l, float3 wi) {
+    float e_i;
+    float a_i = layers_albedo_at(l, (float3)(wi.x, wi.y, -wi.z), &e_i);
+    return l->dtrans * ((1.0f - a_i) * (-wi.z * INV_PI_F));
+}
+#endif
 
 // The lobes at local wo (in the frame of bsdf_frame).
 inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float3 wo) {
@@ -1132,7 +1166,24 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float3 wo) {
     float r_est = luminance(dielectric * spec_dielectric + l.metallic * spec_metal);
     float t_est = dielectric * l.transmission * (1.0f - bsdf_max3(spec_dielectric)) *
                   luminance(m->base_color);
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    // KHR_materials_diffuse_transmission: that share of the diffuse base goes through, tinted.
+    float dt = clamp(m->diffuse_transmission, 0.0f, 1.0f);
+    l.dtrans = (float3)(0.0f);
+    l.p_dtrans = 0.0f;
+    float dt_est = 0.0f;
+    if (dt > 0.0f && a_avg < 1.0f) {
+        l.dtrans = (opaque * dt * ((1.0f - a_o) / (1.0f - a_avg))) *
+                   clamp(m->diffuse_transmission_color, 0.0f, 1.0f);
+        l.diffuse *= 1.0f - dt;
+        d_est = luminance(l.diffuse) * (1.0f - a_avg) + luminance(l.ms) * (1.0f - e_avg.x);
+        dt_est = luminance(l.dtrans) * (1.0f - a_avg);
+    }
+    float total = d_est + r_est + t_est + dt_est;
+    l.p_dtrans = total > 0.0f ? dt_est / total : 0.0f;
+#else
     float total = d_est + r_est + t_est;
+#endif
     l.p_diffuse = total > 0.0f ? d_est / total : 0.0f;
     l.albedo = total;
     return l;
@@ -1252,6 +1303,16 @@ inline float reflect_probability(float3 refl, float3 trans) {
     return r + t > 0.0f ? r / (r + t) : 1.0f;
 }
 
+// The probability of the cosine-sampled lobes (diffuse, multiple scattering and diffuse
+// transmission).
+inline float lobes_p_cosine(const BsdfLobes* l) {
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    return l->p_diffuse + l->p_dtrans;
+#else
+    return l->p_diffuse;
+#endif
+}
+
 // The base lobes (all but the coat) at local wo, wi: f * cos with the glossy ones scaled by gs,
 // and their mixture pdf.
 inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo, float3 wi,
@@ -1262,7 +1323,13 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
         f = cosine_lobes(l, wi, gs);
         p = l->p_diffuse * (wi.z * INV_PI_F);
     }
-    float p_gloss = 1.0f - l->p_diffuse;
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    else if (l->p_dtrans > 0.0f) {
+        f = diffuse_transmission_lobe(l, wi);
+        p = l->p_dtrans * (-wi.z * INV_PI_F);
+    }
+#endif
+    float p_gloss = 1.0f - lobes_p_cosine(l);
     if (l->delta || !(p_gloss > 0.0f)) {
         *pdf = p;
         return f;
@@ -1316,7 +1383,12 @@ inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, flo
     bsdf_frame(m, n, &t, &b);
     float3 wo = (float3)(dot(wo_world, t), dot(wo_world, b), dot(wo_world, n));
     float3 wi = (float3)(dot(wi_world, t), dot(wi_world, b), dot(wi_world, n));
-    if (wo.z <= 0.0f || wi.z == 0.0f || (wi.z < 0.0f && !(m->transmission > 0.0f))) {
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    bool passes = m->transmission > 0.0f || m->diffuse_transmission > 0.0f;
+#else
+    bool passes = m->transmission > 0.0f;
+#endif
+    if (wo.z <= 0.0f || wi.z == 0.0f || (wi.z < 0.0f && !passes)) {
         return (float3)(0.0f);
     }
     BsdfLobes l = bsdf_lobes(m, wo);
@@ -1423,11 +1495,20 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
         u.x = fmin((u.x - q) / p_under_sheen, 0x1.fffffep-1f);
     }
 #endif
+    float p_cos = lobes_p_cosine(&l);
     if (u.x < l.p_diffuse) {
         wi = sample_cosine(u.x / l.p_diffuse, u.y);
-    } else {
+    }
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    else if (u.x < p_cos) {
+        // Diffuse transmission: the cosine lobe below the surface.
+        wi = sample_cosine(fmin((u.x - l.p_diffuse) / l.p_dtrans, 0x1.fffffep-1f), u.y);
+        wi.z = -wi.z;
+    }
+#endif
+    else {
         // A visible microfacet, then reflection or transmission by their share at it.
-        float ug = fmin((u.x - l.p_diffuse) / (1.0f - l.p_diffuse), 0x1.fffffep-1f);
+        float ug = fmin((u.x - p_cos) / (1.0f - p_cos), 0x1.fffffep-1f);
         float3 h = l.delta ? (float3)(0.0f, 0.0f, 1.0f) : lobe_sample_vndf(&l, wo, ug, u.y);
         float cos_oh = dot(wo, h);
         float3 refl, trans;
@@ -1445,7 +1526,7 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
             if (wi.z >= 0.0f) return (float3)(0.0f);
         }
         if (l.delta) {
-            float chosen = (1.0f - l.p_diffuse) * (reflect ? pr : 1.0f - pr);
+            float chosen = (1.0f - p_cos) * (reflect ? pr : 1.0f - pr);
             if (!(chosen > 0.0f)) return (float3)(0.0f);
             *wi_world = normalize(wi.x * t + wi.y * b + wi.z * n);
             *pdf = chosen;

@@ -22,6 +22,12 @@ inline void apply_textures(SurfaceMaterial* m, global const GpuMaterial* mat,
     if (mat->textures2.z >= 0) m->sheen_color *= texture_sample(s, mat->textures2.z, tc).xyz;
     if (mat->textures2.w >= 0) m->sheen_roughness *= texture_sample(s, mat->textures2.w, tc).w;
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    if (mat->textures4.w >= 0) m->diffuse_transmission *= texture_sample(s, mat->textures4.w, tc).w;
+    if (mat->textures5.x >= 0) {
+        m->diffuse_transmission_color *= texture_sample(s, mat->textures5.x, tc).xyz;
+    }
+#endif
 #ifdef HAS_IRIDESCENCE
     // R: the factor; G: the thickness between the minimum and the maximum (else the maximum).
     if (mat->textures4.y >= 0) m->iridescence *= texture_sample(s, mat->textures4.y, tc).x;

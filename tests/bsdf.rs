@@ -41,6 +41,8 @@ struct Mat {
     anisotropy_rotation: f32,
     /// iridescenceFactor, iridescenceIor, thickness (nm).
     iridescence: [f32; 3],
+    /// diffuseTransmissionFactor and its color.
+    diffuse_transmission: (f32, [f32; 3]),
 }
 
 impl Mat {
@@ -61,6 +63,15 @@ impl Mat {
             anisotropy: 0.0,
             anisotropy_rotation: 0.0,
             iridescence: [0.0, 1.3, 400.0],
+            diffuse_transmission: (0.0, [1.0; 3]),
+        }
+    }
+
+    /// This material transmitting `factor` of its diffuse base (`KHR_materials_diffuse_transmission`).
+    fn translucent(self, factor: f32, color: [f32; 3]) -> Self {
+        Self {
+            diffuse_transmission: (factor, color),
+            ..self
         }
     }
 
@@ -155,7 +166,12 @@ impl Mat {
                 100.0,
                 self.iridescence[2],
             ],
-            diffuse_transmission: [1.0, 1.0, 1.0, 0.0],
+            diffuse_transmission: [
+                self.diffuse_transmission.1[0],
+                self.diffuse_transmission.1[1],
+                self.diffuse_transmission.1[2],
+                self.diffuse_transmission.0,
+            ],
             textures4: [-1; 4],
             textures5: [-1; 4],
         }
@@ -177,6 +193,7 @@ impl Device {
             sheen: true,
             anisotropy: true,
             iridescence: true,
+            diffuse_transmission: true,
             ..KernelFeatures::default()
         };
         let program = Program::build(&gpu, features).expect("kernels build");
@@ -714,6 +731,30 @@ fn sampling_matches_pdf_chi_square() {
         45.0,
         false,
     ));
+    // Diffuse transmission: the cosine lobe below the surface, alone, beside a glossy layer and
+    // under a coat.
+    cases.push(case(
+        "diffuse transmission 1, lambert",
+        Mat::lambert([0.8, 0.5, 0.3]).translucent(1.0, [0.4, 0.9, 0.6]),
+        30.0,
+        false,
+    ));
+    for t in [10.0, 70.0] {
+        cases.push(case(
+            "diffuse transmission 0.5, dielectric 0.4",
+            Mat::dielectric([0.8, 0.5, 0.3], 0.4).translucent(0.5, [1.0, 0.6, 0.2]),
+            t,
+            false,
+        ));
+    }
+    cases.push(case(
+        "diffuse transmission 0.7 under a coat 0.3",
+        Mat::dielectric([0.6; 3], 0.2)
+            .translucent(0.7, [0.9; 3])
+            .coated(0.8, 0.3),
+        45.0,
+        false,
+    ));
     // PENUMBRA_CHI2_ONLY=TEXT runs only the cases whose name contains TEXT (while debugging).
     if let Ok(only) = std::env::var("PENUMBRA_CHI2_ONLY") {
         cases.retain(|c| c.name.contains(&only));
@@ -1008,6 +1049,29 @@ fn directional_albedo_never_exceeds_one() {
         materials.push((
             format!("film {ior} / {d} nm over glass 0.3"),
             film(Mat::glass(0.3, 1.0)),
+            false,
+        ));
+    }
+
+    for dt in [0.3, 1.0] {
+        let tr = |m: Mat| m.translucent(dt, [1.0; 3]);
+        materials.push((
+            format!("translucent {dt} white"),
+            tr(Mat::lambert(white)),
+            false,
+        ));
+        for r in [0.0, 0.4, 1.0] {
+            materials.push((
+                format!("translucent {dt} dielectric {r}"),
+                tr(Mat::dielectric(white, r)),
+                false,
+            ));
+        }
+        materials.push((
+            format!("translucent {dt} under coat and sheen"),
+            tr(Mat::dielectric(white, 0.3))
+                .sheened([0.8; 3], 0.5)
+                .coated(1.0, 0.2),
             false,
         ));
     }
@@ -1521,6 +1585,13 @@ fn material_json(g: &mut Gltf, m: &Mat, attenuation: Option<([f32; 3], f32)>) ->
             "sheenRoughnessFactor": m.sheen_roughness
         }
     });
+    if m.diffuse_transmission.0 > 0.0 {
+        g.use_ext("KHR_materials_diffuse_transmission");
+        extensions["KHR_materials_diffuse_transmission"] = json!({
+            "diffuseTransmissionFactor": m.diffuse_transmission.0,
+            "diffuseTransmissionColorFactor": m.diffuse_transmission.1
+        });
+    }
     if m.iridescence[0] > 0.0 {
         g.use_ext("KHR_materials_iridescence");
         extensions["KHR_materials_iridescence"] = json!({
@@ -1896,6 +1967,48 @@ fn white_furnace_iridescent_spheres() {
     eprintln!("{}", report.join("\n"));
 }
 
+/// Translucent spheres in the white furnace: light that goes in diffusely comes out again, so a
+/// white sphere that transmits part of its diffuse base keeps all the light (32 bounces).
+#[test]
+fn white_furnace_translucent_spheres() {
+    let dir = tempfile::tempdir().unwrap();
+    let white = [1.0f32; 3];
+    let pixels = sphere_pixels();
+    let cases = [
+        (
+            "white lambert, transmission 0.5",
+            Mat::lambert(white).translucent(0.5, white),
+            0.98,
+        ),
+        (
+            "white lambert, transmission 1",
+            Mat::lambert(white).translucent(1.0, white),
+            0.98,
+        ),
+        (
+            "white dielectric 0.4, transmission 0.6",
+            Mat::dielectric(white, 0.4).translucent(0.6, white),
+            0.97,
+        ),
+    ];
+    let mut report = vec![];
+    for (k, (name, m, low)) in cases.iter().enumerate() {
+        let scene = furnace_scene(dir.path(), &format!("leaf{k}"), m);
+        let warnings = penumbra::scene::load(&scene).unwrap().warnings;
+        assert!(warnings.is_empty(), "{name}: {warnings:?}");
+        let (summary, px) = furnace_render(&scene, 64, 32);
+        assert_eq!(summary["nonfinite_samples"], 0, "{name}");
+        let (mean, err) = sphere_mean(&px, &pixels);
+        report.push(format!("{name}: mean {mean:.4} ± {err:.4}"));
+        assert!(
+            mean <= 1.0 + 4.0 * err + 1e-3,
+            "{name} gains energy: {mean}"
+        );
+        assert!(mean >= low - 4.0 * err, "{name} loses energy: {mean:.4}");
+    }
+    eprintln!("{}", report.join("\n"));
+}
+
 #[test]
 fn white_furnace_glass_spheres_conserve_energy() {
     let dir = tempfile::tempdir().unwrap();
@@ -1924,6 +2037,51 @@ fn white_furnace_glass_spheres_conserve_energy() {
         assert!(mean >= low - 4.0 * err, "{name} loses too much: {mean}");
     }
     eprintln!("{}", report.join("\n"));
+}
+
+/// Diffuse transmission is reciprocal: f(wo, wi) with wi behind the sheet equals f(wi, wo) seen
+/// from the back (the sheet's normal turned over).
+#[test]
+fn diffuse_transmission_is_reciprocal() {
+    let d = Device::new();
+    let n = [0.0, 0.0, 1.0];
+    let back = [0.0, 0.0, -1.0];
+    let materials = [
+        (
+            "translucent lambert",
+            Mat::lambert([0.8, 0.5, 0.3]).translucent(0.6, [0.3, 0.9, 0.5]),
+        ),
+        (
+            "translucent dielectric",
+            Mat::dielectric([0.7; 3], 0.5).translucent(1.0, [1.0, 0.8, 0.6]),
+        ),
+        (
+            "translucent, coated",
+            Mat::dielectric([0.7; 3], 0.3)
+                .translucent(0.5, [0.9; 3])
+                .coated(0.6, 0.2),
+        ),
+    ];
+    let angles = [5.0, 40.0, 75.0];
+    for (name, m) in &materials {
+        for &a in &angles {
+            for &b in &angles {
+                let wo = direction_at(n, a);
+                let wi = scale(direction_at(n, b), -1.0);
+                let f = d.eval(m, wo, n, false, &[f4(wi)])[0];
+                let g = d.eval(m, wi, back, false, &[f4(wo)])[0];
+                assert!(f[0] > 0.0, "{name}: it transmits");
+                for ch in 0..3 {
+                    let x = f[ch] as f64 / -wi[2];
+                    let y = g[ch] as f64 / wo[2];
+                    assert!(
+                        (x - y).abs() <= 2e-3 * x.abs().max(y.abs()) + 1e-6,
+                        "{name}: f(theta_o {a}, theta_i {b}) = {x}, swapped {y}"
+                    );
+                }
+            }
+        }
+    }
 }
 
 #[test]
@@ -1993,43 +2151,26 @@ fn reflection_is_reciprocal() {
     }
 }
 
-/// A floor lit by an emissive panel through a smooth thin glass pane between them, seen from
-/// under the pane: the floor's radiance (mean over the image) with `strategy` and `kernel`.
-fn lit_through_a_window(dir: &std::path::Path, pane: bool, strategy: &str, kernel: &str) -> f64 {
-    let mut g = Gltf::default();
-    let floor_mat = g.lambert([0.8; 3], [0.0; 3], 1.0, false);
-    let light_mat = g.lambert([0.0; 3], [1.0; 3], 5.0, true);
-    let quad = |y: f32, h: f32, up: bool| {
-        let p = vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
-        let i = if up {
-            vec![0, 2, 1, 0, 3, 2]
-        } else {
-            vec![0, 1, 2, 0, 2, 3]
-        };
-        (p, i)
+/// A horizontal square at height `y` of half-size `h`, facing up or down.
+fn quad(y: f32, h: f32, up: bool) -> (Vec<[f32; 3]>, Vec<u32>) {
+    let p = vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
+    let i = if up {
+        vec![0, 2, 1, 0, 3, 2]
+    } else {
+        vec![0, 1, 2, 0, 2, 3]
     };
-    let (fp, fi) = quad(0.0, 1.0, true);
-    let (lp, li) = quad(2.0, 0.5, false);
-    let mut prims = vec![
-        Prim::triangles(fp, fi, floor_mat),
-        Prim::triangles(lp, li, light_mat),
-    ];
-    if pane {
-        let mut glass = Mat::glass(0.0, 0.0);
-        glass.base = [0.9, 1.0, 0.8];
-        let m = material_json(&mut g, &glass, None);
-        g.materials[m]["doubleSided"] = json!(true);
-        let (pp, pi) = quad(1.0, 3.0, true);
-        prims.push(Prim::triangles(pp, pi, m));
-    }
-    let mesh = g.mesh(prims);
-    g.node(json!({"mesh": mesh}));
-    g.cameras
-        .push(json!({"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.01}}));
-    g.node(json!({"camera": 0, "translation": [0.0, 0.5, 0.0],
-                  "rotation": [-std::f32::consts::FRAC_1_SQRT_2, 0.0, 0.0, std::f32::consts::FRAC_1_SQRT_2]}));
-    let name = format!("window_{pane}_{strategy}_{kernel}");
-    let scene = g.write_glb(dir, &name);
+    (p, i)
+}
+
+/// The render's mean over the image, 24 × 24 pixels, 256 samples, 3 bounces, black sky.
+fn mean_of_render(
+    dir: &std::path::Path,
+    g: &Gltf,
+    name: &str,
+    strategy: &str,
+    kernel: &str,
+) -> f64 {
+    let scene = g.write_glb(dir, name);
     let (summary, px) = render_exr(
         &scene,
         &dir.join(format!("{name}.exr")),
@@ -2052,6 +2193,86 @@ fn lit_through_a_window(dir: &std::path::Path, pane: bool, strategy: &str, kerne
     );
     assert_eq!(summary["nonfinite_samples"], 0);
     common::mean_gray(&px)
+}
+
+/// A translucent sheet seen from below with a light above it: the light comes through by
+/// diffuse transmission, found by light sampling from the back hemisphere and by BSDF sampling.
+fn back_lit_sheet(dir: &std::path::Path, strategy: &str, kernel: &str) -> f64 {
+    let mut g = Gltf::default();
+    let light_mat = g.lambert([0.0; 3], [1.0; 3], 5.0, true);
+    let sheet = Mat::lambert([0.8; 3]).translucent(0.7, [1.0, 0.8, 0.6]);
+    let sheet_mat = material_json(&mut g, &sheet, None);
+    let (sp, si) = quad(1.0, 3.0, false);
+    let (lp, li) = quad(2.0, 0.5, false);
+    let mesh = g.mesh(vec![
+        Prim::triangles(sp, si, sheet_mat),
+        Prim::triangles(lp, li, light_mat),
+    ]);
+    g.node(json!({"mesh": mesh}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 0.0],
+                  "rotation": [std::f32::consts::FRAC_1_SQRT_2, 0.0, 0.0, std::f32::consts::FRAC_1_SQRT_2]}));
+    mean_of_render(
+        dir,
+        &g,
+        &format!("sheet_{strategy}_{kernel}"),
+        strategy,
+        kernel,
+    )
+}
+
+#[test]
+fn light_sampling_reaches_through_diffuse_transmission() {
+    let dir = tempfile::tempdir().unwrap();
+    for kernel in ["wavefront", "megakernel"] {
+        let mis = back_lit_sheet(dir.path(), "mis", kernel);
+        let bsdf = back_lit_sheet(dir.path(), "bsdf", kernel);
+        let lights = back_lit_sheet(dir.path(), "lights", kernel);
+        eprintln!("{kernel}: mis {mis:.4}, bsdf {bsdf:.4}, lights {lights:.4}");
+        assert!(mis > 0.01, "{kernel}: the sheet is dark ({mis})");
+        for (name, v) in [("bsdf", bsdf), ("lights", lights)] {
+            assert!(
+                (v - mis).abs() < 0.04 * mis,
+                "{kernel}: {name}-only {v:.4} and MIS {mis:.4} disagree"
+            );
+        }
+    }
+}
+
+/// A floor lit by an emissive panel through a smooth thin glass pane between them, seen from
+/// under the pane: the floor's radiance (mean over the image) with `strategy` and `kernel`.
+fn lit_through_a_window(dir: &std::path::Path, pane: bool, strategy: &str, kernel: &str) -> f64 {
+    let mut g = Gltf::default();
+    let floor_mat = g.lambert([0.8; 3], [0.0; 3], 1.0, false);
+    let light_mat = g.lambert([0.0; 3], [1.0; 3], 5.0, true);
+    let (fp, fi) = quad(0.0, 1.0, true);
+    let (lp, li) = quad(2.0, 0.5, false);
+    let mut prims = vec![
+        Prim::triangles(fp, fi, floor_mat),
+        Prim::triangles(lp, li, light_mat),
+    ];
+    if pane {
+        let mut glass = Mat::glass(0.0, 0.0);
+        glass.base = [0.9, 1.0, 0.8];
+        let m = material_json(&mut g, &glass, None);
+        g.materials[m]["doubleSided"] = json!(true);
+        let (pp, pi) = quad(1.0, 3.0, true);
+        prims.push(Prim::triangles(pp, pi, m));
+    }
+    let mesh = g.mesh(prims);
+    g.node(json!({"mesh": mesh}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 0.5, 0.0],
+                  "rotation": [-std::f32::consts::FRAC_1_SQRT_2, 0.0, 0.0, std::f32::consts::FRAC_1_SQRT_2]}));
+    mean_of_render(
+        dir,
+        &g,
+        &format!("window_{pane}_{strategy}_{kernel}"),
+        strategy,
+        kernel,
+    )
 }
 
 #[test]

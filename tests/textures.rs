@@ -999,3 +999,52 @@ fn iridescence_factors_and_textures_are_read() {
         mat.textures.iridescence_thickness.unwrap() as i32
     );
 }
+
+/// `KHR_materials_diffuse_transmission` is read: factor and color with their textures (the
+/// color texture is sRGB, the factor texture's alpha is data); nothing warns.
+#[test]
+fn diffuse_transmission_factors_and_textures_are_read() {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let image = t.embedded(&mut g, &png(4, 4, &test_texels()));
+    let factor = t.texture(image, REPEAT);
+    let color = t.texture(image, MIRROR);
+    g.use_ext("KHR_materials_diffuse_transmission");
+    let m = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"extensions": {"KHR_materials_diffuse_transmission": {
+            "diffuseTransmissionFactor": 0.35,
+            "diffuseTransmissionTexture": {"index": factor},
+            "diffuseTransmissionColorFactor": [0.9, 0.5, 2.0],
+            "diffuseTransmissionColorTexture": {"index": color, "texCoord": 1}
+        }}}),
+    );
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, false, false);
+    g.node(json!({"mesh": mesh}));
+    let dir = tempfile::tempdir().unwrap();
+    let s = penumbra::scene::load(&g.write_glb(dir.path(), "leaf")).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let mat = &s.materials[m];
+    assert_eq!(mat.diffuse_transmission, 0.35);
+    assert_eq!(
+        mat.diffuse_transmission_color,
+        [0.9, 0.5, 1.0],
+        "clamped to 1"
+    );
+    let refs = |slot: Option<u32>| &s.texture_refs[slot.expect("a texture") as usize];
+    assert!(!refs(mat.textures.diffuse_transmission).srgb);
+    let c = refs(mat.textures.diffuse_transmission_color);
+    assert!(c.srgb && c.tex_coord == 1);
+    let gpu = penumbra::render::gpu_material(mat);
+    assert_eq!(gpu.diffuse_transmission, [0.9, 0.5, 1.0, 0.35]);
+    assert_eq!(
+        gpu.textures4[3],
+        mat.textures.diffuse_transmission.unwrap() as i32
+    );
+    assert_eq!(
+        gpu.textures5[0],
+        mat.textures.diffuse_transmission_color.unwrap() as i32
+    );
+}

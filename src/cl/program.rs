@@ -65,6 +65,9 @@ pub struct KernelFeatures {
     pub clearcoat: bool,
     /// Some material has a sheen (`HAS_SHEEN`, `KHR_materials_sheen`).
     pub sheen: bool,
+    /// Some material transmits diffusely (`HAS_DIFFUSE_TRANSMISSION`,
+    /// `KHR_materials_diffuse_transmission`).
+    pub diffuse_transmission: bool,
     /// Some material is iridescent (`HAS_IRIDESCENCE`, `KHR_materials_iridescence`).
     pub iridescence: bool,
     /// Some material is anisotropic (`HAS_ANISOTROPY`, `KHR_materials_anisotropy`).
@@ -91,6 +94,7 @@ impl KernelFeatures {
             (self.unlit, "HAS_UNLIT"),
             (self.clearcoat, "HAS_CLEARCOAT"),
             (self.sheen, "HAS_SHEEN"),
+            (self.diffuse_transmission, "HAS_DIFFUSE_TRANSMISSION"),
             (self.iridescence, "HAS_IRIDESCENCE"),
             (self.anisotropy, "HAS_ANISOTROPY"),
             (self.tangents, "HAS_TANGENTS"),

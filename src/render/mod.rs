@@ -85,6 +85,7 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         unlit: used(&|m| m.unlit),
         clearcoat: used(&|m| m.clearcoat > 0.0),
         sheen: used(&|m| m.sheen_color.iter().any(|&c| c > 0.0)),
+        diffuse_transmission: used(&|m| m.diffuse_transmission > 0.0),
         iridescence: used(&|m| m.iridescence > 0.0),
         anisotropy: used(&|m| m.anisotropy > 0.0),
         tangents: used(&|m| m.anisotropy > 0.0) && tangents,

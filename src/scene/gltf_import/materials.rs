@@ -1,6 +1,7 @@
 //! Material extensions the gltf crate does not parse, read from the material's raw
 //! `extensions` JSON: `KHR_materials_clearcoat`, `KHR_materials_sheen`,
-//! `KHR_materials_anisotropy` and `KHR_materials_iridescence`.
+//! `KHR_materials_anisotropy`, `KHR_materials_iridescence` and
+//! `KHR_materials_diffuse_transmission`.
 
 use super::TextureTable;
 use crate::scene::Material;
@@ -33,6 +34,9 @@ pub(super) fn read_extensions(
     }
     if let Some(x) = m.extension_value("KHR_materials_iridescence") {
         reader.iridescence(x, material);
+    }
+    if let Some(x) = m.extension_value("KHR_materials_diffuse_transmission") {
+        reader.diffuse_transmission(x, material);
     }
 }
 
@@ -88,14 +92,20 @@ impl Reader<'_> {
         t.clearcoat_normal = self.texture(x, "clearcoatNormalTexture", false);
     }
 
-    fn sheen(&mut self, x: &Value, material: &mut Material) {
-        let color = x.get("sheenColorFactor").and_then(Value::as_array);
-        material.sheen_color = std::array::from_fn(|i| {
+    /// An RGB factor of the extension object, each channel clamped to [0, 1]; `default` where
+    /// absent or not a number.
+    fn color(x: &Value, key: &str, default: f32) -> [f32; 3] {
+        let color = x.get(key).and_then(Value::as_array);
+        std::array::from_fn(|i| {
             color
                 .and_then(|c| c.get(i))
                 .and_then(Value::as_f64)
-                .map_or(0.0, |v| (v as f32).clamp(0.0, 1.0))
-        });
+                .map_or(default, |v| (v as f32).clamp(0.0, 1.0))
+        })
+    }
+
+    fn sheen(&mut self, x: &Value, material: &mut Material) {
+        material.sheen_color = Self::color(x, "sheenColorFactor", 0.0);
         material.sheen_roughness = Self::unit(x, "sheenRoughnessFactor", 0.0);
         let t: &mut MaterialTextures = &mut material.textures;
         t.sheen_color = self.texture(x, "sheenColorTexture", true);
@@ -118,6 +128,14 @@ impl Reader<'_> {
             .and_then(Value::as_f64)
             .filter(|v| v.is_finite() && *v >= 0.0)
             .map_or(default, |v| v as f32)
+    }
+
+    fn diffuse_transmission(&mut self, x: &Value, material: &mut Material) {
+        material.diffuse_transmission = Self::unit(x, "diffuseTransmissionFactor", 0.0);
+        material.diffuse_transmission_color = Self::color(x, "diffuseTransmissionColorFactor", 1.0);
+        let t: &mut MaterialTextures = &mut material.textures;
+        t.diffuse_transmission = self.texture(x, "diffuseTransmissionTexture", false);
+        t.diffuse_transmission_color = self.texture(x, "diffuseTransmissionColorTexture", true);
     }
 
     fn iridescence(&mut self, x: &Value, material: &mut Material) {
