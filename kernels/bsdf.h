@@ -1376,6 +1376,36 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
     return f;
 }
 
+#ifdef LAMBERT_ONLY
+// Every material of the scene is an opaque dielectric with no specular layer (specularFactor 0,
+// metallic 0, no transmission, coat or sheen): the BSDF above reduces exactly to the Lambertian
+// base_color / pi, sampled by its cosine, and is evaluated as such.
+inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 wi_world,
+                        float* pdf) {
+    float cos_i = dot(wi_world, n);
+    bool lit = dot(wo_world, n) > 0.0f && cos_i > 0.0f;
+    *pdf = lit ? cos_i * INV_PI_F : 0.0f;
+    return lit ? m->base_color * (cos_i * INV_PI_F) : (float3)(0.0f);
+}
+
+inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 u,
+                          float3* wi_world, float* pdf, bool* specular) {
+    *specular = false;
+    *wi_world = n;
+    *pdf = 0.0f;
+    if (dot(wo_world, n) <= 0.0f) return (float3)(0.0f);
+    float3 wi = sample_cosine(u.x, u.y);
+    if (!(wi.z > 0.0f)) return (float3)(0.0f);
+    float3 t, b;
+    onb(n, &t, &b);
+    *wi_world = normalize(wi.x * t + wi.y * b + wi.z * n);
+    // The pdf of the direction as evaluated (cos(n, wi) / pi), so that the weight is exact.
+    float cos_i = dot(*wi_world, n);
+    if (!(cos_i > 0.0f)) return (float3)(0.0f);
+    *pdf = cos_i * INV_PI_F;
+    return m->base_color;
+}
+#else
 inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 wi_world,
                         float* pdf) {
     *pdf = 0.0f;
@@ -1556,3 +1586,4 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
     }
     return f / *pdf;
 }
+#endif  // LAMBERT_ONLY

@@ -35,11 +35,18 @@ inline float3 to_world(float3 v_local, float3 n) {
     return v_local.x * t + v_local.y * b + v_local.z * n;
 }
 
+// The point of the unit circle at angle 2 pi u, u in [0, 1): (cos, sin). cospi and sinpi
+// reduce their argument exactly, where cos(2 pi u) needs the general (and on CPUs costly)
+// argument reduction.
+inline float2 unit_circle(float u) {
+    return (float2)(cospi(2.0f * u), sinpi(2.0f * u));
+}
+
 // Cosine-weighted hemisphere around +z; pdf = cos / pi.
 inline float3 sample_cosine(float u1, float u2) {
     float r = sqrt(u1);
-    float phi = 2.0f * PI_F * u2;
-    return (float3)(r * cos(phi), r * sin(phi), sqrt(fmax(0.0f, 1.0f - u1)));
+    float2 c = unit_circle(u2);
+    return (float3)(r * c.x, r * c.y, sqrt(fmax(0.0f, 1.0f - u1)));
 }
 
 // Uniform direction in a cone around +z given 1 - cos(half-angle) (passed as such so that tiny
@@ -48,8 +55,8 @@ inline float3 sample_cone(float u1, float u2, float one_minus_cos) {
     float x = u1 * one_minus_cos;  // 1 - cos(theta)
     float c = 1.0f - x;
     float s = sqrt(fmax(0.0f, x * (2.0f - x)));
-    float phi = 2.0f * PI_F * u2;
-    return (float3)(s * cos(phi), s * sin(phi), c);
+    float2 circle = unit_circle(u2);
+    return (float3)(s * circle.x, s * circle.y, c);
 }
 
 // Uniform point on a triangle as barycentric weights of vertices 1 and 2.

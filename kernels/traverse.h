@@ -147,36 +147,6 @@ inline bool intersect_leaf(const RayPrep* r, global const GpuTriangle* tris,
     return false;
 }
 
-#define WALK_ON 0u
-#define WALK_DONE 1u
-#define WALK_OVERFLOW 2u
-
-// After a node's two children were tested (child[side] >= 0: an interior child the ray
-// reaches, at entry distance dist[side]): goes on to the nearer one, pushing the other, to the
-// only one, or to the next node on the stack. Returns WALK_DONE when the stack is empty, and
-// WALK_OVERFLOW (raising the counter) when it is full, which the builder's depth limit rules out.
-inline uint next_node(const int* child, const float* dist, uint* stack, uint* sp, uint* node,
-                      volatile global uint* overflow) {
-    if (child[0] >= 0 && child[1] >= 0) {
-        uint first = dist[0] <= dist[1] ? (uint)child[0] : (uint)child[1];
-        uint second = dist[0] <= dist[1] ? (uint)child[1] : (uint)child[0];
-        if (*sp == STACK_SIZE) {
-            atomic_inc(overflow);
-            return WALK_OVERFLOW;
-        }
-        stack[(*sp)++] = second;
-        *node = first;
-    } else if (child[0] >= 0) {
-        *node = (uint)child[0];
-    } else if (child[1] >= 0) {
-        *node = (uint)child[1];
-    } else {
-        if (*sp == 0u) return WALK_DONE;
-        *node = stack[--(*sp)];
-    }
-    return WALK_ON;
-}
-
 // Tests child `side` (0 left, 1 right) of node n: returns its entry distance (INFINITY when
 // the ray misses it before tmax). *child is the node index of an interior child reached, else
 // -1; *first and *count the triangles of a leaf reached (count 0 otherwise).
@@ -208,6 +178,9 @@ inline bool traverse_bvh(global const GpuBvhNode* nodes, uint root,
                          const RayPrep* r, float3 o, float3 d, float tmin, bool any_hit,
                          uint prim_offset, bool swap_uv, GpuHit* hit,
                          volatile global uint* overflow) {
+    // Written out in one loop, without helper functions taking pointers: compilers keep this
+    // form's state in registers (the flat BVH's rays on an H200 lost 8 % to a version through
+    // helpers).
     uint stack[STACK_SIZE];
     uint sp = 0;
     uint node = root;
@@ -216,15 +189,39 @@ inline bool traverse_bvh(global const GpuBvhNode* nodes, uint root,
         float dist[2];
         int child[2];
         for (int side = 0; side < 2; ++side) {
-            uint first, count;
-            dist[side] = child_entry(&n, side, r, tmin, hit->t, &child[side], &first, &count);
-            if (count > 0u && intersect_leaf(r, tris, surf, first, count, tmin, o, d, any_hit,
-                                             prim_offset, swap_uv, hit)) {
+            float4 lo = side == 0 ? n.left_min : n.right_min;
+            float4 hi = side == 0 ? n.left_max : n.right_max;
+            child[side] = -1;
+            dist[side] = box_entry(lo, hi, r, tmin, hit->t);
+            if (dist[side] == INFINITY) continue;
+            int ref = as_int(lo.w);
+            if (ref >= 0) {
+                child[side] = ref;
+                continue;
+            }
+            if (intersect_leaf(r, tris, surf, (uint)(~ref), as_uint(hi.w), tmin, o, d, any_hit,
+                               prim_offset, swap_uv, hit)) {
                 return true;
             }
         }
-        uint next = next_node(child, dist, stack, &sp, &node, overflow);
-        if (next != WALK_ON) return next == WALK_OVERFLOW;
+        // On to the nearer child reached, pushing the other; or to the next node on the stack.
+        if (child[0] >= 0 && child[1] >= 0) {
+            uint first = dist[0] <= dist[1] ? (uint)child[0] : (uint)child[1];
+            uint second = dist[0] <= dist[1] ? (uint)child[1] : (uint)child[0];
+            if (sp == STACK_SIZE) {
+                atomic_inc(overflow);
+                return true;
+            }
+            stack[sp++] = second;
+            node = first;
+        } else if (child[0] >= 0) {
+            node = (uint)child[0];
+        } else if (child[1] >= 0) {
+            node = (uint)child[1];
+        } else {
+            if (sp == 0u) return false;
+            node = stack[--sp];
+        }
     }
 }
 

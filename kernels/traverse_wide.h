@@ -8,17 +8,40 @@
 // The children of wide node `n` that the prepared ray reaches before `tmax`, nearest first
 // (insertion sort of at most four): their entry distances in dist, their slots in slot.
 // Returns how many.
-inline uint wide_children(global const GpuWideNode* n, const RayPrep* r, float tmin, float tmax,
-                          float* dist, uint* slot) {
-    float4 ox = (float4)(r->origin.x), oy = (float4)(r->origin.y), oz = (float4)(r->origin.z);
-    float4 ix = (float4)(r->inv.x), iy = (float4)(r->inv.y), iz = (float4)(r->inv.z);
-    float4 x0 = (n->min_x - ox) * ix, x1 = (n->max_x - ox) * ix;
-    float4 y0 = (n->min_y - oy) * iy, y1 = (n->max_y - oy) * iy;
-    float4 z0 = (n->min_z - oz) * iz, z1 = (n->max_z - oz) * iz;
-    float4 near = fmax(fmax(fmax(fmin(x0, x1), fmin(y0, y1)), fmin(z0, z1)), (float4)(tmin));
+// The ray in four lanes: origin and safe reciprocal direction, one coordinate per vector.
+typedef struct {
+    float4 ox, oy, oz, ix, iy, iz;
+} WideRay;
+
+inline WideRay wide_ray(const RayPrep* r) {
+    WideRay w;
+    w.ox = (float4)(r->origin.x);
+    w.oy = (float4)(r->origin.y);
+    w.oz = (float4)(r->origin.z);
+    w.ix = (float4)(r->inv.x);
+    w.iy = (float4)(r->inv.y);
+    w.iz = (float4)(r->inv.z);
+    return w;
+}
+
+// traverse.h's slab test on the four children of n at once: their entry distances in *near,
+// and the mask of those the ray reaches before tmax (empty slots never).
+inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin, float tmax,
+                       float4* near) {
+    float4 x0 = (n->min_x - w->ox) * w->ix, x1 = (n->max_x - w->ox) * w->ix;
+    float4 y0 = (n->min_y - w->oy) * w->iy, y1 = (n->max_y - w->oy) * w->iy;
+    float4 z0 = (n->min_z - w->oz) * w->iz, z1 = (n->max_z - w->oz) * w->iz;
+    *near = fmax(fmax(fmax(fmin(x0, x1), fmin(y0, y1)), fmin(z0, z1)), (float4)(tmin));
     float4 far = fmin(fmin(fmax(x0, x1), fmax(y0, y1)), fmax(z0, z1)) * 1.00000024f;
     int4 valid = (n->child > 0) | (n->count > 0u);
-    int4 mask = (near <= far) & (near < (float4)(tmax)) & valid;
+    return (*near <= far) & (*near < (float4)(tmax)) & valid;
+}
+
+inline uint wide_children(global const GpuWideNode* n, const RayPrep* r, float tmin, float tmax,
+                          float* dist, uint* slot) {
+    WideRay w = wide_ray(r);
+    float4 near;
+    int4 mask = wide_reach(n, &w, tmin, tmax, &near);
     if (!any(mask)) return 0u;
     uint k = 0;
     float nd[4] = {near.x, near.y, near.z, near.w};
@@ -37,69 +60,88 @@ inline uint wide_children(global const GpuWideNode* n, const RayPrep* r, float t
     return k;
 }
 
-// Pushes the interior children kept[1..count) (farthest first) and goes on to kept[0], or pops
-// the next node when there is none. Returns WALK_ON, WALK_DONE or WALK_OVERFLOW (traverse.h).
-inline uint wide_next(const uint* kept, uint kept_count, uint* stack, uint* sp, uint* node,
-                      volatile global uint* overflow) {
-    if (kept_count == 0u) {
-        if (*sp == 0u) return WALK_DONE;
-        *node = stack[--(*sp)];
-        return WALK_ON;
+// Compare-and-swap of two (entry distance, slot) pairs, ordered by distance and then slot, so
+// that the network below sorts as a stable sort would (the host reference's order).
+#define WIDE_ORDER(A, B)                                           \
+    if (d##B < d##A || (d##B == d##A && s##B < s##A)) {            \
+        float td = d##A;                                           \
+        d##A = d##B;                                               \
+        d##B = td;                                                 \
+        uint ts = s##A;                                            \
+        s##A = s##B;                                               \
+        s##B = ts;                                                 \
     }
-    if (*sp + kept_count - 1u > WIDE_STACK_SIZE) {
-        atomic_inc(overflow);
-        return WALK_OVERFLOW;
+
+// A leaf among the sorted children, tested on the spot when it starts before the hit so far.
+#define WIDE_LEAF(D, S)                                                                     \
+    if (D < hit->t && counts[S] > 0u &&                                                     \
+        intersect_leaf(r, tris, surf, (uint)(~children[S]), counts[S], tmin, o, d, any_hit, \
+                       prim_offset, swap_uv, hit)) {                                        \
+        return true;                                                                        \
     }
-    for (uint i = kept_count - 1u; i > 0u; --i) stack[(*sp)++] = kept[i];
-    *node = kept[0];
-    return WALK_ON;
-}
+
+// An interior child among the sorted ones, pushed with its entry distance (farthest first).
+#define WIDE_PUSH(D, S)                            \
+    if (D < hit->t && counts[S] == 0u) {           \
+        stack[sp] = (uint)children[S];             \
+        stack_d[sp++] = D;                         \
+    }
 
 // Walks the wide BVH below node `root` as traverse_bvh (traverse.h) walks the binary one, with
-// the same arguments and result.
+// the same arguments and result. The children a ray reaches are sorted by entry distance with
+// a five-exchange network on scalars (registers, not arrays): leaves are tested in that order,
+// interior children pushed farthest first with their distance, and a popped node that starts
+// beyond the hit found meanwhile is skipped. The visiting order is src/bvh/wide.rs's.
 inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
                               global const GpuTriangle* tris, const SceneSurfaces* surf,
                               const RayPrep* r, float3 o, float3 d, float tmin, bool any_hit,
                               uint prim_offset, bool swap_uv, GpuHit* hit,
                               volatile global uint* overflow) {
-    uint stack[WIDE_STACK_SIZE];
+    uint stack[WIDE_STACK_SIZE + 1];
+    float stack_d[WIDE_STACK_SIZE + 1];
     uint sp = 0;
     uint node = root;
+    WideRay w = wide_ray(r);
     for (;;) {
         global const GpuWideNode* n = &nodes[node];
-        float dist[4];
-        uint slot[4];
-        uint k = wide_children(n, r, tmin, hit->t, dist, slot);
-        int ch[4] = {n->child.x, n->child.y, n->child.z, n->child.w};
-        uint cnt[4] = {n->count.x, n->count.y, n->count.z, n->count.w};
-        // Leaves on the spot (they shorten the ray); interior children kept in order.
-        uint inner[4];
-        float inner_dist[4];
-        uint inner_count = 0;
-        for (uint i = 0; i < k; ++i) {
-            uint c = slot[i];
-            if (cnt[c] == 0u) {
-                inner[inner_count] = (uint)ch[c];
-                inner_dist[inner_count++] = dist[i];
-                continue;
-            }
-            if (!(dist[i] < hit->t)) continue;
-            uint first = (uint)(~ch[c]);
-            if (intersect_leaf(r, tris, surf, first, cnt[c], tmin, o, d, any_hit, prim_offset,
-                               swap_uv, hit)) {
+        float4 near;
+        int4 mask = wide_reach(n, &w, tmin, hit->t, &near);
+        if (any(mask)) {
+            float4 dist = select((float4)(INFINITY), near, mask);
+            float d0 = dist.x, d1 = dist.y, d2 = dist.z, d3 = dist.w;
+            uint s0 = 0u, s1 = 1u, s2 = 2u, s3 = 3u;
+            WIDE_ORDER(0, 1)
+            WIDE_ORDER(2, 3)
+            WIDE_ORDER(0, 2)
+            WIDE_ORDER(1, 3)
+            WIDE_ORDER(1, 2)
+            global const int* children = (global const int*)&n->child;
+            global const uint* counts = (global const uint*)&n->count;
+            WIDE_LEAF(d0, s0)
+            WIDE_LEAF(d1, s1)
+            WIDE_LEAF(d2, s2)
+            WIDE_LEAF(d3, s3)
+            if (sp + 4u > WIDE_STACK_SIZE + 1u) {
+                atomic_inc(overflow);
                 return true;
             }
+            WIDE_PUSH(d3, s3)
+            WIDE_PUSH(d2, s2)
+            WIDE_PUSH(d1, s1)
+            WIDE_PUSH(d0, s0)
         }
-        // Interior children whose boxes start beyond a hit found meanwhile are skipped.
-        uint kept[4];
-        uint kept_count = 0;
-        for (uint i = 0; i < inner_count; ++i) {
-            if (inner_dist[i] < hit->t) kept[kept_count++] = inner[i];
+        // The nearest pushed node that still starts before the hit.
+        for (;;) {
+            if (sp == 0u) return false;
+            --sp;
+            if (stack_d[sp] < hit->t) break;
         }
-        uint next = wide_next(kept, kept_count, stack, &sp, &node, overflow);
-        if (next != WALK_ON) return next == WALK_OVERFLOW;
+        node = stack[sp];
     }
 }
+#undef WIDE_ORDER
+#undef WIDE_LEAF
+#undef WIDE_PUSH
 
 // Closest hit (any_hit = false) or first hit (any_hit = true), as traverse() in traverse.h.
 inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTriangle* tris,

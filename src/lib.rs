@@ -9,6 +9,7 @@ pub mod bench;
 pub mod bvh;
 pub mod cl;
 pub mod cli;
+pub mod cpu_time;
 pub mod date;
 pub mod image_io;
 pub mod render;

@@ -185,17 +185,20 @@ struct Device {
 
 impl Device {
     fn new() -> Self {
-        let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
-        let gpu = Gpu::open(&choice).expect("the test's OpenCL device is available");
         // Every lobe compiled in; a material without them reduces to the plain BSDF.
-        let features = KernelFeatures {
+        Self::with(KernelFeatures {
             clearcoat: true,
             sheen: true,
             anisotropy: true,
             iridescence: true,
             diffuse_transmission: true,
             ..KernelFeatures::default()
-        };
+        })
+    }
+
+    fn with(features: KernelFeatures) -> Self {
+        let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
+        let gpu = Gpu::open(&choice).expect("the test's OpenCL device is available");
         let program = Program::build(&gpu, features).expect("kernels build");
         Self { gpu, program }
     }
@@ -789,6 +792,62 @@ fn sampling_matches_pdf_chi_square() {
 
 /// INV_PI_F of kernels/rng.h.
 const INV_PI_F: f32 = std::f32::consts::FRAC_1_PI;
+
+/// Scenes whose materials are all Lambertian build the BSDF as base color / pi (LAMBERT_ONLY):
+/// it must sample the same directions with the same weights and pdfs as the general BSDF.
+#[test]
+fn lambert_only_build_matches_the_general_bsdf() {
+    let general = Device::new();
+    let lambert = Device::with(KernelFeatures {
+        lambert_only: true,
+        ..KernelFeatures::default()
+    });
+    let m = Mat::lambert([0.8, 0.5, 0.3]);
+    let n = norm([0.3, -0.2, 1.0]);
+    let mut compared = 0;
+    for theta in [0.0, 30.0, 60.0, 85.0, 89.9] {
+        let wo = direction_at(n, theta);
+        let a = general.sample(&m, wo, n, false, 4096, 11);
+        let b = lambert.sample(&m, wo, n, false, 4096, 11);
+        let ea = general.eval(&m, wo, n, false, &a.wi);
+        let eb = lambert.eval(&m, wo, n, false, &a.wi);
+        for i in 0..a.wi.len() {
+            for c in 0..4 {
+                let close = |x: f32, y: f32| (x - y).abs() <= 2e-6 * (1.0 + x.abs());
+                assert!(
+                    close(a.wi[i][c], b.wi[i][c]),
+                    "θ {theta}: wi/pdf {i}: {:?} vs {:?}",
+                    a.wi[i],
+                    b.wi[i]
+                );
+                assert!(
+                    close(a.w[i][c], b.w[i][c]),
+                    "θ {theta}: weight {i}: {:?} vs {:?}",
+                    a.w[i],
+                    b.w[i]
+                );
+                assert!(
+                    close(ea[i][c], eb[i][c]),
+                    "θ {theta}: eval {i}: {:?} vs {:?}",
+                    ea[i],
+                    eb[i]
+                );
+            }
+            compared += usize::from(a.wi[i][3] > 0.0);
+        }
+        // From below the surface neither scatters.
+        let below = [-wo[0], -wo[1], -wo[2]];
+        let e = lambert.eval(&m, below, n, false, &a.wi[..64]);
+        assert!(
+            e.iter().all(|v| v[..4] == [0.0; 4]),
+            "no scattering seen from below"
+        );
+    }
+    assert!(
+        compared > 15_000,
+        "most samples are valid directions ({compared})"
+    );
+}
 
 #[test]
 fn specular_factor_zero_is_exactly_lambertian() {

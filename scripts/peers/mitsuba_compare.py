@@ -22,7 +22,9 @@ Mitsuba max_depth B + 2, Russian roulette off, hard shadows (point light radius 
 Measured (wall clock, on this machine, one after the other, nothing else of ours running):
   * time for the same spp: `penumbra render --spp S` ("seconds": rendering only, kernel build
     excluded) against mi.render(spp=S) after a warm-up render (the JIT compile is reported
-    separately);
+    separately); with --timing-only also each side's process CPU time for it (penumbra's
+    `cpu_seconds`, Python's process_time() around mi.render), the fair measure on a machine
+    shared with other work;
   * error against the reference as samples double (penumbra: `bench converge --configs mis`,
     progressive; Mitsuba: an independent render per spp count), and the time each needs to
     reach the relMSE Mitsuba reaches at S spp (log-log interpolation on each curve).
@@ -127,12 +129,18 @@ def relmse(img, ref):
     return float(dr.mean(dr.square(x - r) / (dr.square(r) + 0.01))[0])
 
 
+LAST_MITSUBA_CPU_SECONDS = [0.0]
+
+
 def mitsuba_render(scene, spp, seed):
-    """Renders and waits; returns (image, seconds)."""
+    """Renders and waits; returns (image, seconds). The render's process CPU time (all threads)
+    is left in LAST_MITSUBA_CPU_SECONDS[0]."""
     t = time.perf_counter()
+    c = time.process_time()
     img = mi.render(scene, seed=seed, spp=spp)
     dr.eval(img)
     dr.sync_thread()
+    LAST_MITSUBA_CPU_SECONDS[0] = time.process_time() - c
     return img, time.perf_counter() - t
 
 
@@ -186,6 +194,7 @@ def compare(name, glb, msc, reference, args, results):
     if args.timing_only:
         _, compile_s = mitsuba_render(msc, 1, 10_000)
         _, mit_same_spp = mitsuba_render(msc, args.spp, 77)
+        mit_cpu = LAST_MITSUBA_CPU_SECONDS[0]
         pixels = args.size * args.size
         r = {"scene": name, "glb": glb, "size": args.size, "bounces": args.bounces,
              "spp": args.spp, "triangles": pen_render["triangles"],
@@ -194,10 +203,13 @@ def compare(name, glb, msc, reference, args, results):
              "penumbra_kernel_build_ms": pen_render["kernel_build_ms"],
              "penumbra_samples_per_second": pen_render["samples_per_second"],
              "mitsuba_seconds": mit_same_spp, "mitsuba_compile_seconds": compile_s,
-             "mitsuba_samples_per_second": pixels * args.spp / mit_same_spp}
+             "mitsuba_samples_per_second": pixels * args.spp / mit_same_spp,
+             "penumbra_cpu_seconds": pen_render.get("cpu_seconds"),
+             "mitsuba_cpu_seconds": mit_cpu}
         results.append(r)
-        print(f"   penumbra {r['penumbra_seconds']:.3f} s, Mitsuba {mit_same_spp:.3f} s for "
-              f"{args.spp} spp", file=sys.stderr)
+        print(f"   penumbra {r['penumbra_seconds']:.3f} s ({r['penumbra_cpu_seconds']} CPU s), "
+              f"Mitsuba {mit_same_spp:.3f} s ({mit_cpu:.2f} CPU s) for {args.spp} spp",
+              file=sys.stderr)
         return
     pen_conv = run_penumbra(args.penumbra, ["bench", "converge", glb, "--reference", reference,
                                             "--configs", "mis", "--spp", str(args.max_spp),
@@ -316,15 +328,19 @@ def main(argv=None):
     print()
     if args.timing_only:
         print("| scene | triangles | spp | penumbra s | Mitsuba s (compile) | penumbra M samples/s "
-              "| Mitsuba M samples/s | penumbra / Mitsuba |")
-        print("|---|---|---|---|---|---|---|---|")
+              "| Mitsuba M samples/s | penumbra / Mitsuba | penumbra CPU s | Mitsuba CPU s "
+              "| per CPU second, penumbra / Mitsuba |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|")
         for r in results:
+            pc, mc = r["penumbra_cpu_seconds"], r["mitsuba_cpu_seconds"]
+            per_cpu = f"{mc / pc:.2f}×" if pc and mc else "—"
             print(f"| {r['scene']} | {r['triangles']:,} | {r['spp']} "
                   f"| {r['penumbra_seconds']:.3f} "
                   f"| {r['mitsuba_seconds']:.3f} ({r['mitsuba_compile_seconds']:.1f}) "
                   f"| {r['penumbra_samples_per_second'] / 1e6:.2f} "
                   f"| {r['mitsuba_samples_per_second'] / 1e6:.2f} "
-                  f"| {r['penumbra_samples_per_second'] / r['mitsuba_samples_per_second']:.2f}× |")
+                  f"| {r['penumbra_samples_per_second'] / r['mitsuba_samples_per_second']:.2f}× "
+                  f"| {f'{pc:.2f}' if pc is not None else '—'} | {mc:.2f} | {per_cpu} |")
         return 0
     print("| scene | triangles | spp | penumbra s | Mitsuba s (compile) | penumbra M samples/s "
           "| Mitsuba M samples/s | target relMSE | penumbra s to target | Mitsuba s to target "

@@ -75,6 +75,9 @@ pub struct KernelFeatures {
     /// Tangents are uploaded for the anisotropic materials' frames (`HAS_TANGENTS`; only set
     /// with `anisotropy`).
     pub tangents: bool,
+    /// Every material is Lambertian (`LAMBERT_ONLY`: no specular layer, metal, transmission,
+    /// coat or sheen anywhere), so the BSDF is evaluated as base color / pi.
+    pub lambert_only: bool,
     /// Rays descend a top level over instances, then their meshes' bottom levels (`TWO_LEVEL`).
     pub two_level: bool,
 }
@@ -98,6 +101,7 @@ impl KernelFeatures {
             (self.iridescence, "HAS_IRIDESCENCE"),
             (self.anisotropy, "HAS_ANISOTROPY"),
             (self.tangents, "HAS_TANGENTS"),
+            (self.lambert_only, "LAMBERT_ONLY"),
             (self.two_level, "TWO_LEVEL"),
         ] {
             if on {
@@ -120,6 +124,7 @@ pub fn program_source() -> String {
         "#line 1 \"{DEFINES_NAME}\"\n{}",
         super::types::kernel_defines()
     );
+
     append_sources(&mut s, SOURCES);
     s
 }
@@ -172,6 +177,11 @@ pub(crate) fn build_source(
         options.push_str("-cl-fp32-correctly-rounded-divide-sqrt");
     }
     options.push_str(&features.defines());
+    // Extra compiler options for experiments (e.g. `-cl-mad-enable`), space-separated.
+    if let Ok(extra) = std::env::var("PENUMBRA_CL_OPTIONS") {
+        options.push(' ');
+        options.push_str(&extra);
+    }
     let _setup = super::CL_SETUP.lock().unwrap_or_else(|e| e.into_inner());
     let mut program = opencl3::program::Program::create_from_source(&gpu.context, source)
         .map_err(|e| ClError::Build(format!("cannot create the program: {e}")))?;

@@ -65,6 +65,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut lines = (!std::io::stderr().is_terminal()).then(|| ProgressLines::new(spp));
     let chunk = spp.div_ceil(50).max(1);
     let start = Instant::now();
+    let cpu_start = crate::cpu_time::process_cpu_seconds();
     let mut done = 0;
     while done < spp {
         let n = chunk.min(spp - done);
@@ -76,6 +77,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     let seconds = start.elapsed().as_secs_f64();
+    // Process CPU time of the render (on a CPU device, the kernels' threads are ours).
+    let cpu_seconds = cpu_start
+        .zip(crate::cpu_time::process_cpu_seconds())
+        .map(|(a, b)| b - a);
     bar.finish_and_clear();
 
     let image = renderer.image()?;
@@ -162,6 +167,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "focus_distance": renderer.settings().focus_distance,
         "kernel_ms": stats.stage_ms,
     });
+    summary["cpu_seconds"] = serde_json::json!(cpu_seconds);
+    summary["samples_per_cpu_second"] = serde_json::json!(cpu_seconds.map(|c| samples / c));
     // Added after the literal, which is at serde_json's macro recursion limit.
     for (key, value) in [
         ("bvh", serde_json::json!(scene_stats.bvh)),

@@ -65,7 +65,7 @@ impl Renderer {
         }
     }
 
-    /// Launches the megakernel once over no pixels and waits, so that a driver which compiles
+    /// Launches the megakernel once with no samples and waits, so that a driver which compiles
     /// kernels at their first launch (PoCL does, per work-group size) does it now, in the
     /// kernel build time, and not in the first frame. Returns the milliseconds it took.
     pub(super) fn prime_megakernel(&mut self) -> Result<f64, ClError> {
@@ -74,9 +74,9 @@ impl Renderer {
         }
         let t = Instant::now();
         self.ensure_frame()?;
+        // Over every pixel with no samples: PoCL specialises a kernel for its grid (a grid of 0
+        // items compiles a variant the frames never use, and the first frame compiled again).
         let mut frame = self.settings.gpu_frame(self.light_count);
-        frame.width = 0;
-        frame.height = 0;
         frame.samples_in_wave = 0;
         self.launch_megakernel(&frame)?;
         self.gpu

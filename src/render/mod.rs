@@ -72,7 +72,17 @@ pub struct SceneStats {
 /// The kernel features a scene needs; `triangle_lights` and `tangents` come from its upload
 /// (emissive triangles with an area, tangents for normal maps).
 fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> KernelFeatures {
-    let used = |f: &dyn Fn(&crate::scene::Material) -> bool| scene.materials.iter().any(f);
+    // Only the materials some triangle uses (the importer's default material often is not).
+    let in_use = scene.used_materials();
+    let materials = || {
+        scene
+            .materials
+            .iter()
+            .zip(&in_use)
+            .filter(|(_, u)| **u)
+            .map(|(m, _)| m)
+    };
+    let used = |f: &dyn Fn(&crate::scene::Material) -> bool| materials().any(f);
     KernelFeatures {
         triangle_lights,
         textures: used(&|m| m.textures.any()),
@@ -89,6 +99,7 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         iridescence: used(&|m| m.iridescence > 0.0),
         anisotropy: used(&|m| m.anisotropy > 0.0),
         tangents: used(&|m| m.anisotropy > 0.0) && tangents,
+        lambert_only: materials().all(|m| m.is_lambertian()),
     }
 }
 
@@ -637,7 +648,58 @@ fn fits_device(
 
 #[cfg(test)]
 mod fit_tests {
-    use super::fits_device;
+    use super::{fits_device, scene_features};
+    use crate::scene::{Material, Mesh, Object, Scene};
+    use glam::{DMat4, Vec3};
+
+    /// One triangle per material index in `uses`, of a scene with `materials`.
+    fn scene_using(materials: Vec<Material>, uses: &[u32]) -> Scene {
+        let mut mesh = Mesh::default();
+        for &m in uses {
+            let base = mesh.positions.len() as u32;
+            mesh.positions.extend([Vec3::ZERO, Vec3::X, Vec3::Y]);
+            mesh.indices.push([base, base + 1, base + 2]);
+            mesh.materials.push(m);
+        }
+        let object = Object {
+            name: "o".into(),
+            world_from_object: DMat4::IDENTITY,
+            visible: true,
+            mesh,
+        };
+        Scene {
+            materials,
+            objects: vec![object],
+            ..Scene::default()
+        }
+    }
+
+    #[test]
+    fn lambert_only_looks_at_the_materials_in_use() {
+        let lambert = Material {
+            specular_factor: 0.0,
+            ..Material::default()
+        };
+        let glossy = Material::default(); // the importer's fallback: a specular layer
+        let features = |uses: &[u32]| {
+            scene_features(
+                &scene_using(vec![lambert.clone(), glossy.clone()], uses),
+                false,
+                false,
+            )
+        };
+        assert!(
+            features(&[0, 0]).lambert_only,
+            "the unused glossy material does not count"
+        );
+        assert!(!features(&[0, 1]).lambert_only);
+        let metal = Material {
+            metallic: 1.0,
+            ..lambert.clone()
+        };
+        let scene = scene_using(vec![lambert.clone(), metal], &[0, 1]);
+        assert!(!scene_features(&scene, false, false).lambert_only);
+    }
 
     #[test]
     fn scenes_too_large_for_the_device_are_refused_with_a_reason() {

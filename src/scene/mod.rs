@@ -217,6 +217,20 @@ impl Default for Material {
 }
 
 impl Material {
+    /// Whether the material scatters as a pure Lambertian (base color / pi): an opaque
+    /// dielectric without a specular layer, coat, sheen or diffuse transmission. Textures cannot
+    /// change that (the metallic and specular textures scale factors that are 0 here). Unlit
+    /// materials do not scatter at all and do not count against it.
+    pub fn is_lambertian(&self) -> bool {
+        self.unlit
+            || (self.metallic == 0.0
+                && self.specular_factor == 0.0
+                && self.transmission == 0.0
+                && self.clearcoat == 0.0
+                && self.diffuse_transmission == 0.0
+                && self.sheen_color.iter().all(|&c| c == 0.0))
+    }
+
     /// Whether the material emits light.
     pub fn is_emissive(&self) -> bool {
         self.emission.iter().any(|&e| e > 0.0)
@@ -399,6 +413,25 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Which materials some triangle uses, by index: in its own material or in a
+    /// `KHR_materials_variants` variant (hidden objects count: they can be shown again).
+    pub fn used_materials(&self) -> Vec<bool> {
+        let mut used = vec![false; self.materials.len()];
+        let mut mark = |i: u32| {
+            if let Some(u) = used.get_mut(i as usize) {
+                *u = true;
+            }
+        };
+        for o in &self.objects {
+            o.mesh.materials.iter().for_each(|&m| mark(m));
+            for v in &o.mesh.variants {
+                mark(v.default);
+                v.materials.iter().for_each(|&(_, m)| mark(m));
+            }
+        }
+        used
+    }
+
     /// World-space triangles of the visible objects, in object order (absurd ones dropped).
     pub fn world_triangles(&self) -> Vec<WorldTriangle> {
         self.flatten(&RenderFrame::default()).triangles
