@@ -651,33 +651,31 @@ inline float gl_mu(int k) {
 
 #ifdef HAS_ANISOTROPY
 // The perceptual roughness at which the isotropic energy tables stand for the anisotropic lobe
-// seen along local w: towards the horizon the projected alpha Smith's Lambda sees there,
-// sqrt(ax² cos²φ + ay² sin²φ), towards the normal the geometric mean sqrt(ax ay), mixed by
-// sin²θ. E(w) at it is a function of the direction alone, so the lobes built on it stay
-// reciprocal.
+// seen along local w: that of the projected alpha Smith's Lambda sees at w's azimuth,
+// sqrt(ax² cos²φ + ay² sin²φ) (the geometric mean along the normal itself). E(w) at it is a
+// function of the direction alone, so the lobes built on it stay reciprocal.
 inline float aniso_table_roughness(const BsdfLobes* l, float3 w) {
     float x2 = w.x * w.x;
     float y2 = w.y * w.y;
     float s2 = x2 + y2;
-    float a2 = (1.0f - s2) * l->alpha_x * l->alpha_y +
-               (l->alpha_x * l->alpha_x * x2 + l->alpha_y * l->alpha_y * y2);
-    return sqrt(sqrt(fmax(a2, 0.0f)));
+    float a2 = s2 > 1e-12f ? (l->alpha_x * l->alpha_x * x2 + l->alpha_y * l->alpha_y * y2) / s2
+                           : l->alpha_x * l->alpha_y;
+    return sqrt(sqrt(a2));
 }
 
-// The cosine-weighted mean of (E, E_s) at aniso_table_roughness over the hemisphere: 8-point
-// Gauss–Legendre in cos θ times 4 azimuths of a quadrant (E is symmetric about both axes).
+// The cosine-weighted mean of (E, E_s) at aniso_table_roughness over the hemisphere: the
+// tables' own means (E_avg at each azimuth's roughness) averaged over 8 azimuths of a quadrant
+// (E is symmetric about both axes), so that it matches the tables the lobes read.
 inline float2 aniso_energy_avg(const BsdfLobes* l) {
     float2 sum = (float2)(0.0f);
-    for (int k = 0; k < 8; ++k) {
-        float mu = gl_mu(k);
-        float s = sqrt(1.0f - mu * mu);
-        for (int j = 0; j < 4; ++j) {
-            float phi = ((float)j + 0.5f) * (0.125f * PI_F);
-            float3 w = (float3)(s * cos(phi), s * sin(phi), mu);
-            sum += (GL_W[k >> 1] * mu) * ggx_energy(mu, aniso_table_roughness(l, w));
-        }
+    for (int j = 0; j < 8; ++j) {
+        float phi = ((float)j + 0.5f) * (0.0625f * PI_F);
+        float c = cos(phi);
+        float s = sin(phi);
+        float a2 = l->alpha_x * l->alpha_x * c * c + l->alpha_y * l->alpha_y * s * s;
+        sum += ggx_energy_avg(sqrt(sqrt(a2)));
     }
-    return sum * 0.25f;
+    return sum * 0.125f;
 }
 #endif
 

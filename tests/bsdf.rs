@@ -1160,9 +1160,9 @@ fn directional_albedo_never_exceeds_one() {
                 let mean = w.iter().sum::<f64>() / count as f64;
                 let var = w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / count as f64;
                 // Anisotropic lobes are compensated from the isotropic tables at an approximate
-                // roughness (docs/materials.md): they may reflect up to 1% too much near the
-                // horizon.
-                let slack = if m.anisotropy > 0.0 { 0.01 } else { 1e-4 };
+                // roughness (docs/materials.md): single directions of strongly stretched lobes may
+                // reflect up to 6% too much (others too little; whole spheres keep 0.99 to 1.00).
+                let slack = if m.anisotropy > 0.0 { 0.07 } else { 1e-4 };
                 let bound = 1.0 + 4.0 * (var / count as f64).sqrt() + slack;
                 let excess = mean - bound + 1.0;
                 if excess > worst.0 {
@@ -1921,8 +1921,8 @@ fn furnace_scene_uv(dir: &std::path::Path, name: &str, m: &Mat) -> std::path::Pa
 }
 
 /// Anisotropic spheres in the white furnace: never above the sky, and (white metal, white
-/// dielectric) close to it; the compensation reads the isotropic tables at the geometric mean
-/// alpha, so the strongly stretched lobes keep a little less than the isotropic ones.
+/// dielectric) close to it; the compensation reads the isotropic tables at the projected
+/// roughness of each direction (docs/materials.md).
 #[test]
 fn white_furnace_anisotropic_spheres() {
     let dir = tempfile::tempdir().unwrap();
@@ -1937,12 +1937,12 @@ fn white_furnace_anisotropic_spheres() {
         (
             "metal 0.3, anisotropy 1",
             Mat::metal(white, 0.3).anisotropic(1.0, 0.0),
-            0.85,
+            0.97,
         ),
         (
             "metal 0, anisotropy 0.8",
             Mat::metal(white, 0.0).anisotropic(0.8, 0.7),
-            0.85,
+            0.97,
         ),
         (
             "metal 1, anisotropy 1",
