@@ -21,6 +21,17 @@
 //                 sheenColor E_sh(mu) (E_sh tabulated); the diffuse base sees it as one more layer
 //                 of albedo s E_sh (s = max3(sheenColor)), the other base lobes are scaled by
 //                 1 - s max(E_sh(mu_o), E_sh(mu_i)), the spec's albedo scaling made reciprocal
+//   anisotropy    (HAS_ANISOTROPY, KHR_materials_anisotropy) the reflection and transmission
+//                 microfacets are anisotropic GGX, alpha_t = mix(alpha, 1, strength^2) along the
+//                 anisotropy direction and alpha_b = alpha across it, in the frame of that
+//                 direction; the energy tables are read at a projected roughness per direction
+//   iridescence   (HAS_IRIDESCENCE, KHR_materials_iridescence) a thin film over the specular
+//                 layer: the Fresnel of the dielectric and the metal is mixed by iridescenceFactor
+//                 with the film's (Belcour and Barla 2017, as the Khronos sample viewer does it);
+//                 the diffuse base is layered under it at the film's largest reflectance
+//   diffuse transmission (HAS_DIFFUSE_TRANSMISSION, KHR_materials_diffuse_transmission) that
+//                 share of the diffuse base leaves through the back, Lambertian and tinted, under
+//                 the same albedo scaling (a thin sheet: no volume)
 // Below BSDF_DELTA_ALPHA the glossy lobes are perfect mirror and refraction (delta) lobes.
 //
 // Contract: bsdf_eval returns f(wo, wi) * |cos(n, wi)| and its pdf (solid angle) for the non-delta
@@ -49,6 +60,21 @@ typedef struct {
     float3 sheen_color;          // KHR_materials_sheen sheenColorFactor; 0: no sheen
     float sheen_roughness;       // perceptual
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    float diffuse_transmission;        // KHR_materials_diffuse_transmission factor; 0: none
+    float3 diffuse_transmission_color;
+#endif
+#ifdef HAS_IRIDESCENCE
+    float iridescence;           // KHR_materials_iridescence factor; 0: no film
+    float iridescence_ior;       // the film's index of refraction
+    float iridescence_thickness; // the film's thickness in nanometres
+#endif
+#ifdef HAS_ANISOTROPY
+    float anisotropy;            // KHR_materials_anisotropy strength; 0: isotropic
+    float2 aniso_rotation;       // cos, sin of the direction's angle from onb(n)'s t, when
+                                 // aniso_dir is 0 (no tangent frame: the BSDF tests)
+    float3 aniso_dir;            // the anisotropy direction (world), from the tangent frame
+#endif
 } SurfaceMaterial;
 
 // The untextured material.
@@ -73,6 +99,20 @@ inline SurfaceMaterial surface_material(global const GpuMaterial* m) {
     s.sheen_color = m->sheen.xyz;
     s.sheen_roughness = m->sheen.w;
 #endif
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    s.diffuse_transmission = m->diffuse_transmission.w;
+    s.diffuse_transmission_color = m->diffuse_transmission.xyz;
+#endif
+#ifdef HAS_IRIDESCENCE
+    s.iridescence = m->iridescence.x;
+    s.iridescence_ior = m->iridescence.y;
+    s.iridescence_thickness = m->iridescence.w;
+#endif
+#ifdef HAS_ANISOTROPY
+    s.anisotropy = m->aniso.x;
+    s.aniso_rotation = m->aniso.yz;
+    s.aniso_dir = (float3)(0.0f);
+#endif
     return s;
 }
 
@@ -85,6 +125,9 @@ inline void material_from_inside(SurfaceMaterial* m) {
 #endif
 #ifdef HAS_SHEEN
     m->sheen_color = (float3)(0.0f);
+#endif
+#ifdef HAS_IRIDESCENCE
+    m->iridescence = 0.0f;
 #endif
 }
 
@@ -400,6 +443,131 @@ inline float3 ggx_sample_vndf(float3 wo, float alpha, float u1, float u2) {
     return len2 > 0.0f ? h * rsqrt(len2) : (float3)(0.0f, 0.0f, 1.0f);
 }
 
+#ifdef HAS_ANISOTROPY
+// Anisotropic GGX (alpha_x along the frame's t, alpha_y along b): the distribution, Smith's
+// Lambda and the visible normals as above, with the axes stretched.
+inline float ggx_d_aniso(float3 h, float ax, float ay) {
+    float x = h.x / ax;
+    float y = h.y / ay;
+    float d = x * x + y * y + h.z * h.z;
+    return 1.0f / (PI_F * ax * ay * d * d);
+}
+
+inline float ggx_lambda_aniso(float3 w, float ax, float ay) {
+    float x = (ax * ax * w.x * w.x + ay * ay * w.y * w.y) / (w.z * w.z);
+    return x < INFINITY ? x / (2.0f * (sqrt(1.0f + x) + 1.0f)) : INFINITY;
+}
+
+inline float3 ggx_sample_vndf_aniso(float3 wo, float ax, float ay, float u1, float u2) {
+    float3 v = normalize((float3)(ax * wo.x, ay * wo.y, wo.z));
+    float phi = 2.0f * PI_F * u1;
+    float z = (1.0f - u2) * (1.0f + v.z) - v.z;
+    float s = sqrt(clamp(1.0f - z * z, 0.0f, 1.0f));
+    float3 h = (float3)(s * cos(phi), s * sin(phi), z) + v;
+    h = (float3)(ax * h.x, ay * h.y, fmax(h.z, 0.0f));
+    float len2 = dot(h, h);
+    return len2 > 0.0f ? h * rsqrt(len2) : (float3)(0.0f, 0.0f, 1.0f);
+}
+#endif
+
+// The lobes' frame about n: onb's, or (anisotropic) t along the anisotropy direction.
+inline void bsdf_frame(const SurfaceMaterial* m, float3 n, float3* t, float3* b) {
+    onb(n, t, b);
+#ifdef HAS_ANISOTROPY
+    if (m->anisotropy > 0.0f) {
+        float3 d = m->aniso_dir - n * dot(n, m->aniso_dir);
+        float len = length(d);
+        d = len > 1e-6f ? d / len : m->aniso_rotation.x * *t + m->aniso_rotation.y * *b;
+        *t = d;
+        *b = cross(n, d);
+    }
+#endif
+}
+
+// The largest GGX alpha of the glossy lobes (anisotropy stretches one axis).
+inline float bsdf_alpha_max(const SurfaceMaterial* m) {
+    float alpha = m->roughness * m->roughness;
+#ifdef HAS_ANISOTROPY
+    float s = clamp(m->anisotropy, 0.0f, 1.0f);
+    if (s > 0.0f) alpha = mix(alpha, 1.0f, s * s);
+#endif
+    return alpha;
+}
+
+#ifdef HAS_IRIDESCENCE
+// Thin-film interference (Belcour and Barla 2017, "A Practical Extension to Microfacet Theory for
+// the Modeling of Varying Iridescence"), as the Khronos glTF sample viewer evaluates it for
+// KHR_materials_iridescence: air over a film of index film_ior and thickness d (nm) over a base
+// of normal reflectance f0, seen at cos_1; Schlick's Fresnel at both interfaces, the spectral
+// integral of the first two orders against the CIE XYZ curves in Fourier form, then linear sRGB.
+
+// The XYZ sensitivity (Fourier form) at optical path difference opd (nm) and phase shift.
+inline float3 film_sensitivity(float opd, float3 shift) {
+    float phase = 2.0f * PI_F * opd * 1.0e-9f;
+    float3 val = (float3)(5.4856e-13f, 4.4201e-13f, 5.2481e-13f);
+    float3 pos = (float3)(1.6810e+06f, 1.7953e+06f, 2.2084e+06f);
+    float3 var = (float3)(4.3278e+09f, 9.3046e+09f, 6.6121e+09f);
+    float3 xyz = val * sqrt(2.0f * PI_F * var) * cos(pos * phase + shift) * exp(-phase * phase * var);
+    xyz.x += 9.7470e-14f * sqrt(2.0f * PI_F * 4.5282e+09f) * cos(2.2399e+06f * phase + shift.x) *
+             exp(-4.5282e+09f * phase * phase);
+    xyz /= 1.0685e-7f;
+    return (float3)(3.2404542f * xyz.x - 1.5371385f * xyz.y - 0.4985314f * xyz.z,
+                    -0.9692660f * xyz.x + 1.8760108f * xyz.y + 0.0415560f * xyz.z,
+                    0.0556434f * xyz.x - 0.2040259f * xyz.y + 1.0572252f * xyz.z);
+}
+
+inline float film_sq(float x) {
+    return x * x;
+}
+
+// The film's reflectance (RGB, in [0, 1]) at cos_1 over a base of normal reflectance f0.
+inline float3 film_fresnel(float cos_1, float film_ior, float d, float3 f0) {
+    // A vanishing film is no film: the base's own Schlick Fresnel (the sample viewer's blend of
+    // the film's index to the outside's would leave a Schlick interface of f0 = 0 there).
+    if (d < 0.03f) return f0 + (1.0f - f0) * schlick_weight(cos_1);
+    float n2 = film_ior;
+    float sin2_2 = film_sq(1.0f / n2) * (1.0f - cos_1 * cos_1);
+    float cos2_2 = 1.0f - sin2_2;
+    if (cos2_2 < 0.0f) return (float3)(1.0f);
+    float cos_2 = sqrt(cos2_2);
+    // First interface (air to film).
+    float r0 = film_sq((n2 - 1.0f) / (n2 + 1.0f));
+    float r12 = r0 + (1.0f - r0) * schlick_weight(cos_1);
+    float t121 = 1.0f - r12;
+    float phi12 = n2 < 1.0f ? PI_F : 0.0f;
+    float phi21 = PI_F - phi12;
+    // Second interface (film to base); the base's index from its reflectance.
+    float3 sf0 = sqrt(clamp(f0, 0.0f, 0.9999f));
+    float3 n3 = (1.0f + sf0) / (1.0f - sf0);
+    float3 r1 = (n3 - n2) / (n3 + n2);
+    r1 *= r1;
+    float3 r23 = r1 + (1.0f - r1) * schlick_weight(cos_2);
+    float3 phi23 = (float3)(n3.x < n2 ? PI_F : 0.0f, n3.y < n2 ? PI_F : 0.0f, n3.z < n2 ? PI_F : 0.0f);
+    float opd = 2.0f * n2 * d * cos_2;
+    float3 phi = phi21 + phi23;
+    float3 r123 = clamp(r12 * r23, 1e-5f, 0.9999f);
+    float3 s123 = sqrt(r123);
+    float3 rs = t121 * t121 * r23 / (1.0f - r123);
+    float3 color = r12 + rs;
+    float3 cm = rs - t121;
+    for (int m = 1; m <= 2; ++m) {
+        cm *= s123;
+        color += cm * 2.0f * film_sensitivity((float)m * opd, (float)m * phi);
+    }
+    return clamp(color, 0.0f, 1.0f);
+}
+
+// The largest normal-incidence reflectance of a film of index n2 over a base of reflectance f0
+// (its thickness a quarter or a half wave): (|r12| + |r23|)² / (1 + |r12 r23|)².
+inline float film_max_reflectance(float n2, float f0) {
+    float sf0 = sqrt(clamp(f0, 0.0f, 0.9999f));
+    float n3 = (1.0f + sf0) / (1.0f - sf0);
+    float a = fabs((n2 - 1.0f) / (n2 + 1.0f));
+    float b = fabs((n3 - n2) / (n3 + n2));
+    return film_sq((a + b) / (1.0f + a * b));
+}
+#endif
+
 // The material's lobes as seen from one wo.
 typedef struct {
     float roughness;   // clamped perceptual roughness (the energy tables' row)
@@ -416,6 +584,10 @@ typedef struct {
     float3 diffuse;    // Lambertian lobe: base color x its share x (1 - A(mu_o)) / (1 - A_avg)
     float3 ms;         // multiple scattering: its colour x (1 - E(mu_o)) / (1 - E_avg)
     float p_diffuse;   // probability of the cosine-sampled lobes (diffuse and multiple scattering)
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    float3 dtrans;     // diffuse transmission: its color x its share x (1 - A(mu_o)) / (1 - A_avg)
+    float p_dtrans;    // probability of sampling it (cosine-distributed, below the surface)
+#endif
     float albedo;      // estimated albedo at wo of all lobes (luminance)
 #ifdef HAS_CLEARCOAT
     float coat;        // clamped clearcoat factor
@@ -427,7 +599,42 @@ typedef struct {
     float sheen_roughness;  // clamped to [SHEEN_MIN_ROUGHNESS, 1]
     float sheen_o;          // s E_sh(mu_o): what the sheen reflects at wo
 #endif
+#ifdef HAS_IRIDESCENCE
+    float iridescence;  // clamped factor; 0: no film
+    float film_ior;
+    float film_thickness;  // nanometres
+#endif
+#ifdef HAS_ANISOTROPY
+    bool anisotropic;  // alpha_x > alpha_y, the lobe not a delta
+    float alpha_x;     // along the anisotropy direction (the frame's t)
+    float alpha_y;     // across it
+#endif
 } BsdfLobes;
+
+// The GGX distribution, Smith's Lambda and visible-normal sampling of the glossy lobes.
+inline float lobe_d(const BsdfLobes* l, float3 h) {
+#ifdef HAS_ANISOTROPY
+    return ggx_d_aniso(h, l->alpha_x, l->alpha_y);
+#else
+    return ggx_d(h, l->alpha * l->alpha);
+#endif
+}
+
+inline float lobe_lambda(const BsdfLobes* l, float3 w) {
+#ifdef HAS_ANISOTROPY
+    return ggx_lambda_aniso(w, l->alpha_x, l->alpha_y);
+#else
+    return ggx_lambda(w, l->alpha * l->alpha);
+#endif
+}
+
+inline float3 lobe_sample_vndf(const BsdfLobes* l, float3 wo, float u1, float u2) {
+#ifdef HAS_ANISOTROPY
+    return ggx_sample_vndf_aniso(wo, l->alpha_x, l->alpha_y, u1, u2);
+#else
+    return ggx_sample_vndf(wo, l->alpha, u1, u2);
+#endif
+}
 
 // A(mu): what the dielectric specular layer reflects at one cosine, single and multiple
 // scattering (e = (E, E_s) there), times specularFactor.
@@ -443,6 +650,34 @@ constant float GL_W[4] = {0.3626837834f, 0.3137066459f, 0.2223810345f, 0.1012285
 inline float gl_mu(int k) {
     return 0.5f + ((k & 1) ? 0.5f : -0.5f) * GL_X[k >> 1];
 }
+
+#ifdef HAS_ANISOTROPY
+// The perceptual roughness at which the isotropic energy tables stand for the anisotropic lobe:
+// that of its smaller alpha (across the direction). The lobe is at least that rough everywhere,
+// so the tables never under-estimate what it reflects and the compensation never gains energy
+// (it loses some: reading them at each direction's projected alpha kept all the light of a
+// white furnace but reflected up to 17% too much in single directions). Kept per direction so
+// that a better estimate can replace it.
+inline float aniso_table_roughness(const BsdfLobes* l, float3 w) {
+    (void)w;
+    return sqrt(l->alpha_y);
+}
+
+// The cosine-weighted mean of (E, E_s) at aniso_table_roughness over the hemisphere: the
+// tables' own means (E_avg at each azimuth's roughness) averaged over 8 azimuths of a quadrant
+// (E is symmetric about both axes), so that it matches the tables the lobes read.
+inline float2 aniso_energy_avg(const BsdfLobes* l) {
+    float2 sum = (float2)(0.0f);
+    for (int j = 0; j < 8; ++j) {
+        float phi = ((float)j + 0.5f) * (0.0625f * PI_F);
+        float c = cos(phi);
+        float s = sin(phi);
+        float a2 = l->alpha_x * l->alpha_x * c * c + l->alpha_y * l->alpha_y * s * s;
+        sum += ggx_energy_avg(sqrt(sqrt(a2)));
+    }
+    return sum * 0.125f;
+}
+#endif
 
 #ifdef HAS_SHEEN
 // Sheen roughness below this is taken as this (narrower lobes are not tabulated).
@@ -804,20 +1039,60 @@ inline float coated_layer_albedo_avg(const BsdfLobes* l, float a_avg) {
 // appendix, made reciprocal: it integrates to exactly 1 - A(mu_o)), and the Kulla–Conty
 // multiple-scattering lobe (1 - E(mu_o)) (1 - E(mu_i)) / (1 - E_avg) of the GGX reflection,
 // times the clear coat's scaling of the glossy lobes, gs.
-inline float3 cosine_lobes(const BsdfLobes* l, float wi_cos, float gs) {
+// What all layers over the diffuse base reflect towards local wi (wi.z > 0), and E there.
+inline float layers_albedo_at(const BsdfLobes* l, float3 wi, float* e) {
+    float wi_cos = wi.z;
+#ifdef HAS_ANISOTROPY
+    float2 e_i = ggx_energy(wi_cos, l->anisotropic ? aniso_table_roughness(l, wi) : l->roughness);
+#else
     float2 e_i = ggx_energy(wi_cos, l->roughness);
+#endif
     float a_i = under_coat_albedo(l, wi_cos, layer_albedo(l, e_i));
 #ifdef HAS_CLEARCOAT
     if (l->coat > 0.0f) a_i = coated_layer_albedo(l, wi_cos, a_i);
 #endif
-    return (l->diffuse * (1.0f - a_i) + l->ms * ((1.0f - e_i.x) * gs)) * (wi_cos * INV_PI_F);
+    *e = e_i.x;
+    return a_i;
 }
 
-inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
+inline float3 cosine_lobes(const BsdfLobes* l, float3 wi, float gs) {
+    float e_i;
+    float a_i = layers_albedo_at(l, wi, &e_i);
+    return (l->diffuse * (1.0f - a_i) + l->ms * ((1.0f - e_i) * gs)) * (wi.z * INV_PI_F);
+}
+
+#ifdef HAS_DIFFUSE_TRANSMISSION
+// The diffuse transmission lobe at local wi below the surface (wi.z < 0), f * |cos|: the diffuse
+// base's transmitted share under the same layering as its reflection, seen from the mirrored
+// direction (reciprocal, and integrating to exactly its share of 1 - A(mu_o)).
+inline float3 diffuse_transmission_lobe(const BsdfLobes* l, float3 wi) {
+    float e_i;
+    float a_i = layers_albedo_at(l, (float3)(wi.x, wi.y, -wi.z), &e_i);
+    return l->dtrans * ((1.0f - a_i) * (-wi.z * INV_PI_F));
+}
+#endif
+
+// The lobes at local wo (in the frame of bsdf_frame).
+inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float3 wo) {
+    float cos_o = wo.z;
     BsdfLobes l;
     l.roughness = clamp(m->roughness, 0.0f, 1.0f);
     l.alpha = l.roughness * l.roughness;
     l.delta = l.alpha < BSDF_DELTA_ALPHA;
+#ifdef HAS_ANISOTROPY
+    // Anisotropy stretches the lobe along its direction; the tables are read at the geometric
+    // mean alpha (the isotropic lobe of the same peak density).
+    float s = clamp(m->anisotropy, 0.0f, 1.0f);
+    l.alpha_x = mix(l.alpha, 1.0f, s * s);
+    l.delta = l.alpha_x < BSDF_DELTA_ALPHA;
+    l.alpha_y = fmax(l.alpha, BSDF_DELTA_ALPHA);
+    l.alpha_x = fmax(l.alpha_x, BSDF_DELTA_ALPHA);
+    l.anisotropic = s > 0.0f && !l.delta;
+    if (l.anisotropic) {
+        l.alpha = sqrt(l.alpha_x * l.alpha_y);
+        l.roughness = sqrt(l.alpha);
+    }
+#endif
     l.eta = fmax(m->ior, 1e-3f);
     l.metallic = clamp(m->metallic, 0.0f, 1.0f);
     l.transmission = clamp(m->transmission, 0.0f, 1.0f);
@@ -826,10 +1101,27 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
     float r = (l.eta - 1.0f) / (l.eta + 1.0f);
     l.f0 = fmin(r * r * m->specular_color, 1.0f);
     l.f0_layer = bsdf_max3(l.f0);
+#ifdef HAS_IRIDESCENCE
+    // The diffuse base lies under the film at its largest reflectance (any thickness), so it
+    // never takes light the film reflects.
+    l.iridescence = clamp(m->iridescence, 0.0f, 1.0f);
+    l.film_ior = fmax(m->iridescence_ior, 1.0f);
+    l.film_thickness = fmax(m->iridescence_thickness, 0.0f);
+    if (l.iridescence > 0.0f) {
+        float f_max = fmax(l.f0_layer, film_max_reflectance(l.film_ior, l.f0_layer));
+        l.f0_layer = mix(l.f0_layer, f_max, l.iridescence);
+    }
+#endif
     float dielectric = 1.0f - l.metallic;
     float opaque = dielectric * (1.0f - l.transmission);
     float2 e_o = ggx_energy(cos_o, l.roughness);
     float2 e_avg = ggx_energy_avg(l.roughness);
+#ifdef HAS_ANISOTROPY
+    if (l.anisotropic) {
+        e_o = ggx_energy(cos_o, aniso_table_roughness(&l, wo));
+        e_avg = aniso_energy_avg(&l);
+    }
+#endif
     // Multiple scattering of the metal and of the opaque dielectric's reflection (transmitting
     // interfaces are single-scattering only); a delta lobe loses nothing.
     l.ms_layer = 0.0f;
@@ -872,7 +1164,24 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float cos_o) {
     float r_est = luminance(dielectric * spec_dielectric + l.metallic * spec_metal);
     float t_est = dielectric * l.transmission * (1.0f - bsdf_max3(spec_dielectric)) *
                   luminance(m->base_color);
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    // KHR_materials_diffuse_transmission: that share of the diffuse base goes through, tinted.
+    float dt = clamp(m->diffuse_transmission, 0.0f, 1.0f);
+    l.dtrans = (float3)(0.0f);
+    l.p_dtrans = 0.0f;
+    float dt_est = 0.0f;
+    if (dt > 0.0f && a_avg < 1.0f) {
+        l.dtrans = (opaque * dt * ((1.0f - a_o) / (1.0f - a_avg))) *
+                   clamp(m->diffuse_transmission_color, 0.0f, 1.0f);
+        l.diffuse *= 1.0f - dt;
+        d_est = luminance(l.diffuse) * (1.0f - a_avg) + luminance(l.ms) * (1.0f - e_avg.x);
+        dt_est = luminance(l.dtrans) * (1.0f - a_avg);
+    }
+    float total = d_est + r_est + t_est + dt_est;
+    l.p_dtrans = total > 0.0f ? dt_est / total : 0.0f;
+#else
     float total = d_est + r_est + t_est;
+#endif
     l.p_diffuse = total > 0.0f ? d_est / total : 0.0f;
     l.albedo = total;
     return l;
@@ -935,6 +1244,12 @@ inline void bsdf_gloss(const SurfaceMaterial* m, const BsdfLobes* l, float cos_o
                        float3* trans) {
     float sw = l->thin ? schlick_weight(cos_oh) : dielectric_schlick(cos_oh, l->eta);
     float3 fr = l->f0 + (1.0f - l->f0) * sw;
+#ifdef HAS_IRIDESCENCE
+    // The film over the dielectric (its f0 with the specular color), seen from outside.
+    if (l->iridescence > 0.0f) {
+        fr = mix(fr, film_fresnel(cos_oh, l->film_ior, l->film_thickness, l->f0), l->iridescence);
+    }
+#endif
     float3 fr_trans = fr;
     float3 fr_refl = fr;
     if (l->thin && l->transmission > 0.0f) {
@@ -942,6 +1257,13 @@ inline void bsdf_gloss(const SurfaceMaterial* m, const BsdfLobes* l, float cos_o
         fr_refl = mix(fr, fr_trans, l->transmission);
     }
     float3 metal = m->base_color + (1.0f - m->base_color) * schlick_weight(cos_oh);
+#ifdef HAS_IRIDESCENCE
+    // The film over the metal (its f0 the base color).
+    if (l->iridescence > 0.0f && l->metallic > 0.0f) {
+        metal = mix(metal, film_fresnel(cos_oh, l->film_ior, l->film_thickness, m->base_color),
+                    l->iridescence);
+    }
+#endif
     float dielectric = 1.0f - l->metallic;
     *refl = (dielectric * l->specular) * fr_refl + l->metallic * metal;
     bool tir = !l->thin && refracted_cos2(cos_oh, l->eta) <= 0.0f;
@@ -954,13 +1276,13 @@ inline void bsdf_gloss(const SurfaceMaterial* m, const BsdfLobes* l, float cos_o
 // shadow rays pass it, tinted by thin_wall_transmittance.
 inline bool bsdf_passes_straight(const SurfaceMaterial* m) {
     return m->transmission > 0.0f && m->thickness <= 0.0f && m->metallic < 1.0f &&
-           m->roughness * m->roughness < BSDF_DELTA_ALPHA;
+           bsdf_alpha_max(m) < BSDF_DELTA_ALPHA;
 }
 
 // What a smooth thin wall lets straight through at cos(theta) = cos_o: the expected weight of
 // bsdf_sample's straight-through lobe.
 inline float3 thin_wall_transmittance(const SurfaceMaterial* m, float cos_o) {
-    BsdfLobes l = bsdf_lobes(m, cos_o);
+    BsdfLobes l = bsdf_lobes(m, (float3)(sqrt(fmax(1.0f - cos_o * cos_o, 0.0f)), 0.0f, cos_o));
     float3 refl, trans;
     bsdf_gloss(m, &l, cos_o, &refl, &trans);
 #ifdef HAS_CLEARCOAT
@@ -979,6 +1301,16 @@ inline float reflect_probability(float3 refl, float3 trans) {
     return r + t > 0.0f ? r / (r + t) : 1.0f;
 }
 
+// The probability of the cosine-sampled lobes (diffuse, multiple scattering and diffuse
+// transmission).
+inline float lobes_p_cosine(const BsdfLobes* l) {
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    return l->p_diffuse + l->p_dtrans;
+#else
+    return l->p_diffuse;
+#endif
+}
+
 // The base lobes (all but the coat) at local wo, wi: f * cos with the glossy ones scaled by gs,
 // and their mixture pdf.
 inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo, float3 wi,
@@ -986,16 +1318,21 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
     float3 f = (float3)(0.0f);
     float p = 0.0f;
     if (wi.z > 0.0f) {
-        f = cosine_lobes(l, wi.z, gs);
+        f = cosine_lobes(l, wi, gs);
         p = l->p_diffuse * (wi.z * INV_PI_F);
     }
-    float p_gloss = 1.0f - l->p_diffuse;
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    else if (l->p_dtrans > 0.0f) {
+        f = diffuse_transmission_lobe(l, wi);
+        p = l->p_dtrans * (-wi.z * INV_PI_F);
+    }
+#endif
+    float p_gloss = 1.0f - lobes_p_cosine(l);
     if (l->delta || !(p_gloss > 0.0f)) {
         *pdf = p;
         return f;
     }
-    float a2 = l->alpha * l->alpha;
-    float lambda_o = ggx_lambda(wo, a2);
+    float lambda_o = lobe_lambda(l, wo);
     float g1 = 1.0f / (1.0f + lambda_o);
     float inv_cos_o = 1.0f / fmax(wo.z, 1e-20f);
     float3 refl, trans;
@@ -1004,8 +1341,8 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
         float3 wr = (float3)(wi.x, wi.y, fabs(wi.z));
         float3 h = normalize(wo + wr);
         bsdf_gloss(m, l, dot(wo, h), &refl, &trans);
-        float d = ggx_d(h, a2);
-        float g2 = 1.0f / (1.0f + lambda_o + ggx_lambda(wr, a2));
+        float d = lobe_d(l, h);
+        float g2 = 1.0f / (1.0f + lambda_o + lobe_lambda(l, wr));
         float pr = reflect_probability(refl, trans);
         float3 c = wi.z > 0.0f ? refl : trans;
         f += c * (0.25f * d * g2 * inv_cos_o) * gs;
@@ -1023,8 +1360,8 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
         float cos_ih = dot(wi, h);
         if (cos_oh > 0.0f && cos_ih < 0.0f) {
             bsdf_gloss(m, l, cos_oh, &refl, &trans);
-            float d = ggx_d(h, a2);
-            float g2 = 1.0f / (1.0f + lambda_o + ggx_lambda(wi, a2));
+            float d = lobe_d(l, h);
+            float g2 = 1.0f / (1.0f + lambda_o + lobe_lambda(l, wi));
             // dwh/dwi; |wo.h + eta wi.h| = len.
             float jacobian = l->eta * l->eta * -cos_ih / (len * len);
             float vndf = g1 * d * cos_oh * inv_cos_o;
@@ -1071,13 +1408,18 @@ inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, flo
                         float* pdf) {
     *pdf = 0.0f;
     float3 t, b;
-    onb(n, &t, &b);
+    bsdf_frame(m, n, &t, &b);
     float3 wo = (float3)(dot(wo_world, t), dot(wo_world, b), dot(wo_world, n));
     float3 wi = (float3)(dot(wi_world, t), dot(wi_world, b), dot(wi_world, n));
-    if (wo.z <= 0.0f || wi.z == 0.0f || (wi.z < 0.0f && !(m->transmission > 0.0f))) {
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    bool passes = m->transmission > 0.0f || m->diffuse_transmission > 0.0f;
+#else
+    bool passes = m->transmission > 0.0f;
+#endif
+    if (wo.z <= 0.0f || wi.z == 0.0f || (wi.z < 0.0f && !passes)) {
         return (float3)(0.0f);
     }
-    BsdfLobes l = bsdf_lobes(m, wo.z);
+    BsdfLobes l = bsdf_lobes(m, wo);
 #if defined(HAS_CLEARCOAT) || defined(HAS_SHEEN)
     // The coat over the sheen over the base: each scales the glossy lobes under it and is
     // sampled by its share.
@@ -1126,10 +1468,10 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
     *specular = false;
     *wi_world = n;
     float3 t, b;
-    onb(n, &t, &b);
+    bsdf_frame(m, n, &t, &b);
     float3 wo = (float3)(dot(wo_world, t), dot(wo_world, b), dot(wo_world, n));
     if (wo.z <= 0.0f) return (float3)(0.0f);
-    BsdfLobes l = bsdf_lobes(m, wo.z);
+    BsdfLobes l = bsdf_lobes(m, wo);
     float3 wi;
 #ifdef HAS_CLEARCOAT
     // The share of the base lobes (all but the coat).
@@ -1181,12 +1523,21 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
         u.x = fmin((u.x - q) / p_under_sheen, 0x1.fffffep-1f);
     }
 #endif
+    float p_cos = lobes_p_cosine(&l);
     if (u.x < l.p_diffuse) {
         wi = sample_cosine(u.x / l.p_diffuse, u.y);
-    } else {
+    }
+#ifdef HAS_DIFFUSE_TRANSMISSION
+    else if (u.x < p_cos) {
+        // Diffuse transmission: the cosine lobe below the surface.
+        wi = sample_cosine(fmin((u.x - l.p_diffuse) / l.p_dtrans, 0x1.fffffep-1f), u.y);
+        wi.z = -wi.z;
+    }
+#endif
+    else {
         // A visible microfacet, then reflection or transmission by their share at it.
-        float ug = fmin((u.x - l.p_diffuse) / (1.0f - l.p_diffuse), 0x1.fffffep-1f);
-        float3 h = l.delta ? (float3)(0.0f, 0.0f, 1.0f) : ggx_sample_vndf(wo, l.alpha, ug, u.y);
+        float ug = fmin((u.x - p_cos) / (1.0f - p_cos), 0x1.fffffep-1f);
+        float3 h = l.delta ? (float3)(0.0f, 0.0f, 1.0f) : lobe_sample_vndf(&l, wo, ug, u.y);
         float cos_oh = dot(wo, h);
         float3 refl, trans;
         bsdf_gloss(m, &l, cos_oh, &refl, &trans);
@@ -1203,7 +1554,7 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
             if (wi.z >= 0.0f) return (float3)(0.0f);
         }
         if (l.delta) {
-            float chosen = (1.0f - l.p_diffuse) * (reflect ? pr : 1.0f - pr);
+            float chosen = (1.0f - p_cos) * (reflect ? pr : 1.0f - pr);
             if (!(chosen > 0.0f)) return (float3)(0.0f);
             *wi_world = normalize(wi.x * t + wi.y * b + wi.z * n);
             *pdf = chosen;

@@ -4,6 +4,15 @@
 inline SurfaceMaterial bsdf_test_material(global const GpuMaterial* material, uint inside) {
     SurfaceMaterial m = surface_material(material);
     if (inside != 0u) material_from_inside(&m);
+#ifdef HAS_ANISOTROPY
+    // A tangent as the shade kernel gives it (not orthogonal to the normal), turned by the
+    // rotation: the frame comes from the direction, not from onb's fallback.
+    if (m.anisotropy > 0.0f) {
+        float3 t = (float3)(0.6f, -0.48f, 0.64f);
+        float3 b = (float3)(0.8f, 0.36f, -0.48f);
+        m.aniso_dir = m.aniso_rotation.x * t + m.aniso_rotation.y * b;
+    }
+#endif
     return m;
 }
 

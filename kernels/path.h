@@ -239,6 +239,11 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     float alpha_r = m.roughness * m.roughness;
     s->cone = (float2)(cone_width, cone.y + alpha_r);
 #endif
+#ifdef HAS_ANISOTROPY
+    if (m.anisotropy > 0.0f) {
+        m.aniso_dir = anisotropy_direction(surf, hit.prim, hit.u, hit.v, ns, front, m.aniso_rotation);
+    }
+#endif
 
     // Hit from behind, a transmissive volume was travelled through: attenuate the segment
     // (Beer–Lambert) and see the interface from inside. Other back faces shade as front faces.

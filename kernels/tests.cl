@@ -41,7 +41,9 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuMaterial, volume); PROBE_FIELD(GpuMaterial, alpha);
     PROBE_FIELD(GpuMaterial, textures); PROBE_FIELD(GpuMaterial, textures2);
     PROBE_FIELD(GpuMaterial, coat); PROBE_FIELD(GpuMaterial, textures3);
-    PROBE_FIELD(GpuMaterial, sheen);
+    PROBE_FIELD(GpuMaterial, sheen); PROBE_FIELD(GpuMaterial, aniso);
+    PROBE_FIELD(GpuMaterial, iridescence); PROBE_FIELD(GpuMaterial, diffuse_transmission);
+    PROBE_FIELD(GpuMaterial, textures4); PROBE_FIELD(GpuMaterial, textures5);
     PROBE_SIZE(GpuLight);
     PROBE_FIELD(GpuLight, position); PROBE_FIELD(GpuLight, intensity);
     PROBE_FIELD(GpuLight, spot); PROBE_FIELD(GpuLight, extra);

@@ -96,6 +96,12 @@ typedef struct {
     float4 coat;        // clearcoat: .x factor, .y roughness, .z normal texture scale
     int4 textures3;     // texture refs: .x clearcoat, .y clearcoat roughness, .z clearcoat normal
     float4 sheen;       // sheen: .xyz color, .w roughness
+    float4 aniso;       // anisotropy: .x strength, .y cos, .z sin of the rotation; .w dispersion
+    float4 iridescence; // iridescence: .x factor, .y ior, .z thickness minimum, .w maximum (nm)
+    float4 diffuse_transmission;  // .xyz color, .w factor
+    int4 textures4;     // texture refs: .x anisotropy, .y iridescence (R), .z iridescence
+                        // thickness (G), .w diffuse transmission (A); -1 none
+    int4 textures5;     // texture refs: .x diffuse transmission color; -1 none
 } GpuMaterial;
 
 typedef struct {

@@ -884,3 +884,167 @@ fn clearcoat_factors_textures_and_transforms_are_read() {
         "tangents for the coat's normals"
     );
 }
+
+/// `KHR_materials_anisotropy` is read: strength, rotation and the texture with its texCoord
+/// and `KHR_texture_transform`; tangents are made for the anisotropic material (it has no
+/// normal map) and nothing warns.
+#[test]
+fn anisotropy_strength_rotation_and_texture_are_read() {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let image = t.embedded(&mut g, &png(4, 4, &test_texels()));
+    let tex = t.texture(image, REPEAT);
+    g.use_ext("KHR_materials_anisotropy");
+    g.use_ext("KHR_texture_transform");
+    let m = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"extensions": {"KHR_materials_anisotropy": {
+            "anisotropyStrength": 0.6,
+            "anisotropyRotation": 1.25,
+            "anisotropyTexture": {"index": tex, "extensions": {"KHR_texture_transform":
+                {"offset": [0.25, 0.5], "rotation": 0.2, "scale": [3.0, 2.0]}}}
+        }}}),
+    );
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, false, false);
+    g.node(json!({"mesh": mesh}));
+    let dir = tempfile::tempdir().unwrap();
+    let s = penumbra::scene::load(&g.write_glb(dir.path(), "aniso")).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let mat = &s.materials[m];
+    assert_eq!((mat.anisotropy, mat.anisotropy_rotation), (0.6, 1.25));
+    let r = &s.texture_refs[mat.textures.anisotropy.expect("a texture") as usize];
+    assert_eq!(r.tex_coord, 0);
+    assert_eq!(
+        (r.transform.offset, r.transform.rotation, r.transform.scale),
+        ([0.25, 0.5], 0.2, [3.0, 2.0])
+    );
+    assert!(!r.srgb, "the direction is data, not color");
+    let world = s.world_triangles();
+    assert!(
+        world.iter().all(|t| t.tangents.is_some()),
+        "tangents for the anisotropy direction"
+    );
+    let gpu = penumbra::render::gpu_material(mat);
+    assert_eq!(gpu.aniso[0], 0.6);
+    assert!(
+        (gpu.aniso[1] - 1.25f32.cos()).abs() < 1e-6 && (gpu.aniso[2] - 1.25f32.sin()).abs() < 1e-6
+    );
+    assert_eq!(gpu.textures4[0], mat.textures.anisotropy.unwrap() as i32);
+}
+
+/// `KHR_materials_iridescence` is read: factor, film IOR, thickness range and both textures
+/// (the thickness texture with its `KHR_texture_transform`); nothing warns.
+#[test]
+fn iridescence_factors_and_textures_are_read() {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let image = t.embedded(&mut g, &png(4, 4, &test_texels()));
+    let factor = t.texture(image, REPEAT);
+    let thickness = t.texture(image, CLAMP);
+    g.use_ext("KHR_materials_iridescence");
+    g.use_ext("KHR_texture_transform");
+    let m = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"extensions": {"KHR_materials_iridescence": {
+            "iridescenceFactor": 0.8,
+            "iridescenceTexture": {"index": factor},
+            "iridescenceIor": 1.6,
+            "iridescenceThicknessMinimum": 150.0,
+            "iridescenceThicknessMaximum": 650.0,
+            "iridescenceThicknessTexture": {"index": thickness, "extensions": {"KHR_texture_transform":
+                {"scale": [2.0, 2.0]}}}
+        }}}),
+    );
+    // Defaults: a film of 1.3 and 100..400 nm.
+    let d = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"extensions": {"KHR_materials_iridescence": {"iridescenceFactor": 1.0}}}),
+    );
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, false, false);
+    g.node(json!({"mesh": mesh}));
+    let dir = tempfile::tempdir().unwrap();
+    let s = penumbra::scene::load(&g.write_glb(dir.path(), "film")).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let mat = &s.materials[m];
+    assert_eq!(
+        (
+            mat.iridescence,
+            mat.iridescence_ior,
+            mat.iridescence_thickness
+        ),
+        (0.8, 1.6, [150.0, 650.0])
+    );
+    assert!(mat.textures.iridescence.is_some());
+    let r = &s.texture_refs[mat.textures.iridescence_thickness.expect("a texture") as usize];
+    assert_eq!(r.transform.scale, [2.0, 2.0]);
+    let def = &s.materials[d];
+    assert_eq!(
+        (
+            def.iridescence,
+            def.iridescence_ior,
+            def.iridescence_thickness
+        ),
+        (1.0, 1.3, [100.0, 400.0])
+    );
+    let gpu = penumbra::render::gpu_material(mat);
+    assert_eq!(gpu.iridescence, [0.8, 1.6, 150.0, 650.0]);
+    assert_eq!(gpu.textures4[1], mat.textures.iridescence.unwrap() as i32);
+    assert_eq!(
+        gpu.textures4[2],
+        mat.textures.iridescence_thickness.unwrap() as i32
+    );
+}
+
+/// `KHR_materials_diffuse_transmission` is read: factor and color with their textures (the
+/// color texture is sRGB, the factor texture's alpha is data); nothing warns.
+#[test]
+fn diffuse_transmission_factors_and_textures_are_read() {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    let image = t.embedded(&mut g, &png(4, 4, &test_texels()));
+    let factor = t.texture(image, REPEAT);
+    let color = t.texture(image, MIRROR);
+    g.use_ext("KHR_materials_diffuse_transmission");
+    let m = lambert(
+        &mut g,
+        [1.0; 4],
+        json!({"extensions": {"KHR_materials_diffuse_transmission": {
+            "diffuseTransmissionFactor": 0.35,
+            "diffuseTransmissionTexture": {"index": factor},
+            "diffuseTransmissionColorFactor": [0.9, 0.5, 2.0],
+            "diffuseTransmissionColorTexture": {"index": color, "texCoord": 1}
+        }}}),
+    );
+    t.finish(&mut g);
+    let mesh = quad(&mut g, m, false, false);
+    g.node(json!({"mesh": mesh}));
+    let dir = tempfile::tempdir().unwrap();
+    let s = penumbra::scene::load(&g.write_glb(dir.path(), "leaf")).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let mat = &s.materials[m];
+    assert_eq!(mat.diffuse_transmission, 0.35);
+    assert_eq!(
+        mat.diffuse_transmission_color,
+        [0.9, 0.5, 1.0],
+        "clamped to 1"
+    );
+    let refs = |slot: Option<u32>| &s.texture_refs[slot.expect("a texture") as usize];
+    assert!(!refs(mat.textures.diffuse_transmission).srgb);
+    let c = refs(mat.textures.diffuse_transmission_color);
+    assert!(c.srgb && c.tex_coord == 1);
+    let gpu = penumbra::render::gpu_material(mat);
+    assert_eq!(gpu.diffuse_transmission, [0.9, 0.5, 1.0, 0.35]);
+    assert_eq!(
+        gpu.textures4[3],
+        mat.textures.diffuse_transmission.unwrap() as i32
+    );
+    assert_eq!(
+        gpu.textures5[0],
+        mat.textures.diffuse_transmission_color.unwrap() as i32
+    );
+}

@@ -65,6 +65,16 @@ pub struct KernelFeatures {
     pub clearcoat: bool,
     /// Some material has a sheen (`HAS_SHEEN`, `KHR_materials_sheen`).
     pub sheen: bool,
+    /// Some material transmits diffusely (`HAS_DIFFUSE_TRANSMISSION`,
+    /// `KHR_materials_diffuse_transmission`).
+    pub diffuse_transmission: bool,
+    /// Some material is iridescent (`HAS_IRIDESCENCE`, `KHR_materials_iridescence`).
+    pub iridescence: bool,
+    /// Some material is anisotropic (`HAS_ANISOTROPY`, `KHR_materials_anisotropy`).
+    pub anisotropy: bool,
+    /// Tangents are uploaded for the anisotropic materials' frames (`HAS_TANGENTS`; only set
+    /// with `anisotropy`).
+    pub tangents: bool,
     /// Every material is Lambertian (`LAMBERT_ONLY`: no specular layer, metal, transmission,
     /// coat or sheen anywhere), so the BSDF is evaluated as base color / pi.
     pub lambert_only: bool,
@@ -87,6 +97,10 @@ impl KernelFeatures {
             (self.unlit, "HAS_UNLIT"),
             (self.clearcoat, "HAS_CLEARCOAT"),
             (self.sheen, "HAS_SHEEN"),
+            (self.diffuse_transmission, "HAS_DIFFUSE_TRANSMISSION"),
+            (self.iridescence, "HAS_IRIDESCENCE"),
+            (self.anisotropy, "HAS_ANISOTROPY"),
+            (self.tangents, "HAS_TANGENTS"),
             (self.lambert_only, "LAMBERT_ONLY"),
             (self.two_level, "TWO_LEVEL"),
         ] {

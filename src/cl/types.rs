@@ -310,7 +310,7 @@ pub struct GpuEnvironment {
 }
 const _: () = assert!(size_of::<GpuEnvironment>() == 48);
 
-/// A glTF material as the kernels see it (176 bytes).
+/// A glTF material as the kernels see it (256 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuMaterial {
@@ -340,8 +340,23 @@ pub struct GpuMaterial {
     pub textures3: [i32; 4],
     /// `KHR_materials_sheen`: `.xyz` sheenColorFactor, `.w` sheenRoughnessFactor.
     pub sheen: [f32; 4],
+    /// `KHR_materials_anisotropy`: `.x` anisotropyStrength, `.y` cos and `.z` sin of
+    /// anisotropyRotation; `.w` `KHR_materials_dispersion` dispersion.
+    pub aniso: [f32; 4],
+    /// `KHR_materials_iridescence`: `.x` iridescenceFactor, `.y` iridescenceIor, `.z`
+    /// iridescenceThicknessMinimum, `.w` iridescenceThicknessMaximum (nanometres).
+    pub iridescence: [f32; 4],
+    /// `KHR_materials_diffuse_transmission`: `.xyz` diffuseTransmissionColorFactor, `.w`
+    /// diffuseTransmissionFactor.
+    pub diffuse_transmission: [f32; 4],
+    /// Texture references: `.x` anisotropy (RG direction, B strength), `.y` iridescence (R),
+    /// `.z` iridescence thickness (G), `.w` diffuse transmission (A); -1 when absent.
+    pub textures4: [i32; 4],
+    /// Texture references: `.x` diffuse transmission color (sRGB RGB); `.yzw` spare; -1 when
+    /// absent.
+    pub textures5: [i32; 4],
 }
-const _: () = assert!(size_of::<GpuMaterial>() == 176);
+const _: () = assert!(size_of::<GpuMaterial>() == 256);
 
 /// One light for next-event estimation (64 bytes).
 #[repr(C)]
@@ -512,7 +527,12 @@ pub fn layouts() -> Vec<StructLayout> {
             textures2,
             coat,
             textures3,
-            sheen
+            sheen,
+            aniso,
+            iridescence,
+            diffuse_transmission,
+            textures4,
+            textures5
         ),
         layout!(GpuLight, position, intensity, spot, extra),
         layout!(GpuCamera, origin, forward, right, up),

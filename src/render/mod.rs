@@ -20,7 +20,7 @@ pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
 pub use update::InstanceUpdate;
-pub use upload::{Accel, HostScene, gpu_camera};
+pub use upload::{Accel, HostScene, gpu_camera, gpu_material};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
 use crate::bvh::{Ray, WideBvh};
@@ -95,6 +95,10 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         unlit: used(&|m| m.unlit),
         clearcoat: used(&|m| m.clearcoat > 0.0),
         sheen: used(&|m| m.sheen_color.iter().any(|&c| c > 0.0)),
+        diffuse_transmission: used(&|m| m.diffuse_transmission > 0.0),
+        iridescence: used(&|m| m.iridescence > 0.0),
+        anisotropy: used(&|m| m.anisotropy > 0.0),
+        tangents: used(&|m| m.anisotropy > 0.0) && tangents,
         lambert_only: materials().all(|m| m.is_lambertian()),
     }
 }

@@ -233,6 +233,31 @@ pub fn gpu_material(m: &Material) -> GpuMaterial {
             m.sheen_color[2],
             m.sheen_roughness,
         ],
+        aniso: [
+            m.anisotropy,
+            m.anisotropy_rotation.cos(),
+            m.anisotropy_rotation.sin(),
+            m.dispersion,
+        ],
+        iridescence: [
+            m.iridescence,
+            m.iridescence_ior,
+            m.iridescence_thickness[0],
+            m.iridescence_thickness[1],
+        ],
+        diffuse_transmission: [
+            m.diffuse_transmission_color[0],
+            m.diffuse_transmission_color[1],
+            m.diffuse_transmission_color[2],
+            m.diffuse_transmission,
+        ],
+        textures4: [
+            slot(m.textures.anisotropy),
+            slot(m.textures.iridescence),
+            slot(m.textures.iridescence_thickness),
+            slot(m.textures.diffuse_transmission),
+        ],
+        textures5: [slot(m.textures.diffuse_transmission_color), -1, -1, -1],
     }
 }
 

@@ -64,13 +64,17 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         table.drop_missing(&mut m.textures);
     }
     let default_material = materials.len() as u32;
-    // The texture coordinate set of each material's normal map (tangents are made for it).
-    let normal_sets: Vec<Option<u32>> = materials
+    // The texture coordinate set tangents are made for: the material's normal map's, else (an
+    // anisotropic material's frame) its anisotropy texture's or set 0; `true` for a normal map.
+    let normal_sets: Vec<Option<(u32, bool)>> = materials
         .iter()
         .map(|m| {
-            (m.textures.normal)
-                .or(m.textures.clearcoat_normal)
-                .map(|r| table.refs[r as usize].tex_coord)
+            let set = |r: u32| table.refs[r as usize].tex_coord;
+            match (m.textures.normal).or(m.textures.clearcoat_normal) {
+                Some(r) => Some((set(r), true)),
+                None if m.anisotropy > 0.0 => Some((m.textures.anisotropy.map_or(0, set), false)),
+                None => None,
+            }
         })
         .collect();
 
@@ -458,6 +462,11 @@ impl TextureTable {
             &mut slots.clearcoat_normal,
             &mut slots.sheen_color,
             &mut slots.sheen_roughness,
+            &mut slots.anisotropy,
+            &mut slots.iridescence,
+            &mut slots.iridescence_thickness,
+            &mut slots.diffuse_transmission,
+            &mut slots.diffuse_transmission_color,
         ] {
             if let Some(r) = *slot
                 && self.failed[self.refs[r as usize].image as usize]
@@ -774,7 +783,7 @@ fn import_mesh(
     data: &BufferData,
     pose: &Pose,
     default_material: u32,
-    normal_sets: &[Option<u32>],
+    normal_sets: &[Option<(u32, bool)>],
     warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
     let mut out = Mesh::default();
@@ -928,12 +937,16 @@ fn import_mesh(
                 .iter()
                 .map(|tri| tri.map(|i| file_tangents[i as usize]))
                 .collect(),
-            Some(set) => {
+            Some((set, normal_map)) => {
                 let set_uvs = if set == 1 { &uvs1 } else { &uvs };
                 if set_uvs.is_empty() {
-                    warnings.push(format!(
-                        "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"
-                    ));
+                    // An anisotropic material without texture coordinates takes an arbitrary
+                    // frame about the normal (kernels/path.h).
+                    if normal_map {
+                        warnings.push(format!(
+                            "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"
+                        ));
+                    }
                     Vec::new()
                 } else {
                     super::tangents::generate(&positions, &normals, set_uvs, &triangles)

@@ -161,6 +161,23 @@ pub struct Material {
     pub sheen_color: [f32; 3],
     /// `KHR_materials_sheen` sheenRoughnessFactor.
     pub sheen_roughness: f32,
+    /// `KHR_materials_anisotropy` anisotropyStrength (0: isotropic).
+    pub anisotropy: f32,
+    /// `KHR_materials_anisotropy` anisotropyRotation (radians, counter-clockwise from the
+    /// tangent).
+    pub anisotropy_rotation: f32,
+    /// `KHR_materials_iridescence` iridescenceFactor (0: no thin film).
+    pub iridescence: f32,
+    /// `KHR_materials_iridescence` iridescenceIor (of the film).
+    pub iridescence_ior: f32,
+    /// `KHR_materials_iridescence` iridescenceThicknessMinimum and Maximum (nanometres).
+    pub iridescence_thickness: [f32; 2],
+    /// `KHR_materials_diffuse_transmission` diffuseTransmissionFactor (0: none).
+    pub diffuse_transmission: f32,
+    /// `KHR_materials_diffuse_transmission` diffuseTransmissionColorFactor (linear).
+    pub diffuse_transmission_color: [f32; 3],
+    /// `KHR_materials_dispersion` dispersion (20 / Abbe number; 0: none).
+    pub dispersion: f32,
 }
 
 impl Default for Material {
@@ -188,21 +205,30 @@ impl Default for Material {
             clearcoat_normal_scale: 1.0,
             sheen_color: [0.0; 3],
             sheen_roughness: 0.0,
+            anisotropy: 0.0,
+            anisotropy_rotation: 0.0,
+            iridescence: 0.0,
+            iridescence_ior: 1.3,
+            iridescence_thickness: [100.0, 400.0],
+            diffuse_transmission: 0.0,
+            diffuse_transmission_color: [1.0; 3],
+            dispersion: 0.0,
         }
     }
 }
 
 impl Material {
     /// Whether the material scatters as a pure Lambertian (base color / pi): an opaque
-    /// dielectric without a specular layer, coat or sheen. Textures cannot change that (the
-    /// metallic and specular textures scale factors that are 0 here). Unlit materials do not
-    /// scatter at all and do not count against it.
+    /// dielectric without a specular layer, coat, sheen or diffuse transmission. Textures cannot
+    /// change that (the metallic and specular textures scale factors that are 0 here). Unlit
+    /// materials do not scatter at all and do not count against it.
     pub fn is_lambertian(&self) -> bool {
         self.unlit
             || (self.metallic == 0.0
                 && self.specular_factor == 0.0
                 && self.transmission == 0.0
                 && self.clearcoat == 0.0
+                && self.diffuse_transmission == 0.0
                 && self.sheen_color.iter().all(|&c| c == 0.0))
     }
 

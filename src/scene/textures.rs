@@ -134,6 +134,16 @@ pub struct MaterialTextures {
     pub sheen_color: Option<u32>,
     /// `KHR_materials_sheen` sheenRoughnessTexture (A).
     pub sheen_roughness: Option<u32>,
+    /// `KHR_materials_anisotropy` anisotropyTexture (RG direction, B strength).
+    pub anisotropy: Option<u32>,
+    /// `KHR_materials_iridescence` iridescenceTexture (R).
+    pub iridescence: Option<u32>,
+    /// `KHR_materials_iridescence` iridescenceThicknessTexture (G).
+    pub iridescence_thickness: Option<u32>,
+    /// `KHR_materials_diffuse_transmission` diffuseTransmissionTexture (A).
+    pub diffuse_transmission: Option<u32>,
+    /// `KHR_materials_diffuse_transmission` diffuseTransmissionColorTexture (sRGB RGB).
+    pub diffuse_transmission_color: Option<u32>,
 }
 
 impl MaterialTextures {
@@ -149,6 +159,11 @@ impl MaterialTextures {
             || self.clearcoat_normal.is_some()
             || self.sheen_color.is_some()
             || self.sheen_roughness.is_some()
+            || self.anisotropy.is_some()
+            || self.iridescence.is_some()
+            || self.iridescence_thickness.is_some()
+            || self.diffuse_transmission.is_some()
+            || self.diffuse_transmission_color.is_some()
     }
 
     /// Whether a slot holds a tangent-space normal map (the base's or the clearcoat's).

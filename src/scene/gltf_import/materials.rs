@@ -1,5 +1,7 @@
 //! Material extensions the gltf crate does not parse, read from the material's raw
-//! `extensions` JSON: `KHR_materials_clearcoat` and `KHR_materials_sheen`.
+//! `extensions` JSON: `KHR_materials_clearcoat`, `KHR_materials_sheen`,
+//! `KHR_materials_anisotropy`, `KHR_materials_iridescence` and
+//! `KHR_materials_diffuse_transmission`.
 
 use super::TextureTable;
 use crate::scene::Material;
@@ -26,6 +28,15 @@ pub(super) fn read_extensions(
     }
     if let Some(x) = m.extension_value("KHR_materials_sheen") {
         reader.sheen(x, material);
+    }
+    if let Some(x) = m.extension_value("KHR_materials_anisotropy") {
+        reader.anisotropy(x, material);
+    }
+    if let Some(x) = m.extension_value("KHR_materials_iridescence") {
+        reader.iridescence(x, material);
+    }
+    if let Some(x) = m.extension_value("KHR_materials_diffuse_transmission") {
+        reader.diffuse_transmission(x, material);
     }
 }
 
@@ -81,17 +92,61 @@ impl Reader<'_> {
         t.clearcoat_normal = self.texture(x, "clearcoatNormalTexture", false);
     }
 
-    fn sheen(&mut self, x: &Value, material: &mut Material) {
-        let color = x.get("sheenColorFactor").and_then(Value::as_array);
-        material.sheen_color = std::array::from_fn(|i| {
+    /// An RGB factor of the extension object, each channel clamped to [0, 1]; `default` where
+    /// absent or not a number.
+    fn color(x: &Value, key: &str, default: f32) -> [f32; 3] {
+        let color = x.get(key).and_then(Value::as_array);
+        std::array::from_fn(|i| {
             color
                 .and_then(|c| c.get(i))
                 .and_then(Value::as_f64)
-                .map_or(0.0, |v| (v as f32).clamp(0.0, 1.0))
-        });
+                .map_or(default, |v| (v as f32).clamp(0.0, 1.0))
+        })
+    }
+
+    fn sheen(&mut self, x: &Value, material: &mut Material) {
+        material.sheen_color = Self::color(x, "sheenColorFactor", 0.0);
         material.sheen_roughness = Self::unit(x, "sheenRoughnessFactor", 0.0);
         let t: &mut MaterialTextures = &mut material.textures;
         t.sheen_color = self.texture(x, "sheenColorTexture", true);
         t.sheen_roughness = self.texture(x, "sheenRoughnessTexture", false);
+    }
+
+    fn anisotropy(&mut self, x: &Value, material: &mut Material) {
+        material.anisotropy = Self::unit(x, "anisotropyStrength", 0.0);
+        material.anisotropy_rotation = x
+            .get("anisotropyRotation")
+            .and_then(Value::as_f64)
+            .filter(|r| r.is_finite())
+            .map_or(0.0, |r| r as f32);
+        material.textures.anisotropy = self.texture(x, "anisotropyTexture", false);
+    }
+
+    /// A non-negative finite number of the extension object; `default` otherwise.
+    fn non_negative(x: &Value, key: &str, default: f32) -> f32 {
+        x.get(key)
+            .and_then(Value::as_f64)
+            .filter(|v| v.is_finite() && *v >= 0.0)
+            .map_or(default, |v| v as f32)
+    }
+
+    fn diffuse_transmission(&mut self, x: &Value, material: &mut Material) {
+        material.diffuse_transmission = Self::unit(x, "diffuseTransmissionFactor", 0.0);
+        material.diffuse_transmission_color = Self::color(x, "diffuseTransmissionColorFactor", 1.0);
+        let t: &mut MaterialTextures = &mut material.textures;
+        t.diffuse_transmission = self.texture(x, "diffuseTransmissionTexture", false);
+        t.diffuse_transmission_color = self.texture(x, "diffuseTransmissionColorTexture", true);
+    }
+
+    fn iridescence(&mut self, x: &Value, material: &mut Material) {
+        material.iridescence = Self::unit(x, "iridescenceFactor", 0.0);
+        material.iridescence_ior = Self::non_negative(x, "iridescenceIor", 1.3).max(1.0);
+        material.iridescence_thickness = [
+            Self::non_negative(x, "iridescenceThicknessMinimum", 100.0),
+            Self::non_negative(x, "iridescenceThicknessMaximum", 400.0),
+        ];
+        let t: &mut MaterialTextures = &mut material.textures;
+        t.iridescence = self.texture(x, "iridescenceTexture", false);
+        t.iridescence_thickness = self.texture(x, "iridescenceThicknessTexture", false);
     }
 }
