@@ -1928,14 +1928,47 @@ fn furnace_scene_uv(dir: &std::path::Path, name: &str, m: &Mat) -> std::path::Pa
     g.write_glb(dir, name)
 }
 
+/// Renders each case's sphere in the white furnace (the scene written by `scene`, 64 spp and
+/// `bounces` bounces) and checks that it loads without a warning, has no non-finite sample,
+/// gains no energy and keeps at least its lowest accepted mean (within 4 sigma). The EXRs are
+/// kept in the test output as TAG0, TAG1, ...
+fn check_furnace_cases(
+    tag: &str,
+    cases: &[(&str, Mat, f64)],
+    bounces: u32,
+    scene: fn(&std::path::Path, &str, &Mat) -> std::path::PathBuf,
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let pixels = sphere_pixels();
+    let out = output_dir("bsdf");
+    let mut report = vec![];
+    for (k, (name, m, low)) in cases.iter().enumerate() {
+        let scene = scene(dir.path(), &format!("{tag}{k}"), m);
+        let warnings = penumbra::scene::load(&scene).unwrap().warnings;
+        assert!(warnings.is_empty(), "{name}: {warnings:?}");
+        let (summary, px) = furnace_render(&scene, 64, bounces);
+        assert_eq!(summary["nonfinite_samples"], 0, "{name}");
+        let _ = std::fs::copy(
+            scene.with_extension("exr"),
+            out.join(format!("{tag}{k}.exr")),
+        );
+        let (mean, err) = sphere_mean(&px, &pixels);
+        report.push(format!("{name}: mean {mean:.4} ± {err:.4}"));
+        assert!(
+            mean <= 1.0 + 4.0 * err + 1e-3,
+            "{name} gains energy: {mean}"
+        );
+        assert!(mean >= low - 4.0 * err, "{name} loses energy: {mean:.4}");
+    }
+    eprintln!("{}", report.join("\n"));
+}
+
 /// Anisotropic spheres in the white furnace: never above the sky, and (white metal, white
 /// dielectric) close to it; the compensation reads the isotropic tables at the projected
 /// roughness of each direction (docs/materials.md).
 #[test]
 fn white_furnace_anisotropic_spheres() {
-    let dir = tempfile::tempdir().unwrap();
     let white = [1.0f32; 3];
-    let pixels = sphere_pixels();
     let cases = [
         (
             "metal 0.3, anisotropy 0.5",
@@ -1963,27 +1996,7 @@ fn white_furnace_anisotropic_spheres() {
             0.9,
         ),
     ];
-    let mut report = vec![];
-    let out = output_dir("bsdf");
-    for (k, (name, m, low)) in cases.iter().enumerate() {
-        let scene = furnace_scene_uv(dir.path(), &format!("aniso{k}"), m);
-        let (summary, px) = furnace_render(&scene, 64, 8);
-        assert_eq!(summary["nonfinite_samples"], 0, "{name}");
-        let warnings = penumbra::scene::load(&scene).unwrap().warnings;
-        assert!(warnings.is_empty(), "{name}: {warnings:?}");
-        let _ = std::fs::copy(
-            scene.with_extension("exr"),
-            out.join(format!("aniso{k}.exr")),
-        );
-        let (mean, err) = sphere_mean(&px, &pixels);
-        report.push(format!("{name}: mean {mean:.4} ± {err:.4}"));
-        assert!(
-            mean <= 1.0 + 4.0 * err + 1e-3,
-            "{name} gains energy: {mean}"
-        );
-        assert!(mean >= low - 4.0 * err, "{name} loses energy: {mean:.4}");
-    }
-    eprintln!("{}", report.join("\n"));
+    check_furnace_cases("aniso", &cases, 8, furnace_scene_uv);
 }
 
 /// Iridescent spheres in the white furnace: a white dielectric under a film keeps at most all
@@ -1991,9 +2004,7 @@ fn white_furnace_anisotropic_spheres() {
 /// a white metal under a film keeps what the film reflects.
 #[test]
 fn white_furnace_iridescent_spheres() {
-    let dir = tempfile::tempdir().unwrap();
     let white = [1.0f32; 3];
-    let pixels = sphere_pixels();
     let cases = [
         (
             "white dielectric 0.3, film 1.3 / 400 nm",
@@ -2011,36 +2022,14 @@ fn white_furnace_iridescent_spheres() {
             0.9,
         ),
     ];
-    let mut report = vec![];
-    let out = output_dir("bsdf");
-    for (k, (name, m, low)) in cases.iter().enumerate() {
-        let scene = furnace_scene(dir.path(), &format!("film{k}"), m);
-        let warnings = penumbra::scene::load(&scene).unwrap().warnings;
-        assert!(warnings.is_empty(), "{name}: {warnings:?}");
-        let (summary, px) = furnace_render(&scene, 64, 8);
-        assert_eq!(summary["nonfinite_samples"], 0, "{name}");
-        let _ = std::fs::copy(
-            scene.with_extension("exr"),
-            out.join(format!("film{k}.exr")),
-        );
-        let (mean, err) = sphere_mean(&px, &pixels);
-        report.push(format!("{name}: mean {mean:.4} ± {err:.4}"));
-        assert!(
-            mean <= 1.0 + 4.0 * err + 1e-3,
-            "{name} gains energy: {mean}"
-        );
-        assert!(mean >= low - 4.0 * err, "{name} loses energy: {mean:.4}");
-    }
-    eprintln!("{}", report.join("\n"));
+    check_furnace_cases("film", &cases, 8, furnace_scene);
 }
 
 /// Translucent spheres in the white furnace: light that goes in diffusely comes out again, so a
 /// white sphere that transmits part of its diffuse base keeps all the light (32 bounces).
 #[test]
 fn white_furnace_translucent_spheres() {
-    let dir = tempfile::tempdir().unwrap();
     let white = [1.0f32; 3];
-    let pixels = sphere_pixels();
     let cases = [
         (
             "white lambert, transmission 0.5",
@@ -2058,22 +2047,7 @@ fn white_furnace_translucent_spheres() {
             0.97,
         ),
     ];
-    let mut report = vec![];
-    for (k, (name, m, low)) in cases.iter().enumerate() {
-        let scene = furnace_scene(dir.path(), &format!("leaf{k}"), m);
-        let warnings = penumbra::scene::load(&scene).unwrap().warnings;
-        assert!(warnings.is_empty(), "{name}: {warnings:?}");
-        let (summary, px) = furnace_render(&scene, 64, 32);
-        assert_eq!(summary["nonfinite_samples"], 0, "{name}");
-        let (mean, err) = sphere_mean(&px, &pixels);
-        report.push(format!("{name}: mean {mean:.4} ± {err:.4}"));
-        assert!(
-            mean <= 1.0 + 4.0 * err + 1e-3,
-            "{name} gains energy: {mean}"
-        );
-        assert!(mean >= low - 4.0 * err, "{name} loses energy: {mean:.4}");
-    }
-    eprintln!("{}", report.join("\n"));
+    check_furnace_cases("leaf", &cases, 32, furnace_scene);
 }
 
 #[test]
