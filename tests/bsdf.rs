@@ -2052,8 +2052,6 @@ fn white_furnace_translucent_spheres() {
 
 #[test]
 fn white_furnace_glass_spheres_conserve_energy() {
-    let dir = tempfile::tempdir().unwrap();
-    let pixels = sphere_pixels();
     // (name, material, lowest mean accepted): smooth glass loses nothing; rough glass loses what
     // single-scattering microfacets lose at each of its interfaces.
     // Rays that enter near grazing meet the faceted sphere's walls close to the critical angle
@@ -2064,20 +2062,7 @@ fn white_furnace_glass_spheres_conserve_energy() {
         ("rough glass", Mat::glass(0.3, 1.0), 0.9),
         ("rough thin glass", Mat::glass(0.3, 0.0), 0.9),
     ];
-    let mut report = vec![];
-    for (k, (name, m, low)) in cases.iter().enumerate() {
-        let scene = furnace_scene(dir.path(), &format!("glass{k}"), m);
-        let (summary, px) = furnace_render(&scene, 64, 256);
-        assert_eq!(summary["nonfinite_samples"], 0, "{name}");
-        let (mean, err) = sphere_mean(&px, &pixels);
-        report.push(format!("{name}: mean {mean:.4} ± {err:.4}"));
-        assert!(
-            mean <= 1.0 + 4.0 * err + 1e-3,
-            "{name} gains energy: {mean}"
-        );
-        assert!(mean >= low - 4.0 * err, "{name} loses too much: {mean}");
-    }
-    eprintln!("{}", report.join("\n"));
+    check_furnace_cases("glass", &cases, 256, furnace_scene);
 }
 
 /// Diffuse transmission is reciprocal: f(wo, wi) with wi behind the sheet equals f(wi, wo) seen
