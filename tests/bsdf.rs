@@ -16,6 +16,7 @@ use common::stats::chi2;
 use common::{Gltf, Prim, output_dir, render_exr, sphere};
 use penumbra::cl::types::GpuMaterial;
 use penumbra::cl::{DeviceChoice, Gpu, KernelFeatures, Program};
+use penumbra::scene::Material;
 use serde_json::json;
 use std::f64::consts::PI;
 
@@ -134,47 +135,31 @@ impl Mat {
         }
     }
 
+    /// The device form, packed as the renderer packs a scene's material.
     fn gpu(&self) -> GpuMaterial {
         let b = self.base;
-        let s = self.specular_color;
-        GpuMaterial {
+        penumbra::render::gpu_material(&Material {
             base_color: [b[0], b[1], b[2], 1.0],
-            emission: [0.0; 4],
-            params: [self.metallic, self.roughness, self.ior, self.specular],
-            specular: [s[0], s[1], s[2], self.transmission],
-            volume: [1.0, 1.0, 1.0, f32::INFINITY],
-            alpha: [0.5, 0.0, self.thickness, 1.0],
-            textures: [-1; 4],
-            textures2: [-1; 4],
-            coat: [self.clearcoat, self.coat_roughness, 1.0, 0.0],
-            textures3: [-1; 4],
-            sheen: [
-                self.sheen[0],
-                self.sheen[1],
-                self.sheen[2],
-                self.sheen_roughness,
-            ],
-            aniso: [
-                self.anisotropy,
-                self.anisotropy_rotation.cos(),
-                self.anisotropy_rotation.sin(),
-                0.0,
-            ],
-            iridescence: [
-                self.iridescence[0],
-                self.iridescence[1],
-                100.0,
-                self.iridescence[2],
-            ],
-            diffuse_transmission: [
-                self.diffuse_transmission.1[0],
-                self.diffuse_transmission.1[1],
-                self.diffuse_transmission.1[2],
-                self.diffuse_transmission.0,
-            ],
-            textures4: [-1; 4],
-            textures5: [-1; 4],
-        }
+            metallic: self.metallic,
+            roughness: self.roughness,
+            ior: self.ior,
+            specular_factor: self.specular,
+            specular_color: self.specular_color,
+            transmission: self.transmission,
+            thickness: self.thickness,
+            clearcoat: self.clearcoat,
+            clearcoat_roughness: self.coat_roughness,
+            sheen_color: self.sheen,
+            sheen_roughness: self.sheen_roughness,
+            anisotropy: self.anisotropy,
+            anisotropy_rotation: self.anisotropy_rotation,
+            iridescence: self.iridescence[0],
+            iridescence_ior: self.iridescence[1],
+            iridescence_thickness: [100.0, self.iridescence[2]],
+            diffuse_transmission: self.diffuse_transmission.0,
+            diffuse_transmission_color: self.diffuse_transmission.1,
+            ..Material::default()
+        })
     }
 }
 
@@ -2356,6 +2341,27 @@ fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> (Vec<[f32; 3]>, Vec<u32>) {
     (p, idx)
 }
 
+/// An 8×8 render of `scene` at 4 spp and 4 bounces under a uniform sky of radiance `sky`.
+fn render_8x8_under_sky(
+    scene: &std::path::Path,
+    out: &std::path::Path,
+    sky: &str,
+) -> (serde_json::Value, Vec<[f32; 3]>) {
+    let args = [
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "4",
+        "--bounces",
+        "4",
+        "--sky",
+        sky,
+    ];
+    render_exr(scene, out, &args)
+}
+
 #[test]
 fn beer_lambert_absorption_through_a_slab() {
     // Index-matched glass (ior 1: no reflection, no bending) one unit thick: the sky comes
@@ -2371,22 +2377,7 @@ fn beer_lambert_absorption_through_a_slab() {
     g.node(json!({"mesh": mesh}));
     camera_and_no_light(&mut g, 5.0, 0.2);
     let scene = g.write_glb(dir.path(), "slab");
-    let (summary, px) = render_exr(
-        &scene,
-        &dir.path().join("slab.exr"),
-        &[
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--spp",
-            "4",
-            "--bounces",
-            "4",
-            "--sky",
-            "1,1,1",
-        ],
-    );
+    let (summary, px) = render_8x8_under_sky(&scene, &dir.path().join("slab.exr"), "1,1,1");
     assert_eq!(summary["nonfinite_samples"], 0);
     let h = (0.1f64).tan();
     for (i, p) in px.iter().enumerate() {
@@ -2421,22 +2412,7 @@ fn unlit_material_shows_its_base_color() {
     g.node(json!({"mesh": mesh}));
     camera_and_no_light(&mut g, 5.0, 0.2);
     let scene = g.write_glb(dir.path(), "unlit");
-    let (summary, px) = render_exr(
-        &scene,
-        &dir.path().join("unlit.exr"),
-        &[
-            "--width",
-            "8",
-            "--height",
-            "8",
-            "--spp",
-            "4",
-            "--bounces",
-            "4",
-            "--sky",
-            "3,3,3",
-        ],
-    );
+    let (summary, px) = render_8x8_under_sky(&scene, &dir.path().join("unlit.exr"), "3,3,3");
     assert_eq!(summary["nonfinite_samples"], 0);
     for (i, p) in px.iter().enumerate() {
         for ch in 0..3 {
