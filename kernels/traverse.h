@@ -106,12 +106,28 @@ inline bool intersect_triangle(const RayPrep* r, float4 v0, float4 v1, float4 v2
 // Slab test with the far distance scaled up by two ulps (Ize 2013); returns the entry distance
 // or INFINITY on a miss.
 inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float tmax) {
+#if defined(__x86_64__) || defined(__i386__)
+    // A CPU's vector unit computes the .w lanes too, and the boxes' .w lanes hold index bits,
+    // denormal floats: lo.w - origin.w is a denormal result more often than not, and x86 takes
+    // a microcode assist (about 100 cycles) for each one. With the ray's .w at -FLT_MAX the
+    // lane holds FLT_MAX (or NaN) instead, and is taken into far so that the compiler cannot
+    // leave it to chance: min(far, FLT_MAX) scaled up by two ulps rounds to what far does
+    // (to infinity where far is above FLT_MAX), so the result is the same.
+    float4 o = (float4)(r->origin, -FLT_MAX), inv = (float4)(r->inv, 1.0f);
+    float4 t0 = (lo - o) * inv;
+    float4 t1 = (hi - o) * inv;
+    float4 mn = fmin(t0, t1);
+    float4 mx = fmax(t0, t1);
+    float near = fmax(fmax(fmax(mn.x, mn.y), mn.z), tmin);
+    float far = fmin(fmin(fmin(mx.x, mx.y), mx.z), mx.w) * 1.00000024f;
+#else
     float3 t0 = (lo.xyz - r->origin) * r->inv;
     float3 t1 = (hi.xyz - r->origin) * r->inv;
     float3 mn = fmin(t0, t1);
     float3 mx = fmax(t0, t1);
     float near = fmax(fmax(fmax(mn.x, mn.y), mn.z), tmin);
     float far = fmin(fmin(mx.x, mx.y), mx.z) * 1.00000024f;
+#endif
     return (near <= far && near < tmax) ? near : INFINITY;
 }
 
@@ -137,28 +153,6 @@ inline bool intersect_leaf(const RayPrep* r, global const GpuTriangle* tris,
         if (any_hit) return true;
     }
     return false;
-}
-
-// Tests child `side` (0 left, 1 right) of node n: returns its entry distance (INFINITY when
-// the ray misses it before tmax). *child is the node index of an interior child reached, else
-// -1; *first and *count the triangles of a leaf reached (count 0 otherwise).
-inline float child_entry(const GpuBvhNode* n, int side, const RayPrep* r, float tmin,
-                         float tmax, int* child, uint* first, uint* count) {
-    float4 lo = side == 0 ? n->left_min : n->right_min;
-    float4 hi = side == 0 ? n->left_max : n->right_max;
-    *child = -1;
-    *first = 0u;
-    *count = 0u;
-    float dist = box_entry(lo, hi, r, tmin, tmax);
-    if (dist == INFINITY) return dist;
-    int ref = as_int(lo.w);
-    if (ref >= 0) {
-        *child = ref;
-    } else {
-        *first = (uint)(~ref);
-        *count = as_uint(hi.w);
-    }
-    return dist;
 }
 
 // Walks the binary BVH below node `root` along the prepared ray, keeping the closest hit (or
@@ -277,103 +271,120 @@ inline float instance_tmin(const GpuInstance* inst, float3 o, float3 od, float t
     return fmax(tmin, dt);
 }
 
-// The top levels' traversal stack: children still to visit, each an interior node (count 0)
-// or a leaf's instances first .. first + count - 1, with the distance its box starts at.
-typedef struct {
-    uint ref[STACK_SIZE * 3];
-    uint count[STACK_SIZE * 3];
-    float dist[STACK_SIZE * 3];
-    uint sp;
-} TopStack;
+// On the two-level traversal's stack: an instance to enter (its slot in `instances`, with
+// this bit set), else a node.
+#define INSTANCE_BIT 0x80000000u
+// No child reached (the two-level traversal's children are uints: nodes or instances).
+#define NO_CHILD 0xffffffffu
+// A top-level path and a bottom-level one below it on one stack.
+#define TWO_LEVEL_STACK (2 * STACK_SIZE)
 
-inline bool top_push(TopStack* s, uint ref, uint count, float dist,
-                     volatile global uint* overflow) {
-    if (s->sp == STACK_SIZE * 3) {
-        atomic_inc(overflow);
-        return false;
-    }
-    s->ref[s->sp] = ref;
-    s->count[s->sp] = count;
-    s->dist[s->sp++] = dist;
-    return true;
-}
+// The state of a two-level traversal (besides its stack): the world ray, the ray r in the
+// space of the level walked and its tmin (an object-space ray's is raised by the transform's
+// error), the hit so far, the stack pointer, the stack height below which the top level's
+// entries lie, whether the walk is in a bottom level and in which instance, and the node.
+#define TWO_LEVEL_STATE                       \
+    const RayPrep world = prepare_ray(o, d); \
+    RayPrep r = world;                        \
+    float rtmin = tmin;                       \
+    GpuHit hit = no_hit(tmax);                \
+    uint sp = 0;                              \
+    uint base = 0;                            \
+    bool bottom = false;                      \
+    uint slot = 0;                            \
+    uint node = 0;
 
-// Pops the next entry that starts before tmax into *ref and *count; false when none is left.
-inline bool top_pop(TopStack* s, float tmax, uint* ref, uint* count) {
-    while (s->sp > 0u) {
-        --s->sp;
-        if (s->dist[s->sp] < tmax) {
-            *ref = s->ref[s->sp];
-            *count = s->count[s->sp];
-            return true;
-        }
-    }
-    return false;
-}
-
-// Enters the instances first .. first + count - 1 of a top-level leaf: carries the ray into
-// each one's object space and walks its bottom level (binary, or 4-wide with WIDE). A hit keeps
-// the object-space triangle's index and barycentrics and names the instance by its slot in
-// `instances` (TLAS order), where shading finds its transforms. Returns true when
-// the traversal must end (an any-hit, or an overflow).
-#define ENTER_INSTANCES(WALK, ROOT)                                                            \
-    for (uint i = first; i < first + count; ++i) {                                             \
-        GpuInstance inst = instances[i];                                                       \
-        float3 od = instance_vector(&inst, d);                                                 \
-        RayPrep lr = prepare_ray(instance_point(&inst, o), od);                                \
-        float ltmin = instance_tmin(&inst, o, od, tmin);                                       \
-        GpuHit found = hit;                                                                    \
-        found.prim = NO_HIT;                                                                   \
-        bool stop =                                                                            \
-            WALK(nodes, inst.ROOT, object_tris, surf, &lr, o, d, ltmin, any_hit, &found, overflow); \
-        if (found.prim != NO_HIT) {                                                            \
-            hit = found;                                                                       \
-            hit.instance = i;                                                                  \
-        }                                                                                      \
-        if (stop) return hit;                                                                  \
+// Enters the instance that `node` names (INSTANCE_BIT) in a two-level traversal: the ray r
+// (and its rtmin) carried into the instance's object space, the stack height kept in base, and
+// node set to the instance's bottom-level root (ROOT: root, or wide_root in the wide nodes).
+#define ENTER_INSTANCE(ROOT)                                   \
+    {                                                          \
+        slot = node & ~INSTANCE_BIT;                           \
+        GpuInstance inst = instances[slot];                    \
+        float3 od = instance_vector(&inst, d);                 \
+        r = prepare_ray(instance_point(&inst, o), od);         \
+        rtmin = instance_tmin(&inst, o, od, tmin);             \
+        base = sp;                                             \
+        bottom = true;                                         \
+        node = inst.ROOT;                                      \
     }
 
 // Closest or first hit through the top level (`nodes` from 0, leaves index `instances`) and
 // the instances' bottom levels (in the same node array, from each instance's root; leaves
 // index `object_tris`, the meshes' object-space triangles). Hits name the object-space
-// triangle and the instance.
-// Unlike a bottom level's leaves, whose few triangles are tested on the spot, a top-level leaf
-// (a whole mesh) waits on the stack with its children's order: nearest first, and skipped once
-// a hit closer than its box is found.
+// triangle and the instance (its slot, where shading finds its transforms).
+// One loop over both levels, as traverse_bvh's, with one stack: reaching a top-level leaf
+// carries the ray into the instance's object space and goes on at its root, remembering the
+// stack height; when the walk pops below that height the bottom level is done and the world
+// ray (kept, not recomputed) is back. Top-level leaves of several instances push the others.
 inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
                                  global const GpuInstance* instances,
                                  global const GpuTriangle* object_tris,
                                  const SceneSurfaces* surf, float3 o, float3 d, float tmin,
                                  float tmax, bool any_hit, volatile global uint* overflow) {
-    RayPrep r = prepare_ray(o, d);
-    GpuHit hit = no_hit(tmax);
-    TopStack s;
-    s.sp = 0;
-    top_push(&s, 0u, 0u, tmin, overflow);
-    uint first, count;
-    while (top_pop(&s, hit.t, &first, &count)) {
-        if (count > 0u) {
-            ENTER_INSTANCES(traverse_bvh, root)
-            continue;
+    TWO_LEVEL_STATE
+    uint stack[TWO_LEVEL_STACK];
+    for (;;) {
+        if (node & INSTANCE_BIT) {
+            ENTER_INSTANCE(root)
         }
-        GpuBvhNode n = nodes[first];
+        GpuBvhNode n = nodes[node];
         float dist[2];
-        int child[2];
-        uint firsts[2], counts[2];
+        uint child[2];
         for (int side = 0; side < 2; ++side) {
-            dist[side] = child_entry(&n, side, &r, tmin, hit.t, &child[side], &firsts[side],
-                                     &counts[side]);
+            float4 lo = side == 0 ? n.left_min : n.right_min;
+            float4 hi = side == 0 ? n.left_max : n.right_max;
+            child[side] = NO_CHILD;
+            dist[side] = box_entry(lo, hi, &r, rtmin, hit.t);
+            if (dist[side] == INFINITY) continue;
+            int ref = as_int(lo.w);
+            if (ref >= 0) {
+                child[side] = (uint)ref;
+                continue;
+            }
+            uint first = (uint)(~ref), count = as_uint(hi.w);
+            if (bottom) {
+                float before = hit.t;
+                bool stop = intersect_leaf(&r, object_tris, surf, first, count, rtmin, o, d,
+                                           any_hit, &hit);
+                if (hit.t < before) hit.instance = slot;
+                if (stop) return hit;
+            } else if (count > 0u) {
+                // A top-level leaf: its first instance is this side's child, the others wait.
+                child[side] = first | INSTANCE_BIT;
+                for (uint i = first + count - 1u; i > first; --i) {
+                    if (sp == TWO_LEVEL_STACK) {
+                        atomic_inc(overflow);
+                        return hit;
+                    }
+                    stack[sp++] = i | INSTANCE_BIT;
+                }
+            }
         }
-        // The farther child first, so that the nearer is popped first.
-        int far = dist[0] <= dist[1] ? 1 : 0;
-        for (int k = 0; k < 2; ++k) {
-            int side = k == 0 ? far : 1 - far;
-            bool reached = child[side] >= 0 || counts[side] > 0u;
-            uint ref = child[side] >= 0 ? (uint)child[side] : firsts[side];
-            if (reached && !top_push(&s, ref, counts[side], dist[side], overflow)) return hit;
+        // On to the nearer child reached, pushing the other; or to the next entry on the stack.
+        if (child[0] != NO_CHILD && child[1] != NO_CHILD) {
+            uint first = dist[0] <= dist[1] ? child[0] : child[1];
+            uint second = dist[0] <= dist[1] ? child[1] : child[0];
+            if (sp == TWO_LEVEL_STACK) {
+                atomic_inc(overflow);
+                return hit;
+            }
+            stack[sp++] = second;
+            node = first;
+        } else if (child[0] != NO_CHILD) {
+            node = child[0];
+        } else if (child[1] != NO_CHILD) {
+            node = child[1];
+        } else {
+            if (bottom && sp == base) {
+                r = world;
+                rtmin = tmin;
+                bottom = false;
+            }
+            if (sp == 0u) return hit;
+            node = stack[--sp];
         }
     }
-    return hit;
 }
 
 // The scene's traversal: the flat BVH, or with TWO_LEVEL the instances' two levels.

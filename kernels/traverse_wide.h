@@ -5,9 +5,6 @@
 
 #define WIDE_STACK_SIZE 144  // (4 - 1) x the builder's depth limit of 48
 
-// The children of wide node `n` that the prepared ray reaches before `tmax`, nearest first
-// (insertion sort of at most four): their entry distances in dist, their slots in slot.
-// Returns how many.
 // The ray in four lanes: origin and safe reciprocal direction, one coordinate per vector.
 typedef struct {
     float4 ox, oy, oz, ix, iy, iz;
@@ -37,29 +34,6 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
     return (*near <= far) & (*near < (float4)(tmax)) & valid;
 }
 
-inline uint wide_children(global const GpuWideNode* n, const RayPrep* r, float tmin, float tmax,
-                          float* dist, uint* slot) {
-    WideRay w = wide_ray(r);
-    float4 near;
-    int4 mask = wide_reach(n, &w, tmin, tmax, &near);
-    if (!any(mask)) return 0u;
-    uint k = 0;
-    float nd[4] = {near.x, near.y, near.z, near.w};
-    int mk[4] = {mask.x, mask.y, mask.z, mask.w};
-    for (uint c = 0; c < 4u; ++c) {
-        if (!mk[c]) continue;
-        uint j = k++;
-        while (j > 0u && dist[j - 1u] > nd[c]) {
-            dist[j] = dist[j - 1u];
-            slot[j] = slot[j - 1u];
-            --j;
-        }
-        dist[j] = nd[c];
-        slot[j] = c;
-    }
-    return k;
-}
-
 // Compare-and-swap of two (entry distance, slot) pairs, ordered by distance and then slot, so
 // that the network below sorts as a stable sort would (the host reference's order).
 #define WIDE_ORDER(A, B)                                           \
@@ -71,6 +45,21 @@ inline uint wide_children(global const GpuWideNode* n, const RayPrep* r, float t
         s##A = s##B;                                               \
         s##B = ts;                                                 \
     }
+
+// The children of wide node n that `mask` reaches, sorted: declares their entry distances
+// d0 <= d1 <= d2 <= d3 (INFINITY for those not reached, from `near`) and slots s0 .. s3, and
+// the node's children and counts as arrays indexed by slot.
+#define WIDE_SORT_CHILDREN(n, near, mask)                           \
+    float4 dist = select((float4)(INFINITY), near, mask);          \
+    float d0 = dist.x, d1 = dist.y, d2 = dist.z, d3 = dist.w;      \
+    uint s0 = 0u, s1 = 1u, s2 = 2u, s3 = 3u;                       \
+    WIDE_ORDER(0, 1)                                               \
+    WIDE_ORDER(2, 3)                                               \
+    WIDE_ORDER(0, 2)                                               \
+    WIDE_ORDER(1, 3)                                               \
+    WIDE_ORDER(1, 2)                                               \
+    global const int* children = (global const int*)&n->child;    \
+    global const uint* counts = (global const uint*)&n->count;
 
 // A leaf among the sorted children, tested on the spot when it starts before the hit so far.
 #define WIDE_LEAF(D, S)                                                                     \
@@ -107,16 +96,7 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
         float4 near;
         int4 mask = wide_reach(n, &w, tmin, hit->t, &near);
         if (any(mask)) {
-            float4 dist = select((float4)(INFINITY), near, mask);
-            float d0 = dist.x, d1 = dist.y, d2 = dist.z, d3 = dist.w;
-            uint s0 = 0u, s1 = 1u, s2 = 2u, s3 = 3u;
-            WIDE_ORDER(0, 1)
-            WIDE_ORDER(2, 3)
-            WIDE_ORDER(0, 2)
-            WIDE_ORDER(1, 3)
-            WIDE_ORDER(1, 2)
-            global const int* children = (global const int*)&n->child;
-            global const uint* counts = (global const uint*)&n->count;
+            WIDE_SORT_CHILDREN(n, near, mask)
             WIDE_LEAF(d0, s0)
             WIDE_LEAF(d1, s1)
             WIDE_LEAF(d2, s2)
@@ -139,7 +119,6 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
         node = stack[sp];
     }
 }
-#undef WIDE_ORDER
 #undef WIDE_LEAF
 #undef WIDE_PUSH
 
@@ -153,40 +132,98 @@ inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTri
     return hit;
 }
 
-// Two levels through wide nodes, as traverse_two_level (traverse.h): the top level from node
-// 0, each instance's bottom level from its wide_root.
+// A leaf among the sorted children of a bottom-level node, tested on the spot as WIDE_LEAF
+// does; a hit names the instance entered.
+#define TWO_LEVEL_WIDE_LEAF(D, S)                                                         \
+    if (D < hit.t && counts[S] > 0u) {                                                    \
+        float before = hit.t;                                                             \
+        bool stop = intersect_leaf(&r, object_tris, surf, (uint)(~children[S]), counts[S], \
+                                   rtmin, o, d, any_hit, &hit);                           \
+        if (hit.t < before) hit.instance = slot;                                          \
+        if (stop) return hit;                                                             \
+    }
+
+// A child among the sorted ones, pushed with its entry distance (farthest first): an interior
+// node, or in the top level a leaf's instances (INSTANCE_BIT, traverse.h).
+#define TWO_LEVEL_WIDE_PUSH(D, S)                                                   \
+    if (D < hit.t) {                                                                \
+        if (counts[S] == 0u) {                                                      \
+            stack[sp] = (uint)children[S];                                          \
+            stack_d[sp++] = D;                                                      \
+        } else if (!bottom) {                                                       \
+            uint first = (uint)(~children[S]);                                      \
+            for (uint i = first + counts[S]; i > first; --i) {                      \
+                if (sp == TWO_LEVEL_WIDE_STACK) {                                   \
+                    atomic_inc(overflow);                                           \
+                    return hit;                                                     \
+                }                                                                   \
+                stack[sp] = (i - 1u) | INSTANCE_BIT;                                \
+                stack_d[sp++] = D;                                                  \
+            }                                                                       \
+        }                                                                           \
+    }
+
+#define TWO_LEVEL_WIDE_STACK (2 * WIDE_STACK_SIZE + 4)
+
+// Two levels through wide nodes (the top level from node 0, each instance's bottom level from
+// its wide_root), in one loop with one stack as traverse_two_level (traverse.h) walks the
+// binary ones, and visiting as traverse_wide_bvh does: a popped instance that starts beyond
+// the hit found meanwhile is skipped like a node, so instances are entered nearest first.
 inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
                                       global const GpuInstance* instances,
                                       global const GpuTriangle* object_tris,
                                       const SceneSurfaces* surf, float3 o, float3 d,
                                       float tmin, float tmax, bool any_hit,
                                       volatile global uint* overflow) {
-    RayPrep r = prepare_ray(o, d);
-    GpuHit hit = no_hit(tmax);
-    TopStack s;
-    s.sp = 0;
-    top_push(&s, 0u, 0u, tmin, overflow);
-    uint first, count;
-    while (top_pop(&s, hit.t, &first, &count)) {
-        if (count > 0u) {
-            ENTER_INSTANCES(traverse_wide_bvh, wide_root)
-            continue;
+    TWO_LEVEL_STATE
+    WideRay w = wide_ray(&r);
+    uint stack[TWO_LEVEL_WIDE_STACK];
+    float stack_d[TWO_LEVEL_WIDE_STACK];
+    for (;;) {
+        if (node & INSTANCE_BIT) {
+            ENTER_INSTANCE(wide_root)
+            w = wide_ray(&r);
         }
-        global const GpuWideNode* n = &nodes[first];
-        float dist[4];
-        uint slot[4];
-        uint k = wide_children(n, &r, tmin, hit.t, dist, slot);
-        int ch[4] = {n->child.x, n->child.y, n->child.z, n->child.w};
-        uint cnt[4] = {n->count.x, n->count.y, n->count.z, n->count.w};
-        // Farthest first, so that the nearest is popped first.
-        for (uint i = k; i > 0u; --i) {
-            uint c = slot[i - 1u];
-            uint ref = cnt[c] > 0u ? (uint)(~ch[c]) : (uint)ch[c];
-            if (!top_push(&s, ref, cnt[c], dist[i - 1u], overflow)) return hit;
+        global const GpuWideNode* n = &nodes[node];
+        float4 near;
+        int4 mask = wide_reach(n, &w, rtmin, hit.t, &near);
+        if (any(mask)) {
+            WIDE_SORT_CHILDREN(n, near, mask)
+            if (bottom) {
+                TWO_LEVEL_WIDE_LEAF(d0, s0)
+                TWO_LEVEL_WIDE_LEAF(d1, s1)
+                TWO_LEVEL_WIDE_LEAF(d2, s2)
+                TWO_LEVEL_WIDE_LEAF(d3, s3)
+            }
+            if (sp + 4u > TWO_LEVEL_WIDE_STACK) {
+                atomic_inc(overflow);
+                return hit;
+            }
+            TWO_LEVEL_WIDE_PUSH(d3, s3)
+            TWO_LEVEL_WIDE_PUSH(d2, s2)
+            TWO_LEVEL_WIDE_PUSH(d1, s1)
+            TWO_LEVEL_WIDE_PUSH(d0, s0)
         }
+        // The nearest pushed entry that still starts before the hit; below the bottom level's
+        // entries, the world ray again.
+        for (;;) {
+            if (bottom && sp == base) {
+                r = world;
+                w = wide_ray(&r);
+                rtmin = tmin;
+                bottom = false;
+            }
+            if (sp == 0u) return hit;
+            --sp;
+            if (stack_d[sp] < hit.t) break;
+        }
+        node = stack[sp];
     }
-    return hit;
 }
+#undef WIDE_ORDER
+#undef WIDE_SORT_CHILDREN
+#undef TWO_LEVEL_WIDE_LEAF
+#undef TWO_LEVEL_WIDE_PUSH
 
 // The scene's traversal through wide nodes: flat, or with TWO_LEVEL two levels.
 inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const GpuTriangle* tris,
