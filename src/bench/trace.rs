@@ -538,12 +538,13 @@ fn light_targets(lights: &[crate::scene::Light], host: &crate::render::HostScene
         triangles: host
             .emissive
             .iter()
-            .map(|e| {
-                host.hit_triangle(&GpuHit {
+            .map(|e| match &host.accel {
+                // An emitter names its instance by index, not by TLAS slot as a hit does.
+                crate::render::Accel::TwoLevel(two) => two.hit_triangle(e.prim, e.instance),
+                crate::render::Accel::Flat(_) => host.hit_triangle(&GpuHit {
                     prim: e.prim,
-                    instance: e.instance,
                     ..GpuHit::default()
-                })
+                }),
             })
             .collect(),
         ..LightTargets::default()

@@ -14,7 +14,7 @@
 //! device reports them: the device keeps each mesh's triangles and shading data once, in
 //! object space, and shading carries a hit to world space through the instance's transform.
 
-use super::{Aabb, Bvh, Hit, Ray, WideBvh, build, build_boxes};
+use super::{Aabb, Bvh, Child, Hit, Ray, WideBvh, build, build_boxes};
 use crate::cl::types::{GpuBvhNode, GpuHit, GpuWideNode};
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
@@ -254,6 +254,7 @@ impl TwoLevel {
             })
             .collect();
         self.tlas = build_boxes(&boxes);
+        split_instance_leaves(&mut self.tlas, &boxes);
         for i in &mut self.tlas.tri_indices {
             *i = shown[*i as usize];
         }
@@ -398,6 +399,78 @@ impl TwoLevel {
             tri_base += b.triangles.len() as i32;
         }
         (nodes, roots)
+    }
+}
+
+/// Splits every TLAS leaf of several instances into leaves of one, so that a ray tests each
+/// instance's box before it is carried into the instance: entering an instance costs a
+/// transform and a descent from its BLAS root, where the builder's leaves of up to eight boxes
+/// (right for triangles) would enter all of them. A leaf's instances are halved along the
+/// longest axis of their boxes' centres, recursively. The TLAS of n instances then has n - 1
+/// nodes, as many as [`TwoLevel::tlas_slots`] reserves.
+fn split_instance_leaves(tlas: &mut Bvh, boxes: &[Aabb]) {
+    let mut split = false;
+    for node in 0..tlas.nodes.len() as u32 {
+        for side in 0..2 {
+            if let (b, Child::Leaf { first, count }) = tlas.child(node, side)
+                && count > 1
+            {
+                let index = split_range(tlas, boxes, first, count);
+                set_child(&mut tlas.nodes[node as usize], side, b, index as i32, 0);
+                split = true;
+            }
+        }
+    }
+    if split {
+        let (sah, depth) = tlas.sah_and_depth();
+        (tlas.sah_cost, tlas.built_sah_cost, tlas.depth) = (sah, sah, depth);
+    }
+}
+
+/// A new node over the TLAS leaf items `first .. first + count` (at least two), its leaves of
+/// one instance each; returns its index.
+fn split_range(tlas: &mut Bvh, boxes: &[Aabb], first: u32, count: u32) -> u32 {
+    let centre = |i: &u32| (boxes[*i as usize].min + boxes[*i as usize].max) * 0.5;
+    let items = &mut tlas.tri_indices[first as usize..(first + count) as usize];
+    let extent = items.iter().fold(Aabb::EMPTY, |a, i| a.grow(centre(i)));
+    let size = extent.max - extent.min;
+    let axis = if size.x >= size.y && size.x >= size.z {
+        0
+    } else if size.y >= size.z {
+        1
+    } else {
+        2
+    };
+    items.sort_by(|a, b| centre(a)[axis].total_cmp(&centre(b)[axis]));
+    let index = tlas.nodes.len() as u32;
+    tlas.nodes.push(GpuBvhNode::default());
+    let half = count / 2;
+    for (side, (f, c)) in [(first, half), (first + half, count - half)]
+        .into_iter()
+        .enumerate()
+    {
+        let b = tlas.tri_indices[f as usize..(f + c) as usize]
+            .iter()
+            .fold(Aabb::EMPTY, |a, &i| a.union(boxes[i as usize]));
+        let (reference, n) = if c == 1 {
+            (!(f as i32), 1)
+        } else {
+            (split_range(tlas, boxes, f, c) as i32, 0)
+        };
+        set_child(&mut tlas.nodes[index as usize], side, b, reference, n);
+    }
+    index
+}
+
+/// Writes child `side` of a node: its box, its reference (a node index, or `!first` of a leaf)
+/// and its leaf count (0 for a node), as the builder lays them out.
+fn set_child(node: &mut GpuBvhNode, side: usize, b: Aabb, reference: i32, count: u32) {
+    let lo = [b.min.x, b.min.y, b.min.z, f32::from_bits(reference as u32)];
+    let hi = [b.max.x, b.max.y, b.max.z, f32::from_bits(count)];
+    if side == 0 {
+        (node.left_min, node.left_max) = (lo, hi);
+    } else {
+        (node.right_min, node.right_max) = (lo, hi);
     }
 }
 
@@ -554,6 +627,58 @@ mod tests {
         assert_eq!(checked, 2000);
         // A ray pointing away from everything hits nothing.
         assert!(two.intersect(&ray(Vec3::splat(100.0), Vec3::ONE)).is_none());
+    }
+
+    #[test]
+    fn every_tlas_leaf_holds_one_instance() {
+        // 40 small cubes in rows of four, close together: the builder puts several in a leaf.
+        let placed: Vec<(u32, glam::DMat4)> = (0..40)
+            .map(|i| {
+                let at = Vec3::new((i % 4) as f32 * 0.5 + (i / 4) as f32 * 10.0, 0.0, 0.0);
+                let m = Mat4::from_scale_rotation_translation(Vec3::splat(0.2), Quat::IDENTITY, at);
+                (0, m.as_dmat4())
+            })
+            .collect();
+        let built = build_boxes_of(&placed);
+        assert!(
+            (0..built.nodes.len() as u32).any(|n| (0..2)
+                .any(|side| matches!(built.child(n, side).1, Child::Leaf { count: 2.., .. }))),
+            "the builder alone makes leaves of several instances"
+        );
+        let two = TwoLevel::new(&[closed_cube(1)], &placed);
+        let mut leaves = 0;
+        for node in 0..two.tlas.nodes.len() as u32 {
+            for side in 0..2 {
+                if let (_, Child::Leaf { count, .. }) = two.tlas.child(node, side) {
+                    assert_eq!(count, 1, "node {node} side {side}");
+                    leaves += 1;
+                }
+            }
+        }
+        assert_eq!(leaves, 40);
+        assert_eq!(two.tlas.nodes.len(), two.tlas_slots());
+        let mut slots = two.tlas.tri_indices.clone();
+        slots.sort();
+        assert_eq!(slots, (0..40).collect::<Vec<u32>>(), "each instance once");
+        // Every instance is still found: a ray down onto each cube's centre hits it.
+        for (i, (_, m)) in placed.iter().enumerate() {
+            let c = m.transform_point3(glam::DVec3::ZERO).as_vec3();
+            let hit = two
+                .intersect(&ray(c + Vec3::Y * 5.0, -Vec3::Y))
+                .expect("a hit");
+            assert_eq!(hit.instance, i as u32);
+            assert!((hit.hit.t - 4.8).abs() < 1e-5, "{}", hit.hit.t);
+        }
+    }
+
+    /// The builder's tree over the world boxes of closed cubes placed by `placed`.
+    fn build_boxes_of(placed: &[(u32, glam::DMat4)]) -> Bvh {
+        let cube = Blas::new(&closed_cube(1));
+        let boxes: Vec<Aabb> = placed
+            .iter()
+            .map(|&(_, m)| Instance::new(0, m).world_box(cube.bounds()))
+            .collect();
+        build_boxes(&boxes)
     }
 
     #[test]
