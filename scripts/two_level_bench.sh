@@ -14,7 +14,8 @@
 #   log.txt       devices and every table as printed
 #   trace.jsonl   bench trace --json, one line per scene, form and round (`bvh_levels` names
 #                 the form, `results[].median_ms` the three ray sets)
-#   frame.jsonl   bench frame --json, likewise (`samples_per_second`)
+#   frame-flat.jsonl, frame-two-level.jsonl
+#                 bench frame --json per form, likewise (`samples_per_second`)
 #   summary.txt   two-level against flat per scene: rays/s and samples/s ratios (best round)
 set -uo pipefail
 
@@ -60,7 +61,7 @@ for scene in bunnies spheres; do
         for bvh in flat two-level; do
             run "$OUT/trace.jsonl" "$P" bench trace "$TMP/$scene.glb" --device "$DEVICE" \
                 --bvh "$bvh" "${TRACE_SIZE[@]}" --validate 65536 --json
-            run "$OUT/frame.jsonl" "$P" bench frame "$TMP/$scene.glb" --device "$DEVICE" \
+            run "$OUT/frame-$bvh.jsonl" "$P" bench frame "$TMP/$scene.glb" --device "$DEVICE" \
                 --bvh "$bvh" "${FRAME_SIZE[@]}" --json
         done
     done
@@ -77,10 +78,11 @@ for line in open(f"{out}/trace.jsonl"):
         best[key][r["kind"]] = max(best[key].get(r["kind"], 0), r["rays_per_second"])
     if j.get("mismatches"):
         print(f"MISMATCHES {key}: {j['mismatches']}")
-for line in open(f"{out}/frame.jsonl"):
-    j = json.loads(line)
-    key = (j["scene"].rsplit("/", 1)[-1], j["bvh"])
-    best[key]["frame"] = max(best[key].get("frame", 0), j["samples_per_second"])
+for bvh in ("flat", "two-level"):
+    for line in open(f"{out}/frame-{bvh}.jsonl"):
+        j = json.loads(line)
+        key = (j["scene"].rsplit("/", 1)[-1], bvh)
+        best[key]["frame"] = max(best[key].get("frame", 0), j["samples_per_second"])
 print("scene          measure   flat (M/s)  two-level (M/s)  two-level/flat")
 for scene in sorted({k[0] for k in best}):
     flat, two = best[(scene, "flat")], best[(scene, "two-level")]

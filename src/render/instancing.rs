@@ -8,13 +8,15 @@
 //! object is a TLAS rebuild and a few transforms written in place
 //! (`Renderer::move_instances`).
 //!
-//! The automatic choice (`--bvh auto`): two levels when the scene is large and instancing
-//! saves most of the flat BVH (at least 4 M triangles over all instances and at least 8 times
-//! the triangles of the distinct meshes), else the flat BVH. With PoCL's default work-group
-//! method the two-level kernels trace 1.0–3.7 times slower than the flat BVH (within −14 …
-//! +29 % with `POCL_WORK_GROUP_METHOD=cbs`; docs/benchmarks.md, 2026-11-30), so a scene that
-//! fits a flat BVH gets one; `--bvh two-level` trades that for moving objects in milliseconds
-//! in the viewer.
+//! The automatic choice (`--bvh auto`): two levels when the scene is large and instancing saves
+//! most of the flat BVH (at least 1 M triangles over all instances and at least 4 times the
+//! triangles of the distinct meshes), else the flat BVH. On PoCL (2026-11-30, the 1 M rooms of
+//! `bench generate`, same rays) the two-level kernels trace as fast as the flat BVH or faster
+//! with the binary kernels and within −36 … +41 % with the wide ones, and whole frames run
+//! 1.2–1.4 times the flat BVH's speed, while the flat form takes 8–13 times as long to build
+//! (3 s against 0.2–0.4 s on 2 cores) and 7–50 times the device memory (219 MB against 31 and
+//! 4.4 MB; docs/benchmarks.md). A small scene is flattened: its flat BVH is built in well under
+//! a second and tests no transforms.
 
 use crate::bvh::{Blas, TwoLevel};
 use crate::scene::{Object, RenderFrame, Scene, distinct_meshes};
@@ -23,11 +25,11 @@ use rayon::prelude::*;
 use std::str::FromStr;
 
 /// Triangles over all instances from which `--bvh auto` considers two levels.
-pub const AUTO_MIN_TRIANGLES: usize = 4_000_000;
+pub const AUTO_MIN_TRIANGLES: usize = 1_000_000;
 
 /// How many times the distinct meshes' triangles the instances must hold for `--bvh auto` to
 /// take two levels.
-pub const AUTO_MIN_SAVING: usize = 8;
+pub const AUTO_MIN_SAVING: usize = 4;
 
 /// `--bvh`: which acceleration structure the device traverses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -83,7 +85,7 @@ pub fn plan(scene: &Scene, space: &RenderFrame, choice: BvhChoice) -> Option<Ins
         .filter(|o| o.visible)
         .map(|o| o.mesh.indices.len())
         .sum();
-    let auto_flat = total < AUTO_MIN_TRIANGLES || total < AUTO_MIN_SAVING * unique;
+    let auto_flat = !auto_takes_two_levels(total, unique);
     if total == 0 || (choice == BvhChoice::Auto && auto_flat) || scene.absurd_triangles() > 0 {
         return None;
     }
@@ -103,6 +105,12 @@ pub fn plan(scene: &Scene, space: &RenderFrame, choice: BvhChoice) -> Option<Ins
         mesh_objects: meshes.iter().map(|&o| objects[o]).collect(),
         objects,
     })
+}
+
+/// Whether `--bvh auto` takes two levels for `total` triangles over all instances of meshes of
+/// `unique` triangles (see the module's rule).
+pub fn auto_takes_two_levels(total: usize, unique: usize) -> bool {
+    total >= AUTO_MIN_TRIANGLES && total >= AUTO_MIN_SAVING * unique
 }
 
 /// The render frame's map, (p - origin) * scale, as a matrix: render from object is this times
@@ -129,5 +137,16 @@ mod tests {
         assert_eq!("Two-Level".parse(), Ok(BvhChoice::TwoLevel));
         assert_eq!("flat".parse(), Ok(BvhChoice::Flat));
         assert!("deep".parse::<BvhChoice>().is_err());
+    }
+
+    #[test]
+    fn auto_takes_two_levels_for_large_heavily_instanced_scenes() {
+        // The rooms of `bench generate`: 7 bunnies and 49 icospheres, 1 M triangles each.
+        assert!(auto_takes_two_levels(1_008_336, 144_060));
+        assert!(auto_takes_two_levels(1_003_534, 20_494));
+        // Small, or hardly instanced: flat.
+        assert!(!auto_takes_two_levels(500_000, 10_000));
+        assert!(!auto_takes_two_levels(4_000_000, 2_000_000));
+        assert!(!auto_takes_two_levels(0, 0));
     }
 }
