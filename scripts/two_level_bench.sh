@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The flat BVH against two levels on the same rays and frames (issue 14: two levels within
-# 10 % of flat), in one run of about 5 minutes on the GPU machine.
+# 10 % of flat), in one run of about 5 minutes on the GPU machine (DEVICE=cpu ROUNDS=1: about
+# 4 minutes on the 2-core machine).
 #
 # Run from the repository root, with
 #   .device/penumbra                          a release build (cargo build --release)
@@ -32,8 +33,10 @@ if [ "$DEVICE" = cpu ]; then
     TRACE_SIZE=(--width 640 --height 360 --runs 3 --warmup 1)
     FRAME_SIZE=(--width 320 --height 180 --spp 4)
 else
-    TRACE_SIZE=(--width 1920 --height 1080 --runs 10 --warmup 3)
-    FRAME_SIZE=(--width 1920 --height 1080 --spp 32)
+    # The settings of the H200 figures in docs/benchmarks.md (third session): trace at the
+    # default 1280x720, frames at 1024x1024 with 6 bounces.
+    TRACE_SIZE=(--width 1280 --height 720 --runs 10 --warmup 3)
+    FRAME_SIZE=(--width 1024 --height 1024 --bounces 6 --spp 64)
 fi
 
 log() { echo "$*" | tee -a "$LOG" >&2; }
@@ -83,11 +86,11 @@ for bvh in ("flat", "two-level"):
         j = json.loads(line)
         key = (j["scene"].rsplit("/", 1)[-1], bvh)
         best[key]["frame"] = max(best[key].get("frame", 0), j["samples_per_second"])
-print("scene          measure   flat (M/s)  two-level (M/s)  two-level/flat")
+print("scene          measure   flat (M/s)  two-level (M/s)  two-level/flat  (rays/s; frame: samples/s)")
 for scene in sorted({k[0] for k in best}):
     flat, two = best[(scene, "flat")], best[(scene, "two-level")]
     for m in ("primary", "diffuse", "shadow", "frame"):
         if m in flat and m in two:
-            print(f"{scene:14s} {m:8s} {flat[m] / 1e6:10.1f} {two[m] / 1e6:16.1f} {two[m] / flat[m]:15.3f}")
+            print(f"{scene:14s} {m:8s} {flat[m] / 1e6:10.2f} {two[m] / 1e6:16.2f} {two[m] / flat[m]:15.3f}")
 EOF
 cat "$OUT/summary.txt" | tee -a "$LOG"
