@@ -140,6 +140,55 @@ inline float3 volume_transmittance(const SurfaceMaterial* m, float t) {
     return pow(fmax(m->attenuation, 0.0f), (float3)(t / m->attenuation_distance));
 }
 
+#ifdef HAS_DISPERSION
+// KHR_materials_dispersion: a transmitting volume's index of refraction varies with the
+// wavelength. A path that meets such a volume picks one wavelength there (path.h) and carries
+// from then on what light of that wavelength carries, times the wavelength's RGB response over
+// its pdf; every RGB channel's response integrates to 1, so the weight is 1 on average and a
+// white, non-dispersive path keeps its colour and energy in expectation.
+
+// The spec's index at wavelength lambda (nm) for index ior at 587.56 nm and dispersion
+// 20 / Abbe number (Cauchy's two terms fitted to the Abbe number).
+inline float dispersive_ior(float ior, float dispersion, float lambda) {
+    float k = (ior - 1.0f) * dispersion * (1.0f / 20.0f);
+    return fmax(ior + k * (523655.0f / (lambda * lambda) - 1.5168f), 1.0f);
+}
+
+// Wavelengths are sampled on [360, 830] nm by pbrt-v4's visible-wavelength density,
+// 0.0039398042 / cosh²(0.0072 (lambda - 538)), inverted in closed form.
+inline float sample_wavelength(float u) {
+    return 538.0f - 138.888889f * atanh(0.85691062f - 1.82750197f * u);
+}
+
+inline float wavelength_pdf(float lambda) {
+    float c = cosh(0.0072f * (lambda - 538.0f));
+    return 0.0039398042f / (c * c);
+}
+
+// A lobe of Wyman, Sloan and Shirley's (2013) fit of the CIE 1931 observer.
+inline float cie_lobe(float x, float mu, float s1, float s2) {
+    float t = (x - mu) / (x < mu ? s1 : s2);
+    return exp(-0.5f * t * t);
+}
+
+// The linear sRGB response to wavelength lambda: the CIE 1931 matching functions in linear
+// sRGB, negative parts cut, each channel scaled to integrate to 1 over [360, 830] nm
+// (tests/bsdf.rs checks the scales by quadrature).
+inline float3 wavelength_rgb(float lambda) {
+    float x = 1.056f * cie_lobe(lambda, 599.8f, 37.9f, 31.0f) +
+              0.362f * cie_lobe(lambda, 442.0f, 16.0f, 26.7f) -
+              0.065f * cie_lobe(lambda, 501.1f, 20.4f, 26.2f);
+    float y = 0.821f * cie_lobe(lambda, 568.8f, 46.9f, 40.5f) +
+              0.286f * cie_lobe(lambda, 530.9f, 16.3f, 31.1f);
+    float z = 1.217f * cie_lobe(lambda, 437.0f, 11.8f, 36.0f) +
+              0.681f * cie_lobe(lambda, 459.0f, 26.0f, 13.8f);
+    float3 rgb = (float3)(3.2404542f * x - 1.5371385f * y - 0.4985314f * z,
+                          -0.9692660f * x + 1.8760108f * y + 0.0415560f * z,
+                          0.0556434f * x - 0.2040259f * y + 1.0572252f * z);
+    return fmax(rgb, 0.0f) * (float3)(0.00567610f, 0.00866617f, 0.00914323f);
+}
+#endif
+
 // GGX lobes with alpha below this are delta lobes.
 #define BSDF_DELTA_ALPHA 1e-3f
 
