@@ -33,6 +33,8 @@
 //   diffuse transmission (HAS_DIFFUSE_TRANSMISSION, KHR_materials_diffuse_transmission) that
 //                 share of the diffuse base leaves through the back, Lambertian and tinted, under
 //                 the same albedo scaling (a thin sheet: no volume)
+//   dispersion    (HAS_DISPERSION, KHR_materials_dispersion) no lobe of its own: path.h sets a
+//                 dispersive volume's ior to that of the path's wavelength (dispersive_ior)
 // Below BSDF_DELTA_ALPHA the glossy lobes are perfect mirror and refraction (delta) lobes.
 //
 // Contract: bsdf_eval returns f(wo, wi) * |cos(n, wi)| and its pdf (solid angle) for the non-delta

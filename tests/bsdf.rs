@@ -1265,31 +1265,7 @@ fn ggx_albedo(mu: f64, alpha: f64, n: usize) -> (f64, f64) {
     if alpha == 0.0 {
         return (1.0, (1.0 - mu).powi(5));
     }
-    let wo = [(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu];
-    let lambda = |w: V| {
-        let x = alpha * alpha * (w[0] * w[0] + w[1] * w[1]) / (w[2] * w[2]);
-        ((1.0 + x).sqrt() - 1.0) / 2.0
-    };
-    let v = norm([alpha * wo[0], alpha * wo[1], wo[2]]);
-    let (mut e, mut es) = (0.0, 0.0);
-    for i in 0..n {
-        for j in 0..n {
-            let phi = 2.0 * PI * (i as f64 + 0.5) / n as f64;
-            let z = (1.0 - (j as f64 + 0.5) / n as f64) * (1.0 + v[2]) - v[2];
-            let s = (1.0 - z * z).max(0.0).sqrt();
-            let h = add([s * phi.cos(), s * phi.sin(), z], v);
-            let h = norm([alpha * h[0], alpha * h[1], h[2].max(0.0)]);
-            let wi = reflect(wo, h);
-            if wi[2] <= 0.0 {
-                continue;
-            }
-            let g = (1.0 + lambda(wo)) / (1.0 + lambda(wo) + lambda(wi));
-            e += g;
-            es += g * (1.0 - dot(wo, h)).clamp(0.0, 1.0).powi(5);
-        }
-    }
-    let k = (n * n) as f64;
-    (e / k, es / k)
+    aniso_albedo([(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu], alpha, alpha, n)
 }
 
 /// Rows for roughness 0, 1/32 .. 1: E at cos 0, 1/32 .. 1 (33 values), then E_s likewise, then
