@@ -70,6 +70,9 @@ pub struct KernelFeatures {
     pub diffuse_transmission: bool,
     /// Some material is iridescent (`HAS_IRIDESCENCE`, `KHR_materials_iridescence`).
     pub iridescence: bool,
+    /// Some transmitting volume is dispersive (`HAS_DISPERSION`, `KHR_materials_dispersion`):
+    /// paths through it pick a wavelength.
+    pub dispersion: bool,
     /// Some material is anisotropic (`HAS_ANISOTROPY`, `KHR_materials_anisotropy`).
     pub anisotropy: bool,
     /// Tangents are uploaded for the anisotropic materials' frames (`HAS_TANGENTS`; only set
@@ -100,6 +103,7 @@ impl KernelFeatures {
             (self.diffuse_transmission, "HAS_DIFFUSE_TRANSMISSION"),
             (self.iridescence, "HAS_IRIDESCENCE"),
             (self.anisotropy, "HAS_ANISOTROPY"),
+            (self.dispersion, "HAS_DISPERSION"),
             (self.tangents, "HAS_TANGENTS"),
             (self.lambert_only, "LAMBERT_ONLY"),
             (self.two_level, "TWO_LEVEL"),
