@@ -106,28 +106,12 @@ inline bool intersect_triangle(const RayPrep* r, float4 v0, float4 v1, float4 v2
 // Slab test with the far distance scaled up by two ulps (Ize 2013); returns the entry distance
 // or INFINITY on a miss.
 inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float tmax) {
-#if defined(__x86_64__) || defined(__i386__)
-    // A CPU's vector unit computes the .w lanes too, and the boxes' .w lanes hold index bits,
-    // denormal floats: lo.w - origin.w is a denormal result more often than not, and x86 takes
-    // a microcode assist (about 100 cycles) for each one. With the ray's .w at -FLT_MAX the
-    // lane holds FLT_MAX (or NaN) instead, and is taken into far so that the compiler cannot
-    // leave it to chance: min(far, FLT_MAX) scaled up by two ulps rounds to what far does
-    // (to infinity where far is above FLT_MAX), so the result is the same.
-    float4 o = (float4)(r->origin, -FLT_MAX), inv = (float4)(r->inv, 1.0f);
-    float4 t0 = (lo - o) * inv;
-    float4 t1 = (hi - o) * inv;
-    float4 mn = fmin(t0, t1);
-    float4 mx = fmax(t0, t1);
-    float near = fmax(fmax(fmax(mn.x, mn.y), mn.z), tmin);
-    float far = fmin(fmin(fmin(mx.x, mx.y), mx.z), mx.w) * 1.00000024f;
-#else
     float3 t0 = (lo.xyz - r->origin) * r->inv;
     float3 t1 = (hi.xyz - r->origin) * r->inv;
     float3 mn = fmin(t0, t1);
     float3 mx = fmax(t0, t1);
     float near = fmax(fmax(fmax(mn.x, mn.y), mn.z), tmin);
     float far = fmin(fmin(mx.x, mx.y), mx.z) * 1.00000024f;
-#endif
     return (near <= far && near < tmax) ? near : INFINITY;
 }
 

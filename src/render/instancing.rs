@@ -11,12 +11,12 @@
 //! The automatic choice (`--bvh auto`): two levels when the scene is large and instancing saves
 //! most of the flat BVH (at least 1 M triangles over all instances and at least 4 times the
 //! triangles of the distinct meshes), else the flat BVH. On PoCL (2026-11-30, the 1 M rooms of
-//! `bench generate`, same rays) the two-level kernels trace as fast as the flat BVH or faster
-//! with the binary kernels and within −36 … +41 % with the wide ones, and whole frames run
-//! 1.2–1.4 times the flat BVH's speed, while the flat form takes 8–13 times as long to build
-//! (3 s against 0.2–0.4 s on 2 cores) and 7–50 times the device memory (219 MB against 31 and
-//! 4.4 MB; docs/benchmarks.md). A small scene is flattened: its flat BVH is built in well under
-//! a second and tests no transforms.
+//! `bench generate`, same rays, denormals flushed) the two-level kernels trace within +7 % of
+//! the flat BVH (faster on diffuse rays) with the binary kernels and within −10 … +17 % with
+//! the wide ones, and whole frames run 1.2–1.4 times the flat BVH's speed, while the flat form
+//! takes 8–13 times as long to build (3 s against 0.2–0.4 s on 2 cores) and 7–50 times the
+//! device memory (219 MB against 31 and 4.4 MB; docs/benchmarks.md). A small scene is
+//! flattened: its flat BVH is built in well under a second and tests no transforms.
 
 use crate::bvh::{Blas, TwoLevel};
 use crate::scene::{Object, RenderFrame, Scene, distinct_meshes};
