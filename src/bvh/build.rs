@@ -169,6 +169,21 @@ pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
     )
 }
 
+/// Builds a BVH over an indexed mesh's triangles (`indices` into `positions`): the same tree as
+/// [`build`] over the triangles written out, without that copy (36 bytes a triangle).
+pub fn build_indexed(positions: &[Vec3], indices: &[[u32; 3]]) -> Bvh {
+    build_prims(
+        indices
+            .par_iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let [a, b, c] = t.map(|v| positions[v as usize]);
+                Prim::new(i, Aabb::EMPTY.grow(a).grow(b).grow(c))
+            })
+            .collect(),
+    )
+}
+
 /// Builds a BVH over boxes (the instances of a top-level tree); `tri_indices` then index
 /// `boxes`.
 pub fn build_boxes(boxes: &[Aabb]) -> Bvh {
@@ -980,6 +995,36 @@ pub(super) mod tests {
         let bytes = |b: &Bvh| bytemuck::cast_slice::<_, u8>(&b.nodes).to_vec();
         assert!(bytes(&one) == bytes(&four), "the same nodes");
         assert!(one.tri_indices == four.tri_indices, "the same order");
+    }
+
+    #[test]
+    fn an_indexed_mesh_builds_the_tree_of_its_triangles() {
+        // Triangles sharing vertices: a grid of quads, some vertices used by six triangles.
+        let side = 300;
+        let mut s = 5;
+        let positions: Vec<Vec3> = (0..side * side)
+            .map(|i| {
+                let (x, z) = ((i % side) as f32, (i / side) as f32);
+                Vec3::new(x, lcg(&mut s) * 3.0, z)
+            })
+            .collect();
+        let mut indices = vec![];
+        for z in 0..side as u32 - 1 {
+            for x in 0..side as u32 - 1 {
+                let i = z * side as u32 + x;
+                indices.push([i, i + 1, i + side as u32]);
+                indices.push([i + 1, i + side as u32 + 1, i + side as u32]);
+            }
+        }
+        let tris: Vec<[Vec3; 3]> = indices
+            .iter()
+            .map(|t| t.map(|i| positions[i as usize]))
+            .collect();
+        let (a, b) = (build(&tris), build_indexed(&positions, &indices));
+        let bytes = |b: &Bvh| bytemuck::cast_slice::<_, u8>(&b.nodes).to_vec();
+        assert!(bytes(&a) == bytes(&b), "the same nodes");
+        assert!(a.tri_indices == b.tri_indices, "the same order");
+        check_tree(&b, &tris);
     }
 
     #[test]
