@@ -118,6 +118,7 @@ fn weighted_quantile(values: &[(f32, f32)], q: f64) -> f32 {
 /// triangles whose centroids fall in the window, clipped to it, are the result. A stray object
 /// far away is left out; a lone object keeps its exact bounds.
 pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
+    use rayon::prelude::*;
     let mut exact = Bounds::default();
     for t in tris {
         for v in t {
@@ -127,17 +128,21 @@ pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
     if tris.len() < 8 {
         return exact;
     }
-    let centroids: Vec<Vec3> = tris.iter().map(|t| (t[0] + t[1] + t[2]) / 3.0).collect();
-    let weights: Vec<f32> = tris.iter().map(|t| area(t).sqrt() + 1e-12).collect();
+    let centroids: Vec<Vec3> = tris
+        .par_iter()
+        .map(|t| (t[0] + t[1] + t[2]) / 3.0)
+        .collect();
+    let weights: Vec<f32> = tris.par_iter().map(|t| area(t).sqrt() + 1e-12).collect();
     let mut lo = Vec3::ZERO;
     let mut hi = Vec3::ZERO;
     for axis in 0..3 {
         let mut v: Vec<(f32, f32)> = centroids
-            .iter()
+            .par_iter()
             .zip(&weights)
             .map(|(c, &w)| (c[axis], w))
             .collect();
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // Stable, as `sort_by` is: ties keep their order and the quantiles are the same.
+        v.par_sort_by(|a, b| a.0.total_cmp(&b.0));
         let (a, b) = (weighted_quantile(&v, 0.05), weighted_quantile(&v, 0.95));
         let margin = 0.5 * (b - a);
         lo[axis] = a - margin;
