@@ -136,10 +136,20 @@ pub fn test_program_source() -> String {
     s
 }
 
+/// Appends each source behind its `#line` directive. With `PENUMBRA_KERNEL_DIR` set (for
+/// working on the kernels without rebuilding the binary), a file of that name found under
+/// the directory (e.g. `PENUMBRA_KERNEL_DIR=.` for `kernels/path.h`) replaces the built-in text.
 fn append_sources(s: &mut String, sources: &[(&str, &str)]) {
+    let dir = std::env::var_os("PENUMBRA_KERNEL_DIR").map(std::path::PathBuf::from);
     for (name, text) in sources {
         s.push_str(&format!("#line 1 \"{name}\"\n"));
-        s.push_str(text);
+        match dir
+            .as_ref()
+            .and_then(|d| std::fs::read_to_string(d.join(name)).ok())
+        {
+            Some(edited) => s.push_str(&edited),
+            None => s.push_str(text),
+        }
         s.push('\n');
     }
 }
