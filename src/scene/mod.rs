@@ -447,6 +447,30 @@ impl Scene {
         Flattened { dropped, triangles }
     }
 
+    /// [`Scene::flatten`] one visible object at a time: `each` gets every object's kept
+    /// triangles in order (made in parallel), so that a caller converting them holds one
+    /// object's [`WorldTriangle`]s at a time, not the scene's. Returns the number dropped.
+    pub fn flatten_each(
+        &self,
+        frame: &RenderFrame,
+        mut each: impl FnMut(Vec<WorldTriangle>),
+    ) -> usize {
+        use rayon::prelude::*;
+        let mut dropped = 0;
+        for (oi, o) in self.objects.iter().enumerate().filter(|(_, o)| o.visible) {
+            let p = Placed::new(oi as u32, o, frame, true);
+            let all = 0..o.mesh.indices.len();
+            each(if p.dropped == 0 {
+                all.into_par_iter().map(|ti| p.world_triangle(ti)).collect()
+            } else {
+                let kept = all.into_par_iter().filter(|&ti| p.kept(ti));
+                kept.map(|ti| p.world_triangle(ti)).collect()
+            });
+            dropped += p.dropped;
+        }
+        dropped
+    }
+
     /// The visible objects' triangles as [`Scene::flatten`] gives them, vertices and material
     /// alone (40 bytes a triangle, not [`WorldTriangle`]'s 200): what the host probes of the
     /// first view trace.
