@@ -18,7 +18,8 @@ typedef struct {
     float3 throughput;
     float3 radiance;    // gathered so far
     float prev_pdf;     // pdf of the BSDF sample that made the ray (0: camera ray)
-    uint flags;         // PATH_SPECULAR, PATH_ESCAPED, PATH_THROUGH_WALL
+    uint flags;         // PATH_SPECULAR, PATH_ESCAPED, PATH_THROUGH_WALL; the wavelength
+                        // from PATH_WAVELENGTH_SHIFT up (HAS_DISPERSION)
     uint rng;
     float2 cone;        // ray cone (width, spread angle) for texture filtering
 } PathState;
@@ -245,6 +246,22 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     }
 #endif
 
+#ifdef HAS_DISPERSION
+    // A dispersive volume: its index is that of the path's wavelength, picked at the first
+    // such surface (weighted by its RGB response over its pdf) and kept in the flags' high
+    // bits to the end of the path (bsdf.h, "KHR_materials_dispersion").
+    if (mat->aniso.w > 0.0f && m.transmission > 0.0f && m.thickness > 0.0f) {
+        uint wavelength = s->flags >> PATH_WAVELENGTH_SHIFT;
+        if (wavelength == 0u) {
+            float lambda = sample_wavelength(rng_next(&rng));
+            throughput *= wavelength_rgb(lambda) / wavelength_pdf(lambda);
+            wavelength = max((uint)(lambda * 64.0f + 0.5f), 1u);
+            s->flags |= wavelength << PATH_WAVELENGTH_SHIFT;
+        }
+        m.ior = dispersive_ior(m.ior, mat->aniso.w, (float)wavelength * (1.0f / 64.0f));
+    }
+#endif
+
     // Hit from behind, a transmissive volume was travelled through: attenuate the segment
     // (Beer–Lambert) and see the interface from inside. Other back faces shade as front faces.
     if (!front && m.transmission > 0.0f && m.thickness > 0.0f) {
@@ -324,6 +341,9 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
             flags = bounce == 0u ? PATH_SPECULAR : s->flags;
             if (!prev_specular && bounce > 0u) flags |= PATH_THROUGH_WALL;
         }
+#endif
+#ifdef HAS_DISPERSION
+        flags |= s->flags & (0xffffffffu << PATH_WAVELENGTH_SHIFT);  // the path's wavelength
 #endif
         s->origin = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
         s->prev_pdf = pdf;

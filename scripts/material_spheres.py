@@ -8,6 +8,7 @@ with its studio environment, or with `--sky 1` as a white furnace):
     python3 scripts/material_spheres.py anisotropy -o aniso.gltf
     python3 scripts/material_spheres.py iridescence -o film.gltf
     python3 scripts/material_spheres.py diffuse_transmission -o leaf.gltf
+    python3 scripts/material_spheres.py dispersion -o prism.gltf
     penumbra render aniso.gltf -o aniso.png --width 500 --height 120 --spp 64
 
 The spheres are held-out fixtures for docs/materials.md: made here, never copied from the shared
@@ -100,6 +101,26 @@ def materials(ext):
                     },
                 }
             )
+    elif ext == "dispersion":
+        # Clear glass balls of ior 1.7: none, crown glass (Abbe 59), polycarbonate (32), Abbe 20
+        # and rutile (9.8).
+        for dispersion in [0.0, 0.33, 0.625, 1.0, 2.04]:
+            out.append(
+                {
+                    "name": f"dispersion {dispersion}",
+                    "pbrMetallicRoughness": {
+                        "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
+                        "metallicFactor": 0.0,
+                        "roughnessFactor": 0.0,
+                    },
+                    "extensions": {
+                        "KHR_materials_dispersion": {"dispersion": dispersion},
+                        "KHR_materials_ior": {"ior": 1.7},
+                        "KHR_materials_transmission": {"transmissionFactor": 1.0},
+                        "KHR_materials_volume": {"thicknessFactor": 2.0},
+                    },
+                }
+            )
     else:
         raise SystemExit(f"unknown extension {ext}")
     return out
@@ -153,7 +174,7 @@ def write(ext, path):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("extension", choices=["anisotropy", "iridescence", "diffuse_transmission"])
+    p.add_argument("extension", choices=["anisotropy", "iridescence", "diffuse_transmission", "dispersion"])
     p.add_argument("-o", "--output", required=True)
     a = p.parse_args()
     write(a.extension, a.output)

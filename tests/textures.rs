@@ -1000,6 +1000,57 @@ fn iridescence_factors_and_textures_are_read() {
     );
 }
 
+/// `KHR_materials_dispersion` is read (20 / Abbe number, no upper bound; a negative one is
+/// the default 0) and packed in the anisotropy lane's `.w`; nothing warns. It makes a
+/// material dispersive only on a transmitting volume.
+#[test]
+fn dispersion_is_read() {
+    let mut g = Gltf::default();
+    for e in [
+        "KHR_materials_dispersion",
+        "KHR_materials_transmission",
+        "KHR_materials_volume",
+    ] {
+        g.use_ext(e);
+    }
+    let glass = |g: &mut Gltf, dispersion: Value, thickness: f32| {
+        lambert(
+            g,
+            [1.0; 4],
+            json!({"extensions": {
+                "KHR_materials_dispersion": dispersion,
+                "KHR_materials_transmission": {"transmissionFactor": 1.0},
+                "KHR_materials_volume": {"thicknessFactor": thickness}
+            }}),
+        )
+    };
+    let prism = glass(&mut g, json!({"dispersion": 0.4}), 1.0);
+    let rutile = glass(&mut g, json!({"dispersion": 2.04}), 1.0);
+    let default = glass(&mut g, json!({}), 1.0);
+    let negative = glass(&mut g, json!({"dispersion": -1.0}), 1.0);
+    let thin = glass(&mut g, json!({"dispersion": 0.4}), 0.0);
+    let mesh = quad(&mut g, prism, false, false);
+    g.node(json!({"mesh": mesh}));
+    let dir = tempfile::tempdir().unwrap();
+    let s = penumbra::scene::load(&g.write_glb(dir.path(), "dispersion")).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let d: Vec<f32> = [prism, rutile, default, negative, thin]
+        .iter()
+        .map(|&m| s.materials[m].dispersion)
+        .collect();
+    assert_eq!(d, [0.4, 2.04, 0.0, 0.0, 0.4]);
+    assert!(s.materials[prism].is_dispersive());
+    assert!(!s.materials[default].is_dispersive());
+    assert!(
+        !s.materials[thin].is_dispersive(),
+        "no volume, no dispersion"
+    );
+    assert_eq!(
+        penumbra::render::gpu_material(&s.materials[rutile]).aniso[3],
+        2.04
+    );
+}
+
 /// `KHR_materials_diffuse_transmission` is read: factor and color with their textures (the
 /// color texture is sRGB, the factor texture's alpha is data); nothing warns.
 #[test]

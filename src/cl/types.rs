@@ -113,6 +113,9 @@ kernel_constants! {
     /// `GpuPath::direction.w` flag: went straight through a thin wall since the last
     /// scattering vertex.
     PATH_THROUGH_WALL: u32 = 4;
+    /// `GpuPath::direction.w`: the bits from here up hold the wavelength a path picked at its
+    /// first dispersive surface (`KHR_materials_dispersion`), in 1/64 nm; 0: none picked yet.
+    PATH_WAVELENGTH_SHIFT: u32 = 8;
 
     /// Slot of the counters buffer (u32): paths in this bounce's input queue.
     COUNT_IN: usize = 0;

@@ -98,6 +98,7 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         diffuse_transmission: used(&|m| m.diffuse_transmission > 0.0),
         iridescence: used(&|m| m.iridescence > 0.0),
         anisotropy: used(&|m| m.anisotropy > 0.0),
+        dispersion: used(&|m| m.is_dispersive()),
         tangents: used(&|m| m.anisotropy > 0.0) && tangents,
         lambert_only: materials().all(|m| m.is_lambertian()),
     }

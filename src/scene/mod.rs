@@ -232,6 +232,12 @@ impl Material {
                 && self.sheen_color.iter().all(|&c| c == 0.0))
     }
 
+    /// Whether light refracting through the material splits by wavelength: a dispersive
+    /// transmitting volume (`KHR_materials_dispersion` has no effect on thin walls).
+    pub fn is_dispersive(&self) -> bool {
+        self.dispersion > 0.0 && self.transmission > 0.0 && self.thickness > 0.0
+    }
+
     /// Whether the material emits light.
     pub fn is_emissive(&self) -> bool {
         self.emission.iter().any(|&e| e > 0.0)

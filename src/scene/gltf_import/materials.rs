@@ -1,7 +1,7 @@
 //! Material extensions the gltf crate does not parse, read from the material's raw
 //! `extensions` JSON: `KHR_materials_clearcoat`, `KHR_materials_sheen`,
-//! `KHR_materials_anisotropy`, `KHR_materials_iridescence` and
-//! `KHR_materials_diffuse_transmission`.
+//! `KHR_materials_anisotropy`, `KHR_materials_iridescence`,
+//! `KHR_materials_diffuse_transmission` and `KHR_materials_dispersion`.
 
 use super::TextureTable;
 use crate::scene::Material;
@@ -37,6 +37,10 @@ pub(super) fn read_extensions(
     }
     if let Some(x) = m.extension_value("KHR_materials_diffuse_transmission") {
         reader.diffuse_transmission(x, material);
+    }
+    if let Some(x) = m.extension_value("KHR_materials_dispersion") {
+        // 20 / Abbe number; any value >= 0 is valid (above 1 exaggerates).
+        material.dispersion = Reader::non_negative(x, "dispersion", 0.0);
     }
 }
 
