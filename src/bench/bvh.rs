@@ -43,6 +43,17 @@ pub fn run(args: &BvhArgs) -> Result<()> {
     let loaded = peak_rss_bytes();
     let r = crate::bvh::report(&scene, args.runs, !args.two_level_only);
     let peak = peak_rss_bytes();
+    // The first view (framing probe) as `render` and the viewer decide it before the upload:
+    // part of opening a scene without a camera, and of any scene's light test.
+    let t = Instant::now();
+    let own_lights = if scene.default_rig {
+        Vec::new()
+    } else {
+        scene.lights.clone()
+    };
+    crate::scene::framing::first_view(&scene, &own_lights, None, 16.0 / 9.0);
+    let first_view_ms = t.elapsed().as_secs_f64() * 1e3;
+    let first_view_peak = peak_rss_bytes();
     // What loading and building added to the process's peak, per distinct triangle.
     let per_unique = match (before, peak) {
         (Some(b), Some(p)) if r.unique_triangles > 0 => {
@@ -61,6 +72,8 @@ pub fn run(args: &BvhArgs) -> Result<()> {
             "peak_rss_bytes": peak,
             "load_peak_rss_bytes": loaded,
             "start_rss_bytes": before,
+            "first_view_ms": first_view_ms,
+            "first_view_peak_rss_bytes": first_view_peak,
             "added_bytes_per_unique_triangle": per_unique,
         });
         if let (Some(o), serde_json::Value::Object(m)) =
@@ -119,6 +132,10 @@ pub fn run(args: &BvhArgs) -> Result<()> {
     println!(
         "  instance move      {:>12.3} ms (new TLAS, host only)",
         r.instance_move_ms
+    );
+    println!(
+        "  first view         {:>12.1} ms (framing probe: world vertices and their BVH)",
+        first_view_ms
     );
     if let (Some(peak), Some(per), Some(loaded)) = (peak, per_unique, loaded) {
         println!(

@@ -169,6 +169,21 @@ pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
     )
 }
 
+/// Builds a BVH over an indexed mesh's triangles (`indices` into `positions`): the same tree as
+/// [`build`] over the triangles written out, without that copy (36 bytes a triangle).
+pub fn build_indexed(positions: &[Vec3], indices: &[[u32; 3]]) -> Bvh {
+    build_prims(
+        indices
+            .par_iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let [a, b, c] = t.map(|v| positions[v as usize]);
+                Prim::new(i, Aabb::EMPTY.grow(a).grow(b).grow(c))
+            })
+            .collect(),
+    )
+}
+
 /// Builds a BVH over boxes (the instances of a top-level tree); `tri_indices` then index
 /// `boxes`.
 pub fn build_boxes(boxes: &[Aabb]) -> Bvh {
@@ -182,13 +197,26 @@ pub fn build_boxes(boxes: &[Aabb]) -> Bvh {
 }
 
 fn build_prims(mut prims: Vec<Prim>) -> Bvh {
+    let n = prims.len();
     let info = NodeInfo::of(&prims);
-    let root = build_subtree(&mut prims, 0, 0, info);
+    // Every interior node below the root is written once, straight into `arena`, at a
+    // provisional place (see `build_subtree`); `assemble` then packs them into the final
+    // layout in place. The arena is allocated zeroed, so its pages cost memory only once
+    // written: about the tree's own size, where per-task node lists and a final copy of them
+    // cost twice that and left the lists' memory to the allocator.
+    let mut arena: Vec<GpuBvhNode> = bytemuck::zeroed_vec(2 * n.max(1) - 1);
+    let root = build_subtree(&mut prims, 0, 0, info, &mut arena[1..], 1);
     let tri_indices = prims.par_iter().map(Prim::index).collect();
     drop(prims);
     let nodes = match root {
-        Built::Tree { nodes, .. } => nodes,
-        Built::Top { .. } => assemble(root),
+        Built::Tree { at, len, .. } => {
+            // Local indices are final ones: the block moves to the front as it is.
+            arena.copy_within(at..at + len, 0);
+            arena.truncate(len);
+            arena.shrink_to_fit();
+            arena
+        }
+        Built::Top { .. } => assemble(root, arena),
         Built::Leaf {
             bounds,
             first,
@@ -223,11 +251,9 @@ enum Built {
         first: u32,
         count: u32,
     },
-    /// A subtree built by one task, in the final layout with its root at index 0.
-    Tree {
-        bounds: Aabb,
-        nodes: Vec<GpuBvhNode>,
-    },
+    /// A subtree built by one task: `len` nodes in the final layout with its root at local
+    /// index 0, written to the arena from index `at` on.
+    Tree { bounds: Aabb, at: usize, len: usize },
     /// A node split on the parallel levels.
     Top {
         bounds: Aabb,
@@ -248,7 +274,7 @@ impl Built {
     fn node_count(&self) -> usize {
         match self {
             Built::Leaf { .. } => 0,
-            Built::Tree { nodes, .. } => nodes.len(),
+            Built::Tree { len, .. } => *len,
             Built::Top { children, .. } => 1 + children[0].node_count() + children[1].node_count(),
         }
     }
@@ -256,7 +282,22 @@ impl Built {
 
 /// Builds the subtree over `prims` (triangles `first..` in BVH order): large ones split here
 /// and hand their children to rayon, small ones are built by this task alone.
-fn build_subtree(prims: &mut [Prim], first: u32, depth: u32, info: NodeInfo) -> Built {
+///
+/// `space` (arena indices `at..`) has 2m − 2 slots for a subtree of m primitives, a
+/// provisional layout that mirrors the final one with room to spare: a split node keeps its
+/// first two slots for its children (the final layout puts interior children next to each
+/// other) and gives the left child the next 2a − 2 and the right one the 2b − 2 after them; a
+/// task's subtree (at most m − 1 nodes) starts at the first slot of its space. In depth-first
+/// order every node then lands at or after its final place, so packing moves nodes only
+/// towards the front (see `assemble`).
+fn build_subtree(
+    prims: &mut [Prim],
+    first: u32,
+    depth: u32,
+    info: NodeInfo,
+    space: &mut [GpuBvhNode],
+    at: usize,
+) -> Built {
     let bounds = info.bounds.aabb();
     let count = prims.len() as u32;
     let Some(split) = decide(prims, info, depth) else {
@@ -267,18 +308,27 @@ fn build_subtree(prims: &mut [Prim], first: u32, depth: u32, info: NodeInfo) -> 
         };
     };
     if prims.len() <= PARALLEL_THRESHOLD {
-        // A binary tree over n primitives has at most n - 1 interior nodes: no regrowth.
-        let mut nodes = Vec::with_capacity(prims.len() - 1);
-        nodes.push(GpuBvhNode::default());
-        emit(prims, first, depth, split, 0, &mut nodes);
-        nodes.shrink_to_fit();
-        return Built::Tree { bounds, nodes };
+        let mut len = 1;
+        emit(prims, first, depth, split, 0, space, &mut len);
+        return Built::Tree { bounds, at, len };
     }
-    let (left, right) = prims.split_at_mut(split.at);
-    let right_first = first + split.at as u32;
+    let a = split.at;
+    let (left, right) = prims.split_at_mut(a);
+    let right_first = first + a as u32;
+    let (left_space, right_space) = space[2..].split_at_mut(2 * a - 2);
     let (l, r) = rayon::join(
-        || build_subtree(left, first, depth + 1, split.left),
-        || build_subtree(right, right_first, depth + 1, split.right),
+        || build_subtree(left, first, depth + 1, split.left, left_space, at + 2),
+        || {
+            let right_at = at + 2 * a;
+            build_subtree(
+                right,
+                right_first,
+                depth + 1,
+                split.right,
+                right_space,
+                right_at,
+            )
+        },
     );
     Built::Top {
         bounds,
@@ -287,14 +337,15 @@ fn build_subtree(prims: &mut [Prim], first: u32, depth: u32, info: NodeInfo) -> 
 }
 
 /// Writes the interior node at `slot` (already split by `split`), appending its interior
-/// children next to each other and then their subtrees, left first.
+/// children next to each other at `nodes[*len..]` and then their subtrees, left first.
 fn emit(
     prims: &mut [Prim],
     first: u32,
     depth: u32,
     split: Split,
     slot: usize,
-    nodes: &mut Vec<GpuBvhNode>,
+    nodes: &mut [GpuBvhNode],
+    len: &mut usize,
 ) {
     let (left, right) = prims.split_at_mut(split.at);
     let right_first = first + split.at as u32;
@@ -307,9 +358,9 @@ fn emit(
         let bounds = info.bounds.aabb();
         match decide(p, *info, depth + 1) {
             Some(s) => {
-                nodes.push(GpuBvhNode::default());
-                write_interior(&mut node, side, bounds, nodes.len() as u32 - 1);
-                *child = Some((s, nodes.len() - 1));
+                write_interior(&mut node, side, bounds, *len as u32);
+                *child = Some((s, *len));
+                *len += 1;
             }
             None => write_leaf(&mut node, side, bounds, *f, p.len() as u32),
         }
@@ -317,71 +368,82 @@ fn emit(
     nodes[slot] = node;
     for (p, f, _, child) in children {
         if let Some((s, index)) = child {
-            emit(p, f, depth + 1, s, index, nodes);
+            emit(p, f, depth + 1, s, index, nodes, len);
         }
     }
 }
 
-/// The node array of a tree whose top levels were split in parallel, in the layout [`emit`]
+/// Packs the arena of a tree whose top levels were split in parallel into the layout [`emit`]
 /// gives: interior children next to each other, then the left subtree, then the right. The
-/// split levels are placed first (a few nodes a task); then every task's block is copied into
-/// its own range of the array in parallel.
-fn assemble(root: Built) -> Vec<GpuBvhNode> {
-    let mut nodes = vec![GpuBvhNode::default(); root.node_count()];
+/// split levels are placed first (a few nodes a task); each task's block, less its root, then
+/// moves to its final range, blocks in depth-first order (a block's final range starts at or
+/// before its provisional one and ends before the next block's, see `build_subtree`), and its
+/// child indices are shifted in parallel. The arena is cut to the tree's size.
+fn assemble(root: Built, mut arena: Vec<GpuBvhNode>) -> Vec<GpuBvhNode> {
+    let total = root.node_count();
+    let mut tops = Vec::new();
     let mut blocks = Vec::new();
     let mut end = 1;
-    place(root, 0, &mut end, &mut nodes, &mut blocks);
-    // The blocks, less their roots, in ascending disjoint ranges from `start`.
-    let mut jobs = Vec::with_capacity(blocks.len());
-    let mut rest = &mut nodes[..];
-    let mut base = 0;
-    for block in &blocks {
-        let (_, tail) = std::mem::take(&mut rest).split_at_mut(block.start - base);
-        let (range, tail) = tail.split_at_mut(block.nodes.len() - 1);
-        jobs.push((range, block));
-        rest = tail;
-        base = block.start + block.nodes.len() - 1;
+    place(root, 0, &mut end, &mut tops, &mut blocks);
+    // A block's root goes to the slot its parent reserved, which may lie in a range that an
+    // earlier block moves into: read them all first.
+    let roots: Vec<GpuBvhNode> = blocks.iter().map(|b| arena[b.at]).collect();
+    for b in &blocks {
+        arena.copy_within(b.at + 1..b.at + b.len, b.start);
     }
-    let roots: Vec<(usize, GpuBvhNode)> = jobs
-        .into_par_iter()
-        .map(|(range, block)| {
-            // The block's root takes the reserved slot, the rest follows: local index i >= 1
-            // lands at start + i - 1.
-            let offset = block.start as u32 - 1;
-            let shift = |mut n: GpuBvhNode| {
-                for lo in [&mut n.left_min, &mut n.right_min] {
-                    if (lo[3].to_bits() as i32) >= 0 {
-                        lo[3] = f32::from_bits(lo[3].to_bits() + offset);
-                    }
-                }
-                n
-            };
-            for (to, &from) in range.iter_mut().zip(&block.nodes[1..]) {
-                *to = shift(from);
+    // Local index i >= 1 lands at start + i - 1.
+    let shift = |mut n: GpuBvhNode, start: usize| {
+        let offset = start as u32 - 1;
+        for lo in [&mut n.left_min, &mut n.right_min] {
+            if (lo[3].to_bits() as i32) >= 0 {
+                lo[3] = f32::from_bits(lo[3].to_bits() + offset);
             }
-            (block.slot, shift(block.nodes[0]))
-        })
-        .collect();
-    for (slot, node) in roots {
-        nodes[slot] = node;
+        }
+        n
+    };
+    // The blocks' final ranges, ascending and disjoint.
+    let mut jobs = Vec::with_capacity(blocks.len());
+    let mut rest = &mut arena[..total];
+    let mut base = 0;
+    for b in &blocks {
+        let (_, tail) = std::mem::take(&mut rest).split_at_mut(b.start - base);
+        let (range, tail) = tail.split_at_mut(b.len - 1);
+        jobs.push((range, b.start));
+        rest = tail;
+        base = b.start + b.len - 1;
     }
-    nodes
+    jobs.into_par_iter().for_each(|(range, start)| {
+        for n in range {
+            *n = shift(*n, start);
+        }
+    });
+    for (b, root) in blocks.iter().zip(roots) {
+        arena[b.slot] = shift(root, b.start);
+    }
+    for (slot, node) in tops {
+        arena[slot] = node;
+    }
+    arena.truncate(total);
+    arena.shrink_to_fit();
+    arena
 }
 
-/// A task's block of nodes and where it goes: its root at `slot`, the rest from `start` on.
+/// A task's block of nodes: in the arena at `at..at + len`; its root goes to `slot`, the rest
+/// from `start` on.
 struct Block {
     slot: usize,
     start: usize,
-    nodes: Vec<GpuBvhNode>,
+    at: usize,
+    len: usize,
 }
 
-/// Writes the split node `node` at `slot`, reserving slots from `end` for its interior
-/// children, and notes where the blocks below it go.
+/// Places the split node `node` at `slot` (into `tops`), reserving slots from `end` for its
+/// interior children, and notes where the blocks below it go.
 fn place(
     node: Built,
     slot: usize,
     end: &mut usize,
-    nodes: &mut [GpuBvhNode],
+    tops: &mut Vec<(usize, GpuBvhNode)>,
     blocks: &mut Vec<Block>,
 ) {
     let Built::Top { children, .. } = node else {
@@ -403,19 +465,20 @@ fn place(
             }
         }
     }
-    nodes[slot] = gpu;
+    tops.push((slot, gpu));
     let [left, right] = *children;
     for (child, index) in [left, right].into_iter().zip(pending) {
         let Some(index) = index else { continue };
         match child {
-            Built::Top { .. } => place(child, index, end, nodes, blocks),
-            Built::Tree { nodes: block, .. } => {
+            Built::Top { .. } => place(child, index, end, tops, blocks),
+            Built::Tree { at, len, .. } => {
                 blocks.push(Block {
                     slot: index,
                     start: *end,
-                    nodes: block,
+                    at,
+                    len,
                 });
-                *end += blocks.last().map_or(0, |b| b.nodes.len() - 1);
+                *end += len - 1;
             }
             Built::Leaf { .. } => unreachable!("leaves reserve no slot"),
         }
@@ -980,6 +1043,36 @@ pub(super) mod tests {
         let bytes = |b: &Bvh| bytemuck::cast_slice::<_, u8>(&b.nodes).to_vec();
         assert!(bytes(&one) == bytes(&four), "the same nodes");
         assert!(one.tri_indices == four.tri_indices, "the same order");
+    }
+
+    #[test]
+    fn an_indexed_mesh_builds_the_tree_of_its_triangles() {
+        // Triangles sharing vertices: a grid of quads, some vertices used by six triangles.
+        let side = 300;
+        let mut s = 5;
+        let positions: Vec<Vec3> = (0..side * side)
+            .map(|i| {
+                let (x, z) = ((i % side) as f32, (i / side) as f32);
+                Vec3::new(x, lcg(&mut s) * 3.0, z)
+            })
+            .collect();
+        let mut indices = vec![];
+        for z in 0..side as u32 - 1 {
+            for x in 0..side as u32 - 1 {
+                let i = z * side as u32 + x;
+                indices.push([i, i + 1, i + side as u32]);
+                indices.push([i + 1, i + side as u32 + 1, i + side as u32]);
+            }
+        }
+        let tris: Vec<[Vec3; 3]> = indices
+            .iter()
+            .map(|t| t.map(|i| positions[i as usize]))
+            .collect();
+        let (a, b) = (build(&tris), build_indexed(&positions, &indices));
+        let bytes = |b: &Bvh| bytemuck::cast_slice::<_, u8>(&b.nodes).to_vec();
+        assert!(bytes(&a) == bytes(&b), "the same nodes");
+        assert!(a.tri_indices == b.tri_indices, "the same order");
+        check_tree(&b, &tris);
     }
 
     #[test]

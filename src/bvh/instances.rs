@@ -14,7 +14,7 @@
 //! device reports them: the device keeps each mesh's triangles and shading data once, in
 //! object space, and shading carries a hit to world space through the instance's transform.
 
-use super::{Aabb, Bvh, Child, Hit, Ray, WideBvh, build, build_boxes};
+use super::{Aabb, Bvh, Child, Hit, Ray, WideBvh, build, build_boxes, build_indexed};
 use crate::cl::types::{GpuBvhNode, GpuHit, GpuWideNode};
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
@@ -40,14 +40,16 @@ impl Blas {
         Self { bvh, triangles }
     }
 
-    /// Builds the BLAS of an indexed mesh (object space); the copy of its triangles the build
-    /// needs lives only as long as the build.
+    /// Builds the BLAS of an indexed mesh (object space): the same as [`Blas::new`] over its
+    /// triangles, without a copy of them in mesh order.
     pub fn of_mesh(positions: &[Vec3], indices: &[[u32; 3]]) -> Self {
-        let tris: Vec<[Vec3; 3]> = indices
-            .iter()
-            .map(|t| t.map(|i| positions[i as usize]))
+        let bvh = build_indexed(positions, indices);
+        let triangles = bvh
+            .tri_indices
+            .par_iter()
+            .map(|&i| indices[i as usize].map(|v| positions[v as usize]))
             .collect();
-        Self::new(&tris)
+        Self { bvh, triangles }
     }
 
     /// The object-space box of the whole mesh.

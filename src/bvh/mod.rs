@@ -9,7 +9,7 @@ mod stats;
 mod traverse;
 mod wide;
 
-pub use build::{MAX_DEPTH, build, build_boxes};
+pub use build::{MAX_DEPTH, build, build_boxes, build_indexed};
 pub use instances::{Blas, Instance, InstanceHit, TwoLevel, closed_cube};
 pub use refit::{REFIT_MAX_GROWTH, Update};
 pub use stats::{BvhReport, report};

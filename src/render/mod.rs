@@ -200,10 +200,7 @@ impl Renderer {
                 host.layout.objects = plan.objects;
                 (host, 0)
             }
-            None => {
-                let flat = scene.flatten(&space);
-                (HostScene::flat(flat.triangles, &materials), flat.dropped)
-            }
+            None => HostScene::flatten(scene, &space, &materials),
         };
         let bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
 

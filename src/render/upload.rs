@@ -6,7 +6,7 @@
 use crate::bvh::{Bvh, Ray, TwoLevel};
 use crate::cl::types::*;
 use crate::scene::{
-    AlphaMode, Camera, Material, Mesh, RenderFrame, WorldTriangle, robust_bounds_of,
+    AlphaMode, Camera, Material, Mesh, RenderFrame, Scene, WorldTriangle, robust_bounds_of,
 };
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
@@ -271,22 +271,37 @@ impl HostScene {
     /// array at a time, so that the large intermediate triangles and two orders of the same
     /// data are never held together.
     pub fn flat(world: Vec<WorldTriangle>, materials: &[Material]) -> Self {
-        let middle = middle_of(1, &|_| world.iter().map(|t| t.v.map(Vec3::as_dvec3)));
         let normal_mapped = world.iter().any(|t| t.tangents.is_some());
-        let mut triangles = Vec::with_capacity(world.len());
-        let mut shading = Vec::with_capacity(world.len());
-        let mut tangents = Vec::with_capacity(if normal_mapped { world.len() } else { 0 });
-        let mut vertices = Vec::with_capacity(world.len());
-        for t in &world {
-            let (tri, sh, tan) = device_triangle(t, -1);
-            triangles.push(tri);
-            shading.push(sh);
-            if normal_mapped {
-                tangents.push(tan);
-            }
-            vertices.push(t.v);
+        let mut structs = FlatStructs::new(world.len(), normal_mapped);
+        structs.add(world);
+        Self::flat_from(structs, materials)
+    }
+
+    /// [`HostScene::flat`] of `scene`'s visible objects in render space `space`, converted to
+    /// the device structs one object at a time (never the whole scene's [`WorldTriangle`]s
+    /// at once), and the number of triangles dropped ([`Scene::flatten`]).
+    pub fn flatten(scene: &Scene, space: &RenderFrame, materials: &[Material]) -> (Self, usize) {
+        let visible = || scene.objects.iter().filter(|o| o.visible);
+        // Tangents are kept when some kept triangle has them (as `flat` decides).
+        let maybe_mapped = visible().any(|o| !o.mesh.tangents.is_empty());
+        let mut structs = FlatStructs::new(scene.triangle_count(), maybe_mapped);
+        let dropped = scene.flatten_each(space, |world| structs.add(world));
+        if !structs.mapped {
+            structs.tangents = Vec::new();
         }
-        drop(world);
+        (Self::flat_from(structs, materials), dropped)
+    }
+
+    fn flat_from(structs: FlatStructs, materials: &[Material]) -> Self {
+        let FlatStructs {
+            triangles,
+            shading,
+            tangents,
+            vertices,
+            ..
+        } = structs;
+        let normal_mapped = !tangents.is_empty();
+        let middle = middle_of(1, &|_| vertices.iter().map(|v| v.map(Vec3::as_dvec3)));
         let bvh = crate::bvh::build(&vertices);
         fn gather<T: Copy + Send + Sync>(v: Vec<T>, order: &[u32]) -> Vec<T> {
             order.par_iter().map(|&i| v[i as usize]).collect()
@@ -587,6 +602,43 @@ fn object_triangles(
         }
     }
     (tris, shading, tangents, emitters)
+}
+
+/// The flat form's device structs in object order, filled a list of [`WorldTriangle`]s at a
+/// time.
+struct FlatStructs {
+    triangles: Vec<GpuTriangle>,
+    shading: Vec<GpuTriShading>,
+    /// Filled when tangents may be needed (`keep_tangents`).
+    tangents: Vec<GpuTriTangents>,
+    vertices: Vec<[Vec3; 3]>,
+    keep_tangents: bool,
+    /// Whether some triangle added had tangents.
+    mapped: bool,
+}
+
+impl FlatStructs {
+    fn new(capacity: usize, keep_tangents: bool) -> Self {
+        Self {
+            triangles: Vec::with_capacity(capacity),
+            shading: Vec::with_capacity(capacity),
+            tangents: Vec::with_capacity(if keep_tangents { capacity } else { 0 }),
+            vertices: Vec::with_capacity(capacity),
+            keep_tangents,
+            mapped: false,
+        }
+    }
+
+    fn add(&mut self, world: Vec<WorldTriangle>) {
+        self.mapped |= world.iter().any(|t| t.tangents.is_some());
+        let structs = || world.par_iter().map(|t| device_triangle(t, -1));
+        self.triangles.par_extend(structs().map(|s| s.0));
+        self.shading.par_extend(structs().map(|s| s.1));
+        if self.keep_tangents {
+            self.tangents.par_extend(structs().map(|s| s.2));
+        }
+        self.vertices.par_extend(world.par_iter().map(|t| t.v));
+    }
 }
 
 /// A triangle's device structs; `light` is its index among the emissive triangles (-1: none).

@@ -55,31 +55,37 @@ pub fn robust_bounds_of<I: Iterator<Item = [DVec3; 3]>>(
             Some(*acc - c)
         })
         .collect();
-    let sample: Vec<[DVec3; 3]> = (0..parts)
+    let centroid = |t: &[DVec3; 3]| (t[0] + t[1] + t[2]) / 3.0;
+    // Each sampled triangle as its centroid and its largest extent (32 bytes, not 72).
+    let sample: Vec<Vec<(DVec3, f64)>> = (0..parts)
         .into_par_iter()
-        .flat_map_iter(|k| {
+        .map(|k| {
             let skip = (step - starts[k] % step) % step;
-            sane(k).skip(skip).step_by(step)
+            sane(k)
+                .skip(skip)
+                .step_by(step)
+                .map(|t| {
+                    let (a, b) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+                    (centroid(&t), (b - a).max_element())
+                })
+                .collect()
         })
         .collect();
+    let sampled = || sample.iter().flatten();
     let quantile = |mut v: Vec<f64>, q: f64| {
         let k = ((v.len() - 1) as f64 * q).round() as usize;
         *v.select_nth_unstable_by(k, f64::total_cmp).1
     };
-    let centroid = |t: &[DVec3; 3]| (t[0] + t[1] + t[2]) / 3.0;
     let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ZERO);
     for axis in 0..3 {
-        let c: Vec<f64> = sample.iter().map(|t| centroid(t)[axis]).collect();
+        let c: Vec<f64> = sampled().map(|s| s.0[axis]).collect();
         lo[axis] = quantile(c.clone(), 0.25);
         hi[axis] = quantile(c, 0.75);
     }
-    let extents = sample.iter().map(|t| {
-        let (a, b) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
-        (b - a).max_element()
-    });
     let size = (hi - lo)
         .max_element()
-        .max(quantile(extents.collect(), 0.5));
+        .max(quantile(sampled().map(|s| s.1).collect(), 0.5));
+    drop(sample);
     let (lo, hi) = (
         lo - DVec3::splat(64.0 * size),
         hi + DVec3::splat(64.0 * size),

@@ -21,7 +21,7 @@
 //! Small glowing parts (a car's headlights, a lamp's filament behind glass) fail the first test;
 //! a sun or a lamp over the subject passes both.
 
-use super::{Bounds, Camera, Light, LightKind, Scene, WorldTriangle};
+use super::{Bounds, Camera, Light, LightKind, Scene};
 use crate::bvh::{Bvh, Ray};
 use glam::{DVec3, Vec3};
 
@@ -118,6 +118,7 @@ fn weighted_quantile(values: &[(f32, f32)], q: f64) -> f32 {
 /// triangles whose centroids fall in the window, clipped to it, are the result. A stray object
 /// far away is left out; a lone object keeps its exact bounds.
 pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
+    use rayon::prelude::*;
     let mut exact = Bounds::default();
     for t in tris {
         for v in t {
@@ -127,17 +128,21 @@ pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
     if tris.len() < 8 {
         return exact;
     }
-    let centroids: Vec<Vec3> = tris.iter().map(|t| (t[0] + t[1] + t[2]) / 3.0).collect();
-    let weights: Vec<f32> = tris.iter().map(|t| area(t).sqrt() + 1e-12).collect();
+    let centroids: Vec<Vec3> = tris
+        .par_iter()
+        .map(|t| (t[0] + t[1] + t[2]) / 3.0)
+        .collect();
+    let weights: Vec<f32> = tris.par_iter().map(|t| area(t).sqrt() + 1e-12).collect();
     let mut lo = Vec3::ZERO;
     let mut hi = Vec3::ZERO;
     for axis in 0..3 {
         let mut v: Vec<(f32, f32)> = centroids
-            .iter()
+            .par_iter()
             .zip(&weights)
             .map(|(c, &w)| (c[axis], w))
             .collect();
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // Stable, as `sort_by` is: ties keep their order and the quantiles are the same.
+        v.par_sort_by(|a, b| a.0.total_cmp(&b.0));
         let (a, b) = (weighted_quantile(&v, 0.05), weighted_quantile(&v, 0.95));
         let margin = 0.5 * (b - a);
         lo[axis] = a - margin;
@@ -157,45 +162,69 @@ pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
 impl Probe {
     /// Builds the probe for the visible geometry of `scene`. Glass and blended surfaces are left
     /// out of the BVH (light passes them); they still count for the bounds.
+    ///
+    /// The probe keeps the world triangles' vertices alone (gathered in parallel, never as
+    /// [`super::WorldTriangle`]s) and builds one BVH over them, a second only when some
+    /// triangles are see-through.
     pub fn new(scene: &Scene) -> Self {
-        let world = scene.world_triangles();
-        Self::from_triangles(&world, scene)
-    }
-
-    fn from_triangles(world: &[WorldTriangle], scene: &Scene) -> Self {
-        let all: Vec<[Vec3; 3]> = world.iter().map(|t| t.v).collect();
+        use rayon::prelude::*;
+        let world = scene.world_vertices(&super::RenderFrame::default());
+        let all: Vec<[Vec3; 3]> = world.par_iter().map(|t| t.0).collect();
+        let materials: Vec<u32> = world.par_iter().map(|t| t.1).collect();
+        drop(world);
         let bounds = robust_bounds(&all);
         let (lo, hi) = (bounds.min.as_vec3(), bounds.max.as_vec3());
-        let inside: Vec<Vec3> = all
+        let inside = |p: &&Vec3| p.cmpge(lo).all() && p.cmple(hi).all();
+        let count = all
+            .par_iter()
+            .map(|t| t.iter().filter(inside).count())
+            .sum::<usize>();
+        let step = count.div_ceil(FIT_POINTS).max(1);
+        let points = all
             .iter()
             .flatten()
+            .filter(inside)
             .copied()
-            .filter(|p| p.cmpge(lo).all() && p.cmple(hi).all())
+            .step_by(step)
             .collect();
-        let step = inside.len().div_ceil(FIT_POINTS).max(1);
-        let points = inside.into_iter().step_by(step).collect();
-        let see_through = |t: &WorldTriangle| {
+        let see_through = |m: u32| {
             scene
                 .materials
-                .get(t.material as usize)
+                .get(m as usize)
                 .is_some_and(|m| m.transmission > 0.0 || m.alpha == super::AlphaMode::Blend)
         };
-        let kept: Vec<&WorldTriangle> = world.iter().filter(|t| !see_through(t)).collect();
-        let shell = (kept.len() < world.len()).then(|| {
+        let in_bvh_order = |bvh: &Bvh, tris: &[[Vec3; 3]]| -> Vec<[Vec3; 3]> {
+            bvh.tri_indices
+                .par_iter()
+                .map(|&i| tris[i as usize])
+                .collect()
+        };
+        let opaque: Vec<u32> = (0..all.len() as u32)
+            .filter(|&i| !see_through(materials[i as usize]))
+            .collect();
+        let (bvh, tris, kept, shell) = if opaque.len() == all.len() {
             let bvh = crate::bvh::build(&all);
-            let tris = bvh.tri_indices.iter().map(|&i| all[i as usize]).collect();
-            (bvh, tris)
-        });
-        let verts: Vec<[Vec3; 3]> = kept.iter().map(|t| t.v).collect();
-        let bvh = crate::bvh::build(&verts);
-        let tris = bvh.tri_indices.iter().map(|&i| verts[i as usize]).collect();
+            let tris = in_bvh_order(&bvh, &all);
+            drop(all);
+            (bvh, tris, None, None)
+        } else {
+            let shell_bvh = crate::bvh::build(&all);
+            let shell_tris = in_bvh_order(&shell_bvh, &all);
+            let verts: Vec<[Vec3; 3]> = opaque.iter().map(|&i| all[i as usize]).collect();
+            drop(all);
+            let bvh = crate::bvh::build(&verts);
+            let tris = in_bvh_order(&bvh, &verts);
+            (bvh, tris, Some(opaque), Some((shell_bvh, shell_tris)))
+        };
+        // Each BVH-order triangle's index among all the triangles, for its material.
+        let original = |i: u32| kept.as_ref().map_or(i, |k| k[i as usize]);
         let emission = bvh
             .tri_indices
-            .iter()
+            .par_iter()
             .map(|&i| {
                 scene
                     .materials
-                    .get(kept[i as usize].material as usize)
+                    .get(materials[original(i) as usize] as usize)
                     .map_or(0.0, |m| luminance(m.emission))
             })
             .collect();

@@ -34,11 +34,18 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         return Err(fail("cannot read file: not a regular file".into()));
     }
     let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
-    load_from_bytes(&bytes, path.parent(), &path.display().to_string()).map_err(fail)
+    load_owned(bytes, path.parent(), &path.display().to_string()).map_err(fail)
 }
 
 /// Loads glTF or GLB bytes; external files are resolved against `base`.
 pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Result<Scene, String> {
+    load_owned(bytes.to_vec(), base, source)
+}
+
+/// [`load_from_bytes`] taking the bytes: a GLB file's binary chunk is read in place and every
+/// buffer is freed before the scene's bounds are computed, so that the file and the imported
+/// meshes are held together only while the meshes are read.
+fn load_owned(bytes: Vec<u8>, base: Option<&Path>, source: &str) -> Result<Scene, String> {
     let mut warnings = Vec::new();
     let parsed = validate::parse(bytes, &mut warnings)?;
     let document = parsed.document;
@@ -228,6 +235,8 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
         }
     }
 
+    drop(buffer_data);
+    drop(buffers);
     let bounds = scene.bounds();
     if scene.cameras.is_empty() {
         scene.cameras.push(Camera::framing(&bounds, AUTO_YFOV));
@@ -905,8 +914,10 @@ fn import_mesh(
                 positions.len()
             ));
         }
+        // The triangles: the index list read in place (as triples) or unrolled from a strip or
+        // a fan, and the list freed at once.
         let triangles: Vec<[u32; 3]> = match mode {
-            Mode::Triangles => flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            Mode::Triangles => bytemuck::cast_slice(&flat[..flat.len() / 3 * 3]).to_vec(),
             Mode::TriangleStrip => (2..flat.len())
                 .map(|i| {
                     if i % 2 == 0 {
@@ -920,16 +931,8 @@ fn import_mesh(
                 .map(|i| [flat[0], flat[i - 1], flat[i]])
                 .collect(),
         };
+        drop(flat);
         let base = out.positions.len() as u32;
-        // Keep the per-vertex arrays aligned when only some primitives have normals or UVs.
-        pad_attribute(
-            &mut out.normals,
-            out.positions.len(),
-            &normals,
-            positions.len(),
-        );
-        pad_attribute(&mut out.uvs, out.positions.len(), &uvs, positions.len());
-        pad_attribute(&mut out.uvs1, out.positions.len(), &uvs1, positions.len());
         // Tangents at the corners of normal-mapped triangles: the file's, else MikkTSpace's.
         let tangents: Vec<[Vec4; 3]> = match normal_set {
             None => Vec::new(),
@@ -953,32 +956,46 @@ fn import_mesh(
                 }
             }
         };
-        pad_attribute(
-            &mut out.tangents,
-            out.indices.len(),
-            &tangents,
-            triangles.len(),
-        );
-        out.positions.extend_from_slice(&positions);
-        out.indices
-            .extend(triangles.iter().map(|t| t.map(|i| i + base)));
+        let count = triangles.len();
+        pad_attribute(&mut out.tangents, out.indices.len(), tangents, count);
+        // Keep the per-vertex arrays aligned when only some primitives have normals or UVs.
+        // The first primitive's arrays become the mesh's (moved, not copied).
+        let vertices = positions.len();
+        pad_attribute(&mut out.normals, base as usize, normals, vertices);
+        pad_attribute(&mut out.uvs, base as usize, uvs, vertices);
+        pad_attribute(&mut out.uvs1, base as usize, uvs1, vertices);
+        append(&mut out.positions, positions);
+        if base == 0 {
+            append(&mut out.indices, triangles);
+        } else {
+            out.indices
+                .extend(triangles.iter().map(|t| t.map(|i| i + base)));
+        }
         if let Some(x) = prim.extension_value("KHR_materials_variants") {
             let start = out.materials.len() as u32;
             out.variants.push(VariantRange {
-                triangles: start..start + triangles.len() as u32,
+                triangles: start..start + count as u32,
                 default: material,
                 materials: variants::mappings(x, default_material as usize, &what, warnings),
             });
         }
-        out.materials
-            .extend(std::iter::repeat_n(material, triangles.len()));
+        out.materials.extend(std::iter::repeat_n(material, count));
     }
     Ok(out)
 }
 
+/// Appends `new` to `dst`: moved when `dst` is empty (a mesh's first primitive), else copied.
+fn append<T: Copy>(dst: &mut Vec<T>, new: Vec<T>) {
+    if dst.is_empty() {
+        *dst = new;
+    } else {
+        dst.extend_from_slice(&new);
+    }
+}
+
 /// Appends `new` to `dst`, zero-filling where either side lacks the attribute, so that `dst`
 /// stays empty only while no primitive has it.
-fn pad_attribute<T: Copy + Default>(dst: &mut Vec<T>, old_len: usize, new: &[T], new_len: usize) {
+fn pad_attribute<T: Copy + Default>(dst: &mut Vec<T>, old_len: usize, new: Vec<T>, new_len: usize) {
     if dst.is_empty() && new.is_empty() {
         return;
     }
@@ -986,6 +1003,6 @@ fn pad_attribute<T: Copy + Default>(dst: &mut Vec<T>, old_len: usize, new: &[T],
     if new.is_empty() {
         dst.extend(std::iter::repeat_n(T::default(), new_len));
     } else {
-        dst.extend_from_slice(new);
+        append(dst, new);
     }
 }

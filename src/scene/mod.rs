@@ -446,31 +446,86 @@ impl Scene {
 
     /// The visible objects' triangles in the render space of `frame`, in object order: moved
     /// and scaled in f64 before they become f32. Triangles with a non-finite or absurd vertex
-    /// (see [`is_sane`]) are dropped and counted.
+    /// (see [`is_sane`]) are dropped and counted. Written straight into the one list, each
+    /// object's in parallel: no per-object lists to copy over.
     pub fn flatten(&self, frame: &RenderFrame) -> Flattened {
-        use rayon::prelude::*;
-        let per_object: Vec<(Vec<WorldTriangle>, usize)> = self
-            .objects
-            .par_iter()
-            .enumerate()
-            .filter(|(_, o)| o.visible)
-            .map(|(oi, o)| object_triangles(oi as u32, o, frame))
-            .collect();
-        // Each object's triangles are moved over and freed in turn, so the two lists are not
-        // held in full at once.
-        let dropped = per_object.iter().map(|(_, d)| d).sum();
-        let mut triangles = Vec::with_capacity(per_object.iter().map(|(t, _)| t.len()).sum());
-        for (t, _) in per_object {
-            triangles.extend(t);
-        }
+        let (triangles, dropped) = self.gather(frame, true, |p, ti| p.world_triangle(ti));
         Flattened { dropped, triangles }
+    }
+
+    /// [`Scene::flatten`] one visible object at a time: `each` gets every object's kept
+    /// triangles in order (made in parallel), so that a caller converting them holds one
+    /// object's [`WorldTriangle`]s at a time, not the scene's. Returns the number dropped.
+    pub fn flatten_each(
+        &self,
+        frame: &RenderFrame,
+        mut each: impl FnMut(Vec<WorldTriangle>),
+    ) -> usize {
+        use rayon::prelude::*;
+        let mut dropped = 0;
+        for (oi, o) in self.objects.iter().enumerate().filter(|(_, o)| o.visible) {
+            let p = Placed::new(oi as u32, o, frame, true);
+            let all = 0..o.mesh.indices.len();
+            each(if p.dropped == 0 {
+                all.into_par_iter().map(|ti| p.world_triangle(ti)).collect()
+            } else {
+                let kept = all.into_par_iter().filter(|&ti| p.kept(ti));
+                kept.map(|ti| p.world_triangle(ti)).collect()
+            });
+            dropped += p.dropped;
+        }
+        dropped
+    }
+
+    /// The visible objects' triangles as [`Scene::flatten`] gives them, vertices and material
+    /// alone (40 bytes a triangle, not [`WorldTriangle`]'s 200): what the host probes of the
+    /// first view trace.
+    pub fn world_vertices(&self, frame: &RenderFrame) -> Vec<([Vec3; 3], u32)> {
+        self.gather(frame, false, |p, ti| {
+            (p.vertices(ti), p.o.mesh.materials[ti])
+        })
+        .0
+    }
+
+    /// `make(object, triangle)` of every kept triangle of the visible objects, in order, and
+    /// the number dropped. Objects go one after the other, each one's vertices transformed and
+    /// its triangles made in parallel, into one list of the right capacity.
+    fn gather<T: Send>(
+        &self,
+        frame: &RenderFrame,
+        normals: bool,
+        make: impl Fn(&Placed, usize) -> T + Sync,
+    ) -> (Vec<T>, usize) {
+        use rayon::prelude::*;
+        let visible = || self.objects.iter().enumerate().filter(|(_, o)| o.visible);
+        let mut out = Vec::with_capacity(visible().map(|(_, o)| o.mesh.indices.len()).sum());
+        let mut dropped = 0;
+        for (oi, o) in visible() {
+            let p = Placed::new(oi as u32, o, frame, normals);
+            let all = 0..o.mesh.indices.len();
+            if p.dropped == 0 {
+                out.par_extend(all.into_par_iter().map(|ti| make(&p, ti)));
+            } else {
+                let kept = all.into_par_iter().filter(|&ti| p.kept(ti));
+                out.par_extend(kept.map(|ti| make(&p, ti)));
+            }
+            dropped += p.dropped;
+        }
+        (out, dropped)
     }
 
     /// Object `i`'s triangles in the render space of `frame`, in its mesh's order, as
     /// [`Scene::flatten`] gives them (whether or not the object is visible).
     pub fn flatten_object(&self, i: usize, frame: &RenderFrame) -> Flattened {
-        let (triangles, dropped) = object_triangles(i as u32, &self.objects[i], frame);
-        Flattened { triangles, dropped }
+        let p = Placed::new(i as u32, &self.objects[i], frame, true);
+        let triangles = (0..self.objects[i].mesh.indices.len())
+            .filter(|&ti| p.kept(ti))
+            .map(|ti| p.world_triangle(ti))
+            .collect();
+        Flattened {
+            triangles,
+            dropped: p.dropped,
+        }
     }
 
     /// Robust world-space bounds of the visible geometry (see [`robust_bounds`]): what
@@ -548,83 +603,131 @@ pub struct Flattened {
     pub dropped: usize,
 }
 
-fn object_triangles(object: u32, o: &Object, frame: &RenderFrame) -> (Vec<WorldTriangle>, usize) {
-    let m = o.world_from_object;
-    let normal_matrix = m.inverse().transpose();
-    // A mirroring transform flips the winding; swap two vertices to keep front faces in front.
-    let flip = m.determinant() < 0.0;
-    let world: Vec<DVec3> = o
-        .mesh
-        .positions
-        .iter()
-        .map(|p| m.transform_point3(p.as_dvec3()))
-        .collect();
-    let sane = |t: &[u32; 3]| t.iter().all(|&i| is_sane(world[i as usize]));
-    let dropped = o.mesh.indices.iter().filter(|t| !sane(t)).count();
-    let world: Vec<Vec3> = world.iter().map(|&p| frame.point(p)).collect();
-    let normals: Vec<Vec3> = o
-        .mesh
-        .normals
-        .iter()
-        .map(|n| {
-            normal_matrix
-                .transform_vector3(n.as_dvec3())
-                .normalize_or_zero()
-                .as_vec3()
-        })
-        .collect();
-    let triangles = o
-        .mesh
-        .indices
-        .iter()
-        .zip(&o.mesh.materials)
-        .enumerate()
-        .filter(|(_, (t, _))| sane(t))
-        .map(|(ti, (&[a, b, c], &material))| {
-            let idx = if flip { [a, c, b] } else { [a, b, c] };
-            let v = idx.map(|i| world[i as usize]);
-            let geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
-            let smooth = !normals.is_empty();
-            let n = if smooth {
-                idx.map(|i| {
-                    let n = normals[i as usize];
-                    if n == Vec3::ZERO { geometric } else { n }
-                })
-            } else {
-                [geometric; 3]
-            };
-            let uv = if o.mesh.uvs.is_empty() {
-                [Vec2::ZERO; 3]
-            } else {
-                idx.map(|i| o.mesh.uvs[i as usize])
-            };
-            let uv1 = if o.mesh.uvs1.is_empty() {
-                [Vec2::ZERO; 3]
-            } else {
-                idx.map(|i| o.mesh.uvs1[i as usize])
-            };
-            let tangents = o.mesh.tangents.get(ti).map(|t| {
-                let corners = if flip { [t[0], t[2], t[1]] } else { *t };
-                corners.map(|t| {
-                    let d = m
-                        .transform_vector3(t.truncate().as_dvec3())
+/// An object's vertices (and normals, when asked for) in render space, from which its
+/// flattened triangles are made one by one.
+struct Placed<'a> {
+    object: u32,
+    o: &'a Object,
+    /// Render-space vertices.
+    world: Vec<Vec3>,
+    /// Whether each world vertex is sane (see [`is_sane`]).
+    sane: Vec<bool>,
+    /// World-space unit normals (empty when not asked for or the mesh has none).
+    normals: Vec<Vec3>,
+    /// Triangles with an absurd vertex.
+    dropped: usize,
+    /// A mirroring transform: the winding is flipped.
+    flip: bool,
+}
+
+impl<'a> Placed<'a> {
+    fn new(object: u32, o: &'a Object, frame: &RenderFrame, normals: bool) -> Self {
+        use rayon::prelude::*;
+        let m = o.world_from_object;
+        let (world, sane): (Vec<Vec3>, Vec<bool>) = o
+            .mesh
+            .positions
+            .par_iter()
+            .map(|p| {
+                let w = m.transform_point3(p.as_dvec3());
+                (frame.point(w), is_sane(w))
+            })
+            .unzip();
+        let normal_matrix = m.inverse().transpose();
+        let normals = if normals {
+            o.mesh
+                .normals
+                .par_iter()
+                .map(|n| {
+                    normal_matrix
+                        .transform_vector3(n.as_dvec3())
                         .normalize_or_zero()
-                        .as_vec3();
-                    // A mirroring transform flips the bitangent too.
-                    d.extend(if flip { -t.w } else { t.w })
+                        .as_vec3()
                 })
-            });
-            WorldTriangle {
-                v,
-                n,
-                smooth,
-                uv,
-                uv1,
-                tangents,
-                material,
-                object,
-            }
-        })
-        .collect();
-    (triangles, dropped)
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let dropped = o
+            .mesh
+            .indices
+            .par_iter()
+            .filter(|t| !t.iter().all(|&i| sane[i as usize]))
+            .count();
+        Placed {
+            object,
+            o,
+            world,
+            sane,
+            normals,
+            dropped,
+            flip: m.determinant() < 0.0,
+        }
+    }
+
+    fn kept(&self, ti: usize) -> bool {
+        self.o.mesh.indices[ti]
+            .iter()
+            .all(|&i| self.sane[i as usize])
+    }
+
+    /// Triangle `ti`'s corners, two swapped under a mirroring transform to keep front faces
+    /// in front.
+    fn corners(&self, ti: usize) -> [u32; 3] {
+        let [a, b, c] = self.o.mesh.indices[ti];
+        if self.flip { [a, c, b] } else { [a, b, c] }
+    }
+
+    fn vertices(&self, ti: usize) -> [Vec3; 3] {
+        self.corners(ti).map(|i| self.world[i as usize])
+    }
+
+    fn world_triangle(&self, ti: usize) -> WorldTriangle {
+        let o = self.o;
+        let m = o.world_from_object;
+        let idx = self.corners(ti);
+        let v = idx.map(|i| self.world[i as usize]);
+        let geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+        let smooth = !self.normals.is_empty();
+        let n = if smooth {
+            idx.map(|i| {
+                let n = self.normals[i as usize];
+                if n == Vec3::ZERO { geometric } else { n }
+            })
+        } else {
+            [geometric; 3]
+        };
+        let uv = if o.mesh.uvs.is_empty() {
+            [Vec2::ZERO; 3]
+        } else {
+            idx.map(|i| o.mesh.uvs[i as usize])
+        };
+        let uv1 = if o.mesh.uvs1.is_empty() {
+            [Vec2::ZERO; 3]
+        } else {
+            idx.map(|i| o.mesh.uvs1[i as usize])
+        };
+        let flip = self.flip;
+        let tangents = o.mesh.tangents.get(ti).map(|t| {
+            let corners = if flip { [t[0], t[2], t[1]] } else { *t };
+            corners.map(|t| {
+                let d = m
+                    .transform_vector3(t.truncate().as_dvec3())
+                    .normalize_or_zero()
+                    .as_vec3();
+                // A mirroring transform flips the bitangent too.
+                d.extend(if flip { -t.w } else { t.w })
+            })
+        });
+        WorldTriangle {
+            v,
+            n,
+            smooth,
+            uv,
+            uv1,
+            tangents,
+            material: o.mesh.materials[ti],
+            object: self.object,
+        }
+    }
 }

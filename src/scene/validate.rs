@@ -77,13 +77,26 @@ fn precise_nodes(json: &[u8]) -> Vec<PreciseNode> {
 }
 
 /// Parses `.gltf` JSON or `.glb` bytes and validates the document. Warnings (unsupported
-/// optional extensions) are appended to `warnings`.
-pub fn parse(bytes: &[u8], warnings: &mut Vec<String>) -> Result<Parsed, String> {
+/// optional extensions) are appended to `warnings`. A GLB file's `BIN` chunk keeps the
+/// allocation of `bytes` (moved down to its start, not copied): a file of meshes is held once.
+pub fn parse(mut bytes: Vec<u8>, warnings: &mut Vec<String>) -> Result<Parsed, String> {
     let (json_bytes, blob) = if bytes.starts_with(b"glTF") {
-        let glb = gltf::Glb::from_slice(bytes).map_err(|e| format!("not a valid GLB file: {e}"))?;
-        (glb.json.into_owned(), glb.bin.map(|b| b.into_owned()))
+        let glb =
+            gltf::Glb::from_slice(&bytes).map_err(|e| format!("not a valid GLB file: {e}"))?;
+        let json = glb.json.into_owned();
+        // Where the BIN chunk lies in `bytes` (`from_slice` borrows it from there).
+        let bin = glb.bin.map(|b| {
+            let start = b.as_ptr() as usize - bytes.as_ptr() as usize;
+            start..start + b.len()
+        });
+        let blob = bin.map(|range| {
+            bytes.truncate(range.end);
+            bytes.drain(..range.start);
+            bytes
+        });
+        (json, blob)
     } else {
-        (bytes.to_vec(), None)
+        (bytes, None)
     };
     let root =
         json::Root::from_slice(&json_bytes).map_err(|e| format!("not a valid glTF file: {e}"))?;
