@@ -8,15 +8,18 @@
 //! object is a TLAS rebuild and a few transforms written in place
 //! (`Renderer::move_instances`).
 //!
-//! The automatic choice (`--bvh auto`): two levels when the scene is large and instancing saves
-//! most of the flat BVH (at least 1 M triangles over all instances and at least 4 times the
-//! triangles of the distinct meshes), else the flat BVH. On PoCL (2026-11-30, the 1 M rooms of
-//! `bench generate`, same rays, denormals flushed) the two-level kernels trace within +7 % of
-//! the flat BVH (faster on diffuse rays) with the binary kernels and within −10 … +17 % with
-//! the wide ones, and whole frames run 1.2–1.4 times the flat BVH's speed, while the flat form
+//! The automatic choice (`--bvh auto`) depends on the device, as measured on each
+//! (docs/benchmarks.md, 2026-11-30). On a CPU device two levels are taken when the scene is
+//! large and instancing saves most of the flat BVH (at least 1 M triangles over all instances
+//! and at least 4 times the triangles of the distinct meshes): on PoCL, on the 1 M rooms of
+//! `bench generate` with the same rays and denormals flushed, the two-level kernels trace within
+//! +7 % of the flat BVH (faster on diffuse rays) with the binary kernels and within −10 … +17 %
+//! with the wide ones, whole frames run 1.2–1.4 times the flat BVH's speed, and the flat form
 //! takes 8–13 times as long to build (3 s against 0.2–0.4 s on 2 cores) and 7–50 times the
-//! device memory (219 MB against 31 and 4.4 MB; docs/benchmarks.md). A small scene is
-//! flattened: its flat BVH is built in well under a second and tests no transforms.
+//! device memory (219 MB against 31 and 4.4 MB). On a GPU (H200) the same rooms' frames run at
+//! 0.82 of the flat BVH's speed on two levels, so only scenes of at least 4 M triangles that
+//! instancing shrinks eightfold take them. A small scene is flattened: its flat BVH is built in
+//! well under a second and tests no transforms.
 
 use crate::bvh::{Blas, TwoLevel};
 use crate::scene::{Object, RenderFrame, Scene, distinct_meshes};
@@ -24,12 +27,28 @@ use glam::DMat4;
 use rayon::prelude::*;
 use std::str::FromStr;
 
-/// Triangles over all instances from which `--bvh auto` considers two levels.
-pub const AUTO_MIN_TRIANGLES: usize = 1_000_000;
+/// `--bvh auto`'s thresholds for one kind of device: the triangles over all instances from which
+/// it considers two levels, and how many times the distinct meshes' triangles the instances
+/// must hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AutoRule {
+    /// Triangles over all instances from which two levels are considered.
+    pub min_triangles: usize,
+    /// How many times the distinct meshes' triangles the instances must hold.
+    pub min_saving: usize,
+}
 
-/// How many times the distinct meshes' triangles the instances must hold for `--bvh auto` to
-/// take two levels.
-pub const AUTO_MIN_SAVING: usize = 4;
+/// CPU devices, where two levels trace about as fast as flat and frames run faster.
+pub const AUTO_CPU: AutoRule = AutoRule {
+    min_triangles: 1_000_000,
+    min_saving: 4,
+};
+
+/// GPUs, where two levels trace about a fifth slower than flat.
+pub const AUTO_GPU: AutoRule = AutoRule {
+    min_triangles: 4_000_000,
+    min_saving: 8,
+};
 
 /// `--bvh`: which acceleration structure the device traverses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -69,7 +88,12 @@ pub struct Instancing {
 /// The two levels of `scene` in render space `space`, or `None` when the flat BVH is chosen
 /// (or must be: flattening drops triangles with absurd world vertices, which the instances
 /// would keep).
-pub fn plan(scene: &Scene, space: &RenderFrame, choice: BvhChoice) -> Option<Instancing> {
+pub fn plan(
+    scene: &Scene,
+    space: &RenderFrame,
+    choice: BvhChoice,
+    rule: AutoRule,
+) -> Option<Instancing> {
     if choice == BvhChoice::Flat {
         return None;
     }
@@ -85,7 +109,7 @@ pub fn plan(scene: &Scene, space: &RenderFrame, choice: BvhChoice) -> Option<Ins
         .filter(|o| o.visible)
         .map(|o| o.mesh.indices.len())
         .sum();
-    let auto_flat = !auto_takes_two_levels(total, unique);
+    let auto_flat = !auto_takes_two_levels(total, unique, rule);
     if total == 0 || (choice == BvhChoice::Auto && auto_flat) || scene.absurd_triangles() > 0 {
         return None;
     }
@@ -108,9 +132,9 @@ pub fn plan(scene: &Scene, space: &RenderFrame, choice: BvhChoice) -> Option<Ins
 }
 
 /// Whether `--bvh auto` takes two levels for `total` triangles over all instances of meshes of
-/// `unique` triangles (see the module's rule).
-pub fn auto_takes_two_levels(total: usize, unique: usize) -> bool {
-    total >= AUTO_MIN_TRIANGLES && total >= AUTO_MIN_SAVING * unique
+/// `unique` triangles under `rule` (see the module's rules).
+pub fn auto_takes_two_levels(total: usize, unique: usize, rule: AutoRule) -> bool {
+    total >= rule.min_triangles && total >= rule.min_saving * unique
 }
 
 /// The render frame's map, (p - origin) * scale, as a matrix: render from object is this times
@@ -141,12 +165,19 @@ mod tests {
 
     #[test]
     fn auto_takes_two_levels_for_large_heavily_instanced_scenes() {
-        // The rooms of `bench generate`: 7 bunnies and 49 icospheres, 1 M triangles each.
-        assert!(auto_takes_two_levels(1_008_336, 144_060));
-        assert!(auto_takes_two_levels(1_003_534, 20_494));
+        // The rooms of `bench generate`: 7 bunnies and 49 icospheres, 1 M triangles each: two
+        // levels on a CPU, flat on a GPU.
+        for (total, unique) in [(1_008_336, 144_060), (1_003_534, 20_494)] {
+            assert!(auto_takes_two_levels(total, unique, AUTO_CPU));
+            assert!(!auto_takes_two_levels(total, unique, AUTO_GPU));
+        }
+        // 16 M triangles of one 144 k mesh: two levels on both.
+        assert!(auto_takes_two_levels(16_000_000, 144_000, AUTO_GPU));
         // Small, or hardly instanced: flat.
-        assert!(!auto_takes_two_levels(500_000, 10_000));
-        assert!(!auto_takes_two_levels(4_000_000, 2_000_000));
-        assert!(!auto_takes_two_levels(0, 0));
+        for rule in [AUTO_CPU, AUTO_GPU] {
+            assert!(!auto_takes_two_levels(500_000, 10_000, rule));
+            assert!(!auto_takes_two_levels(4_000_000, 2_000_000, rule));
+            assert!(!auto_takes_two_levels(0, 0, rule));
+        }
     }
 }

@@ -188,7 +188,17 @@ impl Renderer {
     ) -> Result<SceneStats, ClError> {
         let t = Instant::now();
         let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
-        let (mut host, dropped) = match instancing::plan(scene, &space, self.bvh_choice) {
+        let rule = if self
+            .gpu
+            .device
+            .dev_type()
+            .is_ok_and(|t| t & opencl3::device::CL_DEVICE_TYPE_CPU != 0)
+        {
+            instancing::AUTO_CPU
+        } else {
+            instancing::AUTO_GPU
+        };
+        let (mut host, dropped) = match instancing::plan(scene, &space, self.bvh_choice, rule) {
             Some(plan) => {
                 // Two levels: nothing is flattened; each mesh goes to the device once.
                 let meshes: Vec<&crate::scene::Mesh> = plan
