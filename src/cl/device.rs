@@ -120,6 +120,14 @@ pub struct Gpu {
 }
 
 impl Gpu {
+    /// Whether the device is a CPU (CL_DEVICE_TYPE_CPU): the megakernel, flushed denormals and
+    /// the CPU's `--bvh auto` rule are chosen by it.
+    pub fn is_cpu(&self) -> bool {
+        self.device
+            .dev_type()
+            .is_ok_and(|t| t & opencl3::device::CL_DEVICE_TYPE_CPU != 0)
+    }
+
     /// Opens the device the choice names.
     pub fn open(choice: &DeviceChoice) -> Result<Self, ClError> {
         let _setup = super::CL_SETUP.lock().unwrap_or_else(|e| e.into_inner());

@@ -196,11 +196,7 @@ pub(crate) fn build_source(
     // zero, as Embree's and Cycles' CPU threads do, makes the megakernel about 1.35 times as
     // fast on PoCL (docs/benchmarks.md). No coordinate, colour or weight a scene means is that
     // small; GPUs keep their own default.
-    if gpu
-        .device
-        .dev_type()
-        .is_ok_and(|t| t & opencl3::device::CL_DEVICE_TYPE_CPU != 0)
-    {
+    if gpu.is_cpu() {
         options.push_str(" -cl-denorms-are-zero");
     }
     options.push_str(&features.defines());

@@ -7,7 +7,6 @@ use super::Renderer;
 use crate::cl::kernels::Launch;
 use crate::cl::types::GpuFrame;
 use crate::cl::{ClError, Stage};
-use opencl3::device::CL_DEVICE_TYPE_CPU;
 use std::str::FromStr;
 use std::time::Instant;
 
@@ -45,11 +44,7 @@ impl Renderer {
     /// Chooses the kernels (resolving `Auto` by the device type). Resets the film.
     pub fn set_kernel(&mut self, choice: KernelChoice) -> Result<(), ClError> {
         self.megakernel = match choice {
-            KernelChoice::Auto => self
-                .gpu
-                .device
-                .dev_type()
-                .is_ok_and(|t| t & CL_DEVICE_TYPE_CPU != 0),
+            KernelChoice::Auto => self.gpu.is_cpu(),
             KernelChoice::Wavefront => false,
             KernelChoice::Megakernel => true,
         };

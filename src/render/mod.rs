@@ -188,12 +188,7 @@ impl Renderer {
     ) -> Result<SceneStats, ClError> {
         let t = Instant::now();
         let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
-        let rule = if self
-            .gpu
-            .device
-            .dev_type()
-            .is_ok_and(|t| t & opencl3::device::CL_DEVICE_TYPE_CPU != 0)
-        {
+        let rule = if self.gpu.is_cpu() {
             instancing::AUTO_CPU
         } else {
             instancing::AUTO_GPU

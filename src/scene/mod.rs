@@ -461,17 +461,12 @@ impl Scene {
         frame: &RenderFrame,
         mut each: impl FnMut(Vec<WorldTriangle>),
     ) -> usize {
-        use rayon::prelude::*;
         let mut dropped = 0;
         for (oi, o) in self.objects.iter().enumerate().filter(|(_, o)| o.visible) {
             let p = Placed::new(oi as u32, o, frame, true);
-            let all = 0..o.mesh.indices.len();
-            each(if p.dropped == 0 {
-                all.into_par_iter().map(|ti| p.world_triangle(ti)).collect()
-            } else {
-                let kept = all.into_par_iter().filter(|&ti| p.kept(ti));
-                kept.map(|ti| p.world_triangle(ti)).collect()
-            });
+            let mut triangles = Vec::new();
+            p.extend_kept(&|p, ti| p.world_triangle(ti), &mut triangles);
+            each(triangles);
             dropped += p.dropped;
         }
         dropped
@@ -496,19 +491,12 @@ impl Scene {
         normals: bool,
         make: impl Fn(&Placed, usize) -> T + Sync,
     ) -> (Vec<T>, usize) {
-        use rayon::prelude::*;
         let visible = || self.objects.iter().enumerate().filter(|(_, o)| o.visible);
         let mut out = Vec::with_capacity(visible().map(|(_, o)| o.mesh.indices.len()).sum());
         let mut dropped = 0;
         for (oi, o) in visible() {
             let p = Placed::new(oi as u32, o, frame, normals);
-            let all = 0..o.mesh.indices.len();
-            if p.dropped == 0 {
-                out.par_extend(all.into_par_iter().map(|ti| make(&p, ti)));
-            } else {
-                let kept = all.into_par_iter().filter(|&ti| p.kept(ti));
-                out.par_extend(kept.map(|ti| make(&p, ti)));
-            }
+            p.extend_kept(&make, &mut out);
             dropped += p.dropped;
         }
         (out, dropped)
@@ -669,6 +657,19 @@ impl<'a> Placed<'a> {
         self.o.mesh.indices[ti]
             .iter()
             .all(|&i| self.sane[i as usize])
+    }
+
+    /// Appends `make(self, triangle)` of each kept triangle, in order, made in parallel (an
+    /// exact-size extend when nothing is dropped).
+    fn extend_kept<T: Send>(&self, make: &(impl Fn(&Self, usize) -> T + Sync), out: &mut Vec<T>) {
+        use rayon::prelude::*;
+        let all = 0..self.o.mesh.indices.len();
+        if self.dropped == 0 {
+            out.par_extend(all.into_par_iter().map(|ti| make(self, ti)));
+        } else {
+            let kept = all.into_par_iter().filter(|&ti| self.kept(ti));
+            out.par_extend(kept.map(|ti| make(self, ti)));
+        }
     }
 
     /// Triangle `ti`'s corners, two swapped under a mirroring transform to keep front faces
