@@ -630,12 +630,21 @@ impl FlatStructs {
     }
 
     fn add(&mut self, world: Vec<WorldTriangle>) {
+        use std::mem::take;
         self.mapped |= world.iter().any(|t| t.tangents.is_some());
-        let structs = || world.par_iter().map(|t| device_triangle(t, -1));
-        self.triangles.par_extend(structs().map(|s| s.0));
-        self.shading.par_extend(structs().map(|s| s.1));
+        // Each triangle's structs made once, and unzipped into the lists in order.
+        let structs = world.par_iter().map(|t| device_triangle(t, -1));
         if self.keep_tangents {
-            self.tangents.par_extend(structs().map(|s| s.2));
+            let mut lists = (
+                take(&mut self.triangles),
+                (take(&mut self.shading), take(&mut self.tangents)),
+            );
+            lists.par_extend(structs.map(|(tri, sh, tan)| (tri, (sh, tan))));
+            (self.triangles, (self.shading, self.tangents)) = lists;
+        } else {
+            let mut lists = (take(&mut self.triangles), take(&mut self.shading));
+            lists.par_extend(structs.map(|(tri, sh, _)| (tri, sh)));
+            (self.triangles, self.shading) = lists;
         }
         self.vertices.par_extend(world.par_iter().map(|t| t.v));
     }
