@@ -34,7 +34,7 @@ inline GpuTriangle instance_triangle(const GpuInstance* inst, GpuTriangle t, flo
 
 // -1 for a mirrored instance (its world triangles wind the other way), else 1.
 inline float instance_normal_sign(const GpuInstance* inst) {
-    return (inst->flags & 1u) != 0u ? -1.0f : 1.0f;
+    return (inst->flags & INSTANCE_MIRRORED) != 0u ? -1.0f : 1.0f;
 }
 
 // A normal to world space: L^T n (the inverse transpose of M), unit; 0 stays 0.

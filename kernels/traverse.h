@@ -255,6 +255,30 @@ inline float instance_tmin(const GpuInstance* inst, float3 o, float3 od, float t
     return fmax(tmin, dt);
 }
 
+// A top-level piece of one triangle (INSTANCE_PIECE_TRIANGLE: a small mesh's, src/bvh/
+// instances.rs) against the world ray: the triangle's world-space copy (`copy` in `tris`,
+// carried to world space by the host as shading carries it), tested without entering the
+// instance. A hit names the mesh's triangle (`prim`) and the slot as a bottom-level hit does.
+// Returns true when an any-hit ends the traversal.
+inline bool intersect_piece_triangle(uint copy, uint prim, uint slot,
+                                     global const GpuTriangle* tris, const SceneSurfaces* surf,
+                                     const RayPrep* r, float3 o, float3 d, float tmin,
+                                     bool any_hit, GpuHit* hit) {
+    GpuTriangle t = tris[copy];
+    float t_hit = hit->t;
+    float bu, bv;
+    if (!intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv)) return false;
+#ifdef HAS_ALPHA
+    if (alpha_passes(surf, prim, as_uint(t.v0.w), bu, bv, o, d)) return false;
+#endif
+    hit->t = t_hit;
+    hit->u = bu;
+    hit->v = bv;
+    hit->prim = prim;
+    hit->instance = slot;
+    return any_hit;
+}
+
 // On the two-level traversal's stack: an instance to enter (its slot in `instances`, with
 // this bit set), else a node.
 #define INSTANCE_BIT 0x80000000u
@@ -278,19 +302,30 @@ inline float instance_tmin(const GpuInstance* inst, float3 o, float3 od, float t
     uint slot = 0;                            \
     uint node = 0;
 
-// Enters the instance that `node` names (INSTANCE_BIT) in a two-level traversal: the ray r
-// (and its rtmin) carried into the instance's object space, the stack height kept in base, and
-// node set to the instance's bottom-level root (ROOT: root, or wide_root in the wide nodes).
+// Enters instance `inst` at slot `slot` in a two-level traversal: the ray r (and its rtmin)
+// carried into the instance's object space, the stack height kept in base, and node set to
+// the piece's bottom-level node (ROOT: root, or wide_root in the wide nodes).
 #define ENTER_INSTANCE(ROOT)                                   \
     {                                                          \
-        slot = node & ~INSTANCE_BIT;                           \
-        GpuInstance inst = instances[slot];                    \
         float3 od = instance_vector(&inst, d);                 \
         r = prepare_ray(instance_point(&inst, o), od);         \
         rtmin = instance_tmin(&inst, o, od, tmin);             \
         base = sp;                                             \
         bottom = true;                                         \
         node = inst.ROOT;                                      \
+    }
+
+// At a top-level piece (`node` with INSTANCE_BIT) of a two-level traversal: sets slot and
+// `piece`, and `triangle` for a piece of one triangle, which is tested on the spot (an any-hit
+// returns from the traversal); any other piece is entered (ENTER_INSTANCE).
+#define VISIT_PIECE                                                                       \
+    slot = node & ~INSTANCE_BIT;                                                          \
+    global const GpuInstance* piece = &instances[slot];                                   \
+    bool triangle = (piece->flags & INSTANCE_PIECE_TRIANGLE) != 0u;                       \
+    if (triangle && intersect_piece_triangle(piece->root, piece->wide_root, slot,         \
+                                             object_tris, surf, &world, o, d, tmin,      \
+                                             any_hit, &hit)) {                            \
+        return hit;                                                                       \
     }
 
 // Closest or first hit through the top level (`nodes` from 0, leaves index `instances`) and
@@ -310,6 +345,14 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
     uint stack[TWO_LEVEL_STACK];
     for (;;) {
         if (node & INSTANCE_BIT) {
+            VISIT_PIECE
+            if (triangle) {
+                // Tested; on to the next entry (still the top level).
+                if (sp == 0u) return hit;
+                node = stack[--sp];
+                continue;
+            }
+            GpuInstance inst = *piece;
             ENTER_INSTANCE(root)
         }
         GpuBvhNode n = nodes[node];

@@ -180,13 +180,19 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
     uint stack[TWO_LEVEL_WIDE_STACK];
     float stack_d[TWO_LEVEL_WIDE_STACK];
     for (;;) {
+        bool visit = true;
         if (node & INSTANCE_BIT) {
-            ENTER_INSTANCE(wide_root)
-            w = wide_ray(&r);
+            VISIT_PIECE
+            visit = !triangle;  // a triangle is tested, not entered
+            if (visit) {
+                GpuInstance inst = *piece;
+                ENTER_INSTANCE(wide_root)
+                w = wide_ray(&r);
+            }
         }
-        global const GpuWideNode* n = &nodes[node];
+        global const GpuWideNode* n = &nodes[node & ~INSTANCE_BIT];
         float4 near;
-        int4 mask = wide_reach(n, &w, rtmin, hit.t, &near);
+        int4 mask = visit ? wide_reach(n, &w, rtmin, hit.t, &near) : (int4)(0);
         if (any(mask)) {
             WIDE_SORT_CHILDREN(n, near, mask)
             if (bottom) {

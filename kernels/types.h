@@ -36,7 +36,7 @@ typedef struct {
     uint root;         // bottom-level root in the binary nodes
     uint wide_root;    // bottom-level root in the wide nodes
     uint id;           // the instance's index in the scene (host bookkeeping)
-    uint flags;        // 1: mirrored (negative determinant)
+    uint flags;        // INSTANCE_MIRRORED, INSTANCE_PIECE_TRIANGLE
 } GpuInstance;
 
 // World space in BVH order; with TWO_LEVEL object space, once per mesh (then v1.w counts the

@@ -114,6 +114,9 @@ pub struct SetResult {
     pub validation: Check,
     /// Rays per second of the host reference traversal while validating (all threads).
     pub host_rays_per_second: f64,
+    /// The process's CPU time per timed launch (all threads; 10 ms resolution over the
+    /// runs), where the platform says: on a shared CPU device, work per launch.
+    pub cpu_ms: Option<f64>,
 }
 
 /// The indices of the rays to check: every k-th so that at least `want` are checked.
@@ -170,15 +173,27 @@ fn check_any(host: &HostScene, rays: &[GpuRay], occluded: &[u32], want: usize) -
         .reduce(Check::default, Check::add)
 }
 
-/// Launches `launch` `warmup` times untimed, then `runs` times; returns the kernel times (ms).
+/// The kernel times of the timed launches (ms), and the process's CPU time over them per
+/// launch (ms, all threads; `None` where the platform does not say): on a CPU device shared
+/// with other work, CPU time per launch follows the kernel's work where wall time does not.
+struct Times {
+    ms: Vec<f64>,
+    cpu_ms: Option<f64>,
+}
+
+/// Launches `launch` `warmup` times untimed, then `runs` times; returns the kernel times.
 fn time_launches(
     gpu: &Gpu,
     warmup: usize,
     runs: usize,
     mut launch: impl FnMut() -> Result<Launch>,
-) -> Result<Vec<f64>> {
+) -> Result<Times> {
     let mut times = Vec::with_capacity(runs);
+    let mut cpu_start = None;
     for i in 0..warmup + runs {
+        if i == warmup {
+            cpu_start = crate::cpu_time::process_cpu_seconds();
+        }
         let l = launch()?;
         gpu.queue
             .finish()
@@ -187,7 +202,10 @@ fn time_launches(
             times.push(l.millis());
         }
     }
-    Ok(times)
+    let cpu_ms = cpu_start
+        .zip(crate::cpu_time::process_cpu_seconds())
+        .map(|(a, b)| (b - a) * 1e3 / runs.max(1) as f64);
+    Ok(Times { ms: times, cpu_ms })
 }
 
 fn set_result(
@@ -195,9 +213,10 @@ fn set_result(
     query: &'static str,
     rays: usize,
     hits: usize,
-    times: &[f64],
+    times: &Times,
     (validation, host_seconds): (Check, f64),
 ) -> SetResult {
+    let (cpu_ms, times) = (times.cpu_ms, &times.ms);
     let median_ms = median(times);
     SetResult {
         kind,
@@ -214,6 +233,7 @@ fn set_result(
         },
         validation,
         host_rays_per_second: validation.checked as f64 / host_seconds.max(1e-9),
+        cpu_ms,
     }
 }
 
@@ -237,7 +257,7 @@ struct Tracer<'a> {
 
 impl Tracer<'_> {
     /// Times closest-hit traversal of `rays`; returns the hits and the times.
-    fn closest(&self, rays: &[GpuRay]) -> Result<(Vec<GpuHit>, Vec<f64>)> {
+    fn closest(&self, rays: &[GpuRay]) -> Result<(Vec<GpuHit>, Times)> {
         let buf = Buffer::from_slice(self.gpu, rays)?;
         let hits = Buffer::<GpuHit>::new(self.gpu, rays.len())?;
         let times = time_launches(self.gpu, self.warmup, self.runs, || {
@@ -254,7 +274,7 @@ impl Tracer<'_> {
     }
 
     /// Times any-hit traversal of `rays`; returns the occlusion flags and the times.
-    fn any(&self, rays: &[GpuRay]) -> Result<(Vec<u32>, Vec<f64>)> {
+    fn any(&self, rays: &[GpuRay]) -> Result<(Vec<u32>, Times)> {
         let buf = Buffer::from_slice(self.gpu, rays)?;
         let occluded = Buffer::<u32>::new(self.gpu, rays.len())?;
         let times = time_launches(self.gpu, self.warmup, self.runs, || {

@@ -14,10 +14,13 @@
 //! device reports them: the device keeps each mesh's triangles and shading data once, in
 //! object space, and shading carries a hit to world space through the instance's transform.
 
+use super::wide::wide_children;
 use super::{Aabb, Bvh, Child, Hit, Ray, WideBvh, build, build_boxes, build_indexed};
 use crate::cl::types::{GpuBvhNode, GpuHit, GpuWideNode};
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 /// A mesh's BVH and its object-space triangles in BVH order.
 #[derive(Clone, Debug)]
@@ -55,6 +58,12 @@ impl Blas {
     /// The object-space box of the whole mesh.
     pub fn bounds(&self) -> Aabb {
         self.bvh.child(0, 0).0.union(self.bvh.child(0, 1).0)
+    }
+
+    /// Whether the mesh is small: its instances' triangles are TLAS leaves of their own
+    /// (see [`TwoLevel::braid`]).
+    pub fn is_small(&self) -> bool {
+        self.triangles.len() <= SMALL_MESH
     }
 }
 
@@ -96,6 +105,16 @@ impl Instance {
             let r = m.row(i);
             [r.x as f32, r.y as f32, r.z as f32, 0.0]
         })
+    }
+
+    /// An object-space triangle in world space as the device carries it, `M v + T` in f32
+    /// (the kernels' `instance_to_world`, operation for operation): a small mesh's triangle
+    /// is tested so ([`TwoLevel::braid`]), and shading finds the same vertices.
+    pub fn device_triangle(&self, t: &[Vec3; 3]) -> [Vec3; 3] {
+        let m = self.world_rows();
+        let at = Vec3::new(self.rows[0][3], self.rows[1][3], self.rows[2][3]);
+        let apply = |r: [f32; 4], v: Vec3| r[0] * v.x + r[1] * v.y + r[2] * v.z;
+        t.map(|v| Vec3::new(apply(m[0], v), apply(m[1], v), apply(m[2], v)) + at)
     }
 
     /// An object-space point in world space (f64).
@@ -173,8 +192,15 @@ pub struct TwoLevel {
     pub blases: Vec<Blas>,
     /// The placed meshes.
     pub instances: Vec<Instance>,
-    /// Over the instances' world boxes; its `tri_indices` are instance indices.
+    /// Over the pieces' world boxes, one piece a leaf; its `tri_indices` are the pieces'
+    /// instance indices (see [`TwoLevel::rebuild_tlas`]).
     pub tlas: Bvh,
+    /// Each TLAS leaf's (slot's) BLAS node, where the piece enters its instance's BLAS: 0 for
+    /// the whole BLAS, else the root of a subtree that re-braiding opened into the TLAS.
+    pub pieces: Vec<u32>,
+    /// The most pieces the TLAS may hold: fixed for the scene, so that the device's TLAS and
+    /// instance buffers, sized for it, hold any later TLAS.
+    pub max_pieces: usize,
     /// Each BLAS's first triangle among the meshes' triangles one after the other.
     pub firsts: Vec<u32>,
     /// Hidden instances are left out of the TLAS (they keep their place among the instances).
@@ -197,7 +223,7 @@ impl TwoLevel {
 
     /// [`TwoLevel::from_blases`] with `hidden` instances left out of the TLAS.
     pub fn with_hidden(blases: Vec<Blas>, instances: &[(u32, DMat4)], hidden: Vec<bool>) -> Self {
-        let instances = instances
+        let instances: Vec<Instance> = instances
             .iter()
             .map(|&(blas, m)| Instance::new(blas, m))
             .collect();
@@ -209,11 +235,14 @@ impl TwoLevel {
                 first - b.triangles.len() as u32
             })
             .collect();
+        let max_pieces = piece_budget(&blases, &instances, rebraid_budget());
         let mut two = Self {
             hidden,
             blases,
             instances,
             tlas: build_boxes(&[]),
+            pieces: vec![],
+            max_pieces,
             firsts,
         };
         two.rebuild_tlas();
@@ -230,6 +259,14 @@ impl TwoLevel {
             .sum()
     }
 
+    /// Sets how many pieces beyond one per instance (and per small mesh's triangle) the TLAS
+    /// may be re-braided into ([`rebraid_budget`]) and rebuilds it; before the device is
+    /// given the scene (its buffers are sized for [`TwoLevel::max_pieces`]).
+    pub fn set_rebraid_budget(&mut self, extra: usize) {
+        self.max_pieces = piece_budget(&self.blases, &self.instances, extra);
+        self.rebuild_tlas();
+    }
+
     /// Moves instance `i` and rebuilds the TLAS.
     pub fn set_transform(&mut self, i: usize, world_from_object: DMat4) {
         self.place(i, world_from_object);
@@ -243,23 +280,90 @@ impl TwoLevel {
         *inst = Instance::new(inst.blas, world_from_object);
     }
 
-    /// Builds the TLAS over the instances' current world boxes.
+    /// Builds the TLAS over the shown instances' current world boxes, partially re-braided
+    /// (Benthin, Woop, Wald et al., "Improved Two-Level BVHs using Partial Re-Braiding", HPG
+    /// 2017): the instances' BLASes are opened from the top into pieces, each a BLAS subtree
+    /// under its instance's transform with the subtree box's world box, and the TLAS is built
+    /// over the pieces. A world box of a whole instance is loose (a rotated object's box grows,
+    /// and a room's box holds everything in it) and overlaps its neighbours', so every ray
+    /// would enter most instances; the pieces' boxes are tight where the flat BVH's are.
+    /// See [`TwoLevel::braid`] for which nodes are opened.
     pub fn rebuild_tlas(&mut self) {
-        let shown: Vec<u32> = (0..self.instances.len() as u32)
-            .filter(|&i| !self.hidden[i as usize])
-            .collect();
-        let boxes: Vec<Aabb> = shown
-            .iter()
-            .map(|&i| {
-                let inst = &self.instances[i as usize];
-                inst.world_box(self.blases[inst.blas as usize].bounds())
-            })
-            .collect();
+        let pieces = self.braid();
+        let boxes: Vec<Aabb> = pieces.iter().map(|p| p.2).collect();
         self.tlas = build_boxes(&boxes);
         split_instance_leaves(&mut self.tlas, &boxes);
-        for i in &mut self.tlas.tri_indices {
-            *i = shown[*i as usize];
+        self.pieces = self
+            .tlas
+            .tri_indices
+            .iter()
+            .map(|&p| pieces[p as usize].1)
+            .collect();
+        for p in &mut self.tlas.tri_indices {
+            *p = pieces[*p as usize].0;
         }
+    }
+
+    /// The pieces of the shown instances (instance, piece, world box). A small mesh's
+    /// instance ([`Blas::is_small`]) is one piece per triangle ([`PIECE_TRIANGLE`]), which
+    /// the traversal tests in world space, carried there as shading carries it
+    /// ([`Instance::device_triangle`]), without entering the instance: a room of a few large
+    /// quads would otherwise be one piece whose box holds the whole scene, entered by every
+    /// ray. Any other instance is its whole BLAS (node 0), then greedily the piece of the
+    /// largest world surface area is replaced by its children in the BLAS's 4-wide tree
+    /// (`WideBvh::collapse`'s nodes, so that the binary and the wide kernels enter at the
+    /// same subtree) while the pieces stay within [`TwoLevel::max_pieces`]; a node with a
+    /// leaf among those children is not opened (a piece enters a node).
+    fn braid(&self) -> Vec<(u32, u32, Aabb)> {
+        let mut pieces: Vec<(u32, u32, Aabb)> = vec![];
+        for i in 0..self.instances.len() as u32 {
+            let inst = &self.instances[i as usize];
+            let blas = &self.blases[inst.blas as usize];
+            if self.hidden[i as usize] {
+                continue;
+            }
+            if !blas.is_small() {
+                pieces.push((i, 0, inst.world_box(blas.bounds())));
+                continue;
+            }
+            for (k, t) in blas.triangles.iter().enumerate() {
+                let world = inst.device_triangle(t);
+                let b = world.iter().fold(Aabb::EMPTY, |b, &v| b.grow(v));
+                pieces.push((i, PIECE_TRIANGLE | k as u32, b));
+            }
+        }
+        // Largest area first, then the earliest piece (areas are not negative, so their bits
+        // order as they do).
+        let mut heap: BinaryHeap<(u32, Reverse<usize>)> = pieces
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.1 & PIECE_TRIANGLE == 0)
+            .map(|(k, p)| (p.2.area().to_bits(), Reverse(k)))
+            .collect();
+        while let Some((_, Reverse(k))) = heap.pop() {
+            let (i, node, _) = pieces[k];
+            let inst = &self.instances[i as usize];
+            let blas = &self.blases[inst.blas as usize];
+            let children = wide_children(&blas.bvh, node);
+            if pieces.len() + children.len() - 1 > self.max_pieces
+                || children.iter().any(|c| !matches!(c.1, Child::Node(_)))
+            {
+                continue;
+            }
+            for (j, (b, child)) in children.into_iter().enumerate() {
+                let Child::Node(n) = child else { continue };
+                let piece = (i, n, inst.world_box(b));
+                let at = if j == 0 {
+                    pieces[k] = piece;
+                    k
+                } else {
+                    pieces.push(piece);
+                    pieces.len() - 1
+                };
+                heap.push((piece.2.area().to_bits(), Reverse(at)));
+            }
+        }
+        pieces
     }
 
     /// The closest hit along `ray`.
@@ -287,11 +391,11 @@ impl TwoLevel {
         })
     }
 
-    /// Each instance's TLAS slot (the inverse of the TLAS's `tri_indices`; `u32::MAX` for a
-    /// hidden one).
+    /// Each instance's first TLAS slot (any of its pieces' slots carries its transforms;
+    /// `u32::MAX` for a hidden one).
     pub fn slots(&self) -> Vec<u32> {
         let mut slots = vec![u32::MAX; self.instances.len()];
-        for (slot, &i) in self.tlas.tri_indices.iter().enumerate() {
+        for (slot, &i) in self.tlas.tri_indices.iter().enumerate().rev() {
             slots[i as usize] = slot as u32;
         }
         slots
@@ -311,17 +415,17 @@ impl TwoLevel {
             let instance = self.tlas.tri_indices[leaf as usize];
             let inst = &self.instances[instance as usize];
             let blas = &self.blases[inst.blas as usize];
-            let local = inst.to_object(r);
-            let hit = if any {
-                blas.bvh.occluded(&local, &blas.triangles).then_some(Hit {
-                    t: r.tmax,
-                    u: 0.0,
-                    v: 0.0,
-                    prim: 0,
-                })
+            let root = self.pieces[leaf as usize];
+            let hit = if root & PIECE_TRIANGLE != 0 {
+                // A small mesh's triangle, tested in world space (see `braid`).
+                let prim = root & !PIECE_TRIANGLE;
+                let world = inst.device_triangle(&blas.triangles[prim as usize]);
+                super::intersect_triangle(r, &world).map(|(t, u, v)| Hit { t, u, v, prim })
             } else {
-                blas.bvh.intersect(&local, &blas.triangles)
+                let local = inst.to_object(r);
+                blas.bvh.traverse(root, &local, &blas.triangles, any)
             };
+            let hit = hit.map(|h| if any { Hit { t: r.tmax, ..h } } else { h });
             hit.map(|hit| {
                 (
                     hit.t,
@@ -336,10 +440,10 @@ impl TwoLevel {
     }
 
     /// Nodes the device reserves for the TLAS at the front of its node arrays (binary and
-    /// wide): as many as a TLAS over these instances can take, so that a rebuilt TLAS is
-    /// written over the old one in place and the BLASes behind it stay where they are.
+    /// wide): as many as a TLAS of [`TwoLevel::max_pieces`] leaves can take, so that a rebuilt
+    /// TLAS is written over the old one in place and the BLASes behind it stay where they are.
     pub fn tlas_slots(&self) -> usize {
-        self.instances.len().saturating_sub(1).max(1)
+        self.max_pieces.saturating_sub(1).max(1)
     }
 
     /// The device form: the TLAS's nodes (padded to [`TwoLevel::tlas_slots`]) followed by every
@@ -355,8 +459,8 @@ impl TwoLevel {
             roots.push(nodes.len() as u32);
             firsts.push(tri_base);
             let base = nodes.len() as i32;
-            nodes.extend(b.bvh.nodes.iter().map(|n| {
-                let mut n = *n;
+            nodes.extend(b.bvh.nodes.iter().map(|&n| {
+                let mut n = n;
                 for (lo, hi) in [
                     (&mut n.left_min, n.left_max),
                     (&mut n.right_min, n.right_max),
@@ -379,16 +483,24 @@ impl TwoLevel {
     }
 
     /// [`TwoLevel::device_nodes`] for the 4-wide form: the collapsed TLAS, then every
-    /// collapsed BLAS, rebased alike; and each BLAS's root.
-    pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>) {
+    /// collapsed BLAS, rebased alike; each BLAS's root; and per BLAS, each binary node's wide
+    /// node (`u32::MAX` for one inside a wide node), where a piece enters the wide BLAS.
+    pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>, Vec<Vec<u32>>) {
         let mut nodes = WideBvh::collapse(&self.tlas).nodes;
         nodes.resize(self.tlas_slots(), GpuWideNode::default());
         let mut roots = vec![];
+        let mut wide_of = vec![];
         let mut tri_base = 0i32;
         for b in &self.blases {
             let base = nodes.len() as i32;
             roots.push(base as u32);
-            nodes.extend(WideBvh::collapse(&b.bvh).nodes.into_iter().map(|mut n| {
+            let (wide, binaries) = WideBvh::collapse_mapped(&b.bvh);
+            let mut map = vec![u32::MAX; b.bvh.nodes.len()];
+            for (w, &n) in binaries.iter().enumerate() {
+                map[n as usize] = w as u32;
+            }
+            wide_of.push(map);
+            nodes.extend(wide.nodes.into_iter().map(|mut n| {
                 for i in 0..super::WIDTH {
                     if n.count[i] > 0 {
                         n.child[i] = !((!n.child[i]) + tri_base);
@@ -400,16 +512,47 @@ impl TwoLevel {
             }));
             tri_base += b.triangles.len() as i32;
         }
-        (nodes, roots)
+        (nodes, roots, wide_of)
     }
 }
 
-/// Splits every TLAS leaf of several instances into leaves of one, so that a ray tests each
-/// instance's box before it is carried into the instance: entering an instance costs a
-/// transform and a descent from its BLAS root, where the builder's leaves of up to eight boxes
-/// (right for triangles) would enter all of them. A leaf's instances are halved along the
-/// longest axis of their boxes' centres, recursively. The TLAS of n instances then has n - 1
-/// nodes, as many as [`TwoLevel::tlas_slots`] reserves.
+/// Meshes of at most this many triangles are small (see [`TwoLevel::braid`]).
+const SMALL_MESH: usize = 64;
+
+/// A piece's mark for one triangle (its index in the BLAS in the other bits), else a BLAS node.
+pub const PIECE_TRIANGLE: u32 = 1 << 31;
+
+/// Pieces beyond one per instance (and one per small mesh's triangle) that re-braiding may
+/// open BLASes into: 0, none, by default, since opening the bunny room's BLASes measured no
+/// faster on PoCL (docs/benchmarks.md, 2026-11-30); `PENUMBRA_REBRAID=n` sets it for
+/// experiments (the H200's figures are still to be measured).
+pub fn rebraid_budget() -> usize {
+    std::env::var("PENUMBRA_REBRAID")
+        .ok()
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(0)
+}
+
+/// The most pieces a TLAS over `instances` may be re-braided into: a small mesh's triangles
+/// each, one for any other instance, and `extra` more for opening BLASes.
+fn piece_budget(blases: &[Blas], instances: &[Instance], extra: usize) -> usize {
+    let base: usize = instances
+        .iter()
+        .map(|i| {
+            let b = &blases[i.blas as usize];
+            if b.is_small() { b.triangles.len() } else { 1 }
+        })
+        .sum();
+    base + extra
+}
+
+/// Splits every TLAS leaf of several pieces into leaves of one, so that a ray tests each
+/// piece's box before it is carried into the instance: entering a piece costs a transform and
+/// a descent from its BLAS node, where the builder's leaves of up to eight boxes (right for
+/// triangles) would enter all of them. A leaf's pieces are split in two along the axis of
+/// their boxes' centres where the SAH cost is least, recursively. The TLAS of n pieces then
+/// has n - 1 nodes, no more than
+/// [`TwoLevel::tlas_slots`] reserves.
 fn split_instance_leaves(tlas: &mut Bvh, boxes: &[Aabb]) {
     let mut split = false;
     for node in 0..tlas.nodes.len() as u32 {
@@ -434,19 +577,30 @@ fn split_instance_leaves(tlas: &mut Bvh, boxes: &[Aabb]) {
 fn split_range(tlas: &mut Bvh, boxes: &[Aabb], first: u32, count: u32) -> u32 {
     let centre = |i: &u32| (boxes[*i as usize].min + boxes[*i as usize].max) * 0.5;
     let items = &mut tlas.tri_indices[first as usize..(first + count) as usize];
-    let extent = items.iter().fold(Aabb::EMPTY, |a, i| a.grow(centre(i)));
-    let size = extent.max - extent.min;
-    let axis = if size.x >= size.y && size.x >= size.z {
-        0
-    } else if size.y >= size.z {
-        1
-    } else {
-        2
-    };
-    items.sort_by(|a, b| centre(a)[axis].total_cmp(&centre(b)[axis]));
+    // The split of the least SAH cost (the sum of each side's box area times its items: every
+    // item is entered at a cost) among the items sorted along each axis by their boxes' centres.
+    let mut best = (f32::INFINITY, 0, count / 2);
+    for axis in 0..3 {
+        items.sort_by(|a, b| centre(a)[axis].total_cmp(&centre(b)[axis]));
+        let mut right = vec![0.0f32; count as usize];
+        let mut b = Aabb::EMPTY;
+        for k in (1..count as usize).rev() {
+            b = b.union(boxes[items[k] as usize]);
+            right[k] = b.area() * (count as usize - k) as f32;
+        }
+        let mut b = Aabb::EMPTY;
+        for k in 1..count as usize {
+            b = b.union(boxes[items[k - 1] as usize]);
+            let cost = b.area() * k as f32 + right[k];
+            if cost < best.0 {
+                best = (cost, axis, k as u32);
+            }
+        }
+    }
+    items.sort_by(|a, b| centre(a)[best.1].total_cmp(&centre(b)[best.1]));
     let index = tlas.nodes.len() as u32;
     tlas.nodes.push(GpuBvhNode::default());
-    let half = count / 2;
+    let half = best.2;
     for (side, (f, c)) in [(first, half), (first + half, count - half)]
         .into_iter()
         .enumerate()
@@ -508,7 +662,7 @@ mod tests {
     use super::super::build::tests::{lcg, random_triangles};
     use super::super::intersect_triangle;
     use super::*;
-    use glam::{Mat4, Quat};
+    use glam::{DMat4, Mat4, Quat};
 
     /// Identity, moved, non-uniformly scaled, mirrored, and rotated-and-mirrored placements.
     fn placements() -> Vec<Mat4> {
@@ -647,7 +801,7 @@ mod tests {
                 .any(|side| matches!(built.child(n, side).1, Child::Leaf { count: 2.., .. }))),
             "the builder alone makes leaves of several instances"
         );
-        let two = TwoLevel::new(&[closed_cube(1)], &placed);
+        let two = TwoLevel::new(&[closed_cube(3)], &placed);
         let mut leaves = 0;
         for node in 0..two.tlas.nodes.len() as u32 {
             for side in 0..2 {
@@ -657,8 +811,12 @@ mod tests {
                 }
             }
         }
-        assert_eq!(leaves, 40);
-        assert_eq!(two.tlas.nodes.len(), two.tlas_slots());
+        assert_eq!(
+            leaves, 40,
+            "a cube of 108 triangles is not small, nor opened"
+        );
+        assert_eq!(two.tlas.nodes.len(), 39);
+        assert!(two.tlas.nodes.len() <= two.tlas_slots());
         let mut slots = two.tlas.tri_indices.clone();
         slots.sort();
         assert_eq!(slots, (0..40).collect::<Vec<u32>>(), "each instance once");
@@ -675,12 +833,132 @@ mod tests {
 
     /// The builder's tree over the world boxes of closed cubes placed by `placed`.
     fn build_boxes_of(placed: &[(u32, glam::DMat4)]) -> Bvh {
-        let cube = Blas::new(&closed_cube(1));
+        let cube = Blas::new(&closed_cube(3));
         let boxes: Vec<Aabb> = placed
             .iter()
             .map(|&(_, m)| Instance::new(0, m).world_box(cube.bounds()))
             .collect();
         build_boxes(&boxes)
+    }
+
+    /// A big mesh and a small one (its instances' triangles are TLAS pieces of their own)
+    /// placed by every placement, with the BLASes opened into `extra` more pieces.
+    fn braided(extra: usize, moved: Option<DMat4>) -> TwoLevel {
+        let meshes = vec![random_triangles(3000, 7), closed_cube(2)];
+        assert!(!Blas::new(&meshes[0]).is_small() && Blas::new(&meshes[1]).is_small());
+        let mut placed: Vec<(u32, DMat4)> = placements()
+            .into_iter()
+            .enumerate()
+            .flat_map(|(i, m)| {
+                let m = (m * Mat4::from_translation(Vec3::splat(i as f32 * 2.0))).as_dmat4();
+                [
+                    (0, m),
+                    (1, m * DMat4::from_translation(glam::DVec3::X * 12.0)),
+                ]
+            })
+            .collect();
+        if let Some(m) = moved {
+            placed[0].1 = m;
+            placed[1].1 = m;
+        }
+        let mut two = TwoLevel::new(&meshes, &placed);
+        two.set_rebraid_budget(extra);
+        two
+    }
+
+    /// Rays through the scene of [`braided`]: from around it towards random points in it.
+    fn rays_through(two: &TwoLevel, n: usize) -> Vec<Ray> {
+        let b = two.tlas.child(0, 0).0.union(two.tlas.child(0, 1).0);
+        let mut s = 11u64;
+        let point = |s: &mut u64| {
+            let t = Vec3::new(lcg(s), lcg(s), lcg(s));
+            b.min + (b.max - b.min) * (t * 1.4 - 0.2)
+        };
+        (0..n)
+            .map(|_| {
+                let (o, aim) = (point(&mut s), point(&mut s));
+                ray(o, aim - o)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn re_braided_pieces_find_the_unopened_and_flattened_hits() {
+        let (plain, opened) = (braided(0, None), braided(300, None));
+        // Each small instance is one piece per triangle; the big ones are opened.
+        let pieces =
+            |two: &TwoLevel, i: u32| two.tlas.tri_indices.iter().filter(|&&k| k == i).count();
+        for i in 0..plain.instances.len() as u32 {
+            let small = i % 2 == 1;
+            assert_eq!(
+                pieces(&plain, i),
+                if small { 48 } else { 1 },
+                "instance {i}"
+            );
+            assert_eq!(
+                pieces(&opened, i) == pieces(&plain, i),
+                small,
+                "instance {i}"
+            );
+        }
+        assert!(opened.pieces.len() > plain.pieces.len() + 250);
+        assert!(opened.pieces.len() <= opened.max_pieces);
+        assert_eq!(opened.tlas.nodes.len(), opened.pieces.len() - 1);
+        let world: Vec<[Vec3; 3]> = (0..plain.instances.len())
+            .flat_map(|i| {
+                let inst = &plain.instances[i];
+                let b = &plain.blases[inst.blas as usize];
+                b.triangles.iter().map(move |t| t.map(|v| inst.to_world(v)))
+            })
+            .collect();
+        let mut hits = 0;
+        for (k, r) in rays_through(&plain, 3000).iter().enumerate() {
+            let (a, b) = (plain.intersect(r), opened.intersect(r));
+            // Entering a subtree of a BLAS tests what entering its root would: the same hit.
+            assert_eq!(
+                a.map(|h| (h.instance, h.hit)),
+                b.map(|h| (h.instance, h.hit)),
+                "ray {k}"
+            );
+            assert_eq!(plain.occluded(r), opened.occluded(r), "ray {k}");
+            assert_eq!(a.is_some(), plain.occluded(r), "ray {k}");
+            // The flattened scene (world triangles carried in f64) agrees up to rounding.
+            let flat = world
+                .iter()
+                .filter_map(|t| intersect_triangle(r, t).map(|h| h.0))
+                .fold(f32::INFINITY, f32::min);
+            let t = a.map_or(f32::INFINITY, |h| h.hit.t);
+            assert!(
+                t == flat || (t - flat).abs() <= 1e-4 * flat.max(1.0),
+                "ray {k}: {t} vs {flat}"
+            );
+            hits += a.is_some() as usize;
+        }
+        assert!(hits > 500, "the rays hit something ({hits})");
+    }
+
+    #[test]
+    fn moving_an_instance_moves_all_its_pieces() {
+        let to =
+            DMat4::from_translation(glam::DVec3::new(3.0, -5.0, 1.0)) * DMat4::from_rotation_y(0.7);
+        let mut two = braided(300, None);
+        // Instances 0 and 1 (a big, opened one and a small one) move as in a scene built so.
+        two.place(0, to);
+        two.place(1, to);
+        two.rebuild_tlas();
+        let built = braided(300, Some(to));
+        assert_eq!(two.pieces, built.pieces);
+        assert_eq!(two.tlas.tri_indices, built.tlas.tri_indices);
+        let mut moved_hits = 0;
+        for (k, r) in rays_through(&built, 3000).iter().enumerate() {
+            let (a, b) = (two.intersect(r), built.intersect(r));
+            assert_eq!(a, b, "ray {k}");
+            moved_hits += a.is_some_and(|h| h.instance < 2) as usize;
+        }
+        assert!(
+            moved_hits > 50,
+            "rays hit the moved instances ({moved_hits})"
+        );
     }
 
     #[test]

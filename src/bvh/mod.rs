@@ -10,7 +10,7 @@ mod traverse;
 mod wide;
 
 pub use build::{MAX_DEPTH, build, build_boxes, build_indexed};
-pub use instances::{Blas, Instance, InstanceHit, TwoLevel, closed_cube};
+pub use instances::{Blas, Instance, InstanceHit, PIECE_TRIANGLE, TwoLevel, closed_cube};
 pub use refit::{REFIT_MAX_GROWTH, Update};
 pub use stats::{BvhReport, report};
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};

@@ -157,17 +157,18 @@ pub const STACK_SIZE: usize = 64;
 impl Bvh {
     /// The closest hit along `ray` among `tris` (in BVH order).
     pub fn intersect(&self, ray: &Ray, tris: &[[Vec3; 3]]) -> Option<Hit> {
-        self.traverse(ray, tris, false)
+        self.traverse(0, ray, tris, false)
     }
 
     /// Whether anything blocks `ray` within its interval.
     pub fn occluded(&self, ray: &Ray, tris: &[[Vec3; 3]]) -> bool {
-        self.traverse(ray, tris, true).is_some()
+        self.traverse(0, ray, tris, true).is_some()
     }
 
-    fn traverse(&self, ray: &Ray, tris: &[[Vec3; 3]], any: bool) -> Option<Hit> {
+    /// The closest hit (or with `any` the first) along `ray` in the subtree below node `root`.
+    pub fn traverse(&self, root: u32, ray: &Ray, tris: &[[Vec3; 3]], any: bool) -> Option<Hit> {
         let sh = Shear::new(ray.direction);
-        self.walk(ray, any, |prim, r| {
+        self.walk_from(root, ray, any, |prim, r| {
             intersect_sheared(r, &sh, &tris[prim as usize])
                 .map(|(t, u, v)| (t, Hit { t, u, v, prim }))
         })
@@ -181,6 +182,17 @@ impl Bvh {
         &self,
         ray: &Ray,
         any: bool,
+        test: impl FnMut(u32, &Ray) -> Option<(f32, H)>,
+    ) -> Option<H> {
+        self.walk_from(0, ray, any, test)
+    }
+
+    /// [`Bvh::walk`] below node `root`.
+    pub fn walk_from<H>(
+        &self,
+        root: u32,
+        ray: &Ray,
+        any: bool,
         mut test: impl FnMut(u32, &Ray) -> Option<(f32, H)>,
     ) -> Option<H> {
         let inv = safe_inverse(ray.direction);
@@ -188,7 +200,7 @@ impl Bvh {
         let mut best = None;
         let mut stack = [0u32; STACK_SIZE];
         let mut sp = 0;
-        let mut node = 0u32;
+        let mut node = root;
         loop {
             let mut near = [None, None];
             for (side, slot) in near.iter_mut().enumerate() {

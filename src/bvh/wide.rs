@@ -24,54 +24,30 @@ pub struct WideBvh {
     pub nodes: Vec<GpuWideNode>,
 }
 
-/// One child slot of a node under construction.
-#[derive(Clone, Copy)]
-struct Slot {
-    bounds: Aabb,
-    child: Child,
-}
-
 impl WideBvh {
     /// Collapses `bvh`: each wide node takes its binary node's two children and keeps opening
     /// the interior child with the largest surface area until it has four (or only leaves).
     pub fn collapse(bvh: &Bvh) -> Self {
+        Self::collapse_mapped(bvh).0
+    }
+
+    /// [`WideBvh::collapse`], and the binary node each wide node collapses (the root of the
+    /// same subtree; two-level re-braiding enters BLASes at such nodes, see `bvh::instances`).
+    pub fn collapse_mapped(bvh: &Bvh) -> (Self, Vec<u32>) {
         let mut nodes = vec![GpuWideNode::default()];
+        let mut binaries = vec![0u32];
         let mut work = vec![(0u32, 0usize)]; // (binary node, wide node)
         while let Some((binary, wide)) = work.pop() {
-            let mut slots: Vec<Slot> = (0..2)
-                .map(|side| {
-                    let (bounds, child) = bvh.child(binary, side);
-                    Slot { bounds, child }
-                })
-                .collect();
-            while slots.len() < WIDTH {
-                let Some((i, node)) = slots
-                    .iter()
-                    .enumerate()
-                    .filter_map(|(i, s)| match s.child {
-                        Child::Node(n) => Some((i, n, s.bounds.area())),
-                        Child::Leaf { .. } => None,
-                    })
-                    .max_by(|a, b| a.2.total_cmp(&b.2))
-                    .map(|(i, n, _)| (i, n))
-                else {
-                    break;
-                };
-                slots.swap_remove(i);
-                for side in 0..2 {
-                    let (bounds, child) = bvh.child(node, side);
-                    slots.push(Slot { bounds, child });
-                }
-            }
+            let slots = wide_children(bvh, binary);
             let mut out = GpuWideNode::default();
-            for (i, s) in slots.iter().enumerate() {
-                out.min_x[i] = s.bounds.min.x;
-                out.min_y[i] = s.bounds.min.y;
-                out.min_z[i] = s.bounds.min.z;
-                out.max_x[i] = s.bounds.max.x;
-                out.max_y[i] = s.bounds.max.y;
-                out.max_z[i] = s.bounds.max.z;
-                match s.child {
+            for (i, &(bounds, child)) in slots.iter().enumerate() {
+                out.min_x[i] = bounds.min.x;
+                out.min_y[i] = bounds.min.y;
+                out.min_z[i] = bounds.min.z;
+                out.max_x[i] = bounds.max.x;
+                out.max_y[i] = bounds.max.y;
+                out.max_z[i] = bounds.max.z;
+                match child {
                     Child::Leaf { first, count } => {
                         out.child[i] = !(first as i32);
                         out.count[i] = count;
@@ -79,6 +55,7 @@ impl WideBvh {
                     Child::Node(n) => {
                         let index = nodes.len();
                         nodes.push(GpuWideNode::default());
+                        binaries.push(n);
                         out.child[i] = index as i32;
                         work.push((n, index));
                     }
@@ -86,7 +63,7 @@ impl WideBvh {
             }
             nodes[wide] = out;
         }
-        Self { nodes }
+        (Self { nodes }, binaries)
     }
 
     /// The decoded children of `node` (empty slots left out).
@@ -158,6 +135,29 @@ impl WideBvh {
             }
         }
     }
+}
+
+/// The children of the wide node that collapses binary node `binary`: its two children, with
+/// the interior child of the largest surface area opened until there are four (or only leaves).
+pub fn wide_children(bvh: &Bvh, binary: u32) -> Vec<(Aabb, Child)> {
+    let mut slots: Vec<(Aabb, Child)> = (0..2).map(|side| bvh.child(binary, side)).collect();
+    while slots.len() < WIDTH {
+        let Some((i, node)) = slots
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| match s.1 {
+                Child::Node(n) => Some((i, n, s.0.area())),
+                Child::Leaf { .. } => None,
+            })
+            .max_by(|a, b| a.2.total_cmp(&b.2))
+            .map(|(i, n, _)| (i, n))
+        else {
+            break;
+        };
+        slots.swap_remove(i);
+        slots.extend((0..2).map(|side| bvh.child(node, side)));
+    }
+    slots
 }
 
 #[cfg(test)]

@@ -69,6 +69,13 @@ kernel_constants! {
     /// `GpuTexRef::info.w` flag: the finest level only (minFilter NEAREST or LINEAR, no mipmaps).
     TEXREF_NO_MIPS: i32 = 2;
 
+    /// `GpuInstance::flags`: the transform mirrors (negative determinant).
+    INSTANCE_MIRRORED: u32 = 1;
+    /// `GpuInstance::flags`: a re-braided piece of one triangle of a small mesh (`root` and
+    /// `wide_root` name it among the meshes' triangles), tested in world space without
+    /// entering the instance (`bvh::instances`, `TwoLevel::braid`).
+    INSTANCE_PIECE_TRIANGLE: u32 = 2;
+
     /// Material flags in `GpuMaterial::emission.w`: both sides are front faces.
     MATERIAL_DOUBLE_SIDED: u32 = 1;
     /// `KHR_materials_unlit`: the surface shows its base color and ends the path.
@@ -203,13 +210,14 @@ pub struct GpuInstance {
     pub world1: [f32; 4],
     /// Third row of M.
     pub world2: [f32; 4],
-    /// Bottom-level root in the binary node array.
+    /// Where the TLAS leaf (the piece) enters the bottom level in the binary node array: the
+    /// BLAS's root or a subtree's; or with `INSTANCE_PIECE_TRIANGLE`, its triangle.
     pub root: u32,
-    /// Bottom-level root in the wide node array.
+    /// The same in the wide node array.
     pub wide_root: u32,
     /// The instance's index in the scene (host bookkeeping; hits name the slot).
     pub id: u32,
-    /// 1 when mirrored (negative determinant).
+    /// `INSTANCE_MIRRORED`, `INSTANCE_PIECE_TRIANGLE`.
     pub flags: u32,
 }
 const _: () = assert!(size_of::<GpuInstance>() == 112);

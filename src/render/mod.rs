@@ -587,9 +587,11 @@ fn device_accel(host: &mut HostScene) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec
         ),
         Accel::TwoLevel(two) => {
             let (nodes, roots, _) = two.device_nodes();
-            let (wide, wide_roots) = two.device_wide_nodes();
+            let (wide, wide_roots, wide_of) = two.device_wide_nodes();
             host.layout.roots = roots;
             host.layout.wide_roots = wide_roots;
+            host.layout.wide_of = wide_of;
+            host.layout.append_piece_copies(two, &mut host.triangles);
             let instances = host.layout.gpu_instances(two);
             (nodes, wide, instances)
         }

@@ -4,6 +4,7 @@
 //! nothing else is written (a moved light also rewrites the small light table).
 
 use super::instancing::{instanced_objects, render_from_world};
+use super::upload::piece_copies;
 use super::{Accel, Renderer};
 use crate::bvh::WideBvh;
 use crate::cl::ClError;
@@ -92,9 +93,19 @@ impl Renderer {
         buffers.nodes.write_at(gpu, 0, &nodes)?;
         buffers.wide_nodes.write_at(gpu, 0, &wide)?;
         buffers.instances.write_at(gpu, 0, &instances)?;
-        let bytes = std::mem::size_of_val(nodes.as_slice())
+        let mut bytes = std::mem::size_of_val(nodes.as_slice())
             + std::mem::size_of_val(wide.as_slice())
             + std::mem::size_of_val(instances.as_slice());
+        // A moved small instance's world-space triangle copies (the TLAS's pieces).
+        for &(i, _, _) in &moved {
+            let base = host.layout.copy_bases[i] as usize;
+            if base != u32::MAX as usize {
+                let copies = piece_copies(two, &host.triangles, i);
+                buffers.triangles.write_at(gpu, base, &copies)?;
+                host.triangles[base..base + copies.len()].copy_from_slice(&copies);
+                bytes += std::mem::size_of_val(copies.as_slice());
+            }
+        }
         for &(i, _, _) in &moved {
             host.replace_emitters(i as u32);
         }

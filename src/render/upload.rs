@@ -3,7 +3,7 @@
 //! triangle), materials and the camera. The light list is built in `lights`, the textures in
 //! `textures`.
 
-use crate::bvh::{Bvh, Ray, TwoLevel};
+use crate::bvh::{Bvh, PIECE_TRIANGLE, Ray, TwoLevel};
 use crate::cl::types::*;
 use crate::scene::{
     AlphaMode, Camera, Material, Mesh, RenderFrame, Scene, WorldTriangle, robust_bounds_of,
@@ -75,21 +75,55 @@ pub struct InstanceLayout {
     pub roots: Vec<u32>,
     /// Each BLAS's root in the wide node array.
     pub wide_roots: Vec<u32>,
+    /// Per BLAS, each binary node's wide node (relative to its root; `u32::MAX` for one inside
+    /// a wide node): where a re-braided piece enters the wide BLAS.
+    pub wide_of: Vec<Vec<u32>>,
     /// Each instance's first light (the light index of its first emissive triangle).
     pub light_bases: Vec<i32>,
+    /// Each small instance's first world-space triangle copy in the device triangles (see
+    /// [`piece_copies`]; `u32::MAX` for an instance that is not small).
+    pub copy_bases: Vec<u32>,
 }
 
 impl InstanceLayout {
-    /// The device instances of `two` in TLAS order, padded to all of them (hidden ones are
-    /// not in the TLAS), so that the buffer holds any later TLAS's.
+    /// Appends the world-space copies of every small instance's triangles (hidden ones too, so
+    /// that showing one writes in place) to the device triangles `triangles` (the meshes'
+    /// object-space ones) and keeps where each instance's copies start.
+    pub fn append_piece_copies(&mut self, two: &TwoLevel, triangles: &mut Vec<GpuTriangle>) {
+        self.copy_bases = (0..two.instances.len())
+            .map(|i| {
+                if !two.blases[two.instances[i].blas as usize].is_small() {
+                    return u32::MAX;
+                }
+                let base = triangles.len() as u32;
+                let copies = piece_copies(two, triangles, i);
+                triangles.extend(copies);
+                base
+            })
+            .collect();
+    }
+
+    /// The device instances of `two` in TLAS order, one per TLAS slot (a re-braided piece of
+    /// an instance: the instance's transforms and the BLAS node it enters at), padded to
+    /// [`TwoLevel::max_pieces`] so that the buffer holds any later TLAS's.
     pub fn gpu_instances(&self, two: &TwoLevel) -> Vec<GpuInstance> {
         let mut out: Vec<GpuInstance> = two
             .tlas
             .tri_indices
             .iter()
-            .map(|&i| {
+            .zip(&two.pieces)
+            .map(|(&i, &node)| {
                 let inst = &two.instances[i as usize];
                 let b = inst.blas as usize;
+                // A piece of one triangle names it (among the meshes' triangles) in both.
+                let triangle = node & PIECE_TRIANGLE != 0;
+                let (root, wide_root) = if triangle {
+                    let k = node & !PIECE_TRIANGLE;
+                    (self.copy_bases[i as usize] + k, two.firsts[b] + k)
+                } else {
+                    let wide = self.wide_of[b][node as usize];
+                    (self.roots[b] + node, self.wide_roots[b] + wide)
+                };
                 let mut world = inst.world_rows();
                 world[0][3] = f32::from_bits(self.light_bases[i as usize] as u32);
                 GpuInstance {
@@ -99,16 +133,41 @@ impl InstanceLayout {
                     world0: world[0],
                     world1: world[1],
                     world2: world[2],
-                    root: self.roots[b],
-                    wide_root: self.wide_roots[b],
+                    root,
+                    wide_root,
                     id: i,
-                    flags: inst.mirrored as u32,
+                    flags: if inst.mirrored { INSTANCE_MIRRORED } else { 0 }
+                        | if triangle { INSTANCE_PIECE_TRIANGLE } else { 0 },
                 }
             })
             .collect();
-        out.resize(two.instances.len().max(1), GpuInstance::default());
+        out.resize(two.max_pieces.max(1), GpuInstance::default());
         out
     }
+}
+
+/// A small instance's triangles in world space, where the two-level traversal tests them as
+/// pieces of the TLAS without entering the instance (`TwoLevel::braid`): the vertices as
+/// [`crate::bvh::Instance::device_triangle`] carries them (the host reference tests the same
+/// values), the payloads of the mesh's triangles in the device triangles `triangles`.
+pub fn piece_copies(two: &TwoLevel, triangles: &[GpuTriangle], i: usize) -> Vec<GpuTriangle> {
+    let inst = &two.instances[i];
+    let b = inst.blas as usize;
+    let first = two.firsts[b] as usize;
+    let v = |p: Vec3, payload: f32| [p.x, p.y, p.z, payload];
+    two.blases[b]
+        .triangles
+        .iter()
+        .zip(&triangles[first..])
+        .map(|(t, o)| {
+            let w = inst.device_triangle(t);
+            GpuTriangle {
+                v0: v(w[0], o.v0[3]),
+                v1: v(w[1], o.v1[3]),
+                v2: v(w[2], o.v2[3]),
+            }
+        })
+        .collect()
 }
 
 /// An emissive triangle of the light table.
