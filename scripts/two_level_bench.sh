@@ -10,7 +10,9 @@
 #   OUT=/some/dir scripts/two_level_bench.sh
 #
 # Environment: DEVICE (default gpu; `cpu` measures PoCL at a smaller size), PENUMBRA (binary),
-# SCENES (folder), ROUNDS (default 2: flat and two-level alternate, ROUNDS times each).
+# SCENES (folder), ROUNDS (default 2: flat and two-level alternate, ROUNDS times each),
+# PENUMBRA_REBRAID (unset: none; n opens the two-level form's BLASes into up to n more TLAS
+# pieces, an experiment, see docs/architecture.md; run once without and once with it).
 # Writes to $OUT:
 #   log.txt       devices and every table as printed
 #   trace.jsonl   bench trace --json, one line per scene, form and round (`bvh_levels` names
@@ -49,6 +51,7 @@ run() {
 
 log "== penumbra flat against two levels, $(date -u +%Y-%m-%dT%H:%M:%SZ)"
 log "commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)"
+log "PENUMBRA_REBRAID=${PENUMBRA_REBRAID:-unset}"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version \
     --format=csv >>"$LOG" 2>&1
 "$P" devices >>"$LOG" 2>&1
