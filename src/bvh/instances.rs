@@ -195,8 +195,9 @@ pub struct TwoLevel {
     /// Over the pieces' world boxes, one piece a leaf; its `tri_indices` are the pieces'
     /// instance indices (see [`TwoLevel::rebuild_tlas`]).
     pub tlas: Bvh,
-    /// Each TLAS leaf's (slot's) BLAS node, where the piece enters its instance's BLAS: 0 for
-    /// the whole BLAS, else the root of a subtree that re-braiding opened into the TLAS.
+    /// Each TLAS leaf's (slot's) piece of its instance: the BLAS node it enters at (0 for the
+    /// whole BLAS, else a subtree that re-braiding opened into the TLAS), or a small mesh's
+    /// triangle (`PIECE_TRIANGLE | k`, tested in world space; see [`TwoLevel::braid`]).
     pub pieces: Vec<u32>,
     /// The most pieces the TLAS may hold: fixed for the scene, so that the device's TLAS and
     /// instance buffers, sized for it, hold any later TLAS.
