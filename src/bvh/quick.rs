@@ -44,12 +44,28 @@ fn triangle_box(t: &[Vec3; 3]) -> Aabb {
 
 /// Builds a quick BVH (see the module docs) over triangles given as three vertices each.
 pub fn build_quick(triangles: &[[Vec3; 3]]) -> Bvh {
-    build_quick_ordered(triangles).0
+    let (tri_indices, codes) = morton_order(triangles);
+    let ordered = in_order(triangles, &tri_indices);
+    tree(codes, tri_indices, &ordered)
 }
 
-/// [`build_quick`], with the triangles in BVH order (what tracing the tree needs): they are
-/// put in that order once, before the tree is made, whose leaves then read them in order.
-pub fn build_quick_ordered(triangles: &[[Vec3; 3]]) -> (Bvh, Vec<[Vec3; 3]>) {
+/// [`build_quick`] of `triangles`, which it takes to return them in BVH order (what tracing the
+/// tree needs): they are put in that order once, and the input is freed before the tree is
+/// made (its leaves then read the triangles in order), so that the two copies and the tree are
+/// never held together.
+pub fn build_quick_ordered(triangles: Vec<[Vec3; 3]>) -> (Bvh, Vec<[Vec3; 3]>) {
+    let (tri_indices, codes) = morton_order(&triangles);
+    let ordered = in_order(&triangles, &tri_indices);
+    drop(triangles);
+    (tree(codes, tri_indices, &ordered), ordered)
+}
+
+fn in_order(triangles: &[[Vec3; 3]], order: &[u32]) -> Vec<[Vec3; 3]> {
+    order.par_iter().map(|&i| triangles[i as usize]).collect()
+}
+
+/// The triangles' indices sorted by their centroids' Morton codes, and the sorted codes.
+fn morton_order(triangles: &[[Vec3; 3]]) -> (Vec<u32>, Vec<u32>) {
     let centres = triangles
         .par_iter()
         .fold(|| Aabb::EMPTY, |b, t| b.grow(centroid(t)))
@@ -72,20 +88,20 @@ pub fn build_quick_ordered(triangles: &[[Vec3; 3]]) -> (Bvh, Vec<[Vec3; 3]>) {
         .collect();
     // Unique keys (the index is part of each), so the order is the same at any thread count.
     keys.par_sort_unstable();
-    let tri_indices: Vec<u32> = keys.par_iter().map(|&k| k as u32).collect();
-    let codes: Vec<u32> = keys.par_iter().map(|&k| (k >> 32) as u32).collect();
-    drop(keys);
-    let ordered: Vec<[Vec3; 3]> = tri_indices
-        .par_iter()
-        .map(|&i| triangles[i as usize])
-        .collect();
+    let tri_indices = keys.par_iter().map(|&k| k as u32).collect();
+    let codes = keys.par_iter().map(|&k| (k >> 32) as u32).collect();
+    (tri_indices, codes)
+}
+
+/// The tree over the BVH-order triangles `ordered` with their sorted `codes`.
+fn tree(codes: Vec<u32>, tri_indices: Vec<u32>, ordered: &[[Vec3; 3]]) -> Bvh {
     // As `build`: interior nodes below the root go straight into a zeroed arena (pages cost
     // memory once written), packed into the final layout by `finish`.
-    let n = triangles.len();
+    let n = ordered.len();
     let mut arena: Vec<GpuBvhNode> = bytemuck::zeroed_vec(2 * n.max(1) - 1);
-    let root = build_range(&codes, &ordered, 0, 0, &mut arena[1..], 1);
+    let root = build_range(&codes, ordered, 0, 0, &mut arena[1..], 1);
     drop(codes);
-    (finish(root, arena, tri_indices), ordered)
+    finish(root, arena, tri_indices)
 }
 
 /// `⌈log2 n⌉` (0 for n ≤ 1).

@@ -327,21 +327,18 @@ impl Probe {
                 .get(m as usize)
                 .is_some_and(|m| m.transmission > 0.0 || m.alpha == super::AlphaMode::Blend)
         };
-        let opaque: Vec<u32> = (0..all.len() as u32)
-            .into_par_iter()
-            .filter(|&i| !see_through(materials[i as usize]))
-            .collect();
-        let (bvh, tris, kept, shell) = if opaque.len() == all.len() {
-            let (bvh, tris) = crate::bvh::build_quick_ordered(&all);
-            drop(all);
+        let (bvh, tris, kept, shell) = if !materials.par_iter().any(|&m| see_through(m)) {
+            let (bvh, tris) = crate::bvh::build_quick_ordered(all);
             (bvh, tris, None, None)
         } else {
-            let (shell_bvh, shell_tris) = crate::bvh::build_quick_ordered(&all);
+            let opaque: Vec<u32> = (0..all.len() as u32)
+                .into_par_iter()
+                .filter(|&i| !see_through(materials[i as usize]))
+                .collect();
             let verts: Vec<[Vec3; 3]> = opaque.par_iter().map(|&i| all[i as usize]).collect();
-            drop(all);
-            let (bvh, tris) = crate::bvh::build_quick_ordered(&verts);
-            drop(verts);
-            (bvh, tris, Some(opaque), Some((shell_bvh, shell_tris)))
+            let shell = crate::bvh::build_quick_ordered(all);
+            let (bvh, tris) = crate::bvh::build_quick_ordered(verts);
+            (bvh, tris, Some(opaque), Some(shell))
         };
         // Each BVH-order triangle's index among all the triangles, for its material.
         let original = |i: u32| kept.as_ref().map_or(i, |k| k[i as usize]);
