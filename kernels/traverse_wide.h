@@ -23,16 +23,27 @@ inline WideRay wide_ray(const RayPrep* r) {
 
 // traverse.h's slab test on the four children of n at once: their entry distances in *near,
 // and the mask of those the ray reaches before tmax (empty slots never).
+// The minimum and maximum are written as comparisons: OpenCL's fmin and fmax must return the
+// other operand of a NaN, which costs x86 two more instructions each (vminps alone does not),
+// and no slab distance here is NaN: the reciprocal direction is finite and nonzero, and empty
+// slots are masked out by `valid`. The bunnies' rays ran 3 % faster on PoCL, with the same
+// images bit for bit.
+#define WIDE_MIN(a, b) select(b, a, a < b)
+#define WIDE_MAX(a, b) select(b, a, a > b)
 inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin, float tmax,
                        float4* near) {
     float4 x0 = (n->min_x - w->ox) * w->ix, x1 = (n->max_x - w->ox) * w->ix;
     float4 y0 = (n->min_y - w->oy) * w->iy, y1 = (n->max_y - w->oy) * w->iy;
     float4 z0 = (n->min_z - w->oz) * w->iz, z1 = (n->max_z - w->oz) * w->iz;
-    *near = fmax(fmax(fmax(fmin(x0, x1), fmin(y0, y1)), fmin(z0, z1)), (float4)(tmin));
-    float4 far = fmin(fmin(fmax(x0, x1), fmax(y0, y1)), fmax(z0, z1)) * 1.00000024f;
+    *near = WIDE_MAX(WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)), WIDE_MIN(z0, z1)),
+                     (float4)(tmin));
+    float4 far =
+        WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)), WIDE_MAX(z0, z1)) * 1.00000024f;
     int4 valid = (n->child > 0) | (n->count > 0u);
     return (*near <= far) & (*near < (float4)(tmax)) & valid;
 }
+#undef WIDE_MIN
+#undef WIDE_MAX
 
 // Compare-and-swap of two (entry distance, slot) pairs, ordered by distance and then slot, so
 // that the network below sorts as a stable sort would (the host reference's order).
