@@ -317,8 +317,7 @@ impl Probe {
     /// are see-through. The probe rays find the same closest hits with either tree.
     pub fn new(scene: &Scene) -> Self {
         use rayon::prelude::*;
-        let world = scene.world_vertices(&super::RenderFrame::default());
-        let (all, materials): (Vec<[Vec3; 3]>, Vec<u32>) = world.into_par_iter().unzip();
+        let (all, materials) = scene.world_vertices(&super::RenderFrame::default());
         let bounds = robust_bounds(&all);
         let points = fit_points(&all, &bounds);
         let see_through = |m: u32| {
