@@ -208,6 +208,13 @@ fn build_prims(mut prims: Vec<Prim>) -> Bvh {
     let root = build_subtree(&mut prims, 0, 0, info, &mut arena[1..], 1);
     let tri_indices = prims.par_iter().map(Prim::index).collect();
     drop(prims);
+    finish(root, arena, tri_indices)
+}
+
+/// The BVH of the subtree `root` built into `arena` (the root's interior nodes from index 1
+/// on, see [`build_subtree`]) over the triangles `tri_indices`: the nodes packed into the
+/// final layout, with the tree's SAH cost and depth.
+pub(super) fn finish(root: Built, mut arena: Vec<GpuBvhNode>, tri_indices: Vec<u32>) -> Bvh {
     let nodes = match root {
         Built::Tree { at, len, .. } => {
             // Local indices are final ones: the block moves to the front as it is.
@@ -244,7 +251,7 @@ fn build_prims(mut prims: Vec<Prim>) -> Bvh {
 }
 
 /// A subtree as a task returns it.
-enum Built {
+pub(super) enum Built {
     /// A leaf: triangles `first..first + count` in BVH order.
     Leaf {
         bounds: Aabb,
@@ -262,7 +269,7 @@ enum Built {
 }
 
 impl Built {
-    fn bounds(&self) -> Aabb {
+    pub(super) fn bounds(&self) -> Aabb {
         match self {
             Built::Leaf { bounds, .. } | Built::Tree { bounds, .. } | Built::Top { bounds, .. } => {
                 *bounds
@@ -934,11 +941,11 @@ fn write_child(node: &mut GpuBvhNode, side: usize, b: Aabb, reference: i32, coun
     }
 }
 
-fn write_leaf(node: &mut GpuBvhNode, side: usize, b: Aabb, first: u32, count: u32) {
+pub(super) fn write_leaf(node: &mut GpuBvhNode, side: usize, b: Aabb, first: u32, count: u32) {
     write_child(node, side, b, !(first as i32), count);
 }
 
-fn write_interior(node: &mut GpuBvhNode, side: usize, b: Aabb, index: u32) {
+pub(super) fn write_interior(node: &mut GpuBvhNode, side: usize, b: Aabb, index: u32) {
     write_child(node, side, b, index as i32, 0);
 }
 

@@ -4,6 +4,7 @@
 
 mod build;
 mod instances;
+mod quick;
 mod refit;
 mod stats;
 mod traverse;
@@ -11,6 +12,7 @@ mod wide;
 
 pub use build::{MAX_DEPTH, build, build_boxes, build_indexed};
 pub use instances::{Blas, Instance, InstanceHit, PIECE_TRIANGLE, TwoLevel, closed_cube};
+pub use quick::{build_quick, build_quick_ordered};
 pub use refit::{REFIT_MAX_GROWTH, Update};
 pub use stats::{BvhReport, report};
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};

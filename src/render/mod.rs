@@ -228,9 +228,11 @@ impl Renderer {
         self.lights = lights.to_vec();
         let (glights, cdf) = self.light_table(&host);
         let (nodes, wide_nodes, instances) = device_accel(&mut host);
-        // Shading data is the device's alone: it leaves the host scene, and each large host
+        // Triangles and shading data are the device's alone (picking keeps each flat triangle's
+        // object, `HostScene::objects`): they leave the host scene, and each large host
         // array is freed as soon as its buffer is made, so that the two copies (host memory
         // either way with a CPU device) are not all held at once.
+        let triangles = std::mem::take(&mut host.triangles);
         let shading = std::mem::take(&mut host.shading);
         let mut tangents = std::mem::take(&mut host.tangents);
         if tangents.is_empty() {
@@ -247,10 +249,7 @@ impl Renderer {
                     "wide BVH nodes",
                     std::mem::size_of_val(wide_nodes.as_slice()),
                 ),
-                (
-                    "triangles",
-                    std::mem::size_of_val(host.triangles.as_slice()),
-                ),
+                ("triangles", std::mem::size_of_val(triangles.as_slice())),
                 ("instances", std::mem::size_of_val(instances.as_slice())),
                 ("shading", std::mem::size_of_val(shading.as_slice())),
                 ("tangents", std::mem::size_of_val(tangents.as_slice())),
@@ -268,10 +267,12 @@ impl Renderer {
         drop(shading);
         let tangents_buffer = Buffer::from_slice(&self.gpu, &tangents)?;
         drop(tangents);
+        let triangles_buffer = Buffer::from_slice(&self.gpu, &triangles)?;
+        drop(triangles);
         let buffers = SceneBuffers {
             nodes: nodes_buffer,
             wide_nodes: wide_buffer,
-            triangles: Buffer::from_slice(&self.gpu, &host.triangles)?,
+            triangles: triangles_buffer,
             instances: Buffer::from_slice(&self.gpu, &instances)?,
             object_triangles: Buffer::from_slice(&self.gpu, &object_tris)?,
             shading: shading_buffer,

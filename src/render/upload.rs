@@ -192,8 +192,12 @@ pub struct HostScene {
     /// Two levels: where the instances' parts sit on the device (empty when flat).
     pub layout: InstanceLayout,
     /// Triangles as the device has them: the flat BVH's world triangles in BVH order, or
-    /// (two levels) every mesh's object-space triangles, mesh after mesh in BLAS order.
+    /// (two levels) every mesh's object-space triangles, mesh after mesh in BLAS order; moved
+    /// to the device by `Renderer::load_scene` (empty after).
     pub triangles: Vec<GpuTriangle>,
+    /// Flat: each triangle's object (index in `Scene::objects`) in BVH order, for picking
+    /// (4 bytes a triangle where `triangles` holds 48); empty with two levels.
+    pub objects: Vec<u32>,
     /// Flat: world vertices in BVH order (for the host traversal); empty with two levels,
     /// whose BLASes hold their triangles.
     pub vertices: Vec<[Vec3; 3]>,
@@ -390,8 +394,10 @@ impl HostScene {
                 });
             }
         }
+        let objects = triangles.par_iter().map(|t| t.v2[3].to_bits()).collect();
         Self {
             vertices,
+            objects,
             ..Self::assemble(
                 Accel::Flat(bvh),
                 InstanceLayout::default(),
@@ -416,6 +422,7 @@ impl HostScene {
             accel,
             layout,
             triangles,
+            objects: vec![],
             vertices: vec![],
             shading,
             tangents,
@@ -491,7 +498,7 @@ impl HostScene {
     /// Triangles over all placed meshes.
     pub fn triangle_count(&self) -> usize {
         match &self.accel {
-            Accel::Flat(_) => self.triangles.len(),
+            Accel::Flat(_) => self.vertices.len(),
             Accel::TwoLevel(t) => t.triangle_count(),
         }
     }
@@ -555,7 +562,7 @@ impl HostScene {
     /// The object (index in `Scene::objects`) a device hit is on.
     pub fn object_of(&self, hit: &GpuHit) -> u32 {
         match &self.accel {
-            Accel::Flat(_) => self.triangles[hit.prim as usize].v2[3].to_bits(),
+            Accel::Flat(_) => self.objects[hit.prim as usize],
             Accel::TwoLevel(t) => {
                 self.layout.objects[t.tlas.tri_indices[hit.instance as usize] as usize]
             }

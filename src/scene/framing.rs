@@ -98,18 +98,129 @@ fn area(t: &[Vec3; 3]) -> f32 {
     0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
 }
 
-/// The `q`-quantile of `values` weighted by `weights` (both non-empty, same length).
-fn weighted_quantile(values: &[(f32, f32)], q: f64) -> f32 {
-    let total: f64 = values.iter().map(|v| v.1 as f64).sum();
-    let target = q * total;
-    let mut acc = 0.0;
-    for &(v, w) in values {
-        acc += w as f64;
-        if acc >= target {
-            return v;
+/// The key of an `f32` whose unsigned order is [`f32::total_cmp`]'s.
+fn order_key(x: f32) -> u32 {
+    let b = x.to_bits();
+    if b >> 31 == 1 { !b } else { b | 0x8000_0000 }
+}
+
+/// The `f32` of an [`order_key`].
+fn from_order_key(k: u32) -> f32 {
+    f32::from_bits(if k >> 31 == 1 { k & 0x7fff_ffff } else { !k })
+}
+
+/// Buckets of a histogram of 16 bits of [`order_key`]s.
+const KEY_BUCKETS: usize = 1 << 16;
+
+/// Per histogram h < `count`, the weights `w` summed per bucket of `sort(i, h)` (`None`: not
+/// counted) over i in `0..n`, where `item(i)` gives (w, what `sort` needs); fixed chunks (by
+/// `n` alone) summed in order, so that the sums do not depend on the thread count.
+fn histograms<T>(
+    n: usize,
+    count: usize,
+    item: &(dyn Fn(usize) -> (f32, T) + Sync),
+    sort: &(dyn Fn(&T, usize) -> Option<usize> + Sync),
+) -> Vec<Vec<f64>> {
+    use rayon::prelude::*;
+    let chunk = n.div_ceil(32).max(1 << 18);
+    let parts: Vec<Vec<Vec<f64>>> = (0..n.div_ceil(chunk))
+        .into_par_iter()
+        .map(|c| {
+            let mut h = vec![vec![0.0; KEY_BUCKETS]; count];
+            for i in c * chunk..((c + 1) * chunk).min(n) {
+                let (w, x) = item(i);
+                for (k, h) in h.iter_mut().enumerate() {
+                    if let Some(b) = sort(&x, k) {
+                        h[b] += w as f64;
+                    }
+                }
+            }
+            h
+        })
+        .collect();
+    let mut sum = vec![vec![0.0; KEY_BUCKETS]; count];
+    for p in parts {
+        for (s, p) in sum.iter_mut().zip(p) {
+            s.iter_mut().zip(p).for_each(|(s, w)| *s += w);
         }
     }
-    values.last().map_or(0.0, |v| v.0)
+    sum
+}
+
+/// Per axis, the 5th and 95th percentiles of the triangles' centroids weighted by √area: the
+/// first value in ascending ([`f32::total_cmp`]) order at which the running sum of the weights
+/// reaches that share of their total, as scanning the sorted (value, weight) pairs gives it.
+/// Found without sorting: a histogram of the high 16 bits of the values' [`order_key`]s finds
+/// the bucket where the sum crosses, one of the low 16 bits within it the value (all values of
+/// a low bucket are the same value). Two passes over the triangles for the six.
+fn centroid_percentiles(tris: &[[Vec3; 3]]) -> [[f32; 2]; 3] {
+    use rayon::prelude::*;
+    const QS: [f64; 2] = [0.05, 0.95];
+    let n = tris.len();
+    let keys = |i: usize| {
+        let t = &tris[i];
+        let c = (t[0] + t[1] + t[2]) / 3.0;
+        (
+            area(t).sqrt() + 1e-12,
+            [order_key(c.x), order_key(c.y), order_key(c.z)],
+        )
+    };
+    let high = histograms(n, 3, &keys, &|k, axis| Some((k[axis] >> 16) as usize));
+    // Where the running sum never reaches the target (a NaN weight): the largest value.
+    let largest = |axis: usize| {
+        from_order_key(
+            (0..n)
+                .into_par_iter()
+                .map(|i| keys(i).1[axis])
+                .max()
+                .unwrap_or(0),
+        )
+    };
+    // Per (axis, q): the running sum before the candidate high bucket, the bucket, the target.
+    let next = |axis: usize, from: usize, mut acc: f64, target: f64| {
+        for (b, &w) in high[axis].iter().enumerate().skip(from) {
+            if w > 0.0 && acc + w >= target {
+                return Some((acc, b));
+            }
+            acc += w;
+        }
+        None
+    };
+    let mut out = [[0.0; 2]; 3];
+    let mut open: Vec<(usize, usize, f64, usize, f64)> = vec![];
+    for axis in 0..3 {
+        let total: f64 = high[axis].iter().sum();
+        for (k, q) in QS.into_iter().enumerate() {
+            let target = q * total;
+            match next(axis, 0, 0.0, target) {
+                Some((acc, b)) if !target.is_nan() => open.push((axis, k, acc, b, target)),
+                _ => out[axis][k] = largest(axis),
+            }
+        }
+    }
+    // Rounding (the sums go in another order) may carry a crossing into a later high bucket.
+    while !open.is_empty() {
+        let low = histograms(n, open.len(), &keys, &|k, j| {
+            let (axis, _, _, b, _) = open[j];
+            ((k[axis] >> 16) as usize == b).then_some((k[axis] & 0xffff) as usize)
+        });
+        let mut still = vec![];
+        for (&(axis, k, mut acc, b, target), low) in open.iter().zip(&low) {
+            let found = low.iter().enumerate().find_map(|(l, &w)| {
+                acc += w;
+                (w > 0.0 && acc >= target).then_some(l)
+            });
+            match found {
+                Some(l) => out[axis][k] = from_order_key(((b as u32) << 16) | l as u32),
+                None => match next(axis, b + 1, acc, target) {
+                    Some((acc, b)) => still.push((axis, k, acc, b, target)),
+                    None => out[axis][k] = largest(axis),
+                },
+            }
+        }
+        open = still;
+    }
+    out
 }
 
 /// Bounds of the bulk of the geometry. Per axis, the 5th–95th percentile range of the triangle
@@ -119,44 +230,81 @@ fn weighted_quantile(values: &[(f32, f32)], q: f64) -> f32 {
 /// far away is left out; a lone object keeps its exact bounds.
 pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
     use rayon::prelude::*;
-    let mut exact = Bounds::default();
-    for t in tris {
-        for v in t {
-            exact.grow(v.as_dvec3());
+    let union = |mut a: Bounds, b: Bounds| {
+        if !b.is_empty() {
+            a.grow(b.min);
+            a.grow(b.max);
         }
-    }
+        a
+    };
+    let exact = tris
+        .par_iter()
+        .fold(Bounds::default, |mut b, t| {
+            t.iter().for_each(|v| b.grow(v.as_dvec3()));
+            b
+        })
+        .reduce(Bounds::default, union);
     if tris.len() < 8 {
         return exact;
     }
-    let centroids: Vec<Vec3> = tris
-        .par_iter()
-        .map(|t| (t[0] + t[1] + t[2]) / 3.0)
-        .collect();
-    let weights: Vec<f32> = tris.par_iter().map(|t| area(t).sqrt() + 1e-12).collect();
+    let centroid = |t: &[Vec3; 3]| (t[0] + t[1] + t[2]) / 3.0;
     let mut lo = Vec3::ZERO;
     let mut hi = Vec3::ZERO;
-    for axis in 0..3 {
-        let mut v: Vec<(f32, f32)> = centroids
-            .par_iter()
-            .zip(&weights)
-            .map(|(c, &w)| (c[axis], w))
-            .collect();
-        // Stable, as `sort_by` is: ties keep their order and the quantiles are the same.
-        v.par_sort_by(|a, b| a.0.total_cmp(&b.0));
-        let (a, b) = (weighted_quantile(&v, 0.05), weighted_quantile(&v, 0.95));
+    for (axis, [a, b]) in centroid_percentiles(tris).into_iter().enumerate() {
         let margin = 0.5 * (b - a);
         lo[axis] = a - margin;
         hi[axis] = b + margin;
     }
-    let mut bounds = Bounds::default();
-    for (t, c) in tris.iter().zip(&centroids) {
-        if c.cmpge(lo).all() && c.cmple(hi).all() {
-            for v in t {
-                bounds.grow(v.clamp(lo, hi).as_dvec3());
+    let bounds = tris
+        .par_iter()
+        .fold(Bounds::default, |mut bounds, t| {
+            let c = centroid(t);
+            if c.cmpge(lo).all() && c.cmple(hi).all() {
+                for v in t {
+                    bounds.grow(v.clamp(lo, hi).as_dvec3());
+                }
             }
-        }
-    }
+            bounds
+        })
+        .reduce(Bounds::default, union);
     if bounds.is_empty() { exact } else { bounds }
+}
+
+/// Every step-th vertex inside `bounds` (all triangles' vertices in order), the step chosen
+/// so that at most [`FIT_POINTS`] are kept. Counted in parallel chunks, each chunk then picking
+/// the vertices whose rank among all those inside is a multiple of the step.
+fn fit_points(all: &[[Vec3; 3]], bounds: &Bounds) -> Vec<Vec3> {
+    use rayon::prelude::*;
+    const CHUNK: usize = 1 << 16;
+    let (lo, hi) = (bounds.min.as_vec3(), bounds.max.as_vec3());
+    let inside = |p: &&Vec3| p.cmpge(lo).all() && p.cmple(hi).all();
+    let counts: Vec<usize> = all
+        .par_chunks(CHUNK)
+        .map(|c| c.iter().flatten().filter(inside).count())
+        .collect();
+    let step = counts.iter().sum::<usize>().div_ceil(FIT_POINTS).max(1);
+    let starts: Vec<usize> = counts
+        .iter()
+        .scan(0, |acc, &c| {
+            *acc += c;
+            Some(*acc - c)
+        })
+        .collect();
+    let picked: Vec<Vec<Vec3>> = all
+        .par_chunks(CHUNK)
+        .zip(starts)
+        .map(|(c, start)| {
+            let skip = (step - start % step) % step;
+            c.iter()
+                .flatten()
+                .filter(inside)
+                .skip(skip)
+                .step_by(step)
+                .copied()
+                .collect()
+        })
+        .collect();
+    picked.into_iter().flatten().collect()
 }
 
 impl Probe {
@@ -164,57 +312,32 @@ impl Probe {
     /// out of the BVH (light passes them); they still count for the bounds.
     ///
     /// The probe keeps the world triangles' vertices alone (gathered in parallel, never as
-    /// [`super::WorldTriangle`]s) and builds one BVH over them, a second only when some
-    /// triangles are see-through.
+    /// [`super::WorldTriangle`]s) and builds one quick BVH over them ([`crate::bvh::build_quick`]:
+    /// a few thousand probe rays do not repay a SAH build), a second only when some triangles
+    /// are see-through. The probe rays find the same closest hits with either tree.
     pub fn new(scene: &Scene) -> Self {
         use rayon::prelude::*;
-        let world = scene.world_vertices(&super::RenderFrame::default());
-        let all: Vec<[Vec3; 3]> = world.par_iter().map(|t| t.0).collect();
-        let materials: Vec<u32> = world.par_iter().map(|t| t.1).collect();
-        drop(world);
+        let (all, materials) = scene.world_vertices(&super::RenderFrame::default());
         let bounds = robust_bounds(&all);
-        let (lo, hi) = (bounds.min.as_vec3(), bounds.max.as_vec3());
-        let inside = |p: &&Vec3| p.cmpge(lo).all() && p.cmple(hi).all();
-        let count = all
-            .par_iter()
-            .map(|t| t.iter().filter(inside).count())
-            .sum::<usize>();
-        let step = count.div_ceil(FIT_POINTS).max(1);
-        let points = all
-            .iter()
-            .flatten()
-            .filter(inside)
-            .copied()
-            .step_by(step)
-            .collect();
+        let points = fit_points(&all, &bounds);
         let see_through = |m: u32| {
             scene
                 .materials
                 .get(m as usize)
                 .is_some_and(|m| m.transmission > 0.0 || m.alpha == super::AlphaMode::Blend)
         };
-        let in_bvh_order = |bvh: &Bvh, tris: &[[Vec3; 3]]| -> Vec<[Vec3; 3]> {
-            bvh.tri_indices
-                .par_iter()
-                .map(|&i| tris[i as usize])
-                .collect()
-        };
-        let opaque: Vec<u32> = (0..all.len() as u32)
-            .filter(|&i| !see_through(materials[i as usize]))
-            .collect();
-        let (bvh, tris, kept, shell) = if opaque.len() == all.len() {
-            let bvh = crate::bvh::build(&all);
-            let tris = in_bvh_order(&bvh, &all);
-            drop(all);
+        let (bvh, tris, kept, shell) = if !materials.par_iter().any(|&m| see_through(m)) {
+            let (bvh, tris) = crate::bvh::build_quick_ordered(all);
             (bvh, tris, None, None)
         } else {
-            let shell_bvh = crate::bvh::build(&all);
-            let shell_tris = in_bvh_order(&shell_bvh, &all);
-            let verts: Vec<[Vec3; 3]> = opaque.iter().map(|&i| all[i as usize]).collect();
-            drop(all);
-            let bvh = crate::bvh::build(&verts);
-            let tris = in_bvh_order(&bvh, &verts);
-            (bvh, tris, Some(opaque), Some((shell_bvh, shell_tris)))
+            let opaque: Vec<u32> = (0..all.len() as u32)
+                .into_par_iter()
+                .filter(|&i| !see_through(materials[i as usize]))
+                .collect();
+            let verts: Vec<[Vec3; 3]> = opaque.par_iter().map(|&i| all[i as usize]).collect();
+            let shell = crate::bvh::build_quick_ordered(all);
+            let (bvh, tris) = crate::bvh::build_quick_ordered(verts);
+            (bvh, tris, Some(opaque), Some(shell))
         };
         // Each BVH-order triangle's index among all the triangles, for its material.
         let original = |i: u32| kept.as_ref().map_or(i, |k| k[i as usize]);
@@ -467,7 +590,8 @@ fn light_directions(probe: &Probe, lights: &[Light], point: DVec3) -> Vec<(DVec3
 }
 
 /// The most powerful emissive triangles: (centroid, unit normal, radiance × area), at most
-/// [`MAX_EMITTERS`], the power scaled up by the share of all emitted power they leave out.
+/// [`MAX_EMITTERS`] (the first in scene order among equals), the power scaled up by the share
+/// of all emitted power they leave out.
 fn emitters(probe: &Probe) -> Vec<(DVec3, DVec3, f64)> {
     let mut all: Vec<(usize, f64)> = probe
         .emission
@@ -477,6 +601,8 @@ fn emitters(probe: &Probe) -> Vec<(DVec3, DVec3, f64)> {
         .map(|(i, &e)| (i, e as f64 * area(&probe.tris[i]) as f64))
         .filter(|(_, p)| *p > 0.0)
         .collect();
+    // In scene order, whatever the tree: equally powerful emitters keep that order.
+    all.sort_by_key(|e| probe.bvh.tri_indices[e.0]);
     let total: f64 = all.iter().map(|e| e.1).sum();
     all.sort_by(|a, b| b.1.total_cmp(&a.1));
     all.truncate(MAX_EMITTERS);
@@ -881,6 +1007,52 @@ mod tests {
         let b = robust_bounds(&tris);
         assert!((b.min - DVec3::splat(-0.5)).length() < 1e-6, "{b:?}");
         assert!((b.max - DVec3::splat(0.5)).length() < 1e-6, "{b:?}");
+    }
+
+    /// The percentiles by histograms are those of sorting (value, weight) pairs and scanning
+    /// them (how they were found before), ties, signs and zeros of both signs included.
+    #[test]
+    fn centroid_percentiles_are_those_of_a_sort() {
+        fn by_sort(tris: &[[Vec3; 3]], axis: usize, q: f64) -> f32 {
+            let mut v: Vec<(f32, f32)> = tris
+                .iter()
+                .map(|t| (((t[0] + t[1] + t[2]) / 3.0)[axis], area(t).sqrt() + 1e-12))
+                .collect();
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let total: f64 = v.iter().map(|v| v.1 as f64).sum();
+            let mut acc = 0.0;
+            for &(x, w) in &v {
+                acc += w as f64;
+                if acc >= q * total {
+                    return x;
+                }
+            }
+            v.last().unwrap().0
+        }
+        // A fixed scramble of (triangle, draw) to [0, 1).
+        let r = |i: usize, k: usize| ((i * 2654435761 + k * 40503) % 997) as f32 / 997.0;
+        for n in [8, 100, 5000] {
+            let tris: Vec<[Vec3; 3]> = (0..n)
+                .map(|i| {
+                    // Centroids on a coarse grid (many ties), some negative, some at ±0.
+                    let y = if i % 7 == 0 {
+                        -0.0
+                    } else {
+                        (r(i, 1) * 3.0).floor()
+                    };
+                    let c = Vec3::new((r(i, 0) * 8.0).floor() - 4.0, y, r(i, 2) * 1e3 - 500.0);
+                    let a = Vec3::new((r(i, 3) * 4.0).floor() + 1.0, 0.0, (r(i, 4) * 2.0).floor());
+                    let b = Vec3::new(0.0, (r(i, 5) * 4.0).floor() + 1.0, 1.0);
+                    [c + a, c + b, c - a - b]
+                })
+                .collect();
+            for (axis, p) in centroid_percentiles(&tris).into_iter().enumerate() {
+                for (k, q) in [0.05, 0.95].into_iter().enumerate() {
+                    let expect = by_sort(&tris, axis, q);
+                    assert_eq!(p[k].to_bits(), expect.to_bits(), "n {n} axis {axis} q {q}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -473,13 +473,18 @@ impl Scene {
     }
 
     /// The visible objects' triangles as [`Scene::flatten`] gives them, vertices and material
-    /// alone (40 bytes a triangle, not [`WorldTriangle`]'s 200): what the host probes of the
-    /// first view trace.
-    pub fn world_vertices(&self, frame: &RenderFrame) -> Vec<([Vec3; 3], u32)> {
-        self.gather(frame, false, |p, ti| {
-            (p.vertices(ti), p.o.mesh.materials[ti])
-        })
-        .0
+    /// alone (40 bytes a triangle, not [`WorldTriangle`]'s 200), in two lists (each object's
+    /// vertices transformed once): what the host probes of the first view trace.
+    pub fn world_vertices(&self, frame: &RenderFrame) -> (Vec<[Vec3; 3]>, Vec<u32>) {
+        let visible = || self.objects.iter().enumerate().filter(|(_, o)| o.visible);
+        let n = visible().map(|(_, o)| o.mesh.indices.len()).sum();
+        let (mut vertices, mut materials) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for (oi, o) in visible() {
+            let p = Placed::new(oi as u32, o, frame, false);
+            p.extend_kept(&|p, ti| p.vertices(ti), &mut vertices);
+            p.extend_kept(&|p, ti| p.o.mesh.materials[ti], &mut materials);
+        }
+        (vertices, materials)
     }
 
     /// `make(object, triangle)` of every kept triangle of the visible objects, in order, and

@@ -1,0 +1,299 @@
+//! A quick BVH: a linear BVH (LBVH) over the triangles' Morton codes, for trees that must be
+//! ready at once and are traced little (the first-view probe's few thousand rays).
+//!
+//! Each triangle's centroid is quantised to a 1024³ grid over the centroids' box and its
+//! 30-bit Morton code sorted together with its index (one `u64` a triangle); a node splits its
+//! sorted range where the highest bit in which its first and last codes differ flips, and in
+//! the middle when they do not differ (or when the tree would get too deep). No surface areas
+//! are evaluated, so the build is a sort and two passes: 16 M triangles in 2.3 s against 17 s
+//! for the binned SAH of [`super::build`] (2-core machine, loaded), for a tree of 1.8 times
+//! its SAH cost. The closest hit along a ray is the same with either tree (each triangle is
+//! tested by the same code; only which of two triangles hit at exactly the same distance is
+//! reported may differ).
+//!
+//! The output has [`super::build`]'s layout: node 0 is the root, a node's interior children lie
+//! next to each other after it, and each subtree less its root is contiguous.
+
+use super::build::{Built, finish, write_interior, write_leaf};
+use super::{Aabb, Bvh, MAX_DEPTH};
+use crate::cl::types::GpuBvhNode;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// Largest leaf.
+const LEAF: usize = 4;
+/// Ranges of at most this many triangles are built by one task.
+const TASK: usize = 1 << 15;
+
+/// The 10 low bits of `v` spread to every third bit.
+fn spread(v: u32) -> u32 {
+    let mut x = v & 0x3ff;
+    x = (x | (x << 16)) & 0x0300_00ff;
+    x = (x | (x << 8)) & 0x0300_f00f;
+    x = (x | (x << 4)) & 0x030c_30c3;
+    (x | (x << 2)) & 0x0924_9249
+}
+
+fn centroid(t: &[Vec3; 3]) -> Vec3 {
+    (t[0] + t[1] + t[2]) / 3.0
+}
+
+fn triangle_box(t: &[Vec3; 3]) -> Aabb {
+    Aabb::EMPTY.grow(t[0]).grow(t[1]).grow(t[2])
+}
+
+/// Builds a quick BVH (see the module docs) over triangles given as three vertices each.
+pub fn build_quick(triangles: &[[Vec3; 3]]) -> Bvh {
+    let (tri_indices, codes) = morton_order(triangles);
+    let ordered = in_order(triangles, &tri_indices);
+    tree(codes, tri_indices, &ordered)
+}
+
+/// [`build_quick`] of `triangles`, which it takes to return them in BVH order (what tracing the
+/// tree needs): they are put in that order once, and the input is freed before the tree is
+/// made (its leaves then read the triangles in order), so that the two copies and the tree are
+/// never held together.
+pub fn build_quick_ordered(triangles: Vec<[Vec3; 3]>) -> (Bvh, Vec<[Vec3; 3]>) {
+    let (tri_indices, codes) = morton_order(&triangles);
+    let ordered = in_order(&triangles, &tri_indices);
+    drop(triangles);
+    (tree(codes, tri_indices, &ordered), ordered)
+}
+
+fn in_order(triangles: &[[Vec3; 3]], order: &[u32]) -> Vec<[Vec3; 3]> {
+    order.par_iter().map(|&i| triangles[i as usize]).collect()
+}
+
+/// The triangles' indices sorted by their centroids' Morton codes, and the sorted codes.
+fn morton_order(triangles: &[[Vec3; 3]]) -> (Vec<u32>, Vec<u32>) {
+    let centres = triangles
+        .par_iter()
+        .fold(|| Aabb::EMPTY, |b, t| b.grow(centroid(t)))
+        .reduce(|| Aabb::EMPTY, Aabb::union);
+    let extent = centres.max - centres.min;
+    // Cells per unit along each axis (0 for a flat or empty axis; NaN centroids land in cell 0).
+    let scale = Vec3::select(
+        extent.cmpgt(Vec3::ZERO) & extent.is_finite_mask(),
+        Vec3::splat(1023.99) / extent,
+        Vec3::ZERO,
+    );
+    let mut keys: Vec<u64> = triangles
+        .par_iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let q = ((centroid(t) - centres.min) * scale).clamp(Vec3::ZERO, Vec3::splat(1023.0));
+            let code = spread(q.x as u32) << 2 | spread(q.y as u32) << 1 | spread(q.z as u32);
+            (code as u64) << 32 | i as u64
+        })
+        .collect();
+    // Unique keys (the index is part of each), so the order is the same at any thread count.
+    keys.par_sort_unstable();
+    let tri_indices = keys.par_iter().map(|&k| k as u32).collect();
+    let codes = keys.par_iter().map(|&k| (k >> 32) as u32).collect();
+    (tri_indices, codes)
+}
+
+/// The tree over the BVH-order triangles `ordered` with their sorted `codes`.
+fn tree(codes: Vec<u32>, tri_indices: Vec<u32>, ordered: &[[Vec3; 3]]) -> Bvh {
+    // As `build`: interior nodes below the root go straight into a zeroed arena (pages cost
+    // memory once written), packed into the final layout by `finish`.
+    let n = ordered.len();
+    let mut arena: Vec<GpuBvhNode> = bytemuck::zeroed_vec(2 * n.max(1) - 1);
+    let root = build_range(&codes, ordered, 0, 0, &mut arena[1..], 1);
+    drop(codes);
+    finish(root, arena, tri_indices)
+}
+
+/// `⌈log2 n⌉` (0 for n ≤ 1).
+fn ceil_log2(n: usize) -> u32 {
+    n.next_power_of_two().trailing_zeros()
+}
+
+/// Where the sorted range `codes` (more than [`LEAF`] of them) of a node at `depth` splits: at
+/// the highest differing bit of its codes while a balanced tree below could still finish
+/// within [`MAX_DEPTH`], else in the middle.
+fn split_point(codes: &[u32], depth: u32) -> usize {
+    let n = codes.len();
+    let (a, b) = (codes[0], codes[n - 1]);
+    let room = depth + 2 + ceil_log2(n.div_ceil(LEAF)) <= MAX_DEPTH;
+    if a == b || !room {
+        return n / 2;
+    }
+    let bit = 31 - (a ^ b).leading_zeros();
+    codes.partition_point(|&c| (c >> bit) & 1 == 0)
+}
+
+fn leaf_bounds(tris: &[[Vec3; 3]]) -> Aabb {
+    tris.iter()
+        .fold(Aabb::EMPTY, |b, t| b.union(triangle_box(t)))
+}
+
+/// The subtree over the sorted `codes` of the BVH-order triangles `tris`, the first of which is
+/// triangle `first`, at `depth`; `space` (arena indices `at..`) has 2m − 2 slots for m
+/// triangles, laid out as `build`'s subtrees are.
+fn build_range(
+    codes: &[u32],
+    tris: &[[Vec3; 3]],
+    first: u32,
+    depth: u32,
+    space: &mut [GpuBvhNode],
+    at: usize,
+) -> Built {
+    let count = codes.len();
+    if count <= LEAF {
+        return Built::Leaf {
+            bounds: leaf_bounds(tris),
+            first,
+            count: count as u32,
+        };
+    }
+    if count <= TASK {
+        let mut len = 1;
+        let bounds = emit(codes, tris, first, depth, 0, space, &mut len);
+        return Built::Tree { bounds, at, len };
+    }
+    let a = split_point(codes, depth);
+    let (left_space, right_space) = space[2..].split_at_mut(2 * a - 2);
+    let (l, r) = rayon::join(
+        || {
+            build_range(
+                &codes[..a],
+                &tris[..a],
+                first,
+                depth + 1,
+                left_space,
+                at + 2,
+            )
+        },
+        || {
+            let (c, t) = (&codes[a..], &tris[a..]);
+            build_range(c, t, first + a as u32, depth + 1, right_space, at + 2 * a)
+        },
+    );
+    Built::Top {
+        bounds: l.bounds().union(r.bounds()),
+        children: Box::new([l, r]),
+    }
+}
+
+/// Writes the interior node at `slot` over `codes` (more than [`LEAF`]; see [`build_range`]),
+/// its interior children next to each other at `nodes[*len..]` and then their subtrees, left
+/// first; its box.
+fn emit(
+    codes: &[u32],
+    tris: &[[Vec3; 3]],
+    first: u32,
+    depth: u32,
+    slot: usize,
+    nodes: &mut [GpuBvhNode],
+    len: &mut usize,
+) -> Aabb {
+    let at = split_point(codes, depth);
+    let parts = [
+        (&codes[..at], &tris[..at], first),
+        (&codes[at..], &tris[at..], first + at as u32),
+    ];
+    let slots = parts.map(|(c, _, _)| {
+        (c.len() > LEAF).then(|| {
+            *len += 1;
+            *len - 1
+        })
+    });
+    let mut node = GpuBvhNode::default();
+    let mut bounds = Aabb::EMPTY;
+    for (side, ((c, t, f), s)) in parts.into_iter().zip(slots).enumerate() {
+        let b = match s {
+            Some(s) => {
+                let b = emit(c, t, f, depth + 1, s, nodes, len);
+                write_interior(&mut node, side, b, s as u32);
+                b
+            }
+            None => {
+                let b = leaf_bounds(t);
+                write_leaf(&mut node, side, b, f, c.len() as u32);
+                b
+            }
+        };
+        bounds = bounds.union(b);
+    }
+    nodes[slot] = node;
+    bounds
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::build::tests::{check_tree, random_rays, random_triangles};
+    use super::super::{Child, build};
+    use super::*;
+
+    fn ordered(bvh: &Bvh, tris: &[[Vec3; 3]]) -> Vec<[Vec3; 3]> {
+        bvh.tri_indices.iter().map(|&i| tris[i as usize]).collect()
+    }
+
+    /// More triangles than one task builds, so that the parallel levels are assembled too.
+    #[test]
+    fn every_triangle_is_in_exactly_one_leaf_inside_its_boxes() {
+        for n in [0, 1, 3, 5, 100, 3 * TASK + 17] {
+            let tris = random_triangles(n, 5 + n as u64);
+            let bvh = build_quick(&tris);
+            if n > LEAF {
+                check_tree(&bvh, &tris);
+            } else {
+                // One root node: the triangles in a leaf on the left, an empty one on the right.
+                assert_eq!(bvh.nodes.len(), 1);
+                let count = n as u32;
+                assert_eq!(bvh.child(0, 0).1, Child::Leaf { first: 0, count });
+                assert_eq!(bvh.child(0, 1).1, Child::Leaf { first: 0, count: 0 });
+            }
+            assert!(bvh.depth <= MAX_DEPTH);
+        }
+    }
+
+    #[test]
+    fn the_quick_tree_finds_the_closest_hits_of_the_full_one() {
+        let tris = random_triangles(2 * TASK + 5, 21);
+        let (quick, full) = (build_quick(&tris), build(&tris));
+        assert!(quick.sah_cost > 0.0 && full.sah_cost > 0.0);
+        let (q, f) = (ordered(&quick, &tris), ordered(&full, &tris));
+        let mut hits = 0;
+        for ray in &random_rays(4000, 7) {
+            let a = quick.intersect(ray, &q);
+            let b = full.intersect(ray, &f);
+            assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "{ray:?}");
+            assert_eq!(
+                a.map(|h| quick.tri_indices[h.prim as usize]),
+                b.map(|h| full.tri_indices[h.prim as usize]),
+                "{ray:?}"
+            );
+            assert_eq!(quick.occluded(ray, &q), full.occluded(ray, &f), "{ray:?}");
+            hits += a.is_some() as usize;
+        }
+        assert!(hits > 1000, "{hits}");
+    }
+
+    #[test]
+    fn identical_triangles_still_build_within_the_depth_limit() {
+        let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let tris = vec![t; 100_000];
+        let bvh = build_quick(&tris);
+        assert!(bvh.depth <= MAX_DEPTH, "{}", bvh.depth);
+        check_tree(&bvh, &tris);
+    }
+
+    #[test]
+    fn the_tree_does_not_depend_on_the_thread_count() {
+        let tris = random_triangles(3 * TASK, 3);
+        let many = build_quick(&tris);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let one = pool.install(|| build_quick(&tris));
+        assert_eq!(many.tri_indices, one.tri_indices);
+        assert_eq!(
+            bytemuck::cast_slice::<_, u8>(&many.nodes),
+            bytemuck::cast_slice::<_, u8>(&one.nodes)
+        );
+        assert!(matches!(many.child(0, 0).1, Child::Node(_)));
+    }
+}
