@@ -100,9 +100,9 @@ impl Renderer {
         for &(i, _, _) in &moved {
             let base = host.layout.copy_bases[i] as usize;
             if base != u32::MAX as usize {
-                let copies = piece_copies(two, &host.triangles, i);
+                let mesh = &host.layout.small_meshes[two.instances[i].blas as usize];
+                let copies = piece_copies(two, mesh, i);
                 buffers.triangles.write_at(gpu, base, &copies)?;
-                host.triangles[base..base + copies.len()].copy_from_slice(&copies);
                 bytes += std::mem::size_of_val(copies.as_slice());
             }
         }

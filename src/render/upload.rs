@@ -83,6 +83,9 @@ pub struct InstanceLayout {
     /// Each small instance's first world-space triangle copy in the device triangles (see
     /// [`piece_copies`]; `u32::MAX` for an instance that is not small).
     pub copy_bases: Vec<u32>,
+    /// Per BLAS, a small mesh's object-space device triangles (empty for the others): what a
+    /// moved small instance's copies are made from once the triangles live on the device only.
+    pub small_meshes: Vec<Vec<GpuTriangle>>,
 }
 
 impl InstanceLayout {
@@ -90,14 +93,24 @@ impl InstanceLayout {
     /// that showing one writes in place) to the device triangles `triangles` (the meshes'
     /// object-space ones) and keeps where each instance's copies start.
     pub fn append_piece_copies(&mut self, two: &TwoLevel, triangles: &mut Vec<GpuTriangle>) {
+        self.small_meshes = (0..two.blases.len())
+            .map(|b| {
+                let blas = &two.blases[b];
+                if !blas.is_small() {
+                    return Vec::new();
+                }
+                let first = two.firsts[b] as usize;
+                triangles[first..first + blas.triangles.len()].to_vec()
+            })
+            .collect();
         self.copy_bases = (0..two.instances.len())
             .map(|i| {
-                if !two.blases[two.instances[i].blas as usize].is_small() {
+                let mesh = &self.small_meshes[two.instances[i].blas as usize];
+                if mesh.is_empty() {
                     return u32::MAX;
                 }
                 let base = triangles.len() as u32;
-                let copies = piece_copies(two, triangles, i);
-                triangles.extend(copies);
+                triangles.extend(piece_copies(two, mesh, i));
                 base
             })
             .collect();
@@ -149,16 +162,14 @@ impl InstanceLayout {
 /// A small instance's triangles in world space, where the two-level traversal tests them as
 /// pieces of the TLAS without entering the instance (`TwoLevel::braid`): the vertices as
 /// [`crate::bvh::Instance::device_triangle`] carries them (the host reference tests the same
-/// values), the payloads of the mesh's triangles in the device triangles `triangles`.
-pub fn piece_copies(two: &TwoLevel, triangles: &[GpuTriangle], i: usize) -> Vec<GpuTriangle> {
+/// values), the payloads of `mesh`, the instance's mesh's object-space device triangles.
+pub fn piece_copies(two: &TwoLevel, mesh: &[GpuTriangle], i: usize) -> Vec<GpuTriangle> {
     let inst = &two.instances[i];
-    let b = inst.blas as usize;
-    let first = two.firsts[b] as usize;
     let v = |p: Vec3, payload: f32| [p.x, p.y, p.z, payload];
-    two.blases[b]
+    two.blases[inst.blas as usize]
         .triangles
         .iter()
-        .zip(&triangles[first..])
+        .zip(mesh)
         .map(|(t, o)| {
             let w = inst.device_triangle(t);
             GpuTriangle {
