@@ -7,7 +7,7 @@ mod common;
 
 use common::{Gltf, Prim, render_exr, sphere};
 use glam::{DMat4, DQuat, DVec3, Vec3};
-use penumbra::bvh::Ray;
+use penumbra::bvh::{Ray, SMALL_MESH};
 use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay};
 use penumbra::cl::{Buffer, DeviceChoice};
 use penumbra::render::{BvhChoice, Renderer};
@@ -168,6 +168,7 @@ fn no_ray_leaks_out_of_scaled_or_mirrored_instances_on_the_device() {
     for n in [6, 2] {
         let mut r = renderer();
         r.set_bvh_choice(BvhChoice::TwoLevel);
+        r.set_small_mesh(Some(SMALL_MESH));
         let scene = cube_scene(n);
         // World coordinates: the rays are made in world space.
         let stats = r
@@ -183,6 +184,7 @@ fn no_ray_leaks_out_of_scaled_or_mirrored_instances_on_the_device() {
 fn moving_instances_updates_the_device_in_place() {
     let mut r = renderer();
     r.set_bvh_choice(BvhChoice::TwoLevel);
+    r.set_small_mesh(Some(SMALL_MESH));
     let mut scene = cube_scene(6);
     let stats = r
         .load_scene_in(&scene, &[], RenderFrame::default())
@@ -252,6 +254,7 @@ fn moving_a_small_instance_moves_its_world_space_pieces() {
     // world space from a copy that a move rewrites.
     let mut r = renderer();
     r.set_bvh_choice(BvhChoice::TwoLevel);
+    r.set_small_mesh(Some(SMALL_MESH));
     let mut scene = cube_scene(2);
     r.load_scene_in(&scene, &[], RenderFrame::default())
         .unwrap();
@@ -304,6 +307,7 @@ fn same_hits_both_ways(n: usize) {
     for choice in [BvhChoice::Flat, BvhChoice::TwoLevel] {
         let mut r = renderer();
         r.set_bvh_choice(choice);
+        r.set_small_mesh(Some(SMALL_MESH));
         r.load_scene_in(&scene, &[], RenderFrame::default())
             .unwrap();
         let ([hits, _], [occluded, _], _) = trace_all(&r, &rays);

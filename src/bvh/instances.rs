@@ -59,12 +59,6 @@ impl Blas {
     pub fn bounds(&self) -> Aabb {
         self.bvh.child(0, 0).0.union(self.bvh.child(0, 1).0)
     }
-
-    /// Whether the mesh is small: its instances' triangles are TLAS leaves of their own
-    /// (see [`TwoLevel::braid`]).
-    pub fn is_small(&self) -> bool {
-        self.triangles.len() <= SMALL_MESH
-    }
 }
 
 /// One placed mesh.
@@ -206,6 +200,9 @@ pub struct TwoLevel {
     pub firsts: Vec<u32>,
     /// Hidden instances are left out of the TLAS (they keep their place among the instances).
     pub hidden: Vec<bool>,
+    /// Meshes of at most this many triangles are small: each of their instances' triangles is
+    /// a TLAS piece of its own (see [`TwoLevel::braid`]; 0: none).
+    pub small_mesh: usize,
 }
 
 impl TwoLevel {
@@ -236,16 +233,17 @@ impl TwoLevel {
                 first - b.triangles.len() as u32
             })
             .collect();
-        let max_pieces = piece_budget(&blases, &instances, rebraid_budget());
         let mut two = Self {
             hidden,
             blases,
             instances,
             tlas: build_boxes(&[]),
             pieces: vec![],
-            max_pieces,
+            max_pieces: 0,
             firsts,
+            small_mesh: SMALL_MESH,
         };
+        two.max_pieces = two.piece_budget(rebraid_budget());
         two.rebuild_tlas();
         two
     }
@@ -264,8 +262,40 @@ impl TwoLevel {
     /// may be re-braided into ([`rebraid_budget`]) and rebuilds it; before the device is
     /// given the scene (its buffers are sized for [`TwoLevel::max_pieces`]).
     pub fn set_rebraid_budget(&mut self, extra: usize) {
-        self.max_pieces = piece_budget(&self.blases, &self.instances, extra);
+        self.max_pieces = self.piece_budget(extra);
         self.rebuild_tlas();
+    }
+
+    /// Sets [`TwoLevel::small_mesh`] (keeping the re-braiding budget) and rebuilds the TLAS;
+    /// before the device is given the scene.
+    pub fn set_small_mesh(&mut self, small_mesh: usize) {
+        let extra = self.max_pieces - self.piece_budget(0);
+        self.small_mesh = small_mesh;
+        self.max_pieces = self.piece_budget(extra);
+        self.rebuild_tlas();
+    }
+
+    /// Whether `blas` is small (see [`TwoLevel::small_mesh`]).
+    pub fn is_small(&self, blas: &Blas) -> bool {
+        blas.triangles.len() <= self.small_mesh
+    }
+
+    /// The most pieces the TLAS may be re-braided into: a small mesh's triangles each, one for
+    /// any other instance, and `extra` more for opening BLASes.
+    fn piece_budget(&self, extra: usize) -> usize {
+        let base: usize = self
+            .instances
+            .iter()
+            .map(|i| {
+                let b = &self.blases[i.blas as usize];
+                if self.is_small(b) {
+                    b.triangles.len()
+                } else {
+                    1
+                }
+            })
+            .sum();
+        base + extra
     }
 
     /// Moves instance `i` and rebuilds the TLAS.
@@ -306,7 +336,7 @@ impl TwoLevel {
     }
 
     /// The pieces of the shown instances (instance, piece, world box). A small mesh's
-    /// instance ([`Blas::is_small`]) is one piece per triangle ([`PIECE_TRIANGLE`]), which
+    /// instance ([`TwoLevel::is_small`]) is one piece per triangle ([`PIECE_TRIANGLE`]), which
     /// the traversal tests in world space, carried there as shading carries it
     /// ([`Instance::device_triangle`]), without entering the instance: a room of a few large
     /// quads would otherwise be one piece whose box holds the whole scene, entered by every
@@ -323,7 +353,7 @@ impl TwoLevel {
             if self.hidden[i as usize] {
                 continue;
             }
-            if !blas.is_small() {
+            if !self.is_small(blas) {
                 pieces.push((i, 0, inst.world_box(blas.bounds())));
                 continue;
             }
@@ -517,8 +547,8 @@ impl TwoLevel {
     }
 }
 
-/// Meshes of at most this many triangles are small (see [`TwoLevel::braid`]).
-const SMALL_MESH: usize = 64;
+/// Meshes of at most this many triangles are small by default (see [`TwoLevel::small_mesh`]).
+pub const SMALL_MESH: usize = 64;
 
 /// A piece's mark for one triangle (its index in the BLAS in the other bits), else a BLAS node.
 pub const PIECE_TRIANGLE: u32 = 1 << 31;
@@ -532,19 +562,6 @@ pub fn rebraid_budget() -> usize {
         .ok()
         .and_then(|v| v.trim().parse().ok())
         .unwrap_or(0)
-}
-
-/// The most pieces a TLAS over `instances` may be re-braided into: a small mesh's triangles
-/// each, one for any other instance, and `extra` more for opening BLASes.
-fn piece_budget(blases: &[Blas], instances: &[Instance], extra: usize) -> usize {
-    let base: usize = instances
-        .iter()
-        .map(|i| {
-            let b = &blases[i.blas as usize];
-            if b.is_small() { b.triangles.len() } else { 1 }
-        })
-        .sum();
-    base + extra
 }
 
 /// Splits every TLAS leaf of several pieces into leaves of one, so that a ray tests each
@@ -846,7 +863,7 @@ mod tests {
     /// placed by every placement, with the BLASes opened into `extra` more pieces.
     fn braided(extra: usize, moved: Option<DMat4>) -> TwoLevel {
         let meshes = vec![random_triangles(3000, 7), closed_cube(2)];
-        assert!(!Blas::new(&meshes[0]).is_small() && Blas::new(&meshes[1]).is_small());
+        assert!(meshes[0].len() > SMALL_MESH && meshes[1].len() <= SMALL_MESH);
         let mut placed: Vec<(u32, DMat4)> = placements()
             .into_iter()
             .enumerate()

@@ -11,7 +11,9 @@ mod traverse;
 mod wide;
 
 pub use build::{MAX_DEPTH, build, build_boxes, build_indexed};
-pub use instances::{Blas, Instance, InstanceHit, PIECE_TRIANGLE, TwoLevel, closed_cube};
+pub use instances::{
+    Blas, Instance, InstanceHit, PIECE_TRIANGLE, SMALL_MESH, TwoLevel, closed_cube,
+};
 pub use quick::{build_quick, build_quick_ordered};
 pub use refit::{REFIT_MAX_GROWTH, Update};
 pub use stats::{BvhReport, report};

@@ -36,18 +36,26 @@ pub struct AutoRule {
     pub min_triangles: usize,
     /// How many times the distinct meshes' triangles the instances must hold.
     pub min_saving: usize,
+    /// Meshes of at most this many triangles become triangle pieces of the top level
+    /// ([`TwoLevel::small_mesh`]) in any two-level scene.
+    pub small_mesh: usize,
 }
 
 /// CPU devices, where two levels trace about as fast as flat and frames run faster.
 pub const AUTO_CPU: AutoRule = AutoRule {
     min_triangles: 1_000_000,
     min_saving: 4,
+    small_mesh: crate::bvh::SMALL_MESH,
 };
 
 /// GPUs, where two levels trace about a fifth slower than flat.
 pub const AUTO_GPU: AutoRule = AutoRule {
     min_triangles: 4_000_000,
     min_saving: 8,
+    // On an H200 triangle pieces made two levels slower (bunny room frames 0.81 -> 0.75 of
+    // flat, spheres 0.82 -> 0.70; docs/benchmarks.md, fifth session), while on PoCL they made
+    // shadow rays as fast as flat: GPUs keep each small instance whole.
+    small_mesh: 0,
 };
 
 /// `--bvh`: which acceleration structure the device traverses.
@@ -124,8 +132,12 @@ pub fn plan(
         .map(|(o, &m)| (m, frame * o.world_from_object))
         .collect();
     let hidden = placed.iter().map(|o| !o.visible).collect();
+    let mut two = TwoLevel::with_hidden(blases, &instances, hidden);
+    if two.small_mesh != rule.small_mesh {
+        two.set_small_mesh(rule.small_mesh);
+    }
     Some(Instancing {
-        two: TwoLevel::with_hidden(blases, &instances, hidden),
+        two,
         mesh_objects: meshes.iter().map(|&o| objects[o]).collect(),
         objects,
     })

@@ -131,6 +131,8 @@ pub struct Renderer {
     megakernel: bool,
     /// The acceleration structure the next scene load builds.
     bvh_choice: BvhChoice,
+    /// Overrides the device's small-mesh rule (see [`Renderer::set_small_mesh`]).
+    small_mesh: Option<usize>,
 }
 
 impl Renderer {
@@ -165,6 +167,7 @@ impl Renderer {
             pending: Vec::new(),
             megakernel: false,
             bvh_choice: BvhChoice::Auto,
+            small_mesh: None,
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -188,11 +191,14 @@ impl Renderer {
     ) -> Result<SceneStats, ClError> {
         let t = Instant::now();
         let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
-        let rule = if self.gpu.is_cpu() {
+        let mut rule = if self.gpu.is_cpu() {
             instancing::AUTO_CPU
         } else {
             instancing::AUTO_GPU
         };
+        if let Some(small_mesh) = self.small_mesh {
+            rule.small_mesh = small_mesh;
+        }
         let (mut host, dropped) = match instancing::plan(scene, &space, self.bvh_choice, rule) {
             Some(plan) => {
                 // Two levels: nothing is flattened; each mesh goes to the device once.
@@ -528,6 +534,13 @@ impl Renderer {
     /// Chooses the acceleration structure of the scenes loaded from now on.
     pub fn set_bvh_choice(&mut self, choice: BvhChoice) {
         self.bvh_choice = choice;
+    }
+
+    /// Sets, for the two-level scenes loaded from now on, the largest mesh whose instances'
+    /// triangles become pieces of the top level (`TwoLevel::small_mesh`); `None`: the device's
+    /// rule (64 triangles on CPU devices, none on GPUs).
+    pub fn set_small_mesh(&mut self, small_mesh: Option<usize>) {
+        self.small_mesh = small_mesh;
     }
 
     /// The film as linear RGB (the mean of the samples), row by row from the top.

@@ -96,7 +96,7 @@ impl InstanceLayout {
         self.small_meshes = (0..two.blases.len())
             .map(|b| {
                 let blas = &two.blases[b];
-                if !blas.is_small() {
+                if !two.is_small(blas) {
                     return Vec::new();
                 }
                 let first = two.firsts[b] as usize;
