@@ -318,6 +318,9 @@ inline bool intersect_piece_triangle(uint copy, uint prim, uint slot,
 // At a top-level piece (`node` with INSTANCE_BIT) of a two-level traversal: sets slot and
 // `piece`, and `triangle` for a piece of one triangle, which is tested on the spot (an any-hit
 // returns from the traversal); any other piece is entered (ENTER_INSTANCE).
+// Without HAS_TRIANGLE_PIECES (no small meshes, and always on GPUs, where the extra code in
+// the loop made two levels slower: docs/benchmarks.md, fifth session) every piece is entered.
+#ifdef HAS_TRIANGLE_PIECES
 #define VISIT_PIECE                                                                       \
     slot = node & ~INSTANCE_BIT;                                                          \
     global const GpuInstance* piece = &instances[slot];                                   \
@@ -327,6 +330,12 @@ inline bool intersect_piece_triangle(uint copy, uint prim, uint slot,
                                              any_hit, &hit)) {                            \
         return hit;                                                                       \
     }
+#else
+#define VISIT_PIECE                                     \
+    slot = node & ~INSTANCE_BIT;                        \
+    global const GpuInstance* piece = &instances[slot]; \
+    const bool triangle = false;
+#endif
 
 // Closest or first hit through the top level (`nodes` from 0, leaves index `instances`) and
 // the instances' bottom levels (in the same node array, from each instance's root; leaves

@@ -275,6 +275,13 @@ impl TwoLevel {
         self.rebuild_tlas();
     }
 
+    /// Whether some instance's mesh is small (its triangles are pieces of the TLAS).
+    pub fn has_small_meshes(&self) -> bool {
+        self.instances
+            .iter()
+            .any(|i| self.is_small(&self.blases[i.blas as usize]))
+    }
+
     /// Whether `blas` is small (see [`TwoLevel::small_mesh`]).
     pub fn is_small(&self, blas: &Blas) -> bool {
         blas.triangles.len() <= self.small_mesh

@@ -83,6 +83,9 @@ pub struct KernelFeatures {
     pub lambert_only: bool,
     /// Rays descend a top level over instances, then their meshes' bottom levels (`TWO_LEVEL`).
     pub two_level: bool,
+    /// Some top-level pieces are single triangles of small meshes, tested in world space
+    /// (`HAS_TRIANGLE_PIECES`, with `TWO_LEVEL`).
+    pub triangle_pieces: bool,
 }
 
 impl KernelFeatures {
@@ -107,6 +110,7 @@ impl KernelFeatures {
             (self.tangents, "HAS_TANGENTS"),
             (self.lambert_only, "LAMBERT_ONLY"),
             (self.two_level, "TWO_LEVEL"),
+            (self.triangle_pieces, "HAS_TRIANGLE_PIECES"),
         ] {
             if on {
                 d.push_str(" -D");

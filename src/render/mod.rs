@@ -91,6 +91,7 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         transmission: used(&|m| m.transmission > 0.0),
         env_map: false,
         two_level: false,
+        triangle_pieces: false,
         thin_walls: used(&|m| m.transmission > 0.0 && m.thickness <= 0.0),
         unlit: used(&|m| m.unlit),
         clearcoat: used(&|m| m.clearcoat > 0.0),
@@ -220,6 +221,7 @@ impl Renderer {
         host.scale_emitter_power(&lights::emissive_texture_means(scene));
         self.scene_features = KernelFeatures {
             two_level: matches!(host.accel, Accel::TwoLevel(_)),
+            triangle_pieces: matches!(&host.accel, Accel::TwoLevel(t) if t.has_small_meshes()),
             ..scene_features(scene, !host.emissive.is_empty(), !host.tangents.is_empty())
         };
         let budget = self
@@ -327,6 +329,7 @@ impl Renderer {
         let features = KernelFeatures {
             env_map: self.environment.is_some(),
             two_level: self.scene_features.two_level,
+            triangle_pieces: self.scene_features.triangle_pieces,
             ..scene_features(scene, any(&|m| m.is_emissive()), true)
         };
         self.program.as_ref().is_none_or(|p| p.features != features)
