@@ -134,46 +134,72 @@ const HUGE_PAGE: usize = 2 << 20;
 /// Host memory for a CPU device's buffer, aligned to and advised for transparent huge pages.
 /// PoCL runs kernels on a `CL_MEM_USE_HOST_PTR` buffer's own memory, and with 4 KiB pages the
 /// traversal of a large scene misses the TLB on nearly every node and triangle it reads: the
-/// 1 M-triangle bunnies render about 8 % faster per CPU second with huge pages
+/// 1 M-triangle bunnies render about 6 % faster per CPU second with huge pages
 /// (docs/benchmarks.md). Linux gives huge pages to advised memory when
 /// /sys/kernel/mm/transparent_hugepage/enabled is `madvise` (Debian's default) or `always`;
 /// with `never` this is ordinary aligned memory.
 struct HostPages {
     ptr: *mut u8,
-    layout: std::alloc::Layout,
+    len: usize,
 }
 
 impl HostPages {
-    /// `bytes` bytes aligned to a huge page, advised before they are first touched (so the
-    /// first write faults whole huge pages in); `None` when they cannot be allocated (the
-    /// driver then allocates the buffer itself).
+    /// `bytes` bytes (rounded up to whole huge pages) of a fresh anonymous mapping aligned to a
+    /// huge page, advised before they are first touched, so that the first write faults whole
+    /// huge pages in (memory the allocator hands back again may already be backed by small
+    /// pages); `None` where they cannot be mapped (the driver then allocates the buffer).
+    #[cfg(target_os = "linux")]
     fn new(bytes: usize) -> Option<Self> {
-        let layout =
-            std::alloc::Layout::from_size_align(bytes.next_multiple_of(HUGE_PAGE), HUGE_PAGE)
-                .ok()?;
-        // SAFETY: the layout's size is nonzero.
-        let ptr = unsafe { std::alloc::alloc(layout) };
-        if ptr.is_null() {
+        let len = bytes.next_multiple_of(HUGE_PAGE);
+        let mapped = len + HUGE_PAGE;
+        // SAFETY: a new private anonymous mapping; no existing memory is touched.
+        let base = unsafe {
+            libc::mmap(
+                ptr::null_mut(),
+                mapped,
+                libc::PROT_READ | libc::PROT_WRITE,
+                libc::MAP_PRIVATE | libc::MAP_ANONYMOUS,
+                -1,
+                0,
+            )
+        };
+        if base == libc::MAP_FAILED {
             return None;
         }
-        #[cfg(target_os = "linux")]
-        // SAFETY: the range is this allocation, page-aligned; the advice changes no contents.
+        let start = base as usize;
+        let aligned = start.next_multiple_of(HUGE_PAGE);
+        let (head, tail) = (aligned - start, start + mapped - (aligned + len));
+        // SAFETY: the slack before and after the aligned range is part of this mapping and
+        // unused; the advice changes no contents.
         unsafe {
-            libc::madvise(ptr.cast(), layout.size(), libc::MADV_HUGEPAGE);
+            if head > 0 {
+                libc::munmap(base, head);
+            }
+            if tail > 0 {
+                libc::munmap((aligned + len) as *mut std::ffi::c_void, tail);
+            }
+            libc::madvise(aligned as *mut std::ffi::c_void, len, libc::MADV_HUGEPAGE);
         }
-        Some(Self { ptr, layout })
+        Some(Self {
+            ptr: aligned as *mut u8,
+            len,
+        })
+    }
+
+    /// Elsewhere the driver allocates every buffer itself.
+    #[cfg(not(target_os = "linux"))]
+    fn new(_bytes: usize) -> Option<Self> {
+        None
     }
 
     /// Hands the memory to buffer `mem`, which uses it until the driver destroys the buffer:
-    /// it is freed then, by the buffer's destructor callback. Should the callback not be
-    /// accepted, the memory is leaked rather than freed under the buffer.
+    /// it is unmapped then, by the buffer's destructor callback. Should the callback not be
+    /// accepted, the memory is leaked rather than unmapped under the buffer.
     fn free_with(self, mem: opencl3::types::cl_mem) {
         extern "C" fn free_pages(_mem: opencl3::types::cl_mem, pages: *mut std::ffi::c_void) {
             // SAFETY: `pages` is the Box::into_raw below, handed to this callback alone, which
             // the driver calls once, after the last use of the buffer's memory.
-            let pages = unsafe { Box::from_raw(pages.cast::<HostPages>()) };
-            // SAFETY: allocated in HostPages::new with this layout, freed once.
-            unsafe { std::alloc::dealloc(pages.ptr, pages.layout) };
+            drop(unsafe { Box::from_raw(pages.cast::<HostPages>()) });
         }
         let pages = Box::into_raw(Box::new(self));
         // SAFETY: `mem` is a live buffer; the callback takes ownership of `pages`.
@@ -182,6 +208,16 @@ impl HostPages {
         };
         if set.is_err() {
             log::warn!("a buffer's host memory cannot be freed with it and is kept");
+        }
+    }
+}
+
+impl Drop for HostPages {
+    fn drop(&mut self) {
+        #[cfg(target_os = "linux")]
+        // SAFETY: the range was mapped by HostPages::new and is unmapped once, here.
+        unsafe {
+            libc::munmap(self.ptr.cast(), self.len);
         }
     }
 }
@@ -983,11 +1019,14 @@ mod tests {
 
     #[test]
     fn host_pages_are_aligned_and_get_huge_pages_where_linux_gives_them() {
-        let pages = HostPages::new(3 * HUGE_PAGE + 1).expect("12 MiB can be allocated");
+        let Some(pages) = HostPages::new(3 * HUGE_PAGE + 1) else {
+            assert!(!cfg!(target_os = "linux"), "8 MiB can be mapped");
+            return;
+        };
         assert_eq!(pages.ptr as usize % HUGE_PAGE, 0);
-        assert_eq!(pages.layout.size(), 4 * HUGE_PAGE);
-        // SAFETY: the allocation is layout.size() bytes long and ours.
-        unsafe { std::ptr::write_bytes(pages.ptr, 1, pages.layout.size()) };
+        assert_eq!(pages.len, 4 * HUGE_PAGE);
+        // SAFETY: the mapping is `len` bytes long and ours.
+        unsafe { std::ptr::write_bytes(pages.ptr, 1, pages.len) };
         if cfg!(target_os = "linux") && huge_pages_on() {
             let kb = huge_kb_at(pages.ptr as usize).expect("the mapping is in smaps");
             assert!(
@@ -995,8 +1034,6 @@ mod tests {
                 "no huge page backs the advised memory ({kb} kB)"
             );
         }
-        // SAFETY: allocated by HostPages::new with this layout, freed once.
-        unsafe { std::alloc::dealloc(pages.ptr, pages.layout) };
     }
 
     #[test]
