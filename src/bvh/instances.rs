@@ -216,11 +216,17 @@ impl TwoLevel {
     /// The TLAS over `instances` of prebuilt BLASes.
     pub fn from_blases(blases: Vec<Blas>, instances: &[(u32, DMat4)]) -> Self {
         let shown = vec![false; instances.len()];
-        Self::with_hidden(blases, instances, shown)
+        Self::with_hidden(blases, instances, shown, SMALL_MESH)
     }
 
-    /// [`TwoLevel::from_blases`] with `hidden` instances left out of the TLAS.
-    pub fn with_hidden(blases: Vec<Blas>, instances: &[(u32, DMat4)], hidden: Vec<bool>) -> Self {
+    /// [`TwoLevel::from_blases`] with `hidden` instances left out of the TLAS and meshes of at
+    /// most `small_mesh` triangles small ([`TwoLevel::small_mesh`]).
+    pub fn with_hidden(
+        blases: Vec<Blas>,
+        instances: &[(u32, DMat4)],
+        hidden: Vec<bool>,
+        small_mesh: usize,
+    ) -> Self {
         let instances: Vec<Instance> = instances
             .iter()
             .map(|&(blas, m)| Instance::new(blas, m))
@@ -241,7 +247,7 @@ impl TwoLevel {
             pieces: vec![],
             max_pieces: 0,
             firsts,
-            small_mesh: SMALL_MESH,
+            small_mesh,
         };
         two.max_pieces = two.piece_budget(rebraid_budget());
         two.rebuild_tlas();
@@ -262,15 +268,6 @@ impl TwoLevel {
     /// may be re-braided into ([`rebraid_budget`]) and rebuilds it; before the device is
     /// given the scene (its buffers are sized for [`TwoLevel::max_pieces`]).
     pub fn set_rebraid_budget(&mut self, extra: usize) {
-        self.max_pieces = self.piece_budget(extra);
-        self.rebuild_tlas();
-    }
-
-    /// Sets [`TwoLevel::small_mesh`] (keeping the re-braiding budget) and rebuilds the TLAS;
-    /// before the device is given the scene.
-    pub fn set_small_mesh(&mut self, small_mesh: usize) {
-        let extra = self.max_pieces - self.piece_budget(0);
-        self.small_mesh = small_mesh;
         self.max_pieces = self.piece_budget(extra);
         self.rebuild_tlas();
     }

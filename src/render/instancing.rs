@@ -132,12 +132,8 @@ pub fn plan(
         .map(|(o, &m)| (m, frame * o.world_from_object))
         .collect();
     let hidden = placed.iter().map(|o| !o.visible).collect();
-    let mut two = TwoLevel::with_hidden(blases, &instances, hidden);
-    if two.small_mesh != rule.small_mesh {
-        two.set_small_mesh(rule.small_mesh);
-    }
     Some(Instancing {
-        two,
+        two: TwoLevel::with_hidden(blases, &instances, hidden, rule.small_mesh),
         mesh_objects: meshes.iter().map(|&o| objects[o]).collect(),
         objects,
     })
