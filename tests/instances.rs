@@ -426,3 +426,84 @@ fn instances_render_the_same_image_both_ways() {
         flat.len()
     );
 }
+
+#[test]
+fn a_quick_first_image_gives_way_to_the_image_of_the_sah_trees() {
+    // The viewer opens a large scene with quick BLASes and swaps the SAH ones in when they are
+    // built: from the swap on, the image is the one of a scene loaded with SAH BLASes alone.
+    let scene = cube_scene(4);
+    let light = penumbra::scene::Light {
+        name: "lamp".into(),
+        kind: penumbra::scene::LightKind::Point,
+        position: DVec3::new(0.5, 9.0, 2.0),
+        direction: DVec3::NEG_Y,
+        color: [1.0; 3],
+        intensity: 400.0,
+        light_radius: 0.0,
+    };
+    let camera = penumbra::scene::Camera::look_at(
+        "test",
+        DVec3::new(2.0, 3.0, 22.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        0.9,
+    );
+    let settings = penumbra::render::RenderSettings {
+        width: 48,
+        height: 32,
+        bounces: 3,
+        ..Default::default()
+    };
+    let open = |quick: bool| {
+        let mut r = renderer();
+        r.set_bvh_choice(BvhChoice::TwoLevel);
+        r.set_quick_first(quick.then_some(0));
+        r.set_settings(&settings).unwrap();
+        r.load_scene_in(&scene, std::slice::from_ref(&light), RenderFrame::default())
+            .unwrap();
+        r.set_camera(&camera).unwrap();
+        r
+    };
+    // Each BLAS's SAH cost: which trees the device has.
+    let blas_costs = |r: &Renderer| match r.accel() {
+        Some(penumbra::render::Accel::TwoLevel(t)) => {
+            t.blases.iter().map(|b| b.bvh.sah_cost).collect::<Vec<_>>()
+        }
+        _ => panic!("two levels"),
+    };
+    let mut plain = open(false);
+    assert!(!plain.sah_pending());
+    let sah_costs = blas_costs(&plain);
+    plain.render(4).unwrap();
+    let want = plain.image().unwrap();
+    let mut r = open(true);
+    assert!(
+        r.sah_pending(),
+        "the SAH BLASes build behind the quick ones"
+    );
+    assert_ne!(blas_costs(&r), sah_costs, "quick BLASes first");
+    // Frames on the quick trees: the same surfaces, lit the same.
+    r.render(4).unwrap();
+    let first = r.image().unwrap();
+    let mean = common::mean_gray(&want);
+    assert!(mean > 0.01, "the cubes are lit ({mean})");
+    assert!((common::mean_gray(&first) - mean).abs() <= 0.05 * mean);
+    let t = std::time::Instant::now();
+    let stats = loop {
+        if let Some(s) = r.swap_in_sah(&scene, std::slice::from_ref(&light)).unwrap() {
+            break s;
+        }
+        assert!(t.elapsed().as_secs() < 60, "the SAH BLASes are built");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    };
+    assert!(!r.sah_pending());
+    assert_eq!(stats.bvh, "two-level");
+    assert_eq!(blas_costs(&r), sah_costs, "the SAH BLASes swapped in");
+    // The swap restarted the film: the same samples as the plain load, bit for bit.
+    assert_eq!(r.samples(), 0);
+    r.render(4).unwrap();
+    let got = r.image().unwrap();
+    assert!(
+        got == want,
+        "the image after the swap is the SAH trees' image"
+    );
+}

@@ -170,6 +170,7 @@ impl FrameLoop {
     /// samples-per-pixel target reached at full resolution.
     pub fn converged(&self, spp_target: Option<u32>) -> bool {
         self.batch.is_none()
+            && !self.renderer.sah_pending()
             && !self.pending.any()
             && self.applied.is_some_and(|(_, d)| d == 1)
             && spp_target.is_some_and(|t| self.renderer.samples() >= t)
@@ -253,6 +254,17 @@ impl FrameLoop {
         let divisor = self.budget.plan(full, world.moving, None).divisor;
         let size = scaled(full, divisor);
         let mut pending = std::mem::take(&mut self.pending);
+        // The SAH BLASes behind a quick first image are done: the scene goes to the device
+        // again with them and the image restarts (unless the scene is reloaded anyway).
+        if self.loaded
+            && !pending.scene
+            && let Some(stats) = self.renderer.swap_in_sah(world.scene, world.lights)?
+        {
+            log::info!("SAH BLASes in after {:.0} ms", stats.bvh_build_ms);
+            self.scene_stats = Some(stats);
+            // The upload reset the film and applied the camera and lights.
+            self.progress = Progress::default();
+        }
         if pending.any() {
             log::debug!(
                 "applying {pending:?} at {}x{} (1/{divisor})",

@@ -154,6 +154,8 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
     renderer.set_kernel(config.kernel)?;
     renderer.set_bvh_choice(config.bvh);
+    // A large scene's first image comes from quick BLASes; the SAH ones follow.
+    renderer.set_quick_first(Some(crate::render::instancing::QUICK_FIRST_TRIANGLES));
     let env_name = config.env_map.as_ref().map(|m| m.name.clone());
     if let Some(map) = config.env_map {
         renderer

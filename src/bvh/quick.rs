@@ -60,6 +60,17 @@ pub fn build_quick_ordered(triangles: Vec<[Vec3; 3]>) -> (Bvh, Vec<[Vec3; 3]>) {
     (tree(codes, tri_indices, &ordered), ordered)
 }
 
+/// The BLAS of an indexed mesh (object space) over a quick tree: what the renderer traces while
+/// the mesh's SAH BLAS ([`super::Blas::of_mesh`]) builds behind it.
+pub fn quick_blas(positions: &[Vec3], indices: &[[u32; 3]]) -> super::Blas {
+    let triangles = indices
+        .iter()
+        .map(|t| t.map(|v| positions[v as usize]))
+        .collect();
+    let (bvh, triangles) = build_quick_ordered(triangles);
+    super::Blas { bvh, triangles }
+}
+
 fn in_order(triangles: &[[Vec3; 3]], order: &[u32]) -> Vec<[Vec3; 3]> {
     order.par_iter().map(|&i| triangles[i as usize]).collect()
 }
@@ -269,6 +280,46 @@ mod tests {
             hits += a.is_some() as usize;
         }
         assert!(hits > 1000, "{hits}");
+    }
+
+    #[test]
+    fn a_quick_blas_finds_the_closest_hits_of_the_sah_blas() {
+        // An indexed mesh whose vertices are shared by several triangles.
+        let soup = random_triangles(3000, 11);
+        let positions: Vec<Vec3> = soup.iter().flatten().copied().collect();
+        let n = positions.len() as u32;
+        let indices: Vec<[u32; 3]> = (0..2 * soup.len() as u32)
+            .map(|i| [(7 * i) % n, (7 * i + 1) % n, (7 * i + 2) % n])
+            .collect();
+        let (quick, sah) = (
+            quick_blas(&positions, &indices),
+            super::super::Blas::of_mesh(&positions, &indices),
+        );
+        let mesh_order = sah_order(&sah);
+        check_tree(&quick.bvh, &mesh_order);
+        assert_eq!(quick.triangles, ordered(&quick.bvh, &mesh_order));
+        let mut hits = 0;
+        for ray in &random_rays(3000, 5) {
+            let a = quick.bvh.intersect(ray, &quick.triangles);
+            let b = sah.bvh.intersect(ray, &sah.triangles);
+            assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "{ray:?}");
+            assert_eq!(
+                a.map(|h| quick.bvh.tri_indices[h.prim as usize]),
+                b.map(|h| sah.bvh.tri_indices[h.prim as usize]),
+                "{ray:?}"
+            );
+            hits += a.is_some() as usize;
+        }
+        assert!(hits > 500, "{hits}");
+    }
+
+    /// A BLAS's triangles back in mesh order.
+    fn sah_order(b: &super::super::Blas) -> Vec<[Vec3; 3]> {
+        let mut tris = vec![[Vec3::ZERO; 3]; b.triangles.len()];
+        for (k, &i) in b.bvh.tri_indices.iter().enumerate() {
+            tris[i as usize] = b.triangles[k];
+        }
+        tris
     }
 
     #[test]

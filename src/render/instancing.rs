@@ -21,11 +21,12 @@
 //! instancing shrinks eightfold take them. A small scene is flattened: its flat BVH is built in
 //! well under a second and tests no transforms.
 
-use crate::bvh::{Blas, TwoLevel};
-use crate::scene::{Object, RenderFrame, Scene, distinct_meshes};
+use crate::bvh::{Blas, TwoLevel, quick_blas};
+use crate::scene::{Mesh, Object, RenderFrame, Scene, distinct_meshes};
 use glam::DMat4;
 use rayon::prelude::*;
 use std::str::FromStr;
+use std::sync::Arc;
 
 /// `--bvh auto`'s thresholds for one kind of device: the triangles over all instances from which
 /// it considers two levels, and how many times the distinct meshes' triangles the instances
@@ -91,6 +92,28 @@ pub struct Instancing {
     pub objects: Vec<u32>,
     /// An object placing each BLAS's mesh (index in `Scene::objects`).
     pub mesh_objects: Vec<u32>,
+    /// Whether the BLASes are quick trees ([`Blases::Quick`] with enough distinct triangles).
+    pub quick: bool,
+}
+
+/// Distinct triangles from which the viewer opens a two-level scene with quick BLASes
+/// ([`crate::render::Renderer::set_quick_first`]): below, the SAH BLASes build in well under a
+/// second on 2 cores (1 M triangles: 0.25 s).
+pub const QUICK_FIRST_TRIANGLES: usize = 2_000_000;
+
+/// How the BLASes of a two-level plan are made.
+pub enum Blases {
+    /// Binned SAH trees ([`Blas::of_mesh`]).
+    Sah,
+    /// Quick trees ([`crate::bvh::quick_blas`]) for a scene of at least `from` distinct
+    /// triangles (else SAH trees), traced at once while its SAH trees build behind it.
+    Quick {
+        /// Distinct triangles from which the trees are quick.
+        from: usize,
+    },
+    /// Trees built already, one per distinct mesh in the plan's order, for the meshes they
+    /// were built from (checked: any other mesh gets a SAH tree).
+    Built(Vec<(Arc<Mesh>, Blas)>),
 }
 
 /// The two levels of `scene` in render space `space`, or `None` when the flat BVH is chosen
@@ -101,6 +124,7 @@ pub fn plan(
     space: &RenderFrame,
     choice: BvhChoice,
     rule: AutoRule,
+    how: Blases,
 ) -> Option<Instancing> {
     if choice == BvhChoice::Flat {
         return None;
@@ -121,10 +145,25 @@ pub fn plan(
     if total == 0 || (choice == BvhChoice::Auto && auto_flat) || scene.absurd_triangles() > 0 {
         return None;
     }
-    let blases: Vec<Blas> = meshes
-        .par_iter()
-        .map(|&o| Blas::of_mesh(&placed[o].mesh.positions, &placed[o].mesh.indices))
-        .collect();
+    let quick = matches!(how, Blases::Quick { from } if unique >= from);
+    let sah = |o: usize| Blas::of_mesh(&placed[o].mesh.positions, &placed[o].mesh.indices);
+    let blases: Vec<Blas> = match how {
+        Blases::Quick { .. } if quick => meshes
+            .par_iter()
+            .map(|&o| quick_blas(&placed[o].mesh.positions, &placed[o].mesh.indices))
+            .collect(),
+        Blases::Sah | Blases::Quick { .. } => meshes.par_iter().map(|&o| sah(o)).collect(),
+        Blases::Built(built) => {
+            let mut built = built.into_iter();
+            meshes
+                .iter()
+                .map(|&o| match built.next() {
+                    Some((mesh, blas)) if Arc::ptr_eq(&mesh, &placed[o].mesh) => blas,
+                    _ => sah(o),
+                })
+                .collect()
+        }
+    };
     let frame = render_from_world(space);
     let instances: Vec<(u32, DMat4)> = placed
         .iter()
@@ -136,14 +175,22 @@ pub fn plan(
         two: TwoLevel::with_hidden(blases, &instances, hidden, rule.small_mesh),
         mesh_objects: meshes.iter().map(|&o| objects[o]).collect(),
         objects,
+        quick,
     })
 }
 
 /// Whether `--bvh auto` takes two levels for `total` triangles over all instances of meshes of
 /// `unique` triangles under `rule` (see the module's rules).
 pub fn auto_takes_two_levels(total: usize, unique: usize, rule: AutoRule) -> bool {
-    total >= rule.min_triangles && total >= rule.min_saving * unique
+    total >= rule.min_triangles && (total >= rule.min_saving * unique || total >= HUGE_SCENE)
 }
+
+/// Triangles over all instances from which `--bvh auto` takes two levels on any device, however
+/// little instancing saves: the flat form's host build needs about 280 bytes a triangle
+/// (64 M triangles: 18 GB, against the 150 a distinct triangle that issue 14 allows) and
+/// 34 s for 16 M distinct triangles on the 2-core machine, against 108 bytes and a few
+/// seconds for two levels (docs/benchmarks.md, "Opening large unique scenes").
+pub const HUGE_SCENE: usize = 16_000_000;
 
 /// The render frame's map, (p - origin) * scale, as a matrix: render from object is this times
 /// the node's world from object.
@@ -186,6 +233,10 @@ mod tests {
             assert!(!auto_takes_two_levels(500_000, 10_000, rule));
             assert!(!auto_takes_two_levels(4_000_000, 2_000_000, rule));
             assert!(!auto_takes_two_levels(0, 0, rule));
+            // Huge, even with no instancing at all: two levels (the flat build's memory).
+            assert!(auto_takes_two_levels(64_000_014, 64_000_014, rule));
+            assert!(auto_takes_two_levels(HUGE_SCENE, HUGE_SCENE, rule));
+            assert!(!auto_takes_two_levels(HUGE_SCENE - 1, HUGE_SCENE - 1, rule));
         }
     }
 }

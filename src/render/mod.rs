@@ -134,6 +134,30 @@ pub struct Renderer {
     bvh_choice: BvhChoice,
     /// Overrides the device's small-mesh rule (see [`Renderer::set_small_mesh`]).
     small_mesh: Option<usize>,
+    /// Distinct triangles from which a two-level scene is loaded with quick BLASes first (see
+    /// [`Renderer::set_quick_first`]).
+    quick_first: Option<usize>,
+    /// The SAH BLASes building behind the quick ones of the scene on the device.
+    sah: Option<SahBuild>,
+}
+
+/// The BLASes of a background build, with their meshes in the plan's order, and its time (ms).
+type BuiltBlases = (Vec<(Arc<crate::scene::Mesh>, crate::bvh::Blas)>, f64);
+
+/// SAH BLASes building on threads of their own behind the quick ones on the device; dropping
+/// it stops the build at the next mesh.
+struct SahBuild {
+    /// The BLASes when done.
+    done: std::sync::mpsc::Receiver<BuiltBlases>,
+    /// Set to stop the build (a new scene was loaded).
+    cancel: Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl Drop for SahBuild {
+    fn drop(&mut self) {
+        self.cancel
+            .store(true, std::sync::atomic::Ordering::Relaxed);
+    }
 }
 
 impl Renderer {
@@ -169,6 +193,8 @@ impl Renderer {
             megakernel: false,
             bvh_choice: BvhChoice::Auto,
             small_mesh: None,
+            quick_first: None,
+            sah: None,
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -190,6 +216,107 @@ impl Renderer {
         lights: &[Light],
         space: RenderFrame,
     ) -> Result<SceneStats, ClError> {
+        let how = match self.quick_first {
+            Some(from) => instancing::Blases::Quick { from },
+            None => instancing::Blases::Sah,
+        };
+        self.load_with(scene, lights, space, how)
+    }
+
+    /// `Some(n)`: a two-level scene of at least n distinct triangles is loaded with quick
+    /// BLASes ([`crate::bvh::quick_blas`], several times faster to build) while its SAH BLASes
+    /// build on threads behind them; [`Renderer::swap_in_sah`] then loads the scene again with
+    /// those, so that the image from then on is the one a plain load gives. The viewer opens
+    /// scenes so ([`instancing::QUICK_FIRST_TRIANGLES`]); `None` (the default, `render`):
+    /// SAH BLASes at once.
+    pub fn set_quick_first(&mut self, from: Option<usize>) {
+        self.quick_first = from;
+    }
+
+    /// Whether SAH BLASes are building behind the quick ones on the device.
+    pub fn sah_pending(&self) -> bool {
+        self.sah.is_some()
+    }
+
+    /// When the SAH BLASes behind the quick ones are done, loads `scene` (the one loaded, as it
+    /// is now: moved or hidden objects stay so) with them in the current render space and
+    /// resets the film; its figures, the wait for the BLASes (ms) in `bvh_build_ms`. `None`
+    /// while they build or when none are.
+    pub fn swap_in_sah(
+        &mut self,
+        scene: &Scene,
+        lights: &[Light],
+    ) -> Result<Option<SceneStats>, ClError> {
+        let Some(build) = &self.sah else {
+            return Ok(None);
+        };
+        let (blases, build_ms) = match build.done.try_recv() {
+            Ok(b) => b,
+            Err(std::sync::mpsc::TryRecvError::Empty) => return Ok(None),
+            // The thread died (it cannot, short of running out of memory): build them here.
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => (vec![], 0.0),
+        };
+        self.sah = None;
+        let space = self.space();
+        // The quick scene's buffers go first: the two are never on the device together.
+        self.scene = None;
+        let mut stats = self.load_with(scene, lights, space, instancing::Blases::Built(blases))?;
+        stats.bvh_build_ms += build_ms;
+        Ok(Some(stats))
+    }
+
+    /// Starts building the SAH BLASes of `plan`'s meshes (of `scene`) on a pool of threads of
+    /// their own, so that the host work of frames (rayon's global pool) never queues behind
+    /// them; `None` when no thread could be started (the quick trees then stay).
+    fn sah_behind(scene: &Scene, plan: &instancing::Instancing) -> Option<SahBuild> {
+        use rayon::prelude::*;
+        use std::sync::atomic::Ordering;
+        let meshes: Vec<Arc<crate::scene::Mesh>> = plan
+            .mesh_objects
+            .iter()
+            .map(|&o| scene.objects[o as usize].mesh.clone())
+            .collect();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .thread_name(|i| format!("sah-blas-{i}"))
+            .build()
+            .ok()?;
+        let cancel = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let stop = cancel.clone();
+        let (tx, done) = std::sync::mpsc::channel();
+        std::thread::Builder::new()
+            .name("sah-blas".into())
+            .spawn(move || {
+                let t = Instant::now();
+                let blases: Option<Vec<_>> = pool.install(|| {
+                    meshes
+                        .into_par_iter()
+                        .map(|m| {
+                            (!stop.load(Ordering::Relaxed)).then(|| {
+                                let b = crate::bvh::Blas::of_mesh(&m.positions, &m.indices);
+                                (m, b)
+                            })
+                        })
+                        .collect()
+                });
+                if let Some(blases) = blases {
+                    // Nobody waits when a new scene replaced this one.
+                    let _ = tx.send((blases, t.elapsed().as_secs_f64() * 1e3));
+                }
+            })
+            .ok()?;
+        Some(SahBuild { done, cancel })
+    }
+
+    /// [`Renderer::load_scene_in`] with BLASes made as `how` says; with quick ones, their SAH
+    /// BLASes start building behind them.
+    fn load_with(
+        &mut self,
+        scene: &Scene,
+        lights: &[Light],
+        space: RenderFrame,
+        how: instancing::Blases,
+    ) -> Result<SceneStats, ClError> {
+        self.sah = None;
         let t = Instant::now();
         let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
         let mut rule = if self.gpu.is_cpu() {
@@ -200,8 +327,12 @@ impl Renderer {
         if let Some(small_mesh) = self.small_mesh {
             rule.small_mesh = small_mesh;
         }
-        let (mut host, dropped) = match instancing::plan(scene, &space, self.bvh_choice, rule) {
+        let (mut host, dropped) = match instancing::plan(scene, &space, self.bvh_choice, rule, how)
+        {
             Some(plan) => {
+                if plan.quick {
+                    self.sah = Self::sah_behind(scene, &plan);
+                }
                 // Two levels: nothing is flattened; each mesh goes to the device once.
                 let meshes: Vec<&crate::scene::Mesh> = plan
                     .mesh_objects
