@@ -470,11 +470,17 @@ impl CommonArgs {
         } else {
             scene.lights.clone()
         };
+        let t = std::time::Instant::now();
         let first = first_image::decide(
             &scene,
             &own_lights,
             camera_chosen.then_some(&camera),
             aspect,
+        );
+        log::info!(
+            "{}: loaded in {load_ms:.0} ms, first view in {:.0} ms",
+            scene.source,
+            t.elapsed().as_secs_f64() * 1e3
         );
         if let Some(c) = &first.camera {
             camera = c.clone();

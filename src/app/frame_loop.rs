@@ -313,6 +313,18 @@ impl FrameLoop {
                     stats.dropped_triangles
                 );
             }
+            log::info!(
+                "scene on the device ({}): BVH {:.0} ms, upload {:.0} ms, kernels {:.0} ms{}",
+                stats.bvh,
+                stats.bvh_build_ms,
+                stats.upload_ms,
+                stats.kernel_build_ms,
+                if self.renderer.sah_pending() {
+                    " (quick BLASes; the SAH ones build behind them)"
+                } else {
+                    ""
+                }
+            );
             self.scene_stats = Some(stats);
             self.loaded = true;
         } else if pending.lights {

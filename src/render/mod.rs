@@ -220,7 +220,7 @@ impl Renderer {
             Some(from) => instancing::Blases::Quick { from },
             None => instancing::Blases::Sah,
         };
-        self.load_with(scene, lights, space, how)
+        self.load_with(scene, lights, space, how, None)
     }
 
     /// `Some(n)`: a two-level scene of at least n distinct triangles is loaded with quick
@@ -258,24 +258,29 @@ impl Renderer {
         };
         self.sah = None;
         let space = self.space();
-        // The quick scene's buffers go first: the two are never on the device together.
-        self.scene = None;
-        let mut stats = self.load_with(scene, lights, space, instancing::Blases::Built(blases))?;
+        // The quick scene's host side goes first; its buffers take the new contents where the
+        // sizes agree (triangles and shading data: the same, reordered).
+        let old = self.scene.take().map(|(buffers, _)| buffers);
+        let how = instancing::Blases::Built(blases);
+        let mut stats = self.load_with(scene, lights, space, how, old)?;
         stats.bvh_build_ms += build_ms;
         Ok(Some(stats))
     }
 
-    /// Starts building the SAH BLASes of `plan`'s meshes (of `scene`) on a pool of threads of
-    /// their own, so that the host work of frames (rayon's global pool) never queues behind
-    /// them; `None` when no thread could be started (the quick trees then stay).
-    fn sah_behind(scene: &Scene, plan: &instancing::Instancing) -> Option<SahBuild> {
-        use rayon::prelude::*;
-        use std::sync::atomic::Ordering;
-        let meshes: Vec<Arc<crate::scene::Mesh>> = plan
-            .mesh_objects
+    /// The meshes of `plan`'s BLASes (of `scene`), in order.
+    fn sah_meshes(scene: &Scene, plan: &instancing::Instancing) -> Vec<Arc<crate::scene::Mesh>> {
+        plan.mesh_objects
             .iter()
             .map(|&o| scene.objects[o as usize].mesh.clone())
-            .collect();
+            .collect()
+    }
+
+    /// Starts building the SAH BLASes of `meshes` on a pool of threads of
+    /// their own, so that the host work of frames (rayon's global pool) never queues behind
+    /// them; `None` when no thread could be started (the quick trees then stay).
+    fn sah_behind(meshes: Vec<Arc<crate::scene::Mesh>>) -> Option<SahBuild> {
+        use rayon::prelude::*;
+        use std::sync::atomic::Ordering;
         let pool = rayon::ThreadPoolBuilder::new()
             .thread_name(|i| format!("sah-blas-{i}"))
             .build()
@@ -315,8 +320,10 @@ impl Renderer {
         lights: &[Light],
         space: RenderFrame,
         how: instancing::Blases,
+        reuse: Option<SceneBuffers>,
     ) -> Result<SceneStats, ClError> {
         self.sah = None;
+        let mut behind = None;
         let t = Instant::now();
         let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
         let mut rule = if self.gpu.is_cpu() {
@@ -330,8 +337,12 @@ impl Renderer {
         let (mut host, dropped) = match instancing::plan(scene, &space, self.bvh_choice, rule, how)
         {
             Some(plan) => {
+                log::debug!(
+                    "BLASes and TLAS in {:.0} ms",
+                    t.elapsed().as_secs_f64() * 1e3
+                );
                 if plan.quick {
-                    self.sah = Self::sah_behind(scene, &plan);
+                    behind = Some(Self::sah_meshes(scene, &plan));
                 }
                 // Two levels: nothing is flattened; each mesh goes to the device once.
                 let meshes: Vec<&crate::scene::Mesh> = plan
@@ -366,7 +377,12 @@ impl Renderer {
         let kernel_build_ms = self.ensure_program()?;
         self.lights = lights.to_vec();
         let (glights, cdf) = self.light_table(&host);
+        log::debug!(
+            "kernels, textures, lights: {:.0} ms",
+            t.elapsed().as_secs_f64() * 1e3
+        );
         let (nodes, wide_nodes, instances) = device_accel(&mut host);
+        log::debug!("device nodes: {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
         // Triangles and shading data are the device's alone (picking keeps each flat triangle's
         // object, `HostScene::objects`): they leave the host scene, and each large host
         // array is freed as soon as its buffer is made, so that the two copies (host memory
@@ -398,21 +414,35 @@ impl Renderer {
             self.gpu.device.max_mem_alloc_size().ok(),
         )
         .map_err(ClError::Device)?;
-        let nodes_buffer = Buffer::from_slice(&self.gpu, &nodes)?;
+        // The large buffers of the scene replaced (a swap to SAH BLASes), written again in
+        // place where the size is the same: no fresh memory to fault in.
+        let mut old = reuse.map(|b| {
+            (
+                Some(b.nodes),
+                Some(b.wide_nodes),
+                Some(b.shading),
+                Some(b.tangents),
+                Some(b.triangles),
+                Some(b.instances),
+            )
+        });
+        let gpu = &self.gpu;
+        let nodes_buffer = put(gpu, old.as_mut().and_then(|o| o.0.take()), &nodes)?;
         drop(nodes);
-        let wide_buffer = Buffer::from_slice(&self.gpu, &wide_nodes)?;
+        let wide_buffer = put(gpu, old.as_mut().and_then(|o| o.1.take()), &wide_nodes)?;
         drop(wide_nodes);
-        let shading_buffer = Buffer::from_slice(&self.gpu, &shading)?;
+        let shading_buffer = put(gpu, old.as_mut().and_then(|o| o.2.take()), &shading)?;
         drop(shading);
-        let tangents_buffer = Buffer::from_slice(&self.gpu, &tangents)?;
+        let tangents_buffer = put(gpu, old.as_mut().and_then(|o| o.3.take()), &tangents)?;
         drop(tangents);
-        let triangles_buffer = Buffer::from_slice(&self.gpu, &triangles)?;
+        let triangles_buffer = put(gpu, old.as_mut().and_then(|o| o.4.take()), &triangles)?;
         drop(triangles);
+        let instances_buffer = put(gpu, old.and_then(|o| o.5), &instances)?;
         let buffers = SceneBuffers {
             nodes: nodes_buffer,
             wide_nodes: wide_buffer,
             triangles: triangles_buffer,
-            instances: Buffer::from_slice(&self.gpu, &instances)?,
+            instances: instances_buffer,
             object_triangles: Buffer::from_slice(&self.gpu, &object_tris)?,
             shading: shading_buffer,
             tangents: tangents_buffer,
@@ -444,6 +474,8 @@ impl Renderer {
             device_bytes: buffers.bytes(),
         };
         self.scene = Some((buffers, host));
+        // The SAH BLASes start once the quick scene is on the device, not to slow its upload.
+        self.sah = behind.and_then(Self::sah_behind);
         if let Some(c) = self.world_camera.clone() {
             self.set_camera(&c)?;
         }
@@ -721,6 +753,25 @@ impl Renderer {
             .iter()
             .map(|p| (p[3] / total).clamp(0.0, 1.0))
             .collect())
+    }
+}
+
+/// A buffer holding `data`: `old` written again when it has `data`'s length, else a new one
+/// (`old` freed first).
+fn put<T: bytemuck::Pod>(
+    gpu: &Gpu,
+    old: Option<Buffer<T>>,
+    data: &[T],
+) -> Result<Buffer<T>, ClError> {
+    match old {
+        Some(mut b) if b.len() == data.len() && !data.is_empty() => {
+            b.write(gpu, data)?;
+            Ok(b)
+        }
+        old => {
+            drop(old);
+            Buffer::from_slice(gpu, data)
+        }
     }
 }
 

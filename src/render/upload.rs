@@ -450,29 +450,31 @@ impl HostScene {
     /// `layout.light_bases`). `two`'s instances are in render space.
     pub fn two_level(two: TwoLevel, meshes: &[&Mesh], materials: &[Material]) -> Self {
         let normal_mapped = meshes.iter().any(|m| !m.tangents.is_empty());
-        let per_mesh: Vec<_> = meshes
+        let sizes: Vec<usize> = two.blases.iter().map(|b| b.bvh.tri_indices.len()).collect();
+        let n = sizes.iter().sum();
+        // Each mesh fills its own range of the arrays, in parallel (no per-mesh copies to
+        // join: on a large scene these arrays are most of the host memory written).
+        let mut triangles: Vec<GpuTriangle> = bytemuck::zeroed_vec(n);
+        let mut shading: Vec<GpuTriShading> = bytemuck::zeroed_vec(n);
+        let mut tangents: Vec<GpuTriTangents> =
+            bytemuck::zeroed_vec(if normal_mapped { n } else { 0 });
+        let parts = split_by(&mut triangles, &sizes)
+            .into_iter()
+            .zip(split_by(&mut shading, &sizes))
+            .zip(split_by(&mut tangents, &sizes));
+        // Each mesh's emissive triangles (index among the meshes' triangles, material).
+        let mesh_emitters: Vec<Vec<(u32, u32)>> = meshes
             .par_iter()
             .zip(&two.blases)
-            .map(|(m, b)| object_triangles(m, &b.bvh.tri_indices, materials, normal_mapped))
-            .collect();
-        let n = two.firsts.last().copied().unwrap_or(0) as usize
-            + two.blases.last().map_or(0, |b| b.triangles.len());
-        let mut triangles = Vec::with_capacity(n);
-        let mut shading = Vec::with_capacity(n);
-        let mut tangents = Vec::with_capacity(if normal_mapped { n } else { 0 });
-        // Each mesh's emissive triangles (index among the meshes' triangles, material).
-        let mut mesh_emitters = vec![];
-        for (b, (tri, sh, tan, emitters)) in per_mesh.into_iter().enumerate() {
-            triangles.extend(tri);
-            shading.extend(sh);
-            tangents.extend(tan);
-            mesh_emitters.push(
-                emitters
+            .zip(parts.collect::<Vec<_>>())
+            .enumerate()
+            .map(|(b, ((m, blas), out))| {
+                object_triangles(m, &blas.bvh.tri_indices, materials, out)
                     .into_iter()
                     .map(|(k, material)| (two.firsts[b] + k, material))
-                    .collect::<Vec<_>>(),
-            );
-        }
+                    .collect()
+            })
+            .collect();
         let mut emissive = vec![];
         let mut light_bases = vec![];
         for (i, inst) in two.instances.iter().enumerate() {
@@ -622,24 +624,37 @@ fn middle_of<I: Iterator<Item = [DVec3; 3]>>(
     }
 }
 
-/// Device structs of one mesh's triangles in object space, in the order `order`, and its
-/// emissive triangles (index in that order, material): emissive materials with a nonzero
-/// object-space area, whose `v1.w` counts them.
-#[allow(clippy::type_complexity)]
+/// `v` cut into consecutive parts of `sizes` elements (empty parts once `v` runs out: the
+/// tangents of a scene without normal maps).
+fn split_by<'a, T>(mut v: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
+    sizes
+        .iter()
+        .map(|&n| {
+            let n = n.min(v.len());
+            let (part, rest) = std::mem::take(&mut v).split_at_mut(n);
+            v = rest;
+            part
+        })
+        .collect()
+}
+
+/// One mesh's device structs for [`object_triangles`] to fill: triangles, shading data and
+/// tangents (empty when no mesh is normal-mapped).
+type MeshStructs<'a> = (
+    (&'a mut [GpuTriangle], &'a mut [GpuTriShading]),
+    &'a mut [GpuTriTangents],
+);
+
+/// Writes the device structs of one mesh's triangles in object space, in the order `order`,
+/// to `out`; its emissive triangles (index in that order, material): emissive materials with
+/// a nonzero object-space area, whose `v1.w` counts them.
 fn object_triangles(
     m: &Mesh,
     order: &[u32],
     materials: &[Material],
-    normal_mapped: bool,
-) -> (
-    Vec<GpuTriangle>,
-    Vec<GpuTriShading>,
-    Vec<GpuTriTangents>,
-    Vec<(u32, u32)>,
-) {
-    let mut tris = Vec::with_capacity(order.len());
-    let mut shading = Vec::with_capacity(order.len());
-    let mut tangents = Vec::with_capacity(if normal_mapped { order.len() } else { 0 });
+    ((tris, shading), tangents): MeshStructs,
+) -> Vec<(u32, u32)> {
+    let normal_mapped = !tangents.is_empty();
     let mut emitters = vec![];
     let corner = |a: &[Vec2], i: u32| a.get(i as usize).copied().unwrap_or(Vec2::ZERO);
     for (k, &ti) in order.iter().enumerate() {
@@ -672,13 +687,13 @@ fn object_triangles(
             object: 0,
         };
         let (tri, sh, tan) = device_triangle(&t, light);
-        tris.push(tri);
-        shading.push(sh);
+        tris[k] = tri;
+        shading[k] = sh;
         if normal_mapped {
-            tangents.push(tan);
+            tangents[k] = tan;
         }
     }
-    (tris, shading, tangents, emitters)
+    emitters
 }
 
 /// The flat form's device structs in object order, filled a list of [`WorldTriangle`]s at a
