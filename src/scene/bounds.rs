@@ -270,6 +270,52 @@ mod tests {
     }
 
     #[test]
+    fn a_scenes_remembered_bounds_follow_its_objects() {
+        use super::super::{Mesh, Object, Scene};
+        let mesh = |center: DVec3| {
+            let t = cube(center, 1.0);
+            std::sync::Arc::new(Mesh {
+                positions: t.iter().flatten().map(|p| p.as_vec3()).collect(),
+                indices: (0..t.len() as u32)
+                    .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                    .collect(),
+                materials: vec![0; t.len()],
+                ..Mesh::default()
+            })
+        };
+        let object = |m| Object {
+            name: "cube".into(),
+            world_from_object: glam::DMat4::IDENTITY,
+            visible: true,
+            mesh: m,
+        };
+        let mut scene = Scene {
+            objects: vec![object(mesh(DVec3::ZERO)), object(mesh(DVec3::X * 3.0))],
+            ..Scene::default()
+        };
+        let fresh = |s: &Scene| {
+            let clone = Scene {
+                bounds_cache: Default::default(),
+                ..s.clone()
+            };
+            clone.bounds()
+        };
+        let first = scene.bounds();
+        assert_eq!(scene.bounds(), first);
+        assert_eq!(first.max.x, 3.5);
+        // Moved, hidden, given another mesh: each time the bounds of a fresh computation.
+        scene.objects[1].world_from_object = glam::DMat4::from_translation(DVec3::Y * 2.0);
+        assert_eq!(scene.bounds(), fresh(&scene));
+        assert_eq!(scene.bounds().max.y, 2.5);
+        scene.objects[1].visible = false;
+        assert_eq!(scene.bounds(), fresh(&scene));
+        assert_eq!(scene.bounds().max.x, 0.5);
+        scene.objects[0].mesh = mesh(DVec3::Z * -4.0);
+        assert_eq!(scene.bounds(), fresh(&scene));
+        assert_eq!(scene.bounds().min.z, -4.5);
+    }
+
+    #[test]
     fn robust_bounds_are_exact_for_an_ordinary_scene() {
         let t = cube(DVec3::new(1.0, 2.0, 3.0), 2.0);
         let mut exact = Bounds::default();
