@@ -260,7 +260,11 @@ impl FrameLoop {
             && !pending.scene
             && let Some(stats) = self.renderer.swap_in_sah(world.scene, world.lights)?
         {
-            log::info!("SAH BLASes in after {:.0} ms", stats.bvh_build_ms);
+            log::info!(
+                "SAH BLASes in: built in {:.0} ms, the scene on the device again in {:.0} ms",
+                stats.bvh_build_ms,
+                stats.upload_ms
+            );
             self.scene_stats = Some(stats);
             // The upload reset the film and applied the camera and lights.
             self.progress = Progress::default();
