@@ -140,8 +140,14 @@ impl WideBvh {
 /// The children of the wide node that collapses binary node `binary`: its two children, with
 /// the interior child of the largest surface area opened until there are four (or only leaves).
 pub fn wide_children(bvh: &Bvh, binary: u32) -> Vec<(Aabb, Child)> {
+    frontier(bvh, binary, WIDTH)
+}
+
+/// Up to `width` boxes below node `binary` of `bvh` that hold all of its triangles: its
+/// children, then repeatedly the inner child of largest area replaced by its own two.
+pub fn frontier(bvh: &Bvh, binary: u32, width: usize) -> Vec<(Aabb, Child)> {
     let mut slots: Vec<(Aabb, Child)> = (0..2).map(|side| bvh.child(binary, side)).collect();
-    while slots.len() < WIDTH {
+    while slots.len() < width {
         let Some((i, node)) = slots
             .iter()
             .enumerate()
