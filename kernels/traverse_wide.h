@@ -49,7 +49,10 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
 // with intersect_triangle's arithmetic lane by lane, so that the same hit is kept: the first
 // triangle of the nearest hit (the scalar loop keeps a later one only when strictly nearer), or
 // with any_hit the first triangle hit. Leaves whose test needs the double-precision edge
-// functions or the rounding-error bound fall back to the scalar loop.
+// functions or the rounding-error bound fall back to the scalar loop. Used for leaves of three
+// or four triangles (src/bvh/wide.rs merges small subtrees into such leaves in large scenes):
+// for one or two, the scalar tests measured as fast or faster (docs/benchmarks.md, "Sixth
+// session").
 #ifndef HAS_ALPHA
 inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
                             const SceneSurfaces* surf, uint first, uint count, float tmin,
@@ -115,7 +118,7 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
     return any_hit;
 }
 #define INTERSECT_LEAF(r, tris, surf, first, count, tmin, o, d, any_hit, hit)                  \
-    ((count) - 2u <= 2u ? intersect_leaf4(r, tris, surf, first, count, tmin, o, d, any_hit, hit) \
+    ((count) - 3u <= 1u ? intersect_leaf4(r, tris, surf, first, count, tmin, o, d, any_hit, hit) \
                    : intersect_leaf(r, tris, surf, first, count, tmin, o, d, any_hit, hit))
 #else
 #define INTERSECT_LEAF intersect_leaf

@@ -13,8 +13,15 @@ use glam::Vec3;
 pub const WIDTH: usize = 4;
 
 /// The largest leaf [`WideBvh::collapse_for_cpu`] makes of a small subtree: the CPU kernels test
-/// a leaf of up to four triangles in one go, one triangle per `float4` lane.
+/// a leaf of three or four triangles in one go, one triangle per `float4` lane.
 pub const MERGED_LEAF: u32 = 4;
+
+/// The fewest triangles for which [`WideBvh::collapse_for_cpu`] merges small subtrees: below
+/// this the wide nodes fit a core's L2 cache (2 MB: 16 K nodes of 128 bytes, from about 30 K
+/// triangles), traversal is bound by arithmetic rather than memory, and the builder's own
+/// leaves measured faster (Cornell box 7–10 % slower merged; docs/benchmarks.md, "Sixth
+/// session").
+pub const MERGE_MIN_TRIANGLES: usize = 65_536;
 
 /// Entries of the wide traversal stack; the kernels use the same size. A visit pushes at most
 /// `WIDTH - 1` children and every wide level is at least one binary level, so a binary tree
@@ -45,12 +52,23 @@ impl WideBvh {
     /// subtree holds at most [`MERGED_LEAF`] triangles (one range in BVH order) becomes a leaf
     /// before the node's slots are filled. The binary builder's leaves hold 1–2 triangles, so
     /// without this 44 % of the 1 M-triangle bunnies' wide nodes have only two children, both
-    /// leaves; merged, there are 0.6 times the nodes and a ray visits fewer of them, while
-    /// traverse_wide.h tests such a leaf's triangles in the four lanes of one `float4` test
-    /// (docs/benchmarks.md, "Sixth session"). The same triangles are tested, in BVH order
+    /// leaves; merged, there are 0.55 times the nodes and a ray visits 4–5 % fewer of them,
+    /// while traverse_wide.h tests a leaf of three or four triangles in the four lanes of one
+    /// `float4` test (docs/benchmarks.md, "Sixth session"). The same triangles are tested, in BVH order
     /// within a merged leaf, so the closest hit is the same (short of exact ties in t).
+    /// Scenes of fewer than [`MERGE_MIN_TRIANGLES`] triangles are collapsed as they are.
     pub fn collapse_for_cpu(bvh: &Bvh) -> Self {
-        Self::collapse_with(bvh, MERGED_LEAF).0
+        if bvh.tri_indices.len() >= MERGE_MIN_TRIANGLES {
+            Self::collapse_merging(bvh, MERGED_LEAF)
+        } else {
+            Self::collapse(bvh)
+        }
+    }
+
+    /// [`WideBvh::collapse`] with each interior child of at most `limit` triangles (in one
+    /// range) made a leaf.
+    pub fn collapse_merging(bvh: &Bvh, limit: u32) -> Self {
+        Self::collapse_with(bvh, limit).0
     }
 
     fn collapse_with(bvh: &Bvh, merge: u32) -> (Self, Vec<u32>) {
@@ -263,7 +281,7 @@ mod tests {
     fn merged_small_subtrees_are_leaves_of_at_most_four_triangles() {
         let tris = random_triangles(5000, 3);
         let bvh = crate::bvh::build(&tris);
-        let merged = WideBvh::collapse_for_cpu(&bvh);
+        let merged = WideBvh::collapse_merging(&bvh, MERGED_LEAF);
         check_leaves(&bvh, &tris, &merged);
         let leaves = leaf_sizes(&merged);
         let mean = leaves.iter().sum::<u32>() as f32 / leaves.len() as f32;
@@ -281,6 +299,8 @@ mod tests {
             plain.nodes.len()
         );
         assert!(mean > 2.0, "mean leaf {mean}");
+        // Small scenes stay as built.
+        assert_eq!(WideBvh::collapse_for_cpu(&bvh).nodes, plain.nodes);
     }
 
     fn leaf_sizes(wide: &WideBvh) -> Vec<u32> {
@@ -331,7 +351,7 @@ mod tests {
         let tris = random_triangles(3000, 9);
         let bvh = crate::bvh::build(&tris);
         let wide = WideBvh::collapse(&bvh);
-        let merged = WideBvh::collapse_for_cpu(&bvh);
+        let merged = WideBvh::collapse_merging(&bvh, MERGED_LEAF);
         let ordered = ordered(&bvh, &tris);
         let mut s = 5u64;
         let mut rnd = move || {
