@@ -14,7 +14,7 @@
 //! device reports them: the device keeps each mesh's triangles and shading data once, in
 //! object space, and shading carries a hit to world space through the instance's transform.
 
-use super::wide::wide_children;
+use super::wide::{frontier, wide_children};
 use super::{Aabb, Bvh, Child, Hit, Ray, WideBvh, build, build_boxes, build_indexed};
 use crate::cl::types::{GpuBvhNode, GpuHit, GpuWideNode};
 use glam::{DMat4, DVec3, Vec3};
@@ -143,6 +143,20 @@ impl Instance {
             tmin: ray.tmin.max(dt),
             tmax: ray.tmax,
         }
+    }
+
+    /// The world box of the triangles below node `node` of `bvh` under this instance: the
+    /// union of the world boxes ([`Instance::world_box`]) of up to [`FRONTIER`] boxes below
+    /// the node, opened largest first. A rotated object's world box grows with its box's
+    /// corners; its parts' boxes grow with theirs, which are smaller, so the union hugs the
+    /// object and fewer rays enter an instance only to miss it.
+    fn node_world_box(&self, bvh: &Bvh, node: u32) -> Aabb {
+        frontier(bvh, node, FRONTIER)
+            .into_iter()
+            // A leaf of no triangles (a one-leaf tree's other side) has the empty box, whose
+            // infinite corners would carry to NaN.
+            .filter(|(b, _)| b.min.cmple(b.max).all())
+            .fold(Aabb::EMPTY, |all, (b, _)| all.union(self.world_box(b)))
     }
 
     /// The world box of a BLAS box under this instance, computed in f64 and padded by 2^-20
@@ -358,7 +372,7 @@ impl TwoLevel {
                 continue;
             }
             if !self.is_small(blas) {
-                pieces.push((i, 0, inst.world_box(blas.bounds())));
+                pieces.push((i, 0, inst.node_world_box(&blas.bvh, 0)));
                 continue;
             }
             for (k, t) in blas.triangles.iter().enumerate() {
@@ -385,9 +399,9 @@ impl TwoLevel {
             {
                 continue;
             }
-            for (j, (b, child)) in children.into_iter().enumerate() {
+            for (j, (_, child)) in children.into_iter().enumerate() {
                 let Child::Node(n) = child else { continue };
-                let piece = (i, n, inst.world_box(b));
+                let piece = (i, n, inst.node_world_box(&blas.bvh, n));
                 let at = if j == 0 {
                     pieces[k] = piece;
                     k
@@ -553,6 +567,10 @@ impl TwoLevel {
 
 /// Meshes of at most this many triangles are small by default (see [`TwoLevel::small_mesh`]).
 pub const SMALL_MESH: usize = 64;
+
+/// How many of a BLAS's boxes bound an instance (or a piece) in the TLAS
+/// ([`Instance::node_world_box`]).
+pub const FRONTIER: usize = 32;
 
 /// A piece's mark for one triangle (its index in the BLAS in the other bits), else a BLAS node.
 pub const PIECE_TRIANGLE: u32 = 1 << 31;
@@ -750,24 +768,41 @@ mod tests {
 
     #[test]
     fn two_levels_find_the_hits_of_the_flattened_scene() {
-        let meshes = vec![random_triangles(400, 1), closed_cube(3)];
+        // A quad is a tree of one leaf (its root's other side is empty): as a small mesh its
+        // triangles are pieces (CPU devices), and with no small meshes (GPUs) it is entered.
+        let quad = vec![
+            [Vec3::ZERO, Vec3::X, Vec3::Y],
+            [Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+        ];
+        let meshes = vec![random_triangles(400, 1), closed_cube(3), quad];
         let placed: Vec<(u32, Mat4)> = placements()
             .into_iter()
+            .chain(placements().into_iter().take(3))
             .enumerate()
             .map(|(i, m)| {
                 (
-                    (i % 2) as u32,
+                    (i % 3) as u32,
                     m * Mat4::from_translation(Vec3::splat(i as f32)),
                 )
             })
             .collect();
-        let two = TwoLevel::new(
-            &meshes,
-            &placed
-                .iter()
-                .map(|&(mesh, m)| (mesh, m.as_dmat4()))
-                .collect::<Vec<_>>(),
-        );
+        let instances: Vec<(u32, DMat4)> = placed
+            .iter()
+            .map(|&(mesh, m)| (mesh, m.as_dmat4()))
+            .collect();
+        for small_mesh in [SMALL_MESH, 0] {
+            let blases = meshes.iter().map(|m| Blas::new(m)).collect();
+            let hidden = vec![false; instances.len()];
+            let two = TwoLevel::with_hidden(blases, &instances, hidden, small_mesh);
+            finds_the_hits_of_the_flattened_scene(&two, &meshes, &placed);
+        }
+    }
+
+    fn finds_the_hits_of_the_flattened_scene(
+        two: &TwoLevel,
+        meshes: &[Vec<[Vec3; 3]>],
+        placed: &[(u32, Mat4)],
+    ) {
         let world: Vec<[Vec3; 3]> = placed
             .iter()
             .flat_map(|&(mesh, m)| {

@@ -76,7 +76,7 @@ impl WideBvh {
         let mut binaries = vec![0u32];
         let mut work = vec![(0u32, 0usize)]; // (binary node, wide node)
         while let Some((binary, wide)) = work.pop() {
-            let slots = wide_children_merged(bvh, binary, merge);
+            let slots = frontier_merged(bvh, binary, WIDTH, merge);
             let mut out = GpuWideNode::default();
             for (i, &(bounds, child)) in slots.iter().enumerate() {
                 out.min_x[i] = bounds.min.x;
@@ -178,7 +178,13 @@ impl WideBvh {
 /// The children of the wide node that collapses binary node `binary`: its two children, with
 /// the interior child of the largest surface area opened until there are four (or only leaves).
 pub fn wide_children(bvh: &Bvh, binary: u32) -> Vec<(Aabb, Child)> {
-    wide_children_merged(bvh, binary, 0)
+    frontier(bvh, binary, WIDTH)
+}
+
+/// Up to `width` boxes below node `binary` of `bvh` that hold all of its triangles: its
+/// children, then repeatedly the inner child of largest area replaced by its own two.
+pub fn frontier(bvh: &Bvh, binary: u32, width: usize) -> Vec<(Aabb, Child)> {
+    frontier_merged(bvh, binary, width, 0)
 }
 
 /// The triangles of the subtree below binary node `node` as one leaf, when they are at most
@@ -207,9 +213,9 @@ fn subtree_leaf(bvh: &Bvh, node: u32, limit: u32) -> Option<Child> {
     })
 }
 
-/// [`wide_children`], with each interior child of at most `merge` triangles made a leaf (see
+/// [`frontier`], with each interior child of at most `merge` triangles made a leaf (see
 /// [`WideBvh::collapse_for_cpu`]; 0 merges nothing).
-fn wide_children_merged(bvh: &Bvh, binary: u32, merge: u32) -> Vec<(Aabb, Child)> {
+fn frontier_merged(bvh: &Bvh, binary: u32, width: usize, merge: u32) -> Vec<(Aabb, Child)> {
     let child = |node: u32, side: usize| {
         let (bounds, c) = bvh.child(node, side);
         match c {
@@ -218,7 +224,7 @@ fn wide_children_merged(bvh: &Bvh, binary: u32, merge: u32) -> Vec<(Aabb, Child)
         }
     };
     let mut slots: Vec<(Aabb, Child)> = (0..2).map(|side| child(binary, side)).collect();
-    while slots.len() < WIDTH {
+    while slots.len() < width {
         let Some((i, node)) = slots
             .iter()
             .enumerate()

@@ -128,6 +128,13 @@ impl Gpu {
             .is_ok_and(|t| t & opencl3::device::CL_DEVICE_TYPE_CPU != 0)
     }
 
+    /// Whether the device's OpenCL reports `extension` (e.g. `cl_nv_compiler_options`).
+    pub fn has_extension(&self, extension: &str) -> bool {
+        self.device
+            .extensions()
+            .is_ok_and(|e| e.split_whitespace().any(|x| x == extension))
+    }
+
     /// Opens the device the choice names.
     pub fn open(choice: &DeviceChoice) -> Result<Self, ClError> {
         let _setup = super::CL_SETUP.lock().unwrap_or_else(|e| e.into_inner());

@@ -204,6 +204,9 @@ pub(crate) fn build_source(
         options.push_str(" -cl-denorms-are-zero");
     }
     options.push_str(&features.defines());
+    if let Some(cap) = register_cap(gpu, features) {
+        options.push_str(&format!(" -cl-nv-maxrregcount={cap}"));
+    }
     // Extra compiler options for experiments (e.g. `-cl-mad-enable`), space-separated.
     if let Ok(extra) = std::env::var("PENUMBRA_CL_OPTIONS") {
         options.push(' ');
@@ -217,8 +220,37 @@ pub(crate) fn build_source(
         log::debug!("kernel build log:\n{log}");
         return Err(ClError::Build(first_error(&log)));
     }
+    // A successful build's log (warnings; with `PENUMBRA_CL_OPTIONS=-cl-nv-verbose`, NVIDIA's
+    // registers and spills per kernel) for RUST_LOG=debug.
+    if log::log_enabled!(log::Level::Debug) {
+        let log = program.get_build_log(gpu.device.id()).unwrap_or_default();
+        if !log.trim().is_empty() {
+            log::debug!("kernel build log ({options}):\n{log}");
+        }
+    }
     Ok(program)
 }
+
+/// The register cap for NVIDIA's compiler, where it pays. The two-level traversal keeps the
+/// world ray beside the object-space one and the instance it is in, which takes the `extend`
+/// and `connect` kernels from the flat BVH's 64-66 registers to 89-94, and fewer warps fit on
+/// a multiprocessor to hide the node loads. Capped at 72 (a few bytes spilled to the L1),
+/// two-level frames on an H200 went from 0.82 to 0.90 of the flat BVH's; flat programs stay
+/// under the cap and the cap does not change them (docs/benchmarks.md, sixth session).
+/// `PENUMBRA_NV_MAXRREG` sets another cap for measuring (0: none).
+fn register_cap(gpu: &Gpu, features: KernelFeatures) -> Option<u32> {
+    if !features.two_level || !gpu.has_extension("cl_nv_compiler_options") {
+        return None;
+    }
+    let cap = match std::env::var("PENUMBRA_NV_MAXRREG") {
+        Ok(v) => v.trim().parse().unwrap_or(TWO_LEVEL_REGISTERS),
+        Err(_) => TWO_LEVEL_REGISTERS,
+    };
+    (cap > 0).then_some(cap)
+}
+
+/// NVIDIA's register cap for two-level programs (see [`register_cap`]).
+const TWO_LEVEL_REGISTERS: u32 = 72;
 
 /// The first line of a build log that reports an error (with its file and line), or the
 /// log's first line.
