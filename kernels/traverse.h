@@ -304,7 +304,7 @@ inline bool intersect_piece_triangle(uint copy, uint prim, uint slot,
 
 // Enters instance `inst` at slot `slot` in a two-level traversal: the ray r (and its rtmin)
 // carried into the instance's object space, the stack height kept in base, and node set to
-// the piece's bottom-level node (ROOT: root, or wide_root in the wide nodes).
+// the piece's bottom-level node (ROOT: the instance's field naming it).
 #define ENTER_INSTANCE(ROOT)                                   \
     {                                                          \
         float3 od = instance_vector(&inst, d);                 \

@@ -223,28 +223,17 @@ inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTri
     return hit;
 }
 
-// A leaf among the sorted children of a bottom-level node, tested on the spot as WIDE_LEAF
-// does; a hit names the instance entered.
-#define TWO_LEVEL_WIDE_LEAF(D, S)                                                         \
-    if (D < hit.t && counts[S] > 0u) {                                                    \
-        float before = hit.t;                                                             \
-        bool stop = intersect_leaf(&r, object_tris, surf, (uint)(~children[S]), counts[S], \
-                                   rtmin, o, d, any_hit, &hit);                           \
-        if (hit.t < before) hit.instance = slot;                                          \
-        if (stop) return hit;                                                             \
-    }
-
-// A child among the sorted ones, pushed with its entry distance (farthest first): an interior
-// node, or in the top level a leaf's instances (INSTANCE_BIT, traverse.h).
-#define TWO_LEVEL_WIDE_PUSH(D, S)                                                   \
+// A top-level child among the sorted ones, pushed with its entry distance (farthest first):
+// an interior node, or a leaf's pieces (INSTANCE_BIT, traverse.h).
+#define TOP_WIDE_PUSH(D, S)                                                         \
     if (D < hit.t) {                                                                \
         if (counts[S] == 0u) {                                                      \
             stack[sp] = (uint)children[S];                                          \
             stack_d[sp++] = D;                                                      \
-        } else if (!bottom) {                                                       \
+        } else {                                                                    \
             uint first = (uint)(~children[S]);                                      \
             for (uint i = first + counts[S]; i > first; --i) {                      \
-                if (sp == TWO_LEVEL_WIDE_STACK) {                                   \
+                if (sp == TOP_WIDE_STACK) {                                         \
                     atomic_inc(overflow);                                           \
                     return hit;                                                     \
                 }                                                                   \
@@ -254,62 +243,95 @@ inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTri
         }                                                                           \
     }
 
-#define TWO_LEVEL_WIDE_STACK (2 * WIDE_STACK_SIZE + 4)
+#define TOP_WIDE_STACK (WIDE_STACK_SIZE + 4)
 
-// Two levels through wide nodes (the top level from node 0, each instance's bottom level from
-// its wide_root), in one loop with one stack as traverse_two_level (traverse.h) walks the
-// binary ones, and visiting as traverse_wide_bvh does: a popped instance that starts beyond
-// the hit found meanwhile is skipped like a node, so instances are entered nearest first.
+#ifdef HAS_TRIANGLE_PIECES
+// A top-level leaf of one triangle piece among the sorted children, tested on the spot (as
+// WIDE_LEAF tests a leaf) when it starts before the hit so far; its distance is then made
+// infinite so that TOP_WIDE_PUSH passes it over.
+#define TOP_WIDE_TRIANGLE(D, S)                                                           \
+    if (D < hit.t && counts[S] == 1u) {                                                   \
+        uint slot = (uint)(~children[S]);                                                 \
+        global const GpuInstance* piece = &instances[slot];                               \
+        if (piece->flags & INSTANCE_PIECE_TRIANGLE) {                                     \
+            if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris, \
+                                         surf, &world, o, d, tmin, any_hit, &hit)) {      \
+                return hit;                                                               \
+            }                                                                             \
+            D = INFINITY;                                                                 \
+        }                                                                                 \
+    }
+#else
+#define TOP_WIDE_TRIANGLE(D, S)
+#endif
+
+// Two levels through wide nodes: the top level (from node 0; its leaves name pieces in
+// `instances`) walked nearest first as traverse_wide_bvh walks a tree: a leaf of a small
+// mesh's triangle is tested on the spot as the flat loop tests its leaves (TOP_WIDE_TRIANGLE:
+// through the stack, primary rays in the bunny room ran about 10 % slower), and any other
+// piece the ray reaches before the hit so far is entered: the ray carried into the instance's object space, and the instance's bottom level
+// walked from its wide_root by traverse_wide_bvh itself, the flat BVH's loop, with a stack of
+// its own. On a CPU this is faster than one loop over both levels (traverse.h's form, which
+// GPUs keep for their binary nodes): the bottom levels, where rays spend nearly all their
+// visits, run the flat loop's code with its registers.
 inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
                                       global const GpuInstance* instances,
                                       global const GpuTriangle* object_tris,
                                       const SceneSurfaces* surf, float3 o, float3 d,
                                       float tmin, float tmax, bool any_hit,
                                       volatile global uint* overflow) {
-    TWO_LEVEL_STATE
-    WideRay w = wide_ray(&r);
-    uint stack[TWO_LEVEL_WIDE_STACK];
-    float stack_d[TWO_LEVEL_WIDE_STACK];
+    const RayPrep world = prepare_ray(o, d);
+    const WideRay w = wide_ray(&world);
+    GpuHit hit = no_hit(tmax);
+    uint stack[TOP_WIDE_STACK];
+    float stack_d[TOP_WIDE_STACK];
+    uint sp = 0;
+    uint node = 0;
     for (;;) {
-        bool visit = true;
         if (node & INSTANCE_BIT) {
-            VISIT_PIECE
-            visit = !triangle;  // a triangle is tested, not entered
-            if (visit) {
+            uint slot = node & ~INSTANCE_BIT;
+            global const GpuInstance* piece = &instances[slot];
+#ifdef HAS_TRIANGLE_PIECES
+            if (piece->flags & INSTANCE_PIECE_TRIANGLE) {
+                if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris,
+                                             surf, &world, o, d, tmin, any_hit, &hit)) {
+                    return hit;
+                }
+            } else
+#endif
+            {
                 GpuInstance inst = *piece;
-                ENTER_INSTANCE(wide_root)
-                w = wide_ray(&r);
+                float3 od = instance_vector(&inst, d);
+                RayPrep r = prepare_ray(instance_point(&inst, o), od);
+                float before = hit.t;
+                bool stop = traverse_wide_bvh(nodes, inst.wide_root, object_tris, surf, &r, o,
+                                              d, instance_tmin(&inst, o, od, tmin), any_hit,
+                                              &hit, overflow);
+                if (hit.t < before) hit.instance = slot;
+                if (stop) return hit;
+            }
+        } else {
+            global const GpuWideNode* n = &nodes[node];
+            float4 near;
+            int4 mask = wide_reach(n, &w, tmin, hit.t, &near);
+            if (any(mask)) {
+                WIDE_SORT_CHILDREN(n, near, mask)
+                TOP_WIDE_TRIANGLE(d0, s0)
+                TOP_WIDE_TRIANGLE(d1, s1)
+                TOP_WIDE_TRIANGLE(d2, s2)
+                TOP_WIDE_TRIANGLE(d3, s3)
+                if (sp + 4u > TOP_WIDE_STACK) {
+                    atomic_inc(overflow);
+                    return hit;
+                }
+                TOP_WIDE_PUSH(d3, s3)
+                TOP_WIDE_PUSH(d2, s2)
+                TOP_WIDE_PUSH(d1, s1)
+                TOP_WIDE_PUSH(d0, s0)
             }
         }
-        global const GpuWideNode* n = &nodes[node & ~INSTANCE_BIT];
-        float4 near;
-        int4 mask = visit ? wide_reach(n, &w, rtmin, hit.t, &near) : (int4)(0);
-        if (any(mask)) {
-            WIDE_SORT_CHILDREN(n, near, mask)
-            if (bottom) {
-                TWO_LEVEL_WIDE_LEAF(d0, s0)
-                TWO_LEVEL_WIDE_LEAF(d1, s1)
-                TWO_LEVEL_WIDE_LEAF(d2, s2)
-                TWO_LEVEL_WIDE_LEAF(d3, s3)
-            }
-            if (sp + 4u > TWO_LEVEL_WIDE_STACK) {
-                atomic_inc(overflow);
-                return hit;
-            }
-            TWO_LEVEL_WIDE_PUSH(d3, s3)
-            TWO_LEVEL_WIDE_PUSH(d2, s2)
-            TWO_LEVEL_WIDE_PUSH(d1, s1)
-            TWO_LEVEL_WIDE_PUSH(d0, s0)
-        }
-        // The nearest pushed entry that still starts before the hit; below the bottom level's
-        // entries, the world ray again.
+        // The nearest pushed entry that still starts before the hit.
         for (;;) {
-            if (bottom && sp == base) {
-                r = world;
-                w = wide_ray(&r);
-                rtmin = tmin;
-                bottom = false;
-            }
             if (sp == 0u) return hit;
             --sp;
             if (stack_d[sp] < hit.t) break;
@@ -319,8 +341,8 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
 }
 #undef WIDE_ORDER
 #undef WIDE_SORT_CHILDREN
-#undef TWO_LEVEL_WIDE_LEAF
-#undef TWO_LEVEL_WIDE_PUSH
+#undef TOP_WIDE_PUSH
+#undef TOP_WIDE_TRIANGLE
 
 // The scene's traversal through wide nodes: flat, or with TWO_LEVEL two levels.
 inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const GpuTriangle* tris,
