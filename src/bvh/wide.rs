@@ -48,6 +48,13 @@ impl WideBvh {
         Self::collapse_with(bvh, 0)
     }
 
+    /// [`WideBvh::collapse_mapped`] with small subtrees merged into leaves as
+    /// [`WideBvh::collapse_merging`] does (`merge`: the largest merged leaf; 0: none). Binary
+    /// nodes inside a merged leaf have no wide node, as those inside a wide node.
+    pub fn collapse_mapped_merging(bvh: &Bvh, merge: u32) -> (Self, Vec<u32>) {
+        Self::collapse_with(bvh, merge)
+    }
+
     /// [`WideBvh::collapse`] for the CPU megakernel's flat scenes: an interior child whose
     /// subtree holds at most [`MERGED_LEAF`] triangles (one range in BVH order) becomes a leaf
     /// before the node's slots are filled. The binary builder's leaves hold 1–2 triangles, so
@@ -175,12 +182,6 @@ impl WideBvh {
     }
 }
 
-/// The children of the wide node that collapses binary node `binary`: its two children, with
-/// the interior child of the largest surface area opened until there are four (or only leaves).
-pub fn wide_children(bvh: &Bvh, binary: u32) -> Vec<(Aabb, Child)> {
-    frontier(bvh, binary, WIDTH)
-}
-
 /// Up to `width` boxes below node `binary` of `bvh` that hold all of its triangles: its
 /// children, then repeatedly the inner child of largest area replaced by its own two.
 pub fn frontier(bvh: &Bvh, binary: u32, width: usize) -> Vec<(Aabb, Child)> {
@@ -215,7 +216,7 @@ fn subtree_leaf(bvh: &Bvh, node: u32, limit: u32) -> Option<Child> {
 
 /// [`frontier`], with each interior child of at most `merge` triangles made a leaf (see
 /// [`WideBvh::collapse_for_cpu`]; 0 merges nothing).
-fn frontier_merged(bvh: &Bvh, binary: u32, width: usize, merge: u32) -> Vec<(Aabb, Child)> {
+pub fn frontier_merged(bvh: &Bvh, binary: u32, width: usize, merge: u32) -> Vec<(Aabb, Child)> {
     let child = |node: u32, side: usize| {
         let (bounds, c) = bvh.child(node, side);
         match c {
