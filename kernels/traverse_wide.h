@@ -45,6 +45,85 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
 #undef WIDE_MIN
 #undef WIDE_MAX
 
+// intersect_leaf for a leaf of at most four triangles, the four tested at once in float4 lanes
+// with intersect_triangle's arithmetic lane by lane, so that the same hit is kept: the first
+// triangle of the nearest hit (the scalar loop keeps a later one only when strictly nearer), or
+// with any_hit the first triangle hit. Leaves whose test needs the double-precision edge
+// functions or the rounding-error bound fall back to the scalar loop. Used for leaves of three
+// or four triangles (src/bvh/wide.rs merges small subtrees into such leaves in large scenes):
+// for one or two, the scalar tests measured as fast or faster (docs/benchmarks.md, "Sixth
+// session").
+#ifndef HAS_ALPHA
+inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
+                            const SceneSurfaces* surf, uint first, uint count, float tmin,
+                            float3 o, float3 d, bool any_hit, GpuHit* hit) {
+    uint last = first + count - 1u;
+    GpuTriangle t0 = tris[first], t1 = tris[min(first + 1u, last)];
+    GpuTriangle t2 = tris[min(first + 2u, last)], t3 = tris[min(first + 3u, last)];
+    float4 o4 = (float4)(r->origin, 0.0f);
+#define LEAF4_VERTEX(V, X, Y, Z)                                                     \
+    float4 X, Y, Z;                                                                \
+    {                                                                              \
+        float4 p0 = shuffle(t0.V - o4, r->perm), p1 = shuffle(t1.V - o4, r->perm); \
+        float4 p2 = shuffle(t2.V - o4, r->perm), p3 = shuffle(t3.V - o4, r->perm); \
+        X = (float4)(p0.x, p1.x, p2.x, p3.x);                                      \
+        Y = (float4)(p0.y, p1.y, p2.y, p3.y);                                      \
+        Z = (float4)(p0.z, p1.z, p2.z, p3.z);                                      \
+    }
+    LEAF4_VERTEX(v0, aX, aY, aZ)
+    LEAF4_VERTEX(v1, bX, bY, bZ)
+    LEAF4_VERTEX(v2, cX, cY, cZ)
+#undef LEAF4_VERTEX
+    float4 sx = (float4)(r->shear.x), sy = (float4)(r->shear.y), sz = (float4)(r->shear.z);
+    float4 ax = aX - sx * aZ;
+    float4 ay = aY - sy * aZ;
+    float4 bx = bX - sx * bZ;
+    float4 by = bY - sy * bZ;
+    float4 cx = cX - sx * cZ;
+    float4 cy = cY - sy * cZ;
+    float4 u = cx * by - cy * bx;
+    float4 v = ax * cy - ay * cx;
+    float4 w = bx * ay - by * ax;
+    int4 lane = (int4)(0, 1, 2, 3) < (int4)((int)count);
+    float4 zero = (float4)(0.0f);
+    int4 ok = lane & ~(((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero)));
+    float4 det = u + v + w;
+    ok &= det != zero;
+    float4 az = sz * aZ, bz = sz * bZ, cz = sz * cZ;
+    float4 t = (u * az + v * bz + w * cz) / det;
+    ok &= (t > (float4)(tmin)) & (t < (float4)(hit->t));
+    float4 near_bound = 0.00390625f * fmax(fmax(fabs(az), fabs(bz)), fabs(cz));
+    // Rare cases for the scalar test: an edge function of zero (double precision there) or a
+    // hit close enough for the error bound.
+    if (any(lane & ((u == zero) | (v == zero) | (w == zero) | (ok & (t < near_bound))))) {
+        return intersect_leaf(r, tris, surf, first, count, tmin, o, d, any_hit, hit);
+    }
+    if (!any(ok)) return false;
+    float4 tt = select((float4)(INFINITY), t, ok);
+    uint k;
+    if (any_hit) {
+        k = ok.x ? 0u : ok.y ? 1u : ok.z ? 2u : 3u;
+    } else {
+        float m = fmin(fmin(tt.x, tt.y), fmin(tt.z, tt.w));
+        k = tt.x == m ? 0u : tt.y == m ? 1u : tt.z == m ? 2u : 3u;
+    }
+    float tk = k == 0u ? t.x : k == 1u ? t.y : k == 2u ? t.z : t.w;
+    float vk = k == 0u ? v.x : k == 1u ? v.y : k == 2u ? v.z : v.w;
+    float wk = k == 0u ? w.x : k == 1u ? w.y : k == 2u ? w.z : w.w;
+    float dk = k == 0u ? det.x : k == 1u ? det.y : k == 2u ? det.z : det.w;
+    hit->t = tk;
+    hit->u = vk / dk;
+    hit->v = wk / dk;
+    hit->prim = first + k;
+    return any_hit;
+}
+#define INTERSECT_LEAF(r, tris, surf, first, count, tmin, o, d, any_hit, hit)                  \
+    ((count) - 3u <= 1u ? intersect_leaf4(r, tris, surf, first, count, tmin, o, d, any_hit, hit) \
+                   : intersect_leaf(r, tris, surf, first, count, tmin, o, d, any_hit, hit))
+#else
+#define INTERSECT_LEAF intersect_leaf
+#endif
+
 // Compare-and-swap of two (entry distance, slot) pairs, ordered by distance and then slot, so
 // that the network below sorts as a stable sort would (the host reference's order).
 #define WIDE_ORDER(A, B)                                           \
@@ -75,7 +154,7 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
 // A leaf among the sorted children, tested on the spot when it starts before the hit so far.
 #define WIDE_LEAF(D, S)                                                                     \
     if (D < hit->t && counts[S] > 0u &&                                                     \
-        intersect_leaf(r, tris, surf, (uint)(~children[S]), counts[S], tmin, o, d, any_hit, \
+        INTERSECT_LEAF(r, tris, surf, (uint)(~children[S]), counts[S], tmin, o, d, any_hit, \
                        hit)) {                                                              \
         return true;                                                                        \
     }
@@ -132,6 +211,7 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
 }
 #undef WIDE_LEAF
 #undef WIDE_PUSH
+#undef INTERSECT_LEAF
 
 // Closest hit (any_hit = false) or first hit (any_hit = true), as traverse() in traverse.h.
 inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTriangle* tris,
@@ -165,10 +245,31 @@ inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTri
 
 #define TOP_WIDE_STACK (WIDE_STACK_SIZE + 4)
 
+#ifdef HAS_TRIANGLE_PIECES
+// A top-level leaf of one triangle piece among the sorted children, tested on the spot (as
+// WIDE_LEAF tests a leaf) when it starts before the hit so far; its distance is then made
+// infinite so that TOP_WIDE_PUSH passes it over.
+#define TOP_WIDE_TRIANGLE(D, S)                                                           \
+    if (D < hit.t && counts[S] == 1u) {                                                   \
+        uint slot = (uint)(~children[S]);                                                 \
+        global const GpuInstance* piece = &instances[slot];                               \
+        if (piece->flags & INSTANCE_PIECE_TRIANGLE) {                                     \
+            if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris, \
+                                         surf, &world, o, d, tmin, any_hit, &hit)) {      \
+                return hit;                                                               \
+            }                                                                             \
+            D = INFINITY;                                                                 \
+        }                                                                                 \
+    }
+#else
+#define TOP_WIDE_TRIANGLE(D, S)
+#endif
+
 // Two levels through wide nodes: the top level (from node 0; its leaves name pieces in
-// `instances`) walked nearest first as traverse_wide_bvh walks a tree, and each piece the ray
-// reaches before the hit so far either tested on the spot (a small mesh's triangle) or
-// entered: the ray carried into the instance's object space, and the instance's bottom level
+// `instances`) walked nearest first as traverse_wide_bvh walks a tree: a leaf of a small
+// mesh's triangle is tested on the spot as the flat loop tests its leaves (TOP_WIDE_TRIANGLE:
+// through the stack, primary rays in the bunny room ran about 10 % slower), and any other
+// piece the ray reaches before the hit so far is entered: the ray carried into the instance's object space, and the instance's bottom level
 // walked from its wide_root by traverse_wide_bvh itself, the flat BVH's loop, with a stack of
 // its own. On a CPU this is faster than one loop over both levels (traverse.h's form, which
 // GPUs keep for their binary nodes): the bottom levels, where rays spend nearly all their
@@ -215,6 +316,10 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
             int4 mask = wide_reach(n, &w, tmin, hit.t, &near);
             if (any(mask)) {
                 WIDE_SORT_CHILDREN(n, near, mask)
+                TOP_WIDE_TRIANGLE(d0, s0)
+                TOP_WIDE_TRIANGLE(d1, s1)
+                TOP_WIDE_TRIANGLE(d2, s2)
+                TOP_WIDE_TRIANGLE(d3, s3)
                 if (sp + 4u > TOP_WIDE_STACK) {
                     atomic_inc(overflow);
                     return hit;
@@ -237,6 +342,7 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
 #undef WIDE_ORDER
 #undef WIDE_SORT_CHILDREN
 #undef TOP_WIDE_PUSH
+#undef TOP_WIDE_TRIANGLE
 
 // The scene's traversal through wide nodes: flat, or with TWO_LEVEL two levels.
 inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const GpuTriangle* tris,

@@ -85,10 +85,23 @@ fn layout_probe_agrees_with_every_shared_rust_struct() {
 
 #[test]
 fn kernel_traversal_equals_host_traversal() {
-    // Binary and 4-wide BVH kernels alike.
+    check_kernel_traversal(3000);
+}
+
+#[test]
+fn kernel_traversal_equals_host_traversal_with_merged_leaves() {
+    // Large enough for the CPU's wide BVH to merge small subtrees into leaves of up to four
+    // triangles, which the wide kernels test in float4 lanes.
+    let n = penumbra::bvh::MERGE_MIN_TRIANGLES + 1000;
+    check_kernel_traversal(n);
+}
+
+/// Binary and 4-wide BVH kernels alike find the host traversal's hits in a scene of `n`
+/// random triangles.
+fn check_kernel_traversal(n: usize) {
     let mut r = renderer();
     // In world coordinates (no render frame): the rays below are made in world space.
-    r.load_scene_in(&random_scene(3000), &[], RenderFrame::default())
+    r.load_scene_in(&random_scene(n), &[], RenderFrame::default())
         .unwrap();
     let host = r.host_scene().unwrap();
     let mut s = 17u64;

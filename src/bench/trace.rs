@@ -291,6 +291,41 @@ impl Tracer<'_> {
     }
 }
 
+/// With `PENUMBRA_DUMP_TRACE=DIR` (flat BVH only): the wide nodes, the triangles (vertices only)
+/// and each ray set with the device's hits, as raw little-endian arrays in DIR, for timing the
+/// same traversal outside OpenCL (scripts/experiments/native_trace/).
+fn dump_trace(dir: &str, host: &HostScene, sets: &[(&str, &[GpuRay], &[GpuHit])]) -> Result<()> {
+    use crate::cl::types::GpuTriangle;
+    let Accel::Flat(bvh) = &host.accel else {
+        anyhow::bail!("PENUMBRA_DUMP_TRACE needs --bvh flat");
+    };
+    let nodes = crate::bvh::WideBvh::collapse_for_cpu(bvh).nodes;
+    let tris: Vec<GpuTriangle> = host
+        .vertices
+        .iter()
+        .map(|v| GpuTriangle {
+            v0: v[0].extend(0.0).to_array(),
+            v1: v[1].extend(0.0).to_array(),
+            v2: v[2].extend(0.0).to_array(),
+        })
+        .collect();
+    let path = |name: &str| std::path::Path::new(dir).join(name);
+    std::fs::create_dir_all(dir)?;
+    std::fs::write(path("nodes.bin"), bytemuck::cast_slice(&nodes))?;
+    std::fs::write(path("tris.bin"), bytemuck::cast_slice(&tris))?;
+    for (name, rays, hits) in sets {
+        std::fs::write(
+            path(&format!("{name}_rays.bin")),
+            bytemuck::cast_slice(rays),
+        )?;
+        std::fs::write(
+            path(&format!("{name}_hits.bin")),
+            bytemuck::cast_slice(hits),
+        )?;
+    }
+    Ok(())
+}
+
 /// Runs the benchmark.
 pub fn run(args: &TraceArgs) -> Result<()> {
     if args.runs == 0 {
@@ -365,6 +400,16 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     } else {
         let diffuse = rays::diffuse_rays(&points, primary.len(), args.seed);
         let (hits, times) = tracer.closest(&diffuse)?;
+        if let Ok(dir) = std::env::var("PENUMBRA_DUMP_TRACE") {
+            dump_trace(
+                &dir,
+                host,
+                &[
+                    ("primary", &primary, &primary_hits),
+                    ("diffuse", &diffuse, &hits),
+                ],
+            )?;
+        }
         let check = timed(|| check_closest(host, &diffuse, &hits, args.validate));
         let n = hits.iter().filter(|h| h.prim != MISS).count();
         results.push(set_result(

@@ -14,8 +14,8 @@
 //! device reports them: the device keeps each mesh's triangles and shading data once, in
 //! object space, and shading carries a hit to world space through the instance's transform.
 
-use super::wide::{frontier, wide_children};
-use super::{Aabb, Bvh, Child, Hit, Ray, WideBvh, build, build_boxes, build_indexed};
+use super::wide::{MERGE_MIN_TRIANGLES, MERGED_LEAF, frontier, frontier_merged};
+use super::{Aabb, Bvh, Child, Hit, Ray, WIDTH, WideBvh, build, build_boxes, build_indexed};
 use crate::cl::types::{GpuBvhNode, GpuHit, GpuWideNode};
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
@@ -217,6 +217,10 @@ pub struct TwoLevel {
     /// Meshes of at most this many triangles are small: each of their instances' triangles is
     /// a TLAS piece of its own (see [`TwoLevel::braid`]; 0: none).
     pub small_mesh: usize,
+    /// The largest leaf the wide BLASes merge small subtrees into (0: none): as the CPU's flat
+    /// BVH does ([`WideBvh::collapse_for_cpu`]) when the meshes hold [`MERGE_MIN_TRIANGLES`]
+    /// or more, so that both levels' bottoms are walked as fast as the flat tree.
+    pub merge: u32,
 }
 
 impl TwoLevel {
@@ -253,7 +257,14 @@ impl TwoLevel {
                 first - b.triangles.len() as u32
             })
             .collect();
+        let unique: usize = blases.iter().map(|b| b.triangles.len()).sum();
+        let merge = if unique >= MERGE_MIN_TRIANGLES {
+            MERGED_LEAF
+        } else {
+            0
+        };
         let mut two = Self {
+            merge,
             hidden,
             blases,
             instances,
@@ -393,7 +404,7 @@ impl TwoLevel {
             let (i, node, _) = pieces[k];
             let inst = &self.instances[i as usize];
             let blas = &self.blases[inst.blas as usize];
-            let children = wide_children(&blas.bvh, node);
+            let children = frontier_merged(&blas.bvh, node, WIDTH, self.merge);
             if pieces.len() + children.len() - 1 > self.max_pieces
                 || children.iter().any(|c| !matches!(c.1, Child::Node(_)))
             {
@@ -543,7 +554,7 @@ impl TwoLevel {
         for b in &self.blases {
             let base = nodes.len() as i32;
             roots.push(base as u32);
-            let (wide, binaries) = WideBvh::collapse_mapped(&b.bvh);
+            let (wide, binaries) = WideBvh::collapse_mapped_merging(&b.bvh, self.merge);
             let mut map = vec![u32::MAX; b.bvh.nodes.len()];
             for (w, &n) in binaries.iter().enumerate() {
                 map[n as usize] = w as u32;

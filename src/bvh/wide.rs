@@ -12,6 +12,17 @@ use glam::Vec3;
 /// Children per wide node.
 pub const WIDTH: usize = 4;
 
+/// The largest leaf [`WideBvh::collapse_for_cpu`] makes of a small subtree: the CPU kernels test
+/// a leaf of three or four triangles in one go, one triangle per `float4` lane.
+pub const MERGED_LEAF: u32 = 4;
+
+/// The fewest triangles for which [`WideBvh::collapse_for_cpu`] merges small subtrees: below
+/// this the wide nodes fit a core's L2 cache (2 MB: 16 K nodes of 128 bytes, from about 30 K
+/// triangles), traversal is bound by arithmetic rather than memory, and the builder's own
+/// leaves measured faster (Cornell box 7–10 % slower merged; docs/benchmarks.md, "Sixth
+/// session").
+pub const MERGE_MIN_TRIANGLES: usize = 65_536;
+
 /// Entries of the wide traversal stack; the kernels use the same size. A visit pushes at most
 /// `WIDTH - 1` children and every wide level is at least one binary level, so a binary tree
 /// within the builder's depth limit needs at most 3 × 48 entries.
@@ -34,11 +45,45 @@ impl WideBvh {
     /// [`WideBvh::collapse`], and the binary node each wide node collapses (the root of the
     /// same subtree; two-level re-braiding enters BLASes at such nodes, see `bvh::instances`).
     pub fn collapse_mapped(bvh: &Bvh) -> (Self, Vec<u32>) {
+        Self::collapse_with(bvh, 0)
+    }
+
+    /// [`WideBvh::collapse_mapped`] with small subtrees merged into leaves as
+    /// [`WideBvh::collapse_merging`] does (`merge`: the largest merged leaf; 0: none). Binary
+    /// nodes inside a merged leaf have no wide node, as those inside a wide node.
+    pub fn collapse_mapped_merging(bvh: &Bvh, merge: u32) -> (Self, Vec<u32>) {
+        Self::collapse_with(bvh, merge)
+    }
+
+    /// [`WideBvh::collapse`] for the CPU megakernel's flat scenes: an interior child whose
+    /// subtree holds at most [`MERGED_LEAF`] triangles (one range in BVH order) becomes a leaf
+    /// before the node's slots are filled. The binary builder's leaves hold 1–2 triangles, so
+    /// without this 44 % of the 1 M-triangle bunnies' wide nodes have only two children, both
+    /// leaves; merged, there are 0.55 times the nodes and a ray visits 4–5 % fewer of them,
+    /// while traverse_wide.h tests a leaf of three or four triangles in the four lanes of one
+    /// `float4` test (docs/benchmarks.md, "Sixth session"). The same triangles are tested, in BVH order
+    /// within a merged leaf, so the closest hit is the same (short of exact ties in t).
+    /// Scenes of fewer than [`MERGE_MIN_TRIANGLES`] triangles are collapsed as they are.
+    pub fn collapse_for_cpu(bvh: &Bvh) -> Self {
+        if bvh.tri_indices.len() >= MERGE_MIN_TRIANGLES {
+            Self::collapse_merging(bvh, MERGED_LEAF)
+        } else {
+            Self::collapse(bvh)
+        }
+    }
+
+    /// [`WideBvh::collapse`] with each interior child of at most `limit` triangles (in one
+    /// range) made a leaf.
+    pub fn collapse_merging(bvh: &Bvh, limit: u32) -> Self {
+        Self::collapse_with(bvh, limit).0
+    }
+
+    fn collapse_with(bvh: &Bvh, merge: u32) -> (Self, Vec<u32>) {
         let mut nodes = vec![GpuWideNode::default()];
         let mut binaries = vec![0u32];
         let mut work = vec![(0u32, 0usize)]; // (binary node, wide node)
         while let Some((binary, wide)) = work.pop() {
-            let slots = wide_children(bvh, binary);
+            let slots = frontier_merged(bvh, binary, WIDTH, merge);
             let mut out = GpuWideNode::default();
             for (i, &(bounds, child)) in slots.iter().enumerate() {
                 out.min_x[i] = bounds.min.x;
@@ -137,16 +182,49 @@ impl WideBvh {
     }
 }
 
-/// The children of the wide node that collapses binary node `binary`: its two children, with
-/// the interior child of the largest surface area opened until there are four (or only leaves).
-pub fn wide_children(bvh: &Bvh, binary: u32) -> Vec<(Aabb, Child)> {
-    frontier(bvh, binary, WIDTH)
-}
-
 /// Up to `width` boxes below node `binary` of `bvh` that hold all of its triangles: its
 /// children, then repeatedly the inner child of largest area replaced by its own two.
 pub fn frontier(bvh: &Bvh, binary: u32, width: usize) -> Vec<(Aabb, Child)> {
-    let mut slots: Vec<(Aabb, Child)> = (0..2).map(|side| bvh.child(binary, side)).collect();
+    frontier_merged(bvh, binary, width, 0)
+}
+
+/// The triangles of the subtree below binary node `node` as one leaf, when they are at most
+/// `limit` and form one range in BVH order.
+fn subtree_leaf(bvh: &Bvh, node: u32, limit: u32) -> Option<Child> {
+    let (mut first, mut end, mut total) = (u32::MAX, 0u32, 0u32);
+    let mut work = vec![node];
+    while let Some(n) = work.pop() {
+        for side in 0..2 {
+            match bvh.child(n, side).1 {
+                Child::Node(c) => work.push(c),
+                Child::Leaf { first: f, count } => {
+                    total += count;
+                    if total > limit {
+                        return None;
+                    }
+                    first = first.min(f);
+                    end = end.max(f + count);
+                }
+            }
+        }
+    }
+    (end - first == total).then_some(Child::Leaf {
+        first,
+        count: total,
+    })
+}
+
+/// [`frontier`], with each interior child of at most `merge` triangles made a leaf (see
+/// [`WideBvh::collapse_for_cpu`]; 0 merges nothing).
+pub fn frontier_merged(bvh: &Bvh, binary: u32, width: usize, merge: u32) -> Vec<(Aabb, Child)> {
+    let child = |node: u32, side: usize| {
+        let (bounds, c) = bvh.child(node, side);
+        match c {
+            Child::Node(n) if merge > 0 => (bounds, subtree_leaf(bvh, n, merge).unwrap_or(c)),
+            _ => (bounds, c),
+        }
+    };
+    let mut slots: Vec<(Aabb, Child)> = (0..2).map(|side| child(binary, side)).collect();
     while slots.len() < width {
         let Some((i, node)) = slots
             .iter()
@@ -161,7 +239,7 @@ pub fn frontier(bvh: &Bvh, binary: u32, width: usize) -> Vec<(Aabb, Child)> {
             break;
         };
         slots.swap_remove(i);
-        slots.extend((0..2).map(|side| bvh.child(node, side)));
+        slots.extend((0..2).map(|side| child(node, side)));
     }
     slots
 }
@@ -197,7 +275,54 @@ mod tests {
         let tris = random_triangles(5000, 3);
         let bvh = crate::bvh::build(&tris);
         let wide = WideBvh::collapse(&bvh);
-        let ordered = ordered(&bvh, &tris);
+        check_leaves(&bvh, &tris, &wide);
+        // Four-wide nodes: about a third as many as the binary tree's.
+        assert!(
+            wide.nodes.len() * 2 < bvh.nodes.len(),
+            "{}",
+            wide.nodes.len()
+        );
+    }
+
+    #[test]
+    fn merged_small_subtrees_are_leaves_of_at_most_four_triangles() {
+        let tris = random_triangles(5000, 3);
+        let bvh = crate::bvh::build(&tris);
+        let merged = WideBvh::collapse_merging(&bvh, MERGED_LEAF);
+        check_leaves(&bvh, &tris, &merged);
+        let leaves = leaf_sizes(&merged);
+        let mean = leaves.iter().sum::<u32>() as f32 / leaves.len() as f32;
+        let plain = WideBvh::collapse(&bvh);
+        // The builder's own leaves may be larger; merging makes none larger than MERGED_LEAF.
+        let builder_max = leaf_sizes(&plain).into_iter().max().unwrap();
+        assert!(
+            leaves.iter().all(|&c| c <= MERGED_LEAF.max(builder_max)),
+            "leaf sizes"
+        );
+        assert!(
+            merged.nodes.len() < plain.nodes.len() * 3 / 4,
+            "{} merged nodes against {}",
+            merged.nodes.len(),
+            plain.nodes.len()
+        );
+        assert!(mean > 2.0, "mean leaf {mean}");
+        // Small scenes stay as built.
+        assert_eq!(WideBvh::collapse_for_cpu(&bvh).nodes, plain.nodes);
+    }
+
+    fn leaf_sizes(wide: &WideBvh) -> Vec<u32> {
+        (0..wide.nodes.len() as u32)
+            .flat_map(|n| wide.children(n).collect::<Vec<_>>())
+            .filter_map(|(_, c)| match c {
+                Child::Leaf { count, .. } => Some(count),
+                Child::Node(_) => None,
+            })
+            .collect()
+    }
+
+    /// Every triangle in exactly one leaf whose box holds it; every node reached once.
+    fn check_leaves(bvh: &Bvh, tris: &[[Vec3; 3]], wide: &WideBvh) {
+        let ordered = ordered(bvh, tris);
         let mut seen = vec![0u32; tris.len()];
         let mut reached = vec![false; wide.nodes.len()];
         reached[0] = true;
@@ -226,12 +351,6 @@ mod tests {
         }
         assert!(seen.iter().all(|&c| c == 1), "each triangle once");
         assert!(reached.iter().all(|&r| r), "every node reachable");
-        // Four-wide nodes: about a third as many as the binary tree's.
-        assert!(
-            wide.nodes.len() * 2 < bvh.nodes.len(),
-            "{}",
-            wide.nodes.len()
-        );
     }
 
     #[test]
@@ -239,6 +358,7 @@ mod tests {
         let tris = random_triangles(3000, 9);
         let bvh = crate::bvh::build(&tris);
         let wide = WideBvh::collapse(&bvh);
+        let merged = WideBvh::collapse_merging(&bvh, MERGED_LEAF);
         let ordered = ordered(&bvh, &tris);
         let mut s = 5u64;
         let mut rnd = move || {
@@ -263,6 +383,8 @@ mod tests {
             let a = bvh.intersect(&ray, &ordered);
             let b = wide.intersect(&ray, &ordered);
             assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "ray {i}");
+            let c = merged.intersect(&ray, &ordered);
+            assert_eq!(a.map(|h| h.t), c.map(|h| h.t), "ray {i}, merged leaves");
             hits += a.is_some() as usize;
         }
         assert!(hits > 400, "the rays hit something ({hits})");

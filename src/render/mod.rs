@@ -781,7 +781,7 @@ fn device_accel(host: &mut HostScene) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec
     match &host.accel {
         Accel::Flat(bvh) => (
             bvh.nodes.clone(),
-            WideBvh::collapse(bvh).nodes,
+            WideBvh::collapse_for_cpu(bvh).nodes,
             vec![GpuInstance::default()],
         ),
         Accel::TwoLevel(two) => {
