@@ -12,6 +12,7 @@ use opencl3::memory::{CL_MEM_READ_WRITE, CL_MEM_USE_HOST_PTR, ClMem};
 use opencl3::types::CL_BLOCKING;
 use std::ptr;
 use std::sync::OnceLock;
+use std::sync::atomic::Ordering;
 
 /// A typed device buffer of `len` elements (at least one is allocated: OpenCL has no empty
 /// buffers).
@@ -138,10 +139,23 @@ const HUGE_PAGE: usize = 2 << 20;
 /// (docs/benchmarks.md). Linux gives huge pages to advised memory when
 /// /sys/kernel/mm/transparent_hugepage/enabled is `madvise` (Debian's default) or `always`;
 /// with `never` this is ordinary aligned memory.
+/// Only the first [`HUGE_BUDGET`] bytes of live buffers are advised: on a machine whose memory
+/// is fragmented Linux compacts memory to fault a huge page in (`defrag` `madvise`, Debian's
+/// default), which cost about 4 s a GB on the development VM against 0.7 s for small pages, and
+/// a 16 M-triangle scene's upload took 14 s instead of 5 s (docs/benchmarks.md, sixth
+/// session). Scenes of up to about two million triangles keep their huge pages.
 struct HostPages {
     ptr: *mut u8,
     len: usize,
+    /// Whether the range was advised for huge pages (and counts in [`HUGE_BYTES`]).
+    huge: bool,
 }
+
+/// The most bytes of CPU device buffers advised for huge pages at once (see [`HostPages`]).
+const HUGE_BUDGET: usize = 512 << 20;
+
+/// Bytes of live [`HostPages`] advised for huge pages.
+static HUGE_BYTES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 impl HostPages {
     /// `bytes` bytes (rounded up to whole huge pages) of a fresh anonymous mapping aligned to a
@@ -170,7 +184,7 @@ impl HostPages {
         let aligned = start.next_multiple_of(HUGE_PAGE);
         let (head, tail) = (aligned - start, start + mapped - (aligned + len));
         // SAFETY: the slack before and after the aligned range is part of this mapping and
-        // unused; the advice changes no contents.
+        // unused.
         unsafe {
             if head > 0 {
                 libc::munmap(base, head);
@@ -178,11 +192,20 @@ impl HostPages {
             if tail > 0 {
                 libc::munmap((aligned + len) as *mut std::ffi::c_void, tail);
             }
-            libc::madvise(aligned as *mut std::ffi::c_void, len, libc::MADV_HUGEPAGE);
+        }
+        let huge = HUGE_BYTES
+            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |used| {
+                (used + len <= HUGE_BUDGET).then_some(used + len)
+            })
+            .is_ok();
+        if huge {
+            // SAFETY: the aligned range is this mapping's; the advice changes no contents.
+            unsafe { libc::madvise(aligned as *mut std::ffi::c_void, len, libc::MADV_HUGEPAGE) };
         }
         Some(Self {
             ptr: aligned as *mut u8,
             len,
+            huge,
         })
     }
 
@@ -214,6 +237,9 @@ impl HostPages {
 
 impl Drop for HostPages {
     fn drop(&mut self) {
+        if self.huge {
+            HUGE_BYTES.fetch_sub(self.len, Ordering::Relaxed);
+        }
         #[cfg(target_os = "linux")]
         // SAFETY: the range was mapped by HostPages::new and is unmapped once, here.
         unsafe {
@@ -1025,6 +1051,7 @@ mod tests {
             return;
         }
         let pages = pages.expect("8 MiB can be mapped");
+        assert!(pages.huge, "8 MiB is within the huge-page budget");
         assert_eq!(pages.ptr as usize % HUGE_PAGE, 0);
         assert_eq!(pages.len, 4 * HUGE_PAGE);
         // SAFETY: the mapping is `len` bytes long and ours.
@@ -1036,6 +1063,20 @@ mod tests {
                 "no huge page backs the advised memory ({kb} kB)"
             );
         }
+    }
+
+    #[test]
+    fn host_pages_beyond_the_huge_page_budget_are_not_advised() {
+        let Some(big) = HostPages::new(HUGE_BUDGET + HUGE_PAGE) else {
+            assert!(
+                cfg!(not(target_os = "linux")),
+                "address space can be mapped"
+            );
+            return;
+        };
+        // Mapped but never touched: no memory is used.
+        assert!(!big.huge, "more than the whole budget is never advised");
+        assert_eq!(big.len, HUGE_BUDGET + HUGE_PAGE);
     }
 
     #[test]
