@@ -269,9 +269,9 @@ inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTri
 // `instances`) walked nearest first as traverse_wide_bvh walks a tree: a leaf of a small
 // mesh's triangle is tested on the spot as the flat loop tests its leaves (TOP_WIDE_TRIANGLE:
 // through the stack, primary rays in the bunny room ran about 10 % slower), and any other
-// piece the ray reaches before the hit so far is entered: the ray carried into the instance's object space, and the instance's bottom level
-// walked from its wide_root by traverse_wide_bvh itself, the flat BVH's loop, with a stack of
-// its own. On a CPU this is faster than one loop over both levels (traverse.h's form, which
+// piece the ray reaches before the hit so far is entered: the ray is carried into the
+// instance's object space, and the instance's bottom level walked from its wide_root by
+// traverse_wide_bvh itself, the flat BVH's loop, with a stack of its own. On a CPU this is faster than one loop over both levels (traverse.h's form, which
 // GPUs keep for their binary nodes): the bottom levels, where rays spend nearly all their
 // visits, run the flat loop's code with its registers.
 inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
