@@ -598,6 +598,16 @@ fn variant_picker(ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
     }
 }
 
+/// A byte count for the overlay: MB, or kB below a tenth of a MB (a small scene's buffers
+/// would read "0.0 MB").
+fn memory_size(bytes: usize) -> String {
+    if bytes < 100_000 {
+        format!("{:.1} kB", bytes as f64 / 1e3)
+    } else {
+        format!("{:.1} MB", bytes as f64 / 1e6)
+    }
+}
+
 fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
     egui::CollapsingHeader::new("Statistics")
         .default_open(true)
@@ -605,8 +615,11 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
             let p = info.progress;
             ui.label(format!("device: {}", info.device));
             if let Some(s) = info.scene_stats {
-                let mb = s.device_bytes as f64 / 1e6;
-                ui.label(format!("device memory {mb:.1} MB · {} BVH", s.bvh));
+                ui.label(format!(
+                    "device memory {} · {} BVH",
+                    memory_size(s.device_bytes),
+                    s.bvh
+                ));
             }
             let moving = if info.film.divisor > 1 {
                 format!(" (1/{} while moving)", info.film.divisor)
@@ -675,4 +688,17 @@ fn controls_section(ui: &mut Ui) {
                 }
             });
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::memory_size;
+
+    #[test]
+    fn memory_sizes_read_in_kilobytes_below_a_tenth_of_a_megabyte() {
+        assert_eq!(memory_size(12_345), "12.3 kB");
+        assert_eq!(memory_size(99_999), "100.0 kB");
+        assert_eq!(memory_size(100_000), "0.1 MB");
+        assert_eq!(memory_size(218_000_000), "218.0 MB");
+    }
 }
