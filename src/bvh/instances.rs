@@ -14,7 +14,7 @@
 //! device reports them: the device keeps each mesh's triangles and shading data once, in
 //! object space, and shading carries a hit to world space through the instance's transform.
 
-use super::wide::{MERGE_MIN_TRIANGLES, MERGED_LEAF, frontier, frontier_merged};
+use super::wide::{frontier, merge_limit};
 use super::{Aabb, Bvh, Child, Hit, Ray, WIDTH, WideBvh, build, build_boxes, build_indexed};
 use crate::cl::types::{GpuBvhNode, GpuHit, GpuWideNode};
 use glam::{DMat4, DVec3, Vec3};
@@ -151,7 +151,7 @@ impl Instance {
     /// corners; its parts' boxes grow with theirs, which are smaller, so the union hugs the
     /// object and fewer rays enter an instance only to miss it.
     fn node_world_box(&self, bvh: &Bvh, node: u32) -> Aabb {
-        frontier(bvh, node, FRONTIER)
+        frontier(bvh, node, FRONTIER, 0)
             .into_iter()
             // A leaf of no triangles (a one-leaf tree's other side) has the empty box, whose
             // infinite corners would carry to NaN.
@@ -218,8 +218,8 @@ pub struct TwoLevel {
     /// a TLAS piece of its own (see [`TwoLevel::braid`]; 0: none).
     pub small_mesh: usize,
     /// The largest leaf the wide BLASes merge small subtrees into (0: none): as the CPU's flat
-    /// BVH does ([`WideBvh::collapse_for_cpu`]) when the meshes hold [`MERGE_MIN_TRIANGLES`]
-    /// or more, so that both levels' bottoms are walked as fast as the flat tree.
+    /// BVH does ([`WideBvh::collapse_for_cpu`]), by the meshes' triangles ([`merge_limit`]), so
+    /// that both levels' bottoms are walked as fast as the flat tree.
     pub merge: u32,
 }
 
@@ -258,13 +258,8 @@ impl TwoLevel {
             })
             .collect();
         let unique: usize = blases.iter().map(|b| b.triangles.len()).sum();
-        let merge = if unique >= MERGE_MIN_TRIANGLES {
-            MERGED_LEAF
-        } else {
-            0
-        };
         let mut two = Self {
-            merge,
+            merge: merge_limit(unique),
             hidden,
             blases,
             instances,
@@ -404,7 +399,7 @@ impl TwoLevel {
             let (i, node, _) = pieces[k];
             let inst = &self.instances[i as usize];
             let blas = &self.blases[inst.blas as usize];
-            let children = frontier_merged(&blas.bvh, node, WIDTH, self.merge);
+            let children = frontier(&blas.bvh, node, WIDTH, self.merge);
             if pieces.len() + children.len() - 1 > self.max_pieces
                 || children.iter().any(|c| !matches!(c.1, Child::Node(_)))
             {
@@ -554,7 +549,7 @@ impl TwoLevel {
         for b in &self.blases {
             let base = nodes.len() as i32;
             roots.push(base as u32);
-            let (wide, binaries) = WideBvh::collapse_mapped_merging(&b.bvh, self.merge);
+            let (wide, binaries) = WideBvh::collapse_mapped(&b.bvh, self.merge);
             let mut map = vec![u32::MAX; b.bvh.nodes.len()];
             for (w, &n) in binaries.iter().enumerate() {
                 map[n as usize] = w as u32;

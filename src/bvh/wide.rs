@@ -23,6 +23,16 @@ pub const MERGED_LEAF: u32 = 4;
 /// session").
 pub const MERGE_MIN_TRIANGLES: usize = 65_536;
 
+/// The largest leaf the CPU's wide trees over `triangles` triangles merge small subtrees into
+/// ([`WideBvh::collapse_for_cpu`]; 0: none, below [`MERGE_MIN_TRIANGLES`]).
+pub fn merge_limit(triangles: usize) -> u32 {
+    if triangles >= MERGE_MIN_TRIANGLES {
+        MERGED_LEAF
+    } else {
+        0
+    }
+}
+
 /// Entries of the wide traversal stack; the kernels use the same size. A visit pushes at most
 /// `WIDTH - 1` children and every wide level is at least one binary level, so a binary tree
 /// within the builder's depth limit needs at most 3 × 48 entries.
@@ -39,20 +49,7 @@ impl WideBvh {
     /// Collapses `bvh`: each wide node takes its binary node's two children and keeps opening
     /// the interior child with the largest surface area until it has four (or only leaves).
     pub fn collapse(bvh: &Bvh) -> Self {
-        Self::collapse_mapped(bvh).0
-    }
-
-    /// [`WideBvh::collapse`], and the binary node each wide node collapses (the root of the
-    /// same subtree; two-level re-braiding enters BLASes at such nodes, see `bvh::instances`).
-    pub fn collapse_mapped(bvh: &Bvh) -> (Self, Vec<u32>) {
-        Self::collapse_with(bvh, 0)
-    }
-
-    /// [`WideBvh::collapse_mapped`] with small subtrees merged into leaves as
-    /// [`WideBvh::collapse_merging`] does (`merge`: the largest merged leaf; 0: none). Binary
-    /// nodes inside a merged leaf have no wide node, as those inside a wide node.
-    pub fn collapse_mapped_merging(bvh: &Bvh, merge: u32) -> (Self, Vec<u32>) {
-        Self::collapse_with(bvh, merge)
+        Self::collapse_mapped(bvh, 0).0
     }
 
     /// [`WideBvh::collapse`] for the CPU megakernel's flat scenes: an interior child whose
@@ -61,29 +58,29 @@ impl WideBvh {
     /// without this 44 % of the 1 M-triangle bunnies' wide nodes have only two children, both
     /// leaves; merged, there are 0.55 times the nodes and a ray visits 4–5 % fewer of them,
     /// while traverse_wide.h tests a leaf of three or four triangles in the four lanes of one
-    /// `float4` test (docs/benchmarks.md, "Sixth session"). The same triangles are tested, in BVH order
-    /// within a merged leaf, so the closest hit is the same (short of exact ties in t).
-    /// Scenes of fewer than [`MERGE_MIN_TRIANGLES`] triangles are collapsed as they are.
+    /// `float4` test (docs/benchmarks.md, "Sixth session"). The same triangles are tested, in
+    /// BVH order within a merged leaf, so the closest hit is the same (short of exact ties in
+    /// t). How much is merged follows the tree's size ([`merge_limit`]).
     pub fn collapse_for_cpu(bvh: &Bvh) -> Self {
-        if bvh.tri_indices.len() >= MERGE_MIN_TRIANGLES {
-            Self::collapse_merging(bvh, MERGED_LEAF)
-        } else {
-            Self::collapse(bvh)
-        }
+        Self::collapse_merging(bvh, merge_limit(bvh.tri_indices.len()))
     }
 
     /// [`WideBvh::collapse`] with each interior child of at most `limit` triangles (in one
     /// range) made a leaf.
     pub fn collapse_merging(bvh: &Bvh, limit: u32) -> Self {
-        Self::collapse_with(bvh, limit).0
+        Self::collapse_mapped(bvh, limit).0
     }
 
-    fn collapse_with(bvh: &Bvh, merge: u32) -> (Self, Vec<u32>) {
+    /// [`WideBvh::collapse_merging`] (`merge` 0: [`WideBvh::collapse`]), and the binary node
+    /// each wide node collapses (the root of the same subtree; two-level re-braiding enters
+    /// BLASes at such nodes, see `bvh::instances`). Binary nodes inside a wide node or a merged
+    /// leaf have none.
+    pub fn collapse_mapped(bvh: &Bvh, merge: u32) -> (Self, Vec<u32>) {
         let mut nodes = vec![GpuWideNode::default()];
         let mut binaries = vec![0u32];
         let mut work = vec![(0u32, 0usize)]; // (binary node, wide node)
         while let Some((binary, wide)) = work.pop() {
-            let slots = frontier_merged(bvh, binary, WIDTH, merge);
+            let slots = frontier(bvh, binary, WIDTH, merge);
             let mut out = GpuWideNode::default();
             for (i, &(bounds, child)) in slots.iter().enumerate() {
                 out.min_x[i] = bounds.min.x;
@@ -182,12 +179,6 @@ impl WideBvh {
     }
 }
 
-/// Up to `width` boxes below node `binary` of `bvh` that hold all of its triangles: its
-/// children, then repeatedly the inner child of largest area replaced by its own two.
-pub fn frontier(bvh: &Bvh, binary: u32, width: usize) -> Vec<(Aabb, Child)> {
-    frontier_merged(bvh, binary, width, 0)
-}
-
 /// The triangles of the subtree below binary node `node` as one leaf, when they are at most
 /// `limit` and form one range in BVH order.
 fn subtree_leaf(bvh: &Bvh, node: u32, limit: u32) -> Option<Child> {
@@ -214,9 +205,11 @@ fn subtree_leaf(bvh: &Bvh, node: u32, limit: u32) -> Option<Child> {
     })
 }
 
-/// [`frontier`], with each interior child of at most `merge` triangles made a leaf (see
+/// Up to `width` boxes below node `binary` of `bvh` that hold all of its triangles: its
+/// children, then repeatedly the inner child of largest area replaced by its own two; each
+/// interior child of at most `merge` triangles is made a leaf (see
 /// [`WideBvh::collapse_for_cpu`]; 0 merges nothing).
-pub fn frontier_merged(bvh: &Bvh, binary: u32, width: usize, merge: u32) -> Vec<(Aabb, Child)> {
+pub fn frontier(bvh: &Bvh, binary: u32, width: usize, merge: u32) -> Vec<(Aabb, Child)> {
     let child = |node: u32, side: usize| {
         let (bounds, c) = bvh.child(node, side);
         match c {

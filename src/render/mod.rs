@@ -416,28 +416,30 @@ impl Renderer {
         .map_err(ClError::Device)?;
         // The large buffers of the scene replaced (a swap to SAH BLASes), written again in
         // place where the size is the same: no fresh memory to fault in.
-        let mut old = reuse.map(|b| {
-            (
-                Some(b.nodes),
-                Some(b.wide_nodes),
-                Some(b.shading),
-                Some(b.tangents),
-                Some(b.triangles),
-                Some(b.instances),
-            )
-        });
+        let (old_nodes, old_wide, old_shading, old_tangents, old_triangles, old_instances) =
+            match reuse {
+                Some(b) => (
+                    Some(b.nodes),
+                    Some(b.wide_nodes),
+                    Some(b.shading),
+                    Some(b.tangents),
+                    Some(b.triangles),
+                    Some(b.instances),
+                ),
+                None => Default::default(),
+            };
         let gpu = &self.gpu;
-        let nodes_buffer = put(gpu, old.as_mut().and_then(|o| o.0.take()), &nodes)?;
+        let nodes_buffer = put(gpu, old_nodes, &nodes)?;
         drop(nodes);
-        let wide_buffer = put(gpu, old.as_mut().and_then(|o| o.1.take()), &wide_nodes)?;
+        let wide_buffer = put(gpu, old_wide, &wide_nodes)?;
         drop(wide_nodes);
-        let shading_buffer = put(gpu, old.as_mut().and_then(|o| o.2.take()), &shading)?;
+        let shading_buffer = put(gpu, old_shading, &shading)?;
         drop(shading);
-        let tangents_buffer = put(gpu, old.as_mut().and_then(|o| o.3.take()), &tangents)?;
+        let tangents_buffer = put(gpu, old_tangents, &tangents)?;
         drop(tangents);
-        let triangles_buffer = put(gpu, old.as_mut().and_then(|o| o.4.take()), &triangles)?;
+        let triangles_buffer = put(gpu, old_triangles, &triangles)?;
         drop(triangles);
-        let instances_buffer = put(gpu, old.and_then(|o| o.5), &instances)?;
+        let instances_buffer = put(gpu, old_instances, &instances)?;
         let buffers = SceneBuffers {
             nodes: nodes_buffer,
             wide_nodes: wide_buffer,
