@@ -54,7 +54,8 @@ pub fn run(args: &BvhArgs) -> Result<()> {
     crate::scene::framing::first_view(&scene, &own_lights, None, 16.0 / 9.0);
     let first_view_ms = t.elapsed().as_secs_f64() * 1e3;
     let first_view_peak = peak_rss_bytes();
-    // The two levels the viewer traces first on a large scene: quick BLASes and the TLAS.
+    // The two levels the viewer traces first on a large scene: quick BLASes and the TLAS, the
+    // BLASes those that the first view's probe built (as the viewer takes them).
     let space = crate::scene::RenderFrame::around(&scene.bounds());
     let t = Instant::now();
     let quick = crate::render::instancing::plan(
@@ -62,7 +63,10 @@ pub fn run(args: &BvhArgs) -> Result<()> {
         &space,
         crate::render::BvhChoice::TwoLevel,
         crate::render::instancing::AUTO_CPU,
-        crate::render::instancing::Blases::Quick { from: 0 },
+        crate::render::instancing::Blases::Quick {
+            from: 0,
+            ready: scene.take_quick_blases(),
+        },
     );
     let quick_ms = quick.is_some().then(|| t.elapsed().as_secs_f64() * 1e3);
     drop(quick);

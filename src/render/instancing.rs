@@ -110,6 +110,9 @@ pub enum Blases {
     Quick {
         /// Distinct triangles from which the trees are quick.
         from: usize,
+        /// Quick trees built already (by the first-view probe, [`Scene::take_quick_blases`])
+        /// with the meshes they were built from: taken for those meshes, the others built.
+        ready: Vec<(Arc<Mesh>, Blas)>,
     },
     /// Trees built already, one per distinct mesh in the plan's order, for the meshes they
     /// were built from (checked: any other mesh gets a SAH tree).
@@ -145,13 +148,29 @@ pub fn plan(
     if total == 0 || (choice == BvhChoice::Auto && auto_flat) || scene.absurd_triangles() > 0 {
         return None;
     }
-    let quick = matches!(how, Blases::Quick { from } if unique >= from);
+    let quick = matches!(how, Blases::Quick { from, .. } if unique >= from);
     let sah = |o: usize| Blas::of_mesh(&placed[o].mesh.positions, &placed[o].mesh.indices);
     let blases: Vec<Blas> = match how {
-        Blases::Quick { .. } if quick => meshes
-            .par_iter()
-            .map(|&o| quick_blas(&placed[o].mesh.positions, &placed[o].mesh.indices))
-            .collect(),
+        Blases::Quick { ready, .. } if quick => {
+            let mut ready: std::collections::HashMap<*const Mesh, Blas> = ready
+                .into_iter()
+                .map(|(m, b)| (Arc::as_ptr(&m), b))
+                .collect();
+            let mut taken: Vec<Option<Blas>> = meshes
+                .iter()
+                .map(|&o| ready.remove(&Arc::as_ptr(&placed[o].mesh)))
+                .collect();
+            drop(ready);
+            taken
+                .par_iter_mut()
+                .zip(&meshes)
+                .map(|(b, &o)| {
+                    b.take().unwrap_or_else(|| {
+                        quick_blas(&placed[o].mesh.positions, &placed[o].mesh.indices)
+                    })
+                })
+                .collect()
+        }
         Blases::Sah | Blases::Quick { .. } => meshes.par_iter().map(|&o| sah(o)).collect(),
         Blases::Built(built) => {
             let mut built = built.into_iter();

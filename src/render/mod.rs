@@ -216,8 +216,11 @@ impl Renderer {
         lights: &[Light],
         space: RenderFrame,
     ) -> Result<SceneStats, ClError> {
+        // The first-view probe's quick BLASes, when it left them: taken either way, so that
+        // they are not kept beside the scene's own.
+        let ready = scene.take_quick_blases();
         let how = match self.quick_first {
-            Some(from) => instancing::Blases::Quick { from },
+            Some(from) => instancing::Blases::Quick { from, ready },
             None => instancing::Blases::Sah,
         };
         self.load_with(scene, lights, space, how, None)

@@ -3,7 +3,12 @@
 //! scene's own lights light that view (else the viewer adds an environment).
 //!
 //! Everything here runs on the host with the reference BVH traversal ([`crate::bvh`]) and is
-//! deterministic: the same scene gives the same first view.
+//! deterministic: the same scene gives the same first view. The probe rays go through quick
+//! BLASes of the distinct meshes under a top level over the visible objects ([`Probe::new`]):
+//! the trees the viewer's first image of a large scene traces, which the probe leaves in the
+//! scene for the renderer, so that opening builds them once and no tree over every placed
+//! triangle is built. Their leaf triangles are tested in world space, so the hits (and the
+//! first view) are those of one tree over the world triangles ([`Probe::flat`]).
 //!
 //! # "The scene's own lights light the view"
 //!
@@ -21,9 +26,10 @@
 //! Small glowing parts (a car's headlights, a lamp's filament behind glass) fail the first test;
 //! a sun or a lamp over the subject passes both.
 
-use super::{Bounds, Camera, Light, LightKind, Scene};
-use crate::bvh::{Bvh, Ray};
-use glam::{DVec3, Vec3};
+use super::{Bounds, Camera, Light, LightKind, Mesh, Scene};
+use crate::bvh::{Blas, Bvh, Ray, TwoLevel, intersect_triangle};
+use glam::{DMat4, DVec3, Vec3};
+use std::sync::Arc;
 
 /// Columns of the probe grid of camera rays.
 pub const PROBE_COLUMNS: usize = 32;
@@ -50,20 +56,48 @@ pub const INTERIOR_YFOV: f64 = 1.15;
 /// Name of the cameras made here (and by [`Camera::framing`]).
 pub const AUTO_CAMERA: &str = "auto";
 
-/// The scene's triangles with a BVH for probe rays.
+/// The scene's world triangles with the trees that probe rays are traced through.
 pub struct Probe {
-    bvh: Bvh,
-    /// Triangles in BVH order.
+    /// How rays find the triangles.
+    tracer: Tracer,
+    /// The visible objects' world triangles in scene order (as [`Scene::world_vertices`]
+    /// gives them); hits name triangles by their index here.
     tris: Vec<[Vec3; 3]>,
-    /// Emitted radiance luminance of each triangle, in BVH order (0 for most).
+    /// Each triangle's material.
+    materials: Vec<u32>,
+    /// Emitted radiance luminance per material (0 for most).
     emission: Vec<f32>,
-    /// All triangles, glass included, with their BVH, when some are see-through (walls with
-    /// windows are still walls when telling an interior).
-    shell: Option<(Bvh, Vec<[Vec3; 3]>)>,
+    /// Whether light passes each material (glass and blended surfaces).
+    see_through: Vec<bool>,
+    /// Whether some triangle is opaque.
+    any_opaque: bool,
     /// Up to [`FIT_POINTS`] vertices inside the robust bounds, for fitting the view.
     points: Vec<Vec3>,
     /// Robust bounds of the visible geometry.
     pub bounds: Bounds,
+}
+
+/// The trees of a [`Probe`].
+enum Tracer {
+    /// A quick BLAS per distinct mesh ([`crate::bvh::quick_blas`], the trees the viewer's first
+    /// image traces) and a top level over the visible objects in world space. Each leaf
+    /// triangle is tested in world space, on its vertices in [`Probe::tris`] (from `starts`,
+    /// each instance's first triangle there), so hits are those of one tree over the world
+    /// triangles, distance for distance.
+    TwoLevel {
+        two: TwoLevel,
+        starts: Vec<usize>,
+        /// Each BLAS's mesh.
+        meshes: Vec<Arc<Mesh>>,
+    },
+    /// One quick tree over the world triangles (its triangles in tree order), a second over
+    /// the opaque ones alone when some are see-through (`kept`: their indices in
+    /// [`Probe::tris`]): scenes with triangles dropped for absurd world vertices, whose
+    /// triangles are no longer those of the meshes.
+    Flat {
+        all: (Bvh, Vec<[Vec3; 3]>),
+        opaque: Option<(Bvh, Vec<[Vec3; 3]>, Vec<u32>)>,
+    },
 }
 
 /// Vertices kept for fitting the view to the subject's silhouette.
@@ -308,86 +342,193 @@ fn fit_points(all: &[[Vec3; 3]], bounds: &Bounds) -> Vec<Vec3> {
 }
 
 impl Probe {
-    /// Builds the probe for the visible geometry of `scene`. Glass and blended surfaces are left
-    /// out of the BVH (light passes them); they still count for the bounds.
-    ///
-    /// The probe keeps the world triangles' vertices alone (gathered in parallel, never as
-    /// [`super::WorldTriangle`]s) and builds one quick BVH over them ([`crate::bvh::build_quick`]:
-    /// a few thousand probe rays do not repay a SAH build), a second only when some triangles
-    /// are see-through. The probe rays find the same closest hits with either tree.
+    /// Builds the probe for the visible geometry of `scene`: over quick BLASes of its distinct
+    /// meshes and a top level ([`Tracer::TwoLevel`]), which it leaves in the scene for the
+    /// renderer ([`Scene::keep_quick_blases`]) when `keep` is set. Glass and blended surfaces
+    /// are passed by the rays that light passes; they still count for the bounds and for
+    /// telling an interior.
     pub fn new(scene: &Scene) -> Self {
-        use rayon::prelude::*;
-        let (all, materials) = scene.world_vertices(&super::RenderFrame::default());
-        let bounds = robust_bounds(&all);
-        let points = fit_points(&all, &bounds);
-        let see_through = |m: u32| {
-            scene
-                .materials
-                .get(m as usize)
-                .is_some_and(|m| m.transmission > 0.0 || m.alpha == super::AlphaMode::Blend)
+        let (tris, materials) = scene.world_vertices(&super::RenderFrame::default());
+        let placed: usize = scene
+            .objects
+            .iter()
+            .filter(|o| o.visible)
+            .map(|o| o.mesh.indices.len())
+            .sum();
+        if tris.len() != placed {
+            // Triangles were dropped: the meshes' triangles are not the world's.
+            return Self::flat(scene);
+        }
+        let objects: Vec<&super::Object> = scene
+            .objects
+            .iter()
+            .filter(|o| o.visible && !o.mesh.indices.is_empty())
+            .collect();
+        let (distinct, mesh_of) = super::distinct_meshes(&objects);
+        let meshes: Vec<Arc<Mesh>> = distinct.iter().map(|&o| objects[o].mesh.clone()).collect();
+        // Several meshes at once, each in parallel within (a large mesh's sort and tree).
+        let blases: Vec<Blas> = {
+            use rayon::prelude::*;
+            meshes
+                .par_iter()
+                .map(|m| crate::bvh::quick_blas(&m.positions, &m.indices))
+                .collect()
         };
-        let (bvh, tris, kept, shell) = if !materials.par_iter().any(|&m| see_through(m)) {
-            let (bvh, tris) = crate::bvh::build_quick_ordered(all);
-            (bvh, tris, None, None)
-        } else {
-            let opaque: Vec<u32> = (0..all.len() as u32)
-                .into_par_iter()
-                .filter(|&i| !see_through(materials[i as usize]))
-                .collect();
-            let verts: Vec<[Vec3; 3]> = opaque.par_iter().map(|&i| all[i as usize]).collect();
-            let shell = crate::bvh::build_quick_ordered(all);
-            let (bvh, tris) = crate::bvh::build_quick_ordered(verts);
-            (bvh, tris, Some(opaque), Some(shell))
-        };
-        // Each BVH-order triangle's index among all the triangles, for its material.
-        let original = |i: u32| kept.as_ref().map_or(i, |k| k[i as usize]);
-        let emission = bvh
-            .tri_indices
-            .par_iter()
-            .map(|&i| {
-                scene
-                    .materials
-                    .get(materials[original(i) as usize] as usize)
-                    .map_or(0.0, |m| luminance(m.emission))
+        let instances: Vec<(u32, DMat4)> = objects
+            .iter()
+            .zip(&mesh_of)
+            .map(|(o, &m)| (m, o.world_from_object))
+            .collect();
+        let starts = objects
+            .iter()
+            .scan(0, |acc, o| {
+                *acc += o.mesh.indices.len();
+                Some(*acc - o.mesh.indices.len())
             })
             .collect();
-        Self {
-            bvh,
+        let hidden = vec![false; instances.len()];
+        let two = TwoLevel::with_hidden(blases, &instances, hidden, 0);
+        Self::with_tracer(
+            scene,
+            Tracer::TwoLevel {
+                two,
+                starts,
+                meshes,
+            },
             tris,
-            emission,
-            shell,
+            materials,
+        )
+    }
+
+    /// The probe over one quick tree of the world triangles ([`Tracer::Flat`]): how the first
+    /// view was found before the two levels, and what it falls back to.
+    pub fn flat(scene: &Scene) -> Self {
+        use rayon::prelude::*;
+        let (tris, materials) = scene.world_vertices(&super::RenderFrame::default());
+        let see_through = see_through_materials(scene);
+        let passes = |m: u32| see_through.get(m as usize).copied().unwrap_or(false);
+        let ordered = |kept: &[u32]| -> (Bvh, Vec<[Vec3; 3]>) {
+            let verts: Vec<[Vec3; 3]> = kept.par_iter().map(|&i| tris[i as usize]).collect();
+            let bvh = crate::bvh::build_quick(&verts);
+            let verts = bvh
+                .tri_indices
+                .par_iter()
+                .map(|&i| verts[i as usize])
+                .collect();
+            (bvh, verts)
+        };
+        let every: Vec<u32> = (0..tris.len() as u32).collect();
+        let all = ordered(&every);
+        let opaque = materials.par_iter().any(|&m| passes(m)).then(|| {
+            let kept: Vec<u32> = every
+                .into_par_iter()
+                .filter(|&i| !passes(materials[i as usize]))
+                .collect();
+            let (bvh, verts) = ordered(&kept);
+            (bvh, verts, kept)
+        });
+        Self::with_tracer(scene, Tracer::Flat { all, opaque }, tris, materials)
+    }
+
+    fn with_tracer(
+        scene: &Scene,
+        tracer: Tracer,
+        tris: Vec<[Vec3; 3]>,
+        materials: Vec<u32>,
+    ) -> Self {
+        use rayon::prelude::*;
+        let bounds = robust_bounds(&tris);
+        let points = fit_points(&tris, &bounds);
+        let see_through = see_through_materials(scene);
+        let any_opaque = materials
+            .par_iter()
+            .any(|&m| !see_through.get(m as usize).copied().unwrap_or(false));
+        Self {
+            tracer,
+            emission: scene
+                .materials
+                .iter()
+                .map(|m| luminance(m.emission))
+                .collect(),
+            see_through,
+            any_opaque,
+            tris,
+            materials,
             points,
             bounds,
         }
     }
 
-    /// The triangles with glass, and their BVH.
-    fn shell(&self) -> (&Bvh, &[[Vec3; 3]]) {
-        match &self.shell {
-            Some((bvh, tris)) => (bvh, tris),
-            None => (&self.bvh, &self.tris),
+    /// Leaves the quick BLASes in `scene` for the renderer's first load
+    /// ([`Scene::keep_quick_blases`]).
+    pub fn keep_blases(self, scene: &Scene) {
+        if let Tracer::TwoLevel { two, meshes, .. } = self.tracer {
+            scene.keep_quick_blases(meshes.into_iter().zip(two.blases).collect());
         }
     }
 
-    /// The closest triangle along a ray, glass included (an index into [`Self::shell`]).
+    /// Triangle `i`'s emitted radiance luminance.
+    fn emission(&self, i: usize) -> f32 {
+        self.emission
+            .get(self.materials[i] as usize)
+            .copied()
+            .unwrap_or(0.0)
+    }
+
+    /// The closest triangle along a ray (with `any`, the first found) between `tmin` and
+    /// `tmax`, see-through ones included unless `opaque`: (distance, index in `tris`).
+    fn trace(&self, ray: &Ray, any: bool, opaque: bool) -> Option<(f32, usize)> {
+        match &self.tracer {
+            Tracer::TwoLevel { two, starts, .. } => {
+                let passes = |i: usize| {
+                    opaque
+                        && self
+                            .see_through
+                            .get(self.materials[i] as usize)
+                            .copied()
+                            .unwrap_or(false)
+                };
+                two.tlas.walk(ray, any, |leaf, r| {
+                    let instance = two.tlas.tri_indices[leaf as usize] as usize;
+                    let inst = &two.instances[instance];
+                    let blas = &two.blases[inst.blas as usize];
+                    let local = inst.to_object(r);
+                    let root = two.pieces[leaf as usize];
+                    let start = starts[instance];
+                    blas.bvh
+                        .walk_from(root, &local, any, |k, l| {
+                            let i = start + blas.bvh.tri_indices[k as usize] as usize;
+                            if passes(i) {
+                                return None;
+                            }
+                            let world = Ray { tmax: l.tmax, ..*r };
+                            intersect_triangle(&world, &self.tris[i]).map(|h| (h.0, (h.0, i)))
+                        })
+                        .map(|h| (h.0, h))
+                })
+            }
+            Tracer::Flat { all, opaque: o } => {
+                let (bvh, verts, kept) = match (o, opaque) {
+                    (Some((bvh, verts, kept)), true) => (bvh, verts, Some(kept)),
+                    _ => (&all.0, &all.1, None),
+                };
+                bvh.traverse(0, ray, verts, any).map(|h| {
+                    let i = bvh.tri_indices[h.prim as usize];
+                    (h.t, kept.map_or(i, |k| k[i as usize]) as usize)
+                })
+            }
+        }
+    }
+
+    /// The closest triangle along a ray, glass included.
     fn hit_all(&self, origin: DVec3, dir: DVec3) -> Option<usize> {
-        let (bvh, tris) = self.shell();
         let ray = Ray {
             origin: origin.as_vec3(),
             direction: dir.as_vec3(),
             tmin: 0.0,
             tmax: f32::INFINITY,
         };
-        bvh.intersect(&ray, tris).map(|h| h.prim as usize)
-    }
-
-    /// The unit geometric normal of a triangle of [`Self::shell`].
-    fn normal_all(&self, prim: usize) -> DVec3 {
-        let t = &self.shell().1[prim];
-        (t[1] - t[0])
-            .cross(t[2] - t[0])
-            .as_dvec3()
-            .normalize_or(DVec3::Y)
+        self.trace(&ray, false, false).map(|h| h.1)
     }
 
     fn hit(&self, origin: DVec3, dir: DVec3, tmax: f64) -> Option<(f64, usize)> {
@@ -397,9 +538,7 @@ impl Probe {
             tmin: 0.0,
             tmax: tmax as f32,
         };
-        self.bvh
-            .intersect(&ray, &self.tris)
-            .map(|h| (h.t as f64, h.prim as usize))
+        self.trace(&ray, false, true).map(|h| (h.0 as f64, h.1))
     }
 
     fn visible(&self, from: DVec3, to: DVec3) -> bool {
@@ -410,7 +549,7 @@ impl Probe {
             tmin: 1e-4,
             tmax: 0.999,
         };
-        !self.bvh.occluded(&ray, &self.tris)
+        self.trace(&ray, true, true).is_none()
     }
 
     fn unobstructed(&self, from: DVec3, dir: DVec3) -> bool {
@@ -420,9 +559,10 @@ impl Probe {
             tmin: 0.0,
             tmax: f32::INFINITY,
         };
-        !self.bvh.occluded(&ray, &self.tris)
+        self.trace(&ray, true, true).is_none()
     }
 
+    /// The unit geometric normal of a triangle.
     fn normal(&self, prim: usize) -> DVec3 {
         let t = &self.tris[prim];
         (t[1] - t[0])
@@ -434,6 +574,15 @@ impl Probe {
     fn scale(&self) -> f64 {
         self.bounds.diagonal().max(1e-6)
     }
+}
+
+/// Whether light passes each of `scene`'s materials (transmission or blending).
+fn see_through_materials(scene: &Scene) -> Vec<bool> {
+    scene
+        .materials
+        .iter()
+        .map(|m| m.transmission > 0.0 || m.alpha == super::AlphaMode::Blend)
+        .collect()
 }
 
 /// Unit directions spread evenly over the sphere (a Fibonacci lattice).
@@ -470,7 +619,7 @@ pub fn classify_shell(probe: &Probe, point: DVec3) -> Shell {
     let mut escape = DVec3::ZERO;
     for d in sphere_directions(SHELL_RAYS) {
         match probe.hit_all(point, d) {
-            Some(prim) if probe.normal_all(prim).dot(d) < 0.0 => front += 1,
+            Some(prim) if probe.normal(prim).dot(d) < 0.0 => front += 1,
             Some(_) => {}
             None => {
                 escape += d;
@@ -593,16 +742,21 @@ fn light_directions(probe: &Probe, lights: &[Light], point: DVec3) -> Vec<(DVec3
 /// [`MAX_EMITTERS`] (the first in scene order among equals), the power scaled up by the share
 /// of all emitted power they leave out.
 fn emitters(probe: &Probe) -> Vec<(DVec3, DVec3, f64)> {
-    let mut all: Vec<(usize, f64)> = probe
-        .emission
-        .iter()
-        .enumerate()
-        .filter(|(_, e)| **e > 0.0)
-        .map(|(i, &e)| (i, e as f64 * area(&probe.tris[i]) as f64))
+    use rayon::prelude::*;
+    // Opaque triangles alone, in scene order: equally powerful emitters keep that order.
+    let see_through = |i: usize| {
+        probe
+            .see_through
+            .get(probe.materials[i] as usize)
+            .copied()
+            .unwrap_or(false)
+    };
+    let mut all: Vec<(usize, f64)> = (0..probe.tris.len())
+        .into_par_iter()
+        .filter(|&i| probe.emission(i) > 0.0 && !see_through(i))
+        .map(|i| (i, probe.emission(i) as f64 * area(&probe.tris[i]) as f64))
         .filter(|(_, p)| *p > 0.0)
         .collect();
-    // In scene order, whatever the tree: equally powerful emitters keep that order.
-    all.sort_by_key(|e| probe.bvh.tri_indices[e.0]);
     let total: f64 = all.iter().map(|e| e.1).sum();
     all.sort_by(|a, b| b.1.total_cmp(&a.1));
     all.truncate(MAX_EMITTERS);
@@ -785,8 +939,8 @@ fn light_test(
             let Some((t, prim)) = probe.hit(camera.eye, d, far) else {
                 return (None, None);
             };
-            if probe.emission[prim] > 0.0 {
-                return (None, Some(probe.emission[prim] as f64));
+            if probe.emission(prim) > 0.0 {
+                return (None, Some(probe.emission(prim) as f64));
             }
             let mut n = probe.normal(prim);
             if n.dot(d) > 0.0 {
@@ -827,7 +981,8 @@ fn light_test(
 
 /// The first view of `scene` lit by `lights` (the scene's own, without a default rig), for an
 /// image of `aspect` (width/height). `camera` is the scene's own camera when it has one: it is
-/// kept ("a scene's camera wins") and only the light rule is evaluated from it.
+/// kept ("a scene's camera wins") and only the light rule is evaluated from it. The probe's
+/// quick BLASes stay in the scene for the renderer ([`Probe::keep_blases`]).
 pub fn first_view(
     scene: &Scene,
     lights: &[Light],
@@ -835,7 +990,9 @@ pub fn first_view(
     aspect: f64,
 ) -> FirstView {
     let probe = Probe::new(scene);
-    first_view_with(&probe, lights, camera, aspect)
+    let view = first_view_with(&probe, lights, camera, aspect);
+    probe.keep_blases(scene);
+    view
 }
 
 /// [`first_view`] with a probe already built.
@@ -848,7 +1005,7 @@ pub fn first_view_with(
     let bounds = probe.bounds;
     let (camera, interior) = match camera {
         Some(c) => (c.clone(), false),
-        None if probe.tris.is_empty() => (Camera::framing(&bounds, super::AUTO_YFOV), false),
+        None if !probe.any_opaque => (Camera::framing(&bounds, super::AUTO_YFOV), false),
         None => {
             let outside = |dir: DVec3| fit(&bounds, &probe.points, dir, super::AUTO_YFOV, aspect);
             match classify_shell(probe, bounds.center()) {
@@ -1171,6 +1328,124 @@ mod tests {
         ));
         let view = first_view(&scene_of(&parts), &[], None, 1.5);
         assert!(!view.lit, "{view:?}");
+    }
+
+    /// A room of shared meshes: a table mesh placed four times (scaled, rotated, mirrored),
+    /// a glass pane, a glowing panel and a lamp-lit subject, with the placed objects' meshes
+    /// shared as the importer shares them.
+    fn instanced_room() -> Scene {
+        let mut room = cuboid(Vec3::ZERO, Vec3::new(6.0, 2.7, 4.0), true);
+        room.extend(cuboid(
+            Vec3::new(0.2, 0.0, 0.2),
+            Vec3::new(0.4, 2.0, 0.4),
+            false,
+        ));
+        let table = cuboid(Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 0.75, 0.5), false);
+        let pane = cuboid(Vec3::new(4.0, 0.5, 3.0), Vec3::new(5.0, 2.0, 3.02), false);
+        let panel = cuboid(Vec3::new(2.5, 2.6, 1.5), Vec3::new(3.5, 2.65, 2.5), false);
+        let glass = Material {
+            transmission: 1.0,
+            ..Material::default()
+        };
+        let glow = Material {
+            emission: [4.0; 3],
+            ..Material::default()
+        };
+        let mut scene = scene_of(&[
+            (room, Material::default()),
+            (pane, glass),
+            (panel, glow),
+            (table, Material::default()),
+        ]);
+        let table = scene.objects[3].clone();
+        let placements = [
+            DMat4::from_translation(DVec3::new(1.5, 0.0, 1.0)),
+            DMat4::from_translation(DVec3::new(4.5, 0.0, 1.2))
+                * DMat4::from_rotation_y(0.7)
+                * DMat4::from_scale(DVec3::new(1.3, 0.8, 0.6)),
+            // Mirrored: its triangles' corners swap in world space.
+            DMat4::from_translation(DVec3::new(2.0, 0.0, 3.0))
+                * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+        ];
+        scene.objects[3].world_from_object = DMat4::from_translation(DVec3::new(3.0, 0.0, 2.0));
+        for (i, m) in placements.into_iter().enumerate() {
+            scene.objects.push(Object {
+                name: format!("table {i}"),
+                world_from_object: m,
+                ..table.clone()
+            });
+        }
+        // A hidden one is left out of both.
+        scene.objects.push(Object {
+            name: "hidden".into(),
+            world_from_object: DMat4::from_translation(DVec3::new(3.0, 1.5, 2.0)),
+            visible: false,
+            ..table
+        });
+        scene
+    }
+
+    /// The probe over quick BLASes and a top level finds, ray for ray, the triangle and
+    /// distance that one tree over the world triangles finds (closest and any hit, with and
+    /// without glass), and the same first view.
+    #[test]
+    fn the_two_level_probe_finds_what_one_tree_over_the_world_finds() {
+        let scene = instanced_room();
+        let two = Probe::new(&scene);
+        let flat = Probe::flat(&scene);
+        assert!(matches!(two.tracer, Tracer::TwoLevel { .. }));
+        assert!(matches!(flat.tracer, Tracer::Flat { .. }));
+        assert_eq!(two.tris, flat.tris);
+        let centre = DVec3::new(3.0, 1.2, 2.0);
+        let mut hits = 0;
+        for (k, d) in sphere_directions(2000).enumerate() {
+            // From points all over the room, some inside the tables.
+            let o = centre
+                + DVec3::new(
+                    (k % 7) as f64 - 3.0,
+                    (k % 5) as f64 * 0.3 - 0.6,
+                    (k % 3) as f64 - 1.0,
+                ) * 0.5;
+            let ray = Ray {
+                origin: o.as_vec3(),
+                direction: d.as_vec3(),
+                tmin: 0.0,
+                tmax: f32::INFINITY,
+            };
+            for (any, opaque) in [(false, false), (false, true), (true, true)] {
+                let (a, b) = (two.trace(&ray, any, opaque), flat.trace(&ray, any, opaque));
+                if any {
+                    assert_eq!(a.is_some(), b.is_some(), "ray {k}");
+                } else {
+                    assert_eq!(a, b, "ray {k} opaque {opaque}");
+                    hits += a.is_some() as usize;
+                }
+            }
+        }
+        assert!(hits > 3000, "{hits}");
+        let lamp = point(DVec3::new(3.0, 2.2, 2.0), 5.0);
+        for lights in [vec![], vec![lamp]] {
+            let a = first_view_with(&two, &lights, None, 1.6);
+            let b = first_view_with(&flat, &lights, None, 1.6);
+            assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        }
+        assert!(first_view_with(&two, &[], None, 1.6).interior);
+    }
+
+    /// The first view leaves its quick BLASes in the scene, one per distinct visible mesh,
+    /// and the renderer's plan takes them for those meshes.
+    #[test]
+    fn the_first_view_leaves_its_quick_blases_for_the_renderer() {
+        let scene = instanced_room();
+        first_view(&scene, &[], None, 1.6);
+        let kept = scene.take_quick_blases();
+        assert_eq!(kept.len(), 4);
+        for (mesh, blas) in &kept {
+            let fresh = crate::bvh::quick_blas(&mesh.positions, &mesh.indices);
+            assert_eq!(blas.triangles, fresh.triangles);
+            assert!(scene.objects.iter().any(|o| Arc::ptr_eq(&o.mesh, mesh)));
+        }
+        assert!(scene.take_quick_blases().is_empty());
     }
 
     #[test]

@@ -419,6 +419,27 @@ pub struct Scene {
     pub texture_refs: Vec<TextureRef>,
     /// The last [`Scene::bounds`] with the placement it was found for.
     pub bounds_cache: BoundsCache,
+    /// Quick BLASes that the first-view probe built, left for the renderer's first load.
+    pub quick_blases: QuickBlases,
+}
+
+/// Quick BLASes ([`crate::bvh::quick_blas`]) of some of a scene's meshes, each with the mesh
+/// it was built from: the first-view probe ([`framing::Probe`]) traces them and leaves them
+/// here, and the renderer's first load takes them ([`Scene::take_quick_blases`]) instead of
+/// building them again. A clone of the scene starts without them.
+#[derive(Debug, Default)]
+pub struct QuickBlases(std::sync::Mutex<Vec<(Arc<Mesh>, crate::bvh::Blas)>>);
+
+impl Clone for QuickBlases {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl QuickBlases {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<(Arc<Mesh>, crate::bvh::Blas)>> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
 }
 
 /// [`Scene::bounds`] remembered with a fingerprint of what it depends on (each object's mesh,
@@ -441,6 +462,16 @@ impl BoundsCache {
 }
 
 impl Scene {
+    /// Leaves quick BLASes of this scene's meshes for the renderer ([`QuickBlases`]).
+    pub fn keep_quick_blases(&self, blases: Vec<(Arc<Mesh>, crate::bvh::Blas)>) {
+        *self.quick_blases.lock() = blases;
+    }
+
+    /// Takes the quick BLASes left by the first-view probe (none the second time).
+    pub fn take_quick_blases(&self) -> Vec<(Arc<Mesh>, crate::bvh::Blas)> {
+        std::mem::take(&mut *self.quick_blases.lock())
+    }
+
     /// Which materials some triangle uses, by index: in its own material or in a
     /// `KHR_materials_variants` variant (hidden objects count: they can be shown again).
     pub fn used_materials(&self) -> Vec<bool> {
