@@ -12,9 +12,12 @@ use penumbra::render::Renderer;
 use penumbra::scene::{Material, Mesh, Object, RenderFrame, Scene};
 use serde_json::json;
 
+/// A renderer that uploads both node arrays: these tests trace through either.
 fn renderer() -> Renderer {
     let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
-    Renderer::new(&choice).expect("the test's OpenCL device is available")
+    let mut r = Renderer::new(&choice).expect("the test's OpenCL device is available");
+    r.set_node_forms(penumbra::render::NodeForms::BOTH).unwrap();
+    r
 }
 
 /// A scene of random small triangles in a 10-unit cube, plus a large floor.

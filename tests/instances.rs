@@ -10,14 +10,17 @@ use glam::{DMat4, DQuat, DVec3, Vec3};
 use penumbra::bvh::{Ray, SMALL_MESH};
 use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay};
 use penumbra::cl::{Buffer, DeviceChoice};
-use penumbra::render::{BvhChoice, Renderer};
+use penumbra::render::{BvhChoice, KernelChoice, NodeForms, Renderer};
 use penumbra::scene::{Material, Mesh, Object, RenderFrame, Scene};
 use serde_json::json;
 use std::f32::consts::FRAC_1_SQRT_2;
 
+/// A renderer that uploads both node arrays: these tests trace through either.
 fn renderer() -> Renderer {
     let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
-    Renderer::new(&choice).expect("the test's OpenCL device is available")
+    let mut r = Renderer::new(&choice).expect("the test's OpenCL device is available");
+    r.set_node_forms(penumbra::render::NodeForms::BOTH).unwrap();
+    r
 }
 
 /// The leak tests' closed cube as a mesh.
@@ -506,4 +509,103 @@ fn a_quick_first_image_gives_way_to_the_image_of_the_sah_trees() {
         got == want,
         "the image after the swap is the SAH trees' image"
     );
+}
+
+#[test]
+fn a_device_gets_the_node_array_its_kernels_traverse() {
+    // The megakernel (a CPU device's) walks the wide nodes alone, the wavefront (a GPU's) the
+    // binary ones: the other array is not uploaded, and the image is the one of a device
+    // that has both. Switching kernels uploads the missing array.
+    let scene = cube_scene(4);
+    let light = penumbra::scene::Light {
+        name: "lamp".into(),
+        kind: penumbra::scene::LightKind::Point,
+        position: DVec3::new(0.5, 9.0, 2.0),
+        direction: DVec3::NEG_Y,
+        color: [1.0; 3],
+        intensity: 400.0,
+        light_radius: 0.0,
+    };
+    let camera = penumbra::scene::Camera::look_at(
+        "test",
+        DVec3::new(2.0, 3.0, 22.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        0.9,
+    );
+    let settings = penumbra::render::RenderSettings {
+        width: 32,
+        height: 24,
+        bounces: 2,
+        ..Default::default()
+    };
+    for bvh in [BvhChoice::Flat, BvhChoice::TwoLevel] {
+        let open = |forms: Option<NodeForms>| {
+            let choice: DeviceChoice = common::test_device().parse().unwrap();
+            let mut r = Renderer::new(&choice).unwrap();
+            r.set_kernel(KernelChoice::Megakernel).unwrap();
+            if let Some(forms) = forms {
+                r.set_node_forms(forms).unwrap();
+            }
+            r.set_bvh_choice(bvh);
+            r.set_settings(&settings).unwrap();
+            r.load_scene_in(&scene, std::slice::from_ref(&light), RenderFrame::default())
+                .unwrap();
+            r.set_camera(&camera).unwrap();
+            r
+        };
+        let mut lean = open(None);
+        let mut full = open(Some(NodeForms::BOTH));
+        let (l, f) = (lean.scene_buffers().unwrap(), full.scene_buffers().unwrap());
+        assert_eq!(l.forms, NodeForms::for_kernels(true), "{bvh:?}");
+        assert_eq!(f.forms, NodeForms::BOTH);
+        assert_eq!(
+            l.nodes.len(),
+            1,
+            "{bvh:?}: a placeholder for the binary nodes"
+        );
+        assert_eq!(l.wide_nodes.len(), f.wide_nodes.len());
+        assert!(f.nodes.len() > 1);
+        assert_eq!(l.bytes() + f.nodes.bytes() - l.nodes.bytes(), f.bytes());
+        // Nothing traces through the missing array.
+        let ray = GpuRay {
+            origin: [0.0, 0.0, 30.0, 0.0],
+            direction: [0.0, 0.0, -1.0, f32::INFINITY],
+        };
+        let rays = Buffer::from_slice(&lean.gpu, &[ray]).unwrap();
+        let hits = Buffer::<GpuHit>::new(&lean.gpu, 1).unwrap();
+        let counters = Buffer::<u32>::new(&lean.gpu, COUNTER_SLOTS).unwrap();
+        let program = lean.program().unwrap();
+        assert!(
+            program
+                .trace_closest(&lean.gpu, l, &rays, &hits, &counters)
+                .is_err()
+        );
+        program
+            .trace_closest_wide(&lean.gpu, l, &rays, &hits, &counters)
+            .unwrap();
+        if bvh == BvhChoice::TwoLevel {
+            // A moved instance's TLAS goes to the wide nodes alone.
+            let mut moved = scene.clone();
+            moved.objects[1].world_from_object = DMat4::from_translation(DVec3::new(0.5, 2.0, 1.0))
+                * moved.objects[1].world_from_object;
+            let update = lean.move_instances(&moved).unwrap().unwrap();
+            full.move_instances(&moved).unwrap().unwrap();
+            let n = placements().len();
+            assert_eq!(update.bytes, (n - 1) * 128 + n * 112, "{update:?}");
+        }
+        for kernel in [KernelChoice::Megakernel, KernelChoice::Wavefront] {
+            lean.set_kernel(kernel).unwrap();
+            full.set_kernel(kernel).unwrap();
+            lean.render(2).unwrap();
+            full.render(2).unwrap();
+            assert!(
+                lean.image().unwrap() == full.image().unwrap(),
+                "{bvh:?} {kernel:?}: the same image"
+            );
+        }
+        // The wavefront's binary nodes came with the switch.
+        let l = lean.scene_buffers().unwrap();
+        assert_eq!(l.forms, NodeForms::BOTH);
+        assert_eq!(l.bytes(), full.scene_buffers().unwrap().bytes());
+    }
 }

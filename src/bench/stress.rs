@@ -516,6 +516,8 @@ pub fn run(args: &StressArgs) -> Result<()> {
     let choice =
         DeviceChoice::from_arg_or_env(args.device.as_deref()).map_err(anyhow::Error::msg)?;
     let mut renderer = Renderer::new(&choice)?;
+    // The leak check traces through the binary nodes on any device.
+    renderer.set_node_forms(crate::render::NodeForms::BOTH)?;
     println!(
         "penumbra bench stress, {}, {}",
         today(),

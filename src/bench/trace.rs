@@ -350,6 +350,8 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     let mut renderer = Renderer::new(&args.device.device_choice()?)?;
     renderer.set_settings(&settings)?;
     renderer.set_bvh_choice(args.bvh);
+    // Traced through the binary or the wide nodes, whichever the device's kernels use.
+    renderer.set_node_forms(crate::render::NodeForms::BOTH)?;
     let stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| source.clone())?;

@@ -679,6 +679,17 @@ impl Program {
         out: &Buffer<T>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
+        let wide = nodes == bvh.wide_nodes.mem();
+        if !(if wide {
+            bvh.forms.wide
+        } else {
+            bvh.forms.binary
+        }) {
+            return Err(ClError::Device(format!(
+                "{stage}: the scene was uploaded without its {} nodes (Renderer::set_node_forms)",
+                if wide { "wide" } else { "binary" }
+            )));
+        }
         let count = rays.len() as u32;
         self.run(gpu, stage, kernel, rays.len(), |e| unsafe {
             set_geometry(e, nodes, bvh);
@@ -964,11 +975,51 @@ pub struct EnvBuffers {
     pub conditional: Buffer<f32>,
 }
 
+/// Which node arrays of the BVH a scene's buffers hold: the binary one (the wavefront's
+/// `extend` and `connect`, `trace_closest` and `trace_any`) and the 4-wide one (the
+/// megakernel's, `trace_closest_wide` and `trace_any_wide`). The array left out is a
+/// placeholder of one node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NodeForms {
+    /// The binary nodes.
+    pub binary: bool,
+    /// The 4-wide nodes.
+    pub wide: bool,
+}
+
+impl NodeForms {
+    /// Both arrays (tests and `bench trace`, which trace through either).
+    pub const BOTH: Self = Self {
+        binary: true,
+        wide: true,
+    };
+
+    /// Those the kernels in use traverse: the megakernel's wide nodes or the wavefront's
+    /// binary ones.
+    pub fn for_kernels(megakernel: bool) -> Self {
+        Self {
+            binary: !megakernel,
+            wide: megakernel,
+        }
+    }
+
+    /// Both this one's arrays and `other`'s.
+    pub fn with(self, other: Self) -> Self {
+        Self {
+            binary: self.binary || other.binary,
+            wide: self.wide || other.wide,
+        }
+    }
+}
+
 /// The scene on the device: BVH, triangles, shading data, materials and lights.
 pub struct SceneBuffers {
-    /// BVH nodes.
+    /// Which of the two node arrays are real (the other a placeholder).
+    pub forms: NodeForms,
+    /// BVH nodes (a placeholder unless `forms.binary`).
     pub nodes: Buffer<GpuBvhNode>,
-    /// The same BVH collapsed to 4-wide nodes (the megakernel's).
+    /// The same BVH collapsed to 4-wide nodes (the megakernel's; a placeholder unless
+    /// `forms.wide`).
     pub wide_nodes: Buffer<GpuWideNode>,
     /// Triangles in shading order (the flat BVH's order, or instance by instance).
     pub triangles: Buffer<GpuTriangle>,

@@ -48,6 +48,8 @@ impl Renderer {
             KernelChoice::Wavefront => false,
             KernelChoice::Megakernel => true,
         };
+        // The loaded scene's node arrays are those of the kernels it was loaded for.
+        self.ensure_node_forms()?;
         self.reset()
     }
 

@@ -24,6 +24,7 @@ pub use upload::{Accel, HostScene, gpu_camera, gpu_material};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
 use crate::bvh::{Ray, WideBvh};
+pub use crate::cl::kernels::NodeForms;
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
@@ -139,6 +140,9 @@ pub struct Renderer {
     quick_first: Option<usize>,
     /// The SAH BLASes building behind the quick ones of the scene on the device.
     sah: Option<SahBuild>,
+    /// Node arrays uploaded beyond those the kernels in use traverse (see
+    /// [`Renderer::set_node_forms`]).
+    extra_forms: NodeForms,
 }
 
 /// The BLASes of a background build, with their meshes in the plan's order, and its time (ms).
@@ -195,6 +199,10 @@ impl Renderer {
             small_mesh: None,
             quick_first: None,
             sah: None,
+            extra_forms: NodeForms {
+                binary: false,
+                wide: false,
+            },
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -234,6 +242,50 @@ impl Renderer {
     /// SAH BLASes at once.
     pub fn set_quick_first(&mut self, from: Option<usize>) {
         self.quick_first = from;
+    }
+
+    /// Uploads `extra` node arrays beside those the kernels in use traverse
+    /// ([`NodeForms::for_kernels`]: a CPU device's megakernel the wide nodes alone, a GPU's
+    /// wavefront the binary ones), now for the loaded scene and at every load: for tests and
+    /// `bench trace`, which trace through either array.
+    pub fn set_node_forms(&mut self, extra: NodeForms) -> Result<(), ClError> {
+        self.extra_forms = extra;
+        self.ensure_node_forms()
+    }
+
+    /// The node arrays a scene load uploads.
+    fn node_forms(&self) -> NodeForms {
+        NodeForms::for_kernels(self.megakernel).with(self.extra_forms)
+    }
+
+    /// Uploads the node arrays of the loaded scene that [`Renderer::node_forms`] asks for and
+    /// it lacks (the kernels or the extra forms changed after the load), with the instances
+    /// that name their roots.
+    pub(crate) fn ensure_node_forms(&mut self) -> Result<(), ClError> {
+        let want = self.node_forms();
+        let Some((buffers, host)) = self.scene.as_mut() else {
+            return Ok(());
+        };
+        let add = NodeForms {
+            binary: want.binary && !buffers.forms.binary,
+            wide: want.wide && !buffers.forms.wide,
+        };
+        if !add.binary && !add.wide {
+            return Ok(());
+        }
+        let (nodes, wide) = device_nodes(host, add);
+        if let Some(nodes) = nodes {
+            buffers.nodes = Buffer::from_slice(&self.gpu, &nodes)?;
+        }
+        if let Some(wide) = wide {
+            buffers.wide_nodes = Buffer::from_slice(&self.gpu, &wide)?;
+        }
+        buffers.forms = buffers.forms.with(add);
+        if let Accel::TwoLevel(two) = &host.accel {
+            let instances = host.layout.gpu_instances(two);
+            buffers.instances.write_at(&self.gpu, 0, &instances)?;
+        }
+        Ok(())
     }
 
     /// Whether SAH BLASes are building behind the quick ones on the device.
@@ -384,7 +436,8 @@ impl Renderer {
             "kernels, textures, lights: {:.0} ms",
             t.elapsed().as_secs_f64() * 1e3
         );
-        let (nodes, wide_nodes, instances) = device_accel(&mut host);
+        let forms = self.node_forms();
+        let (nodes, wide_nodes, instances) = device_accel(&mut host, forms);
         log::debug!("device nodes: {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
         // Triangles and shading data are the device's alone (picking keeps each flat triangle's
         // object, `HostScene::objects`): they leave the host scene, and each large host
@@ -400,19 +453,28 @@ impl Renderer {
         // object-triangle buffer is a placeholder either way.
         let object_tris = [GpuTriangle::default()];
         let bytes = |n: usize, size: usize| n.max(1) * size;
+        let sizes = [
+            ("BVH nodes", std::mem::size_of_val(nodes.as_slice())),
+            (
+                "wide BVH nodes",
+                std::mem::size_of_val(wide_nodes.as_slice()),
+            ),
+            ("triangles", std::mem::size_of_val(triangles.as_slice())),
+            ("instances", std::mem::size_of_val(instances.as_slice())),
+            ("shading", std::mem::size_of_val(shading.as_slice())),
+            ("tangents", std::mem::size_of_val(tangents.as_slice())),
+            ("texels", bytes(pack.texels.len(), 4)),
+        ];
+        log::debug!(
+            "device buffers: {}",
+            sizes
+                .iter()
+                .map(|(name, b)| format!("{name} {:.1} MB", *b as f64 / 1e6))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
         fits_device(
-            &[
-                ("BVH nodes", std::mem::size_of_val(nodes.as_slice())),
-                (
-                    "wide BVH nodes",
-                    std::mem::size_of_val(wide_nodes.as_slice()),
-                ),
-                ("triangles", std::mem::size_of_val(triangles.as_slice())),
-                ("instances", std::mem::size_of_val(instances.as_slice())),
-                ("shading", std::mem::size_of_val(shading.as_slice())),
-                ("tangents", std::mem::size_of_val(tangents.as_slice())),
-                ("texels", bytes(pack.texels.len(), 4)),
-            ],
+            &sizes,
             self.gpu.device.global_mem_size().ok(),
             self.gpu.device.max_mem_alloc_size().ok(),
         )
@@ -444,6 +506,7 @@ impl Renderer {
         drop(triangles);
         let instances_buffer = put(gpu, old_instances, &instances)?;
         let buffers = SceneBuffers {
+            forms,
             nodes: nodes_buffer,
             wide_nodes: wide_buffer,
             triangles: triangles_buffer,
@@ -780,24 +843,64 @@ fn put<T: bytemuck::Pod>(
     }
 }
 
-/// The device's node arrays (binary and wide) and instances for `host`'s acceleration
-/// structure (the instances are a placeholder when flat); fills `host.layout` for two levels.
-fn device_accel(host: &mut HostScene) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec<GpuInstance>) {
+/// The device's node arrays (binary and wide, each a placeholder of one node unless `forms`
+/// has it) and instances for `host`'s acceleration structure (the instances are a
+/// placeholder when flat); fills `host.layout` for two levels.
+fn device_accel(
+    host: &mut HostScene,
+    forms: NodeForms,
+) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec<GpuInstance>) {
+    let (nodes, wide) = device_nodes(host, forms);
+    let nodes = nodes.unwrap_or_else(|| vec![GpuBvhNode::default()]);
+    let wide = wide.unwrap_or_else(|| vec![GpuWideNode::default()]);
+    let instances = match &host.accel {
+        Accel::Flat(_) => vec![GpuInstance::default()],
+        Accel::TwoLevel(two) => {
+            host.layout.append_piece_copies(two, &mut host.triangles);
+            host.layout.gpu_instances(two)
+        }
+    };
+    (nodes, wide, instances)
+}
+
+/// The node arrays that `forms` asks for of `host`'s acceleration structure; for two levels
+/// each BLAS's root in every array made (in the binary array always: they are counted, not
+/// made) goes to `host.layout`.
+fn device_nodes(
+    host: &mut HostScene,
+    forms: NodeForms,
+) -> (Option<Vec<GpuBvhNode>>, Option<Vec<GpuWideNode>>) {
     match &host.accel {
         Accel::Flat(bvh) => (
-            bvh.nodes.clone(),
-            WideBvh::collapse_for_cpu(bvh).nodes,
-            vec![GpuInstance::default()],
+            forms.binary.then(|| bvh.nodes.clone()),
+            forms.wide.then(|| WideBvh::collapse_for_cpu(bvh).nodes),
         ),
         Accel::TwoLevel(two) => {
-            let (nodes, roots, _) = two.device_nodes();
-            let (wide, wide_roots, wide_of) = two.device_wide_nodes();
-            host.layout.roots = roots;
-            host.layout.wide_roots = wide_roots;
-            host.layout.wide_of = wide_of;
-            host.layout.append_piece_copies(two, &mut host.triangles);
-            let instances = host.layout.gpu_instances(two);
-            (nodes, wide, instances)
+            let nodes = if forms.binary {
+                let (nodes, roots, _) = two.device_nodes();
+                host.layout.roots = roots;
+                Some(nodes)
+            } else {
+                // Where `device_nodes` would put each BLAS: after the TLAS's slots, one after
+                // the other.
+                let mut at = two.tlas_slots() as u32;
+                host.layout.roots = two
+                    .blases
+                    .iter()
+                    .map(|b| {
+                        at += b.bvh.nodes.len() as u32;
+                        at - b.bvh.nodes.len() as u32
+                    })
+                    .collect();
+                None
+            };
+            let wide = forms.wide.then(|| {
+                let (wide, wide_roots, wide_of) = two.device_wide_nodes();
+                host.layout.wide_roots = wide_roots;
+                host.layout.wide_of = wide_of;
+                wide
+            });
+            (nodes, wide)
         }
     }
 }

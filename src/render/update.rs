@@ -84,18 +84,23 @@ impl Renderer {
         }
         two.rebuild_tlas();
         let slots = two.tlas_slots();
-        let mut nodes = two.tlas.nodes.clone();
-        nodes.resize(slots, GpuBvhNode::default());
-        let mut wide = WideBvh::collapse(&two.tlas).nodes;
-        wide.resize(slots, GpuWideNode::default());
         let instances = host.layout.gpu_instances(two);
         let gpu = &self.gpu;
-        buffers.nodes.write_at(gpu, 0, &nodes)?;
-        buffers.wide_nodes.write_at(gpu, 0, &wide)?;
+        let mut bytes = std::mem::size_of_val(instances.as_slice());
+        // The TLAS in each node array the device has (`NodeForms`).
+        if buffers.forms.binary {
+            let mut nodes = two.tlas.nodes.clone();
+            nodes.resize(slots, GpuBvhNode::default());
+            buffers.nodes.write_at(gpu, 0, &nodes)?;
+            bytes += std::mem::size_of_val(nodes.as_slice());
+        }
+        if buffers.forms.wide {
+            let mut wide = WideBvh::collapse(&two.tlas).nodes;
+            wide.resize(slots, GpuWideNode::default());
+            buffers.wide_nodes.write_at(gpu, 0, &wide)?;
+            bytes += std::mem::size_of_val(wide.as_slice());
+        }
         buffers.instances.write_at(gpu, 0, &instances)?;
-        let mut bytes = std::mem::size_of_val(nodes.as_slice())
-            + std::mem::size_of_val(wide.as_slice())
-            + std::mem::size_of_val(instances.as_slice());
         // A moved small instance's world-space triangle copies (the TLAS's pieces).
         for &(i, _, _) in &moved {
             let base = host.layout.copy_bases[i] as usize;

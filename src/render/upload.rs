@@ -73,10 +73,11 @@ pub struct InstanceLayout {
     pub objects: Vec<u32>,
     /// Each BLAS's root in the binary node array.
     pub roots: Vec<u32>,
-    /// Each BLAS's root in the wide node array.
+    /// Each BLAS's root in the wide node array (empty while the device has no wide nodes).
     pub wide_roots: Vec<u32>,
     /// Per BLAS, each binary node's wide node (relative to its root; `u32::MAX` for one inside
-    /// a wide node): where a re-braided piece enters the wide BLAS.
+    /// a wide node): where a re-braided piece enters the wide BLAS (empty while the device has
+    /// no wide nodes).
     pub wide_of: Vec<Vec<u32>>,
     /// Each instance's first light (the light index of its first emissive triangle).
     pub light_bases: Vec<i32>,
@@ -134,8 +135,9 @@ impl InstanceLayout {
                     let k = node & !PIECE_TRIANGLE;
                     (self.copy_bases[i as usize] + k, two.firsts[b] + k)
                 } else {
-                    let wide = self.wide_of[b][node as usize];
-                    (self.roots[b] + node, self.wide_roots[b] + wide)
+                    // Without the wide nodes on the device (`NodeForms`), no wide root.
+                    let wide = |m: &Vec<u32>| self.wide_roots[b] + m[node as usize];
+                    (self.roots[b] + node, self.wide_of.get(b).map_or(0, wide))
                 };
                 let mut world = inst.world_rows();
                 world[0][3] = f32::from_bits(self.light_bases[i as usize] as u32);
