@@ -430,11 +430,8 @@ fn instances_render_the_same_image_both_ways() {
     );
 }
 
-#[test]
-fn a_quick_first_image_gives_way_to_the_image_of_the_sah_trees() {
-    // The viewer opens a large scene with quick BLASes and swaps the SAH ones in when they are
-    // built: from the swap on, the image is the one of a scene loaded with SAH BLASes alone.
-    let scene = cube_scene(4);
+/// The cubes of `cube_scene(4)` under a lamp, and a camera that sees them.
+fn lit_cubes() -> (Scene, penumbra::scene::Light, penumbra::scene::Camera) {
     let light = penumbra::scene::Light {
         name: "lamp".into(),
         kind: penumbra::scene::LightKind::Point,
@@ -450,6 +447,14 @@ fn a_quick_first_image_gives_way_to_the_image_of_the_sah_trees() {
         DVec3::new(0.0, 1.0, 0.0),
         0.9,
     );
+    (cube_scene(4), light, camera)
+}
+
+#[test]
+fn a_quick_first_image_gives_way_to_the_image_of_the_sah_trees() {
+    // The viewer opens a large scene with quick BLASes and swaps the SAH ones in when they are
+    // built: from the swap on, the image is the one of a scene loaded with SAH BLASes alone.
+    let (scene, light, camera) = lit_cubes();
     let settings = penumbra::render::RenderSettings {
         width: 48,
         height: 32,
@@ -516,22 +521,7 @@ fn a_device_gets_the_node_array_its_kernels_traverse() {
     // The megakernel (a CPU device's) walks the wide nodes alone, the wavefront (a GPU's) the
     // binary ones: the other array is not uploaded, and the image is the one of a device
     // that has both. Switching kernels uploads the missing array.
-    let scene = cube_scene(4);
-    let light = penumbra::scene::Light {
-        name: "lamp".into(),
-        kind: penumbra::scene::LightKind::Point,
-        position: DVec3::new(0.5, 9.0, 2.0),
-        direction: DVec3::NEG_Y,
-        color: [1.0; 3],
-        intensity: 400.0,
-        light_radius: 0.0,
-    };
-    let camera = penumbra::scene::Camera::look_at(
-        "test",
-        DVec3::new(2.0, 3.0, 22.0),
-        DVec3::new(0.0, 1.0, 0.0),
-        0.9,
-    );
+    let (scene, light, camera) = lit_cubes();
     let settings = penumbra::render::RenderSettings {
         width: 32,
         height: 24,
