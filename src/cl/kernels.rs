@@ -97,6 +97,44 @@ impl<T: Pod> Buffer<T> {
         Ok(())
     }
 
+    /// Writes every element through a mapping of the whole buffer (blocking): `fill` gets the
+    /// buffer's elements, of undefined contents, to write all of them. On a CPU device the
+    /// mapping is the buffer's own memory, so that a large array is written once, in place,
+    /// with no host copy of it beside the buffer.
+    pub fn fill_mapped<R>(
+        &mut self,
+        gpu: &Gpu,
+        fill: impl FnOnce(&mut [T]) -> R,
+    ) -> Result<R, ClError> {
+        let bytes = self.bytes();
+        let mut ptr: opencl3::types::cl_mem = ptr::null_mut();
+        // SAFETY: maps the whole allocation for writing and waits for it; the slice made of
+        // it covers exactly `len.max(1)` elements of a `Pod` type (any bits are a value) and
+        // is gone before the unmap below.
+        let result = unsafe {
+            gpu.queue
+                .enqueue_map_buffer(
+                    &self.inner,
+                    CL_BLOCKING,
+                    opencl3::memory::CL_MAP_WRITE_INVALIDATE_REGION,
+                    0,
+                    bytes,
+                    &mut ptr,
+                    &[],
+                )
+                .map_err(call_err("mapping a buffer"))?;
+            let elements = std::slice::from_raw_parts_mut(ptr.cast::<T>(), self.len.max(1));
+            let result = fill(elements);
+            gpu.queue
+                .enqueue_unmap_mem_object(self.inner.get(), ptr, &[])
+                .map_err(call_err("unmapping a buffer"))?
+                .wait()
+                .map_err(call_err("unmapping a buffer"))?;
+            result
+        };
+        Ok(result)
+    }
+
     /// Reads the whole buffer back (blocking).
     pub fn read(&self, gpu: &Gpu) -> Result<Vec<T>, ClError> {
         let mut out = vec![T::zeroed(); self.len];

@@ -389,6 +389,8 @@ impl Renderer {
         if let Some(small_mesh) = self.small_mesh {
             rule.small_mesh = small_mesh;
         }
+        // Two levels: each BLAS's mesh, whose device structs are written at the upload.
+        let mut meshes: Vec<&crate::scene::Mesh> = vec![];
         let (mut host, dropped) = match instancing::plan(scene, &space, self.bvh_choice, rule, how)
         {
             Some(plan) => {
@@ -400,7 +402,7 @@ impl Renderer {
                     behind = Some(Self::sah_meshes(scene, &plan));
                 }
                 // Two levels: nothing is flattened; each mesh goes to the device once.
-                let meshes: Vec<&crate::scene::Mesh> = plan
+                meshes = plan
                     .mesh_objects
                     .iter()
                     .map(|&o| scene.objects[o as usize].mesh.as_ref())
@@ -416,10 +418,22 @@ impl Renderer {
         let t = Instant::now();
         host.space = space;
         host.scale_emitter_power(&lights::emissive_texture_means(scene));
+        // Two levels: the meshes' triangles (BLAS after BLAS), and whether any has tangents.
+        let (mesh_triangles, mesh_tangents) = match &host.accel {
+            Accel::TwoLevel(two) => (
+                two.blases.iter().map(|b| b.triangles.len()).sum(),
+                meshes.iter().any(|m| !m.tangents.is_empty()),
+            ),
+            Accel::Flat(_) => (0, false),
+        };
         self.scene_features = KernelFeatures {
             two_level: matches!(host.accel, Accel::TwoLevel(_)),
             triangle_pieces: matches!(&host.accel, Accel::TwoLevel(t) if t.has_small_meshes()),
-            ..scene_features(scene, !host.emissive.is_empty(), !host.tangents.is_empty())
+            ..scene_features(
+                scene,
+                !host.emissive.is_empty(),
+                !host.tangents.is_empty() || mesh_tangents,
+            )
         };
         let budget = self
             .gpu
@@ -440,15 +454,21 @@ impl Renderer {
         let (nodes, wide_nodes, instances) = device_accel(&mut host, forms);
         log::debug!("device nodes: {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
         // Triangles and shading data are the device's alone (picking keeps each flat triangle's
-        // object, `HostScene::objects`): they leave the host scene, and each large host
-        // array is freed as soon as its buffer is made, so that the two copies (host memory
-        // either way with a CPU device) are not all held at once.
+        // object, `HostScene::objects`). The flat form's leave the host scene, and each large
+        // host array is freed as soon as its buffer is made, so that the two copies (host
+        // memory either way with a CPU device) are not all held at once. Two levels write
+        // every mesh's straight into the buffers (`HostScene::fill_meshes`), no host copy made;
+        // their host triangles are the small instances' world-space copies, which follow the
+        // meshes' in the device triangles.
         let triangles = std::mem::take(&mut host.triangles);
         let shading = std::mem::take(&mut host.shading);
-        let mut tangents = std::mem::take(&mut host.tangents);
-        if tangents.is_empty() {
-            tangents.push(GpuTriTangents::default());
-        }
+        let tangents = std::mem::take(&mut host.tangents);
+        let tangent_count = if mesh_tangents { mesh_triangles } else { 0 } + tangents.len();
+        let lengths = (
+            mesh_triangles + triangles.len(),
+            mesh_triangles + shading.len(),
+            tangent_count.max(1),
+        );
         // Two levels trace the meshes' object-space triangles in `triangles`: the separate
         // object-triangle buffer is a placeholder either way.
         let object_tris = [GpuTriangle::default()];
@@ -459,10 +479,13 @@ impl Renderer {
                 "wide BVH nodes",
                 std::mem::size_of_val(wide_nodes.as_slice()),
             ),
-            ("triangles", std::mem::size_of_val(triangles.as_slice())),
+            ("triangles", lengths.0 * std::mem::size_of::<GpuTriangle>()),
             ("instances", std::mem::size_of_val(instances.as_slice())),
-            ("shading", std::mem::size_of_val(shading.as_slice())),
-            ("tangents", std::mem::size_of_val(tangents.as_slice())),
+            ("shading", lengths.1 * std::mem::size_of::<GpuTriShading>()),
+            (
+                "tangents",
+                lengths.2 * std::mem::size_of::<GpuTriTangents>(),
+            ),
             ("texels", bytes(pack.texels.len(), 4)),
         ];
         log::debug!(
@@ -498,12 +521,45 @@ impl Renderer {
         drop(nodes);
         let wide_buffer = put(gpu, old_wide, &wide_nodes)?;
         drop(wide_nodes);
-        let shading_buffer = put(gpu, old_shading, &shading)?;
-        drop(shading);
-        let tangents_buffer = put(gpu, old_tangents, &tangents)?;
-        drop(tangents);
-        let triangles_buffer = put(gpu, old_triangles, &triangles)?;
-        drop(triangles);
+        let (shading_buffer, tangents_buffer, triangles_buffer) = match &host.accel {
+            Accel::Flat(_) => {
+                let shading_buffer = put(gpu, old_shading, &shading)?;
+                drop(shading);
+                let mut tangents = tangents;
+                if tangents.is_empty() {
+                    tangents.push(GpuTriTangents::default());
+                }
+                let tangents_buffer = put(gpu, old_tangents, &tangents)?;
+                drop(tangents);
+                let triangles_buffer = put(gpu, old_triangles, &triangles)?;
+                drop(triangles);
+                (shading_buffer, tangents_buffer, triangles_buffer)
+            }
+            Accel::TwoLevel(two) => {
+                let mut shading_buffer = sized(gpu, old_shading, lengths.1)?;
+                let mut tangents_buffer = sized(gpu, old_tangents, lengths.2)?;
+                let mut triangles_buffer = sized(gpu, old_triangles, lengths.0)?;
+                let n = mesh_triangles;
+                triangles_buffer.fill_mapped(gpu, |tris| {
+                    shading_buffer.fill_mapped(gpu, |sh| {
+                        tangents_buffer.fill_mapped(gpu, |tan| {
+                            let tan_out = if mesh_tangents {
+                                &mut tan[..n]
+                            } else {
+                                &mut []
+                            };
+                            let out = (&mut tris[..n], &mut sh[..n], tan_out);
+                            HostScene::fill_meshes(two, &meshes, &materials, out);
+                            tris[n..].copy_from_slice(&triangles);
+                            if !mesh_tangents {
+                                tan.fill(GpuTriTangents::default());
+                            }
+                        })
+                    })
+                })???;
+                (shading_buffer, tangents_buffer, triangles_buffer)
+            }
+        };
         let instances_buffer = put(gpu, old_instances, &instances)?;
         let buffers = SceneBuffers {
             forms,
@@ -843,6 +899,22 @@ fn put<T: bytemuck::Pod>(
     }
 }
 
+/// A buffer of `len` elements: `old` when it has that length (its memory written again in
+/// place, no fresh pages to fault in), else a new one (contents undefined either way).
+fn sized<T: bytemuck::Pod>(
+    gpu: &Gpu,
+    old: Option<Buffer<T>>,
+    len: usize,
+) -> Result<Buffer<T>, ClError> {
+    match old {
+        Some(b) if b.len() == len => Ok(b),
+        old => {
+            drop(old);
+            Buffer::new(gpu, len)
+        }
+    }
+}
+
 /// The device's node arrays (binary and wide, each a placeholder of one node unless `forms`
 /// has it) and instances for `host`'s acceleration structure (the instances are a
 /// placeholder when flat); fills `host.layout` for two levels.
@@ -856,7 +928,9 @@ fn device_accel(
     let instances = match &host.accel {
         Accel::Flat(_) => vec![GpuInstance::default()],
         Accel::TwoLevel(two) => {
-            host.layout.append_piece_copies(two, &mut host.triangles);
+            // The small instances' world-space copies follow the meshes' triangles.
+            let first = two.blases.iter().map(|b| b.triangles.len()).sum();
+            host.triangles = host.layout.piece_copies(two, first);
             host.layout.gpu_instances(two)
         }
     };

@@ -90,31 +90,23 @@ pub struct InstanceLayout {
 }
 
 impl InstanceLayout {
-    /// Appends the world-space copies of every small instance's triangles (hidden ones too, so
-    /// that showing one writes in place) to the device triangles `triangles` (the meshes'
-    /// object-space ones) and keeps where each instance's copies start.
-    pub fn append_piece_copies(&mut self, two: &TwoLevel, triangles: &mut Vec<GpuTriangle>) {
-        self.small_meshes = (0..two.blases.len())
-            .map(|b| {
-                let blas = &two.blases[b];
-                if !two.is_small(blas) {
-                    return Vec::new();
-                }
-                let first = two.firsts[b] as usize;
-                triangles[first..first + blas.triangles.len()].to_vec()
-            })
-            .collect();
+    /// The world-space copies of every small instance's triangles (hidden ones too, so that
+    /// showing one writes in place), to follow the meshes' `first` object-space triangles in
+    /// the device triangles; keeps where each instance's copies start.
+    pub fn piece_copies(&mut self, two: &TwoLevel, first: usize) -> Vec<GpuTriangle> {
+        let mut copies = vec![];
         self.copy_bases = (0..two.instances.len())
             .map(|i| {
                 let mesh = &self.small_meshes[two.instances[i].blas as usize];
                 if mesh.is_empty() {
                     return u32::MAX;
                 }
-                let base = triangles.len() as u32;
-                triangles.extend(piece_copies(two, mesh, i));
+                let base = (first + copies.len()) as u32;
+                copies.extend(piece_copies(two, mesh, i));
                 base
             })
             .collect();
+        copies
     }
 
     /// The device instances of `two` in TLAS order, one per TLAS slot (a re-braided piece of
@@ -196,6 +188,8 @@ pub struct Emitter {
     pub power: f32,
     /// Centroid in render space.
     pub centroid: Vec3,
+    /// Its material (index in the scene's materials).
+    pub material: u32,
 }
 
 /// The scene as uploaded, kept on the host for picking and for tests.
@@ -204,9 +198,11 @@ pub struct HostScene {
     pub accel: Accel,
     /// Two levels: where the instances' parts sit on the device (empty when flat).
     pub layout: InstanceLayout,
-    /// Triangles as the device has them: the flat BVH's world triangles in BVH order, or
-    /// (two levels) every mesh's object-space triangles, mesh after mesh in BLAS order; moved
-    /// to the device by `Renderer::load_scene` (empty after).
+    /// Triangles as the device has them: the flat BVH's world triangles in BVH order; moved
+    /// to the device by `Renderer::load_scene` (empty after). Two levels: only the small
+    /// instances' world-space copies that follow the meshes' object-space triangles on the
+    /// device (mesh after mesh in BLAS order, written straight into the device buffer by
+    /// [`HostScene::fill_meshes`]).
     pub triangles: Vec<GpuTriangle>,
     /// Flat: each triangle's object (index in `Scene::objects`) in BVH order, for picking
     /// (4 bytes a triangle where `triangles` holds 48); empty with two levels.
@@ -214,11 +210,11 @@ pub struct HostScene {
     /// Flat: world vertices in BVH order (for the host traversal); empty with two levels,
     /// whose BLASes hold their triangles.
     pub vertices: Vec<[Vec3; 3]>,
-    /// Shading data, indexed as `triangles` (two levels: object-space normals); moved to the
-    /// device by `Renderer::load_scene` (empty after).
+    /// Shading data, indexed as `triangles`; moved to the device by `Renderer::load_scene`
+    /// (empty after; two levels: always, [`HostScene::fill_meshes`]).
     pub shading: Vec<GpuTriShading>,
-    /// Tangents, indexed as `triangles`; empty when no triangle is normal-mapped, and after
-    /// `Renderer::load_scene` moved them to the device.
+    /// Tangents, indexed as `triangles`; empty when no triangle is normal-mapped, with two
+    /// levels, and after `Renderer::load_scene` moved them to the device.
     pub tangents: Vec<GpuTriTangents>,
     /// Materials.
     pub materials: Vec<GpuMaterial>,
@@ -404,6 +400,7 @@ impl HostScene {
                     area,
                     power,
                     centroid: v.iter().sum::<Vec3>() / 3.0,
+                    material: tri.v0[3].to_bits(),
                 });
             }
         }
@@ -451,30 +448,33 @@ impl HostScene {
     /// table's emissive triangles instance by instance (each instance's first light is kept in
     /// `layout.light_bases`). `two`'s instances are in render space.
     pub fn two_level(two: TwoLevel, meshes: &[&Mesh], materials: &[Material]) -> Self {
-        let normal_mapped = meshes.iter().any(|m| !m.tangents.is_empty());
-        let sizes: Vec<usize> = two.blases.iter().map(|b| b.bvh.tri_indices.len()).collect();
-        let n = sizes.iter().sum();
-        // Each mesh fills its own range of the arrays, in parallel (no per-mesh copies to
-        // join: on a large scene these arrays are most of the host memory written).
-        let mut triangles: Vec<GpuTriangle> = bytemuck::zeroed_vec(n);
-        let mut shading: Vec<GpuTriShading> = bytemuck::zeroed_vec(n);
-        let mut tangents: Vec<GpuTriTangents> =
-            bytemuck::zeroed_vec(if normal_mapped { n } else { 0 });
-        let parts = split_by(&mut triangles, &sizes)
-            .into_iter()
-            .zip(split_by(&mut shading, &sizes))
-            .zip(split_by(&mut tangents, &sizes));
-        // Each mesh's emissive triangles (index among the meshes' triangles, material).
+        // Each mesh's emissive triangles (index among the meshes' triangles, material); the
+        // device structs themselves are written at the upload (`HostScene::fill_meshes`).
         let mesh_emitters: Vec<Vec<(u32, u32)>> = meshes
             .par_iter()
             .zip(&two.blases)
-            .zip(parts.collect::<Vec<_>>())
             .enumerate()
-            .map(|(b, ((m, blas), out))| {
-                object_triangles(m, &blas.bvh.tri_indices, materials, out)
+            .map(|(b, (m, blas))| {
+                emissive_triangles(m, &blas.bvh.tri_indices, materials)
                     .into_iter()
                     .map(|(k, material)| (two.firsts[b] + k, material))
                     .collect()
+            })
+            .collect();
+        // A small mesh's object-space device triangles, for its instances' world-space copies.
+        let small_meshes = meshes
+            .iter()
+            .zip(&two.blases)
+            .map(|(m, blas)| {
+                if !two.is_small(blas) {
+                    return Vec::new();
+                }
+                let n = blas.bvh.tri_indices.len();
+                let mut tris = vec![GpuTriangle::default(); n];
+                let mut shading = vec![GpuTriShading::default(); n];
+                let out = ((&mut tris[..], &mut shading[..]), &mut [][..]);
+                object_triangles(m, &blas.bvh.tri_indices, materials, out);
+                tris
             })
             .collect();
         let mut emissive = vec![];
@@ -483,7 +483,8 @@ impl HostScene {
             light_bases.push(emissive.len() as i32);
             for &(prim, material) in &mesh_emitters[inst.blas as usize] {
                 let v = two.hit_triangle(prim, i as u32);
-                emissive.push(emitter(prim, i as u32, &v, &materials[material as usize]));
+                let m = &materials[material as usize];
+                emissive.push(emitter(prim, i as u32, &v, material, m));
             }
         }
         let shown: Vec<usize> = (0..two.instances.len())
@@ -501,13 +502,48 @@ impl HostScene {
             Accel::TwoLevel(two),
             InstanceLayout {
                 light_bases,
+                small_meshes,
                 ..InstanceLayout::default()
             },
-            (triangles, shading, tangents),
+            (vec![], vec![], vec![]),
             materials,
             emissive,
             middle,
         )
+    }
+
+    /// Two levels: writes every mesh's device structs, once, in object space and BLAS order
+    /// (`meshes[b]` is BLAS b's mesh) to the front of `triangles` and `shading` (and of
+    /// `tangents` when not empty), each mesh its own range, in parallel. The renderer writes
+    /// them straight into the device buffers ([`crate::cl::Buffer::fill_mapped`]): on a CPU
+    /// device no host copy of these arrays (144 bytes a triangle) is made beside them.
+    pub fn fill_meshes(
+        two: &TwoLevel,
+        meshes: &[&Mesh],
+        materials: &[Material],
+        (triangles, shading, tangents): (
+            &mut [GpuTriangle],
+            &mut [GpuTriShading],
+            &mut [GpuTriTangents],
+        ),
+    ) {
+        let sizes: Vec<usize> = two.blases.iter().map(|b| b.bvh.tri_indices.len()).collect();
+        let tangent_sizes: Vec<usize> = if tangents.is_empty() {
+            vec![0; sizes.len()]
+        } else {
+            sizes.clone()
+        };
+        let parts = split_by(triangles, &sizes)
+            .into_iter()
+            .zip(split_by(shading, &sizes))
+            .zip(split_by(tangents, &tangent_sizes));
+        meshes
+            .par_iter()
+            .zip(&two.blases)
+            .zip(parts.collect::<Vec<_>>())
+            .for_each(|((m, blas), out)| {
+                object_triangles(m, &blas.bvh.tri_indices, materials, out);
+            });
     }
 
     /// Triangles over all placed meshes.
@@ -522,8 +558,10 @@ impl HostScene {
     /// `per_material` (see [`emissive_texture_means`]).
     pub fn scale_emitter_power(&mut self, per_material: &[f32]) {
         for e in &mut self.emissive {
-            let material = self.triangles[e.prim as usize].v0[3].to_bits() as usize;
-            e.power *= per_material.get(material).copied().unwrap_or(1.0);
+            e.power *= per_material
+                .get(e.material as usize)
+                .copied()
+                .unwrap_or(1.0);
         }
     }
 
@@ -600,7 +638,7 @@ fn triangle_area(v: &[Vec3; 3]) -> f32 {
 }
 
 /// The light-table entry of an emissive triangle with world vertices `v`.
-fn emitter(prim: u32, instance: u32, v: &[Vec3; 3], m: &Material) -> Emitter {
+fn emitter(prim: u32, instance: u32, v: &[Vec3; 3], material: u32, m: &Material) -> Emitter {
     let area = triangle_area(v);
     let sides = if m.double_sided { 2.0 } else { 1.0 };
     Emitter {
@@ -609,6 +647,7 @@ fn emitter(prim: u32, instance: u32, v: &[Vec3; 3], m: &Material) -> Emitter {
         area,
         power: luminance(m.emission) * area * std::f32::consts::PI * sides,
         centroid: v.iter().sum::<Vec3>() / 3.0,
+        material,
     }
 }
 
@@ -647,26 +686,53 @@ type MeshStructs<'a> = (
     &'a mut [GpuTriTangents],
 );
 
+/// Whether triangle `ti` of `m` (vertices `v`) is a light: an emissive material and a
+/// nonzero object-space area.
+fn emits(m: &Mesh, ti: u32, v: &[Vec3; 3], materials: &[Material]) -> bool {
+    materials[m.materials[ti as usize] as usize].is_emissive() && triangle_area(v) > 0.0
+}
+
+/// One mesh's emissive triangles in the order `order` (index in that order, material), as
+/// [`object_triangles`] finds them.
+fn emissive_triangles(m: &Mesh, order: &[u32], materials: &[Material]) -> Vec<(u32, u32)> {
+    if !m
+        .materials
+        .iter()
+        .any(|&i| materials[i as usize].is_emissive())
+    {
+        return vec![];
+    }
+    order
+        .iter()
+        .enumerate()
+        .filter(|&(_, &ti)| {
+            let v = m.indices[ti as usize].map(|i| m.positions[i as usize]);
+            emits(m, ti, &v, materials)
+        })
+        .map(|(k, &ti)| (k as u32, m.materials[ti as usize]))
+        .collect()
+}
+
 /// Writes the device structs of one mesh's triangles in object space, in the order `order`,
-/// to `out`; its emissive triangles (index in that order, material): emissive materials with
-/// a nonzero object-space area, whose `v1.w` counts them.
+/// to `out` (tangents unless that slice is empty); an emissive triangle's `v1.w` counts the
+/// mesh's emissive triangles ([`emissive_triangles`]).
 fn object_triangles(
     m: &Mesh,
     order: &[u32],
     materials: &[Material],
     ((tris, shading), tangents): MeshStructs,
-) -> Vec<(u32, u32)> {
+) {
     let normal_mapped = !tangents.is_empty();
-    let mut emitters = vec![];
+    let mut emitters = 0;
     let corner = |a: &[Vec2], i: u32| a.get(i as usize).copied().unwrap_or(Vec2::ZERO);
     for (k, &ti) in order.iter().enumerate() {
         let idx = m.indices[ti as usize];
         let material = m.materials[ti as usize];
         let v = idx.map(|i| m.positions[i as usize]);
         let mut light = -1i32;
-        if materials[material as usize].is_emissive() && triangle_area(&v) > 0.0 {
-            light = emitters.len() as i32;
-            emitters.push((k as u32, material));
+        if emits(m, ti, &v, materials) {
+            light = emitters;
+            emitters += 1;
         }
         let geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
         let smooth = !m.normals.is_empty();
@@ -695,7 +761,6 @@ fn object_triangles(
             tangents[k] = tan;
         }
     }
-    emitters
 }
 
 /// The flat form's device structs in object order, filled a list of [`WorldTriangle`]s at a
