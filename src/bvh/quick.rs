@@ -72,13 +72,22 @@ pub fn quick_blas(positions: &[Vec3], indices: &[[u32; 3]]) -> super::Blas {
 }
 
 fn in_order(triangles: &[[Vec3; 3]], order: &[u32]) -> Vec<[Vec3; 3]> {
-    order.par_iter().map(|&i| triangles[i as usize]).collect()
+    order
+        .par_iter()
+        .with_min_len(CHUNK)
+        .map(|&i| triangles[i as usize])
+        .collect()
 }
+
+/// The fewest triangles a parallel pass hands one task: a mesh of a few thousand triangles
+/// (a scene of many distinct meshes builds them side by side) is one task a pass.
+const CHUNK: usize = 1 << 13;
 
 /// The triangles' indices sorted by their centroids' Morton codes, and the sorted codes.
 fn morton_order(triangles: &[[Vec3; 3]]) -> (Vec<u32>, Vec<u32>) {
     let centres = triangles
         .par_iter()
+        .with_min_len(CHUNK)
         .fold(|| Aabb::EMPTY, |b, t| b.grow(centroid(t)))
         .reduce(|| Aabb::EMPTY, Aabb::union);
     let extent = centres.max - centres.min;
@@ -90,6 +99,7 @@ fn morton_order(triangles: &[[Vec3; 3]]) -> (Vec<u32>, Vec<u32>) {
     );
     let mut keys: Vec<u64> = triangles
         .par_iter()
+        .with_min_len(CHUNK)
         .enumerate()
         .map(|(i, t)| {
             let q = ((centroid(t) - centres.min) * scale).clamp(Vec3::ZERO, Vec3::splat(1023.0));
@@ -98,9 +108,21 @@ fn morton_order(triangles: &[[Vec3; 3]]) -> (Vec<u32>, Vec<u32>) {
         })
         .collect();
     // Unique keys (the index is part of each), so the order is the same at any thread count.
-    keys.par_sort_unstable();
-    let tri_indices = keys.par_iter().map(|&k| k as u32).collect();
-    let codes = keys.par_iter().map(|&k| (k >> 32) as u32).collect();
+    if keys.len() <= TASK {
+        keys.sort_unstable();
+    } else {
+        keys.par_sort_unstable();
+    }
+    let tri_indices = keys
+        .par_iter()
+        .with_min_len(CHUNK)
+        .map(|&k| k as u32)
+        .collect();
+    let codes = keys
+        .par_iter()
+        .with_min_len(CHUNK)
+        .map(|&k| (k >> 32) as u32)
+        .collect();
     (tri_indices, codes)
 }
 

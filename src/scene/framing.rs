@@ -348,7 +348,13 @@ impl Probe {
     /// are passed by the rays that light passes; they still count for the bounds and for
     /// telling an interior.
     pub fn new(scene: &Scene) -> Self {
+        let t = std::time::Instant::now();
         let (tris, materials) = scene.world_vertices(&super::RenderFrame::default());
+        log::debug!(
+            "probe: world vertices in {:.0} ms",
+            t.elapsed().as_secs_f64() * 1e3
+        );
+        let t = std::time::Instant::now();
         let placed: usize = scene
             .objects
             .iter()
@@ -388,6 +394,10 @@ impl Probe {
             .collect();
         let hidden = vec![false; instances.len()];
         let two = TwoLevel::with_hidden(blases, &instances, hidden, 0);
+        log::debug!(
+            "probe: quick BLASes and top level in {:.0} ms",
+            t.elapsed().as_secs_f64() * 1e3
+        );
         Self::with_tracer(
             scene,
             Tracer::TwoLevel {
@@ -437,8 +447,13 @@ impl Probe {
         materials: Vec<u32>,
     ) -> Self {
         use rayon::prelude::*;
+        let t = std::time::Instant::now();
         let bounds = robust_bounds(&tris);
         let points = fit_points(&tris, &bounds);
+        log::debug!(
+            "probe: robust bounds and fit points in {:.0} ms",
+            t.elapsed().as_secs_f64() * 1e3
+        );
         let see_through = see_through_materials(scene);
         let any_opaque = materials
             .par_iter()
@@ -990,7 +1005,9 @@ pub fn first_view(
     aspect: f64,
 ) -> FirstView {
     let probe = Probe::new(scene);
+    let t = std::time::Instant::now();
     let view = first_view_with(&probe, lights, camera, aspect);
+    log::debug!("probe: rays in {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
     probe.keep_blases(scene);
     view
 }
