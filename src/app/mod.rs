@@ -212,6 +212,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         notice_frames: 0,
         deferred_env: None,
         frame_key: None,
+        shown_spp: 0,
     };
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.fatal.take() {
@@ -310,6 +311,8 @@ struct App {
     deferred_env: Option<gui::EnvSource>,
     /// The display generation, image area and window size the frame buffer was composed for.
     frame_key: Option<(u64, layout::ImageArea, (u32, u32))>,
+    /// Samples per pixel of the last frame shown (0: none yet since the scene changed).
+    shown_spp: u32,
 }
 
 impl ApplicationHandler for App {
@@ -678,6 +681,13 @@ impl App {
     /// After a frame is shown: reports convergence, and exits on Ctrl+Q or after `--frames`.
     fn frame_shown(&mut self, event_loop: &ActiveEventLoop) {
         self.frames += 1;
+        let spp = self.frame_loop.progress.spp;
+        if self.shown_spp == 0 {
+            // When the first image of a scene reaches the screen (opening times in the debug
+            // log): the frames up to the first with samples.
+            log::debug!("frame {} shown ({spp} spp)", self.frames);
+        }
+        self.shown_spp = spp;
         let converged = self.frame_loop.converged(self.model.view.spp_target);
         if converged && !self.converged {
             // One line per convergence, for scripts (and tests) that wait for a clean frame.

@@ -140,6 +140,9 @@ pub struct Renderer {
     quick_first: Option<usize>,
     /// The SAH BLASes building behind the quick ones of the scene on the device.
     sah: Option<SahBuild>,
+    /// The meshes whose SAH BLASes start building once the quick scene's first samples are
+    /// in (see [`Renderer::swap_in_sah`]).
+    sah_waiting: Option<Vec<Arc<crate::scene::Mesh>>>,
     /// Node arrays uploaded beyond those the kernels in use traverse (see
     /// [`Renderer::set_node_forms`]).
     extra_forms: NodeForms,
@@ -199,6 +202,7 @@ impl Renderer {
             small_mesh: None,
             quick_first: None,
             sah: None,
+            sah_waiting: None,
             extra_forms: NodeForms {
                 binary: false,
                 wide: false,
@@ -288,20 +292,28 @@ impl Renderer {
         Ok(())
     }
 
-    /// Whether SAH BLASes are building behind the quick ones on the device.
+    /// Whether SAH BLASes are building (or waiting to) behind the quick ones on the device.
     pub fn sah_pending(&self) -> bool {
-        self.sah.is_some()
+        self.sah.is_some() || self.sah_waiting.is_some()
     }
 
     /// When the SAH BLASes behind the quick ones are done, loads `scene` (the one loaded, as it
     /// is now: moved or hidden objects stay so) with them in the current render space and
     /// resets the film; its figures, the wait for the BLASes (ms) in `bvh_build_ms`. `None`
-    /// while they build or when none are.
+    /// while they build or when none are. The first call after the quick scene's first
+    /// samples starts their build.
     pub fn swap_in_sah(
         &mut self,
         scene: &Scene,
         lights: &[Light],
     ) -> Result<Option<SceneStats>, ClError> {
+        // The SAH BLASes start once the quick scene has samples: on a CPU device their
+        // threads would otherwise share the cores with the first image.
+        if self.samples > 0
+            && let Some(meshes) = self.sah_waiting.take()
+        {
+            self.sah = Self::sah_behind(meshes);
+        }
         let Some(build) = &self.sah else {
             return Ok(None);
         };
@@ -378,6 +390,7 @@ impl Renderer {
         reuse: Option<SceneBuffers>,
     ) -> Result<SceneStats, ClError> {
         self.sah = None;
+        self.sah_waiting = None;
         let mut behind = None;
         let t = Instant::now();
         let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
@@ -598,8 +611,9 @@ impl Renderer {
             device_bytes: buffers.bytes(),
         };
         self.scene = Some((buffers, host));
-        // The SAH BLASes start once the quick scene is on the device, not to slow its upload.
-        self.sah = behind.and_then(Self::sah_behind);
+        // The SAH BLASes start once the quick scene's first image is in ([`Renderer::swap_in_sah`]),
+        // not to slow its upload nor that image.
+        self.sah_waiting = behind;
         if let Some(c) = self.world_camera.clone() {
             self.set_camera(&c)?;
         }
