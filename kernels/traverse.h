@@ -34,7 +34,9 @@ inline RayPrep prepare_ray(float3 o, float3 d) {
     }
     r.perm = (uint4)(kx, ky, kz, 3u);
     float4 p = shuffle(d4, r.perm);
-    r.shear = (float3)(p.x / p.z, p.y / p.z, 1.0f / p.z);
+    // One division: the shear's x and y scale by its z (src/bvh/traverse.rs computes the same).
+    float iz = 1.0f / p.z;
+    r.shear = (float3)(p.x * iz, p.y * iz, iz);
     return r;
 }
 
