@@ -52,9 +52,11 @@ impl Shear {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        // One division (as the kernels' prepare_ray): x and y scale by the reciprocal of z.
+        let iz = 1.0 / d[kz];
         Self {
             k: [kx, ky, kz],
-            s: Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]),
+            s: Vec3::new(d[kx] * iz, d[ky] * iz, iz),
         }
     }
 }
