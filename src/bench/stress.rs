@@ -262,6 +262,8 @@ pub fn leaks(
     } else {
         RenderFrame::default()
     };
+    // The device rays go through the binary nodes, on any device.
+    renderer.set_node_forms(crate::render::NodeForms::BOTH)?;
     renderer.load_scene_in(&scene, &[], space)?;
     let mut rng = Rng::new(rays as u64 ^ center.x.to_bits());
     let gpu_rays: Vec<GpuRay> = (0..rays)
@@ -516,8 +518,6 @@ pub fn run(args: &StressArgs) -> Result<()> {
     let choice =
         DeviceChoice::from_arg_or_env(args.device.as_deref()).map_err(anyhow::Error::msg)?;
     let mut renderer = Renderer::new(&choice)?;
-    // The leak check traces through the binary nodes on any device.
-    renderer.set_node_forms(crate::render::NodeForms::BOTH)?;
     println!(
         "penumbra bench stress, {}, {}",
         today(),
