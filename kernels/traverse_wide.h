@@ -5,9 +5,13 @@
 
 #define WIDE_STACK_SIZE 144  // (4 - 1) x the builder's depth limit of 48
 
-// The ray in four lanes: origin and safe reciprocal direction, one coordinate per vector.
+// The ray in four lanes: origin and safe reciprocal direction, one coordinate per vector, and
+// for each axis the byte offsets in a GpuWideNode of the box planes the ray meets first (min_*
+// where the direction is positive, max_* where negative) and last, so that a node's entry and
+// exit distances need no minimum and maximum per axis.
 typedef struct {
     float4 ox, oy, oz, ix, iy, iz;
+    uint nx, ny, nz, fx, fy, fz;
 } WideRay;
 
 inline WideRay wide_ray(const RayPrep* r) {
@@ -18,9 +22,17 @@ inline WideRay wide_ray(const RayPrep* r) {
     w.ix = (float4)(r->inv.x);
     w.iy = (float4)(r->inv.y);
     w.iz = (float4)(r->inv.z);
+    // min_x, min_y, min_z, max_x, max_y, max_z: 16 bytes each.
+    w.nx = r->inv.x >= 0.0f ? 0u : 48u;
+    w.ny = r->inv.y >= 0.0f ? 16u : 64u;
+    w.nz = r->inv.z >= 0.0f ? 32u : 80u;
+    w.fx = w.nx ^ 48u;
+    w.fy = w.ny ^ 80u;
+    w.fz = w.nz ^ 112u;
     return w;
 }
 
+#define WIDE_PLANE(n, offset) (*(global const float4*)((global const char*)(n) + (offset)))
 // traverse.h's slab test on the four children of n at once: their entry distances in *near,
 // and the mask of those the ray reaches before tmax (empty slots never).
 // The minimum and maximum are written as comparisons: OpenCL's fmin and fmax must return the
@@ -32,13 +44,13 @@ inline WideRay wide_ray(const RayPrep* r) {
 #define WIDE_MAX(a, b) select(b, a, a > b)
 inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin, float tmax,
                        float4* near) {
-    float4 x0 = (n->min_x - w->ox) * w->ix, x1 = (n->max_x - w->ox) * w->ix;
-    float4 y0 = (n->min_y - w->oy) * w->iy, y1 = (n->max_y - w->oy) * w->iy;
-    float4 z0 = (n->min_z - w->oz) * w->iz, z1 = (n->max_z - w->oz) * w->iz;
-    *near = WIDE_MAX(WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)), WIDE_MIN(z0, z1)),
-                     (float4)(tmin));
-    float4 far =
-        WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)), WIDE_MAX(z0, z1)) * 1.00000024f;
+    // With lo <= hi, (lo - o) * inv <= (hi - o) * inv where inv > 0 (rounding is monotonic) and
+    // >= where inv < 0: the near plane's distance is the minimum of the two, bit for bit.
+    float4 x0 = (WIDE_PLANE(n, w->nx) - w->ox) * w->ix, x1 = (WIDE_PLANE(n, w->fx) - w->ox) * w->ix;
+    float4 y0 = (WIDE_PLANE(n, w->ny) - w->oy) * w->iy, y1 = (WIDE_PLANE(n, w->fy) - w->oy) * w->iy;
+    float4 z0 = (WIDE_PLANE(n, w->nz) - w->oz) * w->iz, z1 = (WIDE_PLANE(n, w->fz) - w->oz) * w->iz;
+    *near = WIDE_MAX(WIDE_MAX(WIDE_MAX(x0, y0), z0), (float4)(tmin));
+    float4 far = WIDE_MIN(WIDE_MIN(x1, y1), z1) * 1.00000024f;
     int4 valid = (n->child > 0) | (n->count > 0u);
     return (*near <= far) & (*near < (float4)(tmax)) & valid;
 }
@@ -137,8 +149,7 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
     }
 
 // The children of wide node n that `mask` reaches, sorted: declares their entry distances
-// d0 <= d1 <= d2 <= d3 (INFINITY for those not reached, from `near`) and slots s0 .. s3, and
-// the node's children and counts as arrays indexed by slot.
+// d0 <= d1 <= d2 <= d3 (INFINITY for those not reached, from `near`) and slots s0 .. s3.
 #define WIDE_SORT_CHILDREN(n, near, mask)                           \
     float4 dist = select((float4)(INFINITY), near, mask);          \
     float d0 = dist.x, d1 = dist.y, d2 = dist.z, d3 = dist.w;      \
@@ -147,9 +158,7 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
     WIDE_ORDER(2, 3)                                               \
     WIDE_ORDER(0, 2)                                               \
     WIDE_ORDER(1, 3)                                               \
-    WIDE_ORDER(1, 2)                                               \
-    global const int* children = (global const int*)&n->child;    \
-    global const uint* counts = (global const uint*)&n->count;
+    WIDE_ORDER(1, 2)
 
 // A leaf among the sorted children, tested on the spot when it starts before the hit so far.
 #define WIDE_LEAF(D, S)                                                                     \
@@ -165,6 +174,17 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
         stack[sp] = (uint)children[S];             \
         stack_d[sp++] = D;                         \
     }
+
+// The lanes of a mask as bits (lane i: bit i). On x86 one movmskps (a kmov from the compare's
+// AVX-512 mask): OpenCL's any() became a dozen instructions and two branches there.
+inline uint wide_bits(int4 mask) {
+#if defined(__SSE__) && defined(__x86_64__)
+    return (uint)__builtin_ia32_movmskps(as_float4(mask));
+#else
+    int4 b = mask & (int4)(1, 2, 4, 8);
+    return (uint)((b.x | b.y) | (b.z | b.w));
+#endif
+}
 
 // Walks the wide BVH below node `root` as traverse_bvh (traverse.h) walks the binary one, with
 // the same arguments and result. The children a ray reaches are sorted by entry distance with
@@ -185,7 +205,9 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
         global const GpuWideNode* n = &nodes[node];
         float4 near;
         int4 mask = wide_reach(n, &w, tmin, hit->t, &near);
-        if (any(mask)) {
+        if (wide_bits(mask) != 0u) {
+            global const int* children = (global const int*)&n->child;
+            global const uint* counts = (global const uint*)&n->count;
             WIDE_SORT_CHILDREN(n, near, mask)
             WIDE_LEAF(d0, s0)
             WIDE_LEAF(d1, s1)
@@ -314,8 +336,10 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
             global const GpuWideNode* n = &nodes[node];
             float4 near;
             int4 mask = wide_reach(n, &w, tmin, hit.t, &near);
-            if (any(mask)) {
+            if (wide_bits(mask) != 0u) {
                 WIDE_SORT_CHILDREN(n, near, mask)
+                global const int* children = (global const int*)&n->child;
+                global const uint* counts = (global const uint*)&n->count;
                 TOP_WIDE_TRIANGLE(d0, s0)
                 TOP_WIDE_TRIANGLE(d1, s1)
                 TOP_WIDE_TRIANGLE(d2, s2)
