@@ -20,7 +20,9 @@ if [ -n "$NATIVE_COUNT" ]; then
         -e 's/^\(    float4 o = (float4)(r->origin, 0.0f);\)$/    count_tri();\n\1/' $O/all.cl
     grep -c 'count_' $O/all.cl
 fi
-clang-15 -x cl -cl-std=CL1.2 -target x86_64-pc-linux-gnu -march=native -O3 \
+# -fgnu89-inline: traverse_wide_bvh is a plain `inline` function called from two places, which
+# C99 rules leave without an out-of-line definition (an undefined symbol at link time).
+clang-15 -x cl -cl-std=CL1.2 -target x86_64-pc-linux-gnu -march=native -O3 -fgnu89-inline \
     -Xclang -finclude-default-header -cl-denorms-are-zero \
     -cl-fp32-correctly-rounded-divide-sqrt "$@" -emit-llvm -c $O/all.cl -o $O/trace.bc
 llvm-link-15 $O/trace.bc /usr/share/pocl/kernel-x86_64-pc-linux-gnu-avx512.bc --only-needed \
