@@ -175,6 +175,19 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
         stack_d[sp++] = D;                         \
     }
 
+// For any hit: child S, when reached, tested if a leaf, else pushed (to be entered whatever its
+// distance: the walk ends at the first hit).
+#define WIDE_ANY(S)                                                                            \
+    if ((bits >> S) & 1u) {                                                                    \
+        if (counts[S] == 0u) {                                                                 \
+            stack[sp] = (uint)children[S];                                                     \
+            stack_d[sp++] = -INFINITY;                                                         \
+        } else if (INTERSECT_LEAF(r, tris, surf, (uint)(~children[S]), counts[S], tmin, o, d, \
+                                  true, hit)) {                                                \
+            return true;                                                                       \
+        }                                                                                      \
+    }
+
 // The lanes of a mask as bits (lane i: bit i). On x86 one movmskps (a kmov from the compare's
 // AVX-512 mask): OpenCL's any() became a dozen instructions and two branches there.
 inline uint wide_bits(int4 mask) {
@@ -190,7 +203,10 @@ inline uint wide_bits(int4 mask) {
 // the same arguments and result. The children a ray reaches are sorted by entry distance with
 // a five-exchange network on scalars (registers, not arrays): leaves are tested in that order,
 // interior children pushed farthest first with their distance, and a popped node that starts
-// beyond the hit found meanwhile is skipped. The visiting order is src/bvh/wide.rs's.
+// beyond the hit found meanwhile is skipped. The visiting order is src/bvh/wide.rs's. With
+// any_hit the children are not sorted (WIDE_ANY): bunnies' shadow rays ran 20-25 % faster
+// (docs/benchmarks.md, "Seventh session"), and a shadow test's result does not depend on which
+// hit is found first (path.h's shadow tests walk thin walls again nearest first).
 inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
                               global const GpuTriangle* tris, const SceneSurfaces* surf,
                               const RayPrep* r, float3 o, float3 d, float tmin, bool any_hit,
@@ -205,7 +221,21 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
         global const GpuWideNode* n = &nodes[node];
         float4 near;
         int4 mask = wide_reach(n, &w, tmin, hit->t, &near);
-        if (wide_bits(mask) != 0u) {
+        uint bits = wide_bits(mask);
+        if (bits != 0u && any_hit) {
+            // Any hit ends the walk, so the order of the children does not matter: they are
+            // taken in slot order, without sorting (as Embree's occlusion walk takes them).
+            global const int* children = (global const int*)&n->child;
+            global const uint* counts = (global const uint*)&n->count;
+            if (sp + 4u > WIDE_STACK_SIZE + 1u) {
+                atomic_inc(overflow);
+                return true;
+            }
+            WIDE_ANY(0)
+            WIDE_ANY(1)
+            WIDE_ANY(2)
+            WIDE_ANY(3)
+        } else if (bits != 0u) {
             global const int* children = (global const int*)&n->child;
             global const uint* counts = (global const uint*)&n->count;
             WIDE_SORT_CHILDREN(n, near, mask)
@@ -233,6 +263,7 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
 }
 #undef WIDE_LEAF
 #undef WIDE_PUSH
+#undef WIDE_ANY
 #undef INTERSECT_LEAF
 
 // Closest hit (any_hit = false) or first hit (any_hit = true), as traverse() in traverse.h.
