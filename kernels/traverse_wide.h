@@ -32,7 +32,9 @@ inline WideRay wide_ray(const RayPrep* r) {
     return w;
 }
 
+// The box plane of node n at a byte offset of wide_ray's.
 #define WIDE_PLANE(n, offset) (*(global const float4*)((global const char*)(n) + (offset)))
+
 // traverse.h's slab test on the four children of n at once: their entry distances in *near,
 // and the mask of those the ray reaches before tmax (empty slots never).
 // The minimum and maximum are written as comparisons: OpenCL's fmin and fmax must return the
@@ -46,9 +48,12 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
                        float4* near) {
     // With lo <= hi, (lo - o) * inv <= (hi - o) * inv where inv > 0 (rounding is monotonic) and
     // >= where inv < 0: the near plane's distance is the minimum of the two, bit for bit.
-    float4 x0 = (WIDE_PLANE(n, w->nx) - w->ox) * w->ix, x1 = (WIDE_PLANE(n, w->fx) - w->ox) * w->ix;
-    float4 y0 = (WIDE_PLANE(n, w->ny) - w->oy) * w->iy, y1 = (WIDE_PLANE(n, w->fy) - w->oy) * w->iy;
-    float4 z0 = (WIDE_PLANE(n, w->nz) - w->oz) * w->iz, z1 = (WIDE_PLANE(n, w->fz) - w->oz) * w->iz;
+    float4 x0 = (WIDE_PLANE(n, w->nx) - w->ox) * w->ix;
+    float4 x1 = (WIDE_PLANE(n, w->fx) - w->ox) * w->ix;
+    float4 y0 = (WIDE_PLANE(n, w->ny) - w->oy) * w->iy;
+    float4 y1 = (WIDE_PLANE(n, w->fy) - w->oy) * w->iy;
+    float4 z0 = (WIDE_PLANE(n, w->nz) - w->oz) * w->iz;
+    float4 z1 = (WIDE_PLANE(n, w->fz) - w->oz) * w->iz;
     *near = WIDE_MAX(WIDE_MAX(WIDE_MAX(x0, y0), z0), (float4)(tmin));
     float4 far = WIDE_MIN(WIDE_MIN(x1, y1), z1) * 1.00000024f;
     int4 valid = (n->child > 0) | (n->count > 0u);
@@ -56,6 +61,7 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
 }
 #undef WIDE_MIN
 #undef WIDE_MAX
+#undef WIDE_PLANE
 
 // intersect_leaf for a leaf of at most four triangles, the four tested at once in float4 lanes
 // with intersect_triangle's arithmetic lane by lane, so that the same hit is kept: the first
