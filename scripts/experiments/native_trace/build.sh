@@ -16,7 +16,7 @@ if [ -n "$NATIVE_QUANT" ]; then cat $D/quant.cl >> $O/all.cl; fi
 if [ -n "$NATIVE_COUNT" ]; then
     sed -i -e 's/^\(inline bool intersect_triangle(.*\)$/void count_tri(void);\n\1/' \
         -e 's/^\(inline int4 wide_reach(.*\)$/void count_node(void);\n\1/' \
-        -e 's/^\(    float4 x0 = (n->min_x - w->ox) \* w->ix.*\)$/    count_node();\n\1/' \
+        -e 's/^\(    float4 x0 = (WIDE_PLANE(n, w->nx) - w->ox) \* w->ix;\)$/    count_node();\n\1/' \
         -e 's/^\(    float4 o = (float4)(r->origin, 0.0f);\)$/    count_tri();\n\1/' $O/all.cl
     grep -c 'count_' $O/all.cl
 fi
