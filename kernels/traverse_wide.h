@@ -177,7 +177,8 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
 // An interior child among the sorted ones, pushed with its entry distance (farthest first).
 #define WIDE_PUSH(D, S)                            \
     if (D < hit->t && counts[S] == 0u) {           \
-        stack[sp] = (uint)children[S];             \
+        next = (uint)children[S];                  \
+        stack[sp] = next;                          \
         stack_d[sp++] = D;                         \
     }
 
@@ -209,7 +210,9 @@ inline uint wide_bits(int4 mask) {
 // the same arguments and result. The children a ray reaches are sorted by entry distance with
 // a five-exchange network on scalars (registers, not arrays): leaves are tested in that order,
 // interior children pushed farthest first with their distance, and a popped node that starts
-// beyond the hit found meanwhile is skipped. The visiting order is src/bvh/wide.rs's. With
+// beyond the hit found meanwhile is skipped; the nearest of them is entered at once, its index
+// from a register rather than read back from the stack. The visiting order is
+// src/bvh/wide.rs's. With
 // any_hit the children are not sorted (WIDE_ANY): bunnies' shadow rays ran 20-25 % faster
 // (docs/benchmarks.md, "Seventh session"), and a shadow test's result does not depend on which
 // hit is found first (path.h's shadow tests walk thin walls again nearest first).
@@ -253,10 +256,18 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
                 atomic_inc(overflow);
                 return true;
             }
+            uint before = sp, next = 0u;
             WIDE_PUSH(d3, s3)
             WIDE_PUSH(d2, s2)
             WIDE_PUSH(d1, s1)
             WIDE_PUSH(d0, s0)
+            // The nearest pushed child is entered at once (it starts before the hit: no leaf
+            // was tested since it was pushed), its address from a register, not the stack.
+            if (sp != before) {
+                --sp;
+                node = next;
+                continue;
+            }
         }
         // The nearest pushed node that still starts before the hit.
         for (;;) {
