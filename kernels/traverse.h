@@ -17,24 +17,38 @@ inline float safe_rcp(float x) {
     return 1.0f / (fabs(x) > 1e-20f ? x : copysign(1e-20f, x));
 }
 
+// v's coordinates in the ray's permuted order (kx, ky, kz), a rotation named by kz. A CPU
+// does this in one shuffle instruction; NVIDIA's compiler turns shuffle() with a mask that
+// changes inside the loop (the two-level traversal's ray changes at every instance) into more
+// work than these selects, which made two levels 3-10 % faster on an H200 and flat about 1-2 %
+// (docs/benchmarks.md, seventh session). The program defines PERMUTE_BY_SELECT for devices other than CPUs.
+inline float4 ray_permute(float4 v, uint4 p) {
+#ifdef PERMUTE_BY_SELECT
+    bool z0 = p.z == 0u, z1 = p.z == 1u;
+    return (float4)(z0 ? v.y : z1 ? v.z : v.x, z0 ? v.z : z1 ? v.x : v.y,
+                    z0 ? v.x : z1 ? v.y : v.z, 0.0f);
+#else
+    return shuffle(v, p);
+#endif
+}
+
 inline RayPrep prepare_ray(float3 o, float3 d) {
     RayPrep r;
     r.origin = o;
     r.inv = (float3)(safe_rcp(d.x), safe_rcp(d.y), safe_rcp(d.z));
     float3 a = fabs(d);
     uint kz = a.x > a.y ? (a.x > a.z ? 0u : 2u) : (a.y > a.z ? 1u : 2u);
+    // The axes rotated so that z is the dominant one. (Woop et al. also swap x and y where the
+    // direction's z is negative, to keep the winding; that only negates the edge functions and
+    // their sum exactly, and this test takes either sign.)
     uint kx = (kz + 1u) % 3u;
     uint ky = (kx + 1u) % 3u;
     float4 d4 = (float4)(d, 0.0f);
-    float dz = kz == 0u ? d.x : (kz == 1u ? d.y : d.z);
-    if (dz < 0.0f) {
-        uint tmp = kx;
-        kx = ky;
-        ky = tmp;
-    }
     r.perm = (uint4)(kx, ky, kz, 3u);
-    float4 p = shuffle(d4, r.perm);
-    r.shear = (float3)(p.x / p.z, p.y / p.z, 1.0f / p.z);
+    float4 p = ray_permute(d4, r.perm);
+    // One division: the shear's x and y scale by its z (src/bvh/traverse.rs computes the same).
+    float iz = 1.0f / p.z;
+    r.shear = (float3)(p.x * iz, p.y * iz, iz);
     return r;
 }
 
@@ -65,9 +79,9 @@ inline float triangle_t_error(float ax, float ay, float bx, float by, float cx, 
 inline bool intersect_triangle(const RayPrep* r, float4 v0, float4 v1, float4 v2, float tmin,
                                float* tmax, float* bu, float* bv) {
     float4 o = (float4)(r->origin, 0.0f);
-    float4 a = shuffle(v0 - o, r->perm);
-    float4 b = shuffle(v1 - o, r->perm);
-    float4 c = shuffle(v2 - o, r->perm);
+    float4 a = ray_permute(v0 - o, r->perm);
+    float4 b = ray_permute(v1 - o, r->perm);
+    float4 c = ray_permute(v2 - o, r->perm);
     float ax = a.x - r->shear.x * a.z;
     float ay = a.y - r->shear.y * a.z;
     float bx = b.x - r->shear.x * b.z;

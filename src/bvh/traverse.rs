@@ -47,14 +47,15 @@ impl Shear {
         } else {
             2
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        // A rotation of the axes (as the kernels' prepare_ray): no swap of x and y for a
+        // negative z, which would only negate the edge functions and their sum exactly.
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
+        // One division (as the kernels' prepare_ray): x and y scale by the reciprocal of z.
+        let iz = 1.0 / d[kz];
         Self {
             k: [kx, ky, kz],
-            s: Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]),
+            s: Vec3::new(d[kx] * iz, d[ky] * iz, iz),
         }
     }
 }
