@@ -17,16 +17,16 @@ inline float safe_rcp(float x) {
     return 1.0f / (fabs(x) > 1e-20f ? x : copysign(1e-20f, x));
 }
 
-// v's coordinates in the ray's permuted order (kx, ky, kz). A CPU does this in one shuffle
-// instruction; NVIDIA's compiler turns shuffle() with a mask that changes inside the loop (the
-// two-level traversal's ray changes at every instance) into more work than these selects,
-// which made two levels 3-10 % faster on an H200 and flat about 1-2 % (docs/benchmarks.md,
-// seventh session). The program defines PERMUTE_BY_SELECT for devices other than CPUs.
+// v's coordinates in the ray's permuted order (kx, ky, kz), a rotation named by kz. A CPU
+// does this in one shuffle instruction; NVIDIA's compiler turns shuffle() with a mask that
+// changes inside the loop (the two-level traversal's ray changes at every instance) into more
+// work than these selects, which made two levels 3-10 % faster on an H200 and flat about 1-2 %
+// (docs/benchmarks.md, seventh session). The program defines PERMUTE_BY_SELECT for devices other than CPUs.
 inline float4 ray_permute(float4 v, uint4 p) {
 #ifdef PERMUTE_BY_SELECT
-    return (float4)(p.x == 0u ? v.x : p.x == 1u ? v.y : v.z,
-                    p.y == 0u ? v.x : p.y == 1u ? v.y : v.z,
-                    p.z == 0u ? v.x : p.z == 1u ? v.y : v.z, 0.0f);
+    bool z0 = p.z == 0u, z1 = p.z == 1u;
+    return (float4)(z0 ? v.y : z1 ? v.z : v.x, z0 ? v.z : z1 ? v.x : v.y,
+                    z0 ? v.x : z1 ? v.y : v.z, 0.0f);
 #else
     return shuffle(v, p);
 #endif
@@ -38,15 +38,12 @@ inline RayPrep prepare_ray(float3 o, float3 d) {
     r.inv = (float3)(safe_rcp(d.x), safe_rcp(d.y), safe_rcp(d.z));
     float3 a = fabs(d);
     uint kz = a.x > a.y ? (a.x > a.z ? 0u : 2u) : (a.y > a.z ? 1u : 2u);
+    // The axes rotated so that z is the dominant one. (Woop et al. also swap x and y where the
+    // direction's z is negative, to keep the winding; that only negates the edge functions and
+    // their sum exactly, and this test takes either sign.)
     uint kx = (kz + 1u) % 3u;
     uint ky = (kx + 1u) % 3u;
     float4 d4 = (float4)(d, 0.0f);
-    float dz = kz == 0u ? d.x : (kz == 1u ? d.y : d.z);
-    if (dz < 0.0f) {
-        uint tmp = kx;
-        kx = ky;
-        ky = tmp;
-    }
     r.perm = (uint4)(kx, ky, kz, 3u);
     float4 p = ray_permute(d4, r.perm);
     // One division: the shear's x and y scale by its z (src/bvh/traverse.rs computes the same).

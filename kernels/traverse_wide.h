@@ -5,9 +5,13 @@
 
 #define WIDE_STACK_SIZE 144  // (4 - 1) x the builder's depth limit of 48
 
-// The ray in four lanes: origin and safe reciprocal direction, one coordinate per vector.
+// The ray in four lanes: origin and safe reciprocal direction, one coordinate per vector, and
+// for each axis the byte offsets in a GpuWideNode of the box planes the ray meets first (min_*
+// where the direction is positive, max_* where negative) and last, so that a node's entry and
+// exit distances need no minimum and maximum per axis.
 typedef struct {
     float4 ox, oy, oz, ix, iy, iz;
+    uint nx, ny, nz, fx, fy, fz;
 } WideRay;
 
 inline WideRay wide_ray(const RayPrep* r) {
@@ -18,8 +22,18 @@ inline WideRay wide_ray(const RayPrep* r) {
     w.ix = (float4)(r->inv.x);
     w.iy = (float4)(r->inv.y);
     w.iz = (float4)(r->inv.z);
+    // min_x, min_y, min_z, max_x, max_y, max_z: 16 bytes each.
+    w.nx = r->inv.x >= 0.0f ? 0u : 48u;
+    w.ny = r->inv.y >= 0.0f ? 16u : 64u;
+    w.nz = r->inv.z >= 0.0f ? 32u : 80u;
+    w.fx = w.nx ^ 48u;
+    w.fy = w.ny ^ 80u;
+    w.fz = w.nz ^ 112u;
     return w;
 }
+
+// The box plane of node n at a byte offset of wide_ray's.
+#define WIDE_PLANE(n, offset) (*(global const float4*)((global const char*)(n) + (offset)))
 
 // traverse.h's slab test on the four children of n at once: their entry distances in *near,
 // and the mask of those the ray reaches before tmax (empty slots never).
@@ -32,18 +46,22 @@ inline WideRay wide_ray(const RayPrep* r) {
 #define WIDE_MAX(a, b) select(b, a, a > b)
 inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin, float tmax,
                        float4* near) {
-    float4 x0 = (n->min_x - w->ox) * w->ix, x1 = (n->max_x - w->ox) * w->ix;
-    float4 y0 = (n->min_y - w->oy) * w->iy, y1 = (n->max_y - w->oy) * w->iy;
-    float4 z0 = (n->min_z - w->oz) * w->iz, z1 = (n->max_z - w->oz) * w->iz;
-    *near = WIDE_MAX(WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)), WIDE_MIN(z0, z1)),
-                     (float4)(tmin));
-    float4 far =
-        WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)), WIDE_MAX(z0, z1)) * 1.00000024f;
+    // With lo <= hi, (lo - o) * inv <= (hi - o) * inv where inv > 0 (rounding is monotonic) and
+    // >= where inv < 0: the near plane's distance is the minimum of the two, bit for bit.
+    float4 x0 = (WIDE_PLANE(n, w->nx) - w->ox) * w->ix;
+    float4 x1 = (WIDE_PLANE(n, w->fx) - w->ox) * w->ix;
+    float4 y0 = (WIDE_PLANE(n, w->ny) - w->oy) * w->iy;
+    float4 y1 = (WIDE_PLANE(n, w->fy) - w->oy) * w->iy;
+    float4 z0 = (WIDE_PLANE(n, w->nz) - w->oz) * w->iz;
+    float4 z1 = (WIDE_PLANE(n, w->fz) - w->oz) * w->iz;
+    *near = WIDE_MAX(WIDE_MAX(WIDE_MAX(x0, y0), z0), (float4)(tmin));
+    float4 far = WIDE_MIN(WIDE_MIN(x1, y1), z1) * 1.00000024f;
     int4 valid = (n->child > 0) | (n->count > 0u);
     return (*near <= far) & (*near < (float4)(tmax)) & valid;
 }
 #undef WIDE_MIN
 #undef WIDE_MAX
+#undef WIDE_PLANE
 
 // intersect_leaf for a leaf of at most four triangles, the four tested at once in float4 lanes
 // with intersect_triangle's arithmetic lane by lane, so that the same hit is kept: the first
@@ -137,8 +155,7 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
     }
 
 // The children of wide node n that `mask` reaches, sorted: declares their entry distances
-// d0 <= d1 <= d2 <= d3 (INFINITY for those not reached, from `near`) and slots s0 .. s3, and
-// the node's children and counts as arrays indexed by slot.
+// d0 <= d1 <= d2 <= d3 (INFINITY for those not reached, from `near`) and slots s0 .. s3.
 #define WIDE_SORT_CHILDREN(n, near, mask)                           \
     float4 dist = select((float4)(INFINITY), near, mask);          \
     float d0 = dist.x, d1 = dist.y, d2 = dist.z, d3 = dist.w;      \
@@ -147,9 +164,7 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
     WIDE_ORDER(2, 3)                                               \
     WIDE_ORDER(0, 2)                                               \
     WIDE_ORDER(1, 3)                                               \
-    WIDE_ORDER(1, 2)                                               \
-    global const int* children = (global const int*)&n->child;    \
-    global const uint* counts = (global const uint*)&n->count;
+    WIDE_ORDER(1, 2)
 
 // A leaf among the sorted children, tested on the spot when it starts before the hit so far.
 #define WIDE_LEAF(D, S)                                                                     \
@@ -162,15 +177,45 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
 // An interior child among the sorted ones, pushed with its entry distance (farthest first).
 #define WIDE_PUSH(D, S)                            \
     if (D < hit->t && counts[S] == 0u) {           \
-        stack[sp] = (uint)children[S];             \
+        next = (uint)children[S];                  \
+        stack[sp] = next;                          \
         stack_d[sp++] = D;                         \
     }
+
+// For any hit: child S, when reached, tested if a leaf, else pushed (to be entered whatever its
+// distance: the walk ends at the first hit).
+#define WIDE_ANY(S)                                                                            \
+    if ((bits >> S) & 1u) {                                                                    \
+        if (counts[S] == 0u) {                                                                 \
+            stack[sp] = (uint)children[S];                                                     \
+            stack_d[sp++] = -INFINITY;                                                         \
+        } else if (INTERSECT_LEAF(r, tris, surf, (uint)(~children[S]), counts[S], tmin, o, d, \
+                                  true, hit)) {                                                \
+            return true;                                                                       \
+        }                                                                                      \
+    }
+
+// The lanes of a mask as bits (lane i: bit i). On x86 one movmskps (a kmov from the compare's
+// AVX-512 mask): OpenCL's any() became a dozen instructions and two branches there.
+inline uint wide_bits(int4 mask) {
+#if defined(__SSE__) && defined(__x86_64__)
+    return (uint)__builtin_ia32_movmskps(as_float4(mask));
+#else
+    int4 b = mask & (int4)(1, 2, 4, 8);
+    return (uint)((b.x | b.y) | (b.z | b.w));
+#endif
+}
 
 // Walks the wide BVH below node `root` as traverse_bvh (traverse.h) walks the binary one, with
 // the same arguments and result. The children a ray reaches are sorted by entry distance with
 // a five-exchange network on scalars (registers, not arrays): leaves are tested in that order,
 // interior children pushed farthest first with their distance, and a popped node that starts
-// beyond the hit found meanwhile is skipped. The visiting order is src/bvh/wide.rs's.
+// beyond the hit found meanwhile is skipped; the nearest of them is entered at once, its index
+// from a register rather than read back from the stack. The visiting order is
+// src/bvh/wide.rs's. With
+// any_hit the children are not sorted (WIDE_ANY): bunnies' shadow rays ran 20-25 % faster
+// (docs/benchmarks.md, "Seventh session"), and a shadow test's result does not depend on which
+// hit is found first (path.h's shadow tests walk thin walls again nearest first).
 inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
                               global const GpuTriangle* tris, const SceneSurfaces* surf,
                               const RayPrep* r, float3 o, float3 d, float tmin, bool any_hit,
@@ -185,7 +230,23 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
         global const GpuWideNode* n = &nodes[node];
         float4 near;
         int4 mask = wide_reach(n, &w, tmin, hit->t, &near);
-        if (any(mask)) {
+        uint bits = wide_bits(mask);
+        if (bits != 0u && any_hit) {
+            // Any hit ends the walk, so the order of the children does not matter: they are
+            // taken in slot order, without sorting (as Embree's occlusion walk takes them).
+            global const int* children = (global const int*)&n->child;
+            global const uint* counts = (global const uint*)&n->count;
+            if (sp + 4u > WIDE_STACK_SIZE + 1u) {
+                atomic_inc(overflow);
+                return true;
+            }
+            WIDE_ANY(0)
+            WIDE_ANY(1)
+            WIDE_ANY(2)
+            WIDE_ANY(3)
+        } else if (bits != 0u) {
+            global const int* children = (global const int*)&n->child;
+            global const uint* counts = (global const uint*)&n->count;
             WIDE_SORT_CHILDREN(n, near, mask)
             WIDE_LEAF(d0, s0)
             WIDE_LEAF(d1, s1)
@@ -195,10 +256,18 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
                 atomic_inc(overflow);
                 return true;
             }
+            uint before = sp, next = 0u;
             WIDE_PUSH(d3, s3)
             WIDE_PUSH(d2, s2)
             WIDE_PUSH(d1, s1)
             WIDE_PUSH(d0, s0)
+            // The nearest pushed child is entered at once (it starts before the hit: no leaf
+            // was tested since it was pushed), its address from a register, not the stack.
+            if (sp != before) {
+                --sp;
+                node = next;
+                continue;
+            }
         }
         // The nearest pushed node that still starts before the hit.
         for (;;) {
@@ -211,6 +280,7 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
 }
 #undef WIDE_LEAF
 #undef WIDE_PUSH
+#undef WIDE_ANY
 #undef INTERSECT_LEAF
 
 // Closest hit (any_hit = false) or first hit (any_hit = true), as traverse() in traverse.h.
@@ -314,8 +384,10 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
             global const GpuWideNode* n = &nodes[node];
             float4 near;
             int4 mask = wide_reach(n, &w, tmin, hit.t, &near);
-            if (any(mask)) {
+            if (wide_bits(mask) != 0u) {
                 WIDE_SORT_CHILDREN(n, near, mask)
+                global const int* children = (global const int*)&n->child;
+                global const uint* counts = (global const uint*)&n->count;
                 TOP_WIDE_TRIANGLE(d0, s0)
                 TOP_WIDE_TRIANGLE(d1, s1)
                 TOP_WIDE_TRIANGLE(d2, s2)

@@ -47,11 +47,10 @@ impl Shear {
         } else {
             2
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        // A rotation of the axes (as the kernels' prepare_ray): no swap of x and y for a
+        // negative z, which would only negate the edge functions and their sum exactly.
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
         // One division (as the kernels' prepare_ray): x and y scale by the reciprocal of z.
         let iz = 1.0 / d[kz];
         Self {

@@ -16,11 +16,13 @@ if [ -n "$NATIVE_QUANT" ]; then cat $D/quant.cl >> $O/all.cl; fi
 if [ -n "$NATIVE_COUNT" ]; then
     sed -i -e 's/^\(inline bool intersect_triangle(.*\)$/void count_tri(void);\n\1/' \
         -e 's/^\(inline int4 wide_reach(.*\)$/void count_node(void);\n\1/' \
-        -e 's/^\(    float4 x0 = (n->min_x - w->ox) \* w->ix.*\)$/    count_node();\n\1/' \
+        -e 's/^\(    float4 x0 = (WIDE_PLANE(n, w->nx) - w->ox) \* w->ix;\)$/    count_node();\n\1/' \
         -e 's/^\(    float4 o = (float4)(r->origin, 0.0f);\)$/    count_tri();\n\1/' $O/all.cl
     grep -c 'count_' $O/all.cl
 fi
-clang-15 -x cl -cl-std=CL1.2 -target x86_64-pc-linux-gnu -march=native -O3 \
+# -fgnu89-inline: traverse_wide_bvh is a plain `inline` function called from two places, which
+# C99 rules leave without an out-of-line definition (an undefined symbol at link time).
+clang-15 -x cl -cl-std=CL1.2 -target x86_64-pc-linux-gnu -march=native -O3 -fgnu89-inline \
     -Xclang -finclude-default-header -cl-denorms-are-zero \
     -cl-fp32-correctly-rounded-divide-sqrt "$@" -emit-llvm -c $O/all.cl -o $O/trace.bc
 llvm-link-15 $O/trace.bc /usr/share/pocl/kernel-x86_64-pc-linux-gnu-avx512.bc --only-needed \
