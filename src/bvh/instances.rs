@@ -508,10 +508,11 @@ impl TwoLevel {
     pub fn device_nodes(&self) -> (Vec<GpuBvhNode>, Vec<u32>, Vec<u32>) {
         let mut nodes = self.tlas.nodes.clone();
         nodes.resize(self.tlas_slots(), GpuBvhNode::default());
-        let (mut roots, mut firsts) = (vec![], vec![]);
+        let roots = self.device_roots();
+        let mut firsts = vec![];
         let mut tri_base = 0u32;
         for b in &self.blases {
-            roots.push(nodes.len() as u32);
+            debug_assert_eq!(roots[firsts.len()], nodes.len() as u32);
             firsts.push(tri_base);
             let base = nodes.len() as i32;
             nodes.extend(b.bvh.nodes.iter().map(|&n| {
@@ -535,6 +536,19 @@ impl TwoLevel {
             tri_base += b.triangles.len() as u32;
         }
         (nodes, roots, firsts)
+    }
+
+    /// Where [`TwoLevel::device_nodes`] puts each BLAS's root: after the TLAS's slots, the
+    /// BLASes one after the other.
+    pub fn device_roots(&self) -> Vec<u32> {
+        let mut at = self.tlas_slots() as u32;
+        self.blases
+            .iter()
+            .map(|b| {
+                at += b.bvh.nodes.len() as u32;
+                at - b.bvh.nodes.len() as u32
+            })
+            .collect()
     }
 
     /// [`TwoLevel::device_nodes`] for the 4-wide form: the collapsed TLAS, then every

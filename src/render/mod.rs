@@ -969,17 +969,7 @@ fn device_nodes(
                 host.layout.roots = roots;
                 Some(nodes)
             } else {
-                // Where `device_nodes` would put each BLAS: after the TLAS's slots, one after
-                // the other.
-                let mut at = two.tlas_slots() as u32;
-                host.layout.roots = two
-                    .blases
-                    .iter()
-                    .map(|b| {
-                        at += b.bvh.nodes.len() as u32;
-                        at - b.bvh.nodes.len() as u32
-                    })
-                    .collect();
+                host.layout.roots = two.device_roots();
                 None
             };
             let wide = forms.wide.then(|| {

@@ -343,8 +343,8 @@ fn fit_points(all: &[[Vec3; 3]], bounds: &Bounds) -> Vec<Vec3> {
 
 impl Probe {
     /// Builds the probe for the visible geometry of `scene`: over quick BLASes of its distinct
-    /// meshes and a top level ([`Tracer::TwoLevel`]), which it leaves in the scene for the
-    /// renderer ([`Scene::keep_quick_blases`]) when `keep` is set. Glass and blended surfaces
+    /// meshes and a top level ([`Tracer::TwoLevel`]), which [`Probe::keep_blases`] leaves in
+    /// the scene for the renderer. Glass and blended surfaces
     /// are passed by the rays that light passes; they still count for the bounds and for
     /// telling an interior.
     pub fn new(scene: &Scene) -> Self {
