@@ -718,11 +718,12 @@ impl Program {
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let wide = nodes == bvh.wide_nodes.mem();
-        if !(if wide {
+        let uploaded = if wide {
             bvh.forms.wide
         } else {
             bvh.forms.binary
-        }) {
+        };
+        if !uploaded {
             return Err(ClError::Device(format!(
                 "{stage}: the scene was uploaded without its {} nodes (Renderer::set_node_forms)",
                 if wide { "wide" } else { "binary" }
@@ -1032,6 +1033,12 @@ impl NodeForms {
         wide: true,
     };
 
+    /// Neither array.
+    pub const NONE: Self = Self {
+        binary: false,
+        wide: false,
+    };
+
     /// Those the kernels in use traverse: the megakernel's wide nodes or the wavefront's
     /// binary ones.
     pub fn for_kernels(megakernel: bool) -> Self {
@@ -1046,6 +1053,14 @@ impl NodeForms {
         Self {
             binary: self.binary || other.binary,
             wide: self.wide || other.wide,
+        }
+    }
+
+    /// This one's arrays that `have` lacks.
+    pub fn beyond(self, have: Self) -> Self {
+        Self {
+            binary: self.binary && !have.binary,
+            wide: self.wide && !have.wide,
         }
     }
 }

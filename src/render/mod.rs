@@ -203,10 +203,7 @@ impl Renderer {
             quick_first: None,
             sah: None,
             sah_waiting: None,
-            extra_forms: NodeForms {
-                binary: false,
-                wide: false,
-            },
+            extra_forms: NodeForms::NONE,
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -270,11 +267,8 @@ impl Renderer {
         let Some((buffers, host)) = self.scene.as_mut() else {
             return Ok(());
         };
-        let add = NodeForms {
-            binary: want.binary && !buffers.forms.binary,
-            wide: want.wide && !buffers.forms.wide,
-        };
-        if !add.binary && !add.wide {
+        let add = want.beyond(buffers.forms);
+        if add == NodeForms::NONE {
             return Ok(());
         }
         let (nodes, wide) = device_nodes(host, add);
