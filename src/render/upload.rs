@@ -490,13 +490,22 @@ impl HostScene {
         let shown: Vec<usize> = (0..two.instances.len())
             .filter(|&k| !two.hidden[k])
             .collect();
+        // BLAS b's triangles are its mesh's in the order of its `tri_indices`: each pass over
+        // an instance transforms the mesh's vertices once, not each triangle's corners.
         let middle = middle_of(shown.len(), &|k| {
             let inst = &two.instances[shown[k]];
             let m = inst.world_from_object;
-            two.blases[inst.blas as usize]
-                .triangles
+            let mesh = meshes[inst.blas as usize];
+            let world: Vec<DVec3> = mesh
+                .positions
                 .iter()
-                .map(move |t| t.map(|v| m.transform_point3(v.as_dvec3())))
+                .map(|p| m.transform_point3(p.as_dvec3()))
+                .collect();
+            two.blases[inst.blas as usize]
+                .bvh
+                .tri_indices
+                .iter()
+                .map(move |&ti| mesh.indices[ti as usize].map(|i| world[i as usize]))
         });
         Self::assemble(
             Accel::TwoLevel(two),
