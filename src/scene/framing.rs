@@ -29,6 +29,7 @@
 use super::{Bounds, Camera, Light, LightKind, Mesh, Scene};
 use crate::bvh::{Blas, Bvh, Ray, TwoLevel, intersect_triangle};
 use glam::{DMat4, DVec3, Vec3};
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Columns of the probe grid of camera rays.
@@ -60,11 +61,9 @@ pub const AUTO_CAMERA: &str = "auto";
 pub struct Probe {
     /// How rays find the triangles.
     tracer: Tracer,
-    /// The visible objects' world triangles in scene order (as [`Scene::world_vertices`]
-    /// gives them); hits name triangles by their index here.
-    tris: Vec<[Vec3; 3]>,
-    /// Each triangle's material.
-    materials: Vec<u32>,
+    /// The visible objects' world triangles in scene order; hits name triangles by their
+    /// index here.
+    tris: WorldTris,
     /// Emitted radiance luminance per material (0 for most).
     emission: Vec<f32>,
     /// Whether light passes each material (glass and blended surfaces).
@@ -81,12 +80,11 @@ pub struct Probe {
 enum Tracer {
     /// A quick BLAS per distinct mesh ([`crate::bvh::quick_blas`], the trees the viewer's first
     /// image traces) and a top level over the visible objects in world space. Each leaf
-    /// triangle is tested in world space, on its vertices in [`Probe::tris`] (from `starts`,
-    /// each instance's first triangle there), so hits are those of one tree over the world
-    /// triangles, distance for distance.
+    /// triangle is tested in world space, on its vertices in [`Probe::tris`] (instance i is
+    /// object i there), so hits are those of one tree over the world triangles, distance for
+    /// distance.
     TwoLevel {
         two: TwoLevel,
-        starts: Vec<usize>,
         /// Each BLAS's mesh.
         meshes: Vec<Arc<Mesh>>,
     },
@@ -124,6 +122,121 @@ pub struct FirstView {
     pub emitter_radiance: f64,
 }
 
+/// The visible objects' world triangles in scene order (as [`Scene::flatten`] keeps them),
+/// read from each object's vertices ([`Scene::world_objects`]) instead of a copy of every
+/// triangle: a 64 M-triangle scene's copy was 2.3 GB and seconds to write.
+#[derive(Clone, Debug)]
+pub struct WorldTris {
+    objects: Vec<super::WorldObject>,
+    /// Each object's first triangle, and the count after the last.
+    starts: Vec<usize>,
+}
+
+impl WorldTris {
+    fn new(objects: Vec<super::WorldObject>) -> Self {
+        let mut starts = Vec::with_capacity(objects.len() + 1);
+        starts.push(0);
+        for o in &objects {
+            starts.push(starts.last().copied().unwrap_or(0) + o.len());
+        }
+        Self { objects, starts }
+    }
+
+    /// Triangles in all.
+    fn len(&self) -> usize {
+        self.starts.last().copied().unwrap_or(0)
+    }
+
+    /// (object, kept triangle in it) of triangle `i`.
+    fn locate(&self, i: usize) -> (usize, usize) {
+        let o = self.starts.partition_point(|&s| s <= i) - 1;
+        (o, i - self.starts[o])
+    }
+
+    /// Triangle `i`'s vertices.
+    fn get(&self, i: usize) -> [Vec3; 3] {
+        let (o, k) = self.locate(i);
+        let o = &self.objects[o];
+        o.vertices(o.triangle(k))
+    }
+
+    /// Triangle `i`'s material.
+    fn material(&self, i: usize) -> u32 {
+        let (o, k) = self.locate(i);
+        let o = &self.objects[o];
+        o.mesh.materials[o.triangle(k)]
+    }
+
+    /// Calls `f(i, vertices, material)` for the triangles `range`, in order.
+    fn visit(&self, range: std::ops::Range<usize>, mut f: impl FnMut(usize, [Vec3; 3], u32)) {
+        if range.is_empty() {
+            return;
+        }
+        let (mut o, mut k) = self.locate(range.start);
+        let mut i = range.start;
+        while i < range.end {
+            let object = &self.objects[o];
+            let end = object.len().min(k + range.end - i);
+            for k in k..end {
+                let ti = object.triangle(k);
+                f(i, object.vertices(ti), object.mesh.materials[ti]);
+                i += 1;
+            }
+            o += 1;
+            k = 0;
+        }
+    }
+
+    /// The triangles `0..len` in chunks of `chunk` (the last shorter), in parallel.
+    fn chunks(&self, chunk: usize) -> impl IndexedParallelIterator<Item = std::ops::Range<usize>> {
+        let n = self.len();
+        (0..n.div_ceil(chunk))
+            .into_par_iter()
+            .map(move |c| c * chunk..((c + 1) * chunk).min(n))
+    }
+
+    /// Every triangle's vertices and material, in order.
+    fn to_vecs(&self) -> (Vec<[Vec3; 3]>, Vec<u32>) {
+        let parts: Vec<(Vec<[Vec3; 3]>, Vec<u32>)> = self
+            .chunks(1 << 16)
+            .map(|r| {
+                let mut out = (Vec::with_capacity(r.len()), Vec::with_capacity(r.len()));
+                self.visit(r, |_, t, m| {
+                    out.0.push(t);
+                    out.1.push(m);
+                });
+                out
+            })
+            .collect();
+        let (mut tris, mut materials) = (Vec::with_capacity(self.len()), vec![]);
+        materials.reserve(self.len());
+        for (t, m) in parts {
+            tris.extend(t);
+            materials.extend(m);
+        }
+        (tris, materials)
+    }
+
+    /// A soup of triangles as one object of material 0 (tests).
+    #[cfg(test)]
+    fn soup(tris: &[[Vec3; 3]]) -> Self {
+        let mesh = Mesh {
+            positions: tris.iter().flatten().copied().collect(),
+            indices: (0..tris.len() as u32)
+                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .collect(),
+            materials: vec![0; tris.len()],
+            ..Mesh::default()
+        };
+        Self::new(vec![super::WorldObject {
+            world: mesh.positions.clone(),
+            mesh: Arc::new(mesh),
+            kept: None,
+            flip: false,
+        }])
+    }
+}
+
 fn luminance(c: [f32; 3]) -> f32 {
     0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
@@ -146,29 +259,28 @@ fn from_order_key(k: u32) -> f32 {
 /// Buckets of a histogram of 16 bits of [`order_key`]s.
 const KEY_BUCKETS: usize = 1 << 16;
 
-/// Per histogram h < `count`, the weights `w` summed per bucket of `sort(i, h)` (`None`: not
-/// counted) over i in `0..n`, where `item(i)` gives (w, what `sort` needs); fixed chunks (by
-/// `n` alone) summed in order, so that the sums do not depend on the thread count.
+/// Per histogram h < `count`, the weights `w` summed per bucket of `sort(x, h)` (`None`: not
+/// counted) over the triangles of `tris`, where `item(triangle)` gives (w, x); fixed chunks (by
+/// the count alone) summed in order, so that the sums do not depend on the thread count.
 fn histograms<T>(
-    n: usize,
+    tris: &WorldTris,
     count: usize,
-    item: &(dyn Fn(usize) -> (f32, T) + Sync),
-    sort: &(dyn Fn(&T, usize) -> Option<usize> + Sync),
+    item: &(impl Fn(&[Vec3; 3]) -> (f32, T) + Sync),
+    sort: &(impl Fn(&T, usize) -> Option<usize> + Sync),
 ) -> Vec<Vec<f64>> {
-    use rayon::prelude::*;
-    let chunk = n.div_ceil(32).max(1 << 18);
-    let parts: Vec<Vec<Vec<f64>>> = (0..n.div_ceil(chunk))
-        .into_par_iter()
-        .map(|c| {
+    let chunk = tris.len().div_ceil(32).max(1 << 18);
+    let parts: Vec<Vec<Vec<f64>>> = tris
+        .chunks(chunk)
+        .map(|range| {
             let mut h = vec![vec![0.0; KEY_BUCKETS]; count];
-            for i in c * chunk..((c + 1) * chunk).min(n) {
-                let (w, x) = item(i);
+            tris.visit(range, |_, t, _| {
+                let (w, x) = item(&t);
                 for (k, h) in h.iter_mut().enumerate() {
                     if let Some(b) = sort(&x, k) {
                         h[b] += w as f64;
                     }
                 }
-            }
+            });
             h
         })
         .collect();
@@ -187,25 +299,25 @@ fn histograms<T>(
 /// Found without sorting: a histogram of the high 16 bits of the values' [`order_key`]s finds
 /// the bucket where the sum crosses, one of the low 16 bits within it the value (all values of
 /// a low bucket are the same value). Two passes over the triangles for the six.
-fn centroid_percentiles(tris: &[[Vec3; 3]]) -> [[f32; 2]; 3] {
-    use rayon::prelude::*;
+fn centroid_percentiles(tris: &WorldTris) -> [[f32; 2]; 3] {
     const QS: [f64; 2] = [0.05, 0.95];
-    let n = tris.len();
-    let keys = |i: usize| {
-        let t = &tris[i];
+    let keys = |t: &[Vec3; 3]| {
         let c = (t[0] + t[1] + t[2]) / 3.0;
         (
             area(t).sqrt() + 1e-12,
             [order_key(c.x), order_key(c.y), order_key(c.z)],
         )
     };
-    let high = histograms(n, 3, &keys, &|k, axis| Some((k[axis] >> 16) as usize));
+    let high = histograms(tris, 3, &keys, &|k, axis| Some((k[axis] >> 16) as usize));
     // Where the running sum never reaches the target (a NaN weight): the largest value.
     let largest = |axis: usize| {
         from_order_key(
-            (0..n)
-                .into_par_iter()
-                .map(|i| keys(i).1[axis])
+            tris.chunks(1 << 16)
+                .map(|range| {
+                    let mut m = 0;
+                    tris.visit(range, |_, t, _| m = m.max(keys(&t).1[axis]));
+                    m
+                })
                 .max()
                 .unwrap_or(0),
         )
@@ -234,7 +346,7 @@ fn centroid_percentiles(tris: &[[Vec3; 3]]) -> [[f32; 2]; 3] {
     }
     // Rounding (the sums go in another order) may carry a crossing into a later high bucket.
     while !open.is_empty() {
-        let low = histograms(n, open.len(), &keys, &|k, j| {
+        let low = histograms(tris, open.len(), &keys, &|k, j| {
             let (axis, _, _, b, _) = open[j];
             ((k[axis] >> 16) as usize == b).then_some((k[axis] & 0xffff) as usize)
         });
@@ -262,8 +374,7 @@ fn centroid_percentiles(tris: &[[Vec3; 3]]) -> [[f32; 2]; 3] {
 /// dominates), widened by half that range on each side, is the window; the bounds of the
 /// triangles whose centroids fall in the window, clipped to it, are the result. A stray object
 /// far away is left out; a lone object keeps its exact bounds.
-pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
-    use rayon::prelude::*;
+pub fn robust_bounds(tris: &WorldTris) -> Bounds {
     let union = |mut a: Bounds, b: Bounds| {
         if !b.is_empty() {
             a.grow(b.min);
@@ -272,9 +383,10 @@ pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
         a
     };
     let exact = tris
-        .par_iter()
-        .fold(Bounds::default, |mut b, t| {
-            t.iter().for_each(|v| b.grow(v.as_dvec3()));
+        .chunks(1 << 16)
+        .map(|range| {
+            let mut b = Bounds::default();
+            tris.visit(range, |_, t, _| t.iter().for_each(|v| b.grow(v.as_dvec3())));
             b
         })
         .reduce(Bounds::default, union);
@@ -290,14 +402,17 @@ pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
         hi[axis] = b + margin;
     }
     let bounds = tris
-        .par_iter()
-        .fold(Bounds::default, |mut bounds, t| {
-            let c = centroid(t);
-            if c.cmpge(lo).all() && c.cmple(hi).all() {
-                for v in t {
-                    bounds.grow(v.clamp(lo, hi).as_dvec3());
+        .chunks(1 << 16)
+        .map(|range| {
+            let mut bounds = Bounds::default();
+            tris.visit(range, |_, t, _| {
+                let c = centroid(&t);
+                if c.cmpge(lo).all() && c.cmple(hi).all() {
+                    for v in t {
+                        bounds.grow(v.clamp(lo, hi).as_dvec3());
+                    }
                 }
-            }
+            });
             bounds
         })
         .reduce(Bounds::default, union);
@@ -307,14 +422,17 @@ pub fn robust_bounds(tris: &[[Vec3; 3]]) -> Bounds {
 /// Every step-th vertex inside `bounds` (all triangles' vertices in order), the step chosen
 /// so that at most [`FIT_POINTS`] are kept. Counted in parallel chunks, each chunk then picking
 /// the vertices whose rank among all those inside is a multiple of the step.
-fn fit_points(all: &[[Vec3; 3]], bounds: &Bounds) -> Vec<Vec3> {
-    use rayon::prelude::*;
+fn fit_points(all: &WorldTris, bounds: &Bounds) -> Vec<Vec3> {
     const CHUNK: usize = 1 << 16;
     let (lo, hi) = (bounds.min.as_vec3(), bounds.max.as_vec3());
-    let inside = |p: &&Vec3| p.cmpge(lo).all() && p.cmple(hi).all();
+    let inside = |p: &Vec3| p.cmpge(lo).all() && p.cmple(hi).all();
     let counts: Vec<usize> = all
-        .par_chunks(CHUNK)
-        .map(|c| c.iter().flatten().filter(inside).count())
+        .chunks(CHUNK)
+        .map(|range| {
+            let mut n = 0;
+            all.visit(range, |_, t, _| n += t.iter().filter(|p| inside(p)).count());
+            n
+        })
         .collect();
     let step = counts.iter().sum::<usize>().div_ceil(FIT_POINTS).max(1);
     let starts: Vec<usize> = counts
@@ -325,17 +443,21 @@ fn fit_points(all: &[[Vec3; 3]], bounds: &Bounds) -> Vec<Vec3> {
         })
         .collect();
     let picked: Vec<Vec<Vec3>> = all
-        .par_chunks(CHUNK)
+        .chunks(CHUNK)
         .zip(starts)
-        .map(|(c, start)| {
+        .map(|(range, start)| {
+            // The chunk's inside vertices from rank `skip` on, every step-th.
             let skip = (step - start % step) % step;
-            c.iter()
-                .flatten()
-                .filter(inside)
-                .skip(skip)
-                .step_by(step)
-                .copied()
-                .collect()
+            let (mut rank, mut out) = (0usize, vec![]);
+            all.visit(range, |_, t, _| {
+                for p in t.into_iter().filter(inside) {
+                    if rank >= skip && (rank - skip) % step == 0 {
+                        out.push(p);
+                    }
+                    rank += 1;
+                }
+            });
+            out
         })
         .collect();
     picked.into_iter().flatten().collect()
@@ -349,21 +471,15 @@ impl Probe {
     /// telling an interior.
     pub fn new(scene: &Scene) -> Self {
         let t = std::time::Instant::now();
-        let (tris, materials) = scene.world_vertices(&super::RenderFrame::default());
+        let tris = WorldTris::new(scene.world_objects(&super::RenderFrame::default()));
         log::debug!(
             "probe: world vertices in {:.0} ms",
             t.elapsed().as_secs_f64() * 1e3
         );
         let t = std::time::Instant::now();
-        let placed: usize = scene
-            .objects
-            .iter()
-            .filter(|o| o.visible)
-            .map(|o| o.mesh.indices.len())
-            .sum();
-        if tris.len() != placed {
+        if tris.objects.iter().any(|o| o.kept.is_some()) {
             // Triangles were dropped: the meshes' triangles are not the world's.
-            return Self::flat(scene);
+            return Self::with_flat(scene, tris);
         }
         let objects: Vec<&super::Object> = scene
             .objects
@@ -373,24 +489,14 @@ impl Probe {
         let (distinct, mesh_of) = super::distinct_meshes(&objects);
         let meshes: Vec<Arc<Mesh>> = distinct.iter().map(|&o| objects[o].mesh.clone()).collect();
         // Several meshes at once, each in parallel within (a large mesh's sort and tree).
-        let blases: Vec<Blas> = {
-            use rayon::prelude::*;
-            meshes
-                .par_iter()
-                .map(|m| crate::bvh::quick_blas(&m.positions, &m.indices))
-                .collect()
-        };
+        let blases: Vec<Blas> = meshes
+            .par_iter()
+            .map(|m| crate::bvh::quick_blas(&m.positions, &m.indices))
+            .collect();
         let instances: Vec<(u32, DMat4)> = objects
             .iter()
             .zip(&mesh_of)
             .map(|(o, &m)| (m, o.world_from_object))
-            .collect();
-        let starts = objects
-            .iter()
-            .scan(0, |acc, o| {
-                *acc += o.mesh.indices.len();
-                Some(*acc - o.mesh.indices.len())
-            })
             .collect();
         let hidden = vec![false; instances.len()];
         let two = TwoLevel::with_hidden(blases, &instances, hidden, 0);
@@ -398,23 +504,20 @@ impl Probe {
             "probe: quick BLASes and top level in {:.0} ms",
             t.elapsed().as_secs_f64() * 1e3
         );
-        Self::with_tracer(
-            scene,
-            Tracer::TwoLevel {
-                two,
-                starts,
-                meshes,
-            },
-            tris,
-            materials,
-        )
+        Self::with_tracer(scene, Tracer::TwoLevel { two, meshes }, tris)
     }
 
     /// The probe over one quick tree of the world triangles ([`Tracer::Flat`]): how the first
     /// view was found before the two levels, and what it falls back to.
     pub fn flat(scene: &Scene) -> Self {
-        use rayon::prelude::*;
-        let (tris, materials) = scene.world_vertices(&super::RenderFrame::default());
+        Self::with_flat(
+            scene,
+            WorldTris::new(scene.world_objects(&super::RenderFrame::default())),
+        )
+    }
+
+    fn with_flat(scene: &Scene, world: WorldTris) -> Self {
+        let (tris, materials) = world.to_vecs();
         let see_through = see_through_materials(scene);
         let passes = |m: u32| see_through.get(m as usize).copied().unwrap_or(false);
         let ordered = |kept: &[u32]| -> (Bvh, Vec<[Vec3; 3]>) {
@@ -437,16 +540,11 @@ impl Probe {
             let (bvh, verts) = ordered(&kept);
             (bvh, verts, kept)
         });
-        Self::with_tracer(scene, Tracer::Flat { all, opaque }, tris, materials)
+        drop((tris, materials));
+        Self::with_tracer(scene, Tracer::Flat { all, opaque }, world)
     }
 
-    fn with_tracer(
-        scene: &Scene,
-        tracer: Tracer,
-        tris: Vec<[Vec3; 3]>,
-        materials: Vec<u32>,
-    ) -> Self {
-        use rayon::prelude::*;
+    fn with_tracer(scene: &Scene, tracer: Tracer, tris: WorldTris) -> Self {
         let t = std::time::Instant::now();
         let bounds = robust_bounds(&tris);
         let points = fit_points(&tris, &bounds);
@@ -455,9 +553,12 @@ impl Probe {
             t.elapsed().as_secs_f64() * 1e3
         );
         let see_through = see_through_materials(scene);
-        let any_opaque = materials
-            .par_iter()
-            .any(|&m| !see_through.get(m as usize).copied().unwrap_or(false));
+        let any_opaque = tris.objects.par_iter().any(|o| {
+            (0..o.len()).any(|k| {
+                let m = o.mesh.materials[o.triangle(k)];
+                !see_through.get(m as usize).copied().unwrap_or(false)
+            })
+        });
         Self {
             tracer,
             emission: scene
@@ -468,7 +569,6 @@ impl Probe {
             see_through,
             any_opaque,
             tris,
-            materials,
             points,
             bounds,
         }
@@ -485,7 +585,7 @@ impl Probe {
     /// Triangle `i`'s emitted radiance luminance.
     fn emission(&self, i: usize) -> f32 {
         self.emission
-            .get(self.materials[i] as usize)
+            .get(self.tris.material(i) as usize)
             .copied()
             .unwrap_or(0.0)
     }
@@ -494,30 +594,26 @@ impl Probe {
     /// `tmax`, see-through ones included unless `opaque`: (distance, index in `tris`).
     fn trace(&self, ray: &Ray, any: bool, opaque: bool) -> Option<(f32, usize)> {
         match &self.tracer {
-            Tracer::TwoLevel { two, starts, .. } => {
-                let passes = |i: usize| {
-                    opaque
-                        && self
-                            .see_through
-                            .get(self.materials[i] as usize)
-                            .copied()
-                            .unwrap_or(false)
-                };
+            Tracer::TwoLevel { two, .. } => {
+                let passes =
+                    |m: u32| opaque && self.see_through.get(m as usize).copied().unwrap_or(false);
                 two.tlas.walk(ray, any, |leaf, r| {
                     let instance = two.tlas.tri_indices[leaf as usize] as usize;
                     let inst = &two.instances[instance];
                     let blas = &two.blases[inst.blas as usize];
                     let local = inst.to_object(r);
                     let root = two.pieces[leaf as usize];
-                    let start = starts[instance];
+                    let object = &self.tris.objects[instance];
+                    let start = self.tris.starts[instance];
                     blas.bvh
                         .walk_from(root, &local, any, |k, l| {
-                            let i = start + blas.bvh.tri_indices[k as usize] as usize;
-                            if passes(i) {
+                            let ti = blas.bvh.tri_indices[k as usize] as usize;
+                            if passes(object.mesh.materials[ti]) {
                                 return None;
                             }
                             let world = Ray { tmax: l.tmax, ..*r };
-                            intersect_triangle(&world, &self.tris[i]).map(|h| (h.0, (h.0, i)))
+                            intersect_triangle(&world, &object.vertices(ti))
+                                .map(|h| (h.0, (h.0, start + ti)))
                         })
                         .map(|h| (h.0, h))
                 })
@@ -579,7 +675,7 @@ impl Probe {
 
     /// The unit geometric normal of a triangle.
     fn normal(&self, prim: usize) -> DVec3 {
-        let t = &self.tris[prim];
+        let t = self.tris.get(prim);
         (t[1] - t[0])
             .cross(t[2] - t[0])
             .as_dvec3()
@@ -757,20 +853,25 @@ fn light_directions(probe: &Probe, lights: &[Light], point: DVec3) -> Vec<(DVec3
 /// [`MAX_EMITTERS`] (the first in scene order among equals), the power scaled up by the share
 /// of all emitted power they leave out.
 fn emitters(probe: &Probe) -> Vec<(DVec3, DVec3, f64)> {
-    use rayon::prelude::*;
     // Opaque triangles alone, in scene order: equally powerful emitters keep that order.
-    let see_through = |i: usize| {
-        probe
-            .see_through
-            .get(probe.materials[i] as usize)
-            .copied()
-            .unwrap_or(false)
-    };
-    let mut all: Vec<(usize, f64)> = (0..probe.tris.len())
-        .into_par_iter()
-        .filter(|&i| probe.emission(i) > 0.0 && !see_through(i))
-        .map(|i| (i, probe.emission(i) as f64 * area(&probe.tris[i]) as f64))
-        .filter(|(_, p)| *p > 0.0)
+    let see_through = |m: u32| probe.see_through.get(m as usize).copied().unwrap_or(false);
+    let emission = |m: u32| probe.emission.get(m as usize).copied().unwrap_or(0.0);
+    let tris = &probe.tris;
+    let mut all: Vec<(usize, f64)> = tris
+        .chunks(1 << 16)
+        .map(|range| {
+            let mut out = vec![];
+            tris.visit(range, |i, t, m| {
+                if emission(m) > 0.0 && !see_through(m) {
+                    let p = emission(m) as f64 * area(&t) as f64;
+                    if p > 0.0 {
+                        out.push((i, p));
+                    }
+                }
+            });
+            out
+        })
+        .flatten_iter()
         .collect();
     let total: f64 = all.iter().map(|e| e.1).sum();
     all.sort_by(|a, b| b.1.total_cmp(&a.1));
@@ -779,7 +880,7 @@ fn emitters(probe: &Probe) -> Vec<(DVec3, DVec3, f64)> {
     let scale = if kept > 0.0 { total / kept } else { 1.0 };
     all.into_iter()
         .map(|(i, p)| {
-            let t = &probe.tris[i];
+            let t = probe.tris.get(i);
             let centre = ((t[0] + t[1] + t[2]) / 3.0).as_dvec3();
             (centre, probe.normal(i), p * scale)
         })
@@ -1178,7 +1279,7 @@ mod tests {
     fn robust_bounds_ignore_a_stray_far_object() {
         let mut tris = subject();
         tris.extend(cuboid(Vec3::splat(1000.0), Vec3::splat(1000.1), false));
-        let b = robust_bounds(&tris);
+        let b = robust_bounds(&WorldTris::soup(&tris));
         assert!((b.min - DVec3::splat(-0.5)).length() < 1e-6, "{b:?}");
         assert!((b.max - DVec3::splat(0.5)).length() < 1e-6, "{b:?}");
     }
@@ -1220,7 +1321,8 @@ mod tests {
                     [c + a, c + b, c - a - b]
                 })
                 .collect();
-            for (axis, p) in centroid_percentiles(&tris).into_iter().enumerate() {
+            let soup = WorldTris::soup(&tris);
+            for (axis, p) in centroid_percentiles(&soup).into_iter().enumerate() {
                 for (k, q) in [0.05, 0.95].into_iter().enumerate() {
                     let expect = by_sort(&tris, axis, q);
                     assert_eq!(p[k].to_bits(), expect.to_bits(), "n {n} axis {axis} q {q}");
@@ -1233,7 +1335,7 @@ mod tests {
     fn a_small_model_fills_the_frame() {
         for size in [0.01f32, 1.0, 300.0] {
             let tris: Vec<[Vec3; 3]> = subject().iter().map(|t| t.map(|v| v * size)).collect();
-            let b = robust_bounds(&tris);
+            let b = robust_bounds(&WorldTris::soup(&tris));
             let cam = fit(&b, &[], DVec3::new(0.3, 0.4, 1.0).normalize(), 0.8, 1.6);
             // Project the corners: the widest one reaches 80–100% of the half-frame.
             let right = cam.forward.cross(cam.up);
@@ -1412,7 +1514,7 @@ mod tests {
         let flat = Probe::flat(&scene);
         assert!(matches!(two.tracer, Tracer::TwoLevel { .. }));
         assert!(matches!(flat.tracer, Tracer::Flat { .. }));
-        assert_eq!(two.tris, flat.tris);
+        assert_eq!(two.tris.to_vecs(), flat.tris.to_vecs());
         let centre = DVec3::new(3.0, 1.2, 2.0);
         let mut hits = 0;
         for (k, d) in sphere_directions(2000).enumerate() {
@@ -1447,6 +1549,32 @@ mod tests {
             assert_eq!(format!("{a:?}"), format!("{b:?}"));
         }
         assert!(first_view_with(&two, &[], None, 1.6).interior);
+    }
+
+    /// The probe's world triangles, read from each object's vertices, are those of
+    /// [`Scene::flatten`] one by one (vertices, material, order), mirrored and hidden objects
+    /// and a dropped triangle (an absurd vertex) included; reads by index and by range agree.
+    #[test]
+    fn world_triangles_are_the_flattened_ones() {
+        let mut scene = instanced_room();
+        let mut far = (*scene.objects[1].mesh).clone();
+        far.positions[0] = Vec3::splat(1e38);
+        scene.objects[1].mesh = Arc::new(far);
+        scene.objects[1].world_from_object = DMat4::from_scale(DVec3::splat(1e10));
+        let frame = crate::scene::RenderFrame::default();
+        let flat = scene.flatten(&frame);
+        assert!(flat.dropped > 0);
+        let world = WorldTris::new(scene.world_objects(&frame));
+        let (tris, materials) = world.to_vecs();
+        assert_eq!(tris.len(), flat.triangles.len());
+        for (i, t) in flat.triangles.iter().enumerate() {
+            assert_eq!((tris[i], materials[i]), (t.v, t.material), "triangle {i}");
+            assert_eq!((world.get(i), world.material(i)), (t.v, t.material));
+        }
+        let mut seen = vec![];
+        world.visit(5..tris.len() - 3, |i, t, _| seen.push((i, t)));
+        let expect: Vec<_> = (5..tris.len() - 3).map(|i| (i, tris[i])).collect();
+        assert_eq!(seen, expect);
     }
 
     /// The first view leaves its quick BLASes in the scene, one per distinct visible mesh,
