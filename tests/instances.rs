@@ -25,15 +25,7 @@ fn renderer() -> Renderer {
 
 /// The leak tests' closed cube as a mesh.
 fn closed_cube(n: usize) -> Mesh {
-    let tris = penumbra::bvh::closed_cube(n);
-    Mesh {
-        positions: tris.iter().flatten().copied().collect(),
-        indices: (0..tris.len() as u32)
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect(),
-        materials: vec![0; tris.len()],
-        ..Mesh::default()
-    }
+    Mesh::soup(&penumbra::bvh::closed_cube(n))
 }
 
 /// Identity, moved, non-uniformly scaled, mirrored, rotated-and-mirrored, and far away.

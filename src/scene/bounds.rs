@@ -274,14 +274,8 @@ mod tests {
         use super::super::{Mesh, Object, Scene};
         let mesh = |center: DVec3| {
             let t = cube(center, 1.0);
-            std::sync::Arc::new(Mesh {
-                positions: t.iter().flatten().map(|p| p.as_vec3()).collect(),
-                indices: (0..t.len() as u32)
-                    .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-                    .collect(),
-                materials: vec![0; t.len()],
-                ..Mesh::default()
-            })
+            let t: Vec<[glam::Vec3; 3]> = t.iter().map(|t| t.map(|p| p.as_vec3())).collect();
+            std::sync::Arc::new(Mesh::soup(&t))
         };
         let object = |m| Object {
             name: "cube".into(),

@@ -220,14 +220,7 @@ impl WorldTris {
     /// A soup of triangles as one object of material 0 (tests).
     #[cfg(test)]
     fn soup(tris: &[[Vec3; 3]]) -> Self {
-        let mesh = Mesh {
-            positions: tris.iter().flatten().copied().collect(),
-            indices: (0..tris.len() as u32)
-                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-                .collect(),
-            materials: vec![0; tris.len()],
-            ..Mesh::default()
-        };
+        let mesh = Mesh::soup(tris);
         Self::new(vec![super::WorldObject {
             world: mesh.positions.clone(),
             mesh: Arc::new(mesh),

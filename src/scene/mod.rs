@@ -88,6 +88,20 @@ pub struct Mesh {
     pub variants: Vec<VariantRange>,
 }
 
+impl Mesh {
+    /// A mesh of separate triangles (three vertices each, none shared), all of material 0.
+    pub fn soup(tris: &[[Vec3; 3]]) -> Self {
+        Mesh {
+            positions: tris.iter().flatten().copied().collect(),
+            indices: (0..tris.len() as u32)
+                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .collect(),
+            materials: vec![0; tris.len()],
+            ..Mesh::default()
+        }
+    }
+}
+
 /// One placed mesh: a glTF node's mesh with its world transform.
 #[derive(Clone, Debug)]
 pub struct Object {
