@@ -555,41 +555,41 @@ impl TwoLevel {
     /// collapsed BLAS, rebased alike; each BLAS's root; and per BLAS, each binary node's wide
     /// node (`u32::MAX` for one inside a wide node), where a piece enters the wide BLAS.
     pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>, Vec<Vec<u32>>) {
-        // Each BLAS collapses on its own (in parallel: the viewer's quick BLASes of a 64 M
-        // triangle scene took 4-7 s one after another), then goes to its slots, rebased.
-        let collapsed: Vec<(WideBvh, Vec<u32>)> = self
-            .blases
-            .par_iter()
-            .map(|b| WideBvh::collapse_mapped(&b.bvh, self.merge))
-            .collect();
         let mut nodes = WideBvh::collapse(&self.tlas).nodes;
         nodes.resize(self.tlas_slots(), GpuWideNode::default());
         let mut roots = Vec::with_capacity(self.blases.len());
-        let mut tri_bases = Vec::with_capacity(self.blases.len());
-        let (mut at, mut tri_base) = (nodes.len(), 0i32);
-        for (b, (wide, _)) in self.blases.iter().zip(&collapsed) {
-            roots.push(at as u32);
-            tri_bases.push(tri_base);
-            at += wide.nodes.len();
-            tri_base += b.triangles.len() as i32;
-        }
-        let top = nodes.len();
-        nodes.resize(at, GpuWideNode::default());
-        let mut slots = vec![];
-        let mut rest = &mut nodes[top..];
-        for (wide, _) in &collapsed {
-            let (head, tail) = rest.split_at_mut(wide.nodes.len());
-            slots.push(head);
+        let mut wide_of = Vec::with_capacity(self.blases.len());
+        let mut tri_base = 0i32;
+        // BLASes collapse in parallel a group at a time (about a million triangles), each
+        // group then appended in order: the viewer's quick BLASes of a 64 M-triangle scene
+        // took seconds one after another, and collapsing all before appending held the wide
+        // nodes twice (fresh memory to fault in, a second or more a GB on the development VM).
+        let mut rest = &self.blases[..];
+        while !rest.is_empty() {
+            let mut take = 0;
+            let mut tris = 0;
+            while take < rest.len() && (take == 0 || tris < GROUP_TRIANGLES) {
+                tris += rest[take].triangles.len();
+                take += 1;
+            }
+            let (group, tail) = rest.split_at(take);
             rest = tail;
-        }
-        let wide_of = collapsed
-            .into_par_iter()
-            .zip(slots)
-            .zip(roots.par_iter().zip(&tri_bases))
-            .zip(&self.blases)
-            .map(|((((wide, binaries), out), (&base, &tri_base)), b)| {
-                let base = base as i32;
-                for (o, mut n) in out.iter_mut().zip(wide.nodes) {
+            let collapsed: Vec<(WideBvh, Vec<u32>)> = group
+                .par_iter()
+                .map(|b| {
+                    let (wide, binaries) = WideBvh::collapse_mapped(&b.bvh, self.merge);
+                    let mut map = vec![u32::MAX; b.bvh.nodes.len()];
+                    for (w, &n) in binaries.iter().enumerate() {
+                        map[n as usize] = w as u32;
+                    }
+                    (wide, map)
+                })
+                .collect();
+            for (b, (wide, map)) in group.iter().zip(collapsed) {
+                let base = nodes.len() as i32;
+                roots.push(base as u32);
+                wide_of.push(map);
+                nodes.extend(wide.nodes.into_iter().map(|mut n| {
                     for i in 0..super::WIDTH {
                         if n.count[i] > 0 {
                             n.child[i] = !((!n.child[i]) + tri_base);
@@ -597,18 +597,17 @@ impl TwoLevel {
                             n.child[i] += base;
                         }
                     }
-                    *o = n;
-                }
-                let mut map = vec![u32::MAX; b.bvh.nodes.len()];
-                for (w, &n) in binaries.iter().enumerate() {
-                    map[n as usize] = w as u32;
-                }
-                map
-            })
-            .collect();
+                    n
+                }));
+                tri_base += b.triangles.len() as i32;
+            }
+        }
         (nodes, roots, wide_of)
     }
 }
+
+/// Triangles of the BLASes that [`TwoLevel::device_wide_nodes`] collapses at once.
+const GROUP_TRIANGLES: usize = 1 << 20;
 
 /// Meshes of at most this many triangles are small by default (see [`TwoLevel::small_mesh`]).
 pub const SMALL_MESH: usize = 64;
