@@ -232,6 +232,7 @@ pub(crate) fn build_source(
             log::debug!("kernel build log ({options}):\n{log}");
         }
     }
+    dump_binary(&program);
     Ok(program)
 }
 
@@ -251,6 +252,29 @@ fn register_cap(gpu: &Gpu, features: KernelFeatures) -> Option<u32> {
         Err(_) => TWO_LEVEL_REGISTERS,
     };
     (cap > 0).then_some(cap)
+}
+
+/// For measuring: with `PENUMBRA_DUMP_BINARY=PREFIX` every program built is written to
+/// `PREFIX.N.bin` (N counting the builds of the process). NVIDIA's binary is its PTX, which
+/// CUDA's `ptxas` and `cuobjdump` turn into the machine code and its register count
+/// (docs/benchmarks.md, seventh and eighth sessions).
+fn dump_binary(program: &opencl3::program::Program) {
+    static BUILDS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let Some(prefix) = std::env::var_os("PENUMBRA_DUMP_BINARY") else {
+        return;
+    };
+    let n = BUILDS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path = format!("{}.{n}.bin", prefix.to_string_lossy());
+    match program.get_binaries() {
+        Ok(binaries) => {
+            for binary in binaries {
+                if let Err(e) = std::fs::write(&path, binary) {
+                    log::warn!("cannot write {path}: {e}");
+                }
+            }
+        }
+        Err(e) => log::warn!("cannot read the program binary: {e}"),
+    }
 }
 
 /// NVIDIA's register cap for two-level programs (see [`register_cap`]).
