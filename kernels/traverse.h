@@ -46,8 +46,9 @@ inline RayPrep prepare_ray(float3 o, float3 d) {
     float4 d4 = (float4)(d, 0.0f);
     r.perm = (uint4)(kx, ky, kz, 3u);
     float4 p = ray_permute(d4, r.perm);
-    // One division: the shear's x and y scale by its z (src/bvh/traverse.rs computes the same).
-    float iz = 1.0f / p.z;
+    // No division of its own: the shear's x and y scale by the reciprocal of its z, which is
+    // the box test's reciprocal of the dominant axis (src/bvh/traverse.rs computes the same).
+    float iz = kz == 0u ? r.inv.x : kz == 1u ? r.inv.y : r.inv.z;
     r.shear = (float3)(p.x * iz, p.y * iz, iz);
     return r;
 }
