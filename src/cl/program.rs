@@ -236,12 +236,13 @@ pub(crate) fn build_source(
     Ok(program)
 }
 
-/// The register cap for NVIDIA's compiler, where it pays. The two-level traversal keeps the
-/// world ray beside the object-space one and the instance it is in, which takes the `extend`
-/// and `connect` kernels from the flat BVH's 64-66 registers to 89-94, and fewer warps fit on
-/// a multiprocessor to hide the node loads. Capped at 72 (a few bytes spilled to the L1),
-/// two-level frames on an H200 went from 0.82 to 0.90 of the flat BVH's; flat programs stay
-/// under the cap and the cap does not change them (docs/benchmarks.md, sixth session).
+/// The register cap for NVIDIA's compiler, where it pays. The two-level traversal needs a few
+/// registers more than flat's (the instance's tmin, the stack height of its walk): `extend`
+/// and `trace_closest` take 72 against flat's 64 and 62. The cap of 72 keeps ptxas from
+/// taking more, so that as many warps fit on a multiprocessor to hide the node loads; it once
+/// took two-level frames on an H200 from 0.82 to 0.90 of flat's, when they took 89-94 (sixth
+/// session), and 64 made frames 2-4 % slower in the eighth. Flat programs stay under the cap
+/// and the cap does not change them (docs/benchmarks.md).
 /// `PENUMBRA_NV_MAXRREG` sets another cap for measuring (0: none).
 fn register_cap(gpu: &Gpu, features: KernelFeatures) -> Option<u32> {
     if !features.two_level || !gpu.has_extension("cl_nv_compiler_options") {
