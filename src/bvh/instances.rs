@@ -577,57 +577,33 @@ impl TwoLevel {
     pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>, Vec<Vec<u32>>) {
         let mut nodes = WideBvh::collapse(&self.tlas).nodes;
         nodes.resize(self.tlas_slots(), GpuWideNode::default());
-        let mut roots = Vec::with_capacity(self.blases.len());
-        let mut wide_of = Vec::with_capacity(self.blases.len());
+        let mut roots = vec![];
+        let mut wide_of = vec![];
         let mut tri_base = 0i32;
-        // BLASes collapse in parallel a group at a time (about a million triangles), each
-        // group then appended in order: the viewer's quick BLASes of a 64 M-triangle scene
-        // took seconds one after another, and collapsing all before appending held the wide
-        // nodes twice (fresh memory to fault in, a second or more a GB on the development VM).
-        let mut rest = &self.blases[..];
-        while !rest.is_empty() {
-            let mut take = 0;
-            let mut tris = 0;
-            while take < rest.len() && (take == 0 || tris < GROUP_TRIANGLES) {
-                tris += rest[take].triangles.len();
-                take += 1;
+        for b in &self.blases {
+            let base = nodes.len() as i32;
+            roots.push(base as u32);
+            let (wide, binaries) = WideBvh::collapse_mapped(&b.bvh, self.merge);
+            let mut map = vec![u32::MAX; b.bvh.nodes.len()];
+            for (w, &n) in binaries.iter().enumerate() {
+                map[n as usize] = w as u32;
             }
-            let (group, tail) = rest.split_at(take);
-            rest = tail;
-            let collapsed: Vec<(WideBvh, Vec<u32>)> = group
-                .par_iter()
-                .map(|b| {
-                    let (wide, binaries) = WideBvh::collapse_mapped(&b.bvh, self.merge);
-                    let mut map = vec![u32::MAX; b.bvh.nodes.len()];
-                    for (w, &n) in binaries.iter().enumerate() {
-                        map[n as usize] = w as u32;
+            wide_of.push(map);
+            nodes.extend(wide.nodes.into_iter().map(|mut n| {
+                for i in 0..super::WIDTH {
+                    if n.count[i] > 0 {
+                        n.child[i] = !((!n.child[i]) + tri_base);
+                    } else if n.child[i] > 0 {
+                        n.child[i] += base;
                     }
-                    (wide, map)
-                })
-                .collect();
-            for (b, (wide, map)) in group.iter().zip(collapsed) {
-                let base = nodes.len() as i32;
-                roots.push(base as u32);
-                wide_of.push(map);
-                nodes.extend(wide.nodes.into_iter().map(|mut n| {
-                    for i in 0..super::WIDTH {
-                        if n.count[i] > 0 {
-                            n.child[i] = !((!n.child[i]) + tri_base);
-                        } else if n.child[i] > 0 {
-                            n.child[i] += base;
-                        }
-                    }
-                    n
-                }));
-                tri_base += b.triangles.len() as i32;
-            }
+                }
+                n
+            }));
+            tri_base += b.triangles.len() as i32;
         }
         (nodes, roots, wide_of)
     }
 }
-
-/// Triangles of the BLASes that [`TwoLevel::device_wide_nodes`] collapses at once.
-const GROUP_TRIANGLES: usize = 1 << 20;
 
 /// Meshes of at most this many triangles are small by default (see [`TwoLevel::small_mesh`]).
 pub const SMALL_MESH: usize = 64;
