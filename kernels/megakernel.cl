@@ -20,6 +20,10 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
                        global const float* env_conditional, global const GpuLight* lights,
                        global const float* light_cdf, global float4* film,
                        volatile global uint* counters) {
+#ifdef SMALL_SCENE
+    local SmallScene small;
+    small_scene_load(tris, &small);  // before any work item returns: it waits for the group
+#endif
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels) return;
@@ -35,8 +39,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
     uint nonfinite = 0;
     uint counted = 0;  // samples whose camera ray hit (the film's .w with the background cut out)
 #ifdef SMALL_SCENE
-    SmallScene small;
-    small_scene_load(tris, &small);
+    sc.surf.small = &small;
 #define MEGA_TRACE(o, d, any_hit) \
     trace_small(&small, tris, &sc.surf, o, d, 0.0f, INFINITY, any_hit)
 #define MEGA_SHADOW(q) shadow_pass_small(&small, tris, instances, object_tris, &sc.surf, q, overflow)

@@ -138,7 +138,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     float w0 = 1.0f - hit.u - hit.v;
     float3 p_err;
     float3 p = surface_point(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, hit.u, hit.v, &p_err);
-    float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
+    float3 ng = flat_normal(surf, hit.prim, tri);
 #ifdef TWO_LEVEL
     p_err += world_err;
     ng *= instance_normal_sign(&inst);
@@ -414,5 +414,5 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
 DEFINE_SHADOW_TEST(shadow_pass, global const GpuBvhNode*, trace_scene)
 DEFINE_SHADOW_TEST(shadow_pass_wide, global const GpuWideNode*, trace_scene_wide)
 #ifdef SMALL_SCENE
-DEFINE_SHADOW_TEST(shadow_pass_small, const SmallScene*, trace_small_scene)
+DEFINE_SHADOW_TEST(shadow_pass_small, local const SmallScene*, trace_small_scene)
 #endif

@@ -446,12 +446,15 @@ inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const Gpu
 // picks rows instead of shuffling each vertex.
 #define SMALL_LANES 16
 #define SMALL_BATCHES ((SMALL_SCENE + SMALL_LANES - 1) / SMALL_LANES)
-typedef struct {
+typedef struct SmallScene {
     float c[9][SMALL_BATCHES * SMALL_LANES];  // [vertex * 3 + axis][triangle]
+    float4 normal[SMALL_SCENE];               // triangle_normal's
 } SmallScene;
 
-inline void small_scene_load(global const GpuTriangle* tris, SmallScene* s) {
-    for (uint i = 0u; i < SMALL_BATCHES * SMALL_LANES; ++i) {
+// The work group's copy of the scene, in local memory (written once a launch for all of the
+// group's paths: a work item, one or a few samples, would not repay it alone).
+inline void small_scene_load(global const GpuTriangle* tris, local SmallScene* s) {
+    for (uint i = get_local_id(0); i < SMALL_BATCHES * SMALL_LANES; i += get_local_size(0)) {
         // Lanes past the last triangle repeat it (and are masked out).
         GpuTriangle t = tris[min(i, (uint)SMALL_SCENE - 1u)];
         s->c[0][i] = t.v0.x;
@@ -463,7 +466,11 @@ inline void small_scene_load(global const GpuTriangle* tris, SmallScene* s) {
         s->c[6][i] = t.v2.x;
         s->c[7][i] = t.v2.y;
         s->c[8][i] = t.v2.z;
+        if (i < SMALL_SCENE) {
+            s->normal[i] = (float4)(triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz), 0.0f);
+        }
     }
+    barrier(CLK_LOCAL_MEM_FENCE);
 }
 
 // The least lane of x.
@@ -479,7 +486,7 @@ inline int small_min(int16 x) {
 // (a later batch's only when strictly nearer), and the lanes' nearest with the lowest index
 // wins, the hit the triangles tested one by one in order would keep. The rare rays that need
 // the scalar test's double precision or error bound somewhere are tested by it throughout.
-inline GpuHit trace_small(const SmallScene* s, global const GpuTriangle* tris,
+inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* tris,
                           const SceneSurfaces* surf, float3 o, float3 d, float tmin, float tmax,
                           bool any_hit) {
     RayPrep r = prepare_ray(o, d);
@@ -548,7 +555,7 @@ inline GpuHit trace_small(const SmallScene* s, global const GpuTriangle* tris,
 }
 
 // trace_small in trace_scene_wide's form (the tree's arguments unused).
-inline GpuHit trace_small_scene(const SmallScene* s, global const GpuTriangle* tris,
+inline GpuHit trace_small_scene(local const SmallScene* s, global const GpuTriangle* tris,
                                 global const GpuInstance* instances,
                                 global const GpuTriangle* object_tris, const SceneSurfaces* surf,
                                 float3 o, float3 d, float tmin, float tmax, bool any_hit,
@@ -556,3 +563,12 @@ inline GpuHit trace_small_scene(const SmallScene* s, global const GpuTriangle* t
     return trace_small(s, tris, surf, o, d, tmin, tmax, any_hit);
 }
 #endif
+
+// triangle_normal of triangle `prim`, t, read from the megakernel's copy of a small scene
+// where there is one.
+inline float3 flat_normal(const SceneSurfaces* surf, uint prim, GpuTriangle t) {
+#ifdef SMALL_SCENE
+    if (surf->small) return surf->small->normal[prim].xyz;
+#endif
+    return triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz);
+}

@@ -95,7 +95,7 @@ pub struct KernelFeatures {
 /// The most triangles a scene may have for the megakernel to test them all for every ray
 /// (`KernelFeatures::small_scene`): up to this many, sixteen at a time in vector lanes, cost
 /// less than walking the 4-wide BVH on PoCL (docs/benchmarks.md, "Eighth session").
-pub const SMALL_SCENE_MAX: usize = 64;
+pub const SMALL_SCENE_MAX: usize = 32;
 
 impl KernelFeatures {
     /// The `-D` options for these features.

@@ -1034,7 +1034,7 @@ mod fit_tests {
     #[test]
     fn small_flat_scenes_on_a_cpu_skip_the_tree() {
         assert_eq!(small_scene(true, true, 32, false), 32);
-        assert_eq!(small_scene(true, true, SMALL_SCENE_MAX, false), 64);
+        assert_eq!(small_scene(true, true, SMALL_SCENE_MAX, false), 32);
         assert_eq!(small_scene(true, true, SMALL_SCENE_MAX + 1, false), 0);
         assert_eq!(small_scene(true, true, 0, false), 0, "nothing to test");
         assert_eq!(
