@@ -46,8 +46,9 @@ inline RayPrep prepare_ray(float3 o, float3 d) {
     float4 d4 = (float4)(d, 0.0f);
     r.perm = (uint4)(kx, ky, kz, 3u);
     float4 p = ray_permute(d4, r.perm);
-    // One division: the shear's x and y scale by its z (src/bvh/traverse.rs computes the same).
-    float iz = 1.0f / p.z;
+    // No division of its own: the shear's x and y scale by the reciprocal of its z, which is
+    // the box test's reciprocal of the dominant axis (src/bvh/traverse.rs computes the same).
+    float iz = kz == 0u ? r.inv.x : kz == 1u ? r.inv.y : r.inv.z;
     r.shear = (float3)(p.x * iz, p.y * iz, iz);
     return r;
 }
@@ -298,85 +299,83 @@ inline bool intersect_piece_triangle(uint copy, uint prim, uint slot,
 #define INSTANCE_BIT 0x80000000u
 // No child reached (the two-level traversal's children are uints: nodes or instances).
 #define NO_CHILD 0xffffffffu
+// A hit's instance while the walk is still in it (the slot waits on the stack).
+#define INSTANCE_PENDING 0xffffffffu
 // A top-level path and a bottom-level one below it on one stack.
 #define TWO_LEVEL_STACK (2 * STACK_SIZE)
+// The world ray at the bottom of the two-level stack: origin, direction, reciprocal
+// direction and tmin, read back where an instance is entered or left.
+#define WORLD_SLOTS 10u
 
-// The state of a two-level traversal (besides its stack): the world ray, the ray r in the
-// space of the level walked and its tmin (an object-space ray's is raised by the transform's
-// error), the hit so far, the stack pointer, the stack height below which the top level's
-// entries lie, whether the walk is in a bottom level and in which instance, and the node.
-#define TWO_LEVEL_STATE                       \
-    const RayPrep world = prepare_ray(o, d); \
-    RayPrep r = world;                        \
-    float rtmin = tmin;                       \
-    GpuHit hit = no_hit(tmax);                \
-    uint sp = 0;                              \
-    uint base = 0;                            \
-    bool bottom = false;                      \
-    uint slot = 0;                            \
-    uint node = 0;
-
-// Enters instance `inst` at slot `slot` in a two-level traversal: the ray r (and its rtmin)
-// carried into the instance's object space, the stack height kept in base, and node set to
-// the piece's bottom-level node (ROOT: the instance's field naming it).
-#define ENTER_INSTANCE(ROOT)                                   \
-    {                                                          \
-        float3 od = instance_vector(&inst, d);                 \
-        r = prepare_ray(instance_point(&inst, o), od);         \
-        rtmin = instance_tmin(&inst, o, od, tmin);             \
-        base = sp;                                             \
-        bottom = true;                                         \
-        node = inst.ROOT;                                      \
-    }
-
-// At a top-level piece (`node` with INSTANCE_BIT) of a two-level traversal: sets slot and
-// `piece`, and `triangle` for a piece of one triangle, which is tested on the spot (an any-hit
-// returns from the traversal); any other piece is entered (ENTER_INSTANCE).
-// Without HAS_TRIANGLE_PIECES (no small meshes, and always on GPUs, where the extra code in
-// the loop made two levels slower: docs/benchmarks.md, fifth session) every piece is entered.
-#ifdef HAS_TRIANGLE_PIECES
-#define VISIT_PIECE                                                                       \
-    slot = node & ~INSTANCE_BIT;                                                          \
-    global const GpuInstance* piece = &instances[slot];                                   \
-    bool triangle = (piece->flags & INSTANCE_PIECE_TRIANGLE) != 0u;                       \
-    if (triangle && intersect_piece_triangle(piece->root, piece->wide_root, slot,         \
-                                             object_tris, surf, &world, o, d, tmin,      \
-                                             any_hit, &hit)) {                            \
-        return hit;                                                                       \
-    }
-#else
-#define VISIT_PIECE                                     \
-    slot = node & ~INSTANCE_BIT;                        \
-    global const GpuInstance* piece = &instances[slot]; \
-    const bool triangle = false;
-#endif
+inline float3 stack_float3(const uint* s, uint i) {
+    return (float3)(as_float(s[i]), as_float(s[i + 1u]), as_float(s[i + 2u]));
+}
 
 // Closest or first hit through the top level (`nodes` from 0, leaves index `instances`) and
 // the instances' bottom levels (in the same node array, from each instance's root; leaves
 // index `object_tris`, the meshes' object-space triangles). Hits name the object-space
 // triangle and the instance (its slot, where shading finds its transforms).
-// One loop over both levels, as traverse_bvh's, with one stack: reaching a top-level leaf
-// carries the ray into the instance's object space and goes on at its root, remembering the
-// stack height; when the walk pops below that height the bottom level is done and the world
-// ray (kept, not recomputed) is back. Top-level leaves of several instances push the others.
+// One loop over both levels, as traverse_bvh's, with one stack. Reaching a top-level leaf
+// (one piece, marked TLAS_LEAF by the host) pushes the piece's slot, carries the ray into the
+// instance's object space and goes on at the piece's node, with `base` the stack height
+// above the slot; popping down to it ends the bottom level and brings the world ray back.
+// What the bottom level does not need stays in memory, not in registers: the world ray in
+// the stack's first slots, the instance's slot under its walk (a hit found there names it as
+// INSTANCE_PENDING until the walk ends). With the fewer registers, more rays run at once to
+// hide the node loads (docs/benchmarks.md, eighth session).
 inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
                                  global const GpuInstance* instances,
                                  global const GpuTriangle* object_tris,
                                  const SceneSurfaces* surf, float3 o, float3 d, float tmin,
                                  float tmax, bool any_hit, volatile global uint* overflow) {
-    TWO_LEVEL_STATE
-    uint stack[TWO_LEVEL_STACK];
+    RayPrep r = prepare_ray(o, d);
+    float rtmin = tmin;
+    GpuHit hit = no_hit(tmax);
+    uint stack[TWO_LEVEL_STACK + WORLD_SLOTS];
+    stack[0] = as_uint(o.x);
+    stack[1] = as_uint(o.y);
+    stack[2] = as_uint(o.z);
+    stack[3] = as_uint(d.x);
+    stack[4] = as_uint(d.y);
+    stack[5] = as_uint(d.z);
+    stack[6] = as_uint(r.inv.x);
+    stack[7] = as_uint(r.inv.y);
+    stack[8] = as_uint(r.inv.z);
+    stack[9] = as_uint(tmin);
+    uint sp = WORLD_SLOTS;
+    // The stack height of the bottom level walked (0: the walk is in the top level).
+    uint base = 0u;
+    uint node = 0;
     for (;;) {
         if (node & INSTANCE_BIT) {
-            VISIT_PIECE
-            if (triangle) {
-                // Tested; on to the next entry (still the top level).
-                if (sp == 0u) return hit;
+            // A piece: tested on the spot when it is one triangle (HAS_TRIANGLE_PIECES: small
+            // meshes on CPUs), else entered.
+            uint slot = node & ~INSTANCE_BIT;
+            global const GpuInstance* piece = &instances[slot];
+#ifdef HAS_TRIANGLE_PIECES
+            if (piece->flags & INSTANCE_PIECE_TRIANGLE) {
+                RayPrep world = prepare_ray(o, d);
+                if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris,
+                                             surf, &world, o, d, tmin, any_hit, &hit)) {
+                    return hit;
+                }
+                if (sp == WORLD_SLOTS) return hit;
                 node = stack[--sp];
                 continue;
             }
+#endif
+            if (sp == TWO_LEVEL_STACK + WORLD_SLOTS) {
+                atomic_inc(overflow);
+                return hit;
+            }
+            stack[sp++] = slot;
+            base = sp;
             GpuInstance inst = *piece;
-            ENTER_INSTANCE(root)
+            float3 wo = stack_float3(stack, 0u);
+            float3 od = instance_vector(&inst, stack_float3(stack, 3u));
+            r = prepare_ray(instance_point(&inst, wo), od);
+            rtmin = instance_tmin(&inst, wo, od, as_float(stack[9]));
+            node = inst.root;
         }
         GpuBvhNode n = nodes[node];
         float dist[2];
@@ -388,26 +387,19 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
             dist[side] = box_entry(lo, hi, &r, rtmin, hit.t);
             if (dist[side] == INFINITY) continue;
             int ref = as_int(lo.w);
+            uint count = as_uint(hi.w);
             if (ref >= 0) {
                 child[side] = (uint)ref;
-                continue;
-            }
-            uint first = (uint)(~ref), count = as_uint(hi.w);
-            if (bottom) {
+            } else if (count & TLAS_LEAF) {
+                child[side] = (uint)(~ref) | INSTANCE_BIT;
+            } else {
                 float before = hit.t;
-                bool stop = intersect_leaf(&r, object_tris, surf, first, count, rtmin, o, d,
-                                           any_hit, &hit);
-                if (hit.t < before) hit.instance = slot;
-                if (stop) return hit;
-            } else if (count > 0u) {
-                // A top-level leaf: its first instance is this side's child, the others wait.
-                child[side] = first | INSTANCE_BIT;
-                for (uint i = first + count - 1u; i > first; --i) {
-                    if (sp == TWO_LEVEL_STACK) {
-                        atomic_inc(overflow);
-                        return hit;
-                    }
-                    stack[sp++] = i | INSTANCE_BIT;
+                bool stop = intersect_leaf(&r, object_tris, surf, (uint)(~ref), count, rtmin, o,
+                                           d, any_hit, &hit);
+                if (hit.t < before) hit.instance = INSTANCE_PENDING;
+                if (stop) {
+                    hit.instance = stack[base - 1u];
+                    return hit;
                 }
             }
         }
@@ -415,8 +407,9 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
         if (child[0] != NO_CHILD && child[1] != NO_CHILD) {
             uint first = dist[0] <= dist[1] ? child[0] : child[1];
             uint second = dist[0] <= dist[1] ? child[1] : child[0];
-            if (sp == TWO_LEVEL_STACK) {
+            if (sp == TWO_LEVEL_STACK + WORLD_SLOTS) {
                 atomic_inc(overflow);
+                if (hit.instance == INSTANCE_PENDING) hit.instance = stack[base - 1u];
                 return hit;
             }
             stack[sp++] = second;
@@ -426,12 +419,17 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
         } else if (child[1] != NO_CHILD) {
             node = child[1];
         } else {
-            if (bottom && sp == base) {
-                r = world;
-                rtmin = tmin;
-                bottom = false;
+            if (sp == base) {
+                // The instance is done: its slot names a hit found in it, and the world ray
+                // and the top level are back.
+                if (hit.instance == INSTANCE_PENDING) hit.instance = stack[base - 1u];
+                r.origin = stack_float3(stack, 0u);
+                r.inv = stack_float3(stack, 6u);
+                rtmin = as_float(stack[9]);
+                base = 0u;
+                --sp;
             }
-            if (sp == 0u) return hit;
+            if (sp == WORLD_SLOTS) return hit;
             node = stack[--sp];
         }
     }

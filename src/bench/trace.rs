@@ -143,8 +143,12 @@ fn check_closest(host: &HostScene, rays: &[GpuRay], hits: &[GpuHit], want: usize
             match host {
                 None if dev.prim == MISS => c.matches = 1,
                 Some(h) if dev.prim != MISS && same_t(h.t, dev.t) => {
-                    if h.prim == dev.prim {
+                    // The same triangle must be in the same instance (shading reads its
+                    // transforms); another triangle at the same distance is a tie.
+                    if h.prim == dev.prim && h.instance == dev.instance {
                         c.matches = 1;
+                    } else if h.prim == dev.prim {
+                        c.mismatches = 1;
                     } else {
                         c.ties = 1;
                     }

@@ -506,8 +506,7 @@ impl TwoLevel {
     /// of all meshes one after the other, TLAS leaves the instances in TLAS order), each BLAS's
     /// root, and each mesh's first object triangle.
     pub fn device_nodes(&self) -> (Vec<GpuBvhNode>, Vec<u32>, Vec<u32>) {
-        let mut nodes = self.tlas.nodes.clone();
-        nodes.resize(self.tlas_slots(), GpuBvhNode::default());
+        let mut nodes = self.device_tlas();
         let roots = self.device_roots();
         let mut firsts = vec![];
         let mut tri_base = 0u32;
@@ -536,6 +535,27 @@ impl TwoLevel {
             tri_base += b.triangles.len() as u32;
         }
         (nodes, roots, firsts)
+    }
+
+    /// The TLAS's binary nodes in the device's form, padded to [`TwoLevel::tlas_slots`]: each
+    /// leaf (one piece, [`split_instance_leaves`]) has [`crate::cl::types::TLAS_LEAF`] set in
+    /// its count.
+    pub fn device_tlas(&self) -> Vec<GpuBvhNode> {
+        let mut nodes = self.tlas.nodes.clone();
+        for n in &mut nodes {
+            for (lo, hi) in [
+                (n.left_min, &mut n.left_max),
+                (n.right_min, &mut n.right_max),
+            ] {
+                let count = hi[3].to_bits();
+                if (lo[3].to_bits() as i32) < 0 && count > 0 {
+                    debug_assert_eq!(count, 1, "a TLAS leaf holds one piece");
+                    hi[3] = f32::from_bits(count | crate::cl::types::TLAS_LEAF);
+                }
+            }
+        }
+        nodes.resize(self.tlas_slots(), GpuBvhNode::default());
+        nodes
     }
 
     /// Where [`TwoLevel::device_nodes`] puts each BLAS's root: after the TLAS's slots, the

@@ -51,8 +51,10 @@ impl Shear {
         // negative z, which would only negate the edge functions and their sum exactly.
         let kx = (kz + 1) % 3;
         let ky = (kx + 1) % 3;
-        // One division (as the kernels' prepare_ray): x and y scale by the reciprocal of z.
-        let iz = 1.0 / d[kz];
+        // As the kernels' prepare_ray: x and y scale by the reciprocal of z, the box test's
+        // reciprocal of the dominant axis (`safe_inverse`; only a direction shorter than
+        // 1e-20 tells it from 1 / z).
+        let iz = safe_inverse(d)[kz];
         Self {
             k: [kx, ky, kz],
             s: Vec3::new(d[kx] * iz, d[ky] * iz, iz),

@@ -244,15 +244,17 @@ pub(crate) fn build_source(
             log::debug!("kernel build log ({options}):\n{log}");
         }
     }
+    dump_binary(&program);
     Ok(program)
 }
 
-/// The register cap for NVIDIA's compiler, where it pays. The two-level traversal keeps the
-/// world ray beside the object-space one and the instance it is in, which takes the `extend`
-/// and `connect` kernels from the flat BVH's 64-66 registers to 89-94, and fewer warps fit on
-/// a multiprocessor to hide the node loads. Capped at 72 (a few bytes spilled to the L1),
-/// two-level frames on an H200 went from 0.82 to 0.90 of the flat BVH's; flat programs stay
-/// under the cap and the cap does not change them (docs/benchmarks.md, sixth session).
+/// The register cap for NVIDIA's compiler, where it pays. The two-level traversal needs a few
+/// registers more than flat's (the instance's tmin, the stack height of its walk): `extend`
+/// and `trace_closest` take 72 against flat's 64 and 62. The cap of 72 keeps ptxas from
+/// taking more, so that as many warps fit on a multiprocessor to hide the node loads; it once
+/// took two-level frames on an H200 from 0.82 to 0.90 of flat's, when they took 89-94 (sixth
+/// session), and 64 made frames 2-4 % slower in the eighth. Flat programs stay under the cap
+/// and the cap does not change them (docs/benchmarks.md).
 /// `PENUMBRA_NV_MAXRREG` sets another cap for measuring (0: none).
 fn register_cap(gpu: &Gpu, features: KernelFeatures) -> Option<u32> {
     if !features.two_level || !gpu.has_extension("cl_nv_compiler_options") {
@@ -263,6 +265,29 @@ fn register_cap(gpu: &Gpu, features: KernelFeatures) -> Option<u32> {
         Err(_) => TWO_LEVEL_REGISTERS,
     };
     (cap > 0).then_some(cap)
+}
+
+/// For measuring: with `PENUMBRA_DUMP_BINARY=PREFIX` every program built is written to
+/// `PREFIX.N.bin` (N counting the builds of the process). NVIDIA's binary is its PTX, which
+/// CUDA's `ptxas` and `cuobjdump` turn into the machine code and its register count
+/// (docs/benchmarks.md, seventh and eighth sessions).
+fn dump_binary(program: &opencl3::program::Program) {
+    static BUILDS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let Some(prefix) = std::env::var_os("PENUMBRA_DUMP_BINARY") else {
+        return;
+    };
+    let n = BUILDS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path = format!("{}.{n}.bin", prefix.to_string_lossy());
+    match program.get_binaries() {
+        Ok(binaries) => {
+            for binary in binaries {
+                if let Err(e) = std::fs::write(&path, binary) {
+                    log::warn!("cannot write {path}: {e}");
+                }
+            }
+        }
+        Err(e) => log::warn!("cannot read the program binary: {e}"),
+    }
 }
 
 /// NVIDIA's register cap for two-level programs (see [`register_cap`]).

@@ -75,6 +75,10 @@ kernel_constants! {
     /// `wide_root` name it among the meshes' triangles), tested in world space without
     /// entering the instance (`bvh::instances`, `TwoLevel::braid`).
     INSTANCE_PIECE_TRIANGLE: u32 = 2;
+    /// A binary TLAS leaf's count flag in the device's node array: the leaf is one piece (its
+    /// slot in the instances), not triangles, so the two-level traversal tells the levels'
+    /// leaves apart by the leaf itself (`TwoLevel::device_tlas`).
+    TLAS_LEAF: u32 = 0x8000_0000;
 
     /// Material flags in `GpuMaterial::emission.w`: both sides are front faces.
     MATERIAL_DOUBLE_SIDED: u32 = 1;

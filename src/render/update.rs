@@ -8,7 +8,7 @@ use super::upload::piece_copies;
 use super::{Accel, Renderer};
 use crate::bvh::WideBvh;
 use crate::cl::ClError;
-use crate::cl::types::{GpuBvhNode, GpuWideNode};
+use crate::cl::types::GpuWideNode;
 use crate::scene::{Scene, is_sane};
 use std::time::Instant;
 
@@ -89,8 +89,7 @@ impl Renderer {
         let mut bytes = std::mem::size_of_val(instances.as_slice());
         // The TLAS in each node array the device has (`NodeForms`).
         if buffers.forms.binary {
-            let mut nodes = two.tlas.nodes.clone();
-            nodes.resize(slots, GpuBvhNode::default());
+            let nodes = two.device_tlas();
             buffers.nodes.write_at(gpu, 0, &nodes)?;
             bytes += std::mem::size_of_val(nodes.as_slice());
         }
