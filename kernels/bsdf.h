@@ -2199,7 +2199,8 @@ inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, f
     if (!(wi.z > 0.0f)) return (float3)(0.0f);
     float3 t, b;
     onb(n, &t, &b);
-    *wi_world = normalize(wi.x * t + wi.y * b + wi.z * n);
+    // Unit within rounding (an orthonormal frame and a unit vector in it): not normalized again.
+    *wi_world = wi.x * t + wi.y * b + wi.z * n;
     // The pdf of the direction as evaluated (cos(n, wi) / pi), so that the weight is exact.
     float cos_i = dot(*wi_world, n);
     if (!(cos_i > 0.0f)) return (float3)(0.0f);

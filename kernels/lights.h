@@ -83,7 +83,7 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
         float2 b = sample_triangle(u1, u2);
         float3 q_err;
         float3 q = surface_point(t.v0.xyz, t.v1.xyz, t.v2.xyz, b.x, b.y, &q_err);
-        float3 ng = triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz);
+        float3 ng = flat_normal(surf, prim, t);
 #ifdef TWO_LEVEL
         q_err += world_err;
         ng *= instance_normal_sign(&inst);

@@ -20,6 +20,10 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
                        global const float* env_conditional, global const GpuLight* lights,
                        global const float* light_cdf, global float4* film,
                        volatile global uint* counters) {
+#ifdef SMALL_SCENE
+    local SmallScene small;
+    small_scene_load(tris, &small);  // before any work item returns: it waits for the group
+#endif
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels) return;
@@ -34,18 +38,27 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
     uint shadow_rays = 0;
     uint nonfinite = 0;
     uint counted = 0;  // samples whose camera ray hit (the film's .w with the background cut out)
+#ifdef SMALL_SCENE
+    sc.surf.small = &small;
+#define MEGA_TRACE(o, d, any_hit) \
+    trace_small(&small, tris, &sc.surf, o, d, 0.0f, INFINITY, any_hit)
+#define MEGA_SHADOW(q) shadow_pass_small(&small, tris, instances, object_tris, &sc.surf, q, overflow)
+#else
+#define MEGA_TRACE(o, d, any_hit)                                                              \
+    trace_scene_wide(nodes, tris, instances, object_tris, &sc.surf, o, d, 0.0f, INFINITY, any_hit, \
+                     overflow)
+#define MEGA_SHADOW(q) shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, q, overflow)
+#endif
     for (uint j = 0; j < frame.samples_in_wave; ++j) {
         PathState s = camera_path(&frame, &camera, pixel, frame.first_sample + j);
         for (uint bounce = 0; bounce <= frame.max_bounces + 1u; ++bounce) {
-            GpuHit hit = trace_scene_wide(nodes, tris, instances, object_tris, &sc.surf, s.origin,
-                                          s.direction, 0.0f, INFINITY, false, overflow);
+            GpuHit hit = MEGA_TRACE(s.origin, s.direction, false);
             ++extension_rays;
             ShadowQuery q;
             bool alive = shade_vertex(&frame, bounce, &sc, hit, &s, &q);
             if (q.valid) {
                 ++shadow_rays;
-                s.radiance += shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, &q,
-                                               overflow);
+                s.radiance += MEGA_SHADOW(&q);
             }
             if (!alive) break;
         }

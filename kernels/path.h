@@ -138,7 +138,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     float w0 = 1.0f - hit.u - hit.v;
     float3 p_err;
     float3 p = surface_point(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, hit.u, hit.v, &p_err);
-    float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
+    float3 ng = flat_normal(surf, hit.prim, tri);
 #ifdef TWO_LEVEL
     p_err += world_err;
     ng *= instance_normal_sign(&inst);
@@ -382,13 +382,13 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
 #endif
 }
 
-// The shadow test of a light sample, for a BVH of NODE traced by TRACE (flat or two-level): what of
+// The shadow test of a light sample, for a scene in NODES traced by TRACE (flat or two-level): what of
 // q->contribution reaches the path, or 0 when something other than smooth thin walls is in the
 // way. Through walls the light comes tinted by each wall and no longer shared with the BSDF
 // sample (the MIS weight undone: BSDF samples through walls leave such lights to light
 // sampling). The wavefront's `connect` and the megakernel use the same test this way.
-#define DEFINE_SHADOW_TEST(NAME, NODE, TRACE)                                                \
-    inline float3 NAME(global const NODE* nodes, global const GpuTriangle* tris,               \
+#define DEFINE_SHADOW_TEST(NAME, NODES, TRACE)                                               \
+    inline float3 NAME(NODES nodes, global const GpuTriangle* tris,                            \
                        global const GpuInstance* instances,                                    \
                        global const GpuTriangle* object_tris, const SceneSurfaces* surf,        \
                        const ShadowQuery* q, volatile global uint* overflow) {                 \
@@ -411,5 +411,8 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
         }                                                                                      \
         return q->contribution * tint;                                                         \
     }
-DEFINE_SHADOW_TEST(shadow_pass, GpuBvhNode, trace_scene)
-DEFINE_SHADOW_TEST(shadow_pass_wide, GpuWideNode, trace_scene_wide)
+DEFINE_SHADOW_TEST(shadow_pass, global const GpuBvhNode*, trace_scene)
+DEFINE_SHADOW_TEST(shadow_pass_wide, global const GpuWideNode*, trace_scene_wide)
+#ifdef SMALL_SCENE
+DEFINE_SHADOW_TEST(shadow_pass_small, local const SmallScene*, trace_small_scene)
+#endif

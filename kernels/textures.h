@@ -15,6 +15,11 @@ typedef struct {
     // Two levels: the instances, whose transforms carry object-space hits to world space for
     // shading (unused with the flat BVH; kernels that only trace may leave it out).
     global const GpuInstance* instances;
+#ifdef SMALL_SCENE
+    // The megakernel's copy of a small scene's triangles and normals (traverse_wide.h), in
+    // local memory; 0 in other kernels, which leave it out.
+    local const struct SmallScene* small;
+#endif
 } SceneSurfaces;
 
 // Texture coordinates at a hit and the mip level of one texel per unit of UV area per set:

@@ -474,7 +474,16 @@ inline float3 surface_point(float3 v0, float3 v1, float3 v2, float u, float v, f
 inline float3 triangle_normal(float3 v0, float3 v1, float3 v2) {
     float3 c = cross(v1 - v0, v2 - v0);
     float m = fmax(fmax(fabs(c.x), fabs(c.y)), fabs(c.z));
-    return m > 0.0f ? normalize(c * ldexp(1.0f, -ilogb(m))) : c;
+    if (!(m > 0.0f)) return c;
+    // 2^-ilogb(m) from m's exponent bits where m is normal and the power too (ldexp's general
+    // form, three multiplications, elsewhere): the same value.
+    uint e = (as_uint(m) >> 23) & 0xffu;
+    float scale = e - 1u < 253u ? as_float((254u - e) << 23) : ldexp(1.0f, -ilogb(m));
+    // normalize() as the OpenCL library computes it (the product by the reciprocal of the
+    // root of the squared length), less its rescaling for tiny or huge lengths: the largest
+    // coordinate is now in [1, 2).
+    c *= scale;
+    return c * (1.0f / sqrt(c.x * c.x + c.y * c.y + c.z * c.z));
 }
 
 // Moves p, whose coordinates are off by at most err, off the surface along the geometric
@@ -485,6 +494,12 @@ inline float3 triangle_normal(float3 v0, float3 v1, float3 v2) {
 inline float3 offset_ray(float3 p, float3 err, float3 n) {
     float3 offset = dot(fabs(n), err) * n;
     float3 po = p + offset;
-    po = select(po, nextafter(po, (float3)(INFINITY)), offset > 0.0f);
-    return select(po, nextafter(po, (float3)(-INFINITY)), offset < 0.0f);
+    // nextafter(po, +-INFINITY) on the bits, for finite po: one step of the magnitude away from
+    // zero where po's sign is the step's, towards zero where it is not, and from a zero the
+    // smallest number of the step's sign.
+    int3 bits = as_int3(po);
+    int3 away = (po > 0.0f) == (offset > 0.0f);  // -1 where the step goes away from zero
+    int3 stepped = select(bits - 1, bits + 1, away);
+    stepped = select(stepped, select((int3)(0x80000001), (int3)(1), offset > 0.0f), po == 0.0f);
+    return select(po, as_float3(stepped), offset != 0.0f);
 }

@@ -63,6 +63,20 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
 #undef WIDE_MAX
 #undef WIDE_PLANE
 
+// intersect_triangle's sheared vertices and edge functions in lanes of TYPE (a triangle a
+// lane), from the vertices relative to the ray's origin in its permuted axes (aX .. cZ) and the
+// shear (sx, sy): declares ax, ay, bx, by, cx, cy and the edge functions u, v, w.
+#define LANE_EDGES(TYPE)                \
+    TYPE ax = aX - sx * aZ;             \
+    TYPE ay = aY - sy * aZ;             \
+    TYPE bx = bX - sx * bZ;             \
+    TYPE by = bY - sy * bZ;             \
+    TYPE cx = cX - sx * cZ;             \
+    TYPE cy = cY - sy * cZ;             \
+    TYPE u = cx * by - cy * bx;         \
+    TYPE v = ax * cy - ay * cx;         \
+    TYPE w = bx * ay - by * ax;
+
 // intersect_leaf for a leaf of at most four triangles, the four tested at once in float4 lanes
 // with intersect_triangle's arithmetic lane by lane, so that the same hit is kept: the first
 // triangle of the nearest hit (the scalar loop keeps a later one only when strictly nearer), or
@@ -93,15 +107,7 @@ inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
     LEAF4_VERTEX(v2, cX, cY, cZ)
 #undef LEAF4_VERTEX
     float4 sx = (float4)(r->shear.x), sy = (float4)(r->shear.y), sz = (float4)(r->shear.z);
-    float4 ax = aX - sx * aZ;
-    float4 ay = aY - sy * aZ;
-    float4 bx = bX - sx * bZ;
-    float4 by = bY - sy * bZ;
-    float4 cx = cX - sx * cZ;
-    float4 cy = cY - sy * cZ;
-    float4 u = cx * by - cy * bx;
-    float4 v = ax * cy - ay * cx;
-    float4 w = bx * ay - by * ax;
+    LANE_EDGES(float4)
     int4 lane = (int4)(0, 1, 2, 3) < (int4)((int)count);
     float4 zero = (float4)(0.0f);
     int4 ok = lane & ~(((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero)));
@@ -429,4 +435,140 @@ inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const Gpu
 #else
     return traverse_wide(nodes, tris, surf, o, d, tmin, tmax, any_hit, overflow);
 #endif
+}
+
+#ifdef SMALL_SCENE
+// A scene of at most a few dozen triangles (SMALL_SCENE is their number, set by the host on CPU
+// devices for flat scenes without alpha): every ray tests every triangle, sixteen at a time in
+// float16 lanes, with no tree. Each lane computes intersect_triangle's arithmetic, so the hits
+// are the same; of equally near hits the lowest triangle index is kept (the tree kept the first
+// it visited). The coordinates are held by vertex and axis, so that a ray's axis permutation
+// picks rows instead of shuffling each vertex.
+#define SMALL_LANES 16
+#define SMALL_BATCHES ((SMALL_SCENE + SMALL_LANES - 1) / SMALL_LANES)
+typedef struct SmallScene {
+    float c[9][SMALL_BATCHES * SMALL_LANES];  // [vertex * 3 + axis][triangle]
+    float4 normal[SMALL_SCENE];               // triangle_normal's
+} SmallScene;
+
+// The work group's copy of the scene, in local memory (written once a launch for all of the
+// group's paths: a work item, one or a few samples, would not repay it alone).
+inline void small_scene_load(global const GpuTriangle* tris, local SmallScene* s) {
+    for (uint i = get_local_id(0); i < SMALL_BATCHES * SMALL_LANES; i += get_local_size(0)) {
+        // Lanes past the last triangle repeat it (and are masked out).
+        GpuTriangle t = tris[min(i, (uint)SMALL_SCENE - 1u)];
+        s->c[0][i] = t.v0.x;
+        s->c[1][i] = t.v0.y;
+        s->c[2][i] = t.v0.z;
+        s->c[3][i] = t.v1.x;
+        s->c[4][i] = t.v1.y;
+        s->c[5][i] = t.v1.z;
+        s->c[6][i] = t.v2.x;
+        s->c[7][i] = t.v2.y;
+        s->c[8][i] = t.v2.z;
+        if (i < SMALL_SCENE) {
+            s->normal[i] = (float4)(triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz), 0.0f);
+        }
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+}
+
+// The least lane of x.
+inline int small_min(int16 x) {
+    int8 y = min(x.lo, x.hi);
+    int4 b = min(y.lo, y.hi);
+    int2 c = min(b.lo, b.hi);
+    return min(c.x, c.y);
+}
+
+// The nearest hit of the ray in (tmin, tmax) among all triangles, or with any_hit some hit.
+// The batches are tested without a branch between them: each lane keeps its nearest hit so far
+// (a later batch's only when strictly nearer), and the lanes' nearest with the lowest index
+// wins, the hit the triangles tested one by one in order would keep. The rare rays that need
+// the scalar test's double precision or error bound somewhere are tested by it throughout.
+inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* tris,
+                          const SceneSurfaces* surf, float3 o, float3 d, float tmin, float tmax,
+                          bool any_hit) {
+    RayPrep r = prepare_ray(o, d);
+    GpuHit hit = no_hit(tmax);
+    float4 op = ray_permute((float4)(o, 0.0f), r.perm);
+    uint kx = r.perm.x, ky = r.perm.y, kz = r.perm.z;
+    float16 sx = (float16)(r.shear.x), sy = (float16)(r.shear.y), sz = (float16)(r.shear.z);
+    float16 zero = (float16)(0.0f);
+    float16 best_t = (float16)(tmax);
+    float16 best_v = zero, best_w = zero, best_det = zero;
+    int16 best_index = (int16)(SMALL_BATCHES * SMALL_LANES);
+    int16 special = (int16)(0);
+    int16 lanes = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+#pragma unroll
+    for (uint at = 0u; at < SMALL_BATCHES * SMALL_LANES; at += SMALL_LANES) {
+        float16 aX = vload16(0, &s->c[kx][at]) - (float16)(op.x);
+        float16 aY = vload16(0, &s->c[ky][at]) - (float16)(op.y);
+        float16 aZ = vload16(0, &s->c[kz][at]) - (float16)(op.z);
+        float16 bX = vload16(0, &s->c[3u + kx][at]) - (float16)(op.x);
+        float16 bY = vload16(0, &s->c[3u + ky][at]) - (float16)(op.y);
+        float16 bZ = vload16(0, &s->c[3u + kz][at]) - (float16)(op.z);
+        float16 cX = vload16(0, &s->c[6u + kx][at]) - (float16)(op.x);
+        float16 cY = vload16(0, &s->c[6u + ky][at]) - (float16)(op.y);
+        float16 cZ = vload16(0, &s->c[6u + kz][at]) - (float16)(op.z);
+        LANE_EDGES(float16)
+        int16 index = lanes + (int16)((int)at);
+        int16 lane = index < (int16)(SMALL_SCENE);
+        int16 ok = lane & ~(((u < zero) | (v < zero) | (w < zero)) &
+                            ((u > zero) | (v > zero) | (w > zero)));
+        float16 det = u + v + w;
+        ok &= det != zero;
+        float16 az = sz * aZ, bz = sz * bZ, cz = sz * cZ;
+        float16 t = (u * az + v * bz + w * cz) / det;
+        ok &= (t > (float16)(tmin)) & (t < best_t);
+        float16 far_z = select(fabs(az), fabs(bz), fabs(bz) > fabs(az));
+        far_z = select(far_z, fabs(cz), fabs(cz) > far_z);
+        special |= lane & ((u == zero) | (v == zero) | (w == zero) |
+                           (ok & (t < 0.00390625f * far_z)));
+        best_t = select(best_t, t, ok);
+        best_v = select(best_v, v, ok);
+        best_w = select(best_w, w, ok);
+        best_det = select(best_det, det, ok);
+        best_index = select(best_index, index, ok);
+    }
+    if (small_min(special) < 0) {
+        // Rare cases for the scalar test, as in intersect_leaf4.
+        intersect_leaf(&r, tris, surf, 0u, SMALL_SCENE, tmin, o, d, any_hit, &hit);
+        return hit;
+    }
+    int16 found = best_index < (int16)(SMALL_SCENE);
+    if (small_min(found) == 0) return hit;
+    // Distances above tmin >= 0 order as their bits do.
+    float m = as_float(small_min(as_int16(best_t)));
+    int k = small_min(select((int16)(SMALL_BATCHES * SMALL_LANES), best_index,
+                             found & (best_t == (float16)(m))));
+    float vk[SMALL_LANES], wk[SMALL_LANES], dk[SMALL_LANES];
+    vstore16(best_v, 0, vk);
+    vstore16(best_w, 0, wk);
+    vstore16(best_det, 0, dk);
+    int lane = k % SMALL_LANES;
+    hit.t = m;
+    hit.u = vk[lane] / dk[lane];
+    hit.v = wk[lane] / dk[lane];
+    hit.prim = (uint)k;
+    return hit;
+}
+
+// trace_small in trace_scene_wide's form (the tree's arguments unused).
+inline GpuHit trace_small_scene(local const SmallScene* s, global const GpuTriangle* tris,
+                                global const GpuInstance* instances,
+                                global const GpuTriangle* object_tris, const SceneSurfaces* surf,
+                                float3 o, float3 d, float tmin, float tmax, bool any_hit,
+                                volatile global uint* overflow) {
+    return trace_small(s, tris, surf, o, d, tmin, tmax, any_hit);
+}
+#endif
+
+// triangle_normal of triangle `prim`, t, read from the megakernel's copy of a small scene
+// where there is one.
+inline float3 flat_normal(const SceneSurfaces* surf, uint prim, GpuTriangle t) {
+#ifdef SMALL_SCENE
+    if (surf->small) return surf->small->normal[prim].xyz;
+#endif
+    return triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz);
 }

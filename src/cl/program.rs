@@ -86,7 +86,16 @@ pub struct KernelFeatures {
     /// Some top-level pieces are single triangles of small meshes, tested in world space
     /// (`HAS_TRIANGLE_PIECES`, with `TWO_LEVEL`).
     pub triangle_pieces: bool,
+    /// The scene's triangles when the megakernel tests them all for every ray instead of
+    /// walking the BVH (`SMALL_SCENE`, kernels/traverse_wide.h): a flat scene of at most
+    /// [`SMALL_SCENE_MAX`] triangles without alpha, on a CPU device; 0 otherwise.
+    pub small_scene: u32,
 }
+
+/// The most triangles a scene may have for the megakernel to test them all for every ray
+/// (`KernelFeatures::small_scene`): up to this many, sixteen at a time in vector lanes, cost
+/// less than walking the 4-wide BVH on PoCL (docs/benchmarks.md, "Eighth session").
+pub const SMALL_SCENE_MAX: usize = 32;
 
 impl KernelFeatures {
     /// The `-D` options for these features.
@@ -116,6 +125,9 @@ impl KernelFeatures {
                 d.push_str(" -D");
                 d.push_str(name);
             }
+        }
+        if self.small_scene > 0 {
+            d.push_str(&format!(" -DSMALL_SCENE={}", self.small_scene));
         }
         d
     }
@@ -295,6 +307,17 @@ fn first_error(log: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_small_scene_is_defined_with_its_triangles() {
+        let small = KernelFeatures {
+            small_scene: 32,
+            lambert_only: true,
+            ..Default::default()
+        };
+        assert_eq!(small.defines(), " -DLAMBERT_ONLY -DSMALL_SCENE=32");
+        assert!(!KernelFeatures::default().defines().contains("SMALL_SCENE"));
+    }
 
     #[test]
     fn every_source_is_marked_with_its_file() {

@@ -27,7 +27,7 @@ use crate::bvh::{Ray, WideBvh};
 pub use crate::cl::kernels::NodeForms;
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
+use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program, SMALL_SCENE_MAX};
 use crate::scene::{AlphaMode, Camera, EnvMap, EnvSampling, Light, RenderFrame, Scene};
 use std::sync::Arc;
 use std::time::Instant;
@@ -103,7 +103,15 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         dispersion: used(&|m| m.is_dispersive()),
         tangents: used(&|m| m.anisotropy > 0.0) && tangents,
         lambert_only: materials().all(|m| m.is_lambertian()),
+        small_scene: 0,
     }
+}
+
+/// `KernelFeatures::small_scene` for a scene of `triangles`: the megakernel (CPU devices) tests
+/// every triangle of a small flat scene without alpha for every ray.
+fn small_scene(cpu: bool, flat: bool, triangles: usize, alpha: bool) -> u32 {
+    let small = cpu && flat && !alpha && (1..=SMALL_SCENE_MAX).contains(&triangles);
+    if small { triangles as u32 } else { 0 }
 }
 
 /// The path tracer on one OpenCL device.
@@ -442,6 +450,12 @@ impl Renderer {
                 !host.tangents.is_empty() || mesh_tangents,
             )
         };
+        self.scene_features.small_scene = small_scene(
+            self.gpu.is_cpu(),
+            matches!(host.accel, Accel::Flat(_)),
+            host.triangles.len(),
+            self.scene_features.alpha,
+        );
         let budget = self
             .gpu
             .device
@@ -625,6 +639,7 @@ impl Renderer {
             env_map: self.environment.is_some(),
             two_level: self.scene_features.two_level,
             triangle_pieces: self.scene_features.triangle_pieces,
+            small_scene: self.scene_features.small_scene,
             ..scene_features(scene, any(&|m| m.is_emissive()), true)
         };
         self.program.as_ref().is_none_or(|p| p.features != features)
@@ -1012,9 +1027,28 @@ fn fits_device(
 
 #[cfg(test)]
 mod fit_tests {
-    use super::{fits_device, scene_features};
+    use super::{SMALL_SCENE_MAX, fits_device, scene_features, small_scene};
     use crate::scene::{Material, Mesh, Object, Scene};
     use glam::{DMat4, Vec3};
+
+    #[test]
+    fn small_flat_scenes_on_a_cpu_skip_the_tree() {
+        assert_eq!(small_scene(true, true, 32, false), 32);
+        assert_eq!(small_scene(true, true, SMALL_SCENE_MAX, false), 32);
+        assert_eq!(small_scene(true, true, SMALL_SCENE_MAX + 1, false), 0);
+        assert_eq!(small_scene(true, true, 0, false), 0, "nothing to test");
+        assert_eq!(
+            small_scene(false, true, 32, false),
+            0,
+            "GPUs keep the wavefront"
+        );
+        assert_eq!(small_scene(true, false, 32, false), 0, "two levels");
+        assert_eq!(
+            small_scene(true, true, 32, true),
+            0,
+            "alpha tests need the tree's loop"
+        );
+    }
 
     /// One triangle per material index in `uses`, of a scene with `materials`.
     fn scene_using(materials: Vec<Material>, uses: &[u32]) -> Scene {
