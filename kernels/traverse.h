@@ -329,6 +329,11 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
                                  const SceneSurfaces* surf, float3 o, float3 d, float tmin,
                                  float tmax, bool any_hit, volatile global uint* overflow) {
     RayPrep r = prepare_ray(o, d);
+#ifdef HAS_TRIANGLE_PIECES
+    // Top-level triangle pieces are tested against the whole world ray (CPUs only, where the
+    // registers matter less).
+    const RayPrep world = r;
+#endif
     float rtmin = tmin;
     GpuHit hit = no_hit(tmax);
     uint stack[TWO_LEVEL_STACK + WORLD_SLOTS];
@@ -354,7 +359,6 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
             global const GpuInstance* piece = &instances[slot];
 #ifdef HAS_TRIANGLE_PIECES
             if (piece->flags & INSTANCE_PIECE_TRIANGLE) {
-                RayPrep world = prepare_ray(o, d);
                 if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris,
                                              surf, &world, o, d, tmin, any_hit, &hit)) {
                     return hit;
