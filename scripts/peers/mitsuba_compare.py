@@ -114,6 +114,38 @@ def bunny_scene(glb_path, copies=1):
             "point_lights": [BUNNY_LIGHT]}
 
 
+def closed_box_scene(splits=0):
+    """The bundled box with closed blocks (a bottom face each, as in Mitsuba's own `cbox`: 36
+    triangles), every triangle then split into four at its edge midpoints `splits` times (144,
+    576, ...): boxes other than the bundled one's 32 triangles, for the small-scene path's limit."""
+    sc = cornell_box.scene()
+    meshes = []
+    for m in sc["meshes"]:
+        pos, nrm = list(m["positions"]), list(m["normals"])
+        idx = list(m["indices"])
+        if m["name"].endswith("Block"):
+            bottom = sorted({p for p in pos if p[1] == 0.0})
+            # The four bottom corners as the top's; order them around their centre.
+            cx = sum(p[0] for p in bottom) / 4.0
+            cz = sum(p[2] for p in bottom) / 4.0
+            bottom.sort(key=lambda p: math.atan2(p[2] - cz, p[0] - cx))
+            q, n, i = cornell_box._quad(bottom, (0.0, -1.0, 0.0))
+            idx += [len(pos) + k for k in i]
+            pos += q
+            nrm += n
+        tris = [(pos[idx[k]], pos[idx[k + 1]], pos[idx[k + 2]], nrm[idx[k]])
+                for k in range(0, len(idx), 3)]
+        for _ in range(splits):
+            mid = lambda a, b: tuple((x + y) / 2.0 for x, y in zip(a, b))  # noqa: E731
+            tris = [t for a, b, c, n in tris
+                    for t in ((a, mid(a, b), mid(c, a), n), (mid(a, b), b, mid(b, c), n),
+                              (mid(c, a), mid(b, c), c, n), (mid(a, b), mid(b, c), mid(c, a), n))]
+        meshes.append(dict(m, positions=[p for t in tris for p in t[:3]],
+                           normals=[t[3] for t in tris for _ in range(3)],
+                           indices=list(range(3 * len(tris)))))
+    return dict(sc, meshes=meshes)
+
+
 def mitsuba_scene(sc, width, height, bounces, twosided):
     """The Mitsuba scene of a cornell_box.scene()-style description, one sample per pass."""
     return mitsuba_reference.build_scene(width, height, 1, bounces, sc=sc, twosided=twosided)
@@ -292,6 +324,16 @@ def main(argv=None):
                     print(f"rendering {reference}", file=sys.stderr)
                     mi.Bitmap(mitsuba_reference_image(msc, args.ref_spp, 1000, 256)).write(
                         reference)
+        elif name in ("cornell36", "cornell144", "cornell576"):
+            sc = closed_box_scene({"cornell36": 0, "cornell144": 1, "cornell576": 2}[name])
+            glb = os.path.join(args.work, f"{name}.glb")
+            cornell_box.write_glb(glb, *cornell_box.build_gltf(sc))
+            msc = mitsuba_scene(sc, args.size, args.size, args.bounces, twosided=False)
+            reference = os.path.join(args.work, f"{name}-mitsuba-{args.size}.exr")
+            if not os.path.exists(reference) and not args.timing_only:
+                print(f"rendering {reference}", file=sys.stderr)
+                mi.Bitmap(mitsuba_reference_image(msc, args.ref_spp, 1000, 256)).write(
+                    reference)
         elif name in ("bunny", "bunnies"):
             scenes = os.environ.get("PENUMBRA_SCENES")
             src = os.path.join(scenes or "", "StanfordBunny", "bunny.glb")
@@ -311,7 +353,8 @@ def main(argv=None):
                     reference)
                 print(f"   {time.perf_counter() - t:.0f} s", file=sys.stderr)
         else:
-            sys.exit(f"unknown scene '{name}' (cornell, bunny, bunnies)")
+            sys.exit(f"unknown scene '{name}' (cornell, cornell36, cornell144, cornell576, bunny, "
+                     "bunnies)")
         compare(name, glb, msc, reference, args, results)
 
     cpu = platform.processor() or platform.machine()

@@ -94,8 +94,10 @@ pub struct KernelFeatures {
 
 /// The most triangles a scene may have for the megakernel to test them all for every ray
 /// (`KernelFeatures::small_scene`): up to this many, sixteen at a time in vector lanes, cost
-/// less than walking the 4-wide BVH on PoCL (docs/benchmarks.md, "Eighth session").
-pub const SMALL_SCENE_MAX: usize = 32;
+/// less than walking the 4-wide BVH on PoCL (docs/benchmarks.md, "Eighth session"; a box of
+/// 36 triangles 7.5–7.8 against the tree's 8.7–8.8 CPU s, one of 144 12.6–13.0 against 11.9–12.2:
+/// "Ninth session").
+pub const SMALL_SCENE_MAX: usize = 64;
 
 impl KernelFeatures {
     /// The `-D` options for these features.

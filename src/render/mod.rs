@@ -110,8 +110,20 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
 /// `KernelFeatures::small_scene` for a scene of `triangles`: the megakernel (CPU devices) tests
 /// every triangle of a small flat scene without alpha for every ray.
 fn small_scene(cpu: bool, flat: bool, triangles: usize, alpha: bool) -> u32 {
-    let small = cpu && flat && !alpha && (1..=SMALL_SCENE_MAX).contains(&triangles);
+    let small = cpu && flat && !alpha && (1..=small_scene_limit()).contains(&triangles);
     if small { triangles as u32 } else { 0 }
+}
+
+/// [`SMALL_SCENE_MAX`], or for measuring the limit against the tree another one from
+/// `PENUMBRA_SMALL_SCENE_MAX` (0 turns small scenes off; at most 1024).
+fn small_scene_limit() -> usize {
+    static LIMIT: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *LIMIT.get_or_init(|| {
+        std::env::var("PENUMBRA_SMALL_SCENE_MAX")
+            .ok()
+            .and_then(|v| v.trim().parse::<usize>().ok())
+            .map_or(SMALL_SCENE_MAX, |n| n.min(1024))
+    })
 }
 
 /// The path tracer on one OpenCL device.
@@ -1034,7 +1046,15 @@ mod fit_tests {
     #[test]
     fn small_flat_scenes_on_a_cpu_skip_the_tree() {
         assert_eq!(small_scene(true, true, 32, false), 32);
-        assert_eq!(small_scene(true, true, SMALL_SCENE_MAX, false), 32);
+        assert_eq!(
+            small_scene(true, true, 36, false),
+            36,
+            "a box with closed blocks"
+        );
+        assert_eq!(
+            small_scene(true, true, SMALL_SCENE_MAX, false),
+            SMALL_SCENE_MAX as u32
+        );
         assert_eq!(small_scene(true, true, SMALL_SCENE_MAX + 1, false), 0);
         assert_eq!(small_scene(true, true, 0, false), 0, "nothing to test");
         assert_eq!(
