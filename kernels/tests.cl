@@ -57,7 +57,7 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuFrame, rr_depth); PROBE_FIELD(GpuFrame, strategy);
     PROBE_FIELD(GpuFrame, sky); PROBE_FIELD(GpuFrame, light_count);
     PROBE_FIELD(GpuFrame, bounce); PROBE_FIELD(GpuFrame, background);
-    PROBE_FIELD(GpuFrame, pad);
+    PROBE_FIELD(GpuFrame, triangles);
     PROBE_SIZE(GpuPath);
     PROBE_FIELD(GpuPath, origin); PROBE_FIELD(GpuPath, direction);
     PROBE_FIELD(GpuPath, throughput); PROBE_FIELD(GpuPath, radiance);

@@ -438,9 +438,10 @@ inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const Gpu
 }
 
 #ifdef SMALL_SCENE
-// A scene of at most a few dozen triangles (SMALL_SCENE is their number, set by the host on CPU
-// devices for flat scenes without alpha): every ray tests every triangle, sixteen at a time in
-// float16 lanes, with no tree. Each lane computes intersect_triangle's arithmetic, so the hits
+// A scene of at most a few dozen triangles (SMALL_SCENE: their number rounded up to a whole
+// batch of SMALL_LANES, set by the host on CPU devices for flat scenes without alpha; the number
+// itself comes with the frame, so that hiding an object builds no kernels unless the batches
+// change): every ray tests every triangle, sixteen at a time in float16 lanes, with no tree. Each lane computes intersect_triangle's arithmetic, so the hits
 // are the same; of equally near hits the lowest triangle index is kept (the tree kept the first
 // it visited). The coordinates are held by vertex and axis, so that a ray's axis permutation
 // picks rows instead of shuffling each vertex.
@@ -449,14 +450,17 @@ inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const Gpu
 typedef struct SmallScene {
     float c[9][SMALL_BATCHES * SMALL_LANES];  // [vertex * 3 + axis][triangle]
     float4 normal[SMALL_SCENE];               // triangle_normal's
+    uint count;                               // triangles, 1..=SMALL_SCENE
 } SmallScene;
 
 // The work group's copy of the scene, in local memory (written once a launch for all of the
 // group's paths: a work item, one or a few samples, would not repay it alone).
-inline void small_scene_load(global const GpuTriangle* tris, local SmallScene* s) {
+inline void small_scene_load(global const GpuTriangle* tris, uint count, local SmallScene* s) {
+    count = clamp(count, 1u, (uint)SMALL_SCENE);
+    if (get_local_id(0) == 0u) s->count = count;
     for (uint i = get_local_id(0); i < SMALL_BATCHES * SMALL_LANES; i += get_local_size(0)) {
         // Lanes past the last triangle repeat it (and are masked out).
-        GpuTriangle t = tris[min(i, (uint)SMALL_SCENE - 1u)];
+        GpuTriangle t = tris[min(i, count - 1u)];
         s->c[0][i] = t.v0.x;
         s->c[1][i] = t.v0.y;
         s->c[2][i] = t.v0.z;
@@ -466,7 +470,7 @@ inline void small_scene_load(global const GpuTriangle* tris, local SmallScene* s
         s->c[6][i] = t.v2.x;
         s->c[7][i] = t.v2.y;
         s->c[8][i] = t.v2.z;
-        if (i < SMALL_SCENE) {
+        if (i < count) {
             s->normal[i] = (float4)(triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz), 0.0f);
         }
     }
@@ -500,6 +504,7 @@ inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* t
     int16 best_index = (int16)(SMALL_BATCHES * SMALL_LANES);
     int16 special = (int16)(0);
     int16 lanes = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    uint count = s->count;
 #pragma unroll
     for (uint at = 0u; at < SMALL_BATCHES * SMALL_LANES; at += SMALL_LANES) {
         float16 aX = vload16(0, &s->c[kx][at]) - (float16)(op.x);
@@ -513,7 +518,7 @@ inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* t
         float16 cZ = vload16(0, &s->c[6u + kz][at]) - (float16)(op.z);
         LANE_EDGES(float16)
         int16 index = lanes + (int16)((int)at);
-        int16 lane = index < (int16)(SMALL_SCENE);
+        int16 lane = index < (int16)((int)count);
         int16 ok = lane & ~(((u < zero) | (v < zero) | (w < zero)) &
                             ((u > zero) | (v > zero) | (w > zero)));
         float16 det = u + v + w;
@@ -533,10 +538,10 @@ inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* t
     }
     if (small_min(special) < 0) {
         // Rare cases for the scalar test, as in intersect_leaf4.
-        intersect_leaf(&r, tris, surf, 0u, SMALL_SCENE, tmin, o, d, any_hit, &hit);
+        intersect_leaf(&r, tris, surf, 0u, count, tmin, o, d, any_hit, &hit);
         return hit;
     }
-    int16 found = best_index < (int16)(SMALL_SCENE);
+    int16 found = best_index < (int16)((int)count);
     if (small_min(found) == 0) return hit;
     // Distances above tmin >= 0 order as their bits do.
     float m = as_float(small_min(as_int16(best_t)));

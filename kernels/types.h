@@ -132,7 +132,7 @@ typedef struct {
     uint light_count;
     uint bounce;
     uint background;  // BACKGROUND_*: what an escaped camera ray adds
-    uint pad;
+    uint triangles;   // the scene's, for SMALL_SCENE (traverse_wide.h); 0 elsewhere
 } GpuFrame;
 
 typedef struct {

@@ -215,3 +215,61 @@ fn the_same_seed_traces_the_same_paths_in_both_kernels() {
     let (ma, mb) = (common::mean_gray(&pa), common::mean_gray(&pb));
     assert!((ma - mb).abs() <= 1e-3 * ma, "mean {ma} against {mb}");
 }
+
+#[test]
+fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
+    // The bundled box (32 triangles) is tested whole on CPU devices (`SMALL_SCENE`), with
+    // kernels built for two batches of sixteen: hiding the tall block (22 left) changes the
+    // count the frame carries, not the kernels, and the block is gone from the image.
+    use penumbra::render::{RenderSettings, Renderer};
+    use penumbra::scene::RenderFrame;
+    let choice = common::test_device().parse().unwrap();
+    let mut r = Renderer::new(&choice).unwrap();
+    r.set_settings(&RenderSettings {
+        width: 32,
+        height: 32,
+        bounces: 2,
+        ..Default::default()
+    })
+    .unwrap();
+    let mut scene = penumbra::scene::load_or_bundled(None).unwrap();
+    let camera = scene.cameras[0].clone();
+    let lights = scene.lights.clone();
+    let render = |r: &mut Renderer, scene: &penumbra::scene::Scene| {
+        let stats = r
+            .load_scene_in(scene, &lights, RenderFrame::default())
+            .unwrap();
+        r.set_camera(&camera).unwrap();
+        r.render(16).unwrap();
+        (stats, r.image().unwrap())
+    };
+    let (first, whole) = render(&mut r, &scene);
+    assert!(first.kernels_built);
+    let features = r.program().unwrap().features;
+    if r.gpu.is_cpu() {
+        assert_eq!(features.small_scene, 32);
+    }
+    let tall = scene
+        .objects
+        .iter()
+        .position(|o| o.name == "TallBlock")
+        .expect("the bundled box has a tall block");
+    scene.objects[tall].visible = false;
+    let (hidden, without) = render(&mut r, &scene);
+    assert_eq!(hidden.triangles, first.triangles - 10);
+    assert!(!hidden.kernels_built, "hiding an object built kernels");
+    assert_eq!(r.program().unwrap().features, features);
+    // The tall block stands left of the middle (its top at x 0.12–0.29 of the box's 0.556):
+    // with it gone, the back wall shows there, and the image changes.
+    let changed = whole
+        .iter()
+        .zip(&without)
+        .filter(|(a, b)| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() + (a[2] - b[2]).abs() > 0.05)
+        .count();
+    assert!(changed > 32, "only {changed} pixels changed");
+    // And back: the same kernels again, the same image as the first (same seed, same samples).
+    scene.objects[tall].visible = true;
+    let (shown, again) = render(&mut r, &scene);
+    assert!(!shown.kernels_built);
+    assert_eq!(again, whole);
+}

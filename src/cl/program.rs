@@ -86,9 +86,10 @@ pub struct KernelFeatures {
     /// Some top-level pieces are single triangles of small meshes, tested in world space
     /// (`HAS_TRIANGLE_PIECES`, with `TWO_LEVEL`).
     pub triangle_pieces: bool,
-    /// The scene's triangles when the megakernel tests them all for every ray instead of
-    /// walking the BVH (`SMALL_SCENE`, kernels/traverse_wide.h): a flat scene of at most
-    /// [`SMALL_SCENE_MAX`] triangles without alpha, on a CPU device; 0 otherwise.
+    /// The scene's triangles rounded up to a multiple of 16 when the megakernel tests them all
+    /// for every ray instead of walking the BVH (`SMALL_SCENE`, kernels/traverse_wide.h; the
+    /// count itself comes with each frame): a flat scene of at most [`SMALL_SCENE_MAX`]
+    /// triangles without alpha, on a CPU device; 0 otherwise.
     pub small_scene: u32,
 }
 

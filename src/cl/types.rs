@@ -436,8 +436,10 @@ pub struct GpuFrame {
     pub bounce: u32,
     /// What an escaped camera ray adds (`BACKGROUND_*`).
     pub background: u32,
-    /// Padding.
-    pub pad: u32,
+    /// The scene's triangles, for the megakernel's small-scene test (`SMALL_SCENE`), which is
+    /// built for up to `SMALL_SCENE_MAX` of them so that hiding or showing an object in such a
+    /// scene does not build the kernels again; 0 elsewhere.
+    pub triangles: u32,
 }
 const _: () = assert!(size_of::<GpuFrame>() == 64);
 
@@ -565,7 +567,7 @@ pub fn layouts() -> Vec<StructLayout> {
             light_count,
             bounce,
             background,
-            pad
+            triangles
         ),
         layout!(GpuPath, origin, direction, throughput, radiance),
         layout!(GpuHit, t, u, v, prim, instance),

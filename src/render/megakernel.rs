@@ -94,6 +94,15 @@ impl Renderer {
             return Err(ClError::Device("no scene is loaded".into()));
         };
         let (gpu, counters) = (&self.gpu, &self.counters);
+        // The small-scene test (kernels built for up to SMALL_SCENE_MAX) takes the count here.
+        let frame = &GpuFrame {
+            triangles: if program.features.small_scene > 0 {
+                scene.triangles.len() as u32
+            } else {
+                0
+            },
+            ..*frame
+        };
         let l = program.megakernel(
             gpu,
             frame,

@@ -48,8 +48,10 @@ pub struct SceneStats {
     pub sah_cost: f32,
     /// Host BVH build time.
     pub bvh_build_ms: f64,
-    /// Kernel build time (0 when the kernels were reused).
+    /// Kernel build time (with the megakernel's first launch, which makes PoCL compile it).
     pub kernel_build_ms: f64,
+    /// Whether kernels were built for this scene (false when the last scene's were reused).
+    pub kernels_built: bool,
     /// Upload time of the scene buffers (texture mip chains included).
     pub upload_ms: f64,
     /// Textures on the device (one per image and color space).
@@ -108,10 +110,16 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
 }
 
 /// `KernelFeatures::small_scene` for a scene of `triangles`: the megakernel (CPU devices) tests
-/// every triangle of a small flat scene without alpha for every ray.
+/// every triangle of a small flat scene without alpha for every ray, sixteen at a time. The
+/// kernels are built for the count rounded up to a whole sixteen (the count itself comes with
+/// each frame), so that hiding or showing an object of such a scene mostly builds nothing.
 fn small_scene(cpu: bool, flat: bool, triangles: usize, alpha: bool) -> u32 {
     let small = cpu && flat && !alpha && (1..=small_scene_limit()).contains(&triangles);
-    if small { triangles as u32 } else { 0 }
+    if small {
+        triangles.next_multiple_of(16) as u32
+    } else {
+        0
+    }
 }
 
 /// [`SMALL_SCENE_MAX`], or for measuring the limit against the tree another one from
@@ -620,6 +628,7 @@ impl Renderer {
             sah_cost: host.accel.sah_cost(),
             bvh_build_ms,
             kernel_build_ms,
+            kernels_built: kernel_build_ms > 0.0,
             upload_ms: t.elapsed().as_secs_f64() * 1e3 - kernel_build_ms,
             textures: pack.textures.len(),
             texture_bytes: pack.bytes(),
@@ -1045,12 +1054,16 @@ mod fit_tests {
 
     #[test]
     fn small_flat_scenes_on_a_cpu_skip_the_tree() {
+        // Built for whole batches of sixteen: counts within one give the same kernels.
         assert_eq!(small_scene(true, true, 32, false), 32);
+        assert_eq!(small_scene(true, true, 22, false), 32);
+        assert_eq!(small_scene(true, true, 17, false), 32);
         assert_eq!(
             small_scene(true, true, 36, false),
-            36,
+            48,
             "a box with closed blocks"
         );
+        assert_eq!(small_scene(true, true, 1, false), 16);
         assert_eq!(
             small_scene(true, true, SMALL_SCENE_MAX, false),
             SMALL_SCENE_MAX as u32

@@ -101,7 +101,7 @@ impl RenderSettings {
                 (false, true) => BACKGROUND_COUNT,
                 (false, false) => BACKGROUND_ENV,
             },
-            pad: 0,
+            triangles: 0,
         }
     }
 }
