@@ -18,7 +18,7 @@ pub use quick::{build_quick, build_quick_ordered, quick_blas};
 pub use refit::{REFIT_MAX_GROWTH, Update};
 pub use stats::{BvhReport, report};
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};
-pub use wide::{MERGE_MIN_TRIANGLES, MERGED_LEAF, WIDE_STACK_SIZE, WIDTH, WideBvh};
+pub use wide::{CollapseCost, MERGE_MIN_TRIANGLES, MERGED_LEAF, WIDE_STACK_SIZE, WIDTH, WideBvh};
 
 use crate::cl::types::GpuBvhNode;
 use glam::Vec3;

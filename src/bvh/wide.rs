@@ -52,17 +52,43 @@ impl WideBvh {
         Self::collapse_mapped(bvh, 0).0
     }
 
-    /// [`WideBvh::collapse`] for the CPU megakernel's flat scenes: an interior child whose
-    /// subtree holds at most [`MERGED_LEAF`] triangles (one range in BVH order) becomes a leaf
-    /// before the node's slots are filled. The binary builder's leaves hold 1–2 triangles, so
-    /// without this 44 % of the 1 M-triangle bunnies' wide nodes have only two children, both
-    /// leaves; merged, there are 0.55 times the nodes and a ray visits 4–5 % fewer of them,
-    /// while traverse_wide.h tests a leaf of three or four triangles in the four lanes of one
-    /// `float4` test (docs/benchmarks.md, "Sixth session"). The same triangles are tested, in
-    /// BVH order within a merged leaf, so the closest hit is the same (short of exact ties in
-    /// t). How much is merged follows the tree's size ([`merge_limit`]).
+    /// The wide tree of the CPU megakernel's flat scenes. In large scenes ([`merge_limit`])
+    /// subtrees of at most [`MERGED_LEAF`] triangles (one range in BVH order) may become
+    /// leaves: the binary builder's leaves hold 1–2 triangles, so without merging 44 % of the
+    /// 1 M-triangle bunnies' wide nodes have only two children, both leaves, while
+    /// traverse_wide.h tests a leaf of three or four triangles in the four lanes of one
+    /// `float4` test (docs/benchmarks.md, "Sixth session"). Which subtrees become leaves and
+    /// which binary nodes become wide nodes is [`WideBvh::collapse_optimal`]'s choice (with
+    /// [`CollapseCost::CPU`]): on the bunnies 18 % fewer nodes than merging every small subtree
+    /// and opening the largest child, for 1.3 % less expected cost and 1 % fewer visits
+    /// (docs/benchmarks.md, "Ninth session"). The same triangles are tested, in BVH order
+    /// within a merged leaf, so the closest hit is the same (short of exact ties in t). Small
+    /// scenes get [`WideBvh::collapse`].
     pub fn collapse_for_cpu(bvh: &Bvh) -> Self {
-        Self::collapse_merging(bvh, merge_limit(bvh.tri_indices.len()))
+        match merge_limit(bvh.tri_indices.len()) {
+            0 => Self::collapse(bvh),
+            limit => Self::collapse_optimal(bvh, limit, CollapseCost::CPU),
+        }
+    }
+
+    /// The expected cost of a ray that the root's box holds under `cost`: wide node visits
+    /// (1 each) and leaf tests, each weighted by its box's area against the root's.
+    pub fn expected_cost(&self, cost: CollapseCost) -> f32 {
+        let mut total = 0.0f64;
+        let mut root = Aabb::EMPTY;
+        for node in 0..self.nodes.len() as u32 {
+            for (bounds, child) in self.children(node) {
+                if node == 0 {
+                    root = root.union(bounds);
+                }
+                total += bounds.area() as f64
+                    * match child {
+                        Child::Leaf { count, .. } => cost.leaf(count) as f64,
+                        Child::Node(_) => 1.0,
+                    };
+            }
+        }
+        (1.0 + total / root.area().max(f32::MIN_POSITIVE) as f64) as f32
     }
 
     /// [`WideBvh::collapse`] with each interior child of at most `limit` triangles (in one
@@ -76,11 +102,19 @@ impl WideBvh {
     /// BLASes at such nodes, see `bvh::instances`). Binary nodes inside a wide node or a merged
     /// leaf have none.
     pub fn collapse_mapped(bvh: &Bvh, merge: u32) -> (Self, Vec<u32>) {
+        Self::assemble(|binary, slots| *slots = frontier(bvh, binary, WIDTH, merge))
+    }
+
+    /// The wide nodes from the root's binary node down, `slots_of` giving the children of
+    /// the wide node made of a binary node; with the binary node of each wide node.
+    fn assemble(mut slots_of: impl FnMut(u32, &mut Vec<(Aabb, Child)>)) -> (Self, Vec<u32>) {
         let mut nodes = vec![GpuWideNode::default()];
         let mut binaries = vec![0u32];
         let mut work = vec![(0u32, 0usize)]; // (binary node, wide node)
+        let mut slots = Vec::with_capacity(WIDTH);
         while let Some((binary, wide)) = work.pop() {
-            let slots = frontier(bvh, binary, WIDTH, merge);
+            slots.clear();
+            slots_of(binary, &mut slots);
             let mut out = GpuWideNode::default();
             for (i, &(bounds, child)) in slots.iter().enumerate() {
                 out.min_x[i] = bounds.min.x;
@@ -176,6 +210,191 @@ impl WideBvh {
                 }
             }
         }
+    }
+}
+
+/// The cost model of [`WideBvh::collapse_optimal`], relative to one wide node visit.
+#[derive(Clone, Copy, Debug)]
+pub struct CollapseCost {
+    /// Testing one triangle of a leaf of one or two (the scalar test).
+    pub triangle: f32,
+    /// Testing a leaf of three or four triangles (one `float4` test).
+    pub leaf4: f32,
+}
+
+impl CollapseCost {
+    /// The costs the CPU megakernel's trees are collapsed with.
+    pub const CPU: CollapseCost = CollapseCost {
+        triangle: 0.6,
+        leaf4: 1.0,
+    };
+
+    /// The cost of testing a leaf of `count` triangles (per unit of its box's area).
+    fn leaf(self, count: u32) -> f32 {
+        if (3..=4).contains(&count) {
+            self.leaf4
+        } else {
+            self.triangle * count as f32
+        }
+    }
+}
+
+/// What [`WideBvh::collapse_optimal`] knows of a binary node's subtree: its triangles (one
+/// range in BVH order when `end - first == count`), its box's area, and the cheapest way to
+/// place it in `k + 1` slots of a wide node.
+#[derive(Clone, Copy)]
+struct Placement {
+    first: u32,
+    end: u32,
+    count: u32,
+    /// Cheapest cost (area-weighted, everything below included) in at most `k + 1` slots.
+    cost: [f32; WIDTH],
+    /// `cost[0]`: whether the subtree is one leaf (else a wide node of its own). `cost[k]`,
+    /// `k ≥ 1`: slots given to the left child when the two children share the `k + 1` slots,
+    /// 0 when fewer slots are cheapest (`cost[k] == cost[k - 1]`).
+    choice: [u8; WIDTH],
+    /// Slots given to the left child when the subtree is a wide node of its own.
+    split: u8,
+}
+
+impl WideBvh {
+    /// The binary tree collapsed so that the expected cost of a ray (the surface-area
+    /// heuristic over wide node visits and leaf tests, with `cost`) is the least among all
+    /// collapses of `bvh` that keep its boxes (dynamic programming over the binary nodes, as
+    /// Ylitie, Karras and Laine, "Efficient incoherent ray traversal on GPUs through compressed
+    /// wide BVHs", 2017, collapse binary trees into 8-wide ones): each binary subtree is a
+    /// leaf (at most `limit` triangles in one range), a wide node of its own, or its children
+    /// share its slot's place among the parent's four slots. The triangles stay in BVH order,
+    /// so the same triangles are found. The builder's leaves stay leaves.
+    pub fn collapse_optimal(bvh: &Bvh, limit: u32, cost: CollapseCost) -> Self {
+        let n = bvh.nodes.len();
+        if n == 0 {
+            return Self {
+                nodes: vec![GpuWideNode::default()],
+            };
+        }
+        let empty = Placement {
+            first: 0,
+            end: 0,
+            count: 0,
+            cost: [0.0; WIDTH],
+            choice: [0; WIDTH],
+            split: 0,
+        };
+        let mut plan = vec![empty; n];
+        // Binary nodes in depth-first order from the root, so that in reverse every node comes
+        // after its children (whatever the builder's layout).
+        let mut order = Vec::with_capacity(n);
+        let mut work = vec![0u32];
+        while let Some(node) = work.pop() {
+            order.push(node);
+            for side in 0..2 {
+                if let Child::Node(c) = bvh.child(node, side).1 {
+                    work.push(c);
+                }
+            }
+        }
+        for &node in order.iter().rev() {
+            let sides = [0, 1].map(|side| {
+                let (bounds, child) = bvh.child(node, side);
+                match child {
+                    Child::Leaf { first, count } => {
+                        let area = bounds.area();
+                        let c = area * cost.leaf(count);
+                        Placement {
+                            first,
+                            end: first + count,
+                            count,
+                            cost: [c; WIDTH],
+                            choice: [1; WIDTH],
+                            split: 0,
+                        }
+                    }
+                    Child::Node(c) => plan[c as usize],
+                }
+            });
+            let [l, r] = sides;
+            let area = bvh.child(node, 0).0.union(bvh.child(node, 1).0).area();
+            let mut p = Placement {
+                first: l.first.min(r.first),
+                end: l.end.max(r.end),
+                count: l.count + r.count,
+                cost: [0.0; WIDTH],
+                choice: [0; WIDTH],
+                split: 0,
+            };
+            // The two children in at most `k + 1` slots.
+            let share = |k: usize| {
+                (1..=k)
+                    .map(|j| (l.cost[j - 1] + r.cost[k - j], j as u8))
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .unwrap()
+            };
+            let (children, split) = share(WIDTH - 1);
+            p.split = split;
+            let interior = area + children;
+            let leaf = if p.count <= limit && p.end - p.first == p.count {
+                area * cost.leaf(p.count)
+            } else {
+                f32::INFINITY
+            };
+            (p.cost[0], p.choice[0]) = if leaf <= interior {
+                (leaf, 1)
+            } else {
+                (interior, 0)
+            };
+            for k in 1..WIDTH {
+                let (c, j) = share(k);
+                (p.cost[k], p.choice[k]) = if c < p.cost[k - 1] {
+                    (c, j)
+                } else {
+                    (p.cost[k - 1], 0)
+                };
+            }
+            plan[node as usize] = p;
+        }
+
+        Self::assemble(|binary, slots| {
+            let j = plan[binary as usize].split as usize;
+            place(bvh, &plan, bvh.child(binary, 0), j, slots);
+            place(bvh, &plan, bvh.child(binary, 1), WIDTH - j, slots);
+        })
+        .0
+    }
+}
+
+/// Appends to `out` the slots of `child` (a box and reference of a binary node's child) in at
+/// most `k` slots, as [`WideBvh::collapse_optimal`] planned them.
+fn place(
+    bvh: &Bvh,
+    plan: &[Placement],
+    child: (Aabb, Child),
+    k: usize,
+    out: &mut Vec<(Aabb, Child)>,
+) {
+    let (bounds, Child::Node(node)) = child else {
+        out.push(child);
+        return;
+    };
+    let p = &plan[node as usize];
+    let mut k = k - 1;
+    while k > 0 && p.choice[k] == 0 {
+        k -= 1;
+    }
+    if k > 0 {
+        let j = p.choice[k] as usize;
+        place(bvh, plan, bvh.child(node, 0), j, out);
+        place(bvh, plan, bvh.child(node, 1), k + 1 - j, out);
+    } else if p.choice[0] == 1 {
+        out.push((
+            bounds,
+            Child::Leaf {
+                first: p.first,
+                count: p.count,
+            },
+        ));
+    } else {
+        out.push(child);
     }
 }
 
@@ -303,6 +522,44 @@ mod tests {
         assert_eq!(WideBvh::collapse_for_cpu(&bvh).nodes, plain.nodes);
     }
 
+    #[test]
+    fn the_optimal_collapse_costs_no_more_than_the_greedy_one() {
+        let tris = random_triangles(20_000, 7);
+        let bvh = crate::bvh::build(&tris);
+        for cost in [
+            CollapseCost::CPU,
+            CollapseCost {
+                triangle: 0.3,
+                leaf4: 2.0,
+            },
+        ] {
+            let greedy = WideBvh::collapse_merging(&bvh, MERGED_LEAF);
+            let optimal = WideBvh::collapse_optimal(&bvh, MERGED_LEAF, cost);
+            check_leaves(&bvh, &tris, &optimal);
+            let builder_max = leaf_sizes(&WideBvh::collapse(&bvh))
+                .into_iter()
+                .max()
+                .unwrap();
+            assert!(
+                leaf_sizes(&optimal)
+                    .iter()
+                    .all(|&c| c <= MERGED_LEAF.max(builder_max)),
+                "leaf sizes"
+            );
+            let (g, o) = (greedy.expected_cost(cost), optimal.expected_cost(cost));
+            assert!(o <= g * 1.0001, "{o} against greedy {g}");
+            // Merging nothing: still no worse than the plain collapse.
+            let plain = WideBvh::collapse(&bvh).expected_cost(cost);
+            let unmerged = WideBvh::collapse_optimal(&bvh, 0, cost);
+            check_leaves(&bvh, &tris, &unmerged);
+            assert!(unmerged.expected_cost(cost) <= plain * 1.0001);
+        }
+        // A quick (unordered) build collapses too.
+        let quick = crate::bvh::build_quick(&tris);
+        let optimal = WideBvh::collapse_optimal(&quick, MERGED_LEAF, CollapseCost::CPU);
+        check_leaves(&quick, &tris, &optimal);
+    }
+
     fn leaf_sizes(wide: &WideBvh) -> Vec<u32> {
         (0..wide.nodes.len() as u32)
             .flat_map(|n| wide.children(n).collect::<Vec<_>>())
@@ -352,6 +609,7 @@ mod tests {
         let bvh = crate::bvh::build(&tris);
         let wide = WideBvh::collapse(&bvh);
         let merged = WideBvh::collapse_merging(&bvh, MERGED_LEAF);
+        let optimal = WideBvh::collapse_optimal(&bvh, MERGED_LEAF, CollapseCost::CPU);
         let ordered = ordered(&bvh, &tris);
         let mut s = 5u64;
         let mut rnd = move || {
@@ -378,6 +636,8 @@ mod tests {
             assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "ray {i}");
             let c = merged.intersect(&ray, &ordered);
             assert_eq!(a.map(|h| h.t), c.map(|h| h.t), "ray {i}, merged leaves");
+            let d = optimal.intersect(&ray, &ordered);
+            assert_eq!(a.map(|h| h.t), d.map(|h| h.t), "ray {i}, optimal collapse");
             hits += a.is_some() as usize;
         }
         assert!(hits > 400, "the rays hit something ({hits})");

@@ -7,7 +7,9 @@ D=scripts/experiments/native_trace
 O=${NATIVE_OUT:-/tmp/native_trace}
 mkdir -p $O
 K=${NATIVE_KERNELS:-kernels}
-cat $K/types.h $K/rng.h $K/textures.h $K/traverse.h $K/traverse_wide.h \
+# Constants the program prepends from src/cl/types.rs that the walk uses.
+printf '#define TLAS_LEAF 0x80000000u\n#define INSTANCE_MIRRORED 1u\n#define INSTANCE_PIECE_TRIANGLE 2u\n' > $O/consts.h
+cat $O/consts.h $K/types.h $K/rng.h $K/textures.h $K/traverse.h $K/traverse_wide.h \
     $D/entry.cl > $O/all.cl
 # NATIVE_QUANT=1: also the quantised-node walk (quant.cl, from scripts/experiments/
 # quantised-nodes.patch: git apply it first; run with NATIVE_QUANT=1 too).
