@@ -985,15 +985,16 @@ unsafe fn set_geometry(e: &mut ExecuteKernel, nodes: opencl3::types::cl_mem, sce
     }
 }
 
-/// Sets the six surface arguments every traversing kernel takes after the triangles, in the
+/// Sets the seven surface arguments every traversing kernel takes after the triangles, in the
 /// order of `SceneSurfaces` (kernels/textures.h).
 ///
 /// # Safety
-/// Only for kernels whose next six parameters are exactly those.
+/// Only for kernels whose next seven parameters are exactly those.
 unsafe fn set_surfaces(e: &mut ExecuteKernel, scene: &SceneBuffers) {
-    // SAFETY: the caller's kernel declares these six buffers next, in this order.
+    // SAFETY: the caller's kernel declares these seven buffers next, in this order.
     unsafe {
         e.set_arg(&scene.shading.mem())
+            .set_arg(&scene.uvs.mem())
             .set_arg(&scene.tangents.mem())
             .set_arg(&scene.materials.mem())
             .set_arg(&scene.tex_refs.mem())
@@ -1081,8 +1082,11 @@ pub struct SceneBuffers {
     /// Two levels: every distinct mesh's object-space triangles in its bottom level's order
     /// (one placeholder when flat).
     pub object_triangles: Buffer<GpuTriangle>,
-    /// Shading data in BVH order.
+    /// Corner normals in BVH order.
     pub shading: Buffer<GpuTriShading>,
+    /// Texture coordinates in BVH order (one placeholder element when no material samples a
+    /// texture).
+    pub uvs: Buffer<GpuTriUvs>,
     /// Tangents in BVH order (one placeholder element without normal maps).
     pub tangents: Buffer<GpuTriTangents>,
     /// Texture references (materials index them).
@@ -1108,6 +1112,7 @@ impl SceneBuffers {
             + self.instances.bytes()
             + self.object_triangles.bytes()
             + self.shading.bytes()
+            + self.uvs.bytes()
             + self.tangents.bytes()
             + self.tex_refs.bytes()
             + self.textures.bytes()
