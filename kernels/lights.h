@@ -105,7 +105,7 @@ inline LightSample sample_light(global const GpuLight* lights, global const GpuT
         if (cos_l <= 0.0f) return s;
         s.pdf = select * dist2 / (area * cos_l);
 #ifdef HAS_TEXTURES
-        TexCoords tc = texcoords_at(surf->shading[prim], b.x, b.y);
+        TexCoords tc = texcoords_at(surf->uvs[prim], b.x, b.y);
         s.radiance = textured_emission(m, surf, &tc) / s.pdf;
 #else
         s.radiance = m->emission.xyz / s.pdf;

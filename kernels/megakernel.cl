@@ -13,6 +13,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
                        global const GpuInstance* instances,
                        global const GpuTriangle* object_tris,
                        global const GpuTriShading* shading,
+                       global const GpuTriUvs* uvs,
                        global const GpuTriTangents* tangents,
                        global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
                        global const GpuTexture* textures, global const uint* texels,
@@ -28,7 +29,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels) return;
     ShadeScene sc = {tris,
-                     {shading, tangents, materials, tex_refs, textures, texels, instances},
+                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances},
                      {environment, env_texels, env_marginal, env_conditional},
                      lights,
                      light_cdf};

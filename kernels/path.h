@@ -145,13 +145,13 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
 #endif
     global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
     bool front = dot(ng, wo) > 0.0f;
-    GpuTriShading sh = surf->shading[hit.prim];
-    TexCoords tc = texcoords_at(sh, hit.u, hit.v);
 #ifdef HAS_TEXTURES
+    GpuTriUvs uvs = surf->uvs[hit.prim];
+    TexCoords tc = texcoords_at(uvs, hit.u, hit.v);
     // The ray cone's footprint picks the mip levels; it widens by the roughness at each bounce.
     float2 cone = s->cone;
     float cone_width = cone.x + cone.y * hit.t;
-    texcoords_footprint(&tc, sh, tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz, cone_width,
+    texcoords_footprint(&tc, uvs, tri.v1.xyz - tri.v0.xyz, tri.v2.xyz - tri.v0.xyz, cone_width,
                         fabs(dot(ng, wo)));
     tc.xi = rng_next(&rng);
 #endif
@@ -174,7 +174,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
         if (light_sampled_only) weight = 0.0f;
 #ifdef HAS_TEXTURES
         // Past the camera ray, emission is read at the finest level, as light sampling reads it.
-        TexCoords etc = bounce == 0u ? tc : texcoords_at(sh, hit.u, hit.v);
+        TexCoords etc = bounce == 0u ? tc : texcoords_at(uvs, hit.u, hit.v);
         radiance += throughput * textured_emission(mat, surf, &etc) * weight;
 #else
         radiance += throughput * mat->emission.xyz * weight;
@@ -204,8 +204,10 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     // Face the normals towards the side the ray came from.
     if (!front) ng = -ng;
     float3 ns = ng;
-    if (sh.n0.w > 0.0f) {
-        float3 n = w0 * sh.n0.xyz + hit.u * sh.n1.xyz + hit.v * sh.n2.xyz;
+    {
+        // A flat-shaded triangle's corner normals are 0: n has length 0 and ns stays ng.
+        global const float* sh = surf->shading[hit.prim].n;
+        float3 n = w0 * vload3(0, sh) + hit.u * vload3(1, sh) + hit.v * vload3(2, sh);
 #ifdef TWO_LEVEL
         n = instance_normal(&inst, n);
 #endif
@@ -366,7 +368,7 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
     global const GpuMaterial* mat = &surf->materials[as_uint(tri.v0.w)];
     SurfaceMaterial m = surface_material(mat);
 #ifdef HAS_TEXTURES
-    TexCoords tc = texcoords_at(surf->shading[hit.prim], hit.u, hit.v);
+    TexCoords tc = texcoords_at(surf->uvs[hit.prim], hit.u, hit.v);
     apply_textures(&m, mat, surf, &tc);
 #endif
     if (!bsdf_passes_straight(&m)) return false;

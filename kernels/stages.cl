@@ -27,14 +27,16 @@ kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, gl
 
 kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
                    global const GpuInstance* instances, global const GpuTriangle* object_tris,
-                   global const GpuTriShading* shading, global const GpuTriTangents* tangents,
+                   global const GpuTriShading* shading, global const GpuTriUvs* uvs,
+                   global const GpuTriTangents* tangents,
                    global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
                    global const GpuTexture* textures, global const uint* texels,
                    global const GpuPath* paths, global const uint* queue,
                    volatile global uint* counters, global GpuHit* hits) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_IN]) return;
-    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels, instances};
+    SceneSurfaces surf = {shading,  uvs,      tangents, materials,
+                          tex_refs, textures, texels,   instances};
     global const GpuPath* p = &paths[queue[i]];
     hits[i] = trace_scene(nodes, tris, instances, object_tris, &surf, p->origin.xyz,
                           p->direction.xyz, 0.0f, INFINITY, false, &counters[COUNT_OVERFLOW]);
@@ -42,7 +44,7 @@ kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tri
 
 kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTriangle* tris,
                   global const GpuInstance* instances, global const GpuTriShading* shading,
-                  global const GpuTriTangents* tangents,
+                  global const GpuTriUvs* uvs, global const GpuTriTangents* tangents,
                   global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
                   global const GpuTexture* textures, global const uint* texels,
                   global const float* env_texels, global const float* env_marginal,
@@ -56,7 +58,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     uint slot = queue_in[i];
     GpuPath path = paths[slot];
     ShadeScene sc = {tris,
-                     {shading, tangents, materials, tex_refs, textures, texels, instances},
+                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances},
                      {environment, env_texels, env_marginal, env_conditional},
                      lights,
                      light_cdf};
@@ -97,14 +99,16 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
 
 kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
                     global const GpuInstance* instances, global const GpuTriangle* object_tris,
-                    global const GpuTriShading* shading, global const GpuTriTangents* tangents,
+                    global const GpuTriShading* shading, global const GpuTriUvs* uvs,
+                    global const GpuTriTangents* tangents,
                     global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
                     global const GpuTexture* textures, global const uint* texels,
                     global const GpuShadowRay* shadow_rays, volatile global uint* counters,
                     global GpuPath* paths) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_SHADOW]) return;
-    SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels, instances};
+    SceneSurfaces surf = {shading,  uvs,      tangents, materials,
+                          tex_refs, textures, texels,   instances};
     GpuShadowRay r = shadow_rays[i];
     ShadowQuery q;
     q.origin = r.origin.xyz;

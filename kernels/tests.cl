@@ -20,9 +20,9 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(GpuInstance, root); PROBE_FIELD(GpuInstance, wide_root);
     PROBE_FIELD(GpuInstance, id); PROBE_FIELD(GpuInstance, flags);
     PROBE_SIZE(GpuTriShading);
-    PROBE_FIELD(GpuTriShading, n0); PROBE_FIELD(GpuTriShading, n1);
-    PROBE_FIELD(GpuTriShading, n2); PROBE_FIELD(GpuTriShading, uv01);
-    PROBE_FIELD(GpuTriShading, uv2); PROBE_FIELD(GpuTriShading, uv1_12);
+    PROBE_FIELD(GpuTriShading, n);
+    PROBE_SIZE(GpuTriUvs);
+    PROBE_FIELD(GpuTriUvs, uv01); PROBE_FIELD(GpuTriUvs, uv2); PROBE_FIELD(GpuTriUvs, uv1_12);
     PROBE_SIZE(GpuTriTangents);
     PROBE_FIELD(GpuTriTangents, t0); PROBE_FIELD(GpuTriTangents, t1);
     PROBE_FIELD(GpuTriTangents, t2);

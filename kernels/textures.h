@@ -7,6 +7,7 @@
 // What traversal and shading read about surfaces besides the triangles themselves.
 typedef struct {
     global const GpuTriShading* shading;
+    global const GpuTriUvs* uvs;  // a placeholder without HAS_TEXTURES
     global const GpuTriTangents* tangents;
     global const GpuMaterial* materials;
     global const GpuTexRef* refs;
@@ -162,7 +163,7 @@ inline float4 texture_sample(const SceneSurfaces* s, int ref, const TexCoords* t
 
 // Interpolated texture coordinates at barycentrics (u, v) with the finest level everywhere
 // (alpha tests and light sampling, where footprints are unknown).
-inline TexCoords texcoords_at(GpuTriShading sh, float u, float v) {
+inline TexCoords texcoords_at(GpuTriUvs sh, float u, float v) {
     float w0 = 1.0f - u - v;
     TexCoords tc;
     tc.uv0 = w0 * sh.uv01.xy + u * sh.uv01.zw + v * sh.uv2.xy;
@@ -175,7 +176,7 @@ inline TexCoords texcoords_at(GpuTriShading sh, float u, float v) {
 
 // The ray-cone level of detail at a hit: a cone of `width` meets the triangle (edges e1, e2)
 // at cosine `cos_i`; each set's level adds half the log of its texture-to-world area ratio.
-inline void texcoords_footprint(TexCoords* tc, GpuTriShading sh, float3 e1, float3 e2,
+inline void texcoords_footprint(TexCoords* tc, GpuTriUvs sh, float3 e1, float3 e2,
                                 float width, float cos_i) {
     float world = fmax(length(cross(e1, e2)), 1e-30f);
     float2 a0 = sh.uv01.zw - sh.uv01.xy;
@@ -201,7 +202,7 @@ inline bool alpha_passes(const SceneSurfaces* s, uint prim, uint material, float
     float alpha = m->base_color.w;
 #ifdef HAS_TEXTURES
     if (m->textures.x >= 0) {
-        TexCoords tc = texcoords_at(s->shading[prim], u, v);
+        TexCoords tc = texcoords_at(s->uvs[prim], u, v);
         alpha *= texture_sample(s, m->textures.x, &tc).w;
     }
 #endif

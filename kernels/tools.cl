@@ -6,13 +6,15 @@
     kernel void trace_closest##SUFFIX(                                                           \
         global const NODE* nodes, global const GpuTriangle* tris,                                \
         global const GpuInstance* instances, global const GpuTriangle* object_tris,              \
-        global const GpuTriShading* shading, global const GpuTriTangents* tangents,              \
+        global const GpuTriShading* shading, global const GpuTriUvs* uvs,                        \
+        global const GpuTriTangents* tangents,                                                   \
         global const GpuMaterial* materials, global const GpuTexRef* tex_refs,                   \
         global const GpuTexture* textures, global const uint* texels, global const GpuRay* rays, \
         uint count, global GpuHit* hits, volatile global uint* counters) {                       \
         uint i = get_global_id(0);                                                               \
         if (i >= count) return;                                                                  \
-        SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels, instances};\
+        SceneSurfaces surf = {shading,  uvs,    tangents, materials,                             \
+                              tex_refs, textures, texels, instances};                            \
         GpuRay r = rays[i];                                                                      \
         hits[i] = TRAVERSE(nodes, tris, instances, object_tris, &surf, r.origin.xyz,             \
                            r.direction.xyz, r.origin.w, r.direction.w, false,                    \
@@ -21,13 +23,15 @@
     kernel void trace_any##SUFFIX(                                                               \
         global const NODE* nodes, global const GpuTriangle* tris,                                \
         global const GpuInstance* instances, global const GpuTriangle* object_tris,              \
-        global const GpuTriShading* shading, global const GpuTriTangents* tangents,              \
+        global const GpuTriShading* shading, global const GpuTriUvs* uvs,                        \
+        global const GpuTriTangents* tangents,                                                   \
         global const GpuMaterial* materials, global const GpuTexRef* tex_refs,                   \
         global const GpuTexture* textures, global const uint* texels, global const GpuRay* rays, \
         uint count, global uint* occluded, volatile global uint* counters) {                     \
         uint i = get_global_id(0);                                                               \
         if (i >= count) return;                                                                  \
-        SceneSurfaces surf = {shading, tangents, materials, tex_refs, textures, texels, instances};\
+        SceneSurfaces surf = {shading,  uvs,    tangents, materials,                             \
+                              tex_refs, textures, texels, instances};                            \
         GpuRay r = rays[i];                                                                      \
         GpuHit h = TRAVERSE(nodes, tris, instances, object_tris, &surf, r.origin.xyz,            \
                             r.direction.xyz, r.origin.w, r.direction.w, true,                    \

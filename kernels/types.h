@@ -47,14 +47,20 @@ typedef struct {
     float4 v2;  // .w = object index (uint bits)
 } GpuTriangle;
 
+// Per-corner normals of a triangle (36 bytes; float3 would pad to 48): n[3c..3c+2] is corner
+// c's. A flat-shaded triangle's are all 0, whose interpolation, of length 0, leaves the
+// geometric normal (path.h), as a flag would.
 typedef struct {
-    float4 n0;    // normal at vertex 0; .w = 1 with file normals, 0 for flat shading
-    float4 n1;    // normal at vertex 1
-    float4 n2;    // normal at vertex 2
+    float n[9];
+} GpuTriShading;
+
+// TEXCOORD_0 and TEXCOORD_1 of a triangle's corners (48 bytes); on the device only when some
+// material samples a texture (HAS_TEXTURES), else a one-element placeholder that is never read.
+typedef struct {
     float4 uv01;  // TEXCOORD_0 of vertices 0 (.xy) and 1 (.zw)
     float4 uv2;   // TEXCOORD_0 of vertex 2 (.xy); TEXCOORD_1 of vertex 0 (.zw)
     float4 uv1_12;  // TEXCOORD_1 of vertices 1 (.xy) and 2 (.zw)
-} GpuTriShading;
+} GpuTriUvs;
 
 typedef struct {
     float4 t0;  // unit tangent at vertex 0; .w = bitangent sign

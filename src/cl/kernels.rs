@@ -192,6 +192,30 @@ struct HostPages {
 /// The most bytes of CPU device buffers advised for huge pages at once (see [`HostPages`]).
 const HUGE_BUDGET: usize = 512 << 20;
 
+/// From this size on, [`HostPages`] are faulted in at once by `MADV_POPULATE_WRITE`, in
+/// parallel pieces, instead of page by page as they are first written.
+const POPULATE_FROM: usize = 64 << 20;
+
+/// Faults `len` bytes from `start` (a fresh mapping of whole huge pages) in for writing, a
+/// piece of [`POPULATE_PIECE`] bytes a task: `MADV_POPULATE_WRITE` (Linux 5.14) takes a page
+/// fault's work without the fault. Where it is not supported (or fails) nothing happens, and
+/// the pages are faulted in as they are first written.
+#[cfg(target_os = "linux")]
+fn populate(start: usize, len: usize) {
+    use rayon::prelude::*;
+    (0..len.div_ceil(POPULATE_PIECE))
+        .into_par_iter()
+        .for_each(|k| {
+            let at = start + k * POPULATE_PIECE;
+            let n = POPULATE_PIECE.min(start + len - at);
+            // SAFETY: [at, at + n) lies in the caller's mapping; populating changes no contents.
+            unsafe { libc::madvise(at as *mut std::ffi::c_void, n, libc::MADV_POPULATE_WRITE) };
+        });
+}
+
+/// The piece of a [`populate`] task (a multiple of [`HUGE_PAGE`]).
+const POPULATE_PIECE: usize = 32 << 20;
+
 /// Bytes of live [`HostPages`] advised for huge pages.
 static HUGE_BYTES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
@@ -239,6 +263,9 @@ impl HostPages {
         if huge {
             // SAFETY: the aligned range is this mapping's; the advice changes no contents.
             unsafe { libc::madvise(aligned as *mut std::ffi::c_void, len, libc::MADV_HUGEPAGE) };
+        }
+        if len >= POPULATE_FROM {
+            populate(aligned, len);
         }
         Some(Self {
             ptr: aligned as *mut u8,
@@ -985,15 +1012,16 @@ unsafe fn set_geometry(e: &mut ExecuteKernel, nodes: opencl3::types::cl_mem, sce
     }
 }
 
-/// Sets the six surface arguments every traversing kernel takes after the triangles, in the
+/// Sets the seven surface arguments every traversing kernel takes after the triangles, in the
 /// order of `SceneSurfaces` (kernels/textures.h).
 ///
 /// # Safety
-/// Only for kernels whose next six parameters are exactly those.
+/// Only for kernels whose next seven parameters are exactly those.
 unsafe fn set_surfaces(e: &mut ExecuteKernel, scene: &SceneBuffers) {
-    // SAFETY: the caller's kernel declares these six buffers next, in this order.
+    // SAFETY: the caller's kernel declares these seven buffers next, in this order.
     unsafe {
         e.set_arg(&scene.shading.mem())
+            .set_arg(&scene.uvs.mem())
             .set_arg(&scene.tangents.mem())
             .set_arg(&scene.materials.mem())
             .set_arg(&scene.tex_refs.mem())
@@ -1081,8 +1109,11 @@ pub struct SceneBuffers {
     /// Two levels: every distinct mesh's object-space triangles in its bottom level's order
     /// (one placeholder when flat).
     pub object_triangles: Buffer<GpuTriangle>,
-    /// Shading data in BVH order.
+    /// Corner normals in BVH order.
     pub shading: Buffer<GpuTriShading>,
+    /// Texture coordinates in BVH order (one placeholder element when no material samples a
+    /// texture).
+    pub uvs: Buffer<GpuTriUvs>,
     /// Tangents in BVH order (one placeholder element without normal maps).
     pub tangents: Buffer<GpuTriTangents>,
     /// Texture references (materials index them).
@@ -1108,6 +1139,7 @@ impl SceneBuffers {
             + self.instances.bytes()
             + self.object_triangles.bytes()
             + self.shading.bytes()
+            + self.uvs.bytes()
             + self.tangents.bytes()
             + self.tex_refs.bytes()
             + self.textures.bytes()

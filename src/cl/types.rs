@@ -241,16 +241,22 @@ pub struct GpuTriangle {
 }
 const _: () = assert!(size_of::<GpuTriangle>() == 48);
 
-/// Per-vertex shading data of a triangle, in BVH order (96 bytes).
+/// Per-corner normals of a triangle, in BVH order (36 bytes): `n[c]` is corner c's. A
+/// flat-shaded triangle's are all zero, which the kernels' interpolation turns into its
+/// geometric normal (a zero-length normal leaves it).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct GpuTriShading {
-    /// Normal at vertex 0; `.w` = 1 when the file had normals, 0 for flat shading.
-    pub n0: [f32; 4],
-    /// Normal at vertex 1; `.w` unused.
-    pub n1: [f32; 4],
-    /// Normal at vertex 2; `.w` unused.
-    pub n2: [f32; 4],
+    /// The corners' normals.
+    pub n: [[f32; 3]; 3],
+}
+const _: () = assert!(size_of::<GpuTriShading>() == 36);
+
+/// Texture coordinates of a triangle's corners, in BVH order (48 bytes); on the device only
+/// when some material samples a texture (else a one-element placeholder the kernels never read).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuTriUvs {
     /// `TEXCOORD_0` of vertices 0 and 1 (`.xy`, `.zw`).
     pub uv01: [f32; 4],
     /// `TEXCOORD_0` of vertex 2 (`.xy`); `TEXCOORD_1` of vertex 0 (`.zw`).
@@ -258,7 +264,7 @@ pub struct GpuTriShading {
     /// `TEXCOORD_1` of vertices 1 and 2 (`.xy`, `.zw`).
     pub uv1_12: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuTriShading>() == 96);
+const _: () = assert!(size_of::<GpuTriUvs>() == 48);
 
 /// Per-vertex tangents of a triangle, in BVH order (48 bytes); uploaded only when the scene
 /// has normal maps.
@@ -527,7 +533,8 @@ pub fn layouts() -> Vec<StructLayout> {
             id,
             flags
         ),
-        layout!(GpuTriShading, n0, n1, n2, uv01, uv2, uv1_12),
+        layout!(GpuTriShading, n),
+        layout!(GpuTriUvs, uv01, uv2, uv1_12),
         layout!(GpuTriTangents, t0, t1, t2),
         layout!(GpuTexture, offset, width, height, flags),
         layout!(GpuTexRef, m0, m1, info),

@@ -20,7 +20,7 @@ pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
 pub use update::InstanceUpdate;
-pub use upload::{Accel, HostScene, gpu_camera, gpu_material};
+pub use upload::{Accel, HostScene, gpu_camera, gpu_material, samples_textures};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
 use crate::bvh::{Ray, WideBvh};
@@ -503,12 +503,18 @@ impl Renderer {
         // meshes' in the device triangles.
         let triangles = std::mem::take(&mut host.triangles);
         let shading = std::mem::take(&mut host.shading);
+        let uvs = std::mem::take(&mut host.uvs);
         let tangents = std::mem::take(&mut host.tangents);
         let tangent_count = if mesh_tangents { mesh_triangles } else { 0 } + tangents.len();
+        // Texture coordinates only when some material samples a texture (a superset of the
+        // kernels' `HAS_TEXTURES`, which alone reads them); else a placeholder.
+        let mesh_uvs = samples_textures(&materials);
+        let uv_count = if mesh_uvs { mesh_triangles } else { 0 } + uvs.len();
         let lengths = (
             mesh_triangles + triangles.len(),
             mesh_triangles + shading.len(),
             tangent_count.max(1),
+            uv_count.max(1),
         );
         // Two levels trace the meshes' object-space triangles in `triangles`: the separate
         // object-triangle buffer is a placeholder either way.
@@ -523,6 +529,7 @@ impl Renderer {
             ("triangles", lengths.0 * std::mem::size_of::<GpuTriangle>()),
             ("instances", std::mem::size_of_val(instances.as_slice())),
             ("shading", lengths.1 * std::mem::size_of::<GpuTriShading>()),
+            ("uvs", lengths.3 * std::mem::size_of::<GpuTriUvs>()),
             (
                 "tangents",
                 lengths.2 * std::mem::size_of::<GpuTriTangents>(),
@@ -545,12 +552,13 @@ impl Renderer {
         .map_err(ClError::Device)?;
         // The large buffers of the scene replaced (a swap to SAH BLASes), written again in
         // place where the size is the same: no fresh memory to fault in.
-        let (old_nodes, old_wide, old_shading, old_tangents, old_triangles, old_instances) =
+        let (old_nodes, old_wide, old_shading, old_uvs, old_tangents, old_triangles, old_instances) =
             match reuse {
                 Some(b) => (
                     Some(b.nodes),
                     Some(b.wide_nodes),
                     Some(b.shading),
+                    Some(b.uvs),
                     Some(b.tangents),
                     Some(b.triangles),
                     Some(b.instances),
@@ -562,10 +570,16 @@ impl Renderer {
         drop(nodes);
         let wide_buffer = put(gpu, old_wide, &wide_nodes)?;
         drop(wide_nodes);
-        let (shading_buffer, tangents_buffer, triangles_buffer) = match &host.accel {
+        let (shading_buffer, uvs_buffer, tangents_buffer, triangles_buffer) = match &host.accel {
             Accel::Flat(_) => {
                 let shading_buffer = put(gpu, old_shading, &shading)?;
                 drop(shading);
+                let mut uvs = uvs;
+                if uvs.is_empty() {
+                    uvs.push(GpuTriUvs::default());
+                }
+                let uvs_buffer = put(gpu, old_uvs, &uvs)?;
+                drop(uvs);
                 let mut tangents = tangents;
                 if tangents.is_empty() {
                     tangents.push(GpuTriTangents::default());
@@ -574,31 +588,44 @@ impl Renderer {
                 drop(tangents);
                 let triangles_buffer = put(gpu, old_triangles, &triangles)?;
                 drop(triangles);
-                (shading_buffer, tangents_buffer, triangles_buffer)
+                (
+                    shading_buffer,
+                    uvs_buffer,
+                    tangents_buffer,
+                    triangles_buffer,
+                )
             }
             Accel::TwoLevel(two) => {
                 let mut shading_buffer = sized(gpu, old_shading, lengths.1)?;
+                let mut uvs_buffer = sized(gpu, old_uvs, lengths.3)?;
                 let mut tangents_buffer = sized(gpu, old_tangents, lengths.2)?;
                 let mut triangles_buffer = sized(gpu, old_triangles, lengths.0)?;
                 let n = mesh_triangles;
                 triangles_buffer.fill_mapped(gpu, |tris| {
                     shading_buffer.fill_mapped(gpu, |sh| {
-                        tangents_buffer.fill_mapped(gpu, |tan| {
-                            let tan_out = if mesh_tangents {
-                                &mut tan[..n]
-                            } else {
-                                &mut []
-                            };
-                            let out = (&mut tris[..n], &mut sh[..n], tan_out);
-                            HostScene::fill_meshes(two, &meshes, &materials, out);
-                            tris[n..].copy_from_slice(&triangles);
-                            if !mesh_tangents {
-                                tan.fill(GpuTriTangents::default());
-                            }
+                        uvs_buffer.fill_mapped(gpu, |uv| {
+                            tangents_buffer.fill_mapped(gpu, |tan| {
+                                let tan_out = &mut tan[..if mesh_tangents { n } else { 0 }];
+                                let uv_out = &mut uv[..if mesh_uvs { n } else { 0 }];
+                                let out = (&mut tris[..n], &mut sh[..n], uv_out, tan_out);
+                                HostScene::fill_meshes(two, &meshes, &materials, out);
+                                tris[n..].copy_from_slice(&triangles);
+                                if !mesh_tangents {
+                                    tan.fill(GpuTriTangents::default());
+                                }
+                                if !mesh_uvs {
+                                    uv.fill(GpuTriUvs::default());
+                                }
+                            })
                         })
                     })
-                })???;
-                (shading_buffer, tangents_buffer, triangles_buffer)
+                })????;
+                (
+                    shading_buffer,
+                    uvs_buffer,
+                    tangents_buffer,
+                    triangles_buffer,
+                )
             }
         };
         let instances_buffer = put(gpu, old_instances, &instances)?;
@@ -610,6 +637,7 @@ impl Renderer {
             instances: instances_buffer,
             object_triangles: Buffer::from_slice(&self.gpu, &object_tris)?,
             shading: shading_buffer,
+            uvs: uvs_buffer,
             tangents: tangents_buffer,
             tex_refs: Buffer::from_slice(&self.gpu, &pack.refs)?,
             textures: Buffer::from_slice(&self.gpu, &pack.textures)?,

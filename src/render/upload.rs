@@ -210,9 +210,12 @@ pub struct HostScene {
     /// Flat: world vertices in BVH order (for the host traversal); empty with two levels,
     /// whose BLASes hold their triangles.
     pub vertices: Vec<[Vec3; 3]>,
-    /// Shading data, indexed as `triangles`; moved to the device by `Renderer::load_scene`
+    /// Corner normals, indexed as `triangles`; moved to the device by `Renderer::load_scene`
     /// (empty after; two levels: always, [`HostScene::fill_meshes`]).
     pub shading: Vec<GpuTriShading>,
+    /// Texture coordinates, indexed as `triangles`; empty when no material samples a texture
+    /// ([`samples_textures`]), with two levels, and after `Renderer::load_scene` moved them.
+    pub uvs: Vec<GpuTriUvs>,
     /// Tangents, indexed as `triangles`; empty when no triangle is normal-mapped, with two
     /// levels, and after `Renderer::load_scene` moved them to the device.
     pub tangents: Vec<GpuTriTangents>,
@@ -337,6 +340,12 @@ fn slot(r: Option<u32>) -> i32 {
     r.map_or(-1, |r| r as i32)
 }
 
+/// Whether some material samples a texture: only then do the kernels read texture coordinates
+/// (`HAS_TEXTURES` comes from the materials in use, a subset), and only then are they uploaded.
+pub fn samples_textures(materials: &[Material]) -> bool {
+    materials.iter().any(|m| m.textures.any())
+}
+
 impl HostScene {
     /// The flat form of `world` (render space, in object order): converted to the device
     /// structs and dropped before the BVH is built, then the structs are put in BVH order one
@@ -344,7 +353,7 @@ impl HostScene {
     /// data are never held together.
     pub fn flat(world: Vec<WorldTriangle>, materials: &[Material]) -> Self {
         let normal_mapped = world.iter().any(|t| t.tangents.is_some());
-        let mut structs = FlatStructs::new(world.len(), normal_mapped);
+        let mut structs = FlatStructs::new(world.len(), normal_mapped, samples_textures(materials));
         structs.add(world);
         Self::flat_from(structs, materials)
     }
@@ -356,7 +365,8 @@ impl HostScene {
         let visible = || scene.objects.iter().filter(|o| o.visible);
         // Tangents are kept when some kept triangle has them (as `flat` decides).
         let maybe_mapped = visible().any(|o| !o.mesh.tangents.is_empty());
-        let mut structs = FlatStructs::new(scene.triangle_count(), maybe_mapped);
+        let textured = samples_textures(materials);
+        let mut structs = FlatStructs::new(scene.triangle_count(), maybe_mapped, textured);
         let dropped = scene.flatten_each(space, |world| structs.add(world));
         if !structs.mapped {
             structs.tangents = Vec::new();
@@ -368,6 +378,7 @@ impl HostScene {
         let FlatStructs {
             triangles,
             shading,
+            uvs,
             tangents,
             vertices,
             ..
@@ -381,6 +392,11 @@ impl HostScene {
         let vertices = gather(vertices, &bvh.tri_indices);
         let mut triangles = gather(triangles, &bvh.tri_indices);
         let shading = gather(shading, &bvh.tri_indices);
+        let uvs = if uvs.is_empty() {
+            uvs
+        } else {
+            gather(uvs, &bvh.tri_indices)
+        };
         let tangents = if normal_mapped {
             gather(tangents, &bvh.tri_indices)
         } else {
@@ -408,6 +424,7 @@ impl HostScene {
         Self {
             vertices,
             objects,
+            uvs,
             ..Self::assemble(
                 Accel::Flat(bvh),
                 InstanceLayout::default(),
@@ -435,6 +452,7 @@ impl HostScene {
             objects: vec![],
             vertices: vec![],
             shading,
+            uvs: vec![],
             tangents,
             materials: materials.iter().map(gpu_material).collect(),
             emissive,
@@ -472,7 +490,10 @@ impl HostScene {
                 let n = blas.bvh.tri_indices.len();
                 let mut tris = vec![GpuTriangle::default(); n];
                 let mut shading = vec![GpuTriShading::default(); n];
-                let out = ((&mut tris[..], &mut shading[..]), &mut [][..]);
+                let out = (
+                    (&mut tris[..], &mut shading[..]),
+                    (&mut [][..], &mut [][..]),
+                );
                 object_triangles(m, &blas.bvh.tri_indices, materials, out);
                 tris
             })
@@ -522,30 +543,38 @@ impl HostScene {
     }
 
     /// Two levels: writes every mesh's device structs, once, in object space and BLAS order
-    /// (`meshes[b]` is BLAS b's mesh) to the front of `triangles` and `shading` (and of
-    /// `tangents` when not empty), each mesh its own range, in parallel. The renderer writes
+    /// (`meshes[b]` is BLAS b's mesh) to the front of `triangles` and `shading` (and of `uvs`
+    /// and `tangents` when not empty), each mesh its own range, in parallel. The renderer writes
     /// them straight into the device buffers ([`crate::cl::Buffer::fill_mapped`]): on a CPU
     /// device no host copy of these arrays (144 bytes a triangle) is made beside them.
     pub fn fill_meshes(
         two: &TwoLevel,
         meshes: &[&Mesh],
         materials: &[Material],
-        (triangles, shading, tangents): (
+        (triangles, shading, uvs, tangents): (
             &mut [GpuTriangle],
             &mut [GpuTriShading],
+            &mut [GpuTriUvs],
             &mut [GpuTriTangents],
         ),
     ) {
         let sizes: Vec<usize> = two.blases.iter().map(|b| b.bvh.tri_indices.len()).collect();
-        let tangent_sizes: Vec<usize> = if tangents.is_empty() {
-            vec![0; sizes.len()]
-        } else {
-            sizes.clone()
+        let sizes_if = |full: bool| {
+            if full {
+                sizes.clone()
+            } else {
+                vec![0; sizes.len()]
+            }
         };
+        let (uv_sizes, tangent_sizes) = (sizes_if(!uvs.is_empty()), sizes_if(!tangents.is_empty()));
         let parts = split_by(triangles, &sizes)
             .into_iter()
             .zip(split_by(shading, &sizes))
-            .zip(split_by(tangents, &tangent_sizes));
+            .zip(
+                split_by(uvs, &uv_sizes)
+                    .into_iter()
+                    .zip(split_by(tangents, &tangent_sizes)),
+            );
         meshes
             .par_iter()
             .zip(&two.blases)
@@ -675,7 +704,7 @@ fn middle_of<I: Iterator<Item = [DVec3; 3]>>(
 }
 
 /// `v` cut into consecutive parts of `sizes` elements (empty parts once `v` runs out: the
-/// tangents of a scene without normal maps).
+/// tangents of a scene without normal maps, the texture coordinates of one without textures).
 fn split_by<'a, T>(mut v: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
     sizes
         .iter()
@@ -688,11 +717,12 @@ fn split_by<'a, T>(mut v: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
         .collect()
 }
 
-/// One mesh's device structs for [`object_triangles`] to fill: triangles, shading data and
-/// tangents (empty when no mesh is normal-mapped).
+/// One mesh's device structs for [`object_triangles`] to fill: triangles, corner normals,
+/// texture coordinates (empty when no material samples a texture) and tangents (empty when no
+/// mesh is normal-mapped).
 type MeshStructs<'a> = (
     (&'a mut [GpuTriangle], &'a mut [GpuTriShading]),
-    &'a mut [GpuTriTangents],
+    (&'a mut [GpuTriUvs], &'a mut [GpuTriTangents]),
 );
 
 /// Whether triangle `ti` of `m` (vertices `v`) is a light: an emissive material and a
@@ -723,15 +753,16 @@ fn emissive_triangles(m: &Mesh, order: &[u32], materials: &[Material]) -> Vec<(u
 }
 
 /// Writes the device structs of one mesh's triangles in object space, in the order `order`,
-/// to `out` (tangents unless that slice is empty); an emissive triangle's `v1.w` counts the
+/// to `out` (texture coordinates and tangents unless their slices are empty); an emissive triangle's `v1.w` counts the
 /// mesh's emissive triangles ([`emissive_triangles`]).
 fn object_triangles(
     m: &Mesh,
     order: &[u32],
     materials: &[Material],
-    ((tris, shading), tangents): MeshStructs,
+    ((tris, shading), (uvs, tangents)): MeshStructs,
 ) {
     let normal_mapped = !tangents.is_empty();
+    let textured = !uvs.is_empty();
     let mut emitters = 0;
     let corner = |a: &[Vec2], i: u32| a.get(i as usize).copied().unwrap_or(Vec2::ZERO);
     for (k, &ti) in order.iter().enumerate() {
@@ -763,11 +794,14 @@ fn object_triangles(
             material,
             object: 0,
         };
-        let (tri, sh, tan) = device_triangle(&t, light);
+        let (tri, sh) = device_triangle(&t, light);
         tris[k] = tri;
         shading[k] = sh;
+        if textured {
+            uvs[k] = device_uvs(&t);
+        }
         if normal_mapped {
-            tangents[k] = tan;
+            tangents[k] = device_tangents(&t);
         }
     }
 }
@@ -777,21 +811,27 @@ fn object_triangles(
 struct FlatStructs {
     triangles: Vec<GpuTriangle>,
     shading: Vec<GpuTriShading>,
+    /// Filled when some material samples a texture (`keep_uvs`).
+    uvs: Vec<GpuTriUvs>,
     /// Filled when tangents may be needed (`keep_tangents`).
     tangents: Vec<GpuTriTangents>,
     vertices: Vec<[Vec3; 3]>,
+    keep_uvs: bool,
     keep_tangents: bool,
     /// Whether some triangle added had tangents.
     mapped: bool,
 }
 
 impl FlatStructs {
-    fn new(capacity: usize, keep_tangents: bool) -> Self {
+    fn new(capacity: usize, keep_tangents: bool, keep_uvs: bool) -> Self {
+        let if_kept = |keep: bool| if keep { capacity } else { 0 };
         Self {
             triangles: Vec::with_capacity(capacity),
             shading: Vec::with_capacity(capacity),
-            tangents: Vec::with_capacity(if keep_tangents { capacity } else { 0 }),
+            uvs: Vec::with_capacity(if_kept(keep_uvs)),
+            tangents: Vec::with_capacity(if_kept(keep_tangents)),
             vertices: Vec::with_capacity(capacity),
+            keep_uvs,
             keep_tangents,
             mapped: false,
         }
@@ -802,46 +842,56 @@ impl FlatStructs {
         self.mapped |= world.iter().any(|t| t.tangents.is_some());
         // Each triangle's structs made once, and unzipped into the lists in order.
         let structs = world.par_iter().map(|t| device_triangle(t, -1));
+        let mut lists = (take(&mut self.triangles), take(&mut self.shading));
+        lists.par_extend(structs);
+        (self.triangles, self.shading) = lists;
+        if self.keep_uvs {
+            self.uvs.par_extend(world.par_iter().map(device_uvs));
+        }
         if self.keep_tangents {
-            let mut lists = (
-                take(&mut self.triangles),
-                (take(&mut self.shading), take(&mut self.tangents)),
-            );
-            lists.par_extend(structs.map(|(tri, sh, tan)| (tri, (sh, tan))));
-            (self.triangles, (self.shading, self.tangents)) = lists;
-        } else {
-            let mut lists = (take(&mut self.triangles), take(&mut self.shading));
-            lists.par_extend(structs.map(|(tri, sh, _)| (tri, sh)));
-            (self.triangles, self.shading) = lists;
+            self.tangents
+                .par_extend(world.par_iter().map(device_tangents));
         }
         self.vertices.par_extend(world.par_iter().map(|t| t.v));
     }
 }
 
-/// A triangle's device structs; `light` is its index among the emissive triangles (-1: none).
-fn device_triangle(t: &WorldTriangle, light: i32) -> (GpuTriangle, GpuTriShading, GpuTriTangents) {
-    let smooth = if t.smooth { 1.0 } else { 0.0 };
-    let c = t.tangents.unwrap_or_default().map(|v| v.to_array());
+/// A triangle's vertices and corner normals on the device; `light` is its index among the
+/// emissive triangles (-1: none). A flat-shaded triangle's normals are zero (the kernels then
+/// take its geometric normal).
+fn device_triangle(t: &WorldTriangle, light: i32) -> (GpuTriangle, GpuTriShading) {
+    let n = if t.smooth {
+        t.n.map(|n| n.to_array())
+    } else {
+        [[0.0; 3]; 3]
+    };
     (
         GpuTriangle {
             v0: f4(t.v[0], f32::from_bits(t.material)),
             v1: f4(t.v[1], f32::from_bits(light as u32)),
             v2: f4(t.v[2], f32::from_bits(t.object)),
         },
-        GpuTriShading {
-            n0: f4(t.n[0], smooth),
-            n1: f4(t.n[1], 0.0),
-            n2: f4(t.n[2], 0.0),
-            uv01: [t.uv[0].x, t.uv[0].y, t.uv[1].x, t.uv[1].y],
-            uv2: [t.uv[2].x, t.uv[2].y, t.uv1[0].x, t.uv1[0].y],
-            uv1_12: [t.uv1[1].x, t.uv1[1].y, t.uv1[2].x, t.uv1[2].y],
-        },
-        GpuTriTangents {
-            t0: c[0],
-            t1: c[1],
-            t2: c[2],
-        },
+        GpuTriShading { n },
     )
+}
+
+/// A triangle's texture coordinates on the device.
+fn device_uvs(t: &WorldTriangle) -> GpuTriUvs {
+    GpuTriUvs {
+        uv01: [t.uv[0].x, t.uv[0].y, t.uv[1].x, t.uv[1].y],
+        uv2: [t.uv[2].x, t.uv[2].y, t.uv1[0].x, t.uv1[0].y],
+        uv1_12: [t.uv1[1].x, t.uv1[1].y, t.uv1[2].x, t.uv1[2].y],
+    }
+}
+
+/// A triangle's tangents on the device (zero without).
+fn device_tangents(t: &WorldTriangle) -> GpuTriTangents {
+    let c = t.tangents.unwrap_or_default().map(|v| v.to_array());
+    GpuTriTangents {
+        t0: c[0],
+        t1: c[1],
+        t2: c[2],
+    }
 }
 
 /// The device camera for an aspect ratio (width / height).
