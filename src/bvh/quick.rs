@@ -44,8 +44,9 @@ fn triangle_box(t: &[Vec3; 3]) -> Aabb {
 
 /// Builds a quick BVH (see the module docs) over triangles given as three vertices each.
 pub fn build_quick(triangles: &[[Vec3; 3]]) -> Bvh {
-    let (tri_indices, codes) = morton_order(triangles);
-    let ordered = in_order(triangles, &tri_indices);
+    let at = |i: usize| triangles[i];
+    let (tri_indices, codes) = morton_order(triangles.len(), &at);
+    let ordered = in_order(&tri_indices, &at);
     tree(codes, tri_indices, &ordered)
 }
 
@@ -54,28 +55,34 @@ pub fn build_quick(triangles: &[[Vec3; 3]]) -> Bvh {
 /// made (its leaves then read the triangles in order), so that the two copies and the tree are
 /// never held together.
 pub fn build_quick_ordered(triangles: Vec<[Vec3; 3]>) -> (Bvh, Vec<[Vec3; 3]>) {
-    let (tri_indices, codes) = morton_order(&triangles);
-    let ordered = in_order(&triangles, &tri_indices);
+    let at = |i: usize| triangles[i];
+    let (tri_indices, codes) = morton_order(triangles.len(), &at);
+    let ordered = in_order(&tri_indices, &at);
     drop(triangles);
     (tree(codes, tri_indices, &ordered), ordered)
 }
 
 /// The BLAS of an indexed mesh (object space) over a quick tree: what the renderer traces while
-/// the mesh's SAH BLAS ([`super::Blas::of_mesh`]) builds behind it.
+/// the mesh's SAH BLAS ([`super::Blas::of_mesh`]) builds behind it. The triangles are read
+/// from the mesh where they are needed (no copy of them in mesh order): the same tree and
+/// triangles as [`build_quick_ordered`] of that copy.
 pub fn quick_blas(positions: &[Vec3], indices: &[[u32; 3]]) -> super::Blas {
-    let triangles = indices
-        .iter()
-        .map(|t| t.map(|v| positions[v as usize]))
-        .collect();
-    let (bvh, triangles) = build_quick_ordered(triangles);
+    let at = |i: usize| indices[i].map(|v| positions[v as usize]);
+    let (tri_indices, codes) = morton_order(indices.len(), &at);
+    let triangles = in_order(&tri_indices, &at);
+    let bvh = tree(codes, tri_indices, &triangles);
     super::Blas { bvh, triangles }
 }
 
-fn in_order(triangles: &[[Vec3; 3]], order: &[u32]) -> Vec<[Vec3; 3]> {
+/// The triangles `triangle(i)` for i in `order`.
+fn in_order(order: &[u32], triangle: &(impl Fn(usize) -> [Vec3; 3] + Sync)) -> Vec<[Vec3; 3]> {
+    if order.len() <= TASK {
+        return order.iter().map(|&i| triangle(i as usize)).collect();
+    }
     order
         .par_iter()
         .with_min_len(CHUNK)
-        .map(|&i| triangles[i as usize])
+        .map(|&i| triangle(i as usize))
         .collect()
 }
 
@@ -83,36 +90,55 @@ fn in_order(triangles: &[[Vec3; 3]], order: &[u32]) -> Vec<[Vec3; 3]> {
 /// (a scene of many distinct meshes builds them side by side) is one task a pass.
 const CHUNK: usize = 1 << 13;
 
-/// The triangles' indices sorted by their centroids' Morton codes, and the sorted codes.
-fn morton_order(triangles: &[[Vec3; 3]]) -> (Vec<u32>, Vec<u32>) {
-    let centres = triangles
-        .par_iter()
-        .with_min_len(CHUNK)
-        .fold(|| Aabb::EMPTY, |b, t| b.grow(centroid(t)))
-        .reduce(|| Aabb::EMPTY, Aabb::union);
+/// The Morton code of centroid `c` in the grid of `min` and `scale` (see [`morton_order`]).
+fn morton(c: Vec3, min: Vec3, scale: Vec3) -> u32 {
+    let q = ((c - min) * scale).clamp(Vec3::ZERO, Vec3::splat(1023.0));
+    spread(q.x as u32) << 2 | spread(q.y as u32) << 1 | spread(q.z as u32)
+}
+
+/// Cells per unit along each axis of the grid over the centroids' box `centres` (0 for a flat
+/// or empty axis; NaN centroids land in cell 0).
+fn grid_scale(centres: &Aabb) -> Vec3 {
     let extent = centres.max - centres.min;
-    // Cells per unit along each axis (0 for a flat or empty axis; NaN centroids land in cell 0).
-    let scale = Vec3::select(
+    Vec3::select(
         extent.cmpgt(Vec3::ZERO) & extent.is_finite_mask(),
         Vec3::splat(1023.99) / extent,
         Vec3::ZERO,
-    );
-    let mut keys: Vec<u64> = triangles
-        .par_iter()
+    )
+}
+
+/// The indices of the `n` triangles `triangle(i)` sorted by their centroids' Morton codes (ties
+/// by index), and the sorted codes.
+fn morton_order(n: usize, triangle: &(impl Fn(usize) -> [Vec3; 3] + Sync)) -> (Vec<u32>, Vec<u32>) {
+    let centroid_of = |i: usize| centroid(&triangle(i));
+    if n <= TASK {
+        // One task (a small mesh, built beside others): the centroids once, then a radix sort
+        // of their codes, stable, so that ties stay in index order as in the sort of (code,
+        // index) keys below.
+        let centroids: Vec<Vec3> = (0..n).map(centroid_of).collect();
+        let centres = centroids.iter().fold(Aabb::EMPTY, |b, &c| b.grow(c));
+        let scale = grid_scale(&centres);
+        return radix_sort(
+            centroids
+                .iter()
+                .map(|&c| morton(c, centres.min, scale))
+                .collect(),
+        );
+    }
+    let centres = (0..n)
+        .into_par_iter()
         .with_min_len(CHUNK)
-        .enumerate()
-        .map(|(i, t)| {
-            let q = ((centroid(t) - centres.min) * scale).clamp(Vec3::ZERO, Vec3::splat(1023.0));
-            let code = spread(q.x as u32) << 2 | spread(q.y as u32) << 1 | spread(q.z as u32);
-            (code as u64) << 32 | i as u64
-        })
+        .fold(|| Aabb::EMPTY, |b, i| b.grow(centroid_of(i)))
+        .reduce(|| Aabb::EMPTY, Aabb::union);
+    let scale = grid_scale(&centres);
+    let code = |i: usize| morton(centroid_of(i), centres.min, scale);
+    let mut keys: Vec<u64> = (0..n)
+        .into_par_iter()
+        .with_min_len(CHUNK)
+        .map(|i| (code(i) as u64) << 32 | i as u64)
         .collect();
     // Unique keys (the index is part of each), so the order is the same at any thread count.
-    if keys.len() <= TASK {
-        keys.sort_unstable();
-    } else {
-        keys.par_sort_unstable();
-    }
+    keys.par_sort_unstable();
     let tri_indices = keys
         .par_iter()
         .with_min_len(CHUNK)
@@ -126,11 +152,62 @@ fn morton_order(triangles: &[[Vec3; 3]]) -> (Vec<u32>, Vec<u32>) {
     (tri_indices, codes)
 }
 
+/// Digits of [`radix_sort`]: three of 10 bits cover the 30-bit codes.
+const DIGIT: u32 = 10;
+
+/// The positions of `codes` (30-bit) in stable sorted order, and the sorted codes: a
+/// least-significant-digit radix sort, three passes of 10 bits.
+fn radix_sort(codes: Vec<u32>) -> (Vec<u32>, Vec<u32>) {
+    const BUCKETS: usize = 1 << DIGIT;
+    let n = codes.len();
+    let mut counts = vec![[0u32; BUCKETS]; 3];
+    for &c in &codes {
+        for (d, count) in counts.iter_mut().enumerate() {
+            count[(c >> (DIGIT * d as u32)) as usize % BUCKETS] += 1;
+        }
+    }
+    let (mut keys, mut order): (Vec<u32>, Vec<u32>) = (codes, (0..n as u32).collect());
+    let (mut keys_to, mut order_to) = (vec![0u32; n], vec![0u32; n]);
+    for (d, count) in counts.iter().enumerate() {
+        let shift = DIGIT * d as u32;
+        if count.iter().any(|&c| c as usize == n) {
+            // Every code has the same digit: the pass would leave the order as it is.
+            continue;
+        }
+        let mut next = [0u32; BUCKETS];
+        let mut sum = 0;
+        for (next, &c) in next.iter_mut().zip(count) {
+            *next = sum;
+            sum += c;
+        }
+        for (&k, &i) in keys.iter().zip(&order) {
+            let b = (k >> shift) as usize % BUCKETS;
+            let at = next[b] as usize;
+            keys_to[at] = k;
+            order_to[at] = i;
+            next[b] += 1;
+        }
+        std::mem::swap(&mut keys, &mut keys_to);
+        std::mem::swap(&mut order, &mut order_to);
+    }
+    (order, keys)
+}
+
 /// The tree over the BVH-order triangles `ordered` with their sorted `codes`.
 fn tree(codes: Vec<u32>, tri_indices: Vec<u32>, ordered: &[[Vec3; 3]]) -> Bvh {
+    let n = ordered.len();
+    if n > LEAF && n <= TASK {
+        // One task: the nodes are pushed in their final layout (a placeholder where a slot is
+        // taken, filled when its subtree is done), no arena to zero and pack.
+        let mut nodes = Vec::with_capacity(n - 1);
+        nodes.push(GpuBvhNode::default());
+        let mut len = 1;
+        let bounds = emit(&codes, ordered, 0, 0, 0, &mut nodes, &mut len);
+        drop(codes);
+        return finish(Built::Tree { bounds, at: 0, len }, nodes, tri_indices);
+    }
     // As `build`: interior nodes below the root go straight into a zeroed arena (pages cost
     // memory once written), packed into the final layout by `finish`.
-    let n = ordered.len();
     let mut arena: Vec<GpuBvhNode> = bytemuck::zeroed_vec(2 * n.max(1) - 1);
     let root = build_range(&codes, ordered, 0, 0, &mut arena[1..], 1);
     drop(codes);
@@ -218,7 +295,7 @@ fn emit(
     first: u32,
     depth: u32,
     slot: usize,
-    nodes: &mut [GpuBvhNode],
+    nodes: &mut (impl Slots + ?Sized),
     len: &mut usize,
 ) -> Aabb {
     let at = split_point(codes, depth);
@@ -228,6 +305,7 @@ fn emit(
     ];
     let slots = parts.map(|(c, _, _)| {
         (c.len() > LEAF).then(|| {
+            nodes.take(*len);
             *len += 1;
             *len - 1
         })
@@ -249,8 +327,36 @@ fn emit(
         };
         bounds = bounds.union(b);
     }
-    nodes[slot] = node;
+    nodes.put(slot, node);
     bounds
+}
+
+/// Where [`emit`] writes nodes: an arena's slice with room for them all, or a vector that
+/// grows as slots are taken.
+trait Slots {
+    /// Makes room for slot `slot`, the next one.
+    fn take(&mut self, slot: usize);
+    /// Writes the node of a slot taken.
+    fn put(&mut self, slot: usize, node: GpuBvhNode);
+}
+
+impl Slots for [GpuBvhNode] {
+    fn take(&mut self, _: usize) {}
+
+    fn put(&mut self, slot: usize, node: GpuBvhNode) {
+        self[slot] = node;
+    }
+}
+
+impl Slots for Vec<GpuBvhNode> {
+    fn take(&mut self, slot: usize) {
+        debug_assert_eq!(slot, self.len());
+        self.push(GpuBvhNode::default());
+    }
+
+    fn put(&mut self, slot: usize, node: GpuBvhNode) {
+        self[slot] = node;
+    }
 }
 
 #[cfg(test)]
@@ -342,6 +448,64 @@ mod tests {
             tris[i as usize] = b.triangles[k];
         }
         tris
+    }
+
+    #[test]
+    fn the_radix_sort_orders_as_the_sort_of_code_and_index_keys() {
+        for (n, spread) in [
+            (0, 1),
+            (1, 1),
+            (7, 3),
+            (5000, 1 << 30),
+            (5000, 40),
+            (3000, 1),
+        ] {
+            let mut state = 0x9e37_79b9_u32 ^ n as u32;
+            let codes: Vec<u32> = (0..n)
+                .map(|_| {
+                    state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                    // Spread over few values (many ties), some with a digit all codes share.
+                    (state >> 2) % spread * (1 << 20) / spread.min(1 << 20) + (state >> 31)
+                })
+                .collect();
+            let mut keys: Vec<u64> = codes
+                .iter()
+                .enumerate()
+                .map(|(i, &c)| (c as u64) << 32 | i as u64)
+                .collect();
+            keys.sort_unstable();
+            let (order, sorted) = radix_sort(codes);
+            assert_eq!(order, keys.iter().map(|&k| k as u32).collect::<Vec<_>>());
+            assert_eq!(
+                sorted,
+                keys.iter().map(|&k| (k >> 32) as u32).collect::<Vec<_>>()
+            );
+        }
+    }
+
+    /// The BLAS read straight from the mesh is the quick tree of its triangles, bit for bit,
+    /// for a mesh one task builds and one built on parallel levels.
+    #[test]
+    fn a_quick_blas_is_the_quick_tree_of_the_mesh_triangles() {
+        for n in [3, 1000, 2 * TASK + 9] {
+            let soup = random_triangles(n, 17 + n as u64);
+            let positions: Vec<Vec3> = soup.iter().flatten().copied().collect();
+            let indices: Vec<[u32; 3]> = (0..n as u32)
+                .map(|i| [3 * i + 2, 3 * i, 3 * i + 1])
+                .collect();
+            let blas = quick_blas(&positions, &indices);
+            let mesh: Vec<[Vec3; 3]> = indices
+                .iter()
+                .map(|t| t.map(|v| positions[v as usize]))
+                .collect();
+            let (bvh, triangles) = build_quick_ordered(mesh);
+            assert_eq!(blas.triangles, triangles);
+            assert_eq!(blas.bvh.tri_indices, bvh.tri_indices);
+            assert_eq!(
+                bytemuck::cast_slice::<_, u8>(&blas.bvh.nodes),
+                bytemuck::cast_slice::<_, u8>(&bvh.nodes)
+            );
+        }
     }
 
     #[test]

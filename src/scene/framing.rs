@@ -470,6 +470,7 @@ impl Probe {
             t.elapsed().as_secs_f64() * 1e3
         );
         let t = std::time::Instant::now();
+        let cpu = crate::cpu_time::process_cpu_seconds().unwrap_or(0.0);
         if tris.objects.iter().any(|o| o.kept.is_some()) {
             // Triangles were dropped: the meshes' triangles are not the world's.
             return Self::with_flat(scene, tris);
@@ -494,8 +495,9 @@ impl Probe {
         let hidden = vec![false; instances.len()];
         let two = TwoLevel::with_hidden(blases, &instances, hidden, 0);
         log::debug!(
-            "probe: quick BLASes and top level in {:.0} ms",
-            t.elapsed().as_secs_f64() * 1e3
+            "probe: quick BLASes and top level in {:.0} ms ({:.2} CPU s)",
+            t.elapsed().as_secs_f64() * 1e3,
+            crate::cpu_time::process_cpu_seconds().unwrap_or(0.0) - cpu
         );
         Self::with_tracer(scene, Tracer::TwoLevel { two, meshes }, tris)
     }
@@ -539,11 +541,13 @@ impl Probe {
 
     fn with_tracer(scene: &Scene, tracer: Tracer, tris: WorldTris) -> Self {
         let t = std::time::Instant::now();
+        let cpu = crate::cpu_time::process_cpu_seconds().unwrap_or(0.0);
         let bounds = robust_bounds(&tris);
         let points = fit_points(&tris, &bounds);
         log::debug!(
-            "probe: robust bounds and fit points in {:.0} ms",
-            t.elapsed().as_secs_f64() * 1e3
+            "probe: robust bounds and fit points in {:.0} ms ({:.2} CPU s)",
+            t.elapsed().as_secs_f64() * 1e3,
+            crate::cpu_time::process_cpu_seconds().unwrap_or(0.0) - cpu
         );
         let see_through = see_through_materials(scene);
         let any_opaque = tris.objects.par_iter().any(|o| {
