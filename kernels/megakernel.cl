@@ -23,7 +23,8 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
                        volatile global uint* counters) {
 #ifdef SMALL_SCENE
     local SmallScene small;
-    small_scene_load(tris, frame.triangles, &small);  // before any work item returns: it waits for the group
+    // Before any work item returns: it waits for the group.
+    small_scene_load(tris, frame.triangles, &small);
 #endif
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;

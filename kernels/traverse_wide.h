@@ -441,10 +441,11 @@ inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const Gpu
 // A scene of at most a few dozen triangles (SMALL_SCENE: their number rounded up to a whole
 // batch of SMALL_LANES, set by the host on CPU devices for flat scenes without alpha; the number
 // itself comes with the frame, so that hiding an object builds no kernels unless the batches
-// change): every ray tests every triangle, sixteen at a time in float16 lanes, with no tree. Each lane computes intersect_triangle's arithmetic, so the hits
-// are the same; of equally near hits the lowest triangle index is kept (the tree kept the first
-// it visited). The coordinates are held by vertex and axis, so that a ray's axis permutation
-// picks rows instead of shuffling each vertex.
+// change): every ray tests every triangle, sixteen at a time in float16 lanes, with no tree.
+// Each lane computes intersect_triangle's arithmetic, so the hits are the same; of equally near
+// hits the lowest triangle index is kept (the tree kept the first it visited). The coordinates
+// are held by vertex and axis, so that a ray's axis permutation picks rows instead of shuffling
+// each vertex.
 #define SMALL_LANES 16
 #define SMALL_BATCHES ((SMALL_SCENE + SMALL_LANES - 1) / SMALL_LANES)
 typedef struct SmallScene {
