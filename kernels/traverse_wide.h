@@ -446,7 +446,6 @@ inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const Gpu
 // hits the lowest triangle index is kept (the tree kept the first it visited). The coordinates
 // are held by vertex and axis, so that a ray's axis permutation picks rows instead of shuffling
 // each vertex.
-#define SMALL_LANES 16
 #define SMALL_BATCHES ((SMALL_SCENE + SMALL_LANES - 1) / SMALL_LANES)
 typedef struct SmallScene {
     float c[9][SMALL_BATCHES * SMALL_LANES];  // [vertex * 3 + axis][triangle]

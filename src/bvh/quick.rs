@@ -44,10 +44,14 @@ fn triangle_box(t: &[Vec3; 3]) -> Aabb {
 
 /// Builds a quick BVH (see the module docs) over triangles given as three vertices each.
 pub fn build_quick(triangles: &[[Vec3; 3]]) -> Bvh {
-    let at = |i: usize| triangles[i];
-    let (tri_indices, codes) = morton_order(triangles.len(), &at);
-    let ordered = in_order(&tri_indices, &at);
-    tree(codes, tri_indices, &ordered)
+    quick_over(triangles.len(), &|i| triangles[i]).0
+}
+
+/// The quick tree over the `n` triangles `triangle(i)`, and the triangles in its order.
+fn quick_over(n: usize, triangle: &(impl Fn(usize) -> [Vec3; 3] + Sync)) -> (Bvh, Vec<[Vec3; 3]>) {
+    let (tri_indices, codes) = morton_order(n, triangle);
+    let ordered = in_order(&tri_indices, triangle);
+    (tree(codes, tri_indices, &ordered), ordered)
 }
 
 /// [`build_quick`] of `triangles`, which it takes to return them in BVH order (what tracing the
@@ -67,10 +71,9 @@ pub fn build_quick_ordered(triangles: Vec<[Vec3; 3]>) -> (Bvh, Vec<[Vec3; 3]>) {
 /// from the mesh where they are needed (no copy of them in mesh order): the same tree and
 /// triangles as [`build_quick_ordered`] of that copy.
 pub fn quick_blas(positions: &[Vec3], indices: &[[u32; 3]]) -> super::Blas {
-    let at = |i: usize| indices[i].map(|v| positions[v as usize]);
-    let (tri_indices, codes) = morton_order(indices.len(), &at);
-    let triangles = in_order(&tri_indices, &at);
-    let bvh = tree(codes, tri_indices, &triangles);
+    let (bvh, triangles) = quick_over(indices.len(), &|i| {
+        indices[i].map(|v| positions[v as usize])
+    });
     super::Blas { bvh, triangles }
 }
 

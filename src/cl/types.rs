@@ -80,6 +80,11 @@ kernel_constants! {
     /// leaves apart by the leaf itself (`TwoLevel::device_tlas`).
     TLAS_LEAF: u32 = 0x8000_0000;
 
+    /// The megakernel's small-scene test (`SMALL_SCENE`, kernels/traverse_wide.h) takes the
+    /// triangles this many at a time, in vector lanes; its kernels are built for a whole number
+    /// of such batches.
+    SMALL_LANES: usize = 16;
+
     /// Material flags in `GpuMaterial::emission.w`: both sides are front faces.
     MATERIAL_DOUBLE_SIDED: u32 = 1;
     /// `KHR_materials_unlit`: the surface shows its base color and ends the path.

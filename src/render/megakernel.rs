@@ -94,7 +94,8 @@ impl Renderer {
             return Err(ClError::Device("no scene is loaded".into()));
         };
         let (gpu, counters) = (&self.gpu, &self.counters);
-        // The small-scene test (kernels built for up to SMALL_SCENE_MAX) takes the count here.
+        // The small-scene test (kernels built for whole batches of triangles) takes the count
+        // here, so that a scene's hidden objects need no other kernels.
         let frame = &GpuFrame {
             triangles: if program.features.small_scene > 0 {
                 scene.triangles.len() as u32

@@ -116,7 +116,7 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
 fn small_scene(cpu: bool, flat: bool, triangles: usize, alpha: bool) -> u32 {
     let small = cpu && flat && !alpha && (1..=small_scene_limit()).contains(&triangles);
     if small {
-        triangles.next_multiple_of(16) as u32
+        triangles.next_multiple_of(crate::cl::types::SMALL_LANES) as u32
     } else {
         0
     }
