@@ -31,13 +31,26 @@ impl Format {
 
 /// Writes linear RGB as a float EXR.
 pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+    use exr::prelude::*;
     let w = width as usize;
-    exr::prelude::write_rgb_file(path, w, height as usize, |x, y| {
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
         let p = rgb[y * w + x];
         (p[0], p[1], p[2])
-    })
-    .with_context(|| format!("{}: cannot write EXR", path.display()))
+    });
+    Image::from_encoded_channels((w, height as usize), EXR_ENCODING, channels)
+        .write()
+        .to_file(path)
+        .with_context(|| format!("{}: cannot write EXR", path.display()))
 }
+
+/// The exr crate's default encoding (RLE, 64-pixel tiles) with the tiles in increasing order:
+/// its default order is "unspecified", and its parallel compression then writes the tiles in
+/// whatever order the threads finish them, so one image gave files that differed from run to
+/// run. In order, the same pixels always make the same bytes.
+const EXR_ENCODING: exr::image::Encoding = exr::image::Encoding {
+    line_order: exr::meta::attribute::LineOrder::Increasing,
+    ..exr::image::Encoding::FAST_LOSSLESS
+};
 
 /// Writes premultiplied linear RGB with `alpha` as a float RGBA EXR.
 pub fn write_exr_rgba(
@@ -47,12 +60,16 @@ pub fn write_exr_rgba(
     rgb: &[[f32; 3]],
     alpha: &[f32],
 ) -> Result<()> {
+    use exr::prelude::*;
     let w = width as usize;
-    exr::prelude::write_rgba_file(path, w, height as usize, |x, y| {
+    let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
         let p = rgb[y * w + x];
         (p[0], p[1], p[2], alpha[y * w + x])
-    })
-    .with_context(|| format!("{}: cannot write EXR", path.display()))
+    });
+    Image::from_encoded_channels((w, height as usize), EXR_ENCODING, channels)
+        .write()
+        .to_file(path)
+        .with_context(|| format!("{}: cannot write EXR", path.display()))
 }
 
 /// The size of each layer of an EXR file and its chunk count, from the header alone (no pixel
@@ -118,6 +135,37 @@ mod tests {
         write_exr(&path, 2, 1, &px).unwrap();
         let (w, h, back) = read_exr(&path).unwrap();
         assert_eq!((w, h), (2, 1));
+        assert_eq!(back, px);
+    }
+
+    #[test]
+    fn the_same_pixels_make_the_same_exr_bytes() {
+        // Many tiles of noisy values, so that the parallel compression finishes them out of
+        // order: the files must still be equal byte for byte, RGB and RGBA.
+        let dir = tempfile::tempdir().unwrap();
+        let (w, h) = (640u32, 448u32);
+        let mut state = 1u32;
+        let mut next = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1 << 24) as f32
+        };
+        let px: Vec<[f32; 3]> = (0..w * h).map(|_| [next(), next(), next()]).collect();
+        let alpha: Vec<f32> = (0..w * h).map(|_| next()).collect();
+        let files: Vec<Vec<u8>> = (0..6)
+            .map(|i| {
+                let path = dir.path().join(format!("{i}.exr"));
+                if i % 2 == 0 {
+                    write_exr(&path, w, h, &px).unwrap();
+                } else {
+                    write_exr_rgba(&path, w, h, &px, &alpha).unwrap();
+                }
+                std::fs::read(path).unwrap()
+            })
+            .collect();
+        for (i, f) in files.iter().enumerate().skip(2) {
+            assert!(*f == files[i % 2], "file {i} differs from file {}", i % 2);
+        }
+        let (_, _, back) = read_exr(&dir.path().join("0.exr")).unwrap();
         assert_eq!(back, px);
     }
 
