@@ -573,34 +573,70 @@ impl TwoLevel {
 
     /// [`TwoLevel::device_nodes`] for the 4-wide form: the collapsed TLAS, then every
     /// collapsed BLAS, rebased alike; each BLAS's root; and per BLAS, each binary node's wide
-    /// node (`u32::MAX` for one inside a wide node), where a piece enters the wide BLAS.
+    /// node (`u32::MAX` for one inside a wide node), where a piece enters the wide BLAS (only
+    /// the root's, `[0]`, when [`TwoLevel::max_pieces`] opens no BLAS).
     pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>, Vec<Vec<u32>>) {
-        let mut nodes = WideBvh::collapse(&self.tlas).nodes;
+        // Every wide node is made of a distinct binary node, so the binary nodes bound the
+        // array: reserved at once (address space; only the pages written are touched), it is
+        // never moved while it grows.
+        let bound =
+            self.tlas_slots() + self.blases.iter().map(|b| b.bvh.nodes.len()).sum::<usize>();
+        let mut nodes = Vec::with_capacity(bound);
+        nodes.extend(WideBvh::collapse(&self.tlas).nodes);
         nodes.resize(self.tlas_slots(), GpuWideNode::default());
         let mut roots = vec![];
         let mut wide_of = vec![];
         let mut tri_base = 0i32;
-        for b in &self.blases {
-            let base = nodes.len() as i32;
-            roots.push(base as u32);
-            let (wide, binaries) = WideBvh::collapse_mapped(&b.bvh, self.merge);
-            let mut map = vec![u32::MAX; b.bvh.nodes.len()];
-            for (w, &n) in binaries.iter().enumerate() {
-                map[n as usize] = w as u32;
+        let opens = self.max_pieces > self.piece_budget(0);
+        // The BLASes are collapsed in parallel, a batch of about COLLAPSE_BATCH triangles at a
+        // time, and appended in order (in parallel too): only one batch's nodes wait beside the
+        // array, so the collapse touches little fresh memory beyond the array itself (a 64
+        // M-triangle scene of 3,125 meshes: 5.6 s one BLAS after another, docs/benchmarks.md).
+        const COLLAPSE_BATCH: usize = 1 << 20;
+        let mut rest = &self.blases[..];
+        while !rest.is_empty() {
+            let mut take = 0;
+            let mut triangles = 0;
+            while take < rest.len() && (take == 0 || triangles < COLLAPSE_BATCH) {
+                triangles += rest[take].triangles.len();
+                take += 1;
             }
-            wide_of.push(map);
-            nodes.extend(wide.nodes.into_iter().map(|mut n| {
-                for i in 0..super::WIDTH {
-                    if n.count[i] > 0 {
-                        n.child[i] = !((!n.child[i]) + tri_base);
-                    } else if n.child[i] > 0 {
-                        n.child[i] += base;
+            let (batch, after) = rest.split_at(take);
+            rest = after;
+            let collapsed: Vec<(WideBvh, Vec<u32>)> = batch
+                .par_iter()
+                .map(|b| WideBvh::collapse_mapped(&b.bvh, self.merge))
+                .collect();
+            for (b, (wide, binaries)) in batch.iter().zip(collapsed) {
+                let base = nodes.len() as i32;
+                roots.push(base as u32);
+                // Without re-braiding every piece enters its BLAS at the root (binary node 0,
+                // wide node 0): the map of every binary node (4 B each, 250 MB at 64 M
+                // triangles) is made only where pieces may enter below it.
+                let map = if opens {
+                    let mut map = vec![u32::MAX; b.bvh.nodes.len()];
+                    for (w, &n) in binaries.iter().enumerate() {
+                        map[n as usize] = w as u32;
                     }
-                }
-                n
-            }));
-            tri_base += b.triangles.len() as i32;
+                    map
+                } else {
+                    vec![0]
+                };
+                wide_of.push(map);
+                nodes.par_extend(wide.nodes.into_par_iter().map(|mut n| {
+                    for i in 0..super::WIDTH {
+                        if n.count[i] > 0 {
+                            n.child[i] = !((!n.child[i]) + tri_base);
+                        } else if n.child[i] > 0 {
+                            n.child[i] += base;
+                        }
+                    }
+                    n
+                }));
+                tri_base += b.triangles.len() as i32;
+            }
         }
+        nodes.shrink_to_fit();
         (nodes, roots, wide_of)
     }
 }

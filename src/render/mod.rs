@@ -442,7 +442,12 @@ impl Renderer {
                     .iter()
                     .map(|&o| scene.objects[o as usize].mesh.as_ref())
                     .collect();
-                let mut host = HostScene::two_level(plan.two, &meshes, &materials);
+                let mut host = HostScene::two_level(
+                    plan.two,
+                    &meshes,
+                    &materials,
+                    upload::render_middle(scene, &space),
+                );
                 host.layout.objects = plan.objects;
                 (host, 0)
             }

@@ -149,7 +149,7 @@ pub fn read_floats<const N: usize>(
     data: &BufferData,
     index: usize,
 ) -> Result<Vec<[f32; N]>, String> {
-    read(root, data, index, N, |layout, bytes| {
+    read(root, data, index, N, ComponentType::F32, |layout, bytes| {
         std::array::from_fn(|c| layout.float(bytes, c))
     })
 }
@@ -173,7 +173,7 @@ pub fn read_uints<const N: usize>(
             "accessors[{index}].componentType: FLOAT where integers are required"
         ));
     }
-    read(root, data, index, N, |layout, bytes| {
+    read(root, data, index, N, ComponentType::U32, |layout, bytes| {
         std::array::from_fn(|c| layout.uint(bytes, c))
     })
 }
@@ -219,11 +219,17 @@ fn elements<'a>(
     }
 }
 
-fn read<T: Copy + Default, const N: usize>(
+/// The elements of an accessor of `want` components per element, each converted from its
+/// bytes by `convert`; where the file holds exactly `[T; N]` (components of type `native`,
+/// `T`'s own little-endian form, N to an element, tightly packed, no sparse values) the bytes
+/// are copied as they are, at memory speed (a 64 M-triangle file's positions and indices:
+/// most of its reading time went to converting element by element).
+fn read<T: bytemuck::Pod + Default, const N: usize>(
     root: &gltf::json::Root,
     data: &BufferData,
     index: usize,
     want: usize,
+    native: ComponentType,
     convert: impl Fn(&Layout, &[u8]) -> [T; N],
 ) -> Result<Vec<[T; N]>, String> {
     let path = format!("accessors[{index}]");
@@ -266,9 +272,20 @@ fn read<T: Copy + Default, const N: usize>(
             let offset = accessor.byte_offset.map_or(0, |o| o.0);
             let (bytes, stride) =
                 elements(root, data, view.value(), offset, count, &layout, &path)?;
-            (0..count as usize)
-                .map(|i| convert(&layout, &bytes[i * stride..i * stride + size]))
-                .collect()
+            let packed = cfg!(target_endian = "little")
+                && layout.component == native
+                && components == N
+                && components <= 4
+                && stride == size
+                && size == std::mem::size_of::<[T; N]>()
+                && accessor.sparse.is_none();
+            if packed {
+                bytemuck::pod_collect_to_vec(&bytes[..count as usize * size])
+            } else {
+                (0..count as usize)
+                    .map(|i| convert(&layout, &bytes[i * stride..i * stride + size]))
+                    .collect()
+            }
         }
         None => {
             // A view-less accessor allocates its count with no bytes to bound it.

@@ -33,26 +33,34 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     if !meta.is_file() {
         return Err(fail("cannot read file: not a regular file".into()));
     }
-    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
+    let bytes =
+        sources::Bytes::of_file(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
     load_owned(bytes, path.parent(), &path.display().to_string()).map_err(fail)
 }
 
 /// Loads glTF or GLB bytes; external files are resolved against `base`.
 pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Result<Scene, String> {
-    load_owned(bytes.to_vec(), base, source)
+    load_owned(sources::Bytes::Owned(bytes.to_vec()), base, source)
 }
 
-/// [`load_from_bytes`] taking the bytes: a GLB file's binary chunk is read in place and every
-/// buffer is freed before the scene's bounds are computed, so that the file and the imported
-/// meshes are held together only while the meshes are read.
-fn load_owned(bytes: Vec<u8>, base: Option<&Path>, source: &str) -> Result<Scene, String> {
+/// [`load_owned`] of bytes with no external files (for tests of [`sources::Bytes`]).
+#[cfg(test)]
+pub(super) fn load_bytes(bytes: sources::Bytes) -> Result<Scene, String> {
+    load_owned(bytes, None, "test")
+}
+
+/// [`load_from_bytes`] taking the bytes (a large file mapped, `Bytes::of_file`): a GLB file's
+/// binary chunk is read in place and every buffer is freed before the scene's bounds are
+/// computed, so that the file and the imported meshes are held together only while the
+/// meshes are read.
+fn load_owned(bytes: sources::Bytes, base: Option<&Path>, source: &str) -> Result<Scene, String> {
     let mut warnings = Vec::new();
     let parsed = validate::parse(bytes, &mut warnings)?;
     let document = parsed.document;
     let buffers = sources::load_buffers(&document, base, parsed.blob)?;
     let root = document.as_json();
     let mut buffer_data = BufferData {
-        buffers: buffers.iter().map(Vec::as_slice).collect(),
+        buffers: buffers.iter().map(|b| &b[..]).collect(),
         decoded_views: HashMap::new(),
     };
     buffer_data.decoded_views = compression::decode_meshopt_views(root, &buffer_data.buffers)?;
@@ -586,7 +594,7 @@ impl TextureTable {
 fn decode_images(
     document: &gltf::Document,
     base: Option<&Path>,
-    buffers: &[Vec<u8>],
+    buffers: &[sources::Bytes],
     table: &mut TextureTable,
     warnings: &mut Vec<String>,
 ) -> Vec<Arc<Image>> {
@@ -996,11 +1004,10 @@ fn import_mesh(
         }
         let flat: Vec<u32> = match (&attributes.draco, json.indices) {
             (Some(d), _) => d.indices.clone(),
-            (None, Some(a)) => accessor::read_uints::<1>(root, data, a.value())
-                .map_err(|e| format!("{what}.indices: {e}"))?
-                .into_iter()
-                .map(|[i]| i)
-                .collect(),
+            (None, Some(a)) => bytemuck::cast_vec(
+                accessor::read_uints::<1>(root, data, a.value())
+                    .map_err(|e| format!("{what}.indices: {e}"))?,
+            ),
             (None, None) => (0..positions.len() as u32).collect(),
         };
         if let Some(&bad) = flat.iter().find(|&&i| i as usize >= positions.len()) {

@@ -7,6 +7,7 @@
 //! Each problem is `JSON path: what is wrong`; the first one is the load error.
 
 use super::limits;
+use super::sources::Bytes;
 use gltf::json::{self, validation::Error as JsonError, validation::Validate};
 
 /// glTF extensions penumbra reads, or may safely ignore when rendering. A file that requires
@@ -44,7 +45,7 @@ pub struct Parsed {
     /// The document; every index in it is in range and every enum valid.
     pub document: gltf::Document,
     /// The GLB `BIN` chunk.
-    pub blob: Option<Vec<u8>>,
+    pub blob: Option<Bytes>,
     /// Node transforms as written, in f64 (gltf-json reads them as f32).
     pub precise_nodes: Vec<PreciseNode>,
 }
@@ -79,22 +80,17 @@ fn precise_nodes(json: &[u8]) -> Vec<PreciseNode> {
 /// Parses `.gltf` JSON or `.glb` bytes and validates the document. Warnings (unsupported
 /// optional extensions) are appended to `warnings`. A GLB file's `BIN` chunk keeps the
 /// allocation of `bytes` (moved down to its start, not copied): a file of meshes is held once.
-pub fn parse(mut bytes: Vec<u8>, warnings: &mut Vec<String>) -> Result<Parsed, String> {
+pub fn parse(bytes: Bytes, warnings: &mut Vec<String>) -> Result<Parsed, String> {
     let (json_bytes, blob) = if bytes.starts_with(b"glTF") {
         let glb =
             gltf::Glb::from_slice(&bytes).map_err(|e| format!("not a valid GLB file: {e}"))?;
-        let json = glb.json.into_owned();
+        let json = Bytes::Owned(glb.json.into_owned());
         // Where the BIN chunk lies in `bytes` (`from_slice` borrows it from there).
         let bin = glb.bin.map(|b| {
             let start = b.as_ptr() as usize - bytes.as_ptr() as usize;
             start..start + b.len()
         });
-        let blob = bin.map(|range| {
-            bytes.truncate(range.end);
-            bytes.drain(..range.start);
-            bytes
-        });
-        (json, blob)
+        (json, bin.map(|range| bytes.into_range(range)))
     } else {
         (bytes, None)
     };
