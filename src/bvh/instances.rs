@@ -17,18 +17,30 @@
 use super::wide::{frontier, merge_limit};
 use super::{Aabb, Bvh, Child, Hit, Ray, WIDTH, WideBvh, build, build_boxes, build_indexed};
 use crate::cl::types::{GpuBvhNode, GpuHit, GpuWideNode};
+use crate::scene::Mesh;
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
+use std::sync::Arc;
 
 /// A mesh's BVH and its object-space triangles in BVH order.
 #[derive(Clone, Debug)]
 pub struct Blas {
     /// The tree.
     pub bvh: Bvh,
-    /// Triangles in BVH order (object space).
-    pub triangles: Vec<[Vec3; 3]>,
+    /// Triangles in BVH order (object space); read them with [`Blas::triangle`].
+    triangles: BlasTriangles,
+}
+
+/// Where a [`Blas`] finds its triangles.
+#[derive(Clone, Debug)]
+enum BlasTriangles {
+    /// Copies in BVH order.
+    Copied(Vec<[Vec3; 3]>),
+    /// The mesh the tree was built over, read through the tree's `tri_indices`: no copy
+    /// (36 B a triangle, 2.3 GB of a 64 M-triangle scene, which only host traversal reads).
+    Mesh(Arc<Mesh>),
 }
 
 impl Blas {
@@ -40,7 +52,25 @@ impl Blas {
             .iter()
             .map(|&i| triangles[i as usize])
             .collect();
-        Self { bvh, triangles }
+        Self::copied(bvh, triangles)
+    }
+
+    /// A BLAS of `bvh` over its triangles in BVH order.
+    pub fn copied(bvh: Bvh, triangles: Vec<[Vec3; 3]>) -> Self {
+        debug_assert_eq!(bvh.tri_indices.len(), triangles.len());
+        Self {
+            bvh,
+            triangles: BlasTriangles::Copied(triangles),
+        }
+    }
+
+    /// A BLAS of `bvh`, built over `mesh`, that reads the mesh's triangles where it needs them.
+    pub fn over_mesh(bvh: Bvh, mesh: &Arc<Mesh>) -> Self {
+        debug_assert_eq!(bvh.tri_indices.len(), mesh.indices.len());
+        Self {
+            bvh,
+            triangles: BlasTriangles::Mesh(mesh.clone()),
+        }
     }
 
     /// Builds the BLAS of an indexed mesh (object space): the same as [`Blas::new`] over its
@@ -52,7 +82,46 @@ impl Blas {
             .par_iter()
             .map(|&i| indices[i as usize].map(|v| positions[v as usize]))
             .collect();
-        Self { bvh, triangles }
+        Self::copied(bvh, triangles)
+    }
+
+    /// [`Blas::of_mesh`] of a scene's mesh, which the BLAS keeps and reads its triangles from
+    /// (no copy of them in BVH order either): the same tree.
+    pub fn of_shared_mesh(mesh: &Arc<Mesh>) -> Self {
+        Self::over_mesh(build_indexed(&mesh.positions, &mesh.indices), mesh)
+    }
+
+    /// Triangles.
+    pub fn len(&self) -> usize {
+        self.bvh.tri_indices.len()
+    }
+
+    /// Whether the BLAS has no triangles.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Triangle `k` in BVH order (object space).
+    pub fn triangle(&self, k: usize) -> [Vec3; 3] {
+        match &self.triangles {
+            BlasTriangles::Copied(t) => t[k],
+            BlasTriangles::Mesh(m) => {
+                m.indices[self.bvh.tri_indices[k] as usize].map(|v| m.positions[v as usize])
+            }
+        }
+    }
+
+    /// The triangles in BVH order.
+    pub fn triangles(&self) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+        (0..self.len()).map(|k| self.triangle(k))
+    }
+
+    /// [`Bvh::traverse`] of this BLAS's tree over its triangles.
+    pub fn traverse(&self, root: u32, ray: &Ray, any: bool) -> Option<Hit> {
+        match &self.triangles {
+            BlasTriangles::Copied(t) => self.bvh.traverse(root, ray, t, any),
+            BlasTriangles::Mesh(_) => self.bvh.traverse_by(root, ray, any, |k| self.triangle(k)),
+        }
     }
 
     /// The object-space box of the whole mesh.
@@ -253,11 +322,11 @@ impl TwoLevel {
         let firsts = blases
             .iter()
             .map(|b| {
-                first += b.triangles.len() as u32;
-                first - b.triangles.len() as u32
+                first += b.len() as u32;
+                first - b.len() as u32
             })
             .collect();
-        let unique: usize = blases.iter().map(|b| b.triangles.len()).sum();
+        let unique: usize = blases.iter().map(|b| b.len()).sum();
         let mut two = Self {
             merge: merge_limit(unique),
             hidden,
@@ -280,7 +349,7 @@ impl TwoLevel {
             .iter()
             .zip(&self.hidden)
             .filter(|(_, hidden)| !**hidden)
-            .map(|(i, _)| self.blases[i.blas as usize].triangles.len())
+            .map(|(i, _)| self.blases[i.blas as usize].len())
             .sum()
     }
 
@@ -301,7 +370,7 @@ impl TwoLevel {
 
     /// Whether `blas` is small (see [`TwoLevel::small_mesh`]).
     pub fn is_small(&self, blas: &Blas) -> bool {
-        blas.triangles.len() <= self.small_mesh
+        blas.len() <= self.small_mesh
     }
 
     /// The most pieces the TLAS may be re-braided into: a small mesh's triangles each, one for
@@ -312,11 +381,7 @@ impl TwoLevel {
             .iter()
             .map(|i| {
                 let b = &self.blases[i.blas as usize];
-                if self.is_small(b) {
-                    b.triangles.len()
-                } else {
-                    1
-                }
+                if self.is_small(b) { b.len() } else { 1 }
             })
             .sum();
         base + extra
@@ -381,8 +446,8 @@ impl TwoLevel {
                 pieces.push((i, 0, inst.node_world_box(&blas.bvh, 0)));
                 continue;
             }
-            for (k, t) in blas.triangles.iter().enumerate() {
-                let world = inst.device_triangle(t);
+            for (k, t) in blas.triangles().enumerate() {
+                let world = inst.device_triangle(&t);
                 let b = world.iter().fold(Aabb::EMPTY, |b, &v| b.grow(v));
                 pieces.push((i, PIECE_TRIANGLE | k as u32, b));
             }
@@ -461,7 +526,7 @@ impl TwoLevel {
     pub fn hit_triangle(&self, prim: u32, instance: u32) -> [Vec3; 3] {
         let inst = &self.instances[instance as usize];
         let b = inst.blas as usize;
-        let t = self.blases[b].triangles[(prim - self.firsts[b]) as usize];
+        let t = self.blases[b].triangle((prim - self.firsts[b]) as usize);
         t.map(|v| inst.to_world(v))
     }
 
@@ -474,11 +539,11 @@ impl TwoLevel {
             let hit = if root & PIECE_TRIANGLE != 0 {
                 // A small mesh's triangle, tested in world space (see `braid`).
                 let prim = root & !PIECE_TRIANGLE;
-                let world = inst.device_triangle(&blas.triangles[prim as usize]);
+                let world = inst.device_triangle(&blas.triangle(prim as usize));
                 super::intersect_triangle(r, &world).map(|(t, u, v)| Hit { t, u, v, prim })
             } else {
                 let local = inst.to_object(r);
-                blas.bvh.traverse(root, &local, &blas.triangles, any)
+                blas.traverse(root, &local, any)
             };
             let hit = hit.map(|h| if any { Hit { t: r.tmax, ..h } } else { h });
             hit.map(|hit| {
@@ -532,7 +597,7 @@ impl TwoLevel {
                 }
                 n
             }));
-            tri_base += b.triangles.len() as u32;
+            tri_base += b.len() as u32;
         }
         (nodes, roots, firsts)
     }
@@ -598,7 +663,7 @@ impl TwoLevel {
             let mut take = 0;
             let mut triangles = 0;
             while take < rest.len() && (take == 0 || triangles < COLLAPSE_BATCH) {
-                triangles += rest[take].triangles.len();
+                triangles += rest[take].len();
                 take += 1;
             }
             let (batch, after) = rest.split_at(take);
@@ -633,7 +698,7 @@ impl TwoLevel {
                     }
                     n
                 }));
-                tri_base += b.triangles.len() as i32;
+                tri_base += b.len() as i32;
             }
         }
         nodes.shrink_to_fit();
@@ -1041,7 +1106,7 @@ mod tests {
             .flat_map(|i| {
                 let inst = &plain.instances[i];
                 let b = &plain.blases[inst.blas as usize];
-                b.triangles.iter().map(move |t| t.map(|v| inst.to_world(v)))
+                b.triangles().map(move |t| t.map(|v| inst.to_world(v)))
             })
             .collect();
         let mut hits = 0;

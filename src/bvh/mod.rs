@@ -14,7 +14,7 @@ pub use build::{MAX_DEPTH, build, build_boxes, build_indexed};
 pub use instances::{
     Blas, Instance, InstanceHit, PIECE_TRIANGLE, SMALL_MESH, TwoLevel, closed_cube,
 };
-pub use quick::{build_quick, build_quick_ordered, quick_blas};
+pub use quick::{build_quick, build_quick_ordered, quick_blas, quick_blas_shared};
 pub use refit::{REFIT_MAX_GROWTH, Update};
 pub use stats::{BvhReport, report};
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};

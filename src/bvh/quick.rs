@@ -74,7 +74,18 @@ pub fn quick_blas(positions: &[Vec3], indices: &[[u32; 3]]) -> super::Blas {
     let (bvh, triangles) = quick_over(indices.len(), &|i| {
         indices[i].map(|v| positions[v as usize])
     });
-    super::Blas { bvh, triangles }
+    super::Blas::copied(bvh, triangles)
+}
+
+/// [`quick_blas`] of a scene's mesh, which the BLAS keeps and reads its triangles from: the
+/// triangles in BVH order the build needs are freed once the tree is made, so that a scene's
+/// BLASes hold no copy of them (a 64 M-triangle scene's 2.3 GB).
+pub fn quick_blas_shared(mesh: &std::sync::Arc<crate::scene::Mesh>) -> super::Blas {
+    let (bvh, triangles) = quick_over(mesh.indices.len(), &|i| {
+        mesh.indices[i].map(|v| mesh.positions[v as usize])
+    });
+    drop(triangles);
+    super::Blas::over_mesh(bvh, mesh)
 }
 
 /// The triangles `triangle(i)` for i in `order`.
@@ -428,11 +439,43 @@ mod tests {
         );
         let mesh_order = sah_order(&sah);
         check_tree(&quick.bvh, &mesh_order);
-        assert_eq!(quick.triangles, ordered(&quick.bvh, &mesh_order));
+        let quick_tris: Vec<[Vec3; 3]> = quick.triangles().collect();
+        assert_eq!(quick_tris, ordered(&quick.bvh, &mesh_order));
+        // The BLASes that read a scene's mesh instead of copying its triangles: the same trees,
+        // triangles and hits.
+        let mesh = std::sync::Arc::new(crate::scene::Mesh {
+            positions: positions.clone(),
+            indices: indices.clone(),
+            ..Default::default()
+        });
+        let (quick_shared, sah_shared) = (
+            quick_blas_shared(&mesh),
+            super::super::Blas::of_shared_mesh(&mesh),
+        );
+        assert_eq!(quick_shared.bvh.tri_indices, quick.bvh.tri_indices);
+        assert_eq!(sah_shared.bvh.tri_indices, sah.bvh.tri_indices);
+        assert!(quick_shared.triangles().eq(quick.triangles()));
+        assert!(sah_shared.triangles().eq(sah.triangles()));
         let mut hits = 0;
         for ray in &random_rays(3000, 5) {
-            let a = quick.bvh.intersect(ray, &quick.triangles);
-            let b = sah.bvh.intersect(ray, &sah.triangles);
+            let a = quick.traverse(0, ray, false);
+            let b = sah.traverse(0, ray, false);
+            for (shared, copied) in [(&quick_shared, &quick), (&sah_shared, &sah)] {
+                let (s, c) = (
+                    shared.traverse(0, ray, false),
+                    copied.traverse(0, ray, false),
+                );
+                assert_eq!(
+                    s.map(|h| (h.t, h.prim)),
+                    c.map(|h| (h.t, h.prim)),
+                    "{ray:?}"
+                );
+                assert_eq!(
+                    shared.traverse(0, ray, true).is_some(),
+                    c.is_some(),
+                    "{ray:?}"
+                );
+            }
             assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "{ray:?}");
             assert_eq!(
                 a.map(|h| quick.bvh.tri_indices[h.prim as usize]),
@@ -446,9 +489,9 @@ mod tests {
 
     /// A BLAS's triangles back in mesh order.
     fn sah_order(b: &super::super::Blas) -> Vec<[Vec3; 3]> {
-        let mut tris = vec![[Vec3::ZERO; 3]; b.triangles.len()];
+        let mut tris = vec![[Vec3::ZERO; 3]; b.len()];
         for (k, &i) in b.bvh.tri_indices.iter().enumerate() {
-            tris[i as usize] = b.triangles[k];
+            tris[i as usize] = b.triangle(k);
         }
         tris
     }
@@ -502,7 +545,7 @@ mod tests {
                 .map(|t| t.map(|v| positions[v as usize]))
                 .collect();
             let (bvh, triangles) = build_quick_ordered(mesh);
-            assert_eq!(blas.triangles, triangles);
+            assert!(blas.triangles().eq(triangles.iter().copied()));
             assert_eq!(blas.bvh.tri_indices, bvh.tri_indices);
             assert_eq!(
                 bytemuck::cast_slice::<_, u8>(&blas.bvh.nodes),

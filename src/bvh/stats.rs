@@ -86,7 +86,7 @@ pub fn report(scene: &Scene, runs: usize, flat: bool) -> BvhReport {
     let build_two = || {
         let blases = first
             .par_iter()
-            .map(|&o| Blas::of_mesh(&objects[o].mesh.positions, &objects[o].mesh.indices))
+            .map(|&o| Blas::of_shared_mesh(&objects[o].mesh))
             .collect();
         TwoLevel::from_blases(blases, &placed)
     };

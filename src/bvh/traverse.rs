@@ -170,9 +170,20 @@ impl Bvh {
 
     /// The closest hit (or with `any` the first) along `ray` in the subtree below node `root`.
     pub fn traverse(&self, root: u32, ray: &Ray, tris: &[[Vec3; 3]], any: bool) -> Option<Hit> {
+        self.traverse_by(root, ray, any, |k| tris[k])
+    }
+
+    /// [`Bvh::traverse`] with triangle k (in BVH order) given by `tri(k)`.
+    pub fn traverse_by(
+        &self,
+        root: u32,
+        ray: &Ray,
+        any: bool,
+        tri: impl Fn(usize) -> [Vec3; 3],
+    ) -> Option<Hit> {
         let sh = Shear::new(ray.direction);
         self.walk_from(root, ray, any, |prim, r| {
-            intersect_sheared(r, &sh, &tris[prim as usize])
+            intersect_sheared(r, &sh, &tri(prim as usize))
                 .map(|(t, u, v)| (t, Hit { t, u, v, prim }))
         })
     }

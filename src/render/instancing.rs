@@ -21,7 +21,7 @@
 //! instancing shrinks eightfold take them. A small scene is flattened: its flat BVH is built in
 //! well under a second and tests no transforms.
 
-use crate::bvh::{Blas, TwoLevel, quick_blas};
+use crate::bvh::{Blas, TwoLevel, quick_blas_shared};
 use crate::scene::{Mesh, Object, RenderFrame, Scene, distinct_meshes};
 use glam::DMat4;
 use rayon::prelude::*;
@@ -149,7 +149,7 @@ pub fn plan(
         return None;
     }
     let quick = matches!(how, Blases::Quick { from, .. } if unique >= from);
-    let sah = |o: usize| Blas::of_mesh(&placed[o].mesh.positions, &placed[o].mesh.indices);
+    let sah = |o: usize| Blas::of_shared_mesh(&placed[o].mesh);
     let blases: Vec<Blas> = match how {
         Blases::Quick { ready, .. } if quick => {
             let mut ready: std::collections::HashMap<*const Mesh, Blas> = ready
@@ -165,9 +165,8 @@ pub fn plan(
                 .par_iter_mut()
                 .zip(&meshes)
                 .map(|(b, &o)| {
-                    b.take().unwrap_or_else(|| {
-                        quick_blas(&placed[o].mesh.positions, &placed[o].mesh.indices)
-                    })
+                    b.take()
+                        .unwrap_or_else(|| quick_blas_shared(&placed[o].mesh))
                 })
                 .collect()
         }

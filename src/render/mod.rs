@@ -386,7 +386,7 @@ impl Renderer {
                         .into_par_iter()
                         .map(|m| {
                             (!stop.load(Ordering::Relaxed)).then(|| {
-                                let b = crate::bvh::Blas::of_mesh(&m.positions, &m.indices);
+                                let b = crate::bvh::Blas::of_shared_mesh(&m);
                                 (m, b)
                             })
                         })
@@ -461,7 +461,7 @@ impl Renderer {
         // Two levels: the meshes' triangles (BLAS after BLAS), and whether any has tangents.
         let (mesh_triangles, mesh_tangents) = match &host.accel {
             Accel::TwoLevel(two) => (
-                two.blases.iter().map(|b| b.triangles.len()).sum(),
+                two.blases.iter().map(|b| b.len()).sum(),
                 meshes.iter().any(|m| !m.tangents.is_empty()),
             ),
             Accel::Flat(_) => (0, false),
@@ -1006,7 +1006,7 @@ fn device_accel(
         Accel::Flat(_) => vec![GpuInstance::default()],
         Accel::TwoLevel(two) => {
             // The small instances' world-space copies follow the meshes' triangles.
-            let first = two.blases.iter().map(|b| b.triangles.len()).sum();
+            let first = two.blases.iter().map(|b| b.len()).sum();
             host.triangles = host.layout.piece_copies(two, first);
             host.layout.gpu_instances(two)
         }

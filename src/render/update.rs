@@ -50,7 +50,7 @@ impl Renderer {
             let object = &scene.objects[o as usize];
             let inst = &two.instances[i];
             let blas = &two.blases[inst.blas as usize];
-            if object.mesh.indices.len() != blas.triangles.len() {
+            if object.mesh.indices.len() != blas.len() {
                 return Ok(None);
             }
             let m = frame * object.world_from_object;

@@ -161,11 +161,10 @@ pub fn piece_copies(two: &TwoLevel, mesh: &[GpuTriangle], i: usize) -> Vec<GpuTr
     let inst = &two.instances[i];
     let v = |p: Vec3, payload: f32| [p.x, p.y, p.z, payload];
     two.blases[inst.blas as usize]
-        .triangles
-        .iter()
+        .triangles()
         .zip(mesh)
         .map(|(t, o)| {
-            let w = inst.device_triangle(t);
+            let w = inst.device_triangle(&t);
             GpuTriangle {
                 v0: v(w[0], o.v0[3]),
                 v1: v(w[1], o.v1[3]),
