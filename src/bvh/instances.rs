@@ -118,10 +118,7 @@ impl Blas {
 
     /// [`Bvh::traverse`] of this BLAS's tree over its triangles.
     pub fn traverse(&self, root: u32, ray: &Ray, any: bool) -> Option<Hit> {
-        match &self.triangles {
-            BlasTriangles::Copied(t) => self.bvh.traverse(root, ray, t, any),
-            BlasTriangles::Mesh(_) => self.bvh.traverse_by(root, ray, any, |k| self.triangle(k)),
-        }
+        self.bvh.traverse_by(root, ray, any, |k| self.triangle(k))
     }
 
     /// The object-space box of the whole mesh.

@@ -81,11 +81,7 @@ pub fn quick_blas(positions: &[Vec3], indices: &[[u32; 3]]) -> super::Blas {
 /// triangles in BVH order the build needs are freed once the tree is made, so that a scene's
 /// BLASes hold no copy of them (a 64 M-triangle scene's 2.3 GB).
 pub fn quick_blas_shared(mesh: &std::sync::Arc<crate::scene::Mesh>) -> super::Blas {
-    let (bvh, triangles) = quick_over(mesh.indices.len(), &|i| {
-        mesh.indices[i].map(|v| mesh.positions[v as usize])
-    });
-    drop(triangles);
-    super::Blas::over_mesh(bvh, mesh)
+    super::Blas::over_mesh(quick_blas(&mesh.positions, &mesh.indices).bvh, mesh)
 }
 
 /// The triangles `triangle(i)` for i in `order`.

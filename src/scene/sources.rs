@@ -45,10 +45,8 @@ impl Bytes {
             let len = map.len();
             return Ok(Bytes::Mapped(map, 0..len));
         }
-        let mut data = Vec::with_capacity(size as usize);
-        let mut file = file;
-        file.read_to_end(&mut data)?;
-        Ok(Bytes::Owned(data))
+        drop(file);
+        Ok(Bytes::Owned(std::fs::read(path)?))
     }
 
     /// The bytes of `range` (within these) alone; owned ones are moved down in place.
