@@ -221,15 +221,20 @@ impl FrameLoop {
         self.budget
             .record(batch.plan.divisor, pixel_count(size), batch.plan.spp, ms);
         let spp = self.renderer.samples();
+        // The last film's arrays take the new one in their allocations: a frame allocates no
+        // film-sized memory.
+        let mut pixels = std::mem::take(&mut self.film.pixels);
+        self.renderer.image_into(&mut pixels)?;
+        let mut coverage = std::mem::take(&mut self.film.coverage);
+        coverage.clear();
+        if settings.cutout || settings.count_coverage {
+            self.renderer.coverage_into(&mut coverage)?;
+        }
         self.film = Film {
             width: size.0,
             height: size.1,
-            pixels: self.renderer.image()?,
-            coverage: if settings.cutout || settings.count_coverage {
-                self.renderer.coverage()?
-            } else {
-                Vec::new()
-            },
+            pixels,
+            coverage,
             cutout: settings.cutout,
             spp,
             divisor: batch.plan.divisor,

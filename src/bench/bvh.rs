@@ -36,6 +36,8 @@ pub fn peak_rss_bytes() -> Option<u64> {
 
 /// Runs the benchmark.
 pub fn run(args: &BvhArgs) -> Result<()> {
+    // Every step measured is part of opening a scene, under its allocator policy.
+    let _memory = crate::cl::kernels::OpeningMemory::begin();
     let before = peak_rss_bytes();
     let t = Instant::now();
     let scene = load(&args.scene)?;

@@ -137,17 +137,26 @@ impl<T: Pod> Buffer<T> {
 
     /// Reads the whole buffer back (blocking).
     pub fn read(&self, gpu: &Gpu) -> Result<Vec<T>, ClError> {
-        let mut out = vec![T::zeroed(); self.len];
+        let mut out = Vec::new();
+        self.read_into(gpu, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Buffer::read`] into `out`, whose allocation is reused when it is large enough (a
+    /// frame's film read back without a fresh allocation).
+    pub fn read_into(&self, gpu: &Gpu, out: &mut Vec<T>) -> Result<(), ClError> {
+        out.truncate(self.len);
+        out.resize(self.len, T::zeroed());
         if self.len == 0 {
-            return Ok(out);
+            return Ok(());
         }
         // SAFETY: `out` has exactly the buffer's length; the read is blocking.
         unsafe {
             gpu.queue
-                .enqueue_read_buffer(&self.inner, CL_BLOCKING, 0, &mut out, &[])
+                .enqueue_read_buffer(&self.inner, CL_BLOCKING, 0, out, &[])
                 .map_err(call_err("reading a buffer back"))?;
         }
-        Ok(out)
+        Ok(())
     }
 
     /// Sets every element to zero.
@@ -221,6 +230,73 @@ pub fn map_file(file: &std::fs::File) -> std::io::Result<memmap2::Mmap> {
     // as with a read racing a writer), and a file truncated meanwhile would fault, the one
     // risk `Mmap` documents, which the loader accepts for files of 64 MiB and more.
     unsafe { memmap2::Mmap::map(file) }
+}
+
+/// While a scene opens, blocks of at least this size are mapped fresh and unmapped when freed
+/// (glibc's `M_MMAP_THRESHOLD`), so that the loader's and the builders' working arrays go back
+/// to the system at once. glibc's default starts at 128 KiB and rises to the largest mapped
+/// block freed so far: after a scene's bounds and first BVH build, arrays of several MB came
+/// from the heaps of the threads that had freed them, stayed resident there, and new ones were
+/// placed beside them (a 1 M-triangle room of 144 K distinct triangles: 155–220 B of peak
+/// memory a distinct triangle, growing with every rebuild, against 127–135 B so).
+const OPENING_MMAP_THRESHOLD: i32 = 2 << 20;
+
+/// Between openings: glibc's own ceiling for its dynamic threshold (32 MiB on 64-bit), which its
+/// default reaches as a session goes on, so that what frames allocate and free again (display
+/// images, the driver's own blocks) is reused from the heap rather than faulted in afresh.
+const STEADY_MMAP_THRESHOLD: i32 = 32 << 20;
+
+/// Openings in progress ([`OpeningMemory`]).
+static OPENINGS: std::sync::Mutex<usize> = std::sync::Mutex::new(0);
+
+/// Sets glibc's mapping and heap-trim thresholds; nothing where the user set one
+/// (`MALLOC_MMAP_THRESHOLD_`) or the allocator is not glibc's.
+fn set_malloc_thresholds(mmap: i32, trim: i32) {
+    if std::env::var_os("MALLOC_MMAP_THRESHOLD_").is_some() {
+        return;
+    }
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: `mallopt` only changes the allocator's policy for later calls.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, mmap);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, trim);
+    }
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    let _ = (mmap, trim);
+}
+
+/// The allocator's policy while a scene opens (loading, the framing probe, BVH builds, the
+/// upload), held as a guard, nested or on several threads: large blocks are mapped while any
+/// opening runs ([`OPENING_MMAP_THRESHOLD`]); when the last one ends the steady policy returns
+/// ([`STEADY_MMAP_THRESHOLD`], the heap trimmed above twice that, as glibc's dynamic rule
+/// does) and what the allocator holds free is given back (`malloc_trim`).
+pub struct OpeningMemory(());
+
+impl OpeningMemory {
+    /// Starts an opening.
+    pub fn begin() -> Self {
+        let mut n = OPENINGS.lock().unwrap_or_else(|e| e.into_inner());
+        if *n == 0 {
+            set_malloc_thresholds(OPENING_MMAP_THRESHOLD, 128 << 10);
+        }
+        *n += 1;
+        OpeningMemory(())
+    }
+}
+
+impl Drop for OpeningMemory {
+    fn drop(&mut self) {
+        let mut n = OPENINGS.lock().unwrap_or_else(|e| e.into_inner());
+        *n -= 1;
+        if *n == 0 {
+            set_malloc_thresholds(STEADY_MMAP_THRESHOLD, 2 * STEADY_MMAP_THRESHOLD);
+            #[cfg(all(target_os = "linux", target_env = "gnu"))]
+            // SAFETY: `malloc_trim` only returns free pages of the allocator's heaps.
+            unsafe {
+                libc::malloc_trim(0);
+            }
+        }
+    }
 }
 
 /// The piece of a [`populate`] task (a multiple of [`HUGE_PAGE`]).
@@ -1244,5 +1320,24 @@ mod tests {
         for _ in 0..8 {
             drop(Buffer::<u32>::new(&gpu, 3 * len).expect("a buffer"));
         }
+    }
+
+    #[test]
+    fn reading_into_a_kept_vector_reuses_its_memory_and_reads_every_element() {
+        let Ok(gpu) = Gpu::open(&DeviceChoice::Cpu) else {
+            return; // no CPU device here (a GPU-only machine)
+        };
+        let data: Vec<u32> = (0..1000u32).map(|i| i * 3 + 1).collect();
+        let b = Buffer::from_slice(&gpu, &data).expect("the buffer is made");
+        // Longer than the buffer, with other contents: cut to its length and overwritten.
+        let mut out = vec![9u32; 1500];
+        let at = out.as_ptr();
+        b.read_into(&gpu, &mut out).expect("it reads back");
+        assert_eq!(out, data);
+        assert_eq!(out.as_ptr(), at, "the vector's allocation is kept");
+        // Shorter: grown to the buffer's length.
+        let mut short = vec![5u32; 10];
+        b.read_into(&gpu, &mut short).expect("it reads back");
+        assert_eq!(short, data);
     }
 }

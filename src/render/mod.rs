@@ -174,6 +174,8 @@ pub struct Renderer {
     /// Node arrays uploaded beyond those the kernels in use traverse (see
     /// [`Renderer::set_node_forms`]).
     extra_forms: NodeForms,
+    /// The film as last read back (sums and counts), kept for the next read.
+    readback: Vec<[f32; 4]>,
 }
 
 /// The BLASes of a background build, with their meshes in the plan's order, and its time (ms).
@@ -232,6 +234,7 @@ impl Renderer {
             sah: None,
             sah_waiting: None,
             extra_forms: NodeForms::NONE,
+            readback: Vec::new(),
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -380,6 +383,7 @@ impl Renderer {
         std::thread::Builder::new()
             .name("sah-blas".into())
             .spawn(move || {
+                let _memory = crate::cl::kernels::OpeningMemory::begin();
                 let t = Instant::now();
                 let blases: Option<Vec<_>> = pool.install(|| {
                     meshes
@@ -411,6 +415,7 @@ impl Renderer {
         how: instancing::Blases,
         reuse: Option<SceneBuffers>,
     ) -> Result<SceneStats, ClError> {
+        let _memory = crate::cl::kernels::OpeningMemory::begin();
         self.sah = None;
         self.sah_waiting = None;
         let mut behind = None;
@@ -912,48 +917,61 @@ impl Renderer {
 
     /// The film as linear RGB (the mean of the samples), row by row from the top.
     pub fn image(&mut self) -> Result<Vec<[f32; 3]>, ClError> {
+        let mut image = Vec::new();
+        self.image_into(&mut image)?;
+        Ok(image)
+    }
+
+    /// [`Renderer::image`] into `image`, reusing its allocation and the renderer's readback
+    /// buffer: the viewer's frames allocate no film-sized memory.
+    pub fn image_into(&mut self, image: &mut Vec<[f32; 3]>) -> Result<(), ClError> {
         if !self.pending.is_empty() {
             self.finish()?;
         }
+        image.clear();
         let Some(f) = self.frame.as_ref() else {
             let n = (self.settings.width * self.settings.height) as usize;
-            return Ok(vec![[0.0; 3]; n]);
+            image.resize(n, [0.0; 3]);
+            return Ok(());
         };
-        let film = f.film.read(&self.gpu)?;
+        f.film.read_into(&self.gpu, &mut self.readback)?;
         if self.settings.cutout || self.settings.count_coverage {
             // `.w` counts the samples whose camera ray hit: the mean is over all samples.
             let n = self.samples.max(1) as f32;
-            return Ok(film
-                .iter()
-                .map(|p| [p[0] / n, p[1] / n, p[2] / n])
-                .collect());
+            image.extend(self.readback.iter().map(|p| [p[0] / n, p[1] / n, p[2] / n]));
+            return Ok(());
         }
-        Ok(film
-            .iter()
-            .map(|p| {
-                let n = p[3].max(1.0);
-                [p[0] / n, p[1] / n, p[2] / n]
-            })
-            .collect())
+        image.extend(self.readback.iter().map(|p| {
+            let n = p[3].max(1.0);
+            [p[0] / n, p[1] / n, p[2] / n]
+        }));
+        Ok(())
     }
 
     /// Each pixel's coverage: the share of its samples whose camera ray hit the scene, with
     /// [`RenderSettings::cutout`] or [`RenderSettings::count_coverage`] (else all 1).
     pub fn coverage(&mut self) -> Result<Vec<f32>, ClError> {
+        let mut coverage = Vec::new();
+        self.coverage_into(&mut coverage)?;
+        Ok(coverage)
+    }
+
+    /// [`Renderer::coverage`] into `coverage`, reusing its allocation and the readback buffer.
+    pub fn coverage_into(&mut self, coverage: &mut Vec<f32>) -> Result<(), ClError> {
         if !self.pending.is_empty() {
             self.finish()?;
         }
+        coverage.clear();
         let n = (self.settings.width * self.settings.height) as usize;
         let counted = self.settings.cutout || self.settings.count_coverage;
         let Some(f) = self.frame.as_ref().filter(|_| counted) else {
-            return Ok(vec![1.0; n]);
+            coverage.resize(n, 1.0);
+            return Ok(());
         };
+        f.film.read_into(&self.gpu, &mut self.readback)?;
         let total = self.samples.max(1) as f32;
-        Ok(f.film
-            .read(&self.gpu)?
-            .iter()
-            .map(|p| (p[3] / total).clamp(0.0, 1.0))
-            .collect())
+        coverage.extend(self.readback.iter().map(|p| (p[3] / total).clamp(0.0, 1.0)));
+        Ok(())
     }
 }
 

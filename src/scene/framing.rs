@@ -1140,6 +1140,7 @@ pub fn first_view(
     camera: Option<&Camera>,
     aspect: f64,
 ) -> FirstView {
+    let _memory = crate::cl::kernels::OpeningMemory::begin();
     let probe = Probe::new(scene);
     let t = std::time::Instant::now();
     let view = first_view_with(&probe, lights, camera, aspect);

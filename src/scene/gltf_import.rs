@@ -54,6 +54,7 @@ pub(super) fn load_bytes(bytes: sources::Bytes) -> Result<Scene, String> {
 /// computed, so that the file and the imported meshes are held together only while the
 /// meshes are read.
 fn load_owned(bytes: sources::Bytes, base: Option<&Path>, source: &str) -> Result<Scene, String> {
+    let _memory = crate::cl::kernels::OpeningMemory::begin();
     let mut warnings = Vec::new();
     let parsed = validate::parse(bytes, &mut warnings)?;
     let document = parsed.document;
