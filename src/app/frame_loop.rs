@@ -224,12 +224,11 @@ impl FrameLoop {
         // The last film's arrays take the new one in their allocations: a frame allocates no
         // film-sized memory.
         let mut pixels = std::mem::take(&mut self.film.pixels);
-        self.renderer.image_into(&mut pixels)?;
         let mut coverage = std::mem::take(&mut self.film.coverage);
         coverage.clear();
-        if settings.cutout || settings.count_coverage {
-            self.renderer.coverage_into(&mut coverage)?;
-        }
+        let counted = settings.cutout || settings.count_coverage;
+        self.renderer
+            .image_into(&mut pixels, counted.then_some(&mut coverage))?;
         self.film = Film {
             width: size.0,
             height: size.1,

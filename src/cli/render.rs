@@ -83,11 +83,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .map(|(a, b)| b - a);
     bar.finish_and_clear();
 
-    let image = renderer.image()?;
+    // The image and each pixel's coverage, from one read of the film: the subject is metered
+    // without the background. With the background cut out, the straight color is metered and
+    // tone-mapped.
+    let (mut image, mut coverage) = (Vec::new(), Vec::new());
+    renderer.image_into(&mut image, Some(&mut coverage))?;
     let background = args.common.background;
-    // Each pixel's coverage: the subject is metered without the background. With the background
-    // cut out, the straight color is metered and tone-mapped.
-    let coverage = renderer.coverage()?;
     let straight = background
         .cutout()
         .then(|| unpremultiply(&image, &coverage));
