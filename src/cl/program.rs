@@ -164,17 +164,43 @@ pub fn test_program_source() -> String {
 /// the directory (e.g. `PENUMBRA_KERNEL_DIR=.` for `kernels/path.h`) replaces the built-in text.
 fn append_sources(s: &mut String, sources: &[(&str, &str)]) {
     let dir = std::env::var_os("PENUMBRA_KERNEL_DIR").map(std::path::PathBuf::from);
+    let found = with_overrides(s, sources, dir.as_deref());
+    if let Some(dir) = dir.filter(|_| found == 0) {
+        // Without this, an experiment run with the wrong folder silently measures the
+        // built-in kernels (the names carry their `kernels/` folder).
+        static WARNED: std::sync::Once = std::sync::Once::new();
+        WARNED.call_once(|| {
+            log::warn!(
+                "PENUMBRA_KERNEL_DIR={}: no kernel file there (it must hold kernels/{}); \
+                 the built-in kernels are used",
+                dir.display(),
+                sources.first().map_or("", |(name, _)| {
+                    name.strip_prefix("kernels/").unwrap_or(name)
+                })
+            )
+        });
+    }
+}
+
+/// [`append_sources`] with the override folder given: returns how many files it replaced.
+fn with_overrides(
+    s: &mut String,
+    sources: &[(&str, &str)],
+    dir: Option<&std::path::Path>,
+) -> usize {
+    let mut found = 0;
     for (name, text) in sources {
         s.push_str(&format!("#line 1 \"{name}\"\n"));
-        match dir
-            .as_ref()
-            .and_then(|d| std::fs::read_to_string(d.join(name)).ok())
-        {
-            Some(edited) => s.push_str(&edited),
+        match dir.and_then(|d| std::fs::read_to_string(d.join(name)).ok()) {
+            Some(edited) => {
+                found += 1;
+                s.push_str(&edited);
+            }
             None => s.push_str(text),
         }
         s.push('\n');
     }
+    found
 }
 
 /// Builds the program for `features` on the device. A failure returns the compiler's first
@@ -320,6 +346,33 @@ mod tests {
         };
         assert_eq!(small.defines(), " -DLAMBERT_ONLY -DSMALL_SCENE=32");
         assert!(!KernelFeatures::default().defines().contains("SMALL_SCENE"));
+    }
+
+    #[test]
+    fn a_kernel_folder_replaces_only_the_files_it_holds() {
+        let dir = tempfile::tempdir().unwrap();
+        let (name, _) = SOURCES[1];
+        let path = dir.path().join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, "// edited\n").unwrap();
+        let mut s = String::new();
+        assert_eq!(with_overrides(&mut s, SOURCES, Some(dir.path())), 1);
+        assert!(s.contains("// edited"));
+        assert!(s.contains(SOURCES[0].1), "the other files stay built in");
+        assert!(!s.contains(SOURCES[1].1));
+        // The files themselves, without their kernels/ folder, are not found.
+        let flat = tempfile::tempdir().unwrap();
+        std::fs::write(
+            flat.path()
+                .join(std::path::Path::new(name).file_name().unwrap()),
+            "x",
+        )
+        .unwrap();
+        assert_eq!(
+            with_overrides(&mut String::new(), SOURCES, Some(flat.path())),
+            0
+        );
+        assert_eq!(with_overrides(&mut String::new(), SOURCES, None), 0);
     }
 
     #[test]
