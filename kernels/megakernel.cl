@@ -3,7 +3,7 @@
 // path state in registers: no queues, no path buffers, one launch per pass. Each vertex is
 // shaded by path.h's shade_vertex, as the wavefront's `shade` does, and its light sample is
 // traced at once (the wavefront's `connect`), so both compute the same estimator from the
-// same random numbers. The samples of a pixel are summed in order and added to the film once.
+// same random numbers. The samples of a pixel are added to its film sum in order, one by one.
 //
 // Rays are traced through the 4-wide BVH (traverse_wide.h), whose box tests use the CPU's
 // vector lanes.
@@ -35,7 +35,10 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
                      lights,
                      light_cdf};
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
-    float3 sum = (float3)(0.0f);
+    // The samples are added to the film's sum one by one, so that the image does not depend
+    // on how many samples each launch took (a float sum depends on its order).
+    float4 pixel_film = film[pixel];
+    float3 sum = pixel_film.xyz;
     uint extension_rays = 0;
     uint shadow_rays = 0;
     uint nonfinite = 0;
@@ -72,7 +75,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
         }
     }
     if (frame.background == BACKGROUND_ENV) counted = frame.samples_in_wave;
-    film[pixel] += (float4)(sum, (float)counted);
+    film[pixel] = (float4)(sum, pixel_film.w + (float)counted);
     // One atomic per work item for the statistics; `advance` moves them into the totals.
     atomic_add(&counters[COUNT_IN], extension_rays);
     atomic_add(&counters[COUNT_SHADOW], shadow_rays);

@@ -139,7 +139,10 @@ kernel void accumulate(GpuFrame frame, global const GpuPath* paths, global float
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels) return;
-    float3 sum = (float3)(0.0f);
+    // Added to the film's sum one by one, so that the image does not depend on how many
+    // samples each wave took (a float sum depends on its order).
+    float4 pixel_film = film[pixel];
+    float3 sum = pixel_film.xyz;
     for (uint j = 0; j < frame.samples_in_wave; ++j) {
         float3 r = paths[pixel + j * pixels].radiance.xyz;
         if (all(isfinite(r))) {
@@ -155,5 +158,5 @@ kernel void accumulate(GpuFrame frame, global const GpuPath* paths, global float
             counted += (as_uint(paths[pixel + j * pixels].direction.w) & PATH_ESCAPED) == 0u;
         }
     }
-    film[pixel] += (float4)(sum, (float)counted);
+    film[pixel] = (float4)(sum, pixel_film.w + (float)counted);
 }

@@ -273,3 +273,50 @@ fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
     assert!(!shown.kernels_built);
     assert_eq!(again, whole);
 }
+
+#[test]
+fn samples_in_one_call_or_many_make_the_same_image() {
+    // `render` sizes its calls by time (a pixel's samples back to back in one launch run
+    // faster on a CPU); the image must not depend on how the samples were split, in either
+    // kernel: each adds a pixel's samples to the film one by one.
+    use penumbra::render::{KernelChoice, RenderSettings, Renderer};
+    use penumbra::scene::RenderFrame;
+    let choice = common::test_device().parse().unwrap();
+    let scene = penumbra::scene::load_or_bundled(None).unwrap();
+    let image = |kernel: KernelChoice, splits: &[u32]| {
+        let mut r = Renderer::new(&choice).unwrap();
+        r.set_kernel(kernel).unwrap();
+        r.set_settings(&RenderSettings {
+            width: 24,
+            height: 20,
+            bounces: 4,
+            ..Default::default()
+        })
+        .unwrap();
+        r.load_scene_in(&scene, &scene.lights, RenderFrame::default())
+            .unwrap();
+        r.set_camera(&scene.cameras[0]).unwrap();
+        for &n in splits {
+            r.render(n).unwrap();
+        }
+        assert_eq!(r.kernel(), kernel);
+        r.image().unwrap()
+    };
+    for kernel in [KernelChoice::Megakernel, KernelChoice::Wavefront] {
+        let whole = image(kernel, &[12]);
+        assert!(
+            whole.iter().any(|p| p[0] + p[1] + p[2] > 0.0),
+            "{kernel:?}: a black image"
+        );
+        assert_eq!(
+            image(kernel, &[1; 12]),
+            whole,
+            "{kernel:?}: twelve calls of one"
+        );
+        assert_eq!(
+            image(kernel, &[5, 7]),
+            whole,
+            "{kernel:?}: calls of five and seven"
+        );
+    }
+}

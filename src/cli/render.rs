@@ -63,13 +63,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     );
     // Without a terminal (a log, CI), plain lines every 10% or 2 s instead of the bar.
     let mut lines = (!std::io::stderr().is_terminal()).then(|| ProgressLines::new(spp));
-    let chunk = spp.div_ceil(50).max(1);
     let start = Instant::now();
     let cpu_start = crate::cpu_time::process_cpu_seconds();
     let mut done = 0;
+    // One sample a pixel first, then calls sized by the time a sample took.
+    let mut chunk = 1;
     while done < spp {
         let n = chunk.min(spp - done);
+        let call = Instant::now();
         renderer.render(n)?;
+        chunk = samples_per_call(call.elapsed().as_secs_f64() / f64::from(n));
         done += n;
         bar.set_position(done as u64);
         if let Some(l) = lines.as_mut() {
@@ -183,6 +186,26 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The seconds a call of `render` aims at: the progress moves about this often.
+const SECONDS_PER_CALL: f64 = 2.0;
+
+/// At most this many samples a pixel in one call.
+const MAX_SAMPLES_PER_CALL: u32 = 1024;
+
+/// The samples a pixel of the next call, from the seconds one took: as many as fill
+/// [`SECONDS_PER_CALL`]. Few large calls are faster than many small ones: a launch of n samples
+/// has each pixel's n paths traced one after the other by the megakernel's work item, so the
+/// tree's nodes around the pixel's first hits are still cached for the next path (on a CPU,
+/// the 1 M-triangle bunnies render 20 % faster at 16 samples a launch than at one:
+/// docs/benchmarks.md, "Thirteenth session"); the image is the same, sample for sample.
+fn samples_per_call(seconds_per_sample: f64) -> u32 {
+    if seconds_per_sample.is_finite() && seconds_per_sample > 0.0 {
+        (SECONDS_PER_CALL / seconds_per_sample).clamp(1.0, MAX_SAMPLES_PER_CALL as f64) as u32
+    } else {
+        MAX_SAMPLES_PER_CALL
+    }
+}
+
 /// Progress as plain lines on stderr: one each 10% of the samples or 2 s, whichever comes first.
 struct ProgressLines {
     spp: u32,
@@ -209,5 +232,22 @@ impl ProgressLines {
             self.next_percent = (percent / 10 + 1) * 10;
             self.last = seconds;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn calls_are_sized_to_the_time_a_sample_takes() {
+        assert_eq!(samples_per_call(0.1), 20);
+        assert_eq!(samples_per_call(SECONDS_PER_CALL), 1);
+        // A sample slower than a whole call still renders, one at a time.
+        assert_eq!(samples_per_call(60.0), 1);
+        assert_eq!(samples_per_call(1e-9), MAX_SAMPLES_PER_CALL);
+        // A call too quick to time (or a clock that did not move) takes the most.
+        assert_eq!(samples_per_call(0.0), MAX_SAMPLES_PER_CALL);
+        assert_eq!(samples_per_call(f64::NAN), MAX_SAMPLES_PER_CALL);
     }
 }
