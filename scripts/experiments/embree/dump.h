@@ -16,3 +16,15 @@ static void save(const char* dir, const char* name, const void* p, size_t size) 
     char path[1024]; snprintf(path, sizeof path, "%s/%s", dir, name);
     FILE* f = fopen(path, "wb"); if (!f) { perror(path); exit(1); } fwrite(p, 1, size, f); fclose(f);
 }
+// Copies the dump's primary and diffuse rays from `in` to `out`, with their hits' triangle
+// indices renumbered through new_index (triangles moved by a relayout).
+static void save_sets(const char* in, const char* out, const uint32_t* new_index) {
+    const char* sets[] = {"primary", "diffuse"};
+    for (int s = 0; s < 2; ++s) {
+        char name[64]; size_t rs, hs;
+        snprintf(name, sizeof name, "%s_rays.bin", sets[s]); void* rays = load(in, name, &rs); save(out, name, rays, rs);
+        snprintf(name, sizeof name, "%s_hits.bin", sets[s]); Hit* h = load(in, name, &hs);
+        for (size_t i = 0; i < hs / sizeof(Hit); ++i) if (h[i].prim != 0xffffffffu) h[i].prim = new_index[h[i].prim];
+        save(out, name, h, hs);
+    }
+}

@@ -62,13 +62,6 @@ int main(int argc, char** argv) {
     size_t leaves = 0; for (size_t i = 0; i < node_count; ++i) for (int k = 0; k < 4; ++k) leaves += nodes[i].count[k] > 0;
     fprintf(stderr, "Embree tree: %zu wide nodes, %zu leaves (%.2f triangles a leaf)\n", node_count, leaves, (double)n / leaves);
     save(out, "nodes.bin", nodes, node_count * sizeof(WideNode)); save(out, "tris.bin", out_tris, ts);
-    const char* sets[] = {"primary", "diffuse"};
-    for (int s = 0; s < 2; ++s) {
-        char name[64]; size_t rs, hs;
-        snprintf(name, sizeof name, "%s_rays.bin", sets[s]); void* rays = load(in, name, &rs); save(out, name, rays, rs);
-        snprintf(name, sizeof name, "%s_hits.bin", sets[s]); Hit* h = load(in, name, &hs);
-        for (size_t i = 0; i < hs / sizeof(Hit); ++i) if (h[i].prim != 0xffffffffu) h[i].prim = new_index[h[i].prim];
-        save(out, name, h, hs);
-    }
+    save_sets(in, out, new_index);
     return 0;
 }

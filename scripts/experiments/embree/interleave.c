@@ -41,13 +41,6 @@ int main(int argc, char** argv) {
     if (new_node[0] != 0) { fprintf(stderr, "root not at 0\n"); return 1; }
     fprintf(stderr, "interleaved: %zu bytes (nodes %zu + triangles %zu)\n", at, ns, ts);
     save(out, "nodes.bin", buf, up(at, 128)); save(out, "tris.bin", "", 0);
-    const char* sets[] = {"primary", "diffuse"};
-    for (int s = 0; s < 2; ++s) {
-        char name[64]; size_t rs, hs;
-        snprintf(name, sizeof name, "%s_rays.bin", sets[s]); void* rays = load(in, name, &rs); save(out, name, rays, rs);
-        snprintf(name, sizeof name, "%s_hits.bin", sets[s]); Hit* h = load(in, name, &hs);
-        for (size_t i = 0; i < hs / sizeof(Hit); ++i) if (h[i].prim != 0xffffffffu) h[i].prim = new_tri[h[i].prim];
-        save(out, name, h, hs);
-    }
+    save_sets(in, out, new_tri);
     return 0;
 }
