@@ -191,8 +191,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 /// The seconds a call of `render` aims at: the progress moves about this often.
 const SECONDS_PER_CALL: f64 = 2.0;
 
-/// At least this many samples a pixel in one call after the first (fewer only at the end):
-/// a large image on a CPU, seconds a sample, still gets most of the gain of back-to-back
+/// At least this many samples a pixel in one call, the first included (fewer only at the
+/// end): a large image on a CPU, seconds a sample, still gets most of the gain of back-to-back
 /// samples (the bunnies at 960×540: +15 % at 8 a call), at the price of coarser progress.
 const MIN_SAMPLES_PER_CALL: u32 = 8;
 
@@ -200,11 +200,12 @@ const MIN_SAMPLES_PER_CALL: u32 = 8;
 const MAX_SAMPLES_PER_CALL: u32 = 1024;
 
 /// The samples a pixel of the next call, from the seconds one took: as many as fill
-/// [`SECONDS_PER_CALL`], and at least [`MIN_SAMPLES_PER_CALL`]. Few large calls are faster than many small ones: a launch of n samples
-/// has each pixel's n paths traced one after the other by the megakernel's work item, so the
-/// tree's nodes around the pixel's first hits are still cached for the next path (on a CPU,
-/// the 1 M-triangle bunnies render 20 % faster at 16 samples a launch than at one:
-/// docs/benchmarks.md, "Thirteenth session"); the image is the same, sample for sample.
+/// [`SECONDS_PER_CALL`], and at least [`MIN_SAMPLES_PER_CALL`]. Few large calls are faster
+/// than many small ones: a launch of n samples has each pixel's n paths traced one after the
+/// other by the megakernel's work item, so the tree's nodes around the pixel's first hits are
+/// still cached for the next path (on a CPU, the 1 M-triangle bunnies render 10–20 % faster
+/// at 16 samples a launch than at one: docs/benchmarks.md, "Thirteenth session"). The image
+/// is the same bit for bit: the kernels add a pixel's samples to the film one by one.
 fn samples_per_call(seconds_per_sample: f64) -> u32 {
     if seconds_per_sample.is_finite() && seconds_per_sample > 0.0 {
         (SECONDS_PER_CALL / seconds_per_sample)
