@@ -8,6 +8,107 @@
 // Rays are traced through the 4-wide BVH (traverse_wide.h), whose box tests use the CPU's
 // vector lanes.
 
+#ifdef MEGA_LANES
+// With MEGA_LANES a work item renders LANES_PIXELS pixels through LANES lanes
+// (traverse_lanes.h): a lane takes a pixel, traces its samples one after the other, as the
+// one-pixel kernel below does (so a pixel's samples are added in the same order, and the
+// image is the same bit for bit), then takes the next pixel. The lanes' extension rays are
+// walked together; when some are done, their vertices are shaded at once by the same
+// shade_vertex, their light samples traced there and then (one ray at a time: the any-hit walk
+// without sorting is as fast alone as in lanes), and each lane takes its path's next ray.
+kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environment,
+                       global const GpuWideNode* nodes, global const GpuTriangle* tris,
+                       global const GpuInstance* instances,
+                       global const GpuTriangle* object_tris,
+                       global const GpuTriShading* shading,
+                       global const GpuTriUvs* uvs,
+                       global const GpuTriTangents* tangents,
+                       global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
+                       global const GpuTexture* textures, global const uint* texels,
+                       global const float* env_texels, global const float* env_marginal,
+                       global const float* env_conditional, global const GpuLight* lights,
+                       global const float* light_cdf, global float4* film,
+                       volatile global uint* counters) {
+    uint pixels = frame.width * frame.height;
+    uint next_pixel = get_global_id(0) * LANES_PIXELS;
+    uint end_pixel = min(next_pixel + LANES_PIXELS, pixels);
+    if (next_pixel >= pixels || frame.samples_in_wave == 0u) return;
+    ShadeScene sc = {tris,
+                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances},
+                     {environment, env_texels, env_marginal, env_conditional},
+                     lights,
+                     light_cdf};
+    volatile global uint* overflow = &counters[COUNT_OVERFLOW];
+    LaneMemory M;
+    lanes_init(&M);
+    PathState s[LANES];
+    float3 sum[LANES];
+    float film_w[LANES];
+    uint pixel[LANES], bounce[LANES], sample[LANES], counted[LANES];
+    uint extension_rays = 0;
+    uint shadow_rays = 0;
+    uint nonfinite = 0;
+    // A lane takes the next pixel (its film sum and its first camera ray); with none left it
+    // stays idle.
+#define LANE_NEXT_PIXEL(l)                                                             \
+    if (next_pixel < end_pixel) {                                                      \
+        uint p = next_pixel++;                                                         \
+        float4 f = film[p];                                                            \
+        pixel[l] = p;                                                                  \
+        sum[l] = f.xyz;                                                                \
+        film_w[l] = f.w;                                                               \
+        counted[l] = 0u;                                                               \
+        sample[l] = 0u;                                                                \
+        bounce[l] = 0u;                                                                \
+        s[l] = camera_path(&frame, &camera, p, frame.first_sample);                    \
+        lanes_set_ray(&M, l, s[l].origin, s[l].direction);                             \
+    }
+    for (int l = 0; l < LANES; ++l) {
+        LANE_NEXT_PIXEL(l)
+    }
+    for (;;) {
+        int16 done = lanes_walk(&M, nodes, tris, &sc.surf, overflow);
+        if (!lanes_any(done)) break;
+        int done_[LANES];
+        vstore16(done, 0, done_);
+        for (int l = 0; l < LANES; ++l) {
+            if (!done_[l]) continue;
+            ++extension_rays;
+            ShadowQuery q;
+            bool alive = shade_vertex(&frame, bounce[l], &sc, lanes_hit(&M, l), &s[l], &q);
+            if (q.valid) {
+                ++shadow_rays;
+                s[l].radiance +=
+                    shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, &q, overflow);
+            }
+            // The path goes on, or the pixel's next sample starts, or the lane's next pixel.
+            if (alive && ++bounce[l] <= frame.max_bounces + 1u) {
+                lanes_set_ray(&M, l, s[l].origin, s[l].direction);
+                continue;
+            }
+            counted[l] += (s[l].flags & PATH_ESCAPED) == 0u;
+            if (all(isfinite(s[l].radiance))) {
+                sum[l] += s[l].radiance;
+            } else {
+                ++nonfinite;
+            }
+            if (++sample[l] < frame.samples_in_wave) {
+                bounce[l] = 0u;
+                s[l] = camera_path(&frame, &camera, pixel[l], frame.first_sample + sample[l]);
+                lanes_set_ray(&M, l, s[l].origin, s[l].direction);
+                continue;
+            }
+            uint c = frame.background == BACKGROUND_ENV ? frame.samples_in_wave : counted[l];
+            film[pixel[l]] = (float4)(sum[l], film_w[l] + (float)c);
+            LANE_NEXT_PIXEL(l)
+        }
+    }
+#undef LANE_NEXT_PIXEL
+    atomic_add(&counters[COUNT_IN], extension_rays);
+    atomic_add(&counters[COUNT_SHADOW], shadow_rays);
+    if (nonfinite > 0u) atomic_add(&counters[COUNT_NONFINITE], nonfinite);
+}
+#else
 kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environment,
                        global const GpuWideNode* nodes, global const GpuTriangle* tris,
                        global const GpuInstance* instances,
@@ -81,3 +182,4 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
     atomic_add(&counters[COUNT_SHADOW], shadow_rays);
     if (nonfinite > 0u) atomic_add(&counters[COUNT_NONFINITE], nonfinite);
 }
+#endif

@@ -97,6 +97,16 @@ pub enum Child {
 }
 
 impl Bvh {
+    /// The most triangles in one leaf (0 for an empty tree).
+    pub fn largest_leaf(&self) -> u32 {
+        self.nodes
+            .iter()
+            .flat_map(|n| [n.left_max[3], n.right_max[3]])
+            .map(f32::to_bits)
+            .max()
+            .unwrap_or(0)
+    }
+
     /// The box and reference of the left (0) or right (1) child of `node`.
     pub fn child(&self, node: u32, side: usize) -> (Aabb, Child) {
         let n = &self.nodes[node as usize];

@@ -872,12 +872,19 @@ impl Program {
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
-        let local = self.mega_local_size;
+        // With lanes a work item takes LANES_PIXELS pixels (kernels/megakernel.cl), and a
+        // work-group is one work item: a group is one task of PoCL's thread pool, and work
+        // items of that size give the pool tasks enough.
+        let (items, local) = if self.features.lanes {
+            (pixels.div_ceil(LANES_PIXELS), lanes_local_size())
+        } else {
+            (pixels, self.mega_local_size)
+        };
         self.run_local(
             gpu,
             Stage::Megakernel.name(),
             &self.megakernel,
-            pixels,
+            items,
             local,
             |e| unsafe {
                 e.set_arg(frame).set_arg(camera).set_arg(&env.info);
@@ -1085,6 +1092,16 @@ fn megakernel_local_size() -> usize {
         .and_then(|v| v.parse::<usize>().ok())
         .filter(|&n| n > 0)
         .unwrap_or(64)
+}
+
+/// The lanes megakernel's work-group size: `PENUMBRA_MEGAKERNEL_GROUP` when set, else 1
+/// (see [`Program::megakernel`]).
+fn lanes_local_size() -> usize {
+    std::env::var("PENUMBRA_MEGAKERNEL_GROUP")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or(1)
 }
 
 /// Sets the four geometry arguments every traversing kernel takes first: the nodes (binary or

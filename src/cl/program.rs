@@ -19,6 +19,10 @@ const SOURCES: &[(&str, &str)] = &[
         "kernels/traverse_wide.h",
         include_str!("../../kernels/traverse_wide.h"),
     ),
+    (
+        "kernels/traverse_lanes.h",
+        include_str!("../../kernels/traverse_lanes.h"),
+    ),
     ("kernels/bsdf.h", include_str!("../../kernels/bsdf.h")),
     ("kernels/surface.h", include_str!("../../kernels/surface.h")),
     ("kernels/env.h", include_str!("../../kernels/env.h")),
@@ -91,6 +95,39 @@ pub struct KernelFeatures {
     /// count itself comes with each frame): a flat scene of at most [`SMALL_SCENE_MAX`]
     /// triangles without alpha, on a CPU device; 0 otherwise.
     pub small_scene: u32,
+    /// The megakernel walks sixteen paths' rays together in vector lanes (`MEGA_LANES`,
+    /// kernels/traverse_lanes.h): a flat scene that is not small, without alpha, on a CPU
+    /// device with AVX-512 (see [`lanes_megakernel`]).
+    pub lanes: bool,
+}
+
+/// Whether the megakernel should walk its rays in lanes (`KernelFeatures::lanes`) on a CPU
+/// device: a flat scene with no alpha that is not small, of fewer than 2^27 triangles in
+/// leaves of at most 15 (a lane's stack entry packs both in a word), the host CPU (PoCL's
+/// device) has AVX-512, whose gathers and scatters the walk uses, and `PENUMBRA_LANES` is not
+/// `0` (docs/benchmarks.md, "Fourteenth session").
+pub fn lanes_megakernel(
+    cpu: bool,
+    flat: bool,
+    alpha: bool,
+    small_scene: u32,
+    triangles: usize,
+    largest_leaf: u32,
+) -> bool {
+    if !cpu || !flat || alpha || small_scene > 0 || triangles >= 1 << 27 || largest_leaf > 15 {
+        return false;
+    }
+    if std::env::var("PENUMBRA_LANES").is_ok_and(|v| v.trim() == "0") {
+        return false;
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
 }
 
 /// The most triangles a scene may have for the megakernel to test them all for every ray
@@ -123,6 +160,7 @@ impl KernelFeatures {
             (self.lambert_only, "LAMBERT_ONLY"),
             (self.two_level, "TWO_LEVEL"),
             (self.triangle_pieces, "HAS_TRIANGLE_PIECES"),
+            (self.lanes, "MEGA_LANES"),
         ] {
             if on {
                 d.push_str(" -D");

@@ -106,6 +106,7 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         tangents: used(&|m| m.anisotropy > 0.0) && tangents,
         lambert_only: materials().all(|m| m.is_lambertian()),
         small_scene: 0,
+        lanes: false,
     }
 }
 
@@ -486,6 +487,17 @@ impl Renderer {
             host.triangles.len(),
             self.scene_features.alpha,
         );
+        self.scene_features.lanes = match &host.accel {
+            Accel::Flat(bvh) => crate::cl::lanes_megakernel(
+                self.gpu.is_cpu(),
+                true,
+                self.scene_features.alpha,
+                self.scene_features.small_scene,
+                host.triangles.len(),
+                bvh.largest_leaf(),
+            ),
+            Accel::TwoLevel(_) => false,
+        };
         let budget = self
             .gpu
             .device

@@ -1,0 +1,410 @@
+// Rays in vector lanes, for the CPU megakernel (MEGA_LANES: set by the host on CPU devices with
+// AVX-512, for flat scenes without alpha that are not small; src/cl/program.rs,
+// lanes_megakernel): sixteen independent rays walk the 4-wide BVH together, one ray a lane,
+// each at its own node, with gathers for the node and triangle data. One ray at a time, a walk
+// waits on memory at nearly every node it visits in a large scene (docs/benchmarks.md, "Sixth
+// session"); sixteen walks keep sixteen loads in flight, and a lane whose ray is done takes its
+// path's next ray while the others go on.
+//
+// The rays are extension rays, from tmin 0 to infinity, for the nearest hit. Each lane computes
+// traverse_wide.h's slab test and intersect_leaf4's watertight arithmetic, so that the hit is
+// traverse_wide's (of equally near hits the two walks may keep different triangles), and the
+// scalar test's rare cases (an edge function of zero, a hit within the rounding-error bound)
+// go to intersect_leaf itself. Leaves are stack items, as in Embree's walk, tested once enough
+// lanes have reached one; a node's reached children are sorted by entry distance in every
+// lane, the nearest entered and the others pushed farthest first.
+
+#ifdef MEGA_LANES
+#define LANES 16
+#define LANES_STACK (WIDE_STACK_SIZE + 1)
+#define LANE_IDS ((int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))
+
+// Whether any lane of a mask (all bits of a lane set or clear) is set.
+inline bool lanes_any(int16 m) {
+    int8 a = m.lo | m.hi;
+    int4 b = a.lo | a.hi;
+    int2 c = b.lo | b.hi;
+    return (c.x | c.y) != 0;
+}
+
+// The number of set lanes of a mask.
+inline int lanes_count(int16 m) {
+    int16 b = m & (int16)(1);
+    int8 a = b.lo + b.hi;
+    int4 c = a.lo + a.hi;
+    int2 d = c.lo + c.hi;
+    return d.x + d.y;
+}
+
+// The greatest lane.
+inline int lanes_max(int16 x) {
+    int8 a = max(x.lo, x.hi);
+    int4 b = max(a.lo, a.hi);
+    int2 c = max(b.lo, b.hi);
+    return max(c.x, c.y);
+}
+
+// Gathers: base[idx] in each lane of m (others 0); with AVX-512 one instruction.
+#if defined(__AVX512F__) && defined(__x86_64__)
+inline ushort lanes_kmask(int16 m) {
+    return __builtin_ia32_cmpd512_mask(m, (int16)(0), 4, (ushort)0xffff);  // m != 0
+}
+#define LANES_GATHER_F(base, idx, m)                                                          \
+    as_float16(__builtin_ia32_gathersiv16sf((float16)(0.0f), (const void*)(ulong)(base), (idx), \
+                                            lanes_kmask(m), 4))
+#define LANES_GATHER_I(base, idx, m)                                                       \
+    as_int16(__builtin_ia32_gathersiv16si((int16)(0), (const void*)(ulong)(base), (idx),   \
+                                          lanes_kmask(m), 4))
+#define LANES_SCATTER_F(base, idx, v, m) \
+    __builtin_ia32_scattersiv16sf((void*)(base), lanes_kmask(m), (idx), (v), 4)
+#define LANES_SCATTER_I(base, idx, v, m) \
+    __builtin_ia32_scattersiv16si((void*)(base), lanes_kmask(m), (idx), (v), 4)
+#else
+inline float16 lanes_gather_f(const float* base, int16 idx, int16 m) {
+    int i[LANES], k[LANES];
+    float out[LANES];
+    vstore16(idx, 0, i);
+    vstore16(m, 0, k);
+    for (int l = 0; l < LANES; ++l) out[l] = k[l] ? base[i[l]] : 0.0f;
+    return vload16(0, out);
+}
+inline int16 lanes_gather_i(const int* base, int16 idx, int16 m) {
+    return as_int16(lanes_gather_f((const float*)base, idx, m));
+}
+inline void lanes_scatter_f(float* base, int16 idx, float16 v, int16 m) {
+    int i[LANES], k[LANES];
+    float x[LANES];
+    vstore16(idx, 0, i);
+    vstore16(m, 0, k);
+    vstore16(v, 0, x);
+    for (int l = 0; l < LANES; ++l)
+        if (k[l]) base[i[l]] = x[l];
+}
+#define LANES_GATHER_F(base, idx, m) lanes_gather_f((const float*)(ulong)(base), (idx), (m))
+#define LANES_GATHER_I(base, idx, m) lanes_gather_i((const int*)(ulong)(base), (idx), (m))
+#define LANES_SCATTER_F(base, idx, v, m) lanes_scatter_f((float*)(base), (idx), (v), (m))
+#define LANES_SCATTER_I(base, idx, v, m) \
+    lanes_scatter_f((float*)(base), (idx), as_float16(v), (m))
+#endif
+
+// The rays of the lanes and their walks. Offsets are in 4-byte words: a GpuWideNode is 32
+// (min_x, min_y, min_z, max_x, max_y, max_z, child, count: 4 each), a GpuTriangle 12.
+typedef struct {
+    float16 ox, oy, oz;     // origin
+    float16 ix, iy, iz;     // safe reciprocal direction (prepare_ray's)
+    float16 px, py, pz;     // origin in the ray's permuted axes
+    float16 sx, sy, sz;     // shear (prepare_ray's)
+    int16 kx, ky, kz;       // the permutation, as word offsets in a vertex
+    float16 tfar;           // the nearest hit's t so far
+    float16 hv, hw, hdet;   // the hit's edge functions v, w and their sum (u = v / det)
+    int16 prim;             // the hit's triangle, NO_HIT (-1) while none
+    int16 cur, cnt;         // the item being visited: node, or a leaf's first and count
+    int16 sp;               // stack entries
+    int16 live;             // lanes with a ray
+    int16 has;              // lanes with an item to visit
+    int16 fin;              // lanes done, not yet returned by lanes_walk
+} Lanes;
+
+// What the lanes keep in memory between walks: their state lane by lane (written by scalar
+// code as a lane takes a ray, loaded into Lanes' vectors as a walk starts), their stacks and
+// rays. Lanes itself lives only inside lanes_walk, where the compiler keeps it in registers.
+#define LANES_FLOAT_FIELDS(X) X(ox) X(oy) X(oz) X(ix) X(iy) X(iz) X(px) X(py) X(pz) \
+    X(sx) X(sy) X(sz) X(tfar) X(hv) X(hw) X(hdet)
+#define LANES_INT_FIELDS(X) X(kx) X(ky) X(kz) X(prim) X(cur) X(cnt) X(sp) X(live) X(has) X(fin)
+typedef struct {
+    // Lanes' fields, lane by lane: what lanes_set_ray writes and lanes_walk loads.
+#define LANES_ARRAY_F(f) float f[LANES];
+#define LANES_ARRAY_I(f) int f[LANES];
+    LANES_FLOAT_FIELDS(LANES_ARRAY_F)
+    LANES_INT_FIELDS(LANES_ARRAY_I)
+#undef LANES_ARRAY_F
+#undef LANES_ARRAY_I
+    float stack_d[LANES_STACK * LANES];  // entry distance; entry k of lane l at k * LANES + l
+    int stack_c[LANES_STACK * LANES];    // the item, in lanes_pack form
+    float3 o[LANES], d[LANES];           // the rays, for the scalar test's rare cases
+} LaneMemory;
+
+#define LANES_INLINE inline __attribute__((always_inline))
+
+LANES_INLINE void lanes_init(LaneMemory* M) {
+    for (int l = 0; l < LANES; ++l) {
+#define LANES_ZERO(f) M->f[l] = 0;
+        LANES_FLOAT_FIELDS(LANES_ZERO)
+        LANES_INT_FIELDS(LANES_ZERO)
+#undef LANES_ZERO
+        M->hdet[l] = 1.0f;
+        M->prim[l] = -1;
+    }
+}
+
+// Lane `lane` takes the ray from o along d.
+LANES_INLINE void lanes_set_ray(LaneMemory* M, int lane, float3 o, float3 d) {
+    RayPrep r = prepare_ray(o, d);
+    float4 p = ray_permute((float4)(o, 0.0f), r.perm);
+    M->ox[lane] = o.x;
+    M->oy[lane] = o.y;
+    M->oz[lane] = o.z;
+    M->ix[lane] = r.inv.x;
+    M->iy[lane] = r.inv.y;
+    M->iz[lane] = r.inv.z;
+    M->px[lane] = p.x;
+    M->py[lane] = p.y;
+    M->pz[lane] = p.z;
+    M->sx[lane] = r.shear.x;
+    M->sy[lane] = r.shear.y;
+    M->sz[lane] = r.shear.z;
+    M->kx[lane] = (int)r.perm.x;
+    M->ky[lane] = (int)r.perm.y;
+    M->kz[lane] = (int)r.perm.z;
+    M->tfar[lane] = INFINITY;
+    M->hv[lane] = 0.0f;
+    M->hw[lane] = 0.0f;
+    M->hdet[lane] = 1.0f;
+    M->prim[lane] = -1;
+    M->cur[lane] = 0;
+    M->cnt[lane] = 0;
+    M->sp[lane] = 0;
+    M->live[lane] = -1;
+    M->has[lane] = -1;
+    M->o[lane] = o;
+    M->d[lane] = d;
+}
+
+// The hit of a lane whose walk is done.
+LANES_INLINE GpuHit lanes_hit(const LaneMemory* M, int lane) {
+    GpuHit h;
+    h.t = M->tfar[lane];
+    h.prim = (uint)M->prim[lane];
+    h.u = h.prim == NO_HIT ? 0.0f : M->hv[lane] / M->hdet[lane];
+    h.v = h.prim == NO_HIT ? 0.0f : M->hw[lane] / M->hdet[lane];
+    h.instance = 0u;
+    return h;
+}
+
+// Lanes at a leaf are tested together once at least this many are (the others wait at it).
+#ifndef LANES_LEAF_MIN
+#define LANES_LEAF_MIN 6
+#endif
+
+// lanes_walk returns once this many lanes are done (or none is left walking): each return
+// costs the shading loop's round over the lanes and the lanes' vectors to and from memory.
+#ifndef LANES_DONE_MIN
+#define LANES_DONE_MIN 4
+#endif
+
+// A stack entry in one word: an interior child's index, or a leaf (child ~first, count k) as
+// the sign bit, k in the next four bits and first below (the host enables lanes only for
+// scenes of fewer than 2^27 triangles and leaves of at most 15: lanes_megakernel).
+#define LANES_FIRST_MASK 0x07ffffff
+LANES_INLINE int16 lanes_pack(int16 c, int16 k) {
+    return select(c, (int16)(0x80000000) | (k << (int16)(27)) | ~c, k != (int16)(0));
+}
+
+// Compare-exchange of two (distance, child, count) triples in every lane, nearest first.
+#define LANES_ORDER(A, B)                      \
+    {                                          \
+        int16 s = d##B < d##A;                 \
+        float16 td = d##A;                     \
+        d##A = select(d##A, d##B, s);          \
+        d##B = select(d##B, td, s);            \
+        int16 tc = c##A;                       \
+        c##A = select(c##A, c##B, s);          \
+        c##B = select(c##B, tc, s);            \
+        int16 tk = k##A;                       \
+        k##A = select(k##A, k##B, s);          \
+        k##B = select(k##B, tk, s);            \
+    }
+
+// Walks the lanes' rays until LANES_DONE_MIN are done or none is left walking; returns the
+// mask of those done (their `live` lanes cleared). No lane live: returns an empty mask.
+LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
+                              global const GpuTriangle* tris, const SceneSurfaces* surf,
+                              volatile global uint* overflow) {
+    const float16 inf = (float16)(INFINITY), zero = (float16)(0.0f);
+    const int16 izero = (int16)(0), lane = LANE_IDS;
+    global const float* nw = (global const float*)nodes;
+    global const float* tw = (global const float*)tris;
+    Lanes V;
+    Lanes* L = &V;
+#define LANES_LOAD(f) V.f = vload16(0, M->f);
+    LANES_FLOAT_FIELDS(LANES_LOAD)
+    LANES_INT_FIELDS(LANES_LOAD)
+#undef LANES_LOAD
+#define LANES_STORE(f) vstore16(V.f, 0, M->f);
+    while (lanes_any(L->live)) {
+        // Interior nodes.
+        int16 mi = L->has & (L->cnt == izero);
+        if (lanes_any(mi)) {
+            int16 base = L->cur * (int16)(32);
+            int16 nx = select((int16)(12), izero, L->ix >= zero);
+            int16 ny = select((int16)(16), (int16)(4), L->iy >= zero);
+            int16 nz = select((int16)(20), (int16)(8), L->iz >= zero);
+            int16 fx = (int16)(12) - nx, fy = (int16)(20) - ny, fz = (int16)(28) - nz;
+            float16 d0, d1, d2, d3;
+            int16 c0, c1, c2, c3, k0, k1, k2, k3;
+#define LANES_CHILD(J)                                                                       \
+    {                                                                                        \
+        int16 bj = base + (int16)(J);                                                        \
+        float16 x0 = (LANES_GATHER_F(nw, bj + nx, mi) - L->ox) * L->ix;                      \
+        float16 x1 = (LANES_GATHER_F(nw, bj + fx, mi) - L->ox) * L->ix;                      \
+        float16 y0 = (LANES_GATHER_F(nw, bj + ny, mi) - L->oy) * L->iy;                      \
+        float16 y1 = (LANES_GATHER_F(nw, bj + fy, mi) - L->oy) * L->iy;                      \
+        float16 z0 = (LANES_GATHER_F(nw, bj + nz, mi) - L->oz) * L->iz;                      \
+        float16 z1 = (LANES_GATHER_F(nw, bj + fz, mi) - L->oz) * L->iz;                      \
+        float16 nr = select(x0, y0, y0 > x0);                                                \
+        nr = select(nr, z0, z0 > nr);                                                        \
+        nr = select(nr, zero, zero > nr);                                                    \
+        float16 fr = select(x1, y1, y1 < x1);                                                \
+        fr = select(fr, z1, z1 < fr) * 1.00000024f;                                          \
+        c##J = LANES_GATHER_I(nw, bj + (int16)(24), mi);                                     \
+        k##J = LANES_GATHER_I(nw, bj + (int16)(28), mi);                                     \
+        int16 reach = mi & ((c##J > izero) | (k##J != izero)) & (nr <= fr) & (nr < L->tfar); \
+        d##J = select(inf, nr, reach);                                                       \
+    }
+            LANES_CHILD(0)
+            LANES_CHILD(1)
+            LANES_CHILD(2)
+            LANES_CHILD(3)
+#undef LANES_CHILD
+            LANES_ORDER(0, 1)
+            LANES_ORDER(2, 3)
+            LANES_ORDER(0, 2)
+            LANES_ORDER(1, 3)
+            LANES_ORDER(1, 2)
+            // A lane about to overflow its stack ends its walk with the hit so far (as
+            // traverse_wide_bvh does; the overflow is counted).
+            int16 full = mi & (L->sp > (int16)(LANES_STACK - 4));
+            if (lanes_any(full)) {
+                atomic_add(overflow, (uint)lanes_count(full));
+                L->sp = select(L->sp, izero, full);
+                mi &= ~full;
+                L->has &= ~full;
+            }
+            // The reached children but the nearest pushed, farthest first; the nearest entered.
+#define LANES_PUSH(J)                                                \
+    {                                                                \
+        int16 p = mi & (d##J < inf);                                 \
+        int16 at = L->sp * (int16)(LANES) + lane;                    \
+        LANES_SCATTER_F(M->stack_d, at, d##J, p);                    \
+        LANES_SCATTER_I(M->stack_c, at, lanes_pack(c##J, k##J), p); \
+        L->sp -= p;                                                  \
+    }
+            LANES_PUSH(3)
+            LANES_PUSH(2)
+            LANES_PUSH(1)
+#undef LANES_PUSH
+            int16 enter = mi & (d0 < inf);
+            L->cur = select(L->cur, c0, enter);
+            L->cnt = select(L->cnt, k0, enter);
+            L->has &= ~(mi & ~enter);
+        }
+        // Leaves, once enough lanes are at one (or no lane is at a node).
+        int16 ml = L->has & (L->cnt != izero);
+        if (lanes_any(ml) && (lanes_count(ml) >= LANES_LEAF_MIN || !lanes_any(L->has & ~ml))) {
+            int16 first = ~L->cur;
+            int kmax = lanes_max(select(izero, L->cnt, ml));
+            for (int k = 0; k < kmax; ++k) {
+                int16 m = ml & ((int16)(k) < L->cnt);
+                int16 tri = first + (int16)(k);
+                int16 b = tri * (int16)(12);
+                float16 aX = LANES_GATHER_F(tw, b + L->kx, m) - L->px;
+                float16 aY = LANES_GATHER_F(tw, b + L->ky, m) - L->py;
+                float16 aZ = LANES_GATHER_F(tw, b + L->kz, m) - L->pz;
+                float16 bX = LANES_GATHER_F(tw, b + (int16)(4) + L->kx, m) - L->px;
+                float16 bY = LANES_GATHER_F(tw, b + (int16)(4) + L->ky, m) - L->py;
+                float16 bZ = LANES_GATHER_F(tw, b + (int16)(4) + L->kz, m) - L->pz;
+                float16 cX = LANES_GATHER_F(tw, b + (int16)(8) + L->kx, m) - L->px;
+                float16 cY = LANES_GATHER_F(tw, b + (int16)(8) + L->ky, m) - L->py;
+                float16 cZ = LANES_GATHER_F(tw, b + (int16)(8) + L->kz, m) - L->pz;
+                float16 sx = L->sx, sy = L->sy, sz = L->sz;
+                LANE_EDGES(float16)
+                int16 ok = m & ~(((u < zero) | (v < zero) | (w < zero)) &
+                                 ((u > zero) | (v > zero) | (w > zero)));
+                float16 det = u + v + w;
+                ok &= det != zero;
+                float16 az = sz * aZ, bz = sz * bZ, cz = sz * cZ;
+                float16 t = (u * az + v * bz + w * cz) / det;
+                ok &= (t > zero) & (t < L->tfar);
+                float16 far_z = select(fabs(az), fabs(bz), fabs(bz) > fabs(az));
+                far_z = select(far_z, fabs(cz), fabs(cz) > far_z);
+                int16 special = m & ((u == zero) | (v == zero) | (w == zero) |
+                                     (ok & (t < 0.00390625f * far_z)));
+                ok &= ~special;
+                L->tfar = select(L->tfar, t, ok);
+                L->hv = select(L->hv, v, ok);
+                L->hw = select(L->hw, w, ok);
+                L->hdet = select(L->hdet, det, ok);
+                L->prim = select(L->prim, tri, ok);
+                if (lanes_any(special)) {
+                    // The scalar test decides these lanes' triangle (double-precision edge
+                    // functions, the error bound), with their hits so far.
+                    int sp_[LANES], tri_[LANES];
+                    float t_[LANES], v_[LANES], w_[LANES], det_[LANES];
+                    int prim_[LANES];
+                    vstore16(special, 0, sp_);
+                    vstore16(tri, 0, tri_);
+                    vstore16(L->tfar, 0, t_);
+                    vstore16(L->hv, 0, v_);
+                    vstore16(L->hw, 0, w_);
+                    vstore16(L->hdet, 0, det_);
+                    vstore16(L->prim, 0, prim_);
+                    for (int l = 0; l < LANES; ++l) {
+                        if (!sp_[l]) continue;
+                        RayPrep r = prepare_ray(M->o[l], M->d[l]);
+                        GpuHit h = no_hit(t_[l]);
+                        intersect_leaf(&r, tris, surf, (uint)tri_[l], 1u, 0.0f, M->o[l], M->d[l],
+                                       false, &h);
+                        if (h.prim != NO_HIT) {
+                            t_[l] = h.t;
+                            v_[l] = h.u;
+                            w_[l] = h.v;
+                            det_[l] = 1.0f;
+                            prim_[l] = (int)h.prim;
+                        }
+                    }
+                    L->tfar = vload16(0, t_);
+                    L->hv = vload16(0, v_);
+                    L->hw = vload16(0, w_);
+                    L->hdet = vload16(0, det_);
+                    L->prim = vload16(0, prim_);
+                }
+            }
+            L->has &= ~ml;
+        }
+        // The lanes without an item pop one, passing over entries beyond their hit; a lane
+        // with an empty stack is done.
+        int16 done = izero;
+        for (int round = 0; round < 3; ++round) {
+            int16 pm = L->live & ~L->has & ~done;
+            if (!lanes_any(pm)) break;
+            int16 m = pm & (L->sp > izero);
+            done |= pm & ~m;
+            if (!lanes_any(m)) break;
+            L->sp += m;
+            int16 at = L->sp * (int16)(LANES) + lane;
+            float16 d = LANES_GATHER_F(M->stack_d, at, m);
+            int16 keep = m & (d < L->tfar);
+            int16 item = LANES_GATHER_I(M->stack_c, at, keep);
+            int16 leaf = item < izero;
+            L->cur = select(L->cur, select(item, ~(item & (int16)(LANES_FIRST_MASK)), leaf), keep);
+            L->cnt = select(L->cnt, select(izero, (item >> (int16)(27)) & (int16)(15), leaf), keep);
+            L->has |= keep;
+        }
+        done &= L->live;
+        L->live &= ~done;
+        L->fin |= done;
+        if (lanes_count(L->fin) >= LANES_DONE_MIN || !lanes_any(L->live)) {
+            int16 fin = L->fin;
+            L->fin = izero;
+            LANES_FLOAT_FIELDS(LANES_STORE)
+            LANES_INT_FIELDS(LANES_STORE)
+            return fin;
+        }
+    }
+    LANES_FLOAT_FIELDS(LANES_STORE)
+    LANES_INT_FIELDS(LANES_STORE)
+#undef LANES_STORE
+    return (int16)(0);
+}
+
+#endif  // MEGA_LANES
