@@ -173,6 +173,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "focus_distance": renderer.settings().focus_distance,
         "kernel_ms": stats.stage_ms,
     });
+    // Whether the megakernel walked its rays in vector lanes (CPU devices with AVX-512).
+    summary["lanes"] = serde_json::json!(renderer.walks_in_lanes());
     summary["cpu_seconds"] = serde_json::json!(cpu_seconds);
     summary["samples_per_cpu_second"] = serde_json::json!(cpu_seconds.map(|c| samples / c));
     // Added after the literal, which is at serde_json's macro recursion limit.

@@ -53,6 +53,12 @@ impl Renderer {
         self.reset()
     }
 
+    /// Whether the megakernel walks its extension rays sixteen at a time in vector lanes
+    /// (`KernelFeatures::lanes`, kernels/traverse_lanes.h) for the loaded scene.
+    pub fn walks_in_lanes(&self) -> bool {
+        self.megakernel && self.program.as_ref().is_some_and(|p| p.features.lanes)
+    }
+
     /// The kernels in use (never `Auto`).
     pub fn kernel(&self) -> KernelChoice {
         if self.megakernel {

@@ -350,17 +350,33 @@ pub fn test_device() -> String {
 
 /// Runs the penumbra binary with `args` on the test device.
 pub fn penumbra(args: &[&str]) -> Output {
+    penumbra_env(args, &[])
+}
+
+/// [`penumbra`] with environment variables set for the child.
+pub fn penumbra_env(args: &[&str], env: &[(&str, &str)]) -> Output {
     let exe = std::env::var("PENUMBRA_TEST_BINARY")
         .unwrap_or_else(|_| env!("CARGO_BIN_EXE_penumbra").to_string());
     Command::new(exe)
         .args(args)
         .env("PENUMBRA_DEVICE", test_device())
+        .envs(env.iter().copied())
         .output()
         .expect("the penumbra binary runs")
 }
 
 /// Runs a render and returns (the JSON summary, the linear image).
 pub fn render_exr(scene: &Path, out: &Path, extra: &[&str]) -> (Value, Vec<[f32; 3]>) {
+    render_exr_env(scene, out, extra, &[])
+}
+
+/// [`render_exr`] with environment variables set for the child.
+pub fn render_exr_env(
+    scene: &Path,
+    out: &Path,
+    extra: &[&str],
+    env: &[(&str, &str)],
+) -> (Value, Vec<[f32; 3]>) {
     let mut args = vec![
         "render",
         scene.to_str().unwrap(),
@@ -368,7 +384,7 @@ pub fn render_exr(scene: &Path, out: &Path, extra: &[&str]) -> (Value, Vec<[f32;
         out.to_str().unwrap(),
     ];
     args.extend_from_slice(extra);
-    let o = penumbra(&args);
+    let o = penumbra_env(&args, env);
     assert!(
         o.status.success(),
         "render failed: {}",
