@@ -14,7 +14,8 @@ pub(crate) static CL_SETUP: std::sync::Mutex<()> = std::sync::Mutex::new(());
 pub use device::{DeviceChoice, DeviceInfo, Gpu, list_devices};
 pub use kernels::{Buffer, Program, Stage};
 pub use program::{
-    KernelFeatures, SMALL_SCENE_MAX, build_program, build_test_program, lanes_megakernel,
+    KernelFeatures, LANES_MIN_TRIANGLES, SMALL_SCENE_MAX, build_program, build_test_program,
+    lanes_megakernel,
 };
 
 /// Errors from OpenCL: no usable device, a failed build, a failed launch.

@@ -101,8 +101,14 @@ pub struct KernelFeatures {
     pub lanes: bool,
 }
 
+/// The fewest triangles for which the megakernel walks its rays in lanes: below, the tree fits
+/// the caches, a walk seldom waits on memory, and the lanes measured 1–4 % slower on the shared
+/// scenes of about 10,000 triangles; from 41,000 on they were 2–6 % faster, and 17 % on the
+/// 1 M-triangle bunnies (docs/benchmarks.md, "Fourteenth session").
+pub const LANES_MIN_TRIANGLES: usize = 32_768;
+
 /// Whether the megakernel should walk its rays in lanes (`KernelFeatures::lanes`) on a CPU
-/// device: a flat scene with no alpha that is not small, of fewer than 2^27 triangles in
+/// device: a flat scene with no alpha of [`LANES_MIN_TRIANGLES`] or more and fewer than 2^27 triangles in
 /// leaves of at most 15 (a lane's stack entry packs both in a word), the host CPU (PoCL's
 /// device) has AVX-512, whose gathers and scatters the walk uses, and `PENUMBRA_LANES` is not
 /// `0` (docs/benchmarks.md, "Fourteenth session").
@@ -114,7 +120,13 @@ pub fn lanes_megakernel(
     triangles: usize,
     largest_leaf: u32,
 ) -> bool {
-    if !cpu || !flat || alpha || small_scene > 0 || triangles >= 1 << 27 || largest_leaf > 15 {
+    if !cpu
+        || !flat
+        || alpha
+        || small_scene > 0
+        || !(LANES_MIN_TRIANGLES..1 << 27).contains(&triangles)
+        || largest_leaf > 15
+    {
         return false;
     }
     if std::env::var("PENUMBRA_LANES").is_ok_and(|v| v.trim() == "0") {
