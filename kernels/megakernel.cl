@@ -8,6 +8,46 @@
 // Rays are traced through the 4-wide BVH (traverse_wide.h), whose box tests use the CPU's
 // vector lanes.
 
+// The kernel's parameters, in both forms below.
+#define MEGAKERNEL_PARAMS                                                                   \
+    GpuFrame frame, GpuCamera camera, GpuEnvironment environment,                           \
+        global const GpuWideNode *nodes, global const GpuTriangle *tris,                    \
+        global const GpuInstance *instances, global const GpuTriangle *object_tris,         \
+        global const GpuTriShading *shading, global const GpuTriUvs *uvs,                   \
+        global const GpuTriTangents *tangents, global const GpuMaterial *materials,         \
+        global const GpuTexRef *tex_refs, global const GpuTexture *textures,                \
+        global const uint *texels, global const float *env_texels,                          \
+        global const float *env_marginal, global const float *env_conditional,              \
+        global const GpuLight *lights, global const float *light_cdf, global float4 *film, \
+        volatile global uint *counters
+
+// What shading reads of the scene, from the kernel's parameters.
+#define MEGA_SHADE_SCENE(sc)                                                                \
+    ShadeScene sc = {tris,                                                                  \
+                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances}, \
+                     {environment, env_texels, env_marginal, env_conditional},              \
+                     lights,                                                                \
+                     light_cdf}
+
+// A finished sample: its radiance added to the pixel's sum (a non-finite one dropped and
+// counted), and counted in the film's .w when its camera ray hit.
+inline void mega_add_sample(const PathState* s, float3* sum, uint* counted, uint* nonfinite) {
+    *counted += (s->flags & PATH_ESCAPED) == 0u;
+    if (all(isfinite(s->radiance))) {
+        *sum += s->radiance;
+    } else {
+        ++*nonfinite;
+    }
+}
+
+// A work item's statistics, one atomic each; `advance` moves them into the totals.
+inline void mega_count(volatile global uint* counters, uint extension_rays, uint shadow_rays,
+                       uint nonfinite) {
+    atomic_add(&counters[COUNT_IN], extension_rays);
+    atomic_add(&counters[COUNT_SHADOW], shadow_rays);
+    if (nonfinite > 0u) atomic_add(&counters[COUNT_NONFINITE], nonfinite);
+}
+
 #ifdef MEGA_LANES
 // With MEGA_LANES a work item renders LANES_PIXELS pixels through LANES lanes
 // (traverse_lanes.h): a lane takes a pixel, traces its samples one after the other, as the
@@ -16,28 +56,12 @@
 // walked together; when some are done, their vertices are shaded at once by the same
 // shade_vertex, their light samples traced there and then (one ray at a time: the any-hit walk
 // without sorting is as fast alone as in lanes), and each lane takes its path's next ray.
-kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environment,
-                       global const GpuWideNode* nodes, global const GpuTriangle* tris,
-                       global const GpuInstance* instances,
-                       global const GpuTriangle* object_tris,
-                       global const GpuTriShading* shading,
-                       global const GpuTriUvs* uvs,
-                       global const GpuTriTangents* tangents,
-                       global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
-                       global const GpuTexture* textures, global const uint* texels,
-                       global const float* env_texels, global const float* env_marginal,
-                       global const float* env_conditional, global const GpuLight* lights,
-                       global const float* light_cdf, global float4* film,
-                       volatile global uint* counters) {
+kernel void megakernel(MEGAKERNEL_PARAMS) {
     uint pixels = frame.width * frame.height;
     uint next_pixel = get_global_id(0) * LANES_PIXELS;
     uint end_pixel = min(next_pixel + LANES_PIXELS, pixels);
     if (next_pixel >= pixels || frame.samples_in_wave == 0u) return;
-    ShadeScene sc = {tris,
-                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances},
-                     {environment, env_texels, env_marginal, env_conditional},
-                     lights,
-                     light_cdf};
+    MEGA_SHADE_SCENE(sc);
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
     LaneMemory M;
     lanes_init(&M);
@@ -86,12 +110,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
                 lanes_set_ray(&M, l, s[l].origin, s[l].direction);
                 continue;
             }
-            counted[l] += (s[l].flags & PATH_ESCAPED) == 0u;
-            if (all(isfinite(s[l].radiance))) {
-                sum[l] += s[l].radiance;
-            } else {
-                ++nonfinite;
-            }
+            mega_add_sample(&s[l], &sum[l], &counted[l], &nonfinite);
             if (++sample[l] < frame.samples_in_wave) {
                 bounce[l] = 0u;
                 s[l] = camera_path(&frame, &camera, pixel[l], frame.first_sample + sample[l]);
@@ -104,24 +123,10 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
         }
     }
 #undef LANE_NEXT_PIXEL
-    atomic_add(&counters[COUNT_IN], extension_rays);
-    atomic_add(&counters[COUNT_SHADOW], shadow_rays);
-    if (nonfinite > 0u) atomic_add(&counters[COUNT_NONFINITE], nonfinite);
+    mega_count(counters, extension_rays, shadow_rays, nonfinite);
 }
 #else
-kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environment,
-                       global const GpuWideNode* nodes, global const GpuTriangle* tris,
-                       global const GpuInstance* instances,
-                       global const GpuTriangle* object_tris,
-                       global const GpuTriShading* shading,
-                       global const GpuTriUvs* uvs,
-                       global const GpuTriTangents* tangents,
-                       global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
-                       global const GpuTexture* textures, global const uint* texels,
-                       global const float* env_texels, global const float* env_marginal,
-                       global const float* env_conditional, global const GpuLight* lights,
-                       global const float* light_cdf, global float4* film,
-                       volatile global uint* counters) {
+kernel void megakernel(MEGAKERNEL_PARAMS) {
 #ifdef SMALL_SCENE
     local SmallScene small;
     // Before any work item returns: it waits for the group.
@@ -130,11 +135,7 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels) return;
-    ShadeScene sc = {tris,
-                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances},
-                     {environment, env_texels, env_marginal, env_conditional},
-                     lights,
-                     light_cdf};
+    MEGA_SHADE_SCENE(sc);
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
     // The samples are added to the film's sum one by one, so that the image does not depend
     // on how many samples each launch took (a float sum depends on its order).
@@ -168,18 +169,10 @@ kernel void megakernel(GpuFrame frame, GpuCamera camera, GpuEnvironment environm
             }
             if (!alive) break;
         }
-        counted += (s.flags & PATH_ESCAPED) == 0u;
-        if (all(isfinite(s.radiance))) {
-            sum += s.radiance;
-        } else {
-            ++nonfinite;
-        }
+        mega_add_sample(&s, &sum, &counted, &nonfinite);
     }
     if (frame.background == BACKGROUND_ENV) counted = frame.samples_in_wave;
     film[pixel] = (float4)(sum, pixel_film.w + (float)counted);
-    // One atomic per work item for the statistics; `advance` moves them into the totals.
-    atomic_add(&counters[COUNT_IN], extension_rays);
-    atomic_add(&counters[COUNT_SHADOW], shadow_rays);
-    if (nonfinite > 0u) atomic_add(&counters[COUNT_NONFINITE], nonfinite);
+    mega_count(counters, extension_rays, shadow_rays, nonfinite);
 }
 #endif

@@ -87,30 +87,34 @@ inline void lanes_scatter_f(float* base, int16 idx, float16 v, int16 m) {
     lanes_scatter_f((float*)(base), (idx), as_float16(v), (m))
 #endif
 
-// The rays of the lanes and their walks. Offsets are in 4-byte words: a GpuWideNode is 32
-// (min_x, min_y, min_z, max_x, max_y, max_z, child, count: 4 each), a GpuTriangle 12.
-typedef struct {
-    float16 ox, oy, oz;     // origin
-    float16 ix, iy, iz;     // safe reciprocal direction (prepare_ray's)
-    float16 px, py, pz;     // origin in the ray's permuted axes
-    float16 sx, sy, sz;     // shear (prepare_ray's)
-    int16 kx, ky, kz;       // the permutation, as word offsets in a vertex
-    float16 tfar;           // the nearest hit's t so far
-    float16 hv, hw, hdet;   // the hit's edge functions v, w and their sum (u = v / det)
-    int16 prim;             // the hit's triangle, NO_HIT (-1) while none
-    int16 cur, cnt;         // the item being visited: node, or a leaf's first and count
-    int16 sp;               // stack entries
-    int16 live;             // lanes with a ray
-    int16 has;              // lanes with an item to visit
-    int16 fin;              // lanes done, not yet returned by lanes_walk
-} Lanes;
-
-// What the lanes keep in memory between walks: their state lane by lane (written by scalar
-// code as a lane takes a ray, loaded into Lanes' vectors as a walk starts), their stacks and
-// rays. Lanes itself lives only inside lanes_walk, where the compiler keeps it in registers.
+// The lanes' rays and walks, one field a lane (offsets are in 4-byte words: a GpuWideNode is 32,
+// min_x, min_y, min_z, max_x, max_y, max_z, child, count, 4 each; a GpuTriangle 12):
+//   ox oy oz     origin                      ix iy iz   safe reciprocal direction (prepare_ray's)
+//   px py pz     origin in the permuted axes sx sy sz   shear (prepare_ray's)
+//   kx ky kz     the permutation, as word offsets in a vertex
+//   tfar         the nearest hit's t so far  hv hw hdet its edge functions v, w and their sum
+//   prim         its triangle (NO_HIT, -1, while none)
+//   cur cnt      the item visited: a node, or a leaf's ~first and count
+//   sp           stack entries               live has fin: lanes with a ray, with an item to
+//                                            visit, done and not yet returned by lanes_walk
 #define LANES_FLOAT_FIELDS(X) X(ox) X(oy) X(oz) X(ix) X(iy) X(iz) X(px) X(py) X(pz) \
     X(sx) X(sy) X(sz) X(tfar) X(hv) X(hw) X(hdet)
 #define LANES_INT_FIELDS(X) X(kx) X(ky) X(kz) X(prim) X(cur) X(cnt) X(sp) X(live) X(has) X(fin)
+
+// The fields as vectors: Lanes lives only inside lanes_walk, where the compiler keeps it in
+// registers.
+typedef struct {
+#define LANES_VECTOR_F(f) float16 f;
+#define LANES_VECTOR_I(f) int16 f;
+    LANES_FLOAT_FIELDS(LANES_VECTOR_F)
+    LANES_INT_FIELDS(LANES_VECTOR_I)
+#undef LANES_VECTOR_F
+#undef LANES_VECTOR_I
+} Lanes;
+
+// What the lanes keep in memory between walks: their fields lane by lane (written by scalar
+// code as a lane takes a ray, loaded into Lanes' vectors as a walk starts), their stacks and
+// rays.
 typedef struct {
     // Lanes' fields, lane by lane: what lanes_set_ray writes and lanes_walk loads.
 #define LANES_ARRAY_F(f) float f[LANES];
@@ -318,17 +322,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 float16 cZ = LANES_GATHER_F(tw, b + (int16)(8) + L->kz, m) - L->pz;
                 float16 sx = L->sx, sy = L->sy, sz = L->sz;
                 LANE_EDGES(float16)
-                int16 ok = m & ~(((u < zero) | (v < zero) | (w < zero)) &
-                                 ((u > zero) | (v > zero) | (w > zero)));
-                float16 det = u + v + w;
-                ok &= det != zero;
-                float16 az = sz * aZ, bz = sz * bZ, cz = sz * cZ;
-                float16 t = (u * az + v * bz + w * cz) / det;
-                ok &= (t > zero) & (t < L->tfar);
-                float16 far_z = select(fabs(az), fabs(bz), fabs(bz) > fabs(az));
-                far_z = select(far_z, fabs(cz), fabs(cz) > far_z);
-                int16 special = m & ((u == zero) | (v == zero) | (w == zero) |
-                                     (ok & (t < 0.00390625f * far_z)));
+                LANE_HITS16(m, zero, L->tfar)
                 ok &= ~special;
                 L->tfar = select(L->tfar, t, ok);
                 L->hv = select(L->hv, v, ok);

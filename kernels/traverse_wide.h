@@ -77,6 +77,24 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
     TYPE v = ax * cy - ay * cx;         \
     TYPE w = bx * ay - by * ax;
 
+// After LANE_EDGES in float16 lanes (trace_small, traverse_lanes.h): intersect_triangle's
+// verdict lane by lane for the lanes of MASK, a hit in (TMIN, TMAX): declares the mask ok, the
+// edge functions' sum det, the distance t and the mask special of the lanes that need the scalar
+// test (an edge function of zero, or a hit close enough for its rounding-error bound). Needs
+// sz, the shear's z, and zero, a float16 of zeros.
+#define LANE_HITS16(MASK, TMIN, TMAX)                                         \
+    int16 ok = (MASK) & ~(((u < zero) | (v < zero) | (w < zero)) &            \
+                          ((u > zero) | (v > zero) | (w > zero)));            \
+    float16 det = u + v + w;                                                  \
+    ok &= det != zero;                                                        \
+    float16 az = sz * aZ, bz = sz * bZ, cz = sz * cZ;                         \
+    float16 t = (u * az + v * bz + w * cz) / det;                             \
+    ok &= (t > (TMIN)) & (t < (TMAX));                                        \
+    float16 far_z = select(fabs(az), fabs(bz), fabs(bz) > fabs(az));          \
+    far_z = select(far_z, fabs(cz), fabs(cz) > far_z);                        \
+    int16 special = (MASK) & ((u == zero) | (v == zero) | (w == zero) |       \
+                              (ok & (t < 0.00390625f * far_z)));
+
 // intersect_leaf for a leaf of at most four triangles, the four tested at once in float4 lanes
 // with intersect_triangle's arithmetic lane by lane, so that the same hit is kept: the first
 // triangle of the nearest hit (the scalar loop keeps a later one only when strictly nearer), or
@@ -502,7 +520,7 @@ inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* t
     float16 best_t = (float16)(tmax);
     float16 best_v = zero, best_w = zero, best_det = zero;
     int16 best_index = (int16)(SMALL_BATCHES * SMALL_LANES);
-    int16 special = (int16)(0);
+    int16 any_special = (int16)(0);
     int16 lanes = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     uint count = s->count;
 #pragma unroll
@@ -519,24 +537,15 @@ inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* t
         LANE_EDGES(float16)
         int16 index = lanes + (int16)((int)at);
         int16 lane = index < (int16)((int)count);
-        int16 ok = lane & ~(((u < zero) | (v < zero) | (w < zero)) &
-                            ((u > zero) | (v > zero) | (w > zero)));
-        float16 det = u + v + w;
-        ok &= det != zero;
-        float16 az = sz * aZ, bz = sz * bZ, cz = sz * cZ;
-        float16 t = (u * az + v * bz + w * cz) / det;
-        ok &= (t > (float16)(tmin)) & (t < best_t);
-        float16 far_z = select(fabs(az), fabs(bz), fabs(bz) > fabs(az));
-        far_z = select(far_z, fabs(cz), fabs(cz) > far_z);
-        special |= lane & ((u == zero) | (v == zero) | (w == zero) |
-                           (ok & (t < 0.00390625f * far_z)));
+        LANE_HITS16(lane, (float16)(tmin), best_t)
+        any_special |= special;
         best_t = select(best_t, t, ok);
         best_v = select(best_v, v, ok);
         best_w = select(best_w, w, ok);
         best_det = select(best_det, det, ok);
         best_index = select(best_index, index, ok);
     }
-    if (small_min(special) < 0) {
+    if (small_min(any_special) < 0) {
         // Rare cases for the scalar test, as in intersect_leaf4.
         intersect_leaf(&r, tris, surf, 0u, count, tmin, o, d, any_hit, &hit);
         return hit;

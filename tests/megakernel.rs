@@ -328,38 +328,11 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
     // samples added in the same order, so the image is the one-ray-at-a-time kernel's bit for
     // bit (but for rays that meet two triangles at exactly the same distance, of which each
     // walk may keep another). A sphere of 34,816 triangles (lanes are for scenes of 32,768 or
-    // more) on a floor, an image of 37 x 23 (its last work item partial).
+    // more: 2 x 128 x 136) on a floor, an image of 37 x 23 (its last work item partial).
     let dir = tempfile::tempdir().unwrap();
-    let scene = {
-        let mut g = Gltf::default();
-        let white = g.lambert([0.9; 3], [0.0; 3], 1.0, false);
-        let gray = g.lambert([0.5; 3], [0.0; 3], 1.0, false);
-        let (positions, normals, indices) = common::sphere(1.0, 128, 136, false);
-        assert!(indices.len() / 3 >= penumbra::cl::LANES_MIN_TRIANGLES);
-        let floor = Prim::triangles(
-            vec![
-                [-5.0, -1.0, -5.0],
-                [5.0, -1.0, -5.0],
-                [5.0, -1.0, 5.0],
-                [-5.0, -1.0, 5.0],
-            ],
-            vec![0, 2, 1, 0, 3, 2],
-            gray,
-        );
-        let sphere = Prim {
-            positions,
-            normals,
-            indices,
-            material: Some(white),
-            mode: 4,
-        };
-        let mesh = g.mesh(vec![sphere, floor]);
-        g.node(json!({"mesh": mesh}));
-        g.cameras
-            .push(json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.01}}));
-        g.node(json!({"camera": 0, "translation": [0.0, 0.0, 4.0]}));
-        g.write_glb(dir.path(), "sphere")
-    };
+    let (rings, segments) = (128, 136);
+    assert!((2 * rings * segments) as usize >= penumbra::cl::LANES_MIN_TRIANGLES);
+    let scene = common::white_sphere_of(dir.path(), true, rings, segments);
     let args = [
         "--kernel",
         "megakernel",

@@ -527,7 +527,7 @@ impl Program {
             trace_closest_wide: kernel(&program, "trace_closest_wide")?,
             trace_any_wide: kernel(&program, "trace_any_wide")?,
             megakernel: k(Stage::Megakernel)?,
-            mega_local_size: megakernel_local_size().min(max_group),
+            mega_local_size: megakernel_local_size(features.lanes).min(max_group),
             tests: OnceLock::new(),
             local_size: 64.min(max_group),
             features,
@@ -872,14 +872,13 @@ impl Program {
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
-        // With lanes a work item takes LANES_PIXELS pixels (kernels/megakernel.cl), and a
-        // work-group is one work item: a group is one task of PoCL's thread pool, and work
-        // items of that size give the pool tasks enough.
-        let (items, local) = if self.features.lanes {
-            (pixels.div_ceil(LANES_PIXELS), lanes_local_size())
+        // With lanes a work item takes LANES_PIXELS pixels (kernels/megakernel.cl).
+        let items = if self.features.lanes {
+            pixels.div_ceil(LANES_PIXELS)
         } else {
-            (pixels, self.mega_local_size)
+            pixels
         };
+        let local = self.mega_local_size;
         self.run_local(
             gpu,
             Stage::Megakernel.name(),
@@ -1083,25 +1082,16 @@ impl Program {
 }
 
 /// The megakernel's work-group size: `PENUMBRA_MEGAKERNEL_GROUP` when set (for measuring),
-/// else 64. On PoCL's CPU device a work-group is one task of its thread pool whose work items
-/// run one after the other (the kernel's loops defeat vectorisation across work items), so the
-/// size only sets the scheduling grain; docs/benchmarks.md has the measurements.
-fn megakernel_local_size() -> usize {
+/// else 64, or 1 with `lanes`. On PoCL's CPU device a work-group is one task of its thread pool
+/// whose work items run one after the other (the kernel's loops defeat vectorisation across
+/// work items), so the size only sets the scheduling grain; docs/benchmarks.md has the
+/// measurements. A lanes work item renders LANES_PIXELS pixels, enough for a task alone.
+fn megakernel_local_size(lanes: bool) -> usize {
     std::env::var("PENUMBRA_MEGAKERNEL_GROUP")
         .ok()
         .and_then(|v| v.parse::<usize>().ok())
         .filter(|&n| n > 0)
-        .unwrap_or(64)
-}
-
-/// The lanes megakernel's work-group size: `PENUMBRA_MEGAKERNEL_GROUP` when set, else 1
-/// (see [`Program::megakernel`]).
-fn lanes_local_size() -> usize {
-    std::env::var("PENUMBRA_MEGAKERNEL_GROUP")
-        .ok()
-        .and_then(|v| v.parse::<usize>().ok())
-        .filter(|&n| n > 0)
-        .unwrap_or(1)
+        .unwrap_or(if lanes { 1 } else { 64 })
 }
 
 /// Sets the four geometry arguments every traversing kernel takes first: the nodes (binary or

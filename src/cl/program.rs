@@ -107,21 +107,19 @@ pub struct KernelFeatures {
 /// 1 M-triangle bunnies (docs/benchmarks.md, "Fourteenth session").
 pub const LANES_MIN_TRIANGLES: usize = 32_768;
 
-/// Whether the megakernel should walk its rays in lanes (`KernelFeatures::lanes`) on a CPU
-/// device: a flat scene with no alpha of [`LANES_MIN_TRIANGLES`] or more and fewer than 2^27 triangles in
-/// leaves of at most 15 (a lane's stack entry packs both in a word), the host CPU (PoCL's
-/// device) has AVX-512, whose gathers and scatters the walk uses, and `PENUMBRA_LANES` is not
-/// `0` (docs/benchmarks.md, "Fourteenth session").
+/// Whether the megakernel should walk a flat scene's rays in lanes (`KernelFeatures::lanes`) on
+/// a CPU device: no alpha, not a small scene, [`LANES_MIN_TRIANGLES`] or more and fewer than
+/// 2^27 triangles in leaves of at most 15 (a lane's stack entry packs both in a word), the host
+/// CPU (PoCL's device) has AVX-512, whose gathers and scatters the walk uses, and
+/// `PENUMBRA_LANES` is not `0` (docs/benchmarks.md, "Fourteenth session").
 pub fn lanes_megakernel(
     cpu: bool,
-    flat: bool,
     alpha: bool,
     small_scene: u32,
     triangles: usize,
     largest_leaf: u32,
 ) -> bool {
     if !cpu
-        || !flat
         || alpha
         || small_scene > 0
         || !(LANES_MIN_TRIANGLES..1 << 27).contains(&triangles)

@@ -490,7 +490,6 @@ impl Renderer {
         self.scene_features.lanes = match &host.accel {
             Accel::Flat(bvh) => crate::cl::lanes_megakernel(
                 self.gpu.is_cpu(),
-                true,
                 self.scene_features.alpha,
                 self.scene_features.small_scene,
                 host.triangles.len(),

@@ -458,9 +458,14 @@ pub fn mean_gray(px: &[[f32; 3]]) -> f64 {
 /// A white (albedo 1) Lambertian sphere of radius 1 at the origin seen from z = 4; a floor
 /// below it when `floor`.
 pub fn white_sphere(dir: &Path, floor: bool) -> PathBuf {
+    white_sphere_of(dir, floor, 32, 64)
+}
+
+/// [`white_sphere`] with `rings` × `segments` quads (2 × rings × segments triangles).
+pub fn white_sphere_of(dir: &Path, floor: bool, rings: u32, segments: u32) -> PathBuf {
     let mut g = Gltf::default();
     let m = g.lambert([1.0; 3], [0.0; 3], 1.0, false);
-    let (positions, normals, indices) = sphere(1.0, 32, 64, false);
+    let (positions, normals, indices) = sphere(1.0, rings, segments, false);
     let mut prims = vec![Prim {
         positions,
         normals,
