@@ -44,47 +44,75 @@ inline int lanes_max(int16 x) {
     return max(c.x, c.y);
 }
 
-// Gathers: base[idx] in each lane of m (others 0); with AVX-512 one instruction.
-#if defined(__AVX512F__) && defined(__x86_64__)
+// Gathers and scatters: base[idx] in each lane of a mask (others 0); with AVX-512 one
+// instruction, else (or with LANES_ELEMENTWISE, to check this form against the other:
+// scripts/experiments/lanes) lane by lane.
+#if defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
 inline ushort lanes_kmask(int16 m) {
     return __builtin_ia32_cmpd512_mask(m, (int16)(0), 4, (ushort)0xffff);  // m != 0
 }
 #define LANES_GATHER_F(base, idx, m)                                                          \
     as_float16(__builtin_ia32_gathersiv16sf((float16)(0.0f), (const void*)(ulong)(base), (idx), \
                                             lanes_kmask(m), 4))
-#define LANES_GATHER_I(base, idx, m)                                                       \
-    as_int16(__builtin_ia32_gathersiv16si((int16)(0), (const void*)(ulong)(base), (idx),   \
-                                          lanes_kmask(m), 4))
-#define LANES_SCATTER_F(base, idx, v, m) \
-    __builtin_ia32_scattersiv16sf((void*)(base), lanes_kmask(m), (idx), (v), 4)
-#define LANES_SCATTER_I(base, idx, v, m) \
-    __builtin_ia32_scattersiv16si((void*)(base), lanes_kmask(m), (idx), (v), 4)
+// Two neighbouring words at word offset idx of each lane of mask km (lanes_kmask): the first
+// in A, the second in B (8-byte gathers, eight lanes each: half the elements of two gathers).
+#define LANES_GATHER_PAIR(base, idx, km, A, B)                                                    \
+    {                                                                                            \
+        float16 lo_ = as_float16(__builtin_ia32_gathersiv8di(                                     \
+            (long8)(0), (const void*)(ulong)(base), (idx).lo, (uchar)(km), 4));                   \
+        float16 hi_ = as_float16(__builtin_ia32_gathersiv8di(                                     \
+            (long8)(0), (const void*)(ulong)(base), (idx).hi, (uchar)((km) >> 8), 4));            \
+        A = __builtin_shufflevector(lo_, hi_, 0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, \
+                                    28, 30);                                                     \
+        B = __builtin_shufflevector(lo_, hi_, 1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, \
+                                    29, 31);                                                     \
+    }
+// The opposite: A and B stored side by side at word offset idx of each lane of km.
+#define LANES_SCATTER_PAIR(base, idx, km, A, B)                                                   \
+    {                                                                                            \
+        float16 lo_ = __builtin_shufflevector(A, B, 0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6,  \
+                                              22, 7, 23);                                        \
+        float16 hi_ = __builtin_shufflevector(A, B, 8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, \
+                                              14, 30, 15, 31);                                   \
+        __builtin_ia32_scattersiv8di((void*)(base), (uchar)(km), (idx).lo, as_long8(lo_), 4);     \
+        __builtin_ia32_scattersiv8di((void*)(base), (uchar)((km) >> 8), (idx).hi, as_long8(hi_),  \
+                                     4);                                                         \
+    }
 #else
-inline float16 lanes_gather_f(const float* base, int16 idx, int16 m) {
-    int i[LANES], k[LANES];
+inline ushort lanes_kmask(int16 m) {
+    int k[LANES];
+    vstore16(m, 0, k);
+    ushort bits = 0;
+    for (int l = 0; l < LANES; ++l) bits |= k[l] ? (ushort)(1 << l) : (ushort)0;
+    return bits;
+}
+inline float16 lanes_gather_f(const float* base, int16 idx, ushort km) {
+    int i[LANES];
     float out[LANES];
     vstore16(idx, 0, i);
-    vstore16(m, 0, k);
-    for (int l = 0; l < LANES; ++l) out[l] = k[l] ? base[i[l]] : 0.0f;
+    for (int l = 0; l < LANES; ++l) out[l] = (km >> l) & 1 ? base[i[l]] : 0.0f;
     return vload16(0, out);
 }
-inline int16 lanes_gather_i(const int* base, int16 idx, int16 m) {
-    return as_int16(lanes_gather_f((const float*)base, idx, m));
-}
-inline void lanes_scatter_f(float* base, int16 idx, float16 v, int16 m) {
-    int i[LANES], k[LANES];
+inline void lanes_scatter_f(float* base, int16 idx, float16 v, ushort km) {
+    int i[LANES];
     float x[LANES];
     vstore16(idx, 0, i);
-    vstore16(m, 0, k);
     vstore16(v, 0, x);
     for (int l = 0; l < LANES; ++l)
-        if (k[l]) base[i[l]] = x[l];
+        if ((km >> l) & 1) base[i[l]] = x[l];
 }
-#define LANES_GATHER_F(base, idx, m) lanes_gather_f((const float*)(ulong)(base), (idx), (m))
-#define LANES_GATHER_I(base, idx, m) lanes_gather_i((const int*)(ulong)(base), (idx), (m))
-#define LANES_SCATTER_F(base, idx, v, m) lanes_scatter_f((float*)(base), (idx), (v), (m))
-#define LANES_SCATTER_I(base, idx, v, m) \
-    lanes_scatter_f((float*)(base), (idx), as_float16(v), (m))
+#define LANES_GATHER_F(base, idx, m) \
+    lanes_gather_f((const float*)(ulong)(base), (idx), lanes_kmask(m))
+#define LANES_GATHER_PAIR(base, idx, km, A, B)                            \
+    {                                                                    \
+        A = lanes_gather_f((const float*)(ulong)(base), (idx), (km));     \
+        B = lanes_gather_f((const float*)(ulong)(base), (idx) + 1, (km)); \
+    }
+#define LANES_SCATTER_PAIR(base, idx, km, A, B)              \
+    {                                                       \
+        lanes_scatter_f((float*)(base), (idx), (A), (km));     \
+        lanes_scatter_f((float*)(base), (idx) + 1, (B), (km)); \
+    }
 #endif
 
 // The lanes' rays and walks, one field a lane (offsets are in 4-byte words: a GpuWideNode is 32,
@@ -123,12 +151,16 @@ typedef struct {
     LANES_INT_FIELDS(LANES_ARRAY_I)
 #undef LANES_ARRAY_F
 #undef LANES_ARRAY_I
-    float stack_d[LANES_STACK * LANES];  // entry distance; entry k of lane l at k * LANES + l
-    int stack_c[LANES_STACK * LANES];    // the item, in lanes_pack form
+    // The stacks: entry k of lane l at word 2 (k LANES + l), its entry distance, then its item
+    // in lanes_pack form (as float bits).
+    float stack[2 * LANES_STACK * LANES];
     float3 o[LANES], d[LANES];           // the rays, for the scalar test's rare cases
 } LaneMemory;
 
 #define LANES_INLINE inline __attribute__((always_inline))
+#ifdef LANES_STATS
+void lanes_stat(int, int);
+#endif
 
 LANES_INLINE void lanes_init(LaneMemory* M) {
     for (int l = 0; l < LANES; ++l) {
@@ -204,6 +236,24 @@ LANES_INLINE int16 lanes_pack(int16 c, int16 k) {
     return select(c, (int16)(0x80000000) | (k << (int16)(27)) | ~c, k != (int16)(0));
 }
 
+// Starts loading, for each lane of m, the `count` elements of `size` bytes from element `first`
+// of the array at `base` into the caches (a lane reaching a leaf waits for others to reach
+// theirs, a lane done for others to finish: the loads meanwhile cost nothing).
+LANES_INLINE void lanes_prefetch(ulong base, int16 first, int16 count, uint size, int16 m) {
+    uint bits = lanes_kmask(m);
+    if (bits == 0u) return;
+    int first_[LANES], count_[LANES];
+    vstore16(first, 0, first_);
+    vstore16(count, 0, count_);
+    while (bits != 0u) {
+        uint l = (uint)__builtin_ctz(bits);
+        bits &= bits - 1u;
+        ulong a = base + (ulong)first_[l] * size;
+        ulong e = a + (ulong)count_[l] * size - 1ul;
+        for (a &= ~63ul; a <= e; a += 64ul) __builtin_prefetch((const void*)a);
+    }
+}
+
 // Compare-exchange of two (distance, child, count) triples in every lane, nearest first.
 #define LANES_ORDER(A, B)                      \
     {                                          \
@@ -230,14 +280,21 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
     global const float* tw = (global const float*)tris;
     Lanes V;
     Lanes* L = &V;
+#ifdef LANES_STATS
+    lanes_stat(6, 1);
+#endif
 #define LANES_LOAD(f) V.f = vload16(0, M->f);
     LANES_FLOAT_FIELDS(LANES_LOAD)
     LANES_INT_FIELDS(LANES_LOAD)
 #undef LANES_LOAD
 #define LANES_STORE(f) vstore16(V.f, 0, M->f);
     while (lanes_any(L->live)) {
+        int16 arrived = izero;  // lanes that reached a leaf in this round
         // Interior nodes.
         int16 mi = L->has & (L->cnt == izero);
+#ifdef LANES_STATS
+        if (lanes_any(mi)) { lanes_stat(0, 1); lanes_stat(1, lanes_count(mi)); }
+#endif
         if (lanes_any(mi)) {
             int16 base = L->cur * (int16)(32);
             int16 nx = select((int16)(12), izero, L->ix >= zero);
@@ -246,30 +303,51 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             int16 fx = (int16)(12) - nx, fy = (int16)(20) - ny, fz = (int16)(28) - nz;
             float16 d0, d1, d2, d3;
             int16 c0, c1, c2, c3, k0, k1, k2, k3;
-#define LANES_CHILD(J)                                                                       \
-    {                                                                                        \
-        int16 bj = base + (int16)(J);                                                        \
-        float16 x0 = (LANES_GATHER_F(nw, bj + nx, mi) - L->ox) * L->ix;                      \
-        float16 x1 = (LANES_GATHER_F(nw, bj + fx, mi) - L->ox) * L->ix;                      \
-        float16 y0 = (LANES_GATHER_F(nw, bj + ny, mi) - L->oy) * L->iy;                      \
-        float16 y1 = (LANES_GATHER_F(nw, bj + fy, mi) - L->oy) * L->iy;                      \
-        float16 z0 = (LANES_GATHER_F(nw, bj + nz, mi) - L->oz) * L->iz;                      \
-        float16 z1 = (LANES_GATHER_F(nw, bj + fz, mi) - L->oz) * L->iz;                      \
-        float16 nr = select(x0, y0, y0 > x0);                                                \
-        nr = select(nr, z0, z0 > nr);                                                        \
-        nr = select(nr, zero, zero > nr);                                                    \
-        float16 fr = select(x1, y1, y1 < x1);                                                \
-        fr = select(fr, z1, z1 < fr) * 1.00000024f;                                          \
-        c##J = LANES_GATHER_I(nw, bj + (int16)(24), mi);                                     \
-        k##J = LANES_GATHER_I(nw, bj + (int16)(28), mi);                                     \
-        int16 reach = mi & ((c##J > izero) | (k##J != izero)) & (nr <= fr) & (nr < L->tfar); \
-        d##J = select(inf, nr, reach);                                                       \
+            // Children J and J + 1 at once: a row's words of two children are side by side, so
+            // one 8-byte gather element brings both (half the gathered elements).
+            ushort km = lanes_kmask(mi);
+#define LANES_CHILDREN(J, K)                                                                \
+    {                                                                                       \
+        int16 bj = base + (int16)(J);                                                       \
+        float16 a, b;                                                                       \
+        LANES_GATHER_PAIR(nw, bj + nx, km, a, b);                                           \
+        float16 x0##J = (a - L->ox) * L->ix, x0##K = (b - L->ox) * L->ix;                   \
+        LANES_GATHER_PAIR(nw, bj + ny, km, a, b);                                           \
+        float16 y0##J = (a - L->oy) * L->iy, y0##K = (b - L->oy) * L->iy;                   \
+        float16 nr##J = select(x0##J, y0##J, y0##J > x0##J);                                \
+        float16 nr##K = select(x0##K, y0##K, y0##K > x0##K);                                \
+        LANES_GATHER_PAIR(nw, bj + nz, km, a, b);                                           \
+        float16 z0##J = (a - L->oz) * L->iz, z0##K = (b - L->oz) * L->iz;                   \
+        nr##J = select(nr##J, z0##J, z0##J > nr##J);                                        \
+        nr##K = select(nr##K, z0##K, z0##K > nr##K);                                        \
+        nr##J = select(nr##J, zero, zero > nr##J);                                          \
+        nr##K = select(nr##K, zero, zero > nr##K);                                          \
+        LANES_GATHER_PAIR(nw, bj + fx, km, a, b);                                           \
+        float16 x1##J = (a - L->ox) * L->ix, x1##K = (b - L->ox) * L->ix;                   \
+        LANES_GATHER_PAIR(nw, bj + fy, km, a, b);                                           \
+        float16 y1##J = (a - L->oy) * L->iy, y1##K = (b - L->oy) * L->iy;                   \
+        float16 fr##J = select(x1##J, y1##J, y1##J < x1##J);                                \
+        float16 fr##K = select(x1##K, y1##K, y1##K < x1##K);                                \
+        LANES_GATHER_PAIR(nw, bj + fz, km, a, b);                                           \
+        float16 z1##J = (a - L->oz) * L->iz, z1##K = (b - L->oz) * L->iz;                   \
+        fr##J = select(fr##J, z1##J, z1##J < fr##J) * 1.00000024f;                          \
+        fr##K = select(fr##K, z1##K, z1##K < fr##K) * 1.00000024f;                          \
+        LANES_GATHER_PAIR(nw, bj + (int16)(24), km, a, b);                                  \
+        c##J = as_int16(a);                                                                 \
+        c##K = as_int16(b);                                                                 \
+        LANES_GATHER_PAIR(nw, bj + (int16)(28), km, a, b);                                  \
+        k##J = as_int16(a);                                                                 \
+        k##K = as_int16(b);                                                                 \
+        int16 reachJ = mi & ((c##J > izero) | (k##J != izero)) & (nr##J <= fr##J) &         \
+                       (nr##J < L->tfar);                                                   \
+        int16 reachK = mi & ((c##K > izero) | (k##K != izero)) & (nr##K <= fr##K) &         \
+                       (nr##K < L->tfar);                                                   \
+        d##J = select(inf, nr##J, reachJ);                                                  \
+        d##K = select(inf, nr##K, reachK);                                                  \
     }
-            LANES_CHILD(0)
-            LANES_CHILD(1)
-            LANES_CHILD(2)
-            LANES_CHILD(3)
-#undef LANES_CHILD
+            LANES_CHILDREN(0, 1)
+            LANES_CHILDREN(2, 3)
+#undef LANES_CHILDREN
             LANES_ORDER(0, 1)
             LANES_ORDER(2, 3)
             LANES_ORDER(0, 2)
@@ -285,19 +363,20 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 L->has &= ~full;
             }
             // The reached children but the nearest pushed, farthest first; the nearest entered.
-#define LANES_PUSH(J)                                                \
-    {                                                                \
-        int16 p = mi & (d##J < inf);                                 \
-        int16 at = L->sp * (int16)(LANES) + lane;                    \
-        LANES_SCATTER_F(M->stack_d, at, d##J, p);                    \
-        LANES_SCATTER_I(M->stack_c, at, lanes_pack(c##J, k##J), p); \
-        L->sp -= p;                                                  \
+#define LANES_PUSH(J)                                                              \
+    {                                                                              \
+        int16 p = mi & (d##J < inf);                                               \
+        int16 at = (L->sp * (int16)(LANES) + lane) * (int16)(2);                   \
+        LANES_SCATTER_PAIR(M->stack, at, lanes_kmask(p), d##J,                     \
+                           as_float16(lanes_pack(c##J, k##J)));                    \
+        L->sp -= p;                                                                \
     }
             LANES_PUSH(3)
             LANES_PUSH(2)
             LANES_PUSH(1)
 #undef LANES_PUSH
             int16 enter = mi & (d0 < inf);
+            arrived |= enter & (k0 != izero);
             L->cur = select(L->cur, c0, enter);
             L->cnt = select(L->cnt, k0, enter);
             L->has &= ~(mi & ~enter);
@@ -307,6 +386,10 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
         if (lanes_any(ml) && (lanes_count(ml) >= LANES_LEAF_MIN || !lanes_any(L->has & ~ml))) {
             int16 first = ~L->cur;
             int kmax = lanes_max(select(izero, L->cnt, ml));
+#ifdef LANES_STATS
+            lanes_stat(2, 1); lanes_stat(3, lanes_count(ml)); lanes_stat(4, kmax);
+            { int cc[16]; vstore16(select(izero, L->cnt, ml), 0, cc); int t_ = 0; for (int q = 0; q < 16; ++q) t_ += cc[q]; lanes_stat(5, t_); }
+#endif
             for (int k = 0; k < kmax; ++k) {
                 int16 m = ml & ((int16)(k) < L->cnt);
                 int16 tri = first + (int16)(k);
@@ -375,16 +458,23 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             done |= pm & ~m;
             if (!lanes_any(m)) break;
             L->sp += m;
-            int16 at = L->sp * (int16)(LANES) + lane;
-            float16 d = LANES_GATHER_F(M->stack_d, at, m);
+            int16 at = (L->sp * (int16)(LANES) + lane) * (int16)(2);
+            float16 d, itemf;
+            LANES_GATHER_PAIR(M->stack, at, lanes_kmask(m), d, itemf);
             int16 keep = m & (d < L->tfar);
-            int16 item = LANES_GATHER_I(M->stack_c, at, keep);
+            int16 item = as_int16(itemf);
             int16 leaf = item < izero;
             L->cur = select(L->cur, select(item, ~(item & (int16)(LANES_FIRST_MASK)), leaf), keep);
             L->cnt = select(L->cnt, select(izero, (item >> (int16)(27)) & (int16)(15), leaf), keep);
             L->has |= keep;
+            arrived |= keep & leaf;
         }
+        // A leaf waits for other lanes to reach theirs: its triangles are fetched meanwhile.
+        lanes_prefetch((ulong)tris, ~L->cur, L->cnt, sizeof(GpuTriangle), arrived & L->has);
         done &= L->live;
+        // What shading reads of the hit (the triangle was just read).
+        lanes_prefetch((ulong)surf->shading, L->prim, (int16)(1), sizeof(GpuTriShading),
+                       done & (L->prim >= izero));
         L->live &= ~done;
         L->fin |= done;
         if (lanes_count(L->fin) >= LANES_DONE_MIN || !lanes_any(L->live)) {

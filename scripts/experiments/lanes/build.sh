@@ -20,6 +20,6 @@ llvm-link-15 $O/trace.bc /usr/share/pocl/kernel-x86_64-pc-linux-gnu-avx512.bc --
     -o $O/linked.bc
 llvm-dis-15 $O/linked.bc -o - | sed 's/spir_func //g' > $O/linked.ll
 clang-15 -O3 -march=native -c $O/linked.ll -o $O/trace.o
-clang-15 -O2 -march=native scripts/experiments/native_trace/main.c $O/trace.o -lm \
+clang-15 -O2 -march=native ${NATIVE_MAIN:-scripts/experiments/native_trace/main.c} $O/trace.o -lm \
     -o $O/native_lanes
 echo $O/native_lanes

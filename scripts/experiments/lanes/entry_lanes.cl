@@ -5,7 +5,7 @@
 void trace_range(global const GpuWideNode* nodes, global const GpuTriangle* tris,
                  global const GpuRay* rays, uint first, uint end, global GpuHit* hits,
                  volatile global uint* counters, uint passes) {
-    SceneSurfaces surf;
+    SceneSurfaces surf = {0};
     LaneMemory M;
     lanes_init(&M);
     int id[LANES];
