@@ -158,10 +158,6 @@ typedef struct {
 } LaneMemory;
 
 #define LANES_INLINE inline __attribute__((always_inline))
-#ifdef LANES_STATS
-void lanes_stat(int, int);
-#endif
-
 LANES_INLINE void lanes_init(LaneMemory* M) {
     for (int l = 0; l < LANES; ++l) {
 #define LANES_ZERO(f) M->f[l] = 0;
@@ -286,9 +282,6 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
     global const float* tw = (global const float*)tris;
     Lanes V;
     Lanes* L = &V;
-#ifdef LANES_STATS
-    lanes_stat(6, 1);
-#endif
 #define LANES_LOAD(f) V.f = vload16(0, M->f);
     LANES_FLOAT_FIELDS(LANES_LOAD)
     LANES_INT_FIELDS(LANES_LOAD)
@@ -298,9 +291,6 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
         int16 arrived = izero;  // lanes that reached a leaf in this round
         // Interior nodes.
         int16 mi = L->has & (L->cnt == izero);
-#ifdef LANES_STATS
-        if (lanes_any(mi)) { lanes_stat(0, 1); lanes_stat(1, lanes_count(mi)); }
-#endif
         if (lanes_any(mi)) {
             int16 base = L->cur * (int16)(32);
             int16 nx = select((int16)(12), izero, L->ix >= zero);
@@ -392,10 +382,6 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
         if (lanes_any(ml) && (lanes_count(ml) >= LANES_LEAF_MIN || !lanes_any(L->has & ~ml))) {
             int16 first = ~L->cur;
             int kmax = lanes_max(select(izero, L->cnt, ml));
-#ifdef LANES_STATS
-            lanes_stat(2, 1); lanes_stat(3, lanes_count(ml)); lanes_stat(4, kmax);
-            { int cc[16]; vstore16(select(izero, L->cnt, ml), 0, cc); int t_ = 0; for (int q = 0; q < 16; ++q) t_ += cc[q]; lanes_stat(5, t_); }
-#endif
             for (int k = 0; k < kmax; ++k) {
                 int16 m = ml & ((int16)(k) < L->cnt);
                 int16 tri = first + (int16)(k);
