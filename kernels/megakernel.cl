@@ -49,7 +49,7 @@ inline void mega_count(volatile global uint* counters, uint extension_rays, uint
 }
 
 #ifdef MEGA_LANES
-// With MEGA_LANES a work item renders LANES_PIXELS pixels through LANES lanes
+// With MEGA_LANES a work item renders a square of LANES_TILE² pixels through LANES lanes
 // (traverse_lanes.h): a lane takes a pixel, traces its samples one after the other, as the
 // one-pixel kernel below does (so a pixel's samples are added in the same order, and the
 // image is the same bit for bit), then takes the next pixel. The lanes' extension rays are
@@ -57,10 +57,14 @@ inline void mega_count(volatile global uint* counters, uint extension_rays, uint
 // shade_vertex, their light samples traced there and then (one ray at a time: the any-hit walk
 // without sorting is as fast alone as in lanes), and each lane takes its path's next ray.
 kernel void megakernel(MEGAKERNEL_PARAMS) {
-    uint pixels = frame.width * frame.height;
-    uint next_pixel = get_global_id(0) * LANES_PIXELS;
-    uint end_pixel = min(next_pixel + LANES_PIXELS, pixels);
-    if (next_pixel >= pixels || frame.samples_in_wave == 0u) return;
+    // The work item's square of pixels, LANES_TILE on a side, taken row by row.
+    uint tiles_x = (frame.width + LANES_TILE - 1u) / LANES_TILE;
+    uint tile_x = (uint)get_global_id(0) % tiles_x * LANES_TILE;
+    uint tile_y = (uint)get_global_id(0) / tiles_x * LANES_TILE;
+    if (tile_y >= frame.height || frame.samples_in_wave == 0u) return;
+    uint tile_w = min((uint)LANES_TILE, frame.width - tile_x);
+    uint next_pixel = 0u;  // of the tile
+    uint end_pixel = tile_w * min((uint)LANES_TILE, frame.height - tile_y);
     MEGA_SHADE_SCENE(sc);
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
     LaneMemory M;
@@ -76,7 +80,8 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     // stays idle.
 #define LANE_NEXT_PIXEL(l)                                                             \
     if (next_pixel < end_pixel) {                                                      \
-        uint p = next_pixel++;                                                         \
+        uint p = (tile_y + next_pixel / tile_w) * frame.width + tile_x + next_pixel % tile_w; \
+        ++next_pixel;                                                                  \
         float4 f = film[p];                                                            \
         pixel[l] = p;                                                                  \
         sum[l] = f.xyz;                                                                \

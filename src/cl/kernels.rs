@@ -872,9 +872,10 @@ impl Program {
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
-        // With lanes a work item takes LANES_PIXELS pixels (kernels/megakernel.cl).
+        // With lanes a work item takes a LANES_TILE-square of pixels (kernels/megakernel.cl).
         let items = if self.features.lanes {
-            pixels.div_ceil(LANES_PIXELS)
+            (frame.width as usize).div_ceil(LANES_TILE)
+                * (frame.height as usize).div_ceil(LANES_TILE)
         } else {
             pixels
         };
@@ -1085,7 +1086,7 @@ impl Program {
 /// else 64, or 1 with `lanes`. On PoCL's CPU device a work-group is one task of its thread pool
 /// whose work items run one after the other (the kernel's loops defeat vectorisation across
 /// work items), so the size only sets the scheduling grain; docs/benchmarks.md has the
-/// measurements. A lanes work item renders LANES_PIXELS pixels, enough for a task alone.
+/// measurements. A lanes work item renders LANES_TILE² pixels, enough for a task alone.
 fn megakernel_local_size(lanes: bool) -> usize {
     std::env::var("PENUMBRA_MEGAKERNEL_GROUP")
         .ok()

@@ -146,10 +146,11 @@ kernel_constants! {
     /// Length of the counters buffer.
     COUNTER_SLOTS: usize = 8;
 
-    /// Pixels a work item of the megakernel with lanes (`MEGA_LANES`) renders: its sixteen
-    /// lanes take them one after the other, so that a lane whose pixels sample quickly (the
-    /// sky) takes more of them and none waits long for the others.
-    LANES_PIXELS: usize = 256;
+    /// The side of the square of pixels a work item of the megakernel with lanes
+    /// (`MEGA_LANES`) renders: its sixteen lanes take them one after the other, so that a lane
+    /// whose pixels sample quickly (the sky) takes more of them and none waits long for the
+    /// others; a square rather than a row keeps the lanes' rays near each other.
+    LANES_TILE: usize = 16;
 
     /// Slot of the statistics buffer (u64): extension rays traced.
     STAT_EXTENSION_RAYS: usize = 0;
