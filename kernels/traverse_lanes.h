@@ -256,7 +256,17 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
 #define LANES_PREFETCH_TRIS 4
 #endif
 
-// Compare-exchange of two (distance, child, count) triples in every lane, nearest first.
+// The lanes of m take the item (lanes_pack form) as the one they visit next.
+#define LANES_TAKE(ITEM, m)                                                                 \
+    {                                                                                      \
+        int16 leaf_ = (ITEM) < izero;                                                      \
+        L->cur = select(L->cur, select(ITEM, ~((ITEM) & (int16)(LANES_FIRST_MASK)), leaf_), \
+                        m);                                                                \
+        L->cnt = select(L->cnt, select(izero, ((ITEM) >> (int16)(27)) & (int16)(15), leaf_), \
+                        m);                                                                \
+    }
+
+// Compare-exchange of two (distance, item) pairs in every lane, nearest first.
 #define LANES_ORDER(A, B)                      \
     {                                          \
         int16 s = d##B < d##A;                 \
@@ -266,9 +276,6 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
         int16 tc = c##A;                       \
         c##A = select(c##A, c##B, s);          \
         c##B = select(c##B, tc, s);            \
-        int16 tk = k##A;                       \
-        k##A = select(k##A, k##B, s);          \
-        k##B = select(k##B, tk, s);            \
     }
 
 // Walks the lanes' rays until LANES_DONE_MIN are done or none is left walking; returns the
@@ -340,6 +347,8 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                        (nr##K < L->tfar);                                                   \
         d##J = select(inf, nr##J, reachJ);                                                  \
         d##K = select(inf, nr##K, reachK);                                                  \
+        c##J = lanes_pack(c##J, k##J);                                                      \
+        c##K = lanes_pack(c##K, k##K);                                                      \
     }
             LANES_CHILDREN(0, 1)
             LANES_CHILDREN(2, 3)
@@ -363,8 +372,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
     {                                                                              \
         int16 p = mi & (d##J < inf);                                               \
         int16 at = (L->sp * (int16)(LANES) + lane) * (int16)(2);                   \
-        LANES_SCATTER_PAIR(M->stack, at, lanes_kmask(p), d##J,                     \
-                           as_float16(lanes_pack(c##J, k##J)));                    \
+        LANES_SCATTER_PAIR(M->stack, at, lanes_kmask(p), d##J, as_float16(c##J)); \
         L->sp -= p;                                                                \
     }
             LANES_PUSH(3)
@@ -372,9 +380,8 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             LANES_PUSH(1)
 #undef LANES_PUSH
             int16 enter = mi & (d0 < inf);
-            arrived |= enter & (k0 != izero);
-            L->cur = select(L->cur, c0, enter);
-            L->cnt = select(L->cnt, k0, enter);
+            arrived |= enter & (c0 < izero);
+            LANES_TAKE(c0, enter);
             L->has &= ~(mi & ~enter);
         }
         // Leaves, once enough lanes are at one (or no lane is at a node).
@@ -455,11 +462,9 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             LANES_GATHER_PAIR(M->stack, at, lanes_kmask(m), d, itemf);
             int16 keep = m & (d < L->tfar);
             int16 item = as_int16(itemf);
-            int16 leaf = item < izero;
-            L->cur = select(L->cur, select(item, ~(item & (int16)(LANES_FIRST_MASK)), leaf), keep);
-            L->cnt = select(L->cnt, select(izero, (item >> (int16)(27)) & (int16)(15), leaf), keep);
+            LANES_TAKE(item, keep);
             L->has |= keep;
-            arrived |= keep & leaf;
+            arrived |= keep & (item < izero);
         }
         // A leaf waits for other lanes to reach theirs: its triangles are fetched meanwhile.
         lanes_prefetch((ulong)tris, ~L->cur, sizeof(GpuTriangle),
