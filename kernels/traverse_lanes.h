@@ -122,12 +122,12 @@ inline void lanes_scatter_f(float* base, int16 idx, float16 v, ushort km) {
 //   kx ky kz     the permutation, as word offsets in a vertex
 //   tfar         the nearest hit's t so far  hv hw hdet its edge functions v, w and their sum
 //   prim         its triangle (NO_HIT, -1, while none)
-//   cur cnt      the item visited: a node, or a leaf's ~first and count
+//   cur          the item visited, in lanes_pack form: a node, or a leaf (negative)
 //   sp           stack entries               live has fin: lanes with a ray, with an item to
 //                                            visit, done and not yet returned by lanes_walk
 #define LANES_FLOAT_FIELDS(X) X(ox) X(oy) X(oz) X(ix) X(iy) X(iz) X(px) X(py) X(pz) \
     X(sx) X(sy) X(sz) X(tfar) X(hv) X(hw) X(hdet)
-#define LANES_INT_FIELDS(X) X(kx) X(ky) X(kz) X(prim) X(cur) X(cnt) X(sp) X(live) X(has) X(fin)
+#define LANES_INT_FIELDS(X) X(kx) X(ky) X(kz) X(prim) X(cur) X(sp) X(live) X(has) X(fin)
 
 // The fields as vectors: Lanes lives only inside lanes_walk, where the compiler keeps it in
 // registers.
@@ -194,7 +194,6 @@ LANES_INLINE void lanes_set_ray(LaneMemory* M, int lane, float3 o, float3 d) {
     M->hdet[lane] = 1.0f;
     M->prim[lane] = -1;
     M->cur[lane] = 0;
-    M->cnt[lane] = 0;
     M->sp[lane] = 0;
     M->live[lane] = -1;
     M->has[lane] = -1;
@@ -224,9 +223,10 @@ LANES_INLINE GpuHit lanes_hit(const LaneMemory* M, int lane) {
 #define LANES_DONE_MIN 4
 #endif
 
-// A stack entry in one word: an interior child's index, or a leaf (child ~first, count k) as
-// the sign bit, k in the next four bits and first below (the host enables lanes only for
-// scenes of fewer than 2^27 triangles and leaves of at most 15: lanes_megakernel).
+// An item (the one a lane visits, or a stack entry) in one word: an interior child's index,
+// or a leaf (child ~first, count k) as the sign bit, k in the next four bits and first below
+// (the host enables lanes only for scenes of fewer than 2^27 triangles and leaves of at most
+// 15: lanes_megakernel).
 #define LANES_FIRST_MASK 0x07ffffff
 LANES_INLINE int16 lanes_pack(int16 c, int16 k) {
     return select(c, (int16)(0x80000000) | (k << (int16)(27)) | ~c, k != (int16)(0));
@@ -255,16 +255,6 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
 #ifndef LANES_PREFETCH_TRIS
 #define LANES_PREFETCH_TRIS 4
 #endif
-
-// The lanes of m take the item (lanes_pack form) as the one they visit next.
-#define LANES_TAKE(ITEM, m)                                                                 \
-    {                                                                                      \
-        int16 leaf_ = (ITEM) < izero;                                                      \
-        L->cur = select(L->cur, select(ITEM, ~((ITEM) & (int16)(LANES_FIRST_MASK)), leaf_), \
-                        m);                                                                \
-        L->cnt = select(L->cnt, select(izero, ((ITEM) >> (int16)(27)) & (int16)(15), leaf_), \
-                        m);                                                                \
-    }
 
 // Compare-exchange of two (distance, item) pairs in every lane, nearest first.
 #define LANES_ORDER(A, B)                      \
@@ -297,7 +287,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
     while (lanes_any(L->live)) {
         int16 arrived = izero;  // lanes that reached a leaf in this round
         // Interior nodes.
-        int16 mi = L->has & (L->cnt == izero);
+        int16 mi = L->has & (L->cur >= izero);
         if (lanes_any(mi)) {
             int16 base = L->cur * (int16)(32);
             int16 nx = select((int16)(12), izero, L->ix >= zero);
@@ -381,16 +371,17 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
 #undef LANES_PUSH
             int16 enter = mi & (d0 < inf);
             arrived |= enter & (c0 < izero);
-            LANES_TAKE(c0, enter);
+            L->cur = select(L->cur, c0, enter);
             L->has &= ~(mi & ~enter);
         }
         // Leaves, once enough lanes are at one (or no lane is at a node).
-        int16 ml = L->has & (L->cnt != izero);
+        int16 ml = L->has & (L->cur < izero);
         if (lanes_any(ml) && (lanes_count(ml) >= LANES_LEAF_MIN || !lanes_any(L->has & ~ml))) {
-            int16 first = ~L->cur;
-            int kmax = lanes_max(select(izero, L->cnt, ml));
+            int16 first = L->cur & (int16)(LANES_FIRST_MASK);
+            int16 cnt = (L->cur >> (int16)(27)) & (int16)(15);
+            int kmax = lanes_max(select(izero, cnt, ml));
             for (int k = 0; k < kmax; ++k) {
-                int16 m = ml & ((int16)(k) < L->cnt);
+                int16 m = ml & ((int16)(k) < cnt);
                 int16 tri = first + (int16)(k);
                 int16 b = tri * (int16)(12);
                 float16 aX = LANES_GATHER_F(tw, b + L->kx, m) - L->px;
@@ -462,12 +453,12 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             LANES_GATHER_PAIR(M->stack, at, lanes_kmask(m), d, itemf);
             int16 keep = m & (d < L->tfar);
             int16 item = as_int16(itemf);
-            LANES_TAKE(item, keep);
+            L->cur = select(L->cur, item, keep);
             L->has |= keep;
             arrived |= keep & (item < izero);
         }
         // A leaf waits for other lanes to reach theirs: its triangles are fetched meanwhile.
-        lanes_prefetch((ulong)tris, ~L->cur, sizeof(GpuTriangle),
+        lanes_prefetch((ulong)tris, L->cur & (int16)(LANES_FIRST_MASK), sizeof(GpuTriangle),
                        LANES_PREFETCH_TRIS * sizeof(GpuTriangle), arrived & L->has);
         done &= L->live;
         // What shading reads of the hit (the triangle was just read).

@@ -103,8 +103,9 @@ pub struct KernelFeatures {
 
 /// The fewest triangles for which the megakernel walks its rays in lanes: below, the tree fits
 /// the caches, a walk seldom waits on memory, and the lanes measured 1–4 % slower on the shared
-/// scenes of about 10,000 triangles; from 41,000 on they were 2–6 % faster, and 17 % on the
-/// 1 M-triangle bunnies (docs/benchmarks.md, "Fourteenth session").
+/// scenes of about 10,000 triangles (6–9 % after the fifteenth session's changes); from 41,000
+/// on they were 2–6 % faster, and 17 % on the 1 M-triangle bunnies (27 % after;
+/// docs/benchmarks.md, "Fourteenth session", "Fifteenth session").
 pub const LANES_MIN_TRIANGLES: usize = 32_768;
 
 /// Whether the megakernel should walk a flat scene's rays in lanes (`KernelFeatures::lanes`) on
