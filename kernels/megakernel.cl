@@ -49,51 +49,233 @@ inline void mega_count(volatile global uint* counters, uint extension_rays, uint
 }
 
 #ifdef MEGA_LANES
-// With MEGA_LANES a work item renders a square of LANES_TILE² pixels through LANES lanes
-// (traverse_lanes.h): a lane takes a pixel, traces its samples one after the other, as the
-// one-pixel kernel below does (so a pixel's samples are added in the same order, and the
-// image is the same bit for bit), then takes the next pixel. The lanes' extension rays are
-// walked together; when some are done, their vertices are shaded at once by the same
-// shade_vertex, their light samples traced there and then (one ray at a time: the any-hit walk
-// without sorting is as fast alone as in lanes), and each lane takes its path's next ray.
+// With MEGA_LANES a work item renders a square of LANES_TILE² pixels in two shapes of walk:
+//   - a chunk of a pixel's samples (sixteen at a time) or, below sixteen samples, of a 4×4
+//     block's, starts together: their camera rays walk the tree as one packet
+//     (traverse_packet.h), their first vertices are shaded by shade_vertex, and their light
+//     samples, which start close together and go to one light, walk as a packet too;
+//   - the paths that go on are taken by sixteen lanes (traverse_lanes.h), one path a lane, whose
+//     extension rays walk together, each at its own node: when some are done, their vertices are
+//     shaded, their light samples traced there and then (one ray at a time: the any-hit walk
+//     without sorting is as fast alone as in lanes, as such rays are incoherent), and each lane
+//     takes its path's next ray, or the next path of a chunk.
+// A chunk's results wait in its record until all its paths are done; then they are added to
+// their pixels' film sums in sample order, and a pixel has one chunk in flight at a time, so
+// each pixel sums its samples in the order the one-pixel kernel below does: the same image,
+// bit for bit (but for rays meeting two triangles at the same distance).
+#define MEGA_CHUNKS 20  // records: a chunk a lane in flight, and the queue's, cannot starve
+
+typedef struct {
+    uint pixel[LANES];    // entry e's pixel (a pixel's entries follow each other, in sample order)
+    float3 result[LANES];  // entry e's radiance, once its path is done
+    uint escaped;          // bit e: entry e's camera ray escaped (PATH_ESCAPED)
+    uint count;            // entries
+    uint remaining;        // paths not yet done: 0 when the record is not in flight
+    uint next_sample;      // one pixel a chunk: the pixel's next sample to start
+    bool more;             // one pixel a chunk: the pixel has samples left (the record is kept)
+} MegaChunk;
+
+// A work item's pixels, chunks, and the paths started but not yet in a lane.
+typedef struct {
+    MegaChunk chunk[MEGA_CHUNKS];
+    PathState queued[LANES];
+    uint queued_chunk[LANES], queued_entry[LANES];
+    uint queue_head, queue_end;
+    uint tile_x, tile_y, tile_w, tile_h;
+    uint next_pixel;  // of the tile, in 4×4 blocks
+    uint extension_rays, shadow_rays, nonfinite;
+} MegaWork;
+
+// The tile's pixel `i` in the order of 4×4 blocks (16 of them, row by row), or -1 outside the
+// image.
+inline int mega_tile_pixel(const MegaWork* W, const GpuFrame* frame, uint i) {
+    uint x = i / 16u % 4u * 4u + i % 4u;
+    uint y = i / 64u * 4u + i % 16u / 4u;
+    if (x >= W->tile_w || y >= W->tile_h) return -1;
+    return (int)((W->tile_y + y) * frame->width + W->tile_x + x);
+}
+
+// A record's chunk done: its results added to the film, pixel by pixel in sample order.
+inline void mega_chunk_done(MegaWork* W, const GpuFrame* frame, global float4* film,
+                            MegaChunk* c) {
+    uint e = 0u;
+    while (e < c->count) {
+        uint p = c->pixel[e];
+        float4 f = film[p];
+        float3 sum = f.xyz;
+        uint counted = 0u, samples = 0u;
+        for (; e < c->count && c->pixel[e] == p; ++e, ++samples) {
+            counted += ((c->escaped >> e) & 1u) == 0u;
+            if (all(isfinite(c->result[e]))) {
+                sum += c->result[e];
+            } else {
+                ++W->nonfinite;
+            }
+        }
+        uint n = frame->background == BACKGROUND_ENV ? samples : counted;
+        film[p] = (float4)(sum, f.w + (float)n);
+    }
+}
+
+// A path done: its radiance into its chunk's record.
+inline void mega_path_done(MegaWork* W, const GpuFrame* frame, global float4* film, uint chunk,
+                           uint entry, const PathState* s) {
+    MegaChunk* c = &W->chunk[chunk];
+    c->result[entry] = s->radiance;
+    if (s->flags & PATH_ESCAPED) c->escaped |= 1u << entry;
+    if (--c->remaining == 0u) mega_chunk_done(W, frame, film, c);
+}
+
+// Starts the next chunk: its camera rays as a packet, their vertices shaded, their light
+// samples as a packet; the paths that go on are queued. Returns false when no chunk can start
+// (the tile's pixels all started, and no pixel with samples left is free of chunks in flight).
+inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera* camera,
+                             const ShadeScene* sc, global const GpuWideNode* nodes,
+                             global const GpuInstance* instances,
+                             global const GpuTriangle* object_tris, global float4* film,
+                             volatile global uint* overflow) {
+    uint spp = frame->samples_in_wave;
+    // A pixel with samples left whose last chunk is done; else a free record for new pixels.
+    int r = -1, free_ = -1;
+    for (int i = 0; i < MEGA_CHUNKS; ++i) {
+        MegaChunk* c = &W->chunk[i];
+        if (c->remaining != 0u) continue;
+        if (c->more) {
+            r = i;
+            break;
+        }
+        if (free_ < 0) free_ = i;
+    }
+    uint sample0[LANES];
+    MegaChunk* c;
+    if (r >= 0) {
+        c = &W->chunk[r];
+        c->count = min(spp - c->next_sample, (uint)LANES);
+        for (uint e = 0u; e < c->count; ++e) sample0[e] = c->next_sample + e;
+        for (uint e = 1u; e < c->count; ++e) c->pixel[e] = c->pixel[0];
+    } else {
+        if (free_ < 0) return false;
+        r = free_;
+        c = &W->chunk[r];
+        // The next pixel (all of its samples, or the first sixteen), or as many pixels as
+        // sixteen lanes take all the samples of.
+        uint pixels = spp >= (uint)LANES ? 1u : (uint)LANES / spp;
+        c->count = 0u;
+        for (uint k = 0u; k < pixels && W->next_pixel < LANES_TILE * LANES_TILE;) {
+            int p = mega_tile_pixel(W, frame, W->next_pixel++);
+            if (p < 0) continue;
+            for (uint j = 0u; j < min(spp, (uint)LANES); ++j) {
+                c->pixel[c->count] = (uint)p;
+                sample0[c->count++] = j;
+            }
+            ++k;
+        }
+        if (c->count == 0u) return false;
+        c->next_sample = 0u;
+    }
+    c->next_sample += spp >= (uint)LANES ? c->count : spp;
+    c->more = c->next_sample < spp;
+    c->escaped = 0u;
+    c->remaining = c->count;
+    uint n = c->count;
+    W->extension_rays += n;
+    Packet P;
+    PathState* s = W->queued;
+    for (uint e = 0u; e < n; ++e) {
+        s[e] = camera_path(frame, camera, c->pixel[e], frame->first_sample + sample0[e]);
+        packet_set_ray(&P, (int)e, s[e].origin, s[e].direction, INFINITY);
+    }
+    int16 lanes = LANE_IDS < (int16)((int)n);
+    packet_walk(&P, lanes, false, nodes, sc->tris, &sc->surf, overflow);
+    ShadowQuery q[LANES];
+    bool alive[LANES];
+    int shadow[LANES];
+    for (uint e = 0u; e < n; ++e) {
+        alive[e] = shade_vertex(frame, 0u, sc, packet_hit(&P, (int)e), &s[e], &q[e]);
+        shadow[e] = q[e].valid ? -1 : 0;
+        if (q[e].valid) packet_set_ray(&P, (int)e, q[e].origin, q[e].direction, q[e].tmax);
+    }
+    for (uint e = n; e < (uint)LANES; ++e) shadow[e] = 0;
+    int16 shadows = vload16(0, shadow);
+    if (lanes_any(shadows)) {
+        W->shadow_rays += (uint)lanes_count(shadows);
+        packet_walk(&P, shadows, true, nodes, sc->tris, &sc->surf, overflow);
+        for (uint e = 0u; e < n; ++e) {
+            if (!shadow[e]) continue;
+            if (P.prim[e] < 0) {
+                s[e].radiance += q[e].contribution;
+            } else {
+#ifdef HAS_THIN_WALLS
+                // Blocked: perhaps only by thin walls, which the scalar test passes.
+                s[e].radiance +=
+                    shadow_pass_wide(nodes, sc->tris, instances, object_tris, &sc->surf, &q[e],
+                                     overflow);
+#endif
+            }
+        }
+    }
+    // The paths that go on wait for lanes; the others are done.
+    W->queue_head = 0u;
+    W->queue_end = 0u;
+    for (uint e = 0u; e < n; ++e) {
+        if (alive[e]) {
+            uint k = W->queue_end++;
+            if (k != e) s[k] = s[e];
+            W->queued_chunk[k] = (uint)r;
+            W->queued_entry[k] = e;
+        } else {
+            mega_path_done(W, frame, film, (uint)r, e, &s[e]);
+        }
+    }
+    return true;
+}
+
 kernel void megakernel(MEGAKERNEL_PARAMS) {
-    // The work item's square of pixels, LANES_TILE on a side, taken row by row.
+    // The work item's square of pixels, LANES_TILE on a side.
     uint tiles_x = (frame.width + LANES_TILE - 1u) / LANES_TILE;
-    uint tile_x = (uint)get_global_id(0) % tiles_x * LANES_TILE;
-    uint tile_y = (uint)get_global_id(0) / tiles_x * LANES_TILE;
-    if (tile_y >= frame.height || frame.samples_in_wave == 0u) return;
-    uint tile_w = min((uint)LANES_TILE, frame.width - tile_x);
-    uint next_pixel = 0u;  // of the tile
-    uint end_pixel = tile_w * min((uint)LANES_TILE, frame.height - tile_y);
+    MegaWork W;
+    W.tile_x = (uint)get_global_id(0) % tiles_x * LANES_TILE;
+    W.tile_y = (uint)get_global_id(0) / tiles_x * LANES_TILE;
+    if (W.tile_y >= frame.height || frame.samples_in_wave == 0u) return;
+    W.tile_w = min((uint)LANES_TILE, frame.width - W.tile_x);
+    W.tile_h = min((uint)LANES_TILE, frame.height - W.tile_y);
+    W.next_pixel = 0u;
+    W.queue_head = W.queue_end = 0u;
+    W.extension_rays = W.shadow_rays = W.nonfinite = 0u;
+    for (int i = 0; i < MEGA_CHUNKS; ++i) {
+        W.chunk[i].remaining = 0u;
+        W.chunk[i].more = false;
+    }
     MEGA_SHADE_SCENE(sc);
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
     LaneMemory M;
     lanes_init(&M);
     PathState s[LANES];
-    float3 sum[LANES];
-    float film_w[LANES];
-    uint pixel[LANES], bounce[LANES], sample[LANES], counted[LANES];
-    uint extension_rays = 0;
-    uint shadow_rays = 0;
-    uint nonfinite = 0;
-    // A lane takes the next pixel (its film sum and its first camera ray); with none left it
-    // stays idle.
-#define LANE_NEXT_PIXEL(l)                                                             \
-    if (next_pixel < end_pixel) {                                                      \
-        uint p = (tile_y + next_pixel / tile_w) * frame.width + tile_x + next_pixel % tile_w; \
-        ++next_pixel;                                                                  \
-        float4 f = film[p];                                                            \
-        pixel[l] = p;                                                                  \
-        sum[l] = f.xyz;                                                                \
-        film_w[l] = f.w;                                                               \
-        counted[l] = 0u;                                                               \
-        sample[l] = 0u;                                                                \
-        bounce[l] = 0u;                                                                \
-        s[l] = camera_path(&frame, &camera, p, frame.first_sample);                    \
-        lanes_set_ray(&M, l, s[l].origin, s[l].direction);                             \
+    uint bounce[LANES], chunk[LANES], entry[LANES];
+    bool busy[LANES];
+    // A lane takes the next queued path (starting chunks while the queue is empty); with none
+    // left it stays idle.
+#define LANE_NEXT_PATH(l)                                                                    \
+    {                                                                                        \
+        while (W.queue_head == W.queue_end &&                                                \
+               mega_chunk_start(&W, &frame, &camera, &sc, nodes, instances, object_tris,     \
+                                film, overflow)) {                                           \
+        }                                                                                    \
+        if (W.queue_head < W.queue_end) {                                                    \
+            uint k = W.queue_head++;                                                         \
+            s[l] = W.queued[k];                                                              \
+            chunk[l] = W.queued_chunk[k];                                                    \
+            entry[l] = W.queued_entry[k];                                                    \
+            bounce[l] = 1u;                                                                  \
+            busy[l] = true;                                                                  \
+            lanes_set_ray(&M, l, s[l].origin, s[l].direction);                               \
+        }                                                                                    \
     }
+    bool idle = false;
     for (int l = 0; l < LANES; ++l) {
-        LANE_NEXT_PIXEL(l)
+        busy[l] = false;
+        LANE_NEXT_PATH(l)
+        idle |= !busy[l];
     }
     for (;;) {
         int16 done = lanes_walk(&M, nodes, tris, &sc.surf, overflow);
@@ -102,33 +284,36 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         vstore16(done, 0, done_);
         for (int l = 0; l < LANES; ++l) {
             if (!done_[l]) continue;
-            ++extension_rays;
+            ++W.extension_rays;
             ShadowQuery q;
             bool alive = shade_vertex(&frame, bounce[l], &sc, lanes_hit(&M, l), &s[l], &q);
             if (q.valid) {
-                ++shadow_rays;
+                ++W.shadow_rays;
                 s[l].radiance +=
                     shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, &q, overflow);
             }
-            // The path goes on, or the pixel's next sample starts, or the lane's next pixel.
+            // The path goes on, or the lane takes the next one.
             if (alive && ++bounce[l] <= frame.max_bounces + 1u) {
                 lanes_set_ray(&M, l, s[l].origin, s[l].direction);
                 continue;
             }
-            mega_add_sample(&s[l], &sum[l], &counted[l], &nonfinite);
-            if (++sample[l] < frame.samples_in_wave) {
-                bounce[l] = 0u;
-                s[l] = camera_path(&frame, &camera, pixel[l], frame.first_sample + sample[l]);
-                lanes_set_ray(&M, l, s[l].origin, s[l].direction);
-                continue;
+            mega_path_done(&W, &frame, film, chunk[l], entry[l], &s[l]);
+            busy[l] = false;
+            LANE_NEXT_PATH(l)
+            idle |= !busy[l];
+        }
+        // Lanes left idle while every pixel with samples left had a chunk in flight take
+        // work again once one is done.
+        if (idle) {
+            idle = false;
+            for (int l = 0; l < LANES; ++l) {
+                if (!busy[l]) LANE_NEXT_PATH(l)
+                idle |= !busy[l];
             }
-            uint c = frame.background == BACKGROUND_ENV ? frame.samples_in_wave : counted[l];
-            film[pixel[l]] = (float4)(sum[l], film_w[l] + (float)c);
-            LANE_NEXT_PIXEL(l)
         }
     }
-#undef LANE_NEXT_PIXEL
-    mega_count(counters, extension_rays, shadow_rays, nonfinite);
+#undef LANE_NEXT_PATH
+    mega_count(counters, W.extension_rays, W.shadow_rays, W.nonfinite);
 }
 #else
 kernel void megakernel(MEGAKERNEL_PARAMS) {

@@ -323,45 +323,50 @@ fn samples_in_one_call_or_many_make_the_same_image() {
 
 #[test]
 fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
-    // On a CPU with AVX-512 the megakernel walks extension rays sixteen at a time in vector
-    // lanes (kernels/traverse_lanes.h), a work item taking 256 pixels: the same hits, the same
-    // samples added in the same order, so the image is the one-ray-at-a-time kernel's bit for
-    // bit (but for rays that meet two triangles at exactly the same distance, of which each
-    // walk may keep another). A sphere of 34,816 triangles (lanes are for scenes of 32,768 or
-    // more: 2 x 128 x 136) on a floor, an image of 37 x 23 (its last work item partial).
+    // On a CPU with AVX-512 the megakernel starts sixteen paths at a time (a pixel's samples,
+    // or a few pixels' below sixteen), their camera rays and first light samples walked as
+    // packets (kernels/traverse_packet.h), and walks the later extension rays sixteen at a
+    // time in vector lanes (kernels/traverse_lanes.h), a work item taking 256 pixels: the same
+    // hits, the same samples added in the same order, so the image is the one-ray-at-a-time
+    // kernel's bit for bit (but for rays that meet two triangles at exactly the same distance,
+    // of which each walk may keep another). A sphere of 34,816 triangles (lanes are for scenes
+    // of 32,768 or more: 2 x 128 x 136) on a floor, an image of 37 x 23 (its last work item
+    // partial), at 5 samples (three pixels a chunk) and 21 (a pixel's chunks of 16 and 5).
     let dir = tempfile::tempdir().unwrap();
     let (rings, segments) = (128, 136);
     assert!((2 * rings * segments) as usize >= penumbra::cl::LANES_MIN_TRIANGLES);
     let scene = common::white_sphere_of(dir.path(), true, rings, segments);
-    let args = [
-        "--kernel",
-        "megakernel",
-        "--width",
-        "37",
-        "--height",
-        "23",
-        "--spp",
-        "5",
-        "--bounces",
-        "4",
-    ];
-    let (a, pa) = render_exr(&scene, &dir.path().join("lanes.exr"), &args);
-    let (b, pb) = render_exr_env(
-        &scene,
-        &dir.path().join("one.exr"),
-        &args,
-        &[("PENUMBRA_LANES", "0")],
-    );
-    assert_eq!(b["lanes"], false, "PENUMBRA_LANES=0 left lanes on");
-    #[cfg(target_arch = "x86_64")]
-    if common::test_device() == "cpu" && std::arch::is_x86_feature_detected!("avx512f") {
-        assert_eq!(a["lanes"], true, "a CPU with AVX-512 did not walk in lanes");
+    for spp in ["5", "21"] {
+        let args = [
+            "--kernel",
+            "megakernel",
+            "--width",
+            "37",
+            "--height",
+            "23",
+            "--spp",
+            spp,
+            "--bounces",
+            "4",
+        ];
+        let (a, pa) = render_exr(&scene, &dir.path().join(format!("lanes-{spp}.exr")), &args);
+        let (b, pb) = render_exr_env(
+            &scene,
+            &dir.path().join(format!("one-{spp}.exr")),
+            &args,
+            &[("PENUMBRA_LANES", "0")],
+        );
+        assert_eq!(b["lanes"], false, "PENUMBRA_LANES=0 left lanes on");
+        #[cfg(target_arch = "x86_64")]
+        if common::test_device() == "cpu" && std::arch::is_x86_feature_detected!("avx512f") {
+            assert_eq!(a["lanes"], true, "a CPU with AVX-512 did not walk in lanes");
+        }
+        assert!(pa.iter().any(|p| p[0] > 0.0), "{spp} spp: a black image");
+        assert_eq!(a["extension_rays"], b["extension_rays"], "{spp} spp");
+        assert_eq!(a["shadow_rays"], b["shadow_rays"], "{spp} spp");
+        assert!(
+            pa == pb,
+            "{spp} spp: the lanes' image differs from one ray at a time's"
+        );
     }
-    assert!(pa.iter().any(|p| p[0] > 0.0), "a black image");
-    assert_eq!(a["extension_rays"], b["extension_rays"]);
-    assert_eq!(a["shadow_rays"], b["shadow_rays"]);
-    assert!(
-        pa == pb,
-        "the lanes' image differs from one ray at a time's"
-    );
 }

@@ -23,6 +23,10 @@ const SOURCES: &[(&str, &str)] = &[
         "kernels/traverse_lanes.h",
         include_str!("../../kernels/traverse_lanes.h"),
     ),
+    (
+        "kernels/traverse_packet.h",
+        include_str!("../../kernels/traverse_packet.h"),
+    ),
     ("kernels/bsdf.h", include_str!("../../kernels/bsdf.h")),
     ("kernels/surface.h", include_str!("../../kernels/surface.h")),
     ("kernels/env.h", include_str!("../../kernels/env.h")),

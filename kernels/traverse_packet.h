@@ -1,0 +1,260 @@
+// Packets of coherent rays, for the CPU megakernel (MEGA_LANES): sixteen rays that start close
+// together and go nearly the same way (a pixel's camera rays, or a 4×4 block's, and their light
+// samples toward one point) walk the 4-wide BVH together, one node at a time for all of them:
+// the node's boxes are read once, as scalars broadcast to the sixteen lanes, and tested against
+// every ray of the packet, and a triangle is read once and tested against all of them. Where
+// traverse_lanes.h's independent lanes pay sixteen gathers for every plane of every node, a
+// packet pays one load, at the price of visiting the union of its rays' nodes, so it is for
+// coherent rays only (Wald, Slusallek, Benthin, Wagner 2001; Embree's packet kernels).
+//
+// Each lane computes traverse_wide.h's slab test and intersect_leaf4's watertight arithmetic,
+// so a closest hit is the scalar walk's (but for equally near triangles) and an any-hit
+// verdict is the same; the scalar test's rare cases go to intersect_leaf itself, as in
+// traverse_lanes.h. A stack entry holds an item (lanes_pack form: a node, or a leaf) and the
+// entry distance of each lane that reached it (infinity for the others), so a popped entry
+// is visited by exactly the lanes that reached it and whose hit is not nearer.
+
+#ifdef MEGA_LANES
+#define PACKET_STACK (WIDE_STACK_SIZE + 1)
+
+// A packet's rays, lane by lane (written by scalar code, loaded into vectors by packet_walk):
+// origin, safe reciprocal direction, origin in the permuted axes, shear, the dominant axis
+// (prepare_ray's kz, which names the permutation), and the hit: its distance (the ray's tmax
+// until one is found), edge functions and triangle (-1 while none).
+typedef struct {
+    float ox[LANES], oy[LANES], oz[LANES], ix[LANES], iy[LANES], iz[LANES];
+    float px[LANES], py[LANES], pz[LANES], sx[LANES], sy[LANES], sz[LANES];
+    int kz[LANES];
+    float tfar[LANES], hv[LANES], hw[LANES], hdet[LANES];
+    int prim[LANES];
+    float3 o[LANES], d[LANES];  // the rays, for the scalar test's rare cases
+} Packet;
+
+// Lane `lane` of the packet takes the ray from o along d, to tmax.
+LANES_INLINE void packet_set_ray(Packet* P, int lane, float3 o, float3 d, float tmax) {
+    RayPrep r = prepare_ray(o, d);
+    float4 p = ray_permute((float4)(o, 0.0f), r.perm);
+    P->ox[lane] = o.x;
+    P->oy[lane] = o.y;
+    P->oz[lane] = o.z;
+    P->ix[lane] = r.inv.x;
+    P->iy[lane] = r.inv.y;
+    P->iz[lane] = r.inv.z;
+    P->px[lane] = p.x;
+    P->py[lane] = p.y;
+    P->pz[lane] = p.z;
+    P->sx[lane] = r.shear.x;
+    P->sy[lane] = r.shear.y;
+    P->sz[lane] = r.shear.z;
+    P->kz[lane] = (int)r.perm.z;
+    P->tfar[lane] = tmax;
+    P->hv[lane] = 0.0f;
+    P->hw[lane] = 0.0f;
+    P->hdet[lane] = 1.0f;
+    P->prim[lane] = -1;
+    P->o[lane] = o;
+    P->d[lane] = d;
+}
+
+// The hit of a lane after a closest-hit walk.
+LANES_INLINE GpuHit packet_hit(const Packet* P, int lane) {
+    GpuHit h;
+    h.t = P->tfar[lane];
+    h.prim = (uint)P->prim[lane];
+    h.u = h.prim == NO_HIT ? 0.0f : P->hv[lane] / P->hdet[lane];
+    h.v = h.prim == NO_HIT ? 0.0f : P->hw[lane] / P->hdet[lane];
+    h.instance = 0u;
+    return h;
+}
+
+// The least lane of x.
+inline float packet_min(float16 x) {
+    float8 a = select(x.hi, x.lo, x.lo < x.hi);
+    float4 b = select(a.hi, a.lo, a.lo < a.hi);
+    float2 c = select(b.hi, b.lo, b.lo < b.hi);
+    return c.x < c.y ? c.x : c.y;
+}
+
+#define PACKET_MIN(a, b) select(b, a, a < b)
+#define PACKET_MAX(a, b) select(b, a, a > b)
+
+// Walks the rays of the lanes `live` (from tmin 0 to each lane's tfar) for their nearest hits,
+// or with any_hit for some hit each (a lane's prim >= 0 after it: occluded), writing the hits
+// to P. A packet whose stack would overflow ends with the hits so far (counted).
+LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
+                              global const GpuWideNode* nodes, global const GpuTriangle* tris,
+                              const SceneSurfaces* surf, volatile global uint* overflow) {
+    const float16 inf = (float16)(INFINITY), zero = (float16)(0.0f);
+    const int16 izero = (int16)(0);
+    float16 ox = vload16(0, P->ox), oy = vload16(0, P->oy), oz = vload16(0, P->oz);
+    float16 ix = vload16(0, P->ix), iy = vload16(0, P->iy), iz = vload16(0, P->iz);
+    float16 px = vload16(0, P->px), py = vload16(0, P->py), pz = vload16(0, P->pz);
+    float16 sx = vload16(0, P->sx), sy = vload16(0, P->sy), sz = vload16(0, P->sz);
+    int16 kz = vload16(0, P->kz);
+    int16 z0 = kz == izero, z1 = kz == (int16)(1);
+    float16 tfar = vload16(0, P->tfar), hv = vload16(0, P->hv), hw = vload16(0, P->hw);
+    float16 hdet = vload16(0, P->hdet);
+    int16 prim = vload16(0, P->prim);
+    float16 stack_d[PACKET_STACK];
+    int stack_item[PACKET_STACK];
+    int sp = 0;
+    int item = 0;       // the root
+    int16 m = live;     // the lanes visiting `item`
+    int16 open = live;  // the lanes still looking (with any_hit: not yet blocked)
+    for (;;) {
+        if (item >= 0) {
+            global const GpuWideNode* n = &nodes[item];
+            float4 lx = n->min_x, ly = n->min_y, lz = n->min_z;
+            float4 hx = n->max_x, hy = n->max_y, hz = n->max_z;
+            int4 ch = n->child;
+            int4 ct = as_int4(n->count);
+            float16 dv[4];
+            float key[4];
+            int cv[4];
+            // Child J (component C): traverse_wide.h's slab test in every lane of m. With lo <=
+            // hi the near plane's distance is the lesser of the two, bit for bit (rounding is
+            // monotonic), so no plane is picked by the direction's sign.
+#define PACKET_CHILD(J, C)                                                                   \
+    {                                                                                        \
+        float16 x0 = ((float16)(lx.C) - ox) * ix, x1 = ((float16)(hx.C) - ox) * ix;          \
+        float16 y0 = ((float16)(ly.C) - oy) * iy, y1 = ((float16)(hy.C) - oy) * iy;          \
+        float16 z0_ = ((float16)(lz.C) - oz) * iz, z1_ = ((float16)(hz.C) - oz) * iz;        \
+        float16 near = PACKET_MAX(PACKET_MAX(PACKET_MIN(x0, x1), PACKET_MIN(y0, y1)),        \
+                                  PACKET_MAX(PACKET_MIN(z0_, z1_), zero));                   \
+        float16 far = PACKET_MIN(PACKET_MIN(PACKET_MAX(x0, x1), PACKET_MAX(y0, y1)),         \
+                                 PACKET_MAX(z0_, z1_)) *                                     \
+                      1.00000024f;                                                           \
+        int16 reach = m & (near <= far) & (near < tfar);                                     \
+        if (ch.C <= 0 && ct.C == 0) reach = izero;                                           \
+        dv[J] = select(inf, near, reach);                                                    \
+        key[J] = packet_min(dv[J]);                                                          \
+        cv[J] = ct.C != 0 ? (int)(0x80000000u | ((uint)ct.C << 27) | (uint)~ch.C) : ch.C;   \
+    }
+            PACKET_CHILD(0, x)
+            PACKET_CHILD(1, y)
+            PACKET_CHILD(2, z)
+            PACKET_CHILD(3, w)
+#undef PACKET_CHILD
+            // Nearest first (by the nearest lane's entry; with any_hit in slot order): the
+            // others pushed farthest first, the nearest entered.
+            uint s0 = 0u, s1 = 1u, s2 = 2u, s3 = 3u;
+            if (!any_hit) {
+#define PACKET_ORDER(A, B)                        \
+    if (key[s##B] < key[s##A]) {                  \
+        uint t_ = s##A;                           \
+        s##A = s##B;                              \
+        s##B = t_;                                \
+    }
+                PACKET_ORDER(0, 1)
+                PACKET_ORDER(2, 3)
+                PACKET_ORDER(0, 2)
+                PACKET_ORDER(1, 3)
+                PACKET_ORDER(1, 2)
+#undef PACKET_ORDER
+            }
+            if (sp + 3 > PACKET_STACK) {
+                atomic_inc(overflow);
+                break;
+            }
+#define PACKET_PUSH(S)                          \
+    if (key[S] < INFINITY) {                    \
+        stack_d[sp] = dv[S];                    \
+        stack_item[sp++] = cv[S];               \
+    }
+            PACKET_PUSH(s3)
+            PACKET_PUSH(s2)
+            PACKET_PUSH(s1)
+#undef PACKET_PUSH
+            if (key[s0] < INFINITY) {
+                item = cv[s0];
+                m = dv[s0] < inf;
+                continue;
+            }
+        } else {
+            // A leaf: each of its triangles against every lane of m.
+            int first = item & LANES_FIRST_MASK;
+            int count = (item >> 27) & 15;
+            for (int k = 0; k < count; ++k) {
+                GpuTriangle tri = tris[first + k];
+#define PACKET_VERTEX(V, X, Y, Z)                                                     \
+    float16 X, Y, Z;                                                                  \
+    {                                                                                 \
+        float16 vx = (float16)(tri.V.x), vy = (float16)(tri.V.y), vz = (float16)(tri.V.z); \
+        X = select(select(vx, vz, z1), vy, z0) - px;                                  \
+        Y = select(select(vy, vx, z1), vz, z0) - py;                                  \
+        Z = select(select(vz, vy, z1), vx, z0) - pz;                                  \
+    }
+                PACKET_VERTEX(v0, aX, aY, aZ)
+                PACKET_VERTEX(v1, bX, bY, bZ)
+                PACKET_VERTEX(v2, cX, cY, cZ)
+#undef PACKET_VERTEX
+                LANE_EDGES(float16)
+                LANE_HITS16(m, zero, tfar)
+                ok &= ~special;
+                tfar = select(tfar, t, ok);
+                hv = select(hv, v, ok);
+                hw = select(hw, w, ok);
+                hdet = select(hdet, det, ok);
+                prim = select(prim, (int16)(first + k), ok);
+                if (lanes_any(special)) {
+                    // The scalar test decides these lanes' triangle, with their hits so far.
+                    int sp_[LANES], prim_[LANES];
+                    float t_[LANES], v_[LANES], w_[LANES], det_[LANES];
+                    vstore16(special, 0, sp_);
+                    vstore16(tfar, 0, t_);
+                    vstore16(hv, 0, v_);
+                    vstore16(hw, 0, w_);
+                    vstore16(hdet, 0, det_);
+                    vstore16(prim, 0, prim_);
+                    for (int l = 0; l < LANES; ++l) {
+                        if (!sp_[l]) continue;
+                        RayPrep r = prepare_ray(P->o[l], P->d[l]);
+                        GpuHit h = no_hit(t_[l]);
+                        intersect_leaf(&r, tris, surf, (uint)(first + k), 1u, 0.0f, P->o[l],
+                                       P->d[l], any_hit, &h);
+                        if (h.prim != NO_HIT) {
+                            t_[l] = h.t;
+                            v_[l] = h.u;
+                            w_[l] = h.v;
+                            det_[l] = 1.0f;
+                            prim_[l] = (int)h.prim;
+                        }
+                    }
+                    tfar = vload16(0, t_);
+                    hv = vload16(0, v_);
+                    hw = vload16(0, w_);
+                    hdet = vload16(0, det_);
+                    prim = vload16(0, prim_);
+                }
+                if (any_hit) {
+                    // A blocked lane is done.
+                    open &= prim < izero;
+                    m &= open;
+                    if (!lanes_any(m)) break;
+                }
+            }
+            if (any_hit && !lanes_any(open)) break;
+        }
+        // The nearest pushed entry that some open lane still reaches before its hit.
+        bool found = false;
+        while (sp > 0) {
+            --sp;
+            m = open & (stack_d[sp] < tfar);
+            if (lanes_any(m)) {
+                item = stack_item[sp];
+                found = true;
+                break;
+            }
+        }
+        if (!found) break;
+    }
+    vstore16(tfar, 0, P->tfar);
+    vstore16(hv, 0, P->hv);
+    vstore16(hw, 0, P->hw);
+    vstore16(hdet, 0, P->hdet);
+    vstore16(prim, 0, P->prim);
+}
+#undef PACKET_MIN
+#undef PACKET_MAX
+
+#endif  // MEGA_LANES
