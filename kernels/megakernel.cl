@@ -63,12 +63,7 @@ inline void mega_count(volatile global uint* counters, uint extension_rays, uint
 // their pixels' film sums in sample order, and a pixel has one chunk in flight at a time, so
 // each pixel sums its samples in the order the one-pixel kernel below does: the same image,
 // bit for bit (but for rays meeting two triangles at the same distance).
-#define MEGA_CHUNKS 20
-// A chunk's light samples walk as a packet when their directions are all within this cosine of
-// one another's (of the first's); else one by one.
-#ifndef PACKET_SHADOW_COS
-#define PACKET_SHADOW_COS 0.95f
-#endif  // records: a chunk a lane in flight, and the queue's, cannot starve
+#define MEGA_CHUNKS 20  // records: a chunk a lane in flight, and the queue's, cannot starve
 
 typedef struct {
     uint pixel[LANES];    // entry e's pixel (a pixel's entries follow each other, in sample order)
@@ -85,10 +80,6 @@ typedef struct {
     MegaChunk chunk[MEGA_CHUNKS];
     PathState queued[LANES];
     uint queued_chunk[LANES], queued_entry[LANES];
-    // The queued paths' next rays, walked as a packet through the top of the tree: where it
-    // handed each ray to lanes (its ray in `next`, the hand-off in `handoff`).
-    Packet next;
-    PacketHandoff handoff;
     uint queue_head, queue_end;
     uint tile_x, tile_y, tile_w, tile_h;
     uint next_pixel;  // of the tile, in 4×4 blocks
@@ -195,37 +186,20 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
         packet_set_ray(&P, (int)e, s[e].origin, s[e].direction, INFINITY);
     }
     int16 lanes = LANE_IDS < (int16)((int)n);
-    packet_walk(&P, &lanes, false, nodes, sc->tris, &sc->surf, overflow, 0);
+    packet_walk(&P, lanes, false, nodes, sc->tris, &sc->surf, overflow);
     ShadowQuery q[LANES];
     bool alive[LANES];
     int shadow[LANES];
-    // The light samples' spread: the least cosine between one's direction and the others'.
-    float3 toward = (float3)(0.0f);
-    float spread = 1.0f;
     for (uint e = 0u; e < n; ++e) {
         alive[e] = shade_vertex(frame, 0u, sc, packet_hit(&P, (int)e), &s[e], &q[e]);
         shadow[e] = q[e].valid ? -1 : 0;
-        if (!q[e].valid) continue;
-        packet_set_ray(&P, (int)e, q[e].origin, q[e].direction, q[e].tmax);
-        if (toward.x == 0.0f && toward.y == 0.0f && toward.z == 0.0f) toward = q[e].direction;
-        spread = fmin(spread, dot(toward, q[e].direction));
+        if (q[e].valid) packet_set_ray(&P, (int)e, q[e].origin, q[e].direction, q[e].tmax);
     }
     for (uint e = n; e < (uint)LANES; ++e) shadow[e] = 0;
     int16 shadows = vload16(0, shadow);
-    if (lanes_any(shadows) && spread < PACKET_SHADOW_COS) {
-        // Light samples that go different ways (an environment's, a large light's near by)
-        // walk one at a time: a packet would visit the union of their paths.
-        for (uint e = 0u; e < n; ++e) {
-            if (!shadow[e]) continue;
-            ++W->shadow_rays;
-            s[e].radiance += shadow_pass_wide(nodes, sc->tris, instances, object_tris,
-                                              &sc->surf, &q[e], overflow);
-        }
-        shadows = (int16)(0);
-    }
     if (lanes_any(shadows)) {
         W->shadow_rays += (uint)lanes_count(shadows);
-        packet_walk(&P, &shadows, true, nodes, sc->tris, &sc->surf, overflow, 0);
+        packet_walk(&P, shadows, true, nodes, sc->tris, &sc->surf, overflow);
         for (uint e = 0u; e < n; ++e) {
             if (!shadow[e]) continue;
             if (P.prim[e] < 0) {
@@ -240,8 +214,7 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
             }
         }
     }
-    // The paths that go on wait for lanes, their next rays walked through the top of the tree
-    // (they leave nearly one point, so share it) by a packet; the others are done.
+    // The paths that go on wait for lanes; the others are done.
     W->queue_head = 0u;
     W->queue_end = 0u;
     for (uint e = 0u; e < n; ++e) {
@@ -250,14 +223,9 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
             if (k != e) s[k] = s[e];
             W->queued_chunk[k] = (uint)r;
             W->queued_entry[k] = e;
-            packet_set_ray(&W->next, (int)k, s[k].origin, s[k].direction, INFINITY);
         } else {
             mega_path_done(W, frame, film, (uint)r, e, &s[e]);
         }
-    }
-    if (W->queue_end > 0u) {
-        int16 going = LANE_IDS < (int16)((int)W->queue_end);
-        packet_walk(&W->next, &going, false, nodes, sc->tris, &sc->surf, overflow, &W->handoff);
     }
     return true;
 }
@@ -301,7 +269,6 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             bounce[l] = 1u;                                                                  \
             busy[l] = true;                                                                  \
             lanes_set_ray(&M, l, s[l].origin, s[l].direction);                               \
-            lanes_take_handoff(&M, l, &W.next, &W.handoff, (int)k);                          \
         }                                                                                    \
     }
     bool idle = false;

@@ -1,37 +1,31 @@
 // trace_range (native_trace's entry point) over kernels/traverse_packet.h: the dump's rays
-// (a square image's, in row order) in packets of PACKET_GROUPS 4×4 blocks of neighbouring
-// pixels side by side, for their nearest hits; with PACKET_SCALAR each ray alone through
-// traverse_wide instead, in the same order.
+// (a square image's, in row order) in packets of 4×4 neighbouring pixels, for their nearest
+// hits; with PACKET_SCALAR each ray alone through traverse_wide instead, in the same order.
 void trace_range(global const GpuWideNode* nodes, global const GpuTriangle* tris,
                  global const GpuRay* rays, uint first, uint end, global GpuHit* hits,
                  volatile global uint* counters, uint passes) {
     SceneSurfaces surf = {0};
     uint side = (uint)sqrt((float)end);
-    uint wide = 4u * PACKET_GROUPS;
+    uint blocks = side / 4u;
     Packet P;
-    int16 live[PACKET_GROUPS];
-    for (int g = 0; g < PACKET_GROUPS; ++g) live[g] = (int16)(-1);
-    for (uint by = 0; by + 4u <= side; by += 4u) {
-        for (uint bx = 0; bx + wide <= side; bx += wide) {
-            for (int i = 0; i < PACKET_RAYS; ++i) {
-                uint k = (by + (uint)(i % LANES) / 4u) * side + bx + (uint)(i / LANES) * 4u +
-                         (uint)i % 4u;
-                GpuRay r = rays[k];
+    for (uint b = 0; b < blocks * blocks; ++b) {
+        uint bx = b % blocks * 4u, by = b / blocks * 4u;
+        for (int l = 0; l < LANES; ++l) {
+            uint i = (by + (uint)l / 4u) * side + bx + (uint)l % 4u;
+            GpuRay r = rays[i];
 #ifdef PACKET_SCALAR
-                hits[k] = traverse_wide(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, 0.0f,
-                                        INFINITY, false, &counters[4]);
+            hits[i] = traverse_wide(nodes, tris, &surf, r.origin.xyz, r.direction.xyz, 0.0f,
+                                    INFINITY, false, &counters[4]);
 #else
-                packet_set_ray(&P, i, r.origin.xyz, r.direction.xyz, INFINITY);
-#endif
-            }
-#ifndef PACKET_SCALAR
-            packet_walk(&P, live, false, nodes, tris, &surf, &counters[4], 0);
-            for (int i = 0; i < PACKET_RAYS; ++i) {
-                uint k = (by + (uint)(i % LANES) / 4u) * side + bx + (uint)(i / LANES) * 4u +
-                         (uint)i % 4u;
-                hits[k] = packet_hit(&P, i);
-            }
+            packet_set_ray(&P, l, r.origin.xyz, r.direction.xyz, INFINITY);
 #endif
         }
+#ifndef PACKET_SCALAR
+        packet_walk(&P, (int16)(-1), false, nodes, tris, &surf, &counters[4]);
+        for (int l = 0; l < LANES; ++l) {
+            uint i = (by + (uint)l / 4u) * side + bx + (uint)l % 4u;
+            hits[i] = packet_hit(&P, l);
+        }
+#endif
     }
 }
