@@ -169,47 +169,100 @@ LANES_INLINE void lanes_init(LaneMemory* M) {
     }
 }
 
+// A ray's fields in lane `lane` of S, a LaneMemory or traverse_packet.h's Packet (which name
+// them alike): the ray from o along d, to tmax, with no hit yet (prepare_ray's values, the
+// origin in the permuted axes, the dominant axis kz naming the permutation) and the ray itself
+// for the scalar test's rare cases. Declares r, prepare_ray's RayPrep.
+#define LANES_SET_RAY_FIELDS(S, lane, o, d, tmax)                  \
+    RayPrep r = prepare_ray(o, d);                                 \
+    {                                                              \
+        float4 p_ = ray_permute((float4)(o, 0.0f), r.perm);        \
+        (S)->ox[lane] = (o).x;                                     \
+        (S)->oy[lane] = (o).y;                                     \
+        (S)->oz[lane] = (o).z;                                     \
+        (S)->ix[lane] = r.inv.x;                                   \
+        (S)->iy[lane] = r.inv.y;                                   \
+        (S)->iz[lane] = r.inv.z;                                   \
+        (S)->px[lane] = p_.x;                                      \
+        (S)->py[lane] = p_.y;                                      \
+        (S)->pz[lane] = p_.z;                                      \
+        (S)->sx[lane] = r.shear.x;                                 \
+        (S)->sy[lane] = r.shear.y;                                 \
+        (S)->sz[lane] = r.shear.z;                                 \
+        (S)->kz[lane] = (int)r.perm.z;                             \
+        (S)->tfar[lane] = (tmax);                                  \
+        (S)->hv[lane] = 0.0f;                                      \
+        (S)->hw[lane] = 0.0f;                                      \
+        (S)->hdet[lane] = 1.0f;                                    \
+        (S)->prim[lane] = -1;                                      \
+        (S)->o[lane] = (o);                                        \
+        (S)->d[lane] = (d);                                        \
+    }
+
 // Lane `lane` takes the ray from o along d.
 LANES_INLINE void lanes_set_ray(LaneMemory* M, int lane, float3 o, float3 d) {
-    RayPrep r = prepare_ray(o, d);
-    float4 p = ray_permute((float4)(o, 0.0f), r.perm);
-    M->ox[lane] = o.x;
-    M->oy[lane] = o.y;
-    M->oz[lane] = o.z;
-    M->ix[lane] = r.inv.x;
-    M->iy[lane] = r.inv.y;
-    M->iz[lane] = r.inv.z;
-    M->px[lane] = p.x;
-    M->py[lane] = p.y;
-    M->pz[lane] = p.z;
-    M->sx[lane] = r.shear.x;
-    M->sy[lane] = r.shear.y;
-    M->sz[lane] = r.shear.z;
+    LANES_SET_RAY_FIELDS(M, lane, o, d, INFINITY)
     M->kx[lane] = (int)r.perm.x;
     M->ky[lane] = (int)r.perm.y;
-    M->kz[lane] = (int)r.perm.z;
-    M->tfar[lane] = INFINITY;
-    M->hv[lane] = 0.0f;
-    M->hw[lane] = 0.0f;
-    M->hdet[lane] = 1.0f;
-    M->prim[lane] = -1;
     M->cur[lane] = 0;
     M->sp[lane] = 0;
     M->live[lane] = -1;
     M->has[lane] = -1;
-    M->o[lane] = o;
-    M->d[lane] = d;
+}
+
+// A lane's hit from its fields: distance, triangle (NO_HIT: none), edge functions v, w and
+// their sum.
+LANES_INLINE GpuHit lanes_hit_from(float t, int prim, float v, float w, float det) {
+    GpuHit h;
+    h.t = t;
+    h.prim = (uint)prim;
+    h.u = h.prim == NO_HIT ? 0.0f : v / det;
+    h.v = h.prim == NO_HIT ? 0.0f : w / det;
+    h.instance = 0u;
+    return h;
 }
 
 // The hit of a lane whose walk is done.
 LANES_INLINE GpuHit lanes_hit(const LaneMemory* M, int lane) {
-    GpuHit h;
-    h.t = M->tfar[lane];
-    h.prim = (uint)M->prim[lane];
-    h.u = h.prim == NO_HIT ? 0.0f : M->hv[lane] / M->hdet[lane];
-    h.v = h.prim == NO_HIT ? 0.0f : M->hw[lane] / M->hdet[lane];
-    h.instance = 0u;
-    return h;
+    return lanes_hit_from(M->tfar[lane], M->prim[lane], M->hv[lane], M->hw[lane],
+                          M->hdet[lane]);
+}
+
+// The lanes' watertight test's rare cases (an edge function of zero, a hit within the
+// rounding-error bound): for each lane of `special`, the scalar test (intersect_leaf: double-
+// precision edge functions, the error bound) decides triangle tri of that lane's ray o, d,
+// with the lane's hit so far in *t, *v, *w, *det, *prim, which it updates.
+LANES_INLINE void lanes_rare_cases(int16 special, int16 tri, const float3* o, const float3* d,
+                                   global const GpuTriangle* tris, const SceneSurfaces* surf,
+                                   bool any_hit, float16* t, float16* v, float16* w,
+                                   float16* det, int16* prim) {
+    int sp_[LANES], tri_[LANES], prim_[LANES];
+    float t_[LANES], v_[LANES], w_[LANES], det_[LANES];
+    vstore16(special, 0, sp_);
+    vstore16(tri, 0, tri_);
+    vstore16(*t, 0, t_);
+    vstore16(*v, 0, v_);
+    vstore16(*w, 0, w_);
+    vstore16(*det, 0, det_);
+    vstore16(*prim, 0, prim_);
+    for (int l = 0; l < LANES; ++l) {
+        if (!sp_[l]) continue;
+        RayPrep r = prepare_ray(o[l], d[l]);
+        GpuHit h = no_hit(t_[l]);
+        intersect_leaf(&r, tris, surf, (uint)tri_[l], 1u, 0.0f, o[l], d[l], any_hit, &h);
+        if (h.prim != NO_HIT) {
+            t_[l] = h.t;
+            v_[l] = h.u;
+            w_[l] = h.v;
+            det_[l] = 1.0f;
+            prim_[l] = (int)h.prim;
+        }
+    }
+    *t = vload16(0, t_);
+    *v = vload16(0, v_);
+    *w = vload16(0, w_);
+    *det = vload16(0, det_);
+    *prim = vload16(0, prim_);
 }
 
 // Lanes at a leaf are tested together once at least this many are (the others wait at it).
@@ -403,37 +456,8 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 L->hdet = select(L->hdet, det, ok);
                 L->prim = select(L->prim, tri, ok);
                 if (lanes_any(special)) {
-                    // The scalar test decides these lanes' triangle (double-precision edge
-                    // functions, the error bound), with their hits so far.
-                    int sp_[LANES], tri_[LANES];
-                    float t_[LANES], v_[LANES], w_[LANES], det_[LANES];
-                    int prim_[LANES];
-                    vstore16(special, 0, sp_);
-                    vstore16(tri, 0, tri_);
-                    vstore16(L->tfar, 0, t_);
-                    vstore16(L->hv, 0, v_);
-                    vstore16(L->hw, 0, w_);
-                    vstore16(L->hdet, 0, det_);
-                    vstore16(L->prim, 0, prim_);
-                    for (int l = 0; l < LANES; ++l) {
-                        if (!sp_[l]) continue;
-                        RayPrep r = prepare_ray(M->o[l], M->d[l]);
-                        GpuHit h = no_hit(t_[l]);
-                        intersect_leaf(&r, tris, surf, (uint)tri_[l], 1u, 0.0f, M->o[l], M->d[l],
-                                       false, &h);
-                        if (h.prim != NO_HIT) {
-                            t_[l] = h.t;
-                            v_[l] = h.u;
-                            w_[l] = h.v;
-                            det_[l] = 1.0f;
-                            prim_[l] = (int)h.prim;
-                        }
-                    }
-                    L->tfar = vload16(0, t_);
-                    L->hv = vload16(0, v_);
-                    L->hw = vload16(0, w_);
-                    L->hdet = vload16(0, det_);
-                    L->prim = vload16(0, prim_);
+                    lanes_rare_cases(special, tri, M->o, M->d, tris, surf, false, &L->tfar,
+                                     &L->hv, &L->hw, &L->hdet, &L->prim);
                 }
             }
             L->has &= ~ml;

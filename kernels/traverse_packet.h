@@ -32,39 +32,13 @@ typedef struct {
 
 // Lane `lane` of the packet takes the ray from o along d, to tmax.
 LANES_INLINE void packet_set_ray(Packet* P, int lane, float3 o, float3 d, float tmax) {
-    RayPrep r = prepare_ray(o, d);
-    float4 p = ray_permute((float4)(o, 0.0f), r.perm);
-    P->ox[lane] = o.x;
-    P->oy[lane] = o.y;
-    P->oz[lane] = o.z;
-    P->ix[lane] = r.inv.x;
-    P->iy[lane] = r.inv.y;
-    P->iz[lane] = r.inv.z;
-    P->px[lane] = p.x;
-    P->py[lane] = p.y;
-    P->pz[lane] = p.z;
-    P->sx[lane] = r.shear.x;
-    P->sy[lane] = r.shear.y;
-    P->sz[lane] = r.shear.z;
-    P->kz[lane] = (int)r.perm.z;
-    P->tfar[lane] = tmax;
-    P->hv[lane] = 0.0f;
-    P->hw[lane] = 0.0f;
-    P->hdet[lane] = 1.0f;
-    P->prim[lane] = -1;
-    P->o[lane] = o;
-    P->d[lane] = d;
+    LANES_SET_RAY_FIELDS(P, lane, o, d, tmax)
 }
 
 // The hit of a lane after a closest-hit walk.
 LANES_INLINE GpuHit packet_hit(const Packet* P, int lane) {
-    GpuHit h;
-    h.t = P->tfar[lane];
-    h.prim = (uint)P->prim[lane];
-    h.u = h.prim == NO_HIT ? 0.0f : P->hv[lane] / P->hdet[lane];
-    h.v = h.prim == NO_HIT ? 0.0f : P->hw[lane] / P->hdet[lane];
-    h.instance = 0u;
-    return h;
+    return lanes_hit_from(P->tfar[lane], P->prim[lane], P->hv[lane], P->hw[lane],
+                          P->hdet[lane]);
 }
 
 // The least lane of x.
@@ -74,9 +48,6 @@ inline float packet_min(float16 x) {
     float2 c = select(b.hi, b.lo, b.lo < b.hi);
     return c.x < c.y ? c.x : c.y;
 }
-
-#define PACKET_MIN(a, b) select(b, a, a < b)
-#define PACKET_MAX(a, b) select(b, a, a > b)
 
 // Walks the rays of the lanes `live` (from tmin 0 to each lane's tfar) for their nearest hits,
 // or with any_hit for some hit each (a lane's prim >= 0 after it: occluded), writing the hits
@@ -119,10 +90,10 @@ LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
         float16 x0 = ((float16)(lx.C) - ox) * ix, x1 = ((float16)(hx.C) - ox) * ix;          \
         float16 y0 = ((float16)(ly.C) - oy) * iy, y1 = ((float16)(hy.C) - oy) * iy;          \
         float16 z0_ = ((float16)(lz.C) - oz) * iz, z1_ = ((float16)(hz.C) - oz) * iz;        \
-        float16 near = PACKET_MAX(PACKET_MAX(PACKET_MIN(x0, x1), PACKET_MIN(y0, y1)),        \
-                                  PACKET_MAX(PACKET_MIN(z0_, z1_), zero));                   \
-        float16 far = PACKET_MIN(PACKET_MIN(PACKET_MAX(x0, x1), PACKET_MAX(y0, y1)),         \
-                                 PACKET_MAX(z0_, z1_)) *                                     \
+        float16 near = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)),        \
+                                  WIDE_MAX(WIDE_MIN(z0_, z1_), zero));                   \
+        float16 far = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)),         \
+                                 WIDE_MAX(z0_, z1_)) *                                     \
                       1.00000024f;                                                           \
         int16 reach = m & (near <= far) & (near < tfar);                                     \
         if (ch.C <= 0 && ct.C == 0) reach = izero;                                           \
@@ -197,34 +168,8 @@ LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
                 hdet = select(hdet, det, ok);
                 prim = select(prim, (int16)(first + k), ok);
                 if (lanes_any(special)) {
-                    // The scalar test decides these lanes' triangle, with their hits so far.
-                    int sp_[LANES], prim_[LANES];
-                    float t_[LANES], v_[LANES], w_[LANES], det_[LANES];
-                    vstore16(special, 0, sp_);
-                    vstore16(tfar, 0, t_);
-                    vstore16(hv, 0, v_);
-                    vstore16(hw, 0, w_);
-                    vstore16(hdet, 0, det_);
-                    vstore16(prim, 0, prim_);
-                    for (int l = 0; l < LANES; ++l) {
-                        if (!sp_[l]) continue;
-                        RayPrep r = prepare_ray(P->o[l], P->d[l]);
-                        GpuHit h = no_hit(t_[l]);
-                        intersect_leaf(&r, tris, surf, (uint)(first + k), 1u, 0.0f, P->o[l],
-                                       P->d[l], any_hit, &h);
-                        if (h.prim != NO_HIT) {
-                            t_[l] = h.t;
-                            v_[l] = h.u;
-                            w_[l] = h.v;
-                            det_[l] = 1.0f;
-                            prim_[l] = (int)h.prim;
-                        }
-                    }
-                    tfar = vload16(0, t_);
-                    hv = vload16(0, v_);
-                    hw = vload16(0, w_);
-                    hdet = vload16(0, det_);
-                    prim = vload16(0, prim_);
+                    lanes_rare_cases(special, (int16)(first + k), P->o, P->d, tris, surf, any_hit,
+                                     &tfar, &hv, &hw, &hdet, &prim);
                 }
                 if (any_hit) {
                     // A blocked lane is done.
@@ -254,7 +199,5 @@ LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
     vstore16(hdet, 0, P->hdet);
     vstore16(prim, 0, P->prim);
 }
-#undef PACKET_MIN
-#undef PACKET_MAX
 
 #endif  // MEGA_LANES

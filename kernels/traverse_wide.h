@@ -41,7 +41,7 @@ inline WideRay wide_ray(const RayPrep* r) {
 // other operand of a NaN, which costs x86 two more instructions each (vminps alone does not),
 // and no slab distance here is NaN: the reciprocal direction is finite and nonzero, and empty
 // slots are masked out by `valid`. The bunnies' rays ran 3 % faster on PoCL, with the same
-// images bit for bit.
+// images bit for bit. (traverse_packet.h's slab test uses them too.)
 #define WIDE_MIN(a, b) select(b, a, a < b)
 #define WIDE_MAX(a, b) select(b, a, a > b)
 inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin, float tmax,
@@ -59,8 +59,6 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
     int4 valid = (n->child > 0) | (n->count > 0u);
     return (*near <= far) & (*near < (float4)(tmax)) & valid;
 }
-#undef WIDE_MIN
-#undef WIDE_MAX
 #undef WIDE_PLANE
 
 // intersect_triangle's sheared vertices and edge functions in lanes of TYPE (a triangle a
