@@ -1,7 +1,8 @@
 // Rays in vector lanes, for the CPU megakernel (MEGA_LANES: set by the host on CPU devices with
 // AVX-512, for flat scenes without alpha that are not small; src/cl/program.rs,
 // lanes_megakernel): sixteen independent rays walk the 4-wide BVH together, one ray a lane,
-// each at its own node, with gathers for the node and triangle data. One ray at a time, a walk
+// each at its own node, the lanes' nodes and triangles loaded as rows and transposed into
+// vectors (lanes_rows8; LANES_GATHERS: by gathers). One ray at a time, a walk
 // waits on memory at nearly every node it visits in a large scene (docs/benchmarks.md, "Sixth
 // session"); sixteen walks keep sixteen loads in flight, and a lane whose ray is done takes its
 // path's next ray while the others go on.
@@ -18,6 +19,7 @@
 #define LANES 16
 #define LANES_STACK (WIDE_STACK_SIZE + 1)
 #define LANE_IDS ((int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))
+#define LANES_INLINE inline __attribute__((always_inline))
 
 // Whether any lane of a mask (all bits of a lane set or clear) is set.
 inline bool lanes_any(int16 m) {
@@ -115,6 +117,64 @@ inline void lanes_scatter_f(float* base, int16 idx, float16 v, ushort km) {
     }
 #endif
 
+// Rows into lanes. A lane's node (32 words) or triangle (12) is a row of neighbouring words,
+// and a gather loads one element at a time: on AMD's Zen 5, 0.5 ns an element, 128 ns for the
+// 32 gathers of a node visit of sixteen lanes against 15 ns for the same bytes as rows
+// (docs/benchmarks.md, "Seventeenth session"). lanes_rows8 loads eight words of each lane's
+// row, two lanes a vector, and transposes them by shuffles; lanes_rows4, four. With
+// LANES_GATHERS the walk gathers instead (the two read the same words: same hits).
+#define LANES_UNPACKLO 0, 16, 1, 17, 4, 20, 5, 21, 8, 24, 9, 25, 12, 28, 13, 29
+#define LANES_UNPACKHI 2, 18, 3, 19, 6, 22, 7, 23, 10, 26, 11, 27, 14, 30, 15, 31
+#define LANES_PAIRSLO 0, 1, 16, 17, 4, 5, 20, 21, 8, 9, 24, 25, 12, 13, 28, 29
+#define LANES_PAIRSHI 2, 3, 18, 19, 6, 7, 22, 23, 10, 11, 26, 27, 14, 15, 30, 31
+#define LANES_QUADSLO 0, 1, 2, 3, 16, 17, 18, 19, 8, 9, 10, 11, 24, 25, 26, 27
+#define LANES_QUADSHI 4, 5, 6, 7, 20, 21, 22, 23, 12, 13, 14, 15, 28, 29, 30, 31
+#define LANES_SHUFFLE(A, B, P) __builtin_shufflevector(A, B, P)
+
+// Words [w, w + 8) of the row at word offset off[l] of base, for each lane l, into c[0..8):
+// word w + i of lane l in lane l of c[i].
+LANES_INLINE void lanes_rows8(global const float* base, const int* off, int w, float16* c) {
+    float16 m[8];
+#pragma unroll
+    for (int i = 0; i < 8; ++i)  // lane i in the low half, lane i + 8 in the high one
+        m[i] = (float16)(vload8(0, base + off[i] + w), vload8(0, base + off[i + 8] + w));
+    float16 t[8], s[8];
+#pragma unroll
+    for (int i = 0; i < 8; i += 2) {
+        t[i] = LANES_SHUFFLE(m[i], m[i + 1], LANES_UNPACKLO);
+        t[i + 1] = LANES_SHUFFLE(m[i], m[i + 1], LANES_UNPACKHI);
+    }
+#pragma unroll
+    for (int i = 0; i < 8; i += 4) {
+        s[i] = LANES_SHUFFLE(t[i], t[i + 2], LANES_PAIRSLO);
+        s[i + 1] = LANES_SHUFFLE(t[i], t[i + 2], LANES_PAIRSHI);
+        s[i + 2] = LANES_SHUFFLE(t[i + 1], t[i + 3], LANES_PAIRSLO);
+        s[i + 3] = LANES_SHUFFLE(t[i + 1], t[i + 3], LANES_PAIRSHI);
+    }
+#pragma unroll
+    for (int i = 0; i < 4; ++i) {
+        c[i] = LANES_SHUFFLE(s[i], s[i + 4], LANES_QUADSLO);
+        c[i + 4] = LANES_SHUFFLE(s[i], s[i + 4], LANES_QUADSHI);
+    }
+}
+
+// The same for words [w, w + 4), into c[0..4).
+LANES_INLINE void lanes_rows4(global const float* base, const int* off, int w, float16* c) {
+    float16 m[4];
+#pragma unroll
+    for (int i = 0; i < 4; ++i)  // lanes i, i + 4, i + 8 and i + 12
+        m[i] = (float16)(vload4(0, base + off[i] + w), vload4(0, base + off[i + 4] + w),
+                         vload4(0, base + off[i + 8] + w), vload4(0, base + off[i + 12] + w));
+    float16 t0 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKLO);
+    float16 t1 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKHI);
+    float16 t2 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKLO);
+    float16 t3 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKHI);
+    c[0] = LANES_SHUFFLE(t0, t2, LANES_PAIRSLO);
+    c[1] = LANES_SHUFFLE(t0, t2, LANES_PAIRSHI);
+    c[2] = LANES_SHUFFLE(t1, t3, LANES_PAIRSLO);
+    c[3] = LANES_SHUFFLE(t1, t3, LANES_PAIRSHI);
+}
+
 // The lanes' rays and walks, one field a lane (offsets are in 4-byte words: a GpuWideNode is 32,
 // min_x, min_y, min_z, max_x, max_y, max_z, child, count, 4 each; a GpuTriangle 12):
 //   ox oy oz     origin                      ix iy iz   safe reciprocal direction (prepare_ray's)
@@ -157,7 +217,6 @@ typedef struct {
     float3 o[LANES], d[LANES];           // the rays, for the scalar test's rare cases
 } LaneMemory;
 
-#define LANES_INLINE inline __attribute__((always_inline))
 LANES_INLINE void lanes_init(LaneMemory* M) {
     for (int l = 0; l < LANES; ++l) {
 #define LANES_ZERO(f) M->f[l] = 0;
@@ -343,59 +402,71 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
         int16 mi = L->has & (L->cur >= izero);
         if (lanes_any(mi)) {
             int16 base = L->cur * (int16)(32);
+// Child J's slab test in every lane of mi from its near and far planes (NX .. FZ) and its
+// child and count words (C, K): declares d##J, the entry distance of a reached child (else
+// infinity), and sets c##J to its item in lanes_pack form.
+#define LANES_CHILD(J, NX, NY, NZ, FX, FY, FZ, C, K)                                         \
+    float16 d##J;                                                                         \
+    {                                                                                     \
+        float16 x0 = (NX - L->ox) * L->ix, y0 = (NY - L->oy) * L->iy;                     \
+        float16 nr = select(x0, y0, y0 > x0);                                             \
+        float16 z0 = (NZ - L->oz) * L->iz;                                                \
+        nr = select(nr, z0, z0 > nr);                                                     \
+        nr = select(nr, zero, zero > nr);                                                 \
+        float16 x1 = (FX - L->ox) * L->ix, y1 = (FY - L->oy) * L->iy;                     \
+        float16 fr = select(x1, y1, y1 < x1);                                             \
+        float16 z1 = (FZ - L->oz) * L->iz;                                                \
+        fr = select(fr, z1, z1 < fr) * 1.00000024f;                                       \
+        int16 cw = (C), kw = (K);                                                         \
+        int16 reach = mi & ((cw > izero) | (kw != izero)) & (nr <= fr) & (nr < L->tfar);  \
+        d##J = select(inf, nr, reach);                                                    \
+        c##J = lanes_pack(cw, kw);                                                        \
+    }
+            int16 c0, c1, c2, c3;
+#ifdef LANES_GATHERS
+            // Children J and J + 1 at once: a row's words of two children are side by side, so
+            // one 8-byte gather element brings both (half the gathered elements).
+            ushort km = lanes_kmask(mi);
             int16 nx = select((int16)(12), izero, L->ix >= zero);
             int16 ny = select((int16)(16), (int16)(4), L->iy >= zero);
             int16 nz = select((int16)(20), (int16)(8), L->iz >= zero);
             int16 fx = (int16)(12) - nx, fy = (int16)(20) - ny, fz = (int16)(28) - nz;
-            float16 d0, d1, d2, d3;
-            int16 c0, c1, c2, c3, k0, k1, k2, k3;
-            // Children J and J + 1 at once: a row's words of two children are side by side, so
-            // one 8-byte gather element brings both (half the gathered elements).
-            ushort km = lanes_kmask(mi);
 #define LANES_CHILDREN(J, K)                                                                \
-    {                                                                                       \
-        int16 bj = base + (int16)(J);                                                       \
-        float16 a, b;                                                                       \
-        LANES_GATHER_PAIR(nw, bj + nx, km, a, b);                                           \
-        float16 x0##J = (a - L->ox) * L->ix, x0##K = (b - L->ox) * L->ix;                   \
-        LANES_GATHER_PAIR(nw, bj + ny, km, a, b);                                           \
-        float16 y0##J = (a - L->oy) * L->iy, y0##K = (b - L->oy) * L->iy;                   \
-        float16 nr##J = select(x0##J, y0##J, y0##J > x0##J);                                \
-        float16 nr##K = select(x0##K, y0##K, y0##K > x0##K);                                \
-        LANES_GATHER_PAIR(nw, bj + nz, km, a, b);                                           \
-        float16 z0##J = (a - L->oz) * L->iz, z0##K = (b - L->oz) * L->iz;                   \
-        nr##J = select(nr##J, z0##J, z0##J > nr##J);                                        \
-        nr##K = select(nr##K, z0##K, z0##K > nr##K);                                        \
-        nr##J = select(nr##J, zero, zero > nr##J);                                          \
-        nr##K = select(nr##K, zero, zero > nr##K);                                          \
-        LANES_GATHER_PAIR(nw, bj + fx, km, a, b);                                           \
-        float16 x1##J = (a - L->ox) * L->ix, x1##K = (b - L->ox) * L->ix;                   \
-        LANES_GATHER_PAIR(nw, bj + fy, km, a, b);                                           \
-        float16 y1##J = (a - L->oy) * L->iy, y1##K = (b - L->oy) * L->iy;                   \
-        float16 fr##J = select(x1##J, y1##J, y1##J < x1##J);                                \
-        float16 fr##K = select(x1##K, y1##K, y1##K < x1##K);                                \
-        LANES_GATHER_PAIR(nw, bj + fz, km, a, b);                                           \
-        float16 z1##J = (a - L->oz) * L->iz, z1##K = (b - L->oz) * L->iz;                   \
-        fr##J = select(fr##J, z1##J, z1##J < fr##J) * 1.00000024f;                          \
-        fr##K = select(fr##K, z1##K, z1##K < fr##K) * 1.00000024f;                          \
-        LANES_GATHER_PAIR(nw, bj + (int16)(24), km, a, b);                                  \
-        c##J = as_int16(a);                                                                 \
-        c##K = as_int16(b);                                                                 \
-        LANES_GATHER_PAIR(nw, bj + (int16)(28), km, a, b);                                  \
-        k##J = as_int16(a);                                                                 \
-        k##K = as_int16(b);                                                                 \
-        int16 reachJ = mi & ((c##J > izero) | (k##J != izero)) & (nr##J <= fr##J) &         \
-                       (nr##J < L->tfar);                                                   \
-        int16 reachK = mi & ((c##K > izero) | (k##K != izero)) & (nr##K <= fr##K) &         \
-                       (nr##K < L->tfar);                                                   \
-        d##J = select(inf, nr##J, reachJ);                                                  \
-        d##K = select(inf, nr##K, reachK);                                                  \
-        c##J = lanes_pack(c##J, k##J);                                                      \
-        c##K = lanes_pack(c##K, k##K);                                                      \
-    }
+    float16 nx##J, nx##K, ny##J, ny##K, nz##J, nz##K, fx##J, fx##K, fy##J, fy##K, fz##J,    \
+        fz##K, cw##J, cw##K, kw##J, kw##K;                                                  \
+    LANES_GATHER_PAIR(nw, base + (int16)(J) + nx, km, nx##J, nx##K);                        \
+    LANES_GATHER_PAIR(nw, base + (int16)(J) + ny, km, ny##J, ny##K);                        \
+    LANES_GATHER_PAIR(nw, base + (int16)(J) + nz, km, nz##J, nz##K);                        \
+    LANES_GATHER_PAIR(nw, base + (int16)(J) + fx, km, fx##J, fx##K);                        \
+    LANES_GATHER_PAIR(nw, base + (int16)(J) + fy, km, fy##J, fy##K);                        \
+    LANES_GATHER_PAIR(nw, base + (int16)(J) + fz, km, fz##J, fz##K);                        \
+    LANES_GATHER_PAIR(nw, base + (int16)(J + 24), km, cw##J, cw##K);                        \
+    LANES_GATHER_PAIR(nw, base + (int16)(J + 28), km, kw##J, kw##K);                        \
+    LANES_CHILD(J, nx##J, ny##J, nz##J, fx##J, fy##J, fz##J, as_int16(cw##J), as_int16(kw##J)) \
+    LANES_CHILD(K, nx##K, ny##K, nz##K, fx##K, fy##K, fz##K, as_int16(cw##K), as_int16(kw##K))
             LANES_CHILDREN(0, 1)
             LANES_CHILDREN(2, 3)
+#else
+            // The nodes as rows: W[w], word w of each lane's node (lanes not at one read the
+            // root's).
+            int off_[LANES];
+            vstore16(select(izero, base, mi), 0, off_);
+            float16 W[32];
+#pragma unroll
+            for (int w = 0; w < 32; w += 8) lanes_rows8(nw, off_, w, W + w);
+            int16 px = L->ix >= zero, py = L->iy >= zero, pz = L->iz >= zero;
+#define LANES_CHILDREN(J)                                                                   \
+    LANES_CHILD(J, select(W[12 + J], W[J], px), select(W[16 + J], W[4 + J], py),            \
+                select(W[20 + J], W[8 + J], pz), select(W[J], W[12 + J], px),               \
+                select(W[4 + J], W[16 + J], py), select(W[8 + J], W[20 + J], pz),           \
+                as_int16(W[24 + J]), as_int16(W[28 + J]))
+            LANES_CHILDREN(0)
+            LANES_CHILDREN(1)
+            LANES_CHILDREN(2)
+            LANES_CHILDREN(3)
+#endif
 #undef LANES_CHILDREN
+#undef LANES_CHILD
             LANES_ORDER(0, 1)
             LANES_ORDER(2, 3)
             LANES_ORDER(0, 2)
@@ -437,6 +508,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 int16 m = ml & ((int16)(k) < cnt);
                 int16 tri = first + (int16)(k);
                 int16 b = tri * (int16)(12);
+#ifdef LANES_GATHERS
                 float16 aX = LANES_GATHER_F(tw, b + L->kx, m) - L->px;
                 float16 aY = LANES_GATHER_F(tw, b + L->ky, m) - L->py;
                 float16 aZ = LANES_GATHER_F(tw, b + L->kz, m) - L->pz;
@@ -446,6 +518,27 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 float16 cX = LANES_GATHER_F(tw, b + (int16)(8) + L->kx, m) - L->px;
                 float16 cY = LANES_GATHER_F(tw, b + (int16)(8) + L->ky, m) - L->py;
                 float16 cZ = LANES_GATHER_F(tw, b + (int16)(8) + L->kz, m) - L->pz;
+#else
+                // The triangles as rows (lanes without one read triangle 0), each vertex's
+                // words in the lane's permuted axes (kx, ky, kz: 0, 1 or 2) by selects.
+                int off_[LANES];
+                vstore16(select(izero, b, m), 0, off_);
+                float16 T[12];
+                lanes_rows8(tw, off_, 0, T);
+                lanes_rows4(tw, off_, 8, T + 8);
+#define LANES_AXIS(V, K) \
+    select(select(T[V], T[V + 1], L->K == (int16)(1)), T[V + 2], L->K == (int16)(2))
+                float16 aX = LANES_AXIS(0, kx) - L->px;
+                float16 aY = LANES_AXIS(0, ky) - L->py;
+                float16 aZ = LANES_AXIS(0, kz) - L->pz;
+                float16 bX = LANES_AXIS(4, kx) - L->px;
+                float16 bY = LANES_AXIS(4, ky) - L->py;
+                float16 bZ = LANES_AXIS(4, kz) - L->pz;
+                float16 cX = LANES_AXIS(8, kx) - L->px;
+                float16 cY = LANES_AXIS(8, ky) - L->py;
+                float16 cZ = LANES_AXIS(8, kz) - L->pz;
+#undef LANES_AXIS
+#endif
                 float16 sx = L->sx, sy = L->sy, sz = L->sz;
                 LANE_EDGES(float16)
                 LANE_HITS16(m, zero, L->tfar)
