@@ -349,7 +349,6 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
             "--bounces",
             "4",
         ];
-        let (a, pa) = render_exr(&scene, &dir.path().join(format!("lanes-{spp}.exr")), &args);
         let (b, pb) = render_exr_env(
             &scene,
             &dir.path().join(format!("one-{spp}.exr")),
@@ -357,16 +356,35 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
             &[("PENUMBRA_LANES", "0")],
         );
         assert_eq!(b["lanes"], false, "PENUMBRA_LANES=0 left lanes on");
-        #[cfg(target_arch = "x86_64")]
-        if common::test_device() == "cpu" && std::arch::is_x86_feature_detected!("avx512f") {
-            assert_eq!(a["lanes"], true, "a CPU with AVX-512 did not walk in lanes");
+        // The lanes load their nodes and triangles as rows (AMD's default) or by gathers.
+        for load in ["rows", "gathers"] {
+            let (a, pa) = render_exr_env(
+                &scene,
+                &dir.path().join(format!("lanes-{load}-{spp}.exr")),
+                &args,
+                &[("PENUMBRA_LANES_LOAD", load)],
+            );
+            #[cfg(target_arch = "x86_64")]
+            if common::test_device() == "cpu" && std::arch::is_x86_feature_detected!("avx512f") {
+                assert_eq!(a["lanes"], true, "a CPU with AVX-512 did not walk in lanes");
+                assert_eq!(
+                    a["lanes_load"], load,
+                    "PENUMBRA_LANES_LOAD={load} not taken"
+                );
+            }
+            assert!(
+                pa.iter().any(|p| p[0] > 0.0),
+                "{spp} spp, {load}: a black image"
+            );
+            assert_eq!(
+                a["extension_rays"], b["extension_rays"],
+                "{spp} spp, {load}"
+            );
+            assert_eq!(a["shadow_rays"], b["shadow_rays"], "{spp} spp, {load}");
+            assert!(
+                pa == pb,
+                "{spp} spp, {load}: the lanes' image differs from one ray at a time's"
+            );
         }
-        assert!(pa.iter().any(|p| p[0] > 0.0), "{spp} spp: a black image");
-        assert_eq!(a["extension_rays"], b["extension_rays"], "{spp} spp");
-        assert_eq!(a["shadow_rays"], b["shadow_rays"], "{spp} spp");
-        assert!(
-            pa == pb,
-            "{spp} spp: the lanes' image differs from one ray at a time's"
-        );
     }
 }

@@ -145,6 +145,44 @@ pub fn lanes_megakernel(
     }
 }
 
+/// Whether the lanes (`MEGA_LANES`) load their nodes and triangles as rows, transposed into
+/// vectors by shuffles, rather than by gathers (`LANES_GATHERS`, kernels/traverse_lanes.h). On
+/// AMD's Zen 5 a gather loads about one element a cycle from L2, and rows make the walk 1.3–1.8×
+/// faster natively; on an Intel Xeon (the H200 machine's host) gathers are 3–7 % faster
+/// (docs/benchmarks.md, "Seventeenth session"). So rows on AMD CPUs, gathers elsewhere;
+/// `PENUMBRA_LANES_LOAD=rows` or `gathers` chooses.
+pub fn lanes_load_rows() -> bool {
+    match std::env::var("PENUMBRA_LANES_LOAD")
+        .as_deref()
+        .map(str::trim)
+    {
+        Ok("rows") => return true,
+        Ok("gathers") => return false,
+        Ok(other) => {
+            log::warn!("PENUMBRA_LANES_LOAD={other:?} is neither rows nor gathers: ignored")
+        }
+        Err(_) => {}
+    }
+    host_cpu_is_amd()
+}
+
+/// Whether the host CPU (PoCL's device) is AMD's, by its CPUID vendor string.
+fn host_cpu_is_amd() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let r = std::arch::x86_64::__cpuid(0);
+        let mut vendor = [0u8; 12];
+        vendor[..4].copy_from_slice(&r.ebx.to_le_bytes());
+        vendor[4..8].copy_from_slice(&r.edx.to_le_bytes());
+        vendor[8..].copy_from_slice(&r.ecx.to_le_bytes());
+        &vendor == b"AuthenticAMD"
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// The most triangles a scene may have for the megakernel to test them all for every ray
 /// (`KernelFeatures::small_scene`): up to this many, sixteen at a time in vector lanes, cost
 /// less than walking the 4-wide BVH on PoCL (docs/benchmarks.md, "Eighth session"; a box of
@@ -184,6 +222,9 @@ impl KernelFeatures {
         }
         if self.small_scene > 0 {
             d.push_str(&format!(" -DSMALL_SCENE={}", self.small_scene));
+        }
+        if self.lanes && !lanes_load_rows() {
+            d.push_str(" -DLANES_GATHERS");
         }
         d
     }
