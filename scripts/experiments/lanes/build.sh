@@ -6,6 +6,7 @@
 # then /tmp/native_lanes/native_lanes DUMP 3 (NATIVE_SHUFFLE=1 for random ray order).
 # NATIVE_ENTRY=scripts/experiments/lanes/entry_packet.cl: the packet walk (traverse_packet.h)
 # over 4x4 blocks of the dump's pixels instead (-DPACKET_SCALAR: the scalar walk, same order).
+# -DLANES_GATHERS: the lanes gather their nodes and triangles instead of loading rows.
 set -e
 D=scripts/experiments/lanes
 O=${NATIVE_OUT:-/tmp/native_lanes}
