@@ -152,18 +152,21 @@ pub fn lanes_megakernel(
 /// (docs/benchmarks.md, "Seventeenth session"). So rows on AMD CPUs, gathers elsewhere;
 /// `PENUMBRA_LANES_LOAD=rows` or `gathers` chooses.
 pub fn lanes_load_rows() -> bool {
-    match std::env::var("PENUMBRA_LANES_LOAD")
-        .as_deref()
-        .map(str::trim)
-    {
-        Ok("rows") => return true,
-        Ok("gathers") => return false,
-        Ok(other) => {
-            log::warn!("PENUMBRA_LANES_LOAD={other:?} is neither rows nor gathers: ignored")
+    static ROWS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ROWS.get_or_init(|| {
+        match std::env::var("PENUMBRA_LANES_LOAD")
+            .as_deref()
+            .map(str::trim)
+        {
+            Ok("rows") => return true,
+            Ok("gathers") => return false,
+            Ok(other) => {
+                log::warn!("PENUMBRA_LANES_LOAD={other:?} is neither rows nor gathers: ignored")
+            }
+            Err(_) => {}
         }
-        Err(_) => {}
-    }
-    host_cpu_is_amd()
+        host_cpu_is_amd()
+    })
 }
 
 /// Whether the host CPU (PoCL's device) is AMD's, by its CPUID vendor string.
