@@ -131,26 +131,30 @@ inline void lanes_scatter_f(float* base, int16 idx, float16 v, ushort km) {
 #define LANES_QUADSHI 4, 5, 6, 7, 20, 21, 22, 23, 12, 13, 14, 15, 28, 29, 30, 31
 #define LANES_SHUFFLE(A, B, P) __builtin_shufflevector(A, B, P)
 
+// Four 4×4 transposes at once, one in each 128-bit quarter: word j of m[i]'s quarter q to word
+// i of c[j]'s quarter q.
+LANES_INLINE void lanes_transpose4(const float16* m, float16* c) {
+    float16 t0 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKLO);
+    float16 t1 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKHI);
+    float16 t2 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKLO);
+    float16 t3 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKHI);
+    c[0] = LANES_SHUFFLE(t0, t2, LANES_PAIRSLO);
+    c[1] = LANES_SHUFFLE(t0, t2, LANES_PAIRSHI);
+    c[2] = LANES_SHUFFLE(t1, t3, LANES_PAIRSLO);
+    c[3] = LANES_SHUFFLE(t1, t3, LANES_PAIRSHI);
+}
+
 // Words [w, w + 8) of the row at word offset off[l] of base, for each lane l, into c[0..8):
 // word w + i of lane l in lane l of c[i].
 LANES_INLINE void lanes_rows8(global const float* base, const int* off, int w, float16* c) {
-    float16 m[8];
+    float16 m[8], s[8];
 #pragma unroll
     for (int i = 0; i < 8; ++i)  // lane i in the low half, lane i + 8 in the high one
         m[i] = (float16)(vload8(0, base + off[i] + w), vload8(0, base + off[i + 8] + w));
-    float16 t[8], s[8];
-#pragma unroll
-    for (int i = 0; i < 8; i += 2) {
-        t[i] = LANES_SHUFFLE(m[i], m[i + 1], LANES_UNPACKLO);
-        t[i + 1] = LANES_SHUFFLE(m[i], m[i + 1], LANES_UNPACKHI);
-    }
-#pragma unroll
-    for (int i = 0; i < 8; i += 4) {
-        s[i] = LANES_SHUFFLE(t[i], t[i + 2], LANES_PAIRSLO);
-        s[i + 1] = LANES_SHUFFLE(t[i], t[i + 2], LANES_PAIRSHI);
-        s[i + 2] = LANES_SHUFFLE(t[i + 1], t[i + 3], LANES_PAIRSLO);
-        s[i + 3] = LANES_SHUFFLE(t[i + 1], t[i + 3], LANES_PAIRSHI);
-    }
+    // s[j]: word j of lanes 0-3 and 8-11 in quarters 0 and 2, word j + 4 in quarters 1 and 3;
+    // s[j + 4] the same for lanes 4-7 and 12-15. Then the quarters of each word together.
+    lanes_transpose4(m, s);
+    lanes_transpose4(m + 4, s + 4);
 #pragma unroll
     for (int i = 0; i < 4; ++i) {
         c[i] = LANES_SHUFFLE(s[i], s[i + 4], LANES_QUADSLO);
@@ -165,14 +169,7 @@ LANES_INLINE void lanes_rows4(global const float* base, const int* off, int w, f
     for (int i = 0; i < 4; ++i)  // lanes i, i + 4, i + 8 and i + 12
         m[i] = (float16)(vload4(0, base + off[i] + w), vload4(0, base + off[i + 4] + w),
                          vload4(0, base + off[i + 8] + w), vload4(0, base + off[i + 12] + w));
-    float16 t0 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKLO);
-    float16 t1 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKHI);
-    float16 t2 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKLO);
-    float16 t3 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKHI);
-    c[0] = LANES_SHUFFLE(t0, t2, LANES_PAIRSLO);
-    c[1] = LANES_SHUFFLE(t0, t2, LANES_PAIRSHI);
-    c[2] = LANES_SHUFFLE(t1, t3, LANES_PAIRSLO);
-    c[3] = LANES_SHUFFLE(t1, t3, LANES_PAIRSHI);
+    lanes_transpose4(m, c);
 }
 
 // The lanes' rays and walks, one field a lane (offsets are in 4-byte words: a GpuWideNode is 32,

@@ -90,10 +90,10 @@ LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
         float16 x0 = ((float16)(lx.C) - ox) * ix, x1 = ((float16)(hx.C) - ox) * ix;          \
         float16 y0 = ((float16)(ly.C) - oy) * iy, y1 = ((float16)(hy.C) - oy) * iy;          \
         float16 z0_ = ((float16)(lz.C) - oz) * iz, z1_ = ((float16)(hz.C) - oz) * iz;        \
-        float16 near = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)),        \
-                                  WIDE_MAX(WIDE_MIN(z0_, z1_), zero));                   \
-        float16 far = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)),         \
-                                 WIDE_MAX(z0_, z1_)) *                                     \
+        float16 near = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)),                \
+                                WIDE_MAX(WIDE_MIN(z0_, z1_), zero));                         \
+        float16 far = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)),                 \
+                               WIDE_MAX(z0_, z1_)) *                                         \
                       1.00000024f;                                                           \
         int16 reach = m & (near <= far) & (near < tfar);                                     \
         if (ch.C <= 0 && ct.C == 0) reach = izero;                                           \

@@ -176,16 +176,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // Whether the megakernel walked its rays in vector lanes (CPU devices with AVX-512).
     summary["lanes"] = serde_json::json!(renderer.walks_in_lanes());
     // How the lanes loaded their nodes and triangles: "rows" or "gathers" (null without lanes).
-    summary["lanes_load"] =
-        serde_json::json!(
-            renderer
-                .walks_in_lanes()
-                .then(|| if crate::cl::lanes_load_rows() {
-                    "rows"
-                } else {
-                    "gathers"
-                })
-        );
+    let load = if crate::cl::lanes_load_rows() {
+        "rows"
+    } else {
+        "gathers"
+    };
+    summary["lanes_load"] = serde_json::json!(renderer.walks_in_lanes().then_some(load));
     summary["cpu_seconds"] = serde_json::json!(cpu_seconds);
     summary["samples_per_cpu_second"] = serde_json::json!(cpu_seconds.map(|c| samples / c));
     // Added after the literal, which is at serde_json's macro recursion limit.
