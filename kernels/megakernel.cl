@@ -253,6 +253,9 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     PathState s[LANES];
     uint bounce[LANES], chunk[LANES], entry[LANES];
     bool busy[LANES];
+    // A lane walking its vertex's light sample: the sample, and whether the path goes on after.
+    ShadowQuery sample[LANES];
+    bool in_shadow[LANES], goes_on[LANES];
     // A lane takes the next queued path (starting chunks while the queue is empty); with none
     // left it stays idle.
 #define LANE_NEXT_PATH(l)                                                                    \
@@ -268,6 +271,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             entry[l] = W.queued_entry[k];                                                    \
             bounce[l] = 1u;                                                                  \
             busy[l] = true;                                                                  \
+            in_shadow[l] = false;                                                            \
             lanes_set_ray(&M, l, s[l].origin, s[l].direction);                               \
         }                                                                                    \
     }
@@ -284,16 +288,36 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         vstore16(done, 0, done_);
         for (int l = 0; l < LANES; ++l) {
             if (!done_[l]) continue;
-            ++W.extension_rays;
-            ShadowQuery q;
-            bool alive = shade_vertex(&frame, bounce[l], &sc, lanes_hit(&M, l), &s[l], &q);
-            if (q.valid) {
-                ++W.shadow_rays;
-                s[l].radiance +=
-                    shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, &q, overflow);
+            bool alive;
+            if (in_shadow[l]) {
+                // The vertex's light sample walked: its light is added (unless blocked, perhaps
+                // only by thin walls, which the scalar test passes) before the path goes on.
+                in_shadow[l] = false;
+                alive = goes_on[l];
+                if (M.prim[l] < 0) {
+                    s[l].radiance += sample[l].contribution;
+                } else {
+#ifdef HAS_THIN_WALLS
+                    s[l].radiance += shadow_pass_wide(nodes, tris, instances, object_tris,
+                                                      &sc.surf, &sample[l], overflow);
+#endif
+                }
+            } else {
+                ++W.extension_rays;
+                alive = shade_vertex(&frame, bounce[l], &sc, lanes_hit(&M, l), &s[l], &sample[l]);
+                alive = alive && ++bounce[l] <= frame.max_bounces + 1u;
+                if (sample[l].valid) {
+                    // The light sample walks in the lane first, an any-hit ray.
+                    ++W.shadow_rays;
+                    in_shadow[l] = true;
+                    goes_on[l] = alive;
+                    lanes_set_segment(&M, l, sample[l].origin, sample[l].direction,
+                                      sample[l].tmax, true);
+                    continue;
+                }
             }
             // The path goes on, or the lane takes the next one.
-            if (alive && ++bounce[l] <= frame.max_bounces + 1u) {
+            if (alive) {
                 lanes_set_ray(&M, l, s[l].origin, s[l].direction);
                 continue;
             }

@@ -311,6 +311,18 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
         }
     }
 
+#if !defined(HAS_TRIANGLE_LIGHTS) && !defined(HAS_ENV_MAP) && !defined(HAS_UNLIT)
+    // The last extension only looks for emitters, and a scene without emissive triangles, an
+    // environment map or unlit materials has none for a ray to find but the sky: under a black
+    // sky the path ends here, its last ray untraced (it would add exactly nothing).
+    if (bounce == frame->max_bounces && frame->sky.x <= 0.0f && frame->sky.y <= 0.0f &&
+        frame->sky.z <= 0.0f) {
+        s->radiance = radiance;
+        s->rng = rng;
+        return false;
+    }
+#endif
+
     // Sample the BSDF for the next ray; Russian roulette after rr_depth bounces.
     float3 wi;
     float pdf;

@@ -7,7 +7,8 @@
 // session"); sixteen walks keep sixteen loads in flight, and a lane whose ray is done takes its
 // path's next ray while the others go on.
 //
-// The rays are extension rays, from tmin 0 to infinity, for the nearest hit. Each lane computes
+// The rays are extension rays, from tmin 0 to infinity, for the nearest hit, or shadow rays, from
+// tmin 0 to their light, for any hit (`any`: such a lane is done at its first). Each lane computes
 // traverse_wide.h's slab test and intersect_leaf4's watertight arithmetic, so that the hit is
 // traverse_wide's (of equally near hits the two walks may keep different triangles), and the
 // scalar test's rare cases (an edge function of zero, a hit within the rounding-error bound)
@@ -182,9 +183,10 @@ LANES_INLINE void lanes_rows4(global const float* base, const int* off, int w, f
 //   cur          the item visited, in lanes_pack form: a node, or a leaf (negative)
 //   sp           stack entries               live has fin: lanes with a ray, with an item to
 //                                            visit, done and not yet returned by lanes_walk
+//   any          lanes whose ray is a shadow ray: done at its first hit before tfar
 #define LANES_FLOAT_FIELDS(X) X(ox) X(oy) X(oz) X(ix) X(iy) X(iz) X(px) X(py) X(pz) \
     X(sx) X(sy) X(sz) X(tfar) X(hv) X(hw) X(hdet)
-#define LANES_INT_FIELDS(X) X(kx) X(ky) X(kz) X(prim) X(cur) X(sp) X(live) X(has) X(fin)
+#define LANES_INT_FIELDS(X) X(kx) X(ky) X(kz) X(prim) X(cur) X(sp) X(live) X(has) X(fin) X(any)
 
 // The fields as vectors: Lanes lives only inside lanes_walk, where the compiler keeps it in
 // registers.
@@ -255,15 +257,23 @@ LANES_INLINE void lanes_init(LaneMemory* M) {
         (S)->d[lane] = (d);                                        \
     }
 
-// Lane `lane` takes the ray from o along d.
-LANES_INLINE void lanes_set_ray(LaneMemory* M, int lane, float3 o, float3 d) {
-    LANES_SET_RAY_FIELDS(M, lane, o, d, INFINITY)
+// Lane `lane` takes the ray from o along d, to tmax; any_hit: a shadow ray, done at its first
+// hit (any one: a hit says the segment is blocked).
+LANES_INLINE void lanes_set_segment(LaneMemory* M, int lane, float3 o, float3 d, float tmax,
+                                    bool any_hit) {
+    LANES_SET_RAY_FIELDS(M, lane, o, d, tmax)
     M->kx[lane] = (int)r.perm.x;
     M->ky[lane] = (int)r.perm.y;
     M->cur[lane] = 0;
     M->sp[lane] = 0;
     M->live[lane] = -1;
     M->has[lane] = -1;
+    M->any[lane] = any_hit ? -1 : 0;
+}
+
+// Lane `lane` takes the extension ray from o along d (the nearest hit).
+LANES_INLINE void lanes_set_ray(LaneMemory* M, int lane, float3 o, float3 d) {
+    lanes_set_segment(M, lane, o, d, INFINITY, false);
 }
 
 // A lane's hit from its fields: distance, triangle (NO_HIT: none), edge functions v, w and
@@ -550,6 +560,8 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                                      &L->hv, &L->hw, &L->hdet, &L->prim);
                 }
             }
+            // A shadow ray that hit something is done: its stack emptied.
+            L->sp = select(L->sp, izero, ml & L->any & (L->prim >= izero));
             L->has &= ~ml;
         }
         // The lanes without an item pop one, passing over entries beyond their hit; a lane

@@ -331,12 +331,16 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
     // kernel's bit for bit (but for rays that meet two triangles at exactly the same distance,
     // of which each walk may keep another). A sphere of 34,816 triangles (lanes are for scenes
     // of 32,768 or more: 2 x 128 x 136) on a floor, an image of 37 x 23 (its last work item
-    // partial), at 5 samples (three pixels a chunk) and 21 (a pixel's chunks of 16 and 5).
+    // partial), at 5 samples (three pixels a chunk) and 21 (a pixel's chunks of 16 and 5); lit
+    // by the default light rig, and by an emissive panel (light samples that end on a
+    // triangle, walked in lanes as any-hit rays, and extension rays that find the light).
     let dir = tempfile::tempdir().unwrap();
     let (rings, segments) = (128, 136);
     assert!((2 * rings * segments) as usize >= penumbra::cl::LANES_MIN_TRIANGLES);
-    let scene = common::white_sphere_of(dir.path(), true, rings, segments);
-    for spp in ["5", "21"] {
+    let rig = common::white_sphere_of(dir.path(), true, rings, segments);
+    let panel = common::white_sphere_under_panel(dir.path(), rings, segments);
+    for (scene, spp) in [(&rig, "5"), (&rig, "21"), (&panel, "5"), (&panel, "21")] {
+        let name = scene.file_stem().unwrap().to_str().unwrap();
         let args = [
             "--kernel",
             "megakernel",
@@ -351,7 +355,7 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
         ];
         let (b, pb) = render_exr_env(
             &scene,
-            &dir.path().join(format!("one-{spp}.exr")),
+            &dir.path().join(format!("one-{name}-{spp}.exr")),
             &args,
             &[("PENUMBRA_LANES", "0")],
         );
@@ -360,7 +364,7 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
         for load in ["rows", "gathers"] {
             let (a, pa) = render_exr_env(
                 &scene,
-                &dir.path().join(format!("lanes-{load}-{spp}.exr")),
+                &dir.path().join(format!("lanes-{load}-{name}-{spp}.exr")),
                 &args,
                 &[("PENUMBRA_LANES_LOAD", load)],
             );
@@ -374,17 +378,82 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
             }
             assert!(
                 pa.iter().any(|p| p[0] > 0.0),
-                "{spp} spp, {load}: a black image"
+                "{name}, {spp} spp, {load}: a black image"
             );
             assert_eq!(
                 a["extension_rays"], b["extension_rays"],
-                "{spp} spp, {load}"
+                "{name}, {spp} spp, {load}"
             );
-            assert_eq!(a["shadow_rays"], b["shadow_rays"], "{spp} spp, {load}");
+            assert_eq!(
+                a["shadow_rays"], b["shadow_rays"],
+                "{name}, {spp} spp, {load}"
+            );
             assert!(
                 pa == pb,
-                "{spp} spp, {load}: the lanes' image differs from one ray at a time's"
+                "{name}, {spp} spp, {load}: the lanes' image differs from one ray at a time's"
             );
+        }
+    }
+}
+
+#[test]
+fn a_last_ray_that_can_find_nothing_is_not_traced() {
+    // A path's last extension ray only looks for emitters. With a point light, no emissive
+    // triangle and a black sky there is none to find: both kernels end the path at its last
+    // vertex's light sample instead, and the image is the one with the ray traced. Traced it
+    // is under a sky too faint to move a pixel (1e-30): more extension rays, the same image
+    // but for the sky's traces in pixels without other light.
+    let dir = tempfile::tempdir().unwrap();
+    let mut g = common::white_sphere_gltf(true, 24, 32);
+    g.lights
+        .push(json!({"type": "point", "intensity": 20.0, "color": [1.0, 1.0, 1.0]}));
+    g.node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [1.0, 3.0, 2.0]}));
+    let scene = g.write_glb(dir.path(), "sphere-point");
+    for kernel in ["megakernel", "wavefront"] {
+        let args = [
+            "--kernel",
+            kernel,
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--spp",
+            "4",
+            "--bounces",
+            "3",
+        ];
+        let (a, pa) = render_exr(
+            &scene,
+            &dir.path().join(format!("{kernel}-black.exr")),
+            &args,
+        );
+        let mut faint = args.to_vec();
+        faint.extend(["--sky", "1e-30"]);
+        let (b, pb) = render_exr(
+            &scene,
+            &dir.path().join(format!("{kernel}-faint.exr")),
+            &faint,
+        );
+        assert_eq!(a["lights"], 1, "{kernel}: {a}");
+        assert_eq!(a["environment"], serde_json::Value::Null, "{kernel}: {a}");
+        let (ra, rb) = (
+            a["extension_rays"].as_u64().unwrap(),
+            b["extension_rays"].as_u64().unwrap(),
+        );
+        assert!(
+            ra < rb,
+            "{kernel}: {ra} extension rays under a black sky, {rb} under a faint one"
+        );
+        assert!(pa.iter().any(|p| p[0] > 0.01), "{kernel}: a black image");
+        for (i, (p, q)) in pa.iter().zip(&pb).enumerate() {
+            for c in 0..3 {
+                assert!(
+                    (p[c] - q[c]).abs() <= 1e-6 * p[c].abs() + 1e-25,
+                    "{kernel}: pixel {i} channel {c}: {} with the last ray untraced, {} traced",
+                    p[c],
+                    q[c]
+                );
+            }
         }
     }
 }

@@ -65,6 +65,9 @@ BUNNY_MATERIALS = [
     {"name": "Floor", "color": (0.5, 0.5, 0.5)},
     {"name": "Wall", "color": (0.6, 0.62, 0.65)},
 ]
+# The closed room's ceiling panel (bunnies-room): radiance 6 W/(m^2 sr), single-sided.
+BUNNY_PANEL = {"name": "Panel", "color": (0.78, 0.78, 0.78), "emissive_factor": (1.0, 1.0, 1.0),
+               "emissive_strength": 6.0}
 BUNNY_CAMERA = {"name": "Camera", "eye": (-0.15, 0.85, 3.4), "forward": (0.0, 0.0, -1.0),
                 "up": (0.0, 1.0, 0.0), "yfov_deg": 40.0, "aspect": 1.0, "znear": 0.01,
                 "zfar": 100.0}
@@ -85,7 +88,7 @@ def _flat_mesh(name, material, positions, triangles):
             "indices": list(range(len(pos)))}
 
 
-def bunny_scene(glb_path, copies=1):
+def bunny_scene(glb_path, copies=1, room=False):
     gltf, bin_data = cornell_box.read_glb(glb_path)
     prim = gltf["meshes"][0]["primitives"][0]
     positions = cornell_box.read_accessor(gltf, bin_data, prim["attributes"]["POSITION"])
@@ -106,10 +109,31 @@ def bunny_scene(glb_path, copies=1):
     meshes = [_flat_mesh(f"Bunny{i}" if i else "Bunny", 0,
                          [(p[0] + o[0], p[1] + o[1], p[2] + o[2]) for p in positions], tris)
               for i, o in enumerate(offsets)]
-    for name, mat, (p, n, i) in [("Floor", 1, cornell_box._merge([floor])),
-                                 ("Wall", 2, cornell_box._merge([wall]))]:
+    parts = [("Floor", 1, [floor]), ("Wall", 2, [wall])]
+    if room:
+        # Closed: side walls, a front wall behind the camera and a ceiling with a panel light
+        # under it (facing down), so that no path escapes and every one can find the light.
+        top = 4.0
+        parts[1] = ("Wall", 2, [
+            wall,
+            cornell_box._quad([(-3.0, y0, -1.5), (-3.0, y0, 4.0), (-3.0, top, 4.0),
+                               (-3.0, top, -1.5)], (1, 0, 0)),
+            cornell_box._quad([(3.0, y0, -1.5), (3.0, y0, 4.0), (3.0, top, 4.0),
+                               (3.0, top, -1.5)], (-1, 0, 0)),
+            cornell_box._quad([(-3.0, y0, 4.0), (3.0, y0, 4.0), (3.0, top, 4.0),
+                               (-3.0, top, 4.0)], (0, 0, -1)),
+            cornell_box._quad([(-3.0, top, -1.5), (3.0, top, -1.5), (3.0, top, 4.0),
+                               (-3.0, top, 4.0)], (0, -1, 0))])
+        parts.append(("Panel", 3, [cornell_box._quad(
+            [(-1.0, top - 0.001, 0.0), (1.0, top - 0.001, 0.0), (1.0, top - 0.001, 2.0),
+             (-1.0, top - 0.001, 2.0)], (0, -1, 0))]))
+    for name, mat, quads in parts:
+        p, n, i = cornell_box._merge(quads)
         meshes.append({"name": name, "material": mat, "positions": p, "normals": n,
                        "indices": i})
+    if room:
+        return {"meshes": meshes, "materials": BUNNY_MATERIALS + [BUNNY_PANEL],
+                "camera": BUNNY_CAMERA, "point_lights": []}
     return {"meshes": meshes, "materials": BUNNY_MATERIALS, "camera": BUNNY_CAMERA,
             "point_lights": [BUNNY_LIGHT]}
 
@@ -334,17 +358,17 @@ def main(argv=None):
                 print(f"rendering {reference}", file=sys.stderr)
                 mi.Bitmap(mitsuba_reference_image(msc, args.ref_spp, 1000, 256)).write(
                     reference)
-        elif name in ("bunny", "bunnies"):
+        elif name in ("bunny", "bunnies", "bunnies-room"):
             scenes = os.environ.get("PENUMBRA_SCENES")
             src = os.path.join(scenes or "", "StanfordBunny", "bunny.glb")
             if not scenes or not os.path.exists(src):
                 sys.exit("bunny: set PENUMBRA_SCENES to the folder holding StanfordBunny/")
-            sc = bunny_scene(src, 7 if name == "bunnies" else 1)
+            sc = bunny_scene(src, 1 if name == "bunny" else 7, room=name == "bunnies-room")
             glb = os.path.join(args.work, f"{name}-lambert.glb")
             cornell_box.write_glb(glb, *cornell_box.build_gltf(sc))
             msc = mitsuba_scene(sc, args.size, args.size, args.bounces, twosided=True)
             reference = os.path.join(args.work,
-                                     f"bunny-mitsuba-{args.size}-{args.bounces}-"
+                                     f"{name}-mitsuba-{args.size}-{args.bounces}-"
                                      f"{args.ref_spp}.exr")
             if not os.path.exists(reference) and not args.timing_only:
                 print(f"rendering {reference} ({args.ref_spp} spp)", file=sys.stderr)
@@ -354,7 +378,7 @@ def main(argv=None):
                 print(f"   {time.perf_counter() - t:.0f} s", file=sys.stderr)
         else:
             sys.exit(f"unknown scene '{name}' (cornell, cornell36, cornell144, cornell576, bunny, "
-                     "bunnies)")
+                     "bunnies, bunnies-room)")
         compare(name, glb, msc, reference, args, results)
 
     cpu = platform.processor() or platform.machine()

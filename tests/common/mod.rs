@@ -463,6 +463,31 @@ pub fn white_sphere(dir: &Path, floor: bool) -> PathBuf {
 
 /// [`white_sphere`] with `rings` × `segments` quads (2 × rings × segments triangles).
 pub fn white_sphere_of(dir: &Path, floor: bool, rings: u32, segments: u32) -> PathBuf {
+    let g = white_sphere_gltf(floor, rings, segments);
+    g.write_glb(dir, if floor { "sphere-floor" } else { "sphere" })
+}
+
+/// The white sphere on its floor lit only by an emissive panel above it, facing down (light
+/// samples that end on a triangle, extension rays that find an emitter).
+pub fn white_sphere_under_panel(dir: &Path, rings: u32, segments: u32) -> PathBuf {
+    let mut g = white_sphere_gltf(true, rings, segments);
+    let light = g.lambert([0.8; 3], [1.0; 3], 6.0, false);
+    let panel = g.mesh(vec![Prim::triangles(
+        vec![
+            [-1.5, 3.0, -1.5],
+            [1.5, 3.0, -1.5],
+            [1.5, 3.0, 1.5],
+            [-1.5, 3.0, 1.5],
+        ],
+        vec![0, 1, 2, 0, 2, 3],
+        light,
+    )]);
+    g.node(json!({"mesh": panel}));
+    g.write_glb(dir, "sphere-panel")
+}
+
+/// The white sphere's document (on its floor or not, a camera, no light), to add to.
+pub fn white_sphere_gltf(floor: bool, rings: u32, segments: u32) -> Gltf {
     let mut g = Gltf::default();
     let m = g.lambert([1.0; 3], [0.0; 3], 1.0, false);
     let (positions, normals, indices) = sphere(1.0, rings, segments, false);
@@ -491,5 +516,5 @@ pub fn white_sphere_of(dir: &Path, floor: bool, rings: u32, segments: u32) -> Pa
     g.cameras
         .push(json!({"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.01}}));
     g.node(json!({"camera": 0, "translation": [0.0, 0.0, 4.0]}));
-    g.write_glb(dir, if floor { "sphere-floor" } else { "sphere" })
+    g
 }
