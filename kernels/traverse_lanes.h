@@ -118,6 +118,36 @@ inline void lanes_scatter_f(float* base, int16 idx, float16 v, ushort km) {
     }
 #endif
 
+// The lanes of mask km of v, in order, in the first lanes (the others 0); and the lanes of v
+// named by idx.
+#if defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+#define lanes_compress(v, km) __builtin_ia32_compresssi512_mask((v), (int16)(0), (km))
+#define lanes_permute(v, idx) __builtin_ia32_permvarsf512((v), (idx))
+#define lanes_permute_i(v, idx) __builtin_ia32_permvarsi512((v), (idx))
+#else
+inline int16 lanes_compress(int16 v, ushort km) {
+    int in[LANES], out[LANES];
+    vstore16(v, 0, in);
+    int n = 0;
+    for (int l = 0; l < LANES; ++l) {
+        out[l] = 0;
+        if ((km >> l) & 1) out[n++] = in[l];
+    }
+    return vload16(0, out);
+}
+inline float16 lanes_permute(float16 v, int16 idx) {
+    float in[LANES], out[LANES];
+    int i[LANES];
+    vstore16(v, 0, in);
+    vstore16(idx, 0, i);
+    for (int l = 0; l < LANES; ++l) out[l] = in[i[l] & (LANES - 1)];
+    return vload16(0, out);
+}
+inline int16 lanes_permute_i(int16 v, int16 idx) {
+    return as_int16(lanes_permute(as_float16(v), idx));
+}
+#endif
+
 // Rows into lanes. A lane's node (32 words) or triangle (12) is a row of neighbouring words,
 // and a gather loads one element at a time: on AMD's Zen 5, 0.5 ns an element, 128 ns for the
 // 32 gathers of a node visit of sixteen lanes against 15 ns for the same bytes as rows
@@ -375,6 +405,48 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
 #define LANES_PREFETCH_TRIS 4
 #endif
 
+// Triangle TRI of each lane of mask M (tw: the triangles as words), its vertices relative to
+// the lane's origin in its permuted axes (KX, KY, KZ: 0, 1 or 2; PX, PY, PZ): declares aX ..
+// cZ. Lanes outside M read triangle 0.
+#ifdef LANES_GATHERS
+#define LANES_TRIANGLE(TRI, M, KX, KY, KZ, PX, PY, PZ)                          \
+    int16 b_ = (TRI) * (int16)(12);                                          \
+    float16 aX = LANES_GATHER_F(tw, b_ + (KX), M) - (PX);                     \
+    float16 aY = LANES_GATHER_F(tw, b_ + (KY), M) - (PY);                     \
+    float16 aZ = LANES_GATHER_F(tw, b_ + (KZ), M) - (PZ);                     \
+    float16 bX = LANES_GATHER_F(tw, b_ + (int16)(4) + (KX), M) - (PX);        \
+    float16 bY = LANES_GATHER_F(tw, b_ + (int16)(4) + (KY), M) - (PY);        \
+    float16 bZ = LANES_GATHER_F(tw, b_ + (int16)(4) + (KZ), M) - (PZ);        \
+    float16 cX = LANES_GATHER_F(tw, b_ + (int16)(8) + (KX), M) - (PX);        \
+    float16 cY = LANES_GATHER_F(tw, b_ + (int16)(8) + (KY), M) - (PY);        \
+    float16 cZ = LANES_GATHER_F(tw, b_ + (int16)(8) + (KZ), M) - (PZ);
+#else
+// As rows: each vertex's words in the lane's permuted axes by selects.
+#define LANES_TRIANGLE(TRI, M, KX, KY, KZ, PX, PY, PZ)                          \
+    int off_[LANES];                                                         \
+    vstore16(select((int16)(0), (TRI) * (int16)(12), M), 0, off_);           \
+    float16 T[12];                                                           \
+    lanes_rows8(tw, off_, 0, T);                                             \
+    lanes_rows4(tw, off_, 8, T + 8);                                         \
+    int16 kx1_ = (KX) == (int16)(1), kx2_ = (KX) == (int16)(2);              \
+    int16 ky1_ = (KY) == (int16)(1), ky2_ = (KY) == (int16)(2);              \
+    int16 kz1_ = (KZ) == (int16)(1), kz2_ = (KZ) == (int16)(2);              \
+    float16 aX = LANES_AXIS(0, kx) - (PX);                                   \
+    float16 aY = LANES_AXIS(0, ky) - (PY);                                   \
+    float16 aZ = LANES_AXIS(0, kz) - (PZ);                                   \
+    float16 bX = LANES_AXIS(4, kx) - (PX);                                   \
+    float16 bY = LANES_AXIS(4, ky) - (PY);                                   \
+    float16 bZ = LANES_AXIS(4, kz) - (PZ);                                   \
+    float16 cX = LANES_AXIS(8, kx) - (PX);                                   \
+    float16 cY = LANES_AXIS(8, ky) - (PY);                                   \
+    float16 cZ = LANES_AXIS(8, kz) - (PZ);
+#define LANES_AXIS(V, K) select(select(T[V], T[V + 1], K##1_), T[V + 2], K##2_)
+#endif
+
+// The most (lane, triangle) pairs a leaf step tests sixteen at a time (more: one triangle of
+// every lane at a time).
+#define LANES_PAIRS_MAX 64
+
 // Compare-exchange of two (distance, item) pairs in every lane, nearest first.
 #define LANES_ORDER(A, B)                      \
     {                                          \
@@ -511,41 +583,82 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             int16 first = L->cur & (int16)(LANES_FIRST_MASK);
             int16 cnt = (L->cur >> (int16)(27)) & (int16)(15);
             int kmax = lanes_max(select(izero, cnt, ml));
+#ifndef LANES_LEAF_BY_K
+            // The leaves' (lane, triangle) pairs in order, each lane's first triangle before its
+            // second (pl, pt): sixteen pairs a test, not one triangle of every lane a test, of
+            // which the lanes whose leaves are done (or that wait at a node) would take no part.
+            int pl[LANES_PAIRS_MAX + LANES], pt[LANES_PAIRS_MAX + LANES];
+            int pairs = 0;
+            bool by_k = kmax > LANES_PAIRS_MAX / LANES;
+            for (int k = 0; k < kmax && !by_k; ++k) {
+                ushort km = lanes_kmask(ml & ((int16)(k) < cnt));
+                vstore16(lanes_compress(lane, km), 0, pl + pairs);
+                vstore16(lanes_compress(first + (int16)(k), km), 0, pt + pairs);
+                pairs += popcount((uint)km);
+            }
+            // Each pair's verdict against its lane's hit before the leaves (the nearest of a
+            // lane's hits is then kept, the first of equally near ones: the walk by triangle
+            // order's). A pair that needs the scalar test sends the leaves to that walk.
+            float rt[LANES_PAIRS_MAX], rv[LANES_PAIRS_MAX], rw[LANES_PAIRS_MAX];
+            float rdet[LANES_PAIRS_MAX];
+            uint hits[LANES_PAIRS_MAX / LANES];
+            for (int p0 = 0; p0 < pairs && !by_k; p0 += LANES) {
+                int16 idx = vload16(0, pl + p0);
+                int16 tri = vload16(0, pt + p0);
+                int16 m = (lane + (int16)(p0)) < (int16)(pairs);
+                idx = select(izero, idx, m);
+                int16 kx = lanes_permute_i(L->kx, idx), ky = lanes_permute_i(L->ky, idx);
+                int16 kz = lanes_permute_i(L->kz, idx);
+                float16 px = lanes_permute(L->px, idx), py = lanes_permute(L->py, idx);
+                float16 pz = lanes_permute(L->pz, idx);
+                float16 sx = lanes_permute(L->sx, idx), sy = lanes_permute(L->sy, idx);
+                float16 sz = lanes_permute(L->sz, idx);
+                LANES_TRIANGLE(tri, m, kx, ky, kz, px, py, pz)
+                LANE_EDGES(float16)
+                LANE_HITS16(m, zero, lanes_permute(L->tfar, idx))
+                by_k = lanes_any(special);
+                vstore16(t, 0, rt + p0);
+                vstore16(v, 0, rv + p0);
+                vstore16(w, 0, rw + p0);
+                vstore16(det, 0, rdet + p0);
+                hits[p0 / LANES] = lanes_kmask(ok);
+            }
+            if (!by_k) {
+                float tf[LANES], hv[LANES], hw[LANES], hdet[LANES];
+                int prim[LANES];
+                vstore16(L->tfar, 0, tf);
+                vstore16(L->hv, 0, hv);
+                vstore16(L->hw, 0, hw);
+                vstore16(L->hdet, 0, hdet);
+                vstore16(L->prim, 0, prim);
+                for (int p0 = 0; p0 < pairs; p0 += LANES) {
+                    for (uint h = hits[p0 / LANES]; h != 0u; h &= h - 1u) {
+                        int i = p0 + (int)__builtin_ctz(h);
+                        int l = pl[i];
+                        if (rt[i] < tf[l]) {
+                            tf[l] = rt[i];
+                            hv[l] = rv[i];
+                            hw[l] = rw[i];
+                            hdet[l] = rdet[i];
+                            prim[l] = pt[i];
+                        }
+                    }
+                }
+                L->tfar = vload16(0, tf);
+                L->hv = vload16(0, hv);
+                L->hw = vload16(0, hw);
+                L->hdet = vload16(0, hdet);
+                L->prim = vload16(0, prim);
+                kmax = 0;  // done: no walk by triangle order
+            }
+#endif
+            // The leaves one triangle of every lane at a time, in order, each lane's hit updated
+            // as it goes; the scalar test's rare cases in turn.
             for (int k = 0; k < kmax; ++k) {
                 int16 m = ml & ((int16)(k) < cnt);
                 int16 tri = first + (int16)(k);
-                int16 b = tri * (int16)(12);
-#ifdef LANES_GATHERS
-                float16 aX = LANES_GATHER_F(tw, b + L->kx, m) - L->px;
-                float16 aY = LANES_GATHER_F(tw, b + L->ky, m) - L->py;
-                float16 aZ = LANES_GATHER_F(tw, b + L->kz, m) - L->pz;
-                float16 bX = LANES_GATHER_F(tw, b + (int16)(4) + L->kx, m) - L->px;
-                float16 bY = LANES_GATHER_F(tw, b + (int16)(4) + L->ky, m) - L->py;
-                float16 bZ = LANES_GATHER_F(tw, b + (int16)(4) + L->kz, m) - L->pz;
-                float16 cX = LANES_GATHER_F(tw, b + (int16)(8) + L->kx, m) - L->px;
-                float16 cY = LANES_GATHER_F(tw, b + (int16)(8) + L->ky, m) - L->py;
-                float16 cZ = LANES_GATHER_F(tw, b + (int16)(8) + L->kz, m) - L->pz;
-#else
-                // The triangles as rows (lanes without one read triangle 0), each vertex's
-                // words in the lane's permuted axes (kx, ky, kz: 0, 1 or 2) by selects.
-                int off_[LANES];
-                vstore16(select(izero, b, m), 0, off_);
-                float16 T[12];
-                lanes_rows8(tw, off_, 0, T);
-                lanes_rows4(tw, off_, 8, T + 8);
-#define LANES_AXIS(V, K) \
-    select(select(T[V], T[V + 1], L->K == (int16)(1)), T[V + 2], L->K == (int16)(2))
-                float16 aX = LANES_AXIS(0, kx) - L->px;
-                float16 aY = LANES_AXIS(0, ky) - L->py;
-                float16 aZ = LANES_AXIS(0, kz) - L->pz;
-                float16 bX = LANES_AXIS(4, kx) - L->px;
-                float16 bY = LANES_AXIS(4, ky) - L->py;
-                float16 bZ = LANES_AXIS(4, kz) - L->pz;
-                float16 cX = LANES_AXIS(8, kx) - L->px;
-                float16 cY = LANES_AXIS(8, ky) - L->py;
-                float16 cZ = LANES_AXIS(8, kz) - L->pz;
-#undef LANES_AXIS
-#endif
+                float16 px = L->px, py = L->py, pz = L->pz;
+                LANES_TRIANGLE(tri, m, L->kx, L->ky, L->kz, px, py, pz)
                 float16 sx = L->sx, sy = L->sy, sz = L->sz;
                 LANE_EDGES(float16)
                 LANE_HITS16(m, zero, L->tfar)
