@@ -56,9 +56,8 @@ inline void mega_count(volatile global uint* counters, uint extension_rays, uint
 //     samples, which start close together and go to one light, walk as a packet too;
 //   - the paths that go on are taken by sixteen lanes (traverse_lanes.h), one path a lane, whose
 //     extension rays walk together, each at its own node: when some are done, their vertices are
-//     shaded, their light samples traced there and then (one ray at a time: the any-hit walk
-//     without sorting is as fast alone as in lanes, as such rays are incoherent), and each lane
-//     takes its path's next ray, or the next path of a chunk.
+//     shaded, the light sample of each walks in its lane next (an any-hit ray), and then each
+//     lane takes its path's next ray, or the next path of a chunk.
 // A chunk's results wait in its record until all its paths are done; then they are added to
 // their pixels' film sums in sample order, and a pixel has one chunk in flight at a time, so
 // each pixel sums its samples in the order the one-pixel kernel below does: the same image,

@@ -354,7 +354,7 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
             "4",
         ];
         let (b, pb) = render_exr_env(
-            &scene,
+            scene,
             &dir.path().join(format!("one-{name}-{spp}.exr")),
             &args,
             &[("PENUMBRA_LANES", "0")],
@@ -363,7 +363,7 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
         // The lanes load their nodes and triangles as rows (AMD's default) or by gathers.
         for load in ["rows", "gathers"] {
             let (a, pa) = render_exr_env(
-                &scene,
+                scene,
                 &dir.path().join(format!("lanes-{load}-{name}-{spp}.exr")),
                 &args,
                 &[("PENUMBRA_LANES_LOAD", load)],

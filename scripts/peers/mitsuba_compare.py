@@ -15,6 +15,11 @@ Two scenes, each defined once here as plain data and given to both renderers:
            arrays. Mitsuba's `diffuse` is one-sided; penumbra scatters from both faces, so the
            Mitsuba BSDFs are wrapped in `twosided`. Reference: Mitsuba at --ref-spp, cached in
            --work.
+  bunnies  seven such bunnies side by side (1,008,326 triangles), the same floor, wall and
+           light: the 1 M-triangle scene, most paths leaving it after a bounce or two.
+  bunnies-room  the seven bunnies in a closed room (side and front walls, a ceiling) lit only
+           by an emissive panel under the ceiling: no path escapes, every one can find the
+           light (1 M triangles, long paths).
 
 Settings on both sides: --size x --size pixels, box pixel filter, penumbra --bounces B =
 Mitsuba max_depth B + 2, Russian roulette off, hard shadows (point light radius 0), MIS.
@@ -31,6 +36,8 @@ Measured (wall clock, on this machine, one after the other, nothing else of ours
 
     python3 scripts/peers/mitsuba_compare.py                      # both scenes, defaults
     python3 scripts/peers/mitsuba_compare.py --scenes cornell --spp 64 --max-spp 256
+    python3 scripts/peers/mitsuba_compare.py --timing-only --rounds 5 --scenes bunnies,bunnies-room \
+        --size 256 --bounces 6 --spp 16    # medians of 5 interleaved renders a side
 
 Needs: mitsuba 3 (pip install mitsuba; see scripts/README.md), a release build of penumbra
 (cargo build --release), PENUMBRA_SCENES for the bunny. Prints a Markdown table and writes
@@ -251,6 +258,24 @@ def compare(name, glb, msc, reference, args, results):
         _, compile_s = mitsuba_render(msc, 1, 10_000)
         _, mit_same_spp = mitsuba_render(msc, args.spp, 77)
         mit_cpu = LAST_MITSUBA_CPU_SECONDS[0]
+        # More rounds, the two renderers one after the other in each: the medians (a shared
+        # machine moves both by 10-20 % from one minute to the next).
+        if args.rounds > 1:
+            runs = [(pen_render, mit_same_spp, mit_cpu)]
+            for k in range(1, args.rounds):
+                pen = run_penumbra(args.penumbra, ["render", glb, "-o", os.path.join(
+                    args.work, f"{name}-penumbra.exr"), "--spp", str(args.spp),
+                    "--no-russian-roulette"] + common)
+                _, secs = mitsuba_render(msc, args.spp, 77 + k)
+                runs.append((pen, secs, LAST_MITSUBA_CPU_SECONDS[0]))
+            median = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731
+            pen_render = dict(pen_render)
+            pen_render["seconds"] = median([r[0]["seconds"] for r in runs])
+            pen_render["samples_per_second"] = median([r[0]["samples_per_second"]
+                                                       for r in runs])
+            pen_render["cpu_seconds"] = median([r[0]["cpu_seconds"] for r in runs])
+            mit_same_spp = median([r[1] for r in runs])
+            mit_cpu = median([r[2] for r in runs])
         pixels = args.size * args.size
         r = {"scene": name, "glb": glb, "size": args.size, "bounces": args.bounces,
              "spp": args.spp, "triangles": pen_render["triangles"],
@@ -261,7 +286,7 @@ def compare(name, glb, msc, reference, args, results):
              "mitsuba_seconds": mit_same_spp, "mitsuba_compile_seconds": compile_s,
              "mitsuba_samples_per_second": pixels * args.spp / mit_same_spp,
              "penumbra_cpu_seconds": pen_render.get("cpu_seconds"),
-             "mitsuba_cpu_seconds": mit_cpu}
+             "mitsuba_cpu_seconds": mit_cpu, "rounds": args.rounds}
         results.append(r)
         print(f"   penumbra {r['penumbra_seconds']:.3f} s ({r['penumbra_cpu_seconds']} CPU s), "
               f"Mitsuba {mit_same_spp:.3f} s ({mit_cpu:.2f} CPU s) for {args.spp} spp",
@@ -327,6 +352,9 @@ def main(argv=None):
     ap.add_argument("--json", default=None, help="write the raw figures here")
     ap.add_argument("--timing-only", action="store_true",
                     help="only the time for the same spp (no error curves, no references)")
+    ap.add_argument("--rounds", type=int, default=1,
+                    help="with --timing-only: this many renders on each side, interleaved; "
+                         "medians reported")
     ap.add_argument("--kernel", default=None,
                     help="penumbra --kernel (wavefront, megakernel; default: penumbra's auto)")
     args = ap.parse_args(argv)
