@@ -283,10 +283,9 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     for (;;) {
         int16 done = lanes_walk(&M, nodes, tris, &sc.surf, overflow);
         if (!lanes_any(done)) break;
-        int done_[LANES];
-        vstore16(done, 0, done_);
-        for (int l = 0; l < LANES; ++l) {
-            if (!done_[l]) continue;
+        // The lanes done, in order (lowest first).
+        for (uint bits = lanes_kmask(done); bits != 0u; bits &= bits - 1u) {
+            int l = (int)__builtin_ctz(bits);
             bool alive;
             if (in_shadow[l]) {
                 // The vertex's light sample walked: its light is added (unless blocked, perhaps
