@@ -601,7 +601,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             // order's). A pair that needs the scalar test sends the leaves to that walk.
             float rt[LANES_PAIRS_MAX], rv[LANES_PAIRS_MAX], rw[LANES_PAIRS_MAX];
             float rdet[LANES_PAIRS_MAX];
-            uint hits[LANES_PAIRS_MAX / LANES];
+            uint hits[LANES_PAIRS_MAX / LANES], found = 0u;
             for (int p0 = 0; p0 < pairs && !by_k; p0 += LANES) {
                 int16 idx = vload16(0, pl + p0);
                 int16 tri = vload16(0, pt + p0);
@@ -622,8 +622,10 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 vstore16(w, 0, rw + p0);
                 vstore16(det, 0, rdet + p0);
                 hits[p0 / LANES] = lanes_kmask(ok);
+                found |= hits[p0 / LANES];
             }
-            if (!by_k) {
+            // No pair hit: the lanes' hits stand as they are.
+            if (!by_k && found != 0u) {
                 float tf[LANES], hv[LANES], hw[LANES], hdet[LANES];
                 int prim[LANES];
                 vstore16(L->tfar, 0, tf);
@@ -649,16 +651,15 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 L->hw = vload16(0, hw);
                 L->hdet = vload16(0, hdet);
                 L->prim = vload16(0, prim);
-                kmax = 0;  // done: no walk by triangle order
             }
+            if (!by_k) kmax = 0;  // done: no walk by triangle order
 #endif
             // The leaves one triangle of every lane at a time, in order, each lane's hit updated
             // as it goes; the scalar test's rare cases in turn.
             for (int k = 0; k < kmax; ++k) {
                 int16 m = ml & ((int16)(k) < cnt);
                 int16 tri = first + (int16)(k);
-                float16 px = L->px, py = L->py, pz = L->pz;
-                LANES_TRIANGLE(tri, m, L->kx, L->ky, L->kz, px, py, pz)
+                LANES_TRIANGLE(tri, m, L->kx, L->ky, L->kz, L->px, L->py, L->pz)
                 float16 sx = L->sx, sy = L->sy, sz = L->sz;
                 LANE_EDGES(float16)
                 LANE_HITS16(m, zero, L->tfar)

@@ -13,7 +13,7 @@
 mod common;
 
 use common::stats::chi2;
-use common::{Gltf, Prim, output_dir, render_exr, sphere};
+use common::{Gltf, Prim, horizontal_square, output_dir, render_exr, sphere};
 use penumbra::cl::types::GpuMaterial;
 use penumbra::cl::{DeviceChoice, Gpu, KernelFeatures, Program};
 use penumbra::scene::Material;
@@ -2669,17 +2669,6 @@ fn reflection_is_reciprocal() {
     }
 }
 
-/// A horizontal square at height `y` of half-size `h`, facing up or down.
-fn quad(y: f32, h: f32, up: bool) -> (Vec<[f32; 3]>, Vec<u32>) {
-    let p = vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
-    let i = if up {
-        vec![0, 2, 1, 0, 3, 2]
-    } else {
-        vec![0, 1, 2, 0, 2, 3]
-    };
-    (p, i)
-}
-
 /// The render's mean over the image, 24 × 24 pixels, 256 samples, 3 bounces, black sky.
 fn mean_of_render(
     dir: &std::path::Path,
@@ -2720,8 +2709,8 @@ fn back_lit_sheet(dir: &std::path::Path, strategy: &str, kernel: &str) -> f64 {
     let light_mat = g.lambert([0.0; 3], [1.0; 3], 5.0, true);
     let sheet = Mat::lambert([0.8; 3]).translucent(0.7, [1.0, 0.8, 0.6]);
     let sheet_mat = material_json(&mut g, &sheet, None);
-    let (sp, si) = quad(1.0, 3.0, false);
-    let (lp, li) = quad(2.0, 0.5, false);
+    let (sp, si) = horizontal_square(1.0, 3.0, false);
+    let (lp, li) = horizontal_square(2.0, 0.5, false);
     let mesh = g.mesh(vec![
         Prim::triangles(sp, si, sheet_mat),
         Prim::triangles(lp, li, light_mat),
@@ -2764,8 +2753,8 @@ fn lit_through_a_window(dir: &std::path::Path, pane: bool, strategy: &str, kerne
     let mut g = Gltf::default();
     let floor_mat = g.lambert([0.8; 3], [0.0; 3], 1.0, false);
     let light_mat = g.lambert([0.0; 3], [1.0; 3], 5.0, true);
-    let (fp, fi) = quad(0.0, 1.0, true);
-    let (lp, li) = quad(2.0, 0.5, false);
+    let (fp, fi) = horizontal_square(0.0, 1.0, true);
+    let (lp, li) = horizontal_square(2.0, 0.5, false);
     let mut prims = vec![
         Prim::triangles(fp, fi, floor_mat),
         Prim::triangles(lp, li, light_mat),
@@ -2775,7 +2764,7 @@ fn lit_through_a_window(dir: &std::path::Path, pane: bool, strategy: &str, kerne
         glass.base = [0.9, 1.0, 0.8];
         let m = material_json(&mut g, &glass, None);
         g.materials[m]["doubleSided"] = json!(true);
-        let (pp, pi) = quad(1.0, 3.0, true);
+        let (pp, pi) = horizontal_square(1.0, 3.0, true);
         prims.push(Prim::triangles(pp, pi, m));
     }
     let mesh = g.mesh(prims);
@@ -2973,28 +2962,12 @@ fn no_nonfinite_samples_at_the_extremes() {
         g.node(json!({"mesh": mesh, "translation": [x, 0.45, z]}));
     }
     let floor = material_json(&mut g, &Mat::dielectric([0.5; 3], 0.4), None);
-    let mesh = g.mesh(vec![Prim::triangles(
-        vec![
-            [-20.0, 0.0, -20.0],
-            [20.0, 0.0, -20.0],
-            [20.0, 0.0, 20.0],
-            [-20.0, 0.0, 20.0],
-        ],
-        vec![0, 2, 1, 0, 3, 2],
-        floor,
-    )]);
+    let (positions, indices) = horizontal_square(0.0, 20.0, true);
+    let mesh = g.mesh(vec![Prim::triangles(positions, indices, floor)]);
     g.node(json!({"mesh": mesh}));
     let lamp = g.lambert([0.0; 3], [1.0; 3], 5.0, true);
-    let mesh = g.mesh(vec![Prim::triangles(
-        vec![
-            [-1.0, 3.0, -1.0],
-            [1.0, 3.0, -1.0],
-            [1.0, 3.0, 1.0],
-            [-1.0, 3.0, 1.0],
-        ],
-        vec![0, 1, 2, 0, 2, 3],
-        lamp,
-    )]);
+    let (positions, indices) = horizontal_square(3.0, 1.0, false);
+    let mesh = g.mesh(vec![Prim::triangles(positions, indices, lamp)]);
     g.node(json!({"mesh": mesh}));
     g.lights
         .push(json!({"type": "point", "intensity": 20.0, "color": [1.0, 1.0, 1.0]}));

@@ -250,10 +250,9 @@ def compare(name, glb, msc, reference, args, results):
     common = ["--width", size, "--height", size, "--bounces", bounces, "--hard-shadows",
               "--device", args.device] + (["--kernel", args.kernel] if args.kernel else [])
     # penumbra: time for S spp (kernels built before the clock starts), then the error curve.
-    pen_render = run_penumbra(args.penumbra, ["render", glb, "-o",
-                                              os.path.join(args.work, f"{name}-penumbra.exr"),
-                                              "--spp", str(args.spp), "--no-russian-roulette"]
-                              + common)
+    render = ["render", glb, "-o", os.path.join(args.work, f"{name}-penumbra.exr"), "--spp",
+              str(args.spp), "--no-russian-roulette"] + common
+    pen_render = run_penumbra(args.penumbra, render)
     if args.timing_only:
         _, compile_s = mitsuba_render(msc, 1, 10_000)
         _, mit_same_spp = mitsuba_render(msc, args.spp, 77)
@@ -263,9 +262,7 @@ def compare(name, glb, msc, reference, args, results):
         if args.rounds > 1:
             runs = [(pen_render, mit_same_spp, mit_cpu)]
             for k in range(1, args.rounds):
-                pen = run_penumbra(args.penumbra, ["render", glb, "-o", os.path.join(
-                    args.work, f"{name}-penumbra.exr"), "--spp", str(args.spp),
-                    "--no-russian-roulette"] + common)
+                pen = run_penumbra(args.penumbra, render)
                 _, secs = mitsuba_render(msc, args.spp, 77 + k)
                 runs.append((pen, secs, LAST_MITSUBA_CPU_SECONDS[0]))
             median = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731

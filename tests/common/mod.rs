@@ -342,6 +342,18 @@ pub fn quad() -> Prim {
     )
 }
 
+/// A horizontal square at height `y` of half-size `h`, facing up or down: its corners and two
+/// triangles.
+pub fn horizontal_square(y: f32, h: f32, up: bool) -> (Vec<[f32; 3]>, Vec<u32>) {
+    let p = vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]];
+    let i = if up {
+        vec![0, 2, 1, 0, 3, 2]
+    } else {
+        vec![0, 1, 2, 0, 2, 3]
+    };
+    (p, i)
+}
+
 /// The device the tests use: `PENUMBRA_TEST_DEVICE` (e.g. `gpu` on the H100 machine), else
 /// the CPU device (PoCL in CI).
 pub fn test_device() -> String {
@@ -472,16 +484,8 @@ pub fn white_sphere_of(dir: &Path, floor: bool, rings: u32, segments: u32) -> Pa
 pub fn white_sphere_under_panel(dir: &Path, rings: u32, segments: u32) -> PathBuf {
     let mut g = white_sphere_gltf(true, rings, segments);
     let light = g.lambert([0.8; 3], [1.0; 3], 6.0, false);
-    let panel = g.mesh(vec![Prim::triangles(
-        vec![
-            [-1.5, 3.0, -1.5],
-            [1.5, 3.0, -1.5],
-            [1.5, 3.0, 1.5],
-            [-1.5, 3.0, 1.5],
-        ],
-        vec![0, 1, 2, 0, 2, 3],
-        light,
-    )]);
+    let (positions, indices) = horizontal_square(3.0, 1.5, false);
+    let panel = g.mesh(vec![Prim::triangles(positions, indices, light)]);
     g.node(json!({"mesh": panel}));
     g.write_glb(dir, "sphere-panel")
 }
@@ -500,16 +504,8 @@ pub fn white_sphere_gltf(floor: bool, rings: u32, segments: u32) -> Gltf {
     }];
     if floor {
         let gray = g.lambert([0.5; 3], [0.0; 3], 1.0, false);
-        prims.push(Prim::triangles(
-            vec![
-                [-5.0, -1.0, -5.0],
-                [5.0, -1.0, -5.0],
-                [5.0, -1.0, 5.0],
-                [-5.0, -1.0, 5.0],
-            ],
-            vec![0, 2, 1, 0, 3, 2],
-            gray,
-        ));
+        let (positions, indices) = horizontal_square(-1.0, 5.0, true);
+        prims.push(Prim::triangles(positions, indices, gray));
     }
     let mesh = g.mesh(prims);
     g.node(json!({"mesh": mesh}));
