@@ -48,6 +48,47 @@ inline void mega_count(volatile global uint* counters, uint extension_rays, uint
     if (nonfinite > 0u) atomic_add(&counters[COUNT_NONFINITE], nonfinite);
 }
 
+// The last extension ray (bounce max_bounces + 1) only looks for emitters: with the lights'
+// triangles the only surfaces that add anything there (no environment map, no unlit
+// materials, a black sky, no alpha), and few of them, the ray is tested against those
+// triangles first, by the traversal's own watertight test. When it meets none, it would add
+// nothing and is not traced; when it meets one at t, only an any-hit ray over (0, t) is
+// traced, and an unblocked ray shades that hit as the closest-hit ray would have found it.
+// The same estimator, the same image (docs/benchmarks.md, "Twenty-first session");
+// -DLAST_RAY_TRACED traces it as before.
+#if defined(HAS_TRIANGLE_LIGHTS) && !defined(HAS_ENV_MAP) && !defined(HAS_UNLIT) && \
+    !defined(HAS_ALPHA) && !defined(TWO_LEVEL) && !defined(LAST_RAY_TRACED)
+#define LAST_RAY_EMITTERS
+// The most lights for which the last ray tests their triangles one by one.
+#define LAST_RAY_LIGHTS_MAX 16u
+
+inline bool mega_last_ray_by_emitters(const GpuFrame* frame) {
+    return frame->light_count <= LAST_RAY_LIGHTS_MAX && frame->sky.x <= 0.0f &&
+           frame->sky.y <= 0.0f && frame->sky.z <= 0.0f;
+}
+
+// The nearest of the lights' triangles along the ray from o along d, or NO_HIT.
+inline GpuHit mega_nearest_emitter(const GpuFrame* frame, const ShadeScene* sc, float3 o,
+                                   float3 d) {
+    RayPrep r = prepare_ray(o, d);
+    GpuHit hit = no_hit(INFINITY);
+    for (uint i = 0u; i < frame->light_count; ++i) {
+        global const GpuLight* l = &sc->lights[i];
+        if (as_uint(l->position.w) != LIGHT_TRIANGLE) continue;
+        uint prim = as_uint(l->spot.x);
+        GpuTriangle t = sc->tris[prim];
+        float t_hit = hit.t, bu, bv;
+        if (intersect_triangle(&r, t.v0, t.v1, t.v2, 0.0f, &t_hit, &bu, &bv)) {
+            hit.t = t_hit;
+            hit.u = bu;
+            hit.v = bv;
+            hit.prim = prim;
+        }
+    }
+    return hit;
+}
+#endif
+
 #ifdef MEGA_LANES
 // With MEGA_LANES a work item renders a square of LANES_TILE² pixels in two shapes of walk:
 //   - a chunk of a pixel's samples (sixteen at a time) or, below sixteen samples, of a 4×4
@@ -255,6 +296,17 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     // A lane walking its vertex's light sample: the sample, and whether the path goes on after.
     ShadowQuery sample[LANES];
     bool in_shadow[LANES], goes_on[LANES];
+#ifdef LAST_RAY_EMITTERS
+    // A lane walking a last ray's segment to the emitter it meets: that hit.
+    bool to_emitter[LANES];
+    GpuHit emitter[LANES];
+    bool last_by_emitters = mega_last_ray_by_emitters(&frame);
+#endif
+#ifdef LAST_RAY_EMITTERS
+#define LANE_NOT_TO_EMITTER(l) to_emitter[l] = false;
+#else
+#define LANE_NOT_TO_EMITTER(l)
+#endif
     // A lane takes the next queued path (starting chunks while the queue is empty); with none
     // left it stays idle.
 #define LANE_NEXT_PATH(l)                                                                    \
@@ -271,12 +323,14 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             bounce[l] = 1u;                                                                  \
             busy[l] = true;                                                                  \
             in_shadow[l] = false;                                                            \
+            LANE_NOT_TO_EMITTER(l)                                                           \
             lanes_set_ray(&M, l, s[l].origin, s[l].direction);                               \
         }                                                                                    \
     }
     bool idle = false;
     for (int l = 0; l < LANES; ++l) {
         busy[l] = false;
+        LANE_NOT_TO_EMITTER(l)
         LANE_NEXT_PATH(l)
         idle |= !busy[l];
     }
@@ -287,6 +341,22 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         for (uint bits = lanes_kmask(done); bits != 0u; bits &= bits - 1u) {
             int l = (int)__builtin_ctz(bits);
             bool alive;
+#ifdef LAST_RAY_EMITTERS
+            if (to_emitter[l]) {
+                // The last ray's segment to its emitter walked: unblocked, the emitter is
+                // its closest hit.
+                to_emitter[l] = false;
+                ++W.extension_rays;
+                if (M.prim[l] < 0) {
+                    shade_vertex(&frame, bounce[l], &sc, emitter[l], &s[l], &sample[l]);
+                }
+                mega_path_done(&W, &frame, film, chunk[l], entry[l], &s[l]);
+                busy[l] = false;
+                LANE_NEXT_PATH(l)
+                idle |= !busy[l];
+                continue;
+            }
+#endif
             if (in_shadow[l]) {
                 // The vertex's light sample walked: its light is added (unless blocked, perhaps
                 // only by thin walls, which the scalar test passes) before the path goes on.
@@ -315,6 +385,18 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
                 }
             }
             // The path goes on, or the lane takes the next one.
+#ifdef LAST_RAY_EMITTERS
+            if (alive && last_by_emitters && bounce[l] == frame.max_bounces + 1u) {
+                GpuHit e = mega_nearest_emitter(&frame, &sc, s[l].origin, s[l].direction);
+                if (e.prim != NO_HIT) {
+                    to_emitter[l] = true;
+                    emitter[l] = e;
+                    lanes_set_segment(&M, l, s[l].origin, s[l].direction, e.t, true);
+                    continue;
+                }
+                alive = false;  // it meets no emitter: it would add nothing
+            }
+#endif
             if (alive) {
                 lanes_set_ray(&M, l, s[l].origin, s[l].direction);
                 continue;
@@ -335,6 +417,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         }
     }
 #undef LANE_NEXT_PATH
+#undef LANE_NOT_TO_EMITTER
     mega_count(counters, W.extension_rays, W.shadow_rays, W.nonfinite);
 }
 #else
@@ -359,20 +442,36 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     uint counted = 0;  // samples whose camera ray hit (the film's .w with the background cut out)
 #ifdef SMALL_SCENE
     sc.surf.small = &small;
-#define MEGA_TRACE(o, d, any_hit) \
-    trace_small(&small, tris, &sc.surf, o, d, 0.0f, INFINITY, any_hit)
+#define MEGA_TRACE_TO(o, d, tmax, any_hit) \
+    trace_small(&small, tris, &sc.surf, o, d, 0.0f, tmax, any_hit)
 #define MEGA_SHADOW(q) shadow_pass_small(&small, tris, instances, object_tris, &sc.surf, q, overflow)
 #else
-#define MEGA_TRACE(o, d, any_hit)                                                              \
-    trace_scene_wide(nodes, tris, instances, object_tris, &sc.surf, o, d, 0.0f, INFINITY, any_hit, \
+#define MEGA_TRACE_TO(o, d, tmax, any_hit)                                                 \
+    trace_scene_wide(nodes, tris, instances, object_tris, &sc.surf, o, d, 0.0f, tmax, any_hit, \
                      overflow)
 #define MEGA_SHADOW(q) shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, q, overflow)
+#endif
+#define MEGA_TRACE(o, d, any_hit) MEGA_TRACE_TO(o, d, INFINITY, any_hit)
+#ifdef LAST_RAY_EMITTERS
+    bool last_by_emitters = mega_last_ray_by_emitters(&frame);
 #endif
     for (uint j = 0; j < frame.samples_in_wave; ++j) {
         PathState s = camera_path(&frame, &camera, pixel, frame.first_sample + j);
         for (uint bounce = 0; bounce <= frame.max_bounces + 1u; ++bounce) {
-            GpuHit hit = MEGA_TRACE(s.origin, s.direction, false);
-            ++extension_rays;
+            GpuHit hit;
+#ifdef LAST_RAY_EMITTERS
+            if (last_by_emitters && bounce == frame.max_bounces + 1u) {
+                // The last ray: the emitter it meets, if nothing is in the way (see above).
+                hit = mega_nearest_emitter(&frame, &sc, s.origin, s.direction);
+                if (hit.prim == NO_HIT) break;
+                ++extension_rays;
+                if (MEGA_TRACE_TO(s.origin, s.direction, hit.t, true).prim != NO_HIT) break;
+            } else
+#endif
+            {
+                hit = MEGA_TRACE(s.origin, s.direction, false);
+                ++extension_rays;
+            }
             ShadowQuery q;
             bool alive = shade_vertex(&frame, bounce, &sc, hit, &s, &q);
             if (q.valid) {
