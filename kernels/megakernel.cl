@@ -63,8 +63,7 @@ inline void mega_count(volatile global uint* counters, uint extension_rays, uint
 #define LAST_RAY_LIGHTS_MAX 16u
 
 inline bool mega_last_ray_by_emitters(const GpuFrame* frame) {
-    return frame->light_count <= LAST_RAY_LIGHTS_MAX && frame->sky.x <= 0.0f &&
-           frame->sky.y <= 0.0f && frame->sky.z <= 0.0f;
+    return frame->light_count <= LAST_RAY_LIGHTS_MAX && frame_sky_black(frame);
 }
 
 // The nearest of the lights' triangles along the ray from o along d, or NO_HIT.
@@ -300,12 +299,8 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     // A lane walking a last ray's segment to the emitter it meets: that hit.
     bool to_emitter[LANES];
     GpuHit emitter[LANES];
+    for (int l = 0; l < LANES; ++l) to_emitter[l] = false;
     bool last_by_emitters = mega_last_ray_by_emitters(&frame);
-#endif
-#ifdef LAST_RAY_EMITTERS
-#define LANE_NOT_TO_EMITTER(l) to_emitter[l] = false;
-#else
-#define LANE_NOT_TO_EMITTER(l)
 #endif
     // A lane takes the next queued path (starting chunks while the queue is empty); with none
     // left it stays idle.
@@ -323,14 +318,12 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             bounce[l] = 1u;                                                                  \
             busy[l] = true;                                                                  \
             in_shadow[l] = false;                                                            \
-            LANE_NOT_TO_EMITTER(l)                                                           \
             lanes_set_ray(&M, l, s[l].origin, s[l].direction);                               \
         }                                                                                    \
     }
     bool idle = false;
     for (int l = 0; l < LANES; ++l) {
         busy[l] = false;
-        LANE_NOT_TO_EMITTER(l)
         LANE_NEXT_PATH(l)
         idle |= !busy[l];
     }
@@ -344,18 +337,14 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #ifdef LAST_RAY_EMITTERS
             if (to_emitter[l]) {
                 // The last ray's segment to its emitter walked: unblocked, the emitter is
-                // its closest hit.
+                // its closest hit. The path ends.
                 to_emitter[l] = false;
                 ++W.extension_rays;
                 if (M.prim[l] < 0) {
                     shade_vertex(&frame, bounce[l], &sc, emitter[l], &s[l], &sample[l]);
                 }
-                mega_path_done(&W, &frame, film, chunk[l], entry[l], &s[l]);
-                busy[l] = false;
-                LANE_NEXT_PATH(l)
-                idle |= !busy[l];
-                continue;
-            }
+                alive = false;
+            } else
 #endif
             if (in_shadow[l]) {
                 // The vertex's light sample walked: its light is added (unless blocked, perhaps
@@ -417,7 +406,6 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         }
     }
 #undef LANE_NEXT_PATH
-#undef LANE_NOT_TO_EMITTER
     mega_count(counters, W.extension_rays, W.shadow_rays, W.nonfinite);
 }
 #else

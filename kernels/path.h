@@ -5,6 +5,11 @@
 //     the light sample later in `connect`;
 //   - the megakernel (megakernel.cl) keeps it in registers and traces the light sample at once.
 
+// Whether the uniform sky is black: an escaped ray then adds nothing.
+inline bool frame_sky_black(const GpuFrame* frame) {
+    return frame->sky.x <= 0.0f && frame->sky.y <= 0.0f && frame->sky.z <= 0.0f;
+}
+
 inline float power_heuristic(float a, float b) {
     float a2 = a * a;
     float b2 = b * b;
@@ -315,8 +320,7 @@ inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* s
     // The last extension only looks for emitters, and a scene without emissive triangles, an
     // environment map or unlit materials has none for a ray to find but the sky: under a black
     // sky the path ends here, its last ray untraced (it would add exactly nothing).
-    if (bounce == frame->max_bounces && frame->sky.x <= 0.0f && frame->sky.y <= 0.0f &&
-        frame->sky.z <= 0.0f) {
+    if (bounce == frame->max_bounces && frame_sky_black(frame)) {
         s->radiance = radiance;
         s->rng = rng;
         return false;

@@ -328,6 +328,23 @@ fn samples_in_one_call_or_many_make_the_same_image() {
     }
 }
 
+/// The megakernel's options for the lanes' tests: an image of 37 x 23 (its last work item
+/// partial) at `spp` samples and `bounces` bounces.
+fn lanes_image_args<'a>(spp: &'a str, bounces: &'a str) -> Vec<&'a str> {
+    vec![
+        "--kernel",
+        "megakernel",
+        "--width",
+        "37",
+        "--height",
+        "23",
+        "--spp",
+        spp,
+        "--bounces",
+        bounces,
+    ]
+}
+
 #[test]
 fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
     // On a CPU with AVX-512 the megakernel starts sixteen paths at a time (a pixel's samples,
@@ -348,18 +365,7 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
     let panel = common::white_sphere_under_panel(dir.path(), rings, segments);
     for (scene, spp) in [(&rig, "5"), (&rig, "21"), (&panel, "5"), (&panel, "21")] {
         let name = scene.file_stem().unwrap().to_str().unwrap();
-        let args = [
-            "--kernel",
-            "megakernel",
-            "--width",
-            "37",
-            "--height",
-            "23",
-            "--spp",
-            spp,
-            "--bounces",
-            "4",
-        ];
+        let args = lanes_image_args(spp, "4");
         let (b, pb) = render_exr_env(
             scene,
             &dir.path().join(format!("one-{name}-{spp}.exr")),
@@ -476,20 +482,8 @@ fn a_last_ray_is_tested_against_the_emitters_first() {
     // triangles (enough for lanes) on a floor under a one-sided emissive panel.
     let dir = tempfile::tempdir().unwrap();
     let scene = common::white_sphere_under_panel(dir.path(), 128, 136);
-    let args = [
-        "--kernel",
-        "megakernel",
-        "--width",
-        "37",
-        "--height",
-        "23",
-        "--spp",
-        "5",
-        "--bounces",
-        "1",
-        "--sky",
-        "0,0,0",
-    ];
+    let mut args = lanes_image_args("5", "1");
+    args.extend(["--sky", "0,0,0"]);
     for lanes in ["0", "1"] {
         let render = |name: &str, options: &str| {
             render_exr_env(
