@@ -405,6 +405,18 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
 #define LANES_PREFETCH_TRIS 4
 #endif
 
+// The node each lane of M goes to next (ITEM, if a node): its two cache lines are fetched as
+// the lane takes it, a node step's leaves and pops before the step loads it, so that the
+// sixteen lanes' misses overlap that work (3-4 % of the 1 M-triangle room's time on Zen 4:
+// docs/benchmarks.md, "Twenty-second session"; -DLANES_NO_NODE_PREFETCH to measure without).
+#ifndef LANES_NO_NODE_PREFETCH
+#define LANES_PREFETCH_NODE(ITEM, M)                                                        \
+    lanes_prefetch((ulong)nodes, (ITEM), sizeof(GpuWideNode), sizeof(GpuWideNode),         \
+                   (M) & ((ITEM) >= (int16)(0)));
+#else
+#define LANES_PREFETCH_NODE(ITEM, M)
+#endif
+
 // Triangle TRI of each lane of mask M (tw: the triangles as words), its vertices relative to
 // the lane's origin in its permuted axes (KX, KY, KZ: 0, 1 or 2; PX, PY, PZ): declares aX ..
 // cZ. Lanes outside M read triangle 0.
@@ -575,6 +587,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             int16 enter = mi & (d0 < inf);
             arrived |= enter & (c0 < izero);
             L->cur = select(L->cur, c0, enter);
+            LANES_PREFETCH_NODE(c0, enter)
             L->has &= ~(mi & ~enter);
         }
         // Leaves, once enough lanes are at one (or no lane is at a node).
@@ -696,6 +709,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             L->cur = select(L->cur, item, keep);
             L->has |= keep;
             arrived |= keep & (item < izero);
+            LANES_PREFETCH_NODE(item, keep)
         }
         // A leaf waits for other lanes to reach theirs: its triangles are fetched meanwhile.
         lanes_prefetch((ulong)tris, L->cur & (int16)(LANES_FIRST_MASK), sizeof(GpuTriangle),
