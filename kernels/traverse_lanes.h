@@ -407,7 +407,7 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
 
 // The node each lane of M goes to next (ITEM, if a node): its two cache lines are fetched as
 // the lane takes it, a node step's leaves and pops before the step loads it, so that the
-// sixteen lanes' misses overlap that work (3-4 % of the 1 M-triangle room's time on Zen 4:
+// sixteen lanes' misses overlap that work (4-8 % of the 1 M-triangle scenes' time on Zen 4:
 // docs/benchmarks.md, "Twenty-second session"; -DLANES_NO_NODE_PREFETCH to measure without).
 #ifndef LANES_NO_NODE_PREFETCH
 #define LANES_PREFETCH_NODE(ITEM, M)                                                        \
