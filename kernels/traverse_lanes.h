@@ -218,8 +218,7 @@ LANES_INLINE void lanes_rows4(global const float* base, const int* off, int w, f
     X(sx) X(sy) X(sz) X(tfar) X(hv) X(hw) X(hdet)
 #define LANES_INT_FIELDS(X) X(kx) X(ky) X(kz) X(prim) X(cur) X(sp) X(live) X(has) X(fin) X(any)
 
-// The fields as vectors: Lanes lives only inside lanes_walk, where the compiler keeps it in
-// registers.
+// The fields as vectors, as lanes_walk works on them.
 typedef struct {
 #define LANES_VECTOR_F(f) float16 f;
 #define LANES_VECTOR_I(f) int16 f;
@@ -229,21 +228,29 @@ typedef struct {
 #undef LANES_VECTOR_I
 } Lanes;
 
-// What the lanes keep in memory between walks: their fields lane by lane (written by scalar
-// code as a lane takes a ray, loaded into Lanes' vectors as a walk starts), their stacks and
-// rays.
+// What the lanes keep: their fields, their stacks and rays. The fields are one block seen two
+// ways: lane by lane (`M->ox[l]`), as scalar code writes a lane's ray, and as Lanes' vectors
+// (`M->V.ox`), which lanes_walk reads and writes where they are. The compiler keeps a walk's
+// fields in memory either way (26 vectors with the walk's temporaries are more than the 32
+// registers); a private copy for the walk, loaded as it began and stored as it returned, cost
+// 3-6 % of the 1 M-triangle scenes' time in the copies (docs/benchmarks.md, "Twenty-second
+// session").
 typedef struct {
-    // Lanes' fields, lane by lane: what lanes_set_ray writes and lanes_walk loads.
+    union {
+        Lanes V;
+        struct {
 #define LANES_ARRAY_F(f) float f[LANES];
 #define LANES_ARRAY_I(f) int f[LANES];
-    LANES_FLOAT_FIELDS(LANES_ARRAY_F)
-    LANES_INT_FIELDS(LANES_ARRAY_I)
+            LANES_FLOAT_FIELDS(LANES_ARRAY_F)
+            LANES_INT_FIELDS(LANES_ARRAY_I)
 #undef LANES_ARRAY_F
 #undef LANES_ARRAY_I
+        };
+    };
     // The stacks: entry k of lane l at word 2 (k LANES + l), its entry distance, then its item
     // in lanes_pack form (as float bits).
     float stack[2 * LANES_STACK * LANES];
-    float3 o[LANES], d[LANES];           // the rays, for the scalar test's rare cases
+    float3 o[LANES], d[LANES];  // the rays, for the scalar test's rare cases
 } LaneMemory;
 
 LANES_INLINE void lanes_init(LaneMemory* M) {
@@ -480,13 +487,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
     const int16 izero = (int16)(0), lane = LANE_IDS;
     global const float* nw = (global const float*)nodes;
     global const float* tw = (global const float*)tris;
-    Lanes V;
-    Lanes* L = &V;
-#define LANES_LOAD(f) V.f = vload16(0, M->f);
-    LANES_FLOAT_FIELDS(LANES_LOAD)
-    LANES_INT_FIELDS(LANES_LOAD)
-#undef LANES_LOAD
-#define LANES_STORE(f) vstore16(V.f, 0, M->f);
+    Lanes* L = &M->V;
     while (lanes_any(L->live)) {
         int16 arrived = izero;  // lanes that reached a leaf in this round
         // Interior nodes.
@@ -723,14 +724,9 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
         if (lanes_count(L->fin) >= LANES_DONE_MIN || !lanes_any(L->live)) {
             int16 fin = L->fin;
             L->fin = izero;
-            LANES_FLOAT_FIELDS(LANES_STORE)
-            LANES_INT_FIELDS(LANES_STORE)
             return fin;
         }
     }
-    LANES_FLOAT_FIELDS(LANES_STORE)
-    LANES_INT_FIELDS(LANES_STORE)
-#undef LANES_STORE
     return (int16)(0);
 }
 
