@@ -43,6 +43,17 @@
 // selection probability, which is then the pdf. Reflection is reciprocal; refraction carries
 // radiance (wo is the side the path came from, towards the camera).
 
+// The functions shading calls at every vertex (shade_vertex in path.h, sample_light in
+// lights.h, bsdf_sample here) are inlined into their callers in the CPU megakernel with lanes
+// (MEGA_LANES), where a call's arguments and results went through memory: 5 % of the
+// 1 M-triangle scenes' time on Zen 4 (docs/benchmarks.md, "Twenty-second session"), for about
+// 2 s more of a first, uncached kernel build. Elsewhere the compiler decides.
+#ifdef MEGA_LANES
+#define SHADE_INLINE inline __attribute__((always_inline))
+#else
+#define SHADE_INLINE inline
+#endif
+
 typedef struct {
     float3 base_color;           // linear base color: diffuse albedo, metal f0, transmission tint
     float metallic;
@@ -2189,8 +2200,8 @@ inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, flo
     return lit ? m->base_color * (cos_i * INV_PI_F) : (float3)(0.0f);
 }
 
-inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 u,
-                          float3* wi_world, float* pdf, bool* specular) {
+SHADE_INLINE float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 u,
+                                float3* wi_world, float* pdf, bool* specular) {
     *specular = false;
     *wi_world = n;
     *pdf = 0.0f;
@@ -2266,8 +2277,8 @@ inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, flo
     return base_eval(m, &l, wo, wi, 1.0f, pdf);
 }
 
-inline float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 u,
-                          float3* wi_world, float* pdf, bool* specular) {
+SHADE_INLINE float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 u,
+                                float3* wi_world, float* pdf, bool* specular) {
     *pdf = 0.0f;
     *specular = false;
     *wi_world = n;

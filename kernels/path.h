@@ -88,8 +88,8 @@ inline PathState camera_path(const GpuFrame* frame, const GpuCamera* camera, uin
 // Shades the vertex that the path's ray found at `bounce` (hit.prim == NO_HIT: it escaped).
 // Adds emission to s->radiance, fills *shadow with the light sample to test (valid = false
 // when there is none) and, when the path goes on, sets the next ray. Returns whether it does.
-inline bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* sc, GpuHit hit,
-                         PathState* s, ShadowQuery* shadow) {
+SHADE_INLINE bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* sc, GpuHit hit,
+                               PathState* s, ShadowQuery* shadow) {
     shadow->valid = false;
     float3 throughput = s->throughput;
     float3 radiance = s->radiance;
