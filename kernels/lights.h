@@ -24,9 +24,11 @@ inline float spot_falloff(global const GpuLight* l, float3 to_point) {
 // Samples light `index` from point p. Punctual lights with radius r > 0 become spheres of the
 // same power (radiance I / (pi r^2)); directional lights with angular radius a > 0 become discs
 // of directions (radiance E / (pi sin^2 a)).
-SHADE_INLINE LightSample sample_light(global const GpuLight* lights, global const GpuTriangle* tris,
-                                global const GpuMaterial* materials, const SceneSurfaces* surf,
-                                const EnvMap* env, uint index, float3 p, float u1, float u2) {
+SHADE_INLINE LightSample sample_light(global const GpuLight* lights,
+                                      global const GpuTriangle* tris,
+                                      global const GpuMaterial* materials,
+                                      const SceneSurfaces* surf, const EnvMap* env, uint index,
+                                      float3 p, float u1, float u2) {
     global const GpuLight* l = &lights[index];
     float select = l->extra.y;
     uint kind = as_uint(l->position.w);
