@@ -391,7 +391,10 @@ LANES_INLINE int16 lanes_pack(int16 c, int16 k) {
 // Starts loading, for each lane of m, `bytes` bytes from element `first` (of `size` bytes) of
 // the array at `base` into the caches, one prefetch a 64 bytes and no branch but the loop over
 // the lanes (a lane reaching a leaf waits for others to reach theirs, a lane done for others
-// to finish: the loads meanwhile cost nothing).
+// to finish: the loads meanwhile cost nothing). The last byte's line is fetched too where an
+// element may straddle one more line than the loop reaches; elements of whole lines (the
+// nodes, 128 bytes, in buffers aligned to pages) need no such fetch, and after inlining the
+// test folds away.
 LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes, int16 m) {
     uint bits = lanes_kmask(m);
     if (bits == 0u) return;
@@ -402,7 +405,8 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
         bits &= bits - 1u;
         ulong a = base + (ulong)first_[l] * size;
         for (uint o = 0u; o < bytes; o += 64u) __builtin_prefetch((const void*)(a + o));
-        __builtin_prefetch((const void*)(a + bytes - 1u));
+        if (size % 64u != 0u || bytes % 64u != 0u)
+            __builtin_prefetch((const void*)(a + bytes - 1u));
     }
 }
 
@@ -412,16 +416,16 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
 #define LANES_PREFETCH_TRIS 4
 #endif
 
-// The node each lane of M goes to next (ITEM, if a node): its two cache lines are fetched as
-// the lane takes it, a node step's leaves and pops before the step loads it, so that the
+// The node of NODES each lane of M goes to next (ITEM, if a node): its two cache lines are
+// fetched as the lane takes it, a node step's leaves and pops before the step loads it, so the
 // sixteen lanes' misses overlap that work (4-8 % of the 1 M-triangle scenes' time on Zen 4:
 // docs/benchmarks.md, "Twenty-second session"; -DLANES_NO_NODE_PREFETCH to measure without).
 #ifndef LANES_NO_NODE_PREFETCH
-#define LANES_PREFETCH_NODE(ITEM, M)                                                        \
-    lanes_prefetch((ulong)nodes, (ITEM), sizeof(GpuWideNode), sizeof(GpuWideNode),         \
+#define LANES_PREFETCH_NODE(NODES, ITEM, M)                                                 \
+    lanes_prefetch((ulong)(NODES), (ITEM), sizeof(GpuWideNode), sizeof(GpuWideNode),       \
                    (M) & ((ITEM) >= (int16)(0)));
 #else
-#define LANES_PREFETCH_NODE(ITEM, M)
+#define LANES_PREFETCH_NODE(NODES, ITEM, M)
 #endif
 
 // Triangle TRI of each lane of mask M (tw: the triangles as words), its vertices relative to
@@ -588,7 +592,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             int16 enter = mi & (d0 < inf);
             arrived |= enter & (c0 < izero);
             L->cur = select(L->cur, c0, enter);
-            LANES_PREFETCH_NODE(c0, enter)
+            LANES_PREFETCH_NODE(nodes, c0, enter)
             L->has &= ~(mi & ~enter);
         }
         // Leaves, once enough lanes are at one (or no lane is at a node).
@@ -710,7 +714,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             L->cur = select(L->cur, item, keep);
             L->has |= keep;
             arrived |= keep & (item < izero);
-            LANES_PREFETCH_NODE(item, keep)
+            LANES_PREFETCH_NODE(nodes, item, keep)
         }
         // A leaf waits for other lanes to reach theirs: its triangles are fetched meanwhile.
         lanes_prefetch((ulong)tris, L->cur & (int16)(LANES_FIRST_MASK), sizeof(GpuTriangle),
