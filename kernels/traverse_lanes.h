@@ -1,5 +1,5 @@
 // Rays in vector lanes, for the CPU megakernel (MEGA_LANES: set by the host on CPU devices with
-// AVX-512, for flat scenes without alpha that are not small; src/cl/program.rs,
+// AVX-512 or AVX2, for flat scenes without alpha that are not small; src/cl/program.rs,
 // lanes_megakernel): sixteen independent rays walk the 4-wide BVH together, one ray a lane,
 // each at its own node, the lanes' nodes and triangles loaded as rows and transposed into
 // vectors (lanes_rows8; LANES_GATHERS: by gathers). One ray at a time, a walk
@@ -47,9 +47,20 @@ inline int lanes_max(int16 x) {
     return max(c.x, c.y);
 }
 
+// The even words of lo and hi (in order) in A, the odd ones in B; and the opposite, A and B
+// interleaved into lo (their lanes 0-7) and hi (8-15), which it declares.
+#define LANES_DEINTERLEAVE(lo, hi, A, B)                                                           \
+    A = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30); \
+    B = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+#define LANES_INTERLEAVE(A, B, lo, hi)                                                            \
+    float16 lo = __builtin_shufflevector(A, B, 0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, \
+                                         23);                                                     \
+    float16 hi = __builtin_shufflevector(A, B, 8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14,  \
+                                         30, 15, 31);
+
 // Gathers and scatters: base[idx] in each lane of a mask (others 0); with AVX-512 one
-// instruction, else (or with LANES_ELEMENTWISE, to check this form against the other:
-// scripts/experiments/lanes) lane by lane.
+// instruction, with AVX2 two gathers or a loop over the mask's lanes (below), else (or with
+// LANES_ELEMENTWISE, to check these forms against it: scripts/experiments/lanes) lane by lane.
 #if defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
 inline ushort lanes_kmask(int16 m) {
     return __builtin_ia32_cmpd512_mask(m, (int16)(0), 4, (ushort)0xffff);  // m != 0
@@ -65,21 +76,54 @@ inline ushort lanes_kmask(int16 m) {
             (long8)(0), (const void*)(ulong)(base), (idx).lo, (uchar)(km), 4));                   \
         float16 hi_ = as_float16(__builtin_ia32_gathersiv8di(                                     \
             (long8)(0), (const void*)(ulong)(base), (idx).hi, (uchar)((km) >> 8), 4));            \
-        A = __builtin_shufflevector(lo_, hi_, 0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, \
-                                    28, 30);                                                     \
-        B = __builtin_shufflevector(lo_, hi_, 1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, \
-                                    29, 31);                                                     \
+        LANES_DEINTERLEAVE(lo_, hi_, A, B)                                                       \
     }
 // The opposite: A and B stored side by side at word offset idx of each lane of km.
 #define LANES_SCATTER_PAIR(base, idx, km, A, B)                                                   \
     {                                                                                            \
-        float16 lo_ = __builtin_shufflevector(A, B, 0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6,  \
-                                              22, 7, 23);                                        \
-        float16 hi_ = __builtin_shufflevector(A, B, 8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, \
-                                              14, 30, 15, 31);                                   \
+        LANES_INTERLEAVE(A, B, lo_, hi_)                                                         \
         __builtin_ia32_scattersiv8di((void*)(base), (uchar)(km), (idx).lo, as_long8(lo_), 4);     \
         __builtin_ia32_scattersiv8di((void*)(base), (uchar)((km) >> 8), (idx).hi, as_long8(hi_),  \
                                      4);                                                         \
+    }
+#elif defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+// AVX2 (no AVX-512): masks by movmskps, gathers by AVX2's eight-lane gathers, scatters lane by
+// lane over the mask's bits (AVX2 has none).
+inline ushort lanes_kmask(int16 m) {
+    int16 t = m != (int16)(0);
+    return (ushort)(__builtin_ia32_movmskps256(as_float8(t.lo)) |
+                    (__builtin_ia32_movmskps256(as_float8(t.hi)) << 8));
+}
+// The mask bits km as a four-lane vector mask of 8-byte lanes (lane i: bit i).
+#define LANES_BITS4(km) as_long4(((long4)(1, 2, 4, 8) & (long4)((long)(km))) != (long4)(0))
+#define LANES_GATHER_F(base, idx, m)                                                        \
+    ((float16)(__builtin_ia32_gatherd_ps256((float8)(0.0f), (const void*)(ulong)(base), (idx).lo, \
+                                            as_float8((m).lo != (int8)(0)), 4),              \
+               __builtin_ia32_gatherd_ps256((float8)(0.0f), (const void*)(ulong)(base), (idx).hi, \
+                                            as_float8((m).hi != (int8)(0)), 4)))
+#define LANES_GATHER4Q(base, idx4, bits)                                                  \
+    as_float8(__builtin_ia32_gatherd_q256((long4)(0), (const void*)(ulong)(base), (idx4), \
+                                          LANES_BITS4(bits), 4))
+#define LANES_GATHER_PAIR(base, idx, km, A, B)                                                    \
+    {                                                                                            \
+        float16 lo_ = (float16)(LANES_GATHER4Q(base, (idx).lo.lo, (km)),                          \
+                                LANES_GATHER4Q(base, (idx).lo.hi, (km) >> 4));                    \
+        float16 hi_ = (float16)(LANES_GATHER4Q(base, (idx).hi.lo, (km) >> 8),                     \
+                                LANES_GATHER4Q(base, (idx).hi.hi, (km) >> 12));                   \
+        LANES_DEINTERLEAVE(lo_, hi_, A, B)                                                       \
+    }
+#define LANES_SCATTER_PAIR(base, idx, km, A, B)                                                   \
+    {                                                                                            \
+        LANES_INTERLEAVE(A, B, lo_, hi_)                                                         \
+        long q_[LANES];                                                                          \
+        int i_[LANES];                                                                           \
+        vstore8(as_long8(lo_), 0, q_);                                                           \
+        vstore8(as_long8(hi_), 0, q_ + 8);                                                       \
+        vstore16((idx), 0, i_);                                                                  \
+        for (uint b_ = (km); b_ != 0u; b_ &= b_ - 1u) {                                          \
+            uint l_ = (uint)__builtin_ctz(b_);                                                   \
+            *(long*)((float*)(base) + i_[l_]) = q_[l_];                                         \
+        }                                                                                        \
     }
 #else
 inline ushort lanes_kmask(int16 m) {
@@ -124,6 +168,72 @@ inline void lanes_scatter_f(float* base, int16 idx, float16 v, ushort km) {
 #define lanes_compress(v, km) __builtin_ia32_compresssi512_mask((v), (int16)(0), (km))
 #define lanes_permute(v, idx) __builtin_ia32_permvarsf512((v), (idx))
 #define lanes_permute_i(v, idx) __builtin_ia32_permvarsi512((v), (idx))
+#elif defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+// For eight mask bits, the indices of the set ones in order, four bits each (others 0).
+constant uint LANES_COMPRESS8[256] = {
+    0x00000000u, 0x00000000u, 0x00000001u, 0x00000010u, 0x00000002u, 0x00000020u, 0x00000021u, 0x00000210u,
+    0x00000003u, 0x00000030u, 0x00000031u, 0x00000310u, 0x00000032u, 0x00000320u, 0x00000321u, 0x00003210u,
+    0x00000004u, 0x00000040u, 0x00000041u, 0x00000410u, 0x00000042u, 0x00000420u, 0x00000421u, 0x00004210u,
+    0x00000043u, 0x00000430u, 0x00000431u, 0x00004310u, 0x00000432u, 0x00004320u, 0x00004321u, 0x00043210u,
+    0x00000005u, 0x00000050u, 0x00000051u, 0x00000510u, 0x00000052u, 0x00000520u, 0x00000521u, 0x00005210u,
+    0x00000053u, 0x00000530u, 0x00000531u, 0x00005310u, 0x00000532u, 0x00005320u, 0x00005321u, 0x00053210u,
+    0x00000054u, 0x00000540u, 0x00000541u, 0x00005410u, 0x00000542u, 0x00005420u, 0x00005421u, 0x00054210u,
+    0x00000543u, 0x00005430u, 0x00005431u, 0x00054310u, 0x00005432u, 0x00054320u, 0x00054321u, 0x00543210u,
+    0x00000006u, 0x00000060u, 0x00000061u, 0x00000610u, 0x00000062u, 0x00000620u, 0x00000621u, 0x00006210u,
+    0x00000063u, 0x00000630u, 0x00000631u, 0x00006310u, 0x00000632u, 0x00006320u, 0x00006321u, 0x00063210u,
+    0x00000064u, 0x00000640u, 0x00000641u, 0x00006410u, 0x00000642u, 0x00006420u, 0x00006421u, 0x00064210u,
+    0x00000643u, 0x00006430u, 0x00006431u, 0x00064310u, 0x00006432u, 0x00064320u, 0x00064321u, 0x00643210u,
+    0x00000065u, 0x00000650u, 0x00000651u, 0x00006510u, 0x00000652u, 0x00006520u, 0x00006521u, 0x00065210u,
+    0x00000653u, 0x00006530u, 0x00006531u, 0x00065310u, 0x00006532u, 0x00065320u, 0x00065321u, 0x00653210u,
+    0x00000654u, 0x00006540u, 0x00006541u, 0x00065410u, 0x00006542u, 0x00065420u, 0x00065421u, 0x00654210u,
+    0x00006543u, 0x00065430u, 0x00065431u, 0x00654310u, 0x00065432u, 0x00654320u, 0x00654321u, 0x06543210u,
+    0x00000007u, 0x00000070u, 0x00000071u, 0x00000710u, 0x00000072u, 0x00000720u, 0x00000721u, 0x00007210u,
+    0x00000073u, 0x00000730u, 0x00000731u, 0x00007310u, 0x00000732u, 0x00007320u, 0x00007321u, 0x00073210u,
+    0x00000074u, 0x00000740u, 0x00000741u, 0x00007410u, 0x00000742u, 0x00007420u, 0x00007421u, 0x00074210u,
+    0x00000743u, 0x00007430u, 0x00007431u, 0x00074310u, 0x00007432u, 0x00074320u, 0x00074321u, 0x00743210u,
+    0x00000075u, 0x00000750u, 0x00000751u, 0x00007510u, 0x00000752u, 0x00007520u, 0x00007521u, 0x00075210u,
+    0x00000753u, 0x00007530u, 0x00007531u, 0x00075310u, 0x00007532u, 0x00075320u, 0x00075321u, 0x00753210u,
+    0x00000754u, 0x00007540u, 0x00007541u, 0x00075410u, 0x00007542u, 0x00075420u, 0x00075421u, 0x00754210u,
+    0x00007543u, 0x00075430u, 0x00075431u, 0x00754310u, 0x00075432u, 0x00754320u, 0x00754321u, 0x07543210u,
+    0x00000076u, 0x00000760u, 0x00000761u, 0x00007610u, 0x00000762u, 0x00007620u, 0x00007621u, 0x00076210u,
+    0x00000763u, 0x00007630u, 0x00007631u, 0x00076310u, 0x00007632u, 0x00076320u, 0x00076321u, 0x00763210u,
+    0x00000764u, 0x00007640u, 0x00007641u, 0x00076410u, 0x00007642u, 0x00076420u, 0x00076421u, 0x00764210u,
+    0x00007643u, 0x00076430u, 0x00076431u, 0x00764310u, 0x00076432u, 0x00764320u, 0x00764321u, 0x07643210u,
+    0x00000765u, 0x00007650u, 0x00007651u, 0x00076510u, 0x00007652u, 0x00076520u, 0x00076521u, 0x00765210u,
+    0x00007653u, 0x00076530u, 0x00076531u, 0x00765310u, 0x00076532u, 0x00765320u, 0x00765321u, 0x07653210u,
+    0x00007654u, 0x00076540u, 0x00076541u, 0x00765410u, 0x00076542u, 0x00765420u, 0x00765421u, 0x07654210u,
+    0x00076543u, 0x00765430u, 0x00765431u, 0x07654310u, 0x00765432u, 0x07654320u, 0x07654321u, 0x76543210u,
+};
+inline int8 lanes_compress8_index(uint km8) {
+    return ((int8)((int)LANES_COMPRESS8[km8 & 255u]) >> (int8)(0, 4, 8, 12, 16, 20, 24, 28)) &
+           (int8)(7);
+}
+// Each half compressed by a table-driven permute, the high half's lanes then moved up past the
+// low half's n.
+inline int16 lanes_compress(int16 v, ushort km) {
+    uint klo = km & 255u, khi = (uint)km >> 8;
+    int n = popcount(klo), m = popcount(khi);
+    int8 lo = __builtin_ia32_permvarsi256(v.lo, lanes_compress8_index(klo));
+    int8 hi = __builtin_ia32_permvarsi256(v.hi, lanes_compress8_index(khi));
+    int8 i8 = (int8)(0, 1, 2, 3, 4, 5, 6, 7);
+    int8 jlo = i8 - (int8)(n), jhi = i8 + (int8)(8 - n);
+    int8 hlo = __builtin_ia32_permvarsi256(hi, jlo & (int8)(7));
+    int8 hhi = __builtin_ia32_permvarsi256(hi, jhi & (int8)(7));
+    int8 rlo = select(select((int8)(0), hlo, jlo < (int8)(m)), lo, i8 < (int8)(n));
+    int8 rhi = select((int8)(0), hhi, jhi < (int8)(m));
+    return (int16)(rlo, rhi);
+}
+inline float16 lanes_permute(float16 v, int16 idx) {
+    int8 a = idx.lo & (int8)(7), b = idx.hi & (int8)(7);
+    float8 lo = select(__builtin_ia32_permvarsf256(v.lo, a), __builtin_ia32_permvarsf256(v.hi, a),
+                       (idx.lo & (int8)(8)) != (int8)(0));
+    float8 hi = select(__builtin_ia32_permvarsf256(v.lo, b), __builtin_ia32_permvarsf256(v.hi, b),
+                       (idx.hi & (int8)(8)) != (int8)(0));
+    return (float16)(lo, hi);
+}
+inline int16 lanes_permute_i(int16 v, int16 idx) {
+    return as_int16(lanes_permute(as_float16(v), idx));
+}
 #else
 inline int16 lanes_compress(int16 v, ushort km) {
     int in[LANES], out[LANES];

@@ -347,7 +347,7 @@ fn lanes_image_args<'a>(spp: &'a str, bounces: &'a str) -> Vec<&'a str> {
 
 #[test]
 fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
-    // On a CPU with AVX-512 the megakernel starts sixteen paths at a time (a pixel's samples,
+    // On a CPU with AVX-512 or AVX2 the megakernel starts sixteen paths at a time (a pixel's samples,
     // or a few pixels' below sixteen), their camera rays and first light samples walked as
     // packets (kernels/traverse_packet.h), and walks the later extension rays sixteen at a
     // time in vector lanes (kernels/traverse_lanes.h), a work item taking 256 pixels: the same
@@ -382,8 +382,14 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
                 &[("PENUMBRA_LANES_LOAD", load)],
             );
             #[cfg(target_arch = "x86_64")]
-            if common::test_device() == "cpu" && std::arch::is_x86_feature_detected!("avx512f") {
-                assert_eq!(a["lanes"], true, "a CPU with AVX-512 did not walk in lanes");
+            if common::test_device() == "cpu"
+                && (std::arch::is_x86_feature_detected!("avx512f")
+                    || std::arch::is_x86_feature_detected!("avx2"))
+            {
+                assert_eq!(
+                    a["lanes"], true,
+                    "a CPU with AVX-512 or AVX2 did not walk in lanes"
+                );
                 assert_eq!(
                     a["lanes_load"], load,
                     "PENUMBRA_LANES_LOAD={load} not taken"

@@ -101,7 +101,7 @@ pub struct KernelFeatures {
     pub small_scene: u32,
     /// The megakernel walks sixteen paths' rays together in vector lanes (`MEGA_LANES`,
     /// kernels/traverse_lanes.h): a flat scene that is not small, without alpha, on a CPU
-    /// device with AVX-512 (see [`lanes_megakernel`]).
+    /// device with AVX-512 or AVX2 (see [`lanes_megakernel`]).
     pub lanes: bool,
 }
 
@@ -115,8 +115,11 @@ pub const LANES_MIN_TRIANGLES: usize = 32_768;
 /// Whether the megakernel should walk a flat scene's rays in lanes (`KernelFeatures::lanes`) on
 /// a CPU device: no alpha, not a small scene, [`LANES_MIN_TRIANGLES`] or more and fewer than
 /// 2^27 triangles in leaves of at most 15 (a lane's stack entry packs both in a word), the host
-/// CPU (PoCL's device) has AVX-512, whose gathers and scatters the walk uses, and
-/// `PENUMBRA_LANES` is not `0` (docs/benchmarks.md, "Fourteenth session").
+/// CPU (PoCL's device) has AVX-512 (whose gathers, scatters and compresses the walk uses) or
+/// AVX2 (gathers, table-driven compresses, scatters lane by lane: 10-15 % faster than one ray at
+/// a time on AMD's Zen 3, docs/benchmarks.md, "Twenty-fourth session"), and `PENUMBRA_LANES`
+/// is not `0` (docs/benchmarks.md, "Fourteenth session"). `PENUMBRA_LANES=1` walks in lanes on
+/// any CPU device (lane by lane where the CPU has neither: for measurements).
 pub fn lanes_megakernel(
     cpu: bool,
     alpha: bool,
@@ -132,12 +135,15 @@ pub fn lanes_megakernel(
     {
         return false;
     }
-    if std::env::var("PENUMBRA_LANES").is_ok_and(|v| v.trim() == "0") {
-        return false;
+    match std::env::var("PENUMBRA_LANES").as_deref().map(str::trim) {
+        Ok("0") => return false,
+        Ok("1") => return true,
+        _ => {}
     }
     #[cfg(target_arch = "x86_64")]
     {
         std::arch::is_x86_feature_detected!("avx512f")
+            || std::arch::is_x86_feature_detected!("avx2")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {

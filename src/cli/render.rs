@@ -173,7 +173,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "focus_distance": renderer.settings().focus_distance,
         "kernel_ms": stats.stage_ms,
     });
-    // Whether the megakernel walked its rays in vector lanes (CPU devices with AVX-512).
+    // Whether the megakernel walked its rays in vector lanes (CPU devices with AVX-512 or AVX2).
     summary["lanes"] = serde_json::json!(renderer.walks_in_lanes());
     // How the lanes loaded their nodes and triangles: "rows" or "gathers" (null without lanes).
     let load = if crate::cl::lanes_load_rows() {
