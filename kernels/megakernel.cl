@@ -224,7 +224,7 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
         s[e] = camera_path(frame, camera, c->pixel[e], frame->first_sample + sample0[e]);
         packet_set_ray(&P, (int)e, s[e].origin, s[e].direction, INFINITY);
     }
-    int16 lanes = LANE_IDS < (int16)((int)n);
+    lanes_i lanes = LANE_IDS < (lanes_i)((int)n);
     packet_walk(&P, lanes, false, nodes, sc->tris, &sc->surf, overflow);
     ShadowQuery q[LANES];
     bool alive[LANES];
@@ -235,7 +235,7 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
         if (q[e].valid) packet_set_ray(&P, (int)e, q[e].origin, q[e].direction, q[e].tmax);
     }
     for (uint e = n; e < (uint)LANES; ++e) shadow[e] = 0;
-    int16 shadows = vload16(0, shadow);
+    lanes_i shadows = lanes_vload(0, shadow);
     if (lanes_any(shadows)) {
         W->shadow_rays += (uint)lanes_count(shadows);
         packet_walk(&P, shadows, true, nodes, sc->tris, &sc->surf, overflow);
@@ -328,7 +328,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         idle |= !busy[l];
     }
     for (;;) {
-        int16 done = lanes_walk(&M, nodes, tris, &sc.surf, overflow);
+        lanes_i done = lanes_walk(&M, nodes, tris, &sc.surf, overflow);
         if (!lanes_any(done)) break;
         // The lanes done, in order (lowest first).
         for (uint bits = lanes_kmask(done); bits != 0u; bits &= bits - 1u) {

@@ -17,64 +17,114 @@
 // lane, the nearest entered and the others pushed farthest first.
 
 #ifdef MEGA_LANES
+// The lanes: sixteen, or eight where the CPU has AVX2 but not AVX-512 (-DLANES=16 or 8 chooses):
+// sixteen lanes there are two 256-bit halves to every vector operation and half as many vectors
+// in its sixteen registers, and eight took 7-8 % less time on AMD's Zen 3 (docs/benchmarks.md,
+// "Twenty-fourth session"). Below, "sixteen" is LANES.
+#ifndef LANES
+#if defined(__AVX2__) && !defined(__AVX512F__) && defined(__x86_64__)
+#define LANES 8
+#else
 #define LANES 16
+#endif
+#endif
 #define LANES_STACK (WIDE_STACK_SIZE + 1)
-#define LANE_IDS ((int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))
 #define LANES_INLINE inline __attribute__((always_inline))
+#if LANES == 16
+typedef float16 lanes_f;
+typedef int16 lanes_i;
+#define as_lanes_f as_float16
+#define as_lanes_i as_int16
+#define lanes_vload vload16
+#define lanes_vstore vstore16
+#define LANE_IDS ((lanes_i)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15))
+// A vector's words in pairs, as 8-byte words (typed: not through an int pointer, which
+// the compiler may take for another object).
+#define lanes_vstore_pairs(v, p) vstore8(as_long8(v), 0, (p))
+#elif LANES == 8
+typedef float8 lanes_f;
+typedef int8 lanes_i;
+#define as_lanes_f as_float8
+#define as_lanes_i as_int8
+#define lanes_vload vload8
+#define lanes_vstore vstore8
+#define LANE_IDS ((lanes_i)(0, 1, 2, 3, 4, 5, 6, 7))
+#define lanes_vstore_pairs(v, p) vstore4(as_long4(v), 0, (p))
+#else
+#error "LANES is 8 or 16"
+#endif
+
+// x's lanes folded to eight by F (sixteen lanes: F of the halves).
+#if LANES == 16
+#define LANES_FOLD8(x, F) F((x).lo, (x).hi)
+#else
+#define LANES_FOLD8(x, F) (x)
+#endif
+#define LANES_OR(a, b) ((a) | (b))
+#define LANES_ADD(a, b) ((a) + (b))
 
 // Whether any lane of a mask (all bits of a lane set or clear) is set.
-inline bool lanes_any(int16 m) {
-    int8 a = m.lo | m.hi;
+inline bool lanes_any(lanes_i m) {
+    int8 a = LANES_FOLD8(m, LANES_OR);
     int4 b = a.lo | a.hi;
     int2 c = b.lo | b.hi;
     return (c.x | c.y) != 0;
 }
 
 // The number of set lanes of a mask.
-inline int lanes_count(int16 m) {
-    int16 b = m & (int16)(1);
-    int8 a = b.lo + b.hi;
+inline int lanes_count(lanes_i m) {
+    lanes_i b = m & (lanes_i)(1);
+    int8 a = LANES_FOLD8(b, LANES_ADD);
     int4 c = a.lo + a.hi;
     int2 d = c.lo + c.hi;
     return d.x + d.y;
 }
 
 // The greatest lane.
-inline int lanes_max(int16 x) {
-    int8 a = max(x.lo, x.hi);
+inline int lanes_max(lanes_i x) {
+    int8 a = LANES_FOLD8(x, max);
     int4 b = max(a.lo, a.hi);
     int2 c = max(b.lo, b.hi);
     return max(c.x, c.y);
 }
 
+#if LANES == 16
 // The even words of lo and hi (in order) in A, the odd ones in B; and the opposite, A and B
 // interleaved into lo (their lanes 0-7) and hi (8-15), which it declares.
 #define LANES_DEINTERLEAVE(lo, hi, A, B)                                                           \
     A = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30); \
     B = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
 #define LANES_INTERLEAVE(A, B, lo, hi)                                                            \
-    float16 lo = __builtin_shufflevector(A, B, 0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, \
+    lanes_f lo = __builtin_shufflevector(A, B, 0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, \
                                          23);                                                     \
-    float16 hi = __builtin_shufflevector(A, B, 8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14,  \
+    lanes_f hi = __builtin_shufflevector(A, B, 8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14,  \
                                          30, 15, 31);
+#else
+#define LANES_DEINTERLEAVE(lo, hi, A, B)                              \
+    A = __builtin_shufflevector(lo, hi, 0, 2, 4, 6, 8, 10, 12, 14); \
+    B = __builtin_shufflevector(lo, hi, 1, 3, 5, 7, 9, 11, 13, 15);
+#define LANES_INTERLEAVE(A, B, lo, hi)                                       \
+    lanes_f lo = __builtin_shufflevector(A, B, 0, 8, 1, 9, 2, 10, 3, 11); \
+    lanes_f hi = __builtin_shufflevector(A, B, 4, 12, 5, 13, 6, 14, 7, 15);
+#endif
 
 // Gathers and scatters: base[idx] in each lane of a mask (others 0); with AVX-512 one
 // instruction, with AVX2 two gathers or a loop over the mask's lanes (below), else (or with
 // LANES_ELEMENTWISE, to check these forms against it: scripts/experiments/lanes) lane by lane.
-#if defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
-inline ushort lanes_kmask(int16 m) {
-    return __builtin_ia32_cmpd512_mask(m, (int16)(0), 4, (ushort)0xffff);  // m != 0
+#if LANES == 16 && defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+inline ushort lanes_kmask(lanes_i m) {
+    return __builtin_ia32_cmpd512_mask(m, (lanes_i)(0), 4, (ushort)0xffff);  // m != 0
 }
 #define LANES_GATHER_F(base, idx, m)                                                          \
-    as_float16(__builtin_ia32_gathersiv16sf((float16)(0.0f), (const void*)(ulong)(base), (idx), \
+    as_lanes_f(__builtin_ia32_gathersiv16sf((lanes_f)(0.0f), (const void*)(ulong)(base), (idx), \
                                             lanes_kmask(m), 4))
 // Two neighbouring words at word offset idx of each lane of mask km (lanes_kmask): the first
 // in A, the second in B (8-byte gathers, eight lanes each: half the elements of two gathers).
 #define LANES_GATHER_PAIR(base, idx, km, A, B)                                                    \
     {                                                                                            \
-        float16 lo_ = as_float16(__builtin_ia32_gathersiv8di(                                     \
+        lanes_f lo_ = as_lanes_f(__builtin_ia32_gathersiv8di(                                     \
             (long8)(0), (const void*)(ulong)(base), (idx).lo, (uchar)(km), 4));                   \
-        float16 hi_ = as_float16(__builtin_ia32_gathersiv8di(                                     \
+        lanes_f hi_ = as_lanes_f(__builtin_ia32_gathersiv8di(                                     \
             (long8)(0), (const void*)(ulong)(base), (idx).hi, (uchar)((km) >> 8), 4));            \
         LANES_DEINTERLEAVE(lo_, hi_, A, B)                                                       \
     }
@@ -87,64 +137,77 @@ inline ushort lanes_kmask(int16 m) {
                                      4);                                                         \
     }
 #elif defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
-// AVX2 (no AVX-512): masks by movmskps, gathers by AVX2's eight-lane gathers, scatters lane by
-// lane over the mask's bits (AVX2 has none).
-inline ushort lanes_kmask(int16 m) {
-    int16 t = m != (int16)(0);
+// AVX2 (no AVX-512): masks by movmskps, gathers by AVX2's eight-lane gathers (pairs of words by
+// its four-lane 8-byte ones), scatters lane by lane over the mask's bits (AVX2 has none).
+inline ushort lanes_kmask(lanes_i m) {
+    lanes_i t = m != (lanes_i)(0);
+#if LANES == 16
     return (ushort)(__builtin_ia32_movmskps256(as_float8(t.lo)) |
                     (__builtin_ia32_movmskps256(as_float8(t.hi)) << 8));
+#else
+    return (ushort)__builtin_ia32_movmskps256(as_float8(t));
+#endif
 }
-// The mask bits km as a four-lane vector mask of 8-byte lanes (lane i: bit i).
-#define LANES_BITS4(km) as_long4(((long4)(1, 2, 4, 8) & (long4)((long)(km))) != (long4)(0))
-#define LANES_GATHER_F(base, idx, m)                                                        \
-    ((float16)(__builtin_ia32_gatherd_ps256((float8)(0.0f), (const void*)(ulong)(base), (idx).lo, \
-                                            as_float8((m).lo != (int8)(0)), 4),              \
-               __builtin_ia32_gatherd_ps256((float8)(0.0f), (const void*)(ulong)(base), (idx).hi, \
-                                            as_float8((m).hi != (int8)(0)), 4)))
-#define LANES_GATHER4Q(base, idx4, bits)                                                  \
-    as_float8(__builtin_ia32_gatherd_q256((long4)(0), (const void*)(ulong)(base), (idx4), \
-                                          LANES_BITS4(bits), 4))
-#define LANES_GATHER_PAIR(base, idx, km, A, B)                                                    \
-    {                                                                                            \
-        float16 lo_ = (float16)(LANES_GATHER4Q(base, (idx).lo.lo, (km)),                          \
-                                LANES_GATHER4Q(base, (idx).lo.hi, (km) >> 4));                    \
-        float16 hi_ = (float16)(LANES_GATHER4Q(base, (idx).hi.lo, (km) >> 8),                     \
-                                LANES_GATHER4Q(base, (idx).hi.hi, (km) >> 12));                   \
-        LANES_DEINTERLEAVE(lo_, hi_, A, B)                                                       \
+#define LANES_GATHER8(base, idx8, m8)                                                       \
+    __builtin_ia32_gatherd_ps256((float8)(0.0f), (const void*)(ulong)(base), (idx8),        \
+                                 as_float8((m8) != (int8)(0)), 4)
+// Four lanes' 8-byte words at word offsets idx4, for the lanes of the low four bits.
+#define LANES_GATHER4Q(base, idx4, bits)                                                    \
+    as_float8(__builtin_ia32_gatherd_q256(                                                  \
+        (long4)(0), (const void*)(ulong)(base), (idx4),                                     \
+        as_long4(((long4)(1, 2, 4, 8) & (long4)((long)(bits))) != (long4)(0)), 4))
+#if LANES == 16
+#define LANES_GATHER_F(base, idx, m) \
+    ((lanes_f)(LANES_GATHER8(base, (idx).lo, (m).lo), LANES_GATHER8(base, (idx).hi, (m).hi)))
+#define LANES_GATHER_HALVES(base, idx, km, lo_, hi_)                                  \
+    lanes_f lo_ = (lanes_f)(LANES_GATHER4Q(base, (idx).lo.lo, (km)),                  \
+                            LANES_GATHER4Q(base, (idx).lo.hi, (km) >> 4));            \
+    lanes_f hi_ = (lanes_f)(LANES_GATHER4Q(base, (idx).hi.lo, (km) >> 8),             \
+                            LANES_GATHER4Q(base, (idx).hi.hi, (km) >> 12));
+#else
+#define LANES_GATHER_F(base, idx, m) LANES_GATHER8(base, idx, m)
+#define LANES_GATHER_HALVES(base, idx, km, lo_, hi_)      \
+    lanes_f lo_ = LANES_GATHER4Q(base, (idx).lo, (km)); \
+    lanes_f hi_ = LANES_GATHER4Q(base, (idx).hi, (km) >> 4);
+#endif
+#define LANES_GATHER_PAIR(base, idx, km, A, B)       \
+    {                                               \
+        LANES_GATHER_HALVES(base, idx, km, lo_, hi_) \
+        LANES_DEINTERLEAVE(lo_, hi_, A, B)           \
     }
-#define LANES_SCATTER_PAIR(base, idx, km, A, B)                                                   \
-    {                                                                                            \
-        LANES_INTERLEAVE(A, B, lo_, hi_)                                                         \
-        long q_[LANES];                                                                          \
-        int i_[LANES];                                                                           \
-        vstore8(as_long8(lo_), 0, q_);                                                           \
-        vstore8(as_long8(hi_), 0, q_ + 8);                                                       \
-        vstore16((idx), 0, i_);                                                                  \
-        for (uint b_ = (km); b_ != 0u; b_ &= b_ - 1u) {                                          \
-            uint l_ = (uint)__builtin_ctz(b_);                                                   \
-            *(long*)((float*)(base) + i_[l_]) = q_[l_];                                         \
-        }                                                                                        \
+#define LANES_SCATTER_PAIR(base, idx, km, A, B)                          \
+    {                                                                   \
+        LANES_INTERLEAVE(A, B, lo_, hi_)                                \
+        long q_[LANES];                                                 \
+        int i_[LANES];                                                  \
+        lanes_vstore_pairs(lo_, q_);                                    \
+        lanes_vstore_pairs(hi_, q_ + LANES / 2);                        \
+        lanes_vstore((idx), 0, i_);                                     \
+        for (uint b_ = (km); b_ != 0u; b_ &= b_ - 1u) {                 \
+            uint l_ = (uint)__builtin_ctz(b_);                          \
+            *(long*)((float*)(base) + i_[l_]) = q_[l_];                \
+        }                                                               \
     }
 #else
-inline ushort lanes_kmask(int16 m) {
+inline ushort lanes_kmask(lanes_i m) {
     int k[LANES];
-    vstore16(m, 0, k);
+    lanes_vstore(m, 0, k);
     ushort bits = 0;
     for (int l = 0; l < LANES; ++l) bits |= k[l] ? (ushort)(1 << l) : (ushort)0;
     return bits;
 }
-inline float16 lanes_gather_f(const float* base, int16 idx, ushort km) {
+inline lanes_f lanes_gather_f(const float* base, lanes_i idx, ushort km) {
     int i[LANES];
     float out[LANES];
-    vstore16(idx, 0, i);
+    lanes_vstore(idx, 0, i);
     for (int l = 0; l < LANES; ++l) out[l] = (km >> l) & 1 ? base[i[l]] : 0.0f;
-    return vload16(0, out);
+    return lanes_vload(0, out);
 }
-inline void lanes_scatter_f(float* base, int16 idx, float16 v, ushort km) {
+inline void lanes_scatter_f(float* base, lanes_i idx, lanes_f v, ushort km) {
     int i[LANES];
     float x[LANES];
-    vstore16(idx, 0, i);
-    vstore16(v, 0, x);
+    lanes_vstore(idx, 0, i);
+    lanes_vstore(v, 0, x);
     for (int l = 0; l < LANES; ++l)
         if ((km >> l) & 1) base[i[l]] = x[l];
 }
@@ -162,13 +225,7 @@ inline void lanes_scatter_f(float* base, int16 idx, float16 v, ushort km) {
     }
 #endif
 
-// The lanes of mask km of v, in order, in the first lanes (the others 0); and the lanes of v
-// named by idx.
-#if defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
-#define lanes_compress(v, km) __builtin_ia32_compresssi512_mask((v), (int16)(0), (km))
-#define lanes_permute(v, idx) __builtin_ia32_permvarsf512((v), (idx))
-#define lanes_permute_i(v, idx) __builtin_ia32_permvarsi512((v), (idx))
-#elif defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+#if defined(__AVX2__) && !defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
 // For eight mask bits, the indices of the set ones in order, four bits each (others 0).
 constant uint LANES_COMPRESS8[256] = {
     0x00000000u, 0x00000000u, 0x00000001u, 0x00000010u, 0x00000002u, 0x00000020u, 0x00000021u, 0x00000210u,
@@ -208,9 +265,18 @@ inline int8 lanes_compress8_index(uint km8) {
     return ((int8)((int)LANES_COMPRESS8[km8 & 255u]) >> (int8)(0, 4, 8, 12, 16, 20, 24, 28)) &
            (int8)(7);
 }
+#endif
+
+// The lanes of mask km of v, in order, in the first lanes (the others 0); and the lanes of v
+// named by idx.
+#if LANES == 16 && defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+#define lanes_compress(v, km) __builtin_ia32_compresssi512_mask((v), (lanes_i)(0), (km))
+#define lanes_permute(v, idx) __builtin_ia32_permvarsf512((v), (idx))
+#define lanes_permute_i(v, idx) __builtin_ia32_permvarsi512((v), (idx))
+#elif LANES == 16 && defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
 // Each half compressed by a table-driven permute, the high half's lanes then moved up past the
 // low half's n.
-inline int16 lanes_compress(int16 v, ushort km) {
+inline lanes_i lanes_compress(lanes_i v, ushort km) {
     uint klo = km & 255u, khi = (uint)km >> 8;
     int n = popcount(klo), m = popcount(khi);
     int8 lo = __builtin_ia32_permvarsi256(v.lo, lanes_compress8_index(klo));
@@ -221,40 +287,47 @@ inline int16 lanes_compress(int16 v, ushort km) {
     int8 hhi = __builtin_ia32_permvarsi256(hi, jhi & (int8)(7));
     int8 rlo = select(select((int8)(0), hlo, jlo < (int8)(m)), lo, i8 < (int8)(n));
     int8 rhi = select((int8)(0), hhi, jhi < (int8)(m));
-    return (int16)(rlo, rhi);
+    return (lanes_i)(rlo, rhi);
 }
-inline float16 lanes_permute(float16 v, int16 idx) {
+inline lanes_f lanes_permute(lanes_f v, lanes_i idx) {
     int8 a = idx.lo & (int8)(7), b = idx.hi & (int8)(7);
     float8 lo = select(__builtin_ia32_permvarsf256(v.lo, a), __builtin_ia32_permvarsf256(v.hi, a),
                        (idx.lo & (int8)(8)) != (int8)(0));
     float8 hi = select(__builtin_ia32_permvarsf256(v.lo, b), __builtin_ia32_permvarsf256(v.hi, b),
                        (idx.hi & (int8)(8)) != (int8)(0));
-    return (float16)(lo, hi);
+    return (lanes_f)(lo, hi);
 }
-inline int16 lanes_permute_i(int16 v, int16 idx) {
-    return as_int16(lanes_permute(as_float16(v), idx));
+inline lanes_i lanes_permute_i(lanes_i v, lanes_i idx) {
+    return as_lanes_i(lanes_permute(as_lanes_f(v), idx));
 }
+#elif LANES == 8 && defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+inline lanes_i lanes_compress(lanes_i v, ushort km) {
+    return select((int8)(0), __builtin_ia32_permvarsi256(v, lanes_compress8_index(km)),
+                  LANE_IDS < (int8)(popcount((uint)km & 255u)));
+}
+#define lanes_permute(v, idx) __builtin_ia32_permvarsf256((v), (idx))
+#define lanes_permute_i(v, idx) __builtin_ia32_permvarsi256((v), (idx))
 #else
-inline int16 lanes_compress(int16 v, ushort km) {
+inline lanes_i lanes_compress(lanes_i v, ushort km) {
     int in[LANES], out[LANES];
-    vstore16(v, 0, in);
+    lanes_vstore(v, 0, in);
     int n = 0;
     for (int l = 0; l < LANES; ++l) {
         out[l] = 0;
         if ((km >> l) & 1) out[n++] = in[l];
     }
-    return vload16(0, out);
+    return lanes_vload(0, out);
 }
-inline float16 lanes_permute(float16 v, int16 idx) {
+inline lanes_f lanes_permute(lanes_f v, lanes_i idx) {
     float in[LANES], out[LANES];
     int i[LANES];
-    vstore16(v, 0, in);
-    vstore16(idx, 0, i);
+    lanes_vstore(v, 0, in);
+    lanes_vstore(idx, 0, i);
     for (int l = 0; l < LANES; ++l) out[l] = in[i[l] & (LANES - 1)];
-    return vload16(0, out);
+    return lanes_vload(0, out);
 }
-inline int16 lanes_permute_i(int16 v, int16 idx) {
-    return as_int16(lanes_permute(as_float16(v), idx));
+inline lanes_i lanes_permute_i(lanes_i v, lanes_i idx) {
+    return as_lanes_i(lanes_permute(as_lanes_f(v), idx));
 }
 #endif
 
@@ -264,21 +337,42 @@ inline int16 lanes_permute_i(int16 v, int16 idx) {
 // (docs/benchmarks.md, "Seventeenth session"). lanes_rows8 loads eight words of each lane's
 // row, two lanes a vector, and transposes them by shuffles; lanes_rows4, four. With
 // LANES_GATHERS the walk gathers instead (the two read the same words: same hits).
+#if LANES == 16
 #define LANES_UNPACKLO 0, 16, 1, 17, 4, 20, 5, 21, 8, 24, 9, 25, 12, 28, 13, 29
 #define LANES_UNPACKHI 2, 18, 3, 19, 6, 22, 7, 23, 10, 26, 11, 27, 14, 30, 15, 31
 #define LANES_PAIRSLO 0, 1, 16, 17, 4, 5, 20, 21, 8, 9, 24, 25, 12, 13, 28, 29
 #define LANES_PAIRSHI 2, 3, 18, 19, 6, 7, 22, 23, 10, 11, 26, 27, 14, 15, 30, 31
 #define LANES_QUADSLO 0, 1, 2, 3, 16, 17, 18, 19, 8, 9, 10, 11, 24, 25, 26, 27
 #define LANES_QUADSHI 4, 5, 6, 7, 20, 21, 22, 23, 12, 13, 14, 15, 28, 29, 30, 31
+// rows8's vector i: lane i's eight words in the low half, lane i + 8's in the high one; rows4's:
+// the four words of lanes i, i + 4, i + 8 and i + 12.
+#define LANES_ROW8(base, off, w, i) \
+    (lanes_f)(vload8(0, base + off[i] + w), vload8(0, base + off[i + 8] + w))
+#define LANES_ROW4(base, off, w, i)                                                    \
+    (lanes_f)(vload4(0, base + off[i] + w), vload4(0, base + off[i + 4] + w),        \
+              vload4(0, base + off[i + 8] + w), vload4(0, base + off[i + 12] + w))
+#else
+// Eight lanes: the same in 128-bit halves (a 4×4 transpose in each), rows8's vector i lane i's
+// words, rows4's the words of lanes i and i + 4.
+#define LANES_UNPACKLO 0, 8, 1, 9, 4, 12, 5, 13
+#define LANES_UNPACKHI 2, 10, 3, 11, 6, 14, 7, 15
+#define LANES_PAIRSLO 0, 1, 8, 9, 4, 5, 12, 13
+#define LANES_PAIRSHI 2, 3, 10, 11, 6, 7, 14, 15
+#define LANES_QUADSLO 0, 1, 2, 3, 8, 9, 10, 11
+#define LANES_QUADSHI 4, 5, 6, 7, 12, 13, 14, 15
+#define LANES_ROW8(base, off, w, i) vload8(0, base + off[i] + w)
+#define LANES_ROW4(base, off, w, i) \
+    (lanes_f)(vload4(0, base + off[i] + w), vload4(0, base + off[i + 4] + w))
+#endif
 #define LANES_SHUFFLE(A, B, P) __builtin_shufflevector(A, B, P)
 
-// Four 4×4 transposes at once, one in each 128-bit quarter: word j of m[i]'s quarter q to word
-// i of c[j]'s quarter q.
-LANES_INLINE void lanes_transpose4(const float16* m, float16* c) {
-    float16 t0 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKLO);
-    float16 t1 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKHI);
-    float16 t2 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKLO);
-    float16 t3 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKHI);
+// 4×4 transposes, one in each 128-bit quarter: word j of m[i]'s quarter q to word i of c[j]'s
+// quarter q.
+LANES_INLINE void lanes_transpose4(const lanes_f* m, lanes_f* c) {
+    lanes_f t0 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKLO);
+    lanes_f t1 = LANES_SHUFFLE(m[0], m[1], LANES_UNPACKHI);
+    lanes_f t2 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKLO);
+    lanes_f t3 = LANES_SHUFFLE(m[2], m[3], LANES_UNPACKHI);
     c[0] = LANES_SHUFFLE(t0, t2, LANES_PAIRSLO);
     c[1] = LANES_SHUFFLE(t0, t2, LANES_PAIRSHI);
     c[2] = LANES_SHUFFLE(t1, t3, LANES_PAIRSLO);
@@ -287,13 +381,12 @@ LANES_INLINE void lanes_transpose4(const float16* m, float16* c) {
 
 // Words [w, w + 8) of the row at word offset off[l] of base, for each lane l, into c[0..8):
 // word w + i of lane l in lane l of c[i].
-LANES_INLINE void lanes_rows8(global const float* base, const int* off, int w, float16* c) {
-    float16 m[8], s[8];
+LANES_INLINE void lanes_rows8(global const float* base, const int* off, int w, lanes_f* c) {
+    lanes_f m[8], s[8];
 #pragma unroll
-    for (int i = 0; i < 8; ++i)  // lane i in the low half, lane i + 8 in the high one
-        m[i] = (float16)(vload8(0, base + off[i] + w), vload8(0, base + off[i + 8] + w));
-    // s[j]: word j of lanes 0-3 and 8-11 in quarters 0 and 2, word j + 4 in quarters 1 and 3;
-    // s[j + 4] the same for lanes 4-7 and 12-15. Then the quarters of each word together.
+    for (int i = 0; i < 8; ++i) m[i] = LANES_ROW8(base, off, w, i);
+    // s[j]: word j of lanes 0-3 (and 8-11) in quarter 0 (and 2), word j + 4 in quarter 1 (and
+    // 3); s[j + 4] the same for lanes 4-7 (and 12-15). Then the quarters of each word together.
     lanes_transpose4(m, s);
     lanes_transpose4(m + 4, s + 4);
 #pragma unroll
@@ -304,12 +397,10 @@ LANES_INLINE void lanes_rows8(global const float* base, const int* off, int w, f
 }
 
 // The same for words [w, w + 4), into c[0..4).
-LANES_INLINE void lanes_rows4(global const float* base, const int* off, int w, float16* c) {
-    float16 m[4];
+LANES_INLINE void lanes_rows4(global const float* base, const int* off, int w, lanes_f* c) {
+    lanes_f m[4];
 #pragma unroll
-    for (int i = 0; i < 4; ++i)  // lanes i, i + 4, i + 8 and i + 12
-        m[i] = (float16)(vload4(0, base + off[i] + w), vload4(0, base + off[i + 4] + w),
-                         vload4(0, base + off[i + 8] + w), vload4(0, base + off[i + 12] + w));
+    for (int i = 0; i < 4; ++i) m[i] = LANES_ROW4(base, off, w, i);
     lanes_transpose4(m, c);
 }
 
@@ -330,8 +421,8 @@ LANES_INLINE void lanes_rows4(global const float* base, const int* off, int w, f
 
 // The fields as vectors, as lanes_walk works on them.
 typedef struct {
-#define LANES_VECTOR_F(f) float16 f;
-#define LANES_VECTOR_I(f) int16 f;
+#define LANES_VECTOR_F(f) lanes_f f;
+#define LANES_VECTOR_I(f) lanes_i f;
     LANES_FLOAT_FIELDS(LANES_VECTOR_F)
     LANES_INT_FIELDS(LANES_VECTOR_I)
 #undef LANES_VECTOR_F
@@ -445,19 +536,19 @@ LANES_INLINE GpuHit lanes_hit(const LaneMemory* M, int lane) {
 // rounding-error bound): for each lane of `special`, the scalar test (intersect_leaf: double-
 // precision edge functions, the error bound) decides triangle tri of that lane's ray o, d,
 // with the lane's hit so far in *t, *v, *w, *det, *prim, which it updates.
-LANES_INLINE void lanes_rare_cases(int16 special, int16 tri, const float3* o, const float3* d,
+LANES_INLINE void lanes_rare_cases(lanes_i special, lanes_i tri, const float3* o, const float3* d,
                                    global const GpuTriangle* tris, const SceneSurfaces* surf,
-                                   bool any_hit, float16* t, float16* v, float16* w,
-                                   float16* det, int16* prim) {
+                                   bool any_hit, lanes_f* t, lanes_f* v, lanes_f* w,
+                                   lanes_f* det, lanes_i* prim) {
     int sp_[LANES], tri_[LANES], prim_[LANES];
     float t_[LANES], v_[LANES], w_[LANES], det_[LANES];
-    vstore16(special, 0, sp_);
-    vstore16(tri, 0, tri_);
-    vstore16(*t, 0, t_);
-    vstore16(*v, 0, v_);
-    vstore16(*w, 0, w_);
-    vstore16(*det, 0, det_);
-    vstore16(*prim, 0, prim_);
+    lanes_vstore(special, 0, sp_);
+    lanes_vstore(tri, 0, tri_);
+    lanes_vstore(*t, 0, t_);
+    lanes_vstore(*v, 0, v_);
+    lanes_vstore(*w, 0, w_);
+    lanes_vstore(*det, 0, det_);
+    lanes_vstore(*prim, 0, prim_);
     for (int l = 0; l < LANES; ++l) {
         if (!sp_[l]) continue;
         RayPrep r = prepare_ray(o[l], d[l]);
@@ -471,22 +562,23 @@ LANES_INLINE void lanes_rare_cases(int16 special, int16 tri, const float3* o, co
             prim_[l] = (int)h.prim;
         }
     }
-    *t = vload16(0, t_);
-    *v = vload16(0, v_);
-    *w = vload16(0, w_);
-    *det = vload16(0, det_);
-    *prim = vload16(0, prim_);
+    *t = lanes_vload(0, t_);
+    *v = lanes_vload(0, v_);
+    *w = lanes_vload(0, w_);
+    *det = lanes_vload(0, det_);
+    *prim = lanes_vload(0, prim_);
 }
 
 // Lanes at a leaf are tested together once at least this many are (the others wait at it).
+// (Six of sixteen, three of eight: docs/benchmarks.md, "Twenty-fourth session".)
 #ifndef LANES_LEAF_MIN
-#define LANES_LEAF_MIN 6
+#define LANES_LEAF_MIN (LANES == 16 ? 6 : 3)
 #endif
 
 // lanes_walk returns once this many lanes are done (or none is left walking): each return
 // costs the shading loop's round over the lanes and the lanes' vectors to and from memory.
 #ifndef LANES_DONE_MIN
-#define LANES_DONE_MIN 4
+#define LANES_DONE_MIN (LANES / 4)
 #endif
 
 // An item (the one a lane visits, or a stack entry) in one word: an interior child's index,
@@ -494,8 +586,8 @@ LANES_INLINE void lanes_rare_cases(int16 special, int16 tri, const float3* o, co
 // (the host enables lanes only for scenes of fewer than 2^27 triangles and leaves of at most
 // 15: lanes_megakernel).
 #define LANES_FIRST_MASK 0x07ffffff
-LANES_INLINE int16 lanes_pack(int16 c, int16 k) {
-    return select(c, (int16)(0x80000000) | (k << (int16)(27)) | ~c, k != (int16)(0));
+LANES_INLINE lanes_i lanes_pack(lanes_i c, lanes_i k) {
+    return select(c, (lanes_i)(0x80000000) | (k << (lanes_i)(27)) | ~c, k != (lanes_i)(0));
 }
 
 // Starts loading, for each lane of m, `bytes` bytes from element `first` (of `size` bytes) of
@@ -505,11 +597,11 @@ LANES_INLINE int16 lanes_pack(int16 c, int16 k) {
 // element may straddle one more line than the loop reaches; elements of whole lines (the
 // nodes, 128 bytes, in buffers aligned to pages) need no such fetch, and after inlining the
 // test folds away.
-LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes, int16 m) {
+LANES_INLINE void lanes_prefetch(ulong base, lanes_i first, uint size, uint bytes, lanes_i m) {
     uint bits = lanes_kmask(m);
     if (bits == 0u) return;
     int first_[LANES];
-    vstore16(first, 0, first_);
+    lanes_vstore(first, 0, first_);
     while (bits != 0u) {
         uint l = (uint)__builtin_ctz(bits);
         bits &= bits - 1u;
@@ -533,7 +625,7 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
 #ifndef LANES_NO_NODE_PREFETCH
 #define LANES_PREFETCH_NODE(NODES, ITEM, M)                                                 \
     lanes_prefetch((ulong)(NODES), (ITEM), sizeof(GpuWideNode), sizeof(GpuWideNode),       \
-                   (M) & ((ITEM) >= (int16)(0)));
+                   (M) & ((ITEM) >= (lanes_i)(0)));
 #else
 #define LANES_PREFETCH_NODE(NODES, ITEM, M)
 #endif
@@ -543,36 +635,36 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
 // cZ. Lanes outside M read triangle 0.
 #ifdef LANES_GATHERS
 #define LANES_TRIANGLE(TRI, M, KX, KY, KZ, PX, PY, PZ)                          \
-    int16 b_ = (TRI) * (int16)(12);                                          \
-    float16 aX = LANES_GATHER_F(tw, b_ + (KX), M) - (PX);                     \
-    float16 aY = LANES_GATHER_F(tw, b_ + (KY), M) - (PY);                     \
-    float16 aZ = LANES_GATHER_F(tw, b_ + (KZ), M) - (PZ);                     \
-    float16 bX = LANES_GATHER_F(tw, b_ + (int16)(4) + (KX), M) - (PX);        \
-    float16 bY = LANES_GATHER_F(tw, b_ + (int16)(4) + (KY), M) - (PY);        \
-    float16 bZ = LANES_GATHER_F(tw, b_ + (int16)(4) + (KZ), M) - (PZ);        \
-    float16 cX = LANES_GATHER_F(tw, b_ + (int16)(8) + (KX), M) - (PX);        \
-    float16 cY = LANES_GATHER_F(tw, b_ + (int16)(8) + (KY), M) - (PY);        \
-    float16 cZ = LANES_GATHER_F(tw, b_ + (int16)(8) + (KZ), M) - (PZ);
+    lanes_i b_ = (TRI) * (lanes_i)(12);                                          \
+    lanes_f aX = LANES_GATHER_F(tw, b_ + (KX), M) - (PX);                     \
+    lanes_f aY = LANES_GATHER_F(tw, b_ + (KY), M) - (PY);                     \
+    lanes_f aZ = LANES_GATHER_F(tw, b_ + (KZ), M) - (PZ);                     \
+    lanes_f bX = LANES_GATHER_F(tw, b_ + (lanes_i)(4) + (KX), M) - (PX);        \
+    lanes_f bY = LANES_GATHER_F(tw, b_ + (lanes_i)(4) + (KY), M) - (PY);        \
+    lanes_f bZ = LANES_GATHER_F(tw, b_ + (lanes_i)(4) + (KZ), M) - (PZ);        \
+    lanes_f cX = LANES_GATHER_F(tw, b_ + (lanes_i)(8) + (KX), M) - (PX);        \
+    lanes_f cY = LANES_GATHER_F(tw, b_ + (lanes_i)(8) + (KY), M) - (PY);        \
+    lanes_f cZ = LANES_GATHER_F(tw, b_ + (lanes_i)(8) + (KZ), M) - (PZ);
 #else
 // As rows: each vertex's words in the lane's permuted axes by selects.
 #define LANES_TRIANGLE(TRI, M, KX, KY, KZ, PX, PY, PZ)                          \
     int off_[LANES];                                                         \
-    vstore16(select((int16)(0), (TRI) * (int16)(12), M), 0, off_);           \
-    float16 T[12];                                                           \
+    lanes_vstore(select((lanes_i)(0), (TRI) * (lanes_i)(12), M), 0, off_);           \
+    lanes_f T[12];                                                           \
     lanes_rows8(tw, off_, 0, T);                                             \
     lanes_rows4(tw, off_, 8, T + 8);                                         \
-    int16 kx1_ = (KX) == (int16)(1), kx2_ = (KX) == (int16)(2);              \
-    int16 ky1_ = (KY) == (int16)(1), ky2_ = (KY) == (int16)(2);              \
-    int16 kz1_ = (KZ) == (int16)(1), kz2_ = (KZ) == (int16)(2);              \
-    float16 aX = LANES_AXIS(0, kx) - (PX);                                   \
-    float16 aY = LANES_AXIS(0, ky) - (PY);                                   \
-    float16 aZ = LANES_AXIS(0, kz) - (PZ);                                   \
-    float16 bX = LANES_AXIS(4, kx) - (PX);                                   \
-    float16 bY = LANES_AXIS(4, ky) - (PY);                                   \
-    float16 bZ = LANES_AXIS(4, kz) - (PZ);                                   \
-    float16 cX = LANES_AXIS(8, kx) - (PX);                                   \
-    float16 cY = LANES_AXIS(8, ky) - (PY);                                   \
-    float16 cZ = LANES_AXIS(8, kz) - (PZ);
+    lanes_i kx1_ = (KX) == (lanes_i)(1), kx2_ = (KX) == (lanes_i)(2);              \
+    lanes_i ky1_ = (KY) == (lanes_i)(1), ky2_ = (KY) == (lanes_i)(2);              \
+    lanes_i kz1_ = (KZ) == (lanes_i)(1), kz2_ = (KZ) == (lanes_i)(2);              \
+    lanes_f aX = LANES_AXIS(0, kx) - (PX);                                   \
+    lanes_f aY = LANES_AXIS(0, ky) - (PY);                                   \
+    lanes_f aZ = LANES_AXIS(0, kz) - (PZ);                                   \
+    lanes_f bX = LANES_AXIS(4, kx) - (PX);                                   \
+    lanes_f bY = LANES_AXIS(4, ky) - (PY);                                   \
+    lanes_f bZ = LANES_AXIS(4, kz) - (PZ);                                   \
+    lanes_f cX = LANES_AXIS(8, kx) - (PX);                                   \
+    lanes_f cY = LANES_AXIS(8, ky) - (PY);                                   \
+    lanes_f cZ = LANES_AXIS(8, kz) - (PZ);
 #define LANES_AXIS(V, K) select(select(T[V], T[V + 1], K##1_), T[V + 2], K##2_)
 #endif
 
@@ -583,89 +675,89 @@ LANES_INLINE void lanes_prefetch(ulong base, int16 first, uint size, uint bytes,
 // Compare-exchange of two (distance, item) pairs in every lane, nearest first.
 #define LANES_ORDER(A, B)                      \
     {                                          \
-        int16 s = d##B < d##A;                 \
-        float16 td = d##A;                     \
+        lanes_i s = d##B < d##A;                 \
+        lanes_f td = d##A;                     \
         d##A = select(d##A, d##B, s);          \
         d##B = select(d##B, td, s);            \
-        int16 tc = c##A;                       \
+        lanes_i tc = c##A;                       \
         c##A = select(c##A, c##B, s);          \
         c##B = select(c##B, tc, s);            \
     }
 
 // Walks the lanes' rays until LANES_DONE_MIN are done or none is left walking; returns the
 // mask of those done (their `live` lanes cleared). No lane live: returns an empty mask.
-LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
+LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                               global const GpuTriangle* tris, const SceneSurfaces* surf,
                               volatile global uint* overflow) {
-    const float16 inf = (float16)(INFINITY), zero = (float16)(0.0f);
-    const int16 izero = (int16)(0), lane = LANE_IDS;
+    const lanes_f inf = (lanes_f)(INFINITY), zero = (lanes_f)(0.0f);
+    const lanes_i izero = (lanes_i)(0), lane = LANE_IDS;
     global const float* nw = (global const float*)nodes;
     global const float* tw = (global const float*)tris;
     Lanes* L = &M->V;
     while (lanes_any(L->live)) {
-        int16 arrived = izero;  // lanes that reached a leaf in this round
+        lanes_i arrived = izero;  // lanes that reached a leaf in this round
         // Interior nodes.
-        int16 mi = L->has & (L->cur >= izero);
+        lanes_i mi = L->has & (L->cur >= izero);
         if (lanes_any(mi)) {
-            int16 base = L->cur * (int16)(32);
+            lanes_i base = L->cur * (lanes_i)(32);
 // Child J's slab test in every lane of mi from its near and far planes (NX .. FZ) and its
 // child and count words (C, K): declares d##J, the entry distance of a reached child (else
 // infinity), and sets c##J to its item in lanes_pack form.
 #define LANES_CHILD(J, NX, NY, NZ, FX, FY, FZ, C, K)                                         \
-    float16 d##J;                                                                         \
+    lanes_f d##J;                                                                         \
     {                                                                                     \
-        float16 x0 = (NX - L->ox) * L->ix, y0 = (NY - L->oy) * L->iy;                     \
-        float16 nr = select(x0, y0, y0 > x0);                                             \
-        float16 z0 = (NZ - L->oz) * L->iz;                                                \
+        lanes_f x0 = (NX - L->ox) * L->ix, y0 = (NY - L->oy) * L->iy;                     \
+        lanes_f nr = select(x0, y0, y0 > x0);                                             \
+        lanes_f z0 = (NZ - L->oz) * L->iz;                                                \
         nr = select(nr, z0, z0 > nr);                                                     \
         nr = select(nr, zero, zero > nr);                                                 \
-        float16 x1 = (FX - L->ox) * L->ix, y1 = (FY - L->oy) * L->iy;                     \
-        float16 fr = select(x1, y1, y1 < x1);                                             \
-        float16 z1 = (FZ - L->oz) * L->iz;                                                \
+        lanes_f x1 = (FX - L->ox) * L->ix, y1 = (FY - L->oy) * L->iy;                     \
+        lanes_f fr = select(x1, y1, y1 < x1);                                             \
+        lanes_f z1 = (FZ - L->oz) * L->iz;                                                \
         fr = select(fr, z1, z1 < fr) * 1.00000024f;                                       \
-        int16 cw = (C), kw = (K);                                                         \
-        int16 reach = mi & ((cw > izero) | (kw != izero)) & (nr <= fr) & (nr < L->tfar);  \
+        lanes_i cw = (C), kw = (K);                                                         \
+        lanes_i reach = mi & ((cw > izero) | (kw != izero)) & (nr <= fr) & (nr < L->tfar);  \
         d##J = select(inf, nr, reach);                                                    \
         c##J = lanes_pack(cw, kw);                                                        \
     }
-            int16 c0, c1, c2, c3;
+            lanes_i c0, c1, c2, c3;
 #ifdef LANES_GATHERS
             // Children J and J + 1 at once: a row's words of two children are side by side, so
             // one 8-byte gather element brings both (half the gathered elements).
             ushort km = lanes_kmask(mi);
-            int16 nx = select((int16)(12), izero, L->ix >= zero);
-            int16 ny = select((int16)(16), (int16)(4), L->iy >= zero);
-            int16 nz = select((int16)(20), (int16)(8), L->iz >= zero);
-            int16 fx = (int16)(12) - nx, fy = (int16)(20) - ny, fz = (int16)(28) - nz;
+            lanes_i nx = select((lanes_i)(12), izero, L->ix >= zero);
+            lanes_i ny = select((lanes_i)(16), (lanes_i)(4), L->iy >= zero);
+            lanes_i nz = select((lanes_i)(20), (lanes_i)(8), L->iz >= zero);
+            lanes_i fx = (lanes_i)(12) - nx, fy = (lanes_i)(20) - ny, fz = (lanes_i)(28) - nz;
 #define LANES_CHILDREN(J, K)                                                                \
-    float16 nx##J, nx##K, ny##J, ny##K, nz##J, nz##K, fx##J, fx##K, fy##J, fy##K, fz##J,    \
+    lanes_f nx##J, nx##K, ny##J, ny##K, nz##J, nz##K, fx##J, fx##K, fy##J, fy##K, fz##J,    \
         fz##K, cw##J, cw##K, kw##J, kw##K;                                                  \
-    LANES_GATHER_PAIR(nw, base + (int16)(J) + nx, km, nx##J, nx##K);                        \
-    LANES_GATHER_PAIR(nw, base + (int16)(J) + ny, km, ny##J, ny##K);                        \
-    LANES_GATHER_PAIR(nw, base + (int16)(J) + nz, km, nz##J, nz##K);                        \
-    LANES_GATHER_PAIR(nw, base + (int16)(J) + fx, km, fx##J, fx##K);                        \
-    LANES_GATHER_PAIR(nw, base + (int16)(J) + fy, km, fy##J, fy##K);                        \
-    LANES_GATHER_PAIR(nw, base + (int16)(J) + fz, km, fz##J, fz##K);                        \
-    LANES_GATHER_PAIR(nw, base + (int16)(J + 24), km, cw##J, cw##K);                        \
-    LANES_GATHER_PAIR(nw, base + (int16)(J + 28), km, kw##J, kw##K);                        \
-    LANES_CHILD(J, nx##J, ny##J, nz##J, fx##J, fy##J, fz##J, as_int16(cw##J), as_int16(kw##J)) \
-    LANES_CHILD(K, nx##K, ny##K, nz##K, fx##K, fy##K, fz##K, as_int16(cw##K), as_int16(kw##K))
+    LANES_GATHER_PAIR(nw, base + (lanes_i)(J) + nx, km, nx##J, nx##K);                        \
+    LANES_GATHER_PAIR(nw, base + (lanes_i)(J) + ny, km, ny##J, ny##K);                        \
+    LANES_GATHER_PAIR(nw, base + (lanes_i)(J) + nz, km, nz##J, nz##K);                        \
+    LANES_GATHER_PAIR(nw, base + (lanes_i)(J) + fx, km, fx##J, fx##K);                        \
+    LANES_GATHER_PAIR(nw, base + (lanes_i)(J) + fy, km, fy##J, fy##K);                        \
+    LANES_GATHER_PAIR(nw, base + (lanes_i)(J) + fz, km, fz##J, fz##K);                        \
+    LANES_GATHER_PAIR(nw, base + (lanes_i)(J + 24), km, cw##J, cw##K);                        \
+    LANES_GATHER_PAIR(nw, base + (lanes_i)(J + 28), km, kw##J, kw##K);                        \
+    LANES_CHILD(J, nx##J, ny##J, nz##J, fx##J, fy##J, fz##J, as_lanes_i(cw##J), as_lanes_i(kw##J)) \
+    LANES_CHILD(K, nx##K, ny##K, nz##K, fx##K, fy##K, fz##K, as_lanes_i(cw##K), as_lanes_i(kw##K))
             LANES_CHILDREN(0, 1)
             LANES_CHILDREN(2, 3)
 #else
             // The nodes as rows: W[w], word w of each lane's node (lanes not at one read the
             // root's).
             int off_[LANES];
-            vstore16(select(izero, base, mi), 0, off_);
-            float16 W[32];
+            lanes_vstore(select(izero, base, mi), 0, off_);
+            lanes_f W[32];
 #pragma unroll
             for (int w = 0; w < 32; w += 8) lanes_rows8(nw, off_, w, W + w);
-            int16 px = L->ix >= zero, py = L->iy >= zero, pz = L->iz >= zero;
+            lanes_i px = L->ix >= zero, py = L->iy >= zero, pz = L->iz >= zero;
 #define LANES_CHILDREN(J)                                                                   \
     LANES_CHILD(J, select(W[12 + J], W[J], px), select(W[16 + J], W[4 + J], py),            \
                 select(W[20 + J], W[8 + J], pz), select(W[J], W[12 + J], px),               \
                 select(W[4 + J], W[16 + J], py), select(W[8 + J], W[20 + J], pz),           \
-                as_int16(W[24 + J]), as_int16(W[28 + J]))
+                as_lanes_i(W[24 + J]), as_lanes_i(W[28 + J]))
             LANES_CHILDREN(0)
             LANES_CHILDREN(1)
             LANES_CHILDREN(2)
@@ -680,7 +772,7 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             LANES_ORDER(1, 2)
             // A lane about to overflow its stack ends its walk with the hit so far (as
             // traverse_wide_bvh does; the overflow is counted).
-            int16 full = mi & (L->sp > (int16)(LANES_STACK - 4));
+            lanes_i full = mi & (L->sp > (lanes_i)(LANES_STACK - 4));
             if (lanes_any(full)) {
                 atomic_add(overflow, (uint)lanes_count(full));
                 L->sp = select(L->sp, izero, full);
@@ -690,26 +782,26 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             // The reached children but the nearest pushed, farthest first; the nearest entered.
 #define LANES_PUSH(J)                                                              \
     {                                                                              \
-        int16 p = mi & (d##J < inf);                                               \
-        int16 at = (L->sp * (int16)(LANES) + lane) * (int16)(2);                   \
-        LANES_SCATTER_PAIR(M->stack, at, lanes_kmask(p), d##J, as_float16(c##J)); \
+        lanes_i p = mi & (d##J < inf);                                               \
+        lanes_i at = (L->sp * (lanes_i)(LANES) + lane) * (lanes_i)(2);                   \
+        LANES_SCATTER_PAIR(M->stack, at, lanes_kmask(p), d##J, as_lanes_f(c##J)); \
         L->sp -= p;                                                                \
     }
             LANES_PUSH(3)
             LANES_PUSH(2)
             LANES_PUSH(1)
 #undef LANES_PUSH
-            int16 enter = mi & (d0 < inf);
+            lanes_i enter = mi & (d0 < inf);
             arrived |= enter & (c0 < izero);
             L->cur = select(L->cur, c0, enter);
             LANES_PREFETCH_NODE(nodes, c0, enter)
             L->has &= ~(mi & ~enter);
         }
         // Leaves, once enough lanes are at one (or no lane is at a node).
-        int16 ml = L->has & (L->cur < izero);
+        lanes_i ml = L->has & (L->cur < izero);
         if (lanes_any(ml) && (lanes_count(ml) >= LANES_LEAF_MIN || !lanes_any(L->has & ~ml))) {
-            int16 first = L->cur & (int16)(LANES_FIRST_MASK);
-            int16 cnt = (L->cur >> (int16)(27)) & (int16)(15);
+            lanes_i first = L->cur & (lanes_i)(LANES_FIRST_MASK);
+            lanes_i cnt = (L->cur >> (lanes_i)(27)) & (lanes_i)(15);
             int kmax = lanes_max(select(izero, cnt, ml));
 #ifndef LANES_LEAF_BY_K
             // The leaves' (lane, triangle) pairs in order, each lane's first triangle before its
@@ -719,9 +811,9 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             int pairs = 0;
             bool by_k = kmax > LANES_PAIRS_MAX / LANES;
             for (int k = 0; k < kmax && !by_k; ++k) {
-                ushort km = lanes_kmask(ml & ((int16)(k) < cnt));
-                vstore16(lanes_compress(lane, km), 0, pl + pairs);
-                vstore16(lanes_compress(first + (int16)(k), km), 0, pt + pairs);
+                ushort km = lanes_kmask(ml & ((lanes_i)(k) < cnt));
+                lanes_vstore(lanes_compress(lane, km), 0, pl + pairs);
+                lanes_vstore(lanes_compress(first + (lanes_i)(k), km), 0, pt + pairs);
                 pairs += popcount((uint)km);
             }
             // Each pair's verdict against its lane's hit before the leaves (the nearest of a
@@ -731,24 +823,24 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             float rdet[LANES_PAIRS_MAX];
             uint hits[LANES_PAIRS_MAX / LANES], found = 0u;
             for (int p0 = 0; p0 < pairs && !by_k; p0 += LANES) {
-                int16 idx = vload16(0, pl + p0);
-                int16 tri = vload16(0, pt + p0);
-                int16 m = (lane + (int16)(p0)) < (int16)(pairs);
+                lanes_i idx = lanes_vload(0, pl + p0);
+                lanes_i tri = lanes_vload(0, pt + p0);
+                lanes_i m = (lane + (lanes_i)(p0)) < (lanes_i)(pairs);
                 idx = select(izero, idx, m);
-                int16 kx = lanes_permute_i(L->kx, idx), ky = lanes_permute_i(L->ky, idx);
-                int16 kz = lanes_permute_i(L->kz, idx);
-                float16 px = lanes_permute(L->px, idx), py = lanes_permute(L->py, idx);
-                float16 pz = lanes_permute(L->pz, idx);
-                float16 sx = lanes_permute(L->sx, idx), sy = lanes_permute(L->sy, idx);
-                float16 sz = lanes_permute(L->sz, idx);
+                lanes_i kx = lanes_permute_i(L->kx, idx), ky = lanes_permute_i(L->ky, idx);
+                lanes_i kz = lanes_permute_i(L->kz, idx);
+                lanes_f px = lanes_permute(L->px, idx), py = lanes_permute(L->py, idx);
+                lanes_f pz = lanes_permute(L->pz, idx);
+                lanes_f sx = lanes_permute(L->sx, idx), sy = lanes_permute(L->sy, idx);
+                lanes_f sz = lanes_permute(L->sz, idx);
                 LANES_TRIANGLE(tri, m, kx, ky, kz, px, py, pz)
-                LANE_EDGES(float16)
-                LANE_HITS16(m, zero, lanes_permute(L->tfar, idx))
+                LANE_EDGES(lanes_f)
+                LANE_HITS_T(lanes_f, lanes_i, m, zero, lanes_permute(L->tfar, idx))
                 by_k = lanes_any(special);
-                vstore16(t, 0, rt + p0);
-                vstore16(v, 0, rv + p0);
-                vstore16(w, 0, rw + p0);
-                vstore16(det, 0, rdet + p0);
+                lanes_vstore(t, 0, rt + p0);
+                lanes_vstore(v, 0, rv + p0);
+                lanes_vstore(w, 0, rw + p0);
+                lanes_vstore(det, 0, rdet + p0);
                 hits[p0 / LANES] = lanes_kmask(ok);
                 found |= hits[p0 / LANES];
             }
@@ -756,11 +848,11 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             if (!by_k && found != 0u) {
                 float tf[LANES], hv[LANES], hw[LANES], hdet[LANES];
                 int prim[LANES];
-                vstore16(L->tfar, 0, tf);
-                vstore16(L->hv, 0, hv);
-                vstore16(L->hw, 0, hw);
-                vstore16(L->hdet, 0, hdet);
-                vstore16(L->prim, 0, prim);
+                lanes_vstore(L->tfar, 0, tf);
+                lanes_vstore(L->hv, 0, hv);
+                lanes_vstore(L->hw, 0, hw);
+                lanes_vstore(L->hdet, 0, hdet);
+                lanes_vstore(L->prim, 0, prim);
                 for (int p0 = 0; p0 < pairs; p0 += LANES) {
                     for (uint h = hits[p0 / LANES]; h != 0u; h &= h - 1u) {
                         int i = p0 + (int)__builtin_ctz(h);
@@ -774,23 +866,23 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                         }
                     }
                 }
-                L->tfar = vload16(0, tf);
-                L->hv = vload16(0, hv);
-                L->hw = vload16(0, hw);
-                L->hdet = vload16(0, hdet);
-                L->prim = vload16(0, prim);
+                L->tfar = lanes_vload(0, tf);
+                L->hv = lanes_vload(0, hv);
+                L->hw = lanes_vload(0, hw);
+                L->hdet = lanes_vload(0, hdet);
+                L->prim = lanes_vload(0, prim);
             }
             if (!by_k) kmax = 0;  // done: no walk by triangle order
 #endif
             // The leaves one triangle of every lane at a time, in order, each lane's hit updated
             // as it goes; the scalar test's rare cases in turn.
             for (int k = 0; k < kmax; ++k) {
-                int16 m = ml & ((int16)(k) < cnt);
-                int16 tri = first + (int16)(k);
+                lanes_i m = ml & ((lanes_i)(k) < cnt);
+                lanes_i tri = first + (lanes_i)(k);
                 LANES_TRIANGLE(tri, m, L->kx, L->ky, L->kz, L->px, L->py, L->pz)
-                float16 sx = L->sx, sy = L->sy, sz = L->sz;
-                LANE_EDGES(float16)
-                LANE_HITS16(m, zero, L->tfar)
+                lanes_f sx = L->sx, sy = L->sy, sz = L->sz;
+                LANE_EDGES(lanes_f)
+                LANE_HITS_T(lanes_f, lanes_i, m, zero, L->tfar)
                 ok &= ~special;
                 L->tfar = select(L->tfar, t, ok);
                 L->hv = select(L->hv, v, ok);
@@ -808,26 +900,26 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
         }
         // The lanes without an item pop one, passing over entries beyond their hit; a lane
         // with an empty stack is done.
-        int16 done = izero;
+        lanes_i done = izero;
         for (int round = 0; round < 3; ++round) {
-            int16 pm = L->live & ~L->has & ~done;
+            lanes_i pm = L->live & ~L->has & ~done;
             if (!lanes_any(pm)) break;
-            int16 m = pm & (L->sp > izero);
+            lanes_i m = pm & (L->sp > izero);
             done |= pm & ~m;
             if (!lanes_any(m)) break;
             L->sp += m;
-            int16 at = (L->sp * (int16)(LANES) + lane) * (int16)(2);
-            float16 d, itemf;
+            lanes_i at = (L->sp * (lanes_i)(LANES) + lane) * (lanes_i)(2);
+            lanes_f d, itemf;
             LANES_GATHER_PAIR(M->stack, at, lanes_kmask(m), d, itemf);
-            int16 keep = m & (d < L->tfar);
-            int16 item = as_int16(itemf);
+            lanes_i keep = m & (d < L->tfar);
+            lanes_i item = as_lanes_i(itemf);
             L->cur = select(L->cur, item, keep);
             L->has |= keep;
             arrived |= keep & (item < izero);
             LANES_PREFETCH_NODE(nodes, item, keep)
         }
         // A leaf waits for other lanes to reach theirs: its triangles are fetched meanwhile.
-        lanes_prefetch((ulong)tris, L->cur & (int16)(LANES_FIRST_MASK), sizeof(GpuTriangle),
+        lanes_prefetch((ulong)tris, L->cur & (lanes_i)(LANES_FIRST_MASK), sizeof(GpuTriangle),
                        LANES_PREFETCH_TRIS * sizeof(GpuTriangle), arrived & L->has);
         done &= L->live;
         // What shading reads of the hit (the triangle was just read).
@@ -836,12 +928,12 @@ LANES_INLINE int16 lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
         L->live &= ~done;
         L->fin |= done;
         if (lanes_count(L->fin) >= LANES_DONE_MIN || !lanes_any(L->live)) {
-            int16 fin = L->fin;
+            lanes_i fin = L->fin;
             L->fin = izero;
             return fin;
         }
     }
-    return (int16)(0);
+    return (lanes_i)(0);
 }
 
 #endif  // MEGA_LANES

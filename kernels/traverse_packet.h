@@ -42,8 +42,12 @@ LANES_INLINE GpuHit packet_hit(const Packet* P, int lane) {
 }
 
 // The least lane of x.
-inline float packet_min(float16 x) {
+inline float packet_min(lanes_f x) {
+#if LANES == 16
     float8 a = select(x.hi, x.lo, x.lo < x.hi);
+#else
+    float8 a = x;
+#endif
     float4 b = select(a.hi, a.lo, a.lo < a.hi);
     float2 c = select(b.hi, b.lo, b.lo < b.hi);
     return c.x < c.y ? c.x : c.y;
@@ -52,26 +56,26 @@ inline float packet_min(float16 x) {
 // Walks the rays of the lanes `live` (from tmin 0 to each lane's tfar) for their nearest hits,
 // or with any_hit for some hit each (a lane's prim >= 0 after it: occluded), writing the hits
 // to P. A packet whose stack would overflow ends with the hits so far (counted).
-LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
+LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
                               global const GpuWideNode* nodes, global const GpuTriangle* tris,
                               const SceneSurfaces* surf, volatile global uint* overflow) {
-    const float16 inf = (float16)(INFINITY), zero = (float16)(0.0f);
-    const int16 izero = (int16)(0);
-    float16 ox = vload16(0, P->ox), oy = vload16(0, P->oy), oz = vload16(0, P->oz);
-    float16 ix = vload16(0, P->ix), iy = vload16(0, P->iy), iz = vload16(0, P->iz);
-    float16 px = vload16(0, P->px), py = vload16(0, P->py), pz = vload16(0, P->pz);
-    float16 sx = vload16(0, P->sx), sy = vload16(0, P->sy), sz = vload16(0, P->sz);
-    int16 kz = vload16(0, P->kz);
-    int16 z0 = kz == izero, z1 = kz == (int16)(1);
-    float16 tfar = vload16(0, P->tfar), hv = vload16(0, P->hv), hw = vload16(0, P->hw);
-    float16 hdet = vload16(0, P->hdet);
-    int16 prim = vload16(0, P->prim);
-    float16 stack_d[PACKET_STACK];
+    const lanes_f inf = (lanes_f)(INFINITY), zero = (lanes_f)(0.0f);
+    const lanes_i izero = (lanes_i)(0);
+    lanes_f ox = lanes_vload(0, P->ox), oy = lanes_vload(0, P->oy), oz = lanes_vload(0, P->oz);
+    lanes_f ix = lanes_vload(0, P->ix), iy = lanes_vload(0, P->iy), iz = lanes_vload(0, P->iz);
+    lanes_f px = lanes_vload(0, P->px), py = lanes_vload(0, P->py), pz = lanes_vload(0, P->pz);
+    lanes_f sx = lanes_vload(0, P->sx), sy = lanes_vload(0, P->sy), sz = lanes_vload(0, P->sz);
+    lanes_i kz = lanes_vload(0, P->kz);
+    lanes_i z0 = kz == izero, z1 = kz == (lanes_i)(1);
+    lanes_f tfar = lanes_vload(0, P->tfar), hv = lanes_vload(0, P->hv), hw = lanes_vload(0, P->hw);
+    lanes_f hdet = lanes_vload(0, P->hdet);
+    lanes_i prim = lanes_vload(0, P->prim);
+    lanes_f stack_d[PACKET_STACK];
     int stack_item[PACKET_STACK];
     int sp = 0;
     int item = 0;       // the root
-    int16 m = live;     // the lanes visiting `item`
-    int16 open = live;  // the lanes still looking (with any_hit: not yet blocked)
+    lanes_i m = live;     // the lanes visiting `item`
+    lanes_i open = live;  // the lanes still looking (with any_hit: not yet blocked)
     for (;;) {
         if (item >= 0) {
             global const GpuWideNode* n = &nodes[item];
@@ -79,7 +83,7 @@ LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
             float4 hx = n->max_x, hy = n->max_y, hz = n->max_z;
             int4 ch = n->child;
             int4 ct = as_int4(n->count);
-            float16 dv[4];
+            lanes_f dv[4];
             float key[4];
             int cv[4];
             // Child J (component C): traverse_wide.h's slab test in every lane of m. With lo <=
@@ -87,15 +91,15 @@ LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
             // monotonic), so no plane is picked by the direction's sign.
 #define PACKET_CHILD(J, C)                                                                   \
     {                                                                                        \
-        float16 x0 = ((float16)(lx.C) - ox) * ix, x1 = ((float16)(hx.C) - ox) * ix;          \
-        float16 y0 = ((float16)(ly.C) - oy) * iy, y1 = ((float16)(hy.C) - oy) * iy;          \
-        float16 z0_ = ((float16)(lz.C) - oz) * iz, z1_ = ((float16)(hz.C) - oz) * iz;        \
-        float16 near = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)),                \
+        lanes_f x0 = ((lanes_f)(lx.C) - ox) * ix, x1 = ((lanes_f)(hx.C) - ox) * ix;          \
+        lanes_f y0 = ((lanes_f)(ly.C) - oy) * iy, y1 = ((lanes_f)(hy.C) - oy) * iy;          \
+        lanes_f z0_ = ((lanes_f)(lz.C) - oz) * iz, z1_ = ((lanes_f)(hz.C) - oz) * iz;        \
+        lanes_f near = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)),                \
                                 WIDE_MAX(WIDE_MIN(z0_, z1_), zero));                         \
-        float16 far = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)),                 \
+        lanes_f far = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)),                 \
                                WIDE_MAX(z0_, z1_)) *                                         \
                       1.00000024f;                                                           \
-        int16 reach = m & (near <= far) & (near < tfar);                                     \
+        lanes_i reach = m & (near <= far) & (near < tfar);                                     \
         if (ch.C <= 0 && ct.C == 0) reach = izero;                                           \
         dv[J] = select(inf, near, reach);                                                    \
         key[J] = packet_min(dv[J]);                                                          \
@@ -148,9 +152,9 @@ LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
             for (int k = 0; k < count; ++k) {
                 GpuTriangle tri = tris[first + k];
 #define PACKET_VERTEX(V, X, Y, Z)                                                     \
-    float16 X, Y, Z;                                                                  \
+    lanes_f X, Y, Z;                                                                  \
     {                                                                                 \
-        float16 vx = (float16)(tri.V.x), vy = (float16)(tri.V.y), vz = (float16)(tri.V.z); \
+        lanes_f vx = (lanes_f)(tri.V.x), vy = (lanes_f)(tri.V.y), vz = (lanes_f)(tri.V.z); \
         X = select(select(vx, vz, z1), vy, z0) - px;                                  \
         Y = select(select(vy, vx, z1), vz, z0) - py;                                  \
         Z = select(select(vz, vy, z1), vx, z0) - pz;                                  \
@@ -159,16 +163,16 @@ LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
                 PACKET_VERTEX(v1, bX, bY, bZ)
                 PACKET_VERTEX(v2, cX, cY, cZ)
 #undef PACKET_VERTEX
-                LANE_EDGES(float16)
-                LANE_HITS16(m, zero, tfar)
+                LANE_EDGES(lanes_f)
+                LANE_HITS_T(lanes_f, lanes_i, m, zero, tfar)
                 ok &= ~special;
                 tfar = select(tfar, t, ok);
                 hv = select(hv, v, ok);
                 hw = select(hw, w, ok);
                 hdet = select(hdet, det, ok);
-                prim = select(prim, (int16)(first + k), ok);
+                prim = select(prim, (lanes_i)(first + k), ok);
                 if (lanes_any(special)) {
-                    lanes_rare_cases(special, (int16)(first + k), P->o, P->d, tris, surf, any_hit,
+                    lanes_rare_cases(special, (lanes_i)(first + k), P->o, P->d, tris, surf, any_hit,
                                      &tfar, &hv, &hw, &hdet, &prim);
                 }
                 if (any_hit) {
@@ -193,11 +197,11 @@ LANES_INLINE void packet_walk(Packet* P, int16 live, bool any_hit,
         }
         if (!found) break;
     }
-    vstore16(tfar, 0, P->tfar);
-    vstore16(hv, 0, P->hv);
-    vstore16(hw, 0, P->hw);
-    vstore16(hdet, 0, P->hdet);
-    vstore16(prim, 0, P->prim);
+    lanes_vstore(tfar, 0, P->tfar);
+    lanes_vstore(hv, 0, P->hv);
+    lanes_vstore(hw, 0, P->hw);
+    lanes_vstore(hdet, 0, P->hdet);
+    lanes_vstore(prim, 0, P->prim);
 }
 
 #endif  // MEGA_LANES

@@ -75,23 +75,23 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
     TYPE v = ax * cy - ay * cx;         \
     TYPE w = bx * ay - by * ax;
 
-// After LANE_EDGES in float16 lanes (trace_small, traverse_lanes.h): intersect_triangle's
-// verdict lane by lane for the lanes of MASK, a hit in (TMIN, TMAX): declares the mask ok, the
-// edge functions' sum det, the distance t and the mask special of the lanes that need the scalar
-// test (an edge function of zero, or a hit close enough for its rounding-error bound). Needs
-// sz, the shear's z, and zero, a float16 of zeros.
-#define LANE_HITS16(MASK, TMIN, TMAX)                                         \
-    int16 ok = (MASK) & ~(((u < zero) | (v < zero) | (w < zero)) &            \
-                          ((u > zero) | (v > zero) | (w > zero)));            \
-    float16 det = u + v + w;                                                  \
+// After LANE_EDGES in lanes of TF (float16 in trace_small; traverse_lanes.h's width there), with
+// masks of TI: intersect_triangle's verdict lane by lane for the lanes of MASK, a hit in (TMIN,
+// TMAX): declares the mask ok, the edge functions' sum det, the distance t and the mask special
+// of the lanes that need the scalar test (an edge function of zero, or a hit close enough for its
+// rounding-error bound). Needs sz, the shear's z, and zero, a TF of zeros.
+#define LANE_HITS_T(TF, TI, MASK, TMIN, TMAX)                                 \
+    TI ok = (MASK) & ~(((u < zero) | (v < zero) | (w < zero)) &               \
+                       ((u > zero) | (v > zero) | (w > zero)));               \
+    TF det = u + v + w;                                                       \
     ok &= det != zero;                                                        \
-    float16 az = sz * aZ, bz = sz * bZ, cz = sz * cZ;                         \
-    float16 t = (u * az + v * bz + w * cz) / det;                             \
+    TF az = sz * aZ, bz = sz * bZ, cz = sz * cZ;                              \
+    TF t = (u * az + v * bz + w * cz) / det;                                  \
     ok &= (t > (TMIN)) & (t < (TMAX));                                        \
-    float16 far_z = select(fabs(az), fabs(bz), fabs(bz) > fabs(az));          \
+    TF far_z = select(fabs(az), fabs(bz), fabs(bz) > fabs(az));               \
     far_z = select(far_z, fabs(cz), fabs(cz) > far_z);                        \
-    int16 special = (MASK) & ((u == zero) | (v == zero) | (w == zero) |       \
-                              (ok & (t < 0.00390625f * far_z)));
+    TI special = (MASK) & ((u == zero) | (v == zero) | (w == zero) |          \
+                           (ok & (t < 0.00390625f * far_z)));
 
 // intersect_leaf for a leaf of at most four triangles, the four tested at once in float4 lanes
 // with intersect_triangle's arithmetic lane by lane, so that the same hit is kept: the first
@@ -535,7 +535,7 @@ inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* t
         LANE_EDGES(float16)
         int16 index = lanes + (int16)((int)at);
         int16 lane = index < (int16)((int)count);
-        LANE_HITS16(lane, (float16)(tmin), best_t)
+        LANE_HITS_T(float16, int16, lane, (float16)(tmin), best_t)
         any_special |= special;
         best_t = select(best_t, t, ok);
         best_v = select(best_v, v, ok);
