@@ -20,7 +20,7 @@
 // The lanes: sixteen, or eight where the CPU has AVX2 but not AVX-512 (-DLANES=16 or 8 chooses):
 // sixteen lanes there are two 256-bit halves to every vector operation and half as many vectors
 // in its sixteen registers, and eight took 7-8 % less time on AMD's Zen 3 (docs/benchmarks.md,
-// "Twenty-fourth session"). Below, "sixteen" is LANES.
+// "Twenty-third session"). Below, "sixteen" is LANES.
 #ifndef LANES
 #if defined(__AVX2__) && !defined(__AVX512F__) && defined(__x86_64__)
 #define LANES 8
@@ -138,7 +138,7 @@ inline ushort lanes_kmask(lanes_i m) {
     }
 #elif defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
 // AVX2 (no AVX-512): masks by movmskps, gathers by AVX2's eight-lane gathers (pairs of words by
-// its four-lane 8-byte ones), scatters lane by lane over the mask's bits (AVX2 has none).
+// its four-lane 8-byte ones); AVX2 has no scatter.
 inline ushort lanes_kmask(lanes_i m) {
     lanes_i t = m != (lanes_i)(0);
 #if LANES == 16
@@ -175,7 +175,12 @@ inline ushort lanes_kmask(lanes_i m) {
         LANES_GATHER_HALVES(base, idx, km, lo_, hi_) \
         LANES_DEINTERLEAVE(lo_, hi_, A, B)           \
     }
-#define LANES_SCATTER_PAIR(base, idx, km, A, B)                          \
+// A push (LANES_PUSH_PAIR, below) without a scatter: every lane stores, one 8-byte store after
+// another, those outside km into their free entry (the one at their stack pointer, which no
+// walk reads: their pushes and pops leave it above the top). A loop over km's lanes alone cost
+// a branch a lane and a mispredicted exit a push; the stores in every lane took 4-5 % less time
+// on the 1 M-triangle scenes (docs/benchmarks.md, "Twenty-third session").
+#define LANES_PUSH_PAIR(base, idx, km, A, B)                            \
     {                                                                   \
         LANES_INTERLEAVE(A, B, lo_, hi_)                                \
         long q_[LANES];                                                 \
@@ -183,10 +188,8 @@ inline ushort lanes_kmask(lanes_i m) {
         lanes_vstore_pairs(lo_, q_);                                    \
         lanes_vstore_pairs(hi_, q_ + LANES / 2);                        \
         lanes_vstore((idx), 0, i_);                                     \
-        for (uint b_ = (km); b_ != 0u; b_ &= b_ - 1u) {                 \
-            uint l_ = (uint)__builtin_ctz(b_);                          \
+        _Pragma("unroll") for (int l_ = 0; l_ < LANES; ++l_)            \
             *(long*)((float*)(base) + i_[l_]) = q_[l_];                \
-        }                                                               \
     }
 #else
 inline ushort lanes_kmask(lanes_i m) {
@@ -265,6 +268,12 @@ inline int8 lanes_compress8_index(uint km8) {
     return ((int8)((int)LANES_COMPRESS8[km8 & 255u]) >> (int8)(0, 4, 8, 12, 16, 20, 24, 28)) &
            (int8)(7);
 }
+#endif
+
+// A lane's push of A and B side by side at word offset idx, for the lanes of km: a scatter,
+// unless the form above stores in every lane.
+#ifndef LANES_PUSH_PAIR
+#define LANES_PUSH_PAIR LANES_SCATTER_PAIR
 #endif
 
 // The lanes of mask km of v, in order, in the first lanes (the others 0); and the lanes of v
@@ -570,7 +579,7 @@ LANES_INLINE void lanes_rare_cases(lanes_i special, lanes_i tri, const float3* o
 }
 
 // Lanes at a leaf are tested together once at least this many are (the others wait at it).
-// (Six of sixteen, three of eight: docs/benchmarks.md, "Twenty-fourth session".)
+// (Six of sixteen, three of eight: docs/benchmarks.md, "Twenty-third session".)
 #ifndef LANES_LEAF_MIN
 #define LANES_LEAF_MIN (LANES == 16 ? 6 : 3)
 #endif
@@ -670,7 +679,9 @@ LANES_INLINE void lanes_prefetch(ulong base, lanes_i first, uint size, uint byte
 
 // The most (lane, triangle) pairs a leaf step tests sixteen at a time (more: one triangle of
 // every lane at a time).
+#ifndef LANES_PAIRS_MAX
 #define LANES_PAIRS_MAX 64
+#endif
 
 // Compare-exchange of two (distance, item) pairs in every lane, nearest first.
 #define LANES_ORDER(A, B)                      \
@@ -784,7 +795,7 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
     {                                                                              \
         lanes_i p = mi & (d##J < inf);                                               \
         lanes_i at = (L->sp * (lanes_i)(LANES) + lane) * (lanes_i)(2);                   \
-        LANES_SCATTER_PAIR(M->stack, at, lanes_kmask(p), d##J, as_lanes_f(c##J)); \
+        LANES_PUSH_PAIR(M->stack, at, lanes_kmask(p), d##J, as_lanes_f(c##J));    \
         L->sp -= p;                                                                \
     }
             LANES_PUSH(3)

@@ -116,10 +116,10 @@ pub const LANES_MIN_TRIANGLES: usize = 32_768;
 /// a CPU device: no alpha, not a small scene, [`LANES_MIN_TRIANGLES`] or more and fewer than
 /// 2^27 triangles in leaves of at most 15 (a lane's stack entry packs both in a word), the host
 /// CPU (PoCL's device) has AVX-512 (whose gathers, scatters and compresses the walk uses) or
-/// AVX2 (gathers, table-driven compresses, scatters lane by lane: 10-15 % faster than one ray at
-/// a time on AMD's Zen 3, docs/benchmarks.md, "Twenty-fourth session"), and `PENUMBRA_LANES`
-/// is not `0` (docs/benchmarks.md, "Fourteenth session"). `PENUMBRA_LANES=1` walks in lanes on
-/// any CPU device (lane by lane where the CPU has neither: for measurements).
+/// AVX2 (eight lanes: gathers, table-driven compresses, stores for scatters; 17-25 % less time
+/// than one ray at a time on AMD's Zen 3, docs/benchmarks.md, "Twenty-third session"), and
+/// `PENUMBRA_LANES` is not `0` (docs/benchmarks.md, "Fourteenth session"). `PENUMBRA_LANES=1`
+/// walks in lanes on any CPU device (lane by lane where the CPU has neither: for measurements).
 pub fn lanes_megakernel(
     cpu: bool,
     alpha: bool,
