@@ -606,10 +606,28 @@ LANES_INLINE lanes_i lanes_pack(lanes_i c, lanes_i k) {
 // element may straddle one more line than the loop reaches; elements of whole lines (the
 // nodes, 128 bytes, in buffers aligned to pages) need no such fetch, and after inlining the
 // test folds away.
+// With eight lanes (LANES_PREFETCH_ALL) every lane prefetches, those outside m element 0 (the
+// root node, the first triangle: cached), with no branch but the mask's test: the loop over m's
+// lanes took 6 % more time on the 1 M-triangle scenes on Zen 3 (docs/benchmarks.md,
+// "Twenty-third session"); sixteen lanes keep the loop (not measured where they run).
+#if LANES == 8 && !defined(LANES_PREFETCH_MASKED)
+#define LANES_PREFETCH_ALL
+#endif
 LANES_INLINE void lanes_prefetch(ulong base, lanes_i first, uint size, uint bytes, lanes_i m) {
     uint bits = lanes_kmask(m);
     if (bits == 0u) return;
     int first_[LANES];
+#ifdef LANES_PREFETCH_ALL
+    lanes_vstore(select((lanes_i)(0), first, m), 0, first_);
+#pragma unroll
+    for (int l = 0; l < LANES; ++l) {
+        ulong a = base + (ulong)first_[l] * size;
+        for (uint o = 0u; o < bytes; o += 64u) __builtin_prefetch((const void*)(a + o));
+        if (size % 64u != 0u || bytes % 64u != 0u)
+            __builtin_prefetch((const void*)(a + bytes - 1u));
+    }
+    return;
+#endif
     lanes_vstore(first, 0, first_);
     while (bits != 0u) {
         uint l = (uint)__builtin_ctz(bits);
