@@ -613,6 +613,13 @@ LANES_INLINE lanes_i lanes_pack(lanes_i c, lanes_i k) {
 #if LANES == 8 && !defined(LANES_PREFETCH_MASKED)
 #define LANES_PREFETCH_ALL
 #endif
+
+// lanes_prefetch's loads of one element, at a.
+LANES_INLINE void lanes_prefetch_element(ulong a, uint size, uint bytes) {
+    for (uint o = 0u; o < bytes; o += 64u) __builtin_prefetch((const void*)(a + o));
+    if (size % 64u != 0u || bytes % 64u != 0u) __builtin_prefetch((const void*)(a + bytes - 1u));
+}
+
 LANES_INLINE void lanes_prefetch(ulong base, lanes_i first, uint size, uint bytes, lanes_i m) {
     uint bits = lanes_kmask(m);
     if (bits == 0u) return;
@@ -620,23 +627,16 @@ LANES_INLINE void lanes_prefetch(ulong base, lanes_i first, uint size, uint byte
 #ifdef LANES_PREFETCH_ALL
     lanes_vstore(select((lanes_i)(0), first, m), 0, first_);
 #pragma unroll
-    for (int l = 0; l < LANES; ++l) {
-        ulong a = base + (ulong)first_[l] * size;
-        for (uint o = 0u; o < bytes; o += 64u) __builtin_prefetch((const void*)(a + o));
-        if (size % 64u != 0u || bytes % 64u != 0u)
-            __builtin_prefetch((const void*)(a + bytes - 1u));
-    }
-    return;
-#endif
+    for (int l = 0; l < LANES; ++l)
+        lanes_prefetch_element(base + (ulong)first_[l] * size, size, bytes);
+#else
     lanes_vstore(first, 0, first_);
     while (bits != 0u) {
         uint l = (uint)__builtin_ctz(bits);
         bits &= bits - 1u;
-        ulong a = base + (ulong)first_[l] * size;
-        for (uint o = 0u; o < bytes; o += 64u) __builtin_prefetch((const void*)(a + o));
-        if (size % 64u != 0u || bytes % 64u != 0u)
-            __builtin_prefetch((const void*)(a + bytes - 1u));
+        lanes_prefetch_element(base + (ulong)first_[l] * size, size, bytes);
     }
+#endif
 }
 
 // The triangles prefetched of a leaf (a fixed number: a loop over each leaf's own count cost
