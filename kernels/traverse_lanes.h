@@ -616,6 +616,7 @@ LANES_INLINE lanes_i lanes_pack(lanes_i c, lanes_i k) {
 
 // lanes_prefetch's loads of one element, at a.
 LANES_INLINE void lanes_prefetch_element(ulong a, uint size, uint bytes) {
+#pragma unroll
     for (uint o = 0u; o < bytes; o += 64u) __builtin_prefetch((const void*)(a + o));
     if (size % 64u != 0u || bytes % 64u != 0u) __builtin_prefetch((const void*)(a + bytes - 1u));
 }
@@ -774,19 +775,54 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             LANES_CHILDREN(0, 1)
             LANES_CHILDREN(2, 3)
 #else
-            // The nodes as rows: W[w], word w of each lane's node (lanes not at one read the
-            // root's).
+            // The nodes as rows, one axis at a time (each child's near and far distances
+            // folded in as in LANES_CHILD, x, y, z in turn), so that only one axis's planes and
+            // the running distances are live: the 32 words of a node at once were more vectors
+            // than registers.
             int off_[LANES];
             lanes_vstore(select(izero, base, mi), 0, off_);
-            lanes_f W[32];
-#pragma unroll
-            for (int w = 0; w < 32; w += 8) lanes_rows8(nw, off_, w, W + w);
-            lanes_i px = L->ix >= zero, py = L->iy >= zero, pz = L->iz >= zero;
+            lanes_f d0, d1, d2, d3, f0, f1, f2, f3;
+            {
+                lanes_f lo[4], hi[4];
+                lanes_i pos = L->ix >= zero;
+                lanes_rows4(nw, off_, 0, lo);
+                lanes_rows4(nw, off_, 12, hi);
+#define LANES_SLAB_X(J)                                                \
+    d##J = (select(hi[J], lo[J], pos) - L->ox) * L->ix;              \
+    f##J = (select(lo[J], hi[J], pos) - L->ox) * L->ix;
+                LANES_SLAB_X(0) LANES_SLAB_X(1) LANES_SLAB_X(2) LANES_SLAB_X(3)
+#undef LANES_SLAB_X
+            }
+#define LANES_SLAB(J, O, I)                                                              \
+    {                                                                                  \
+        lanes_f n_ = (select(hi[J], lo[J], pos) - L->O) * L->I;                        \
+        lanes_f f_ = (select(lo[J], hi[J], pos) - L->O) * L->I;                        \
+        d##J = select(d##J, n_, n_ > d##J);                                            \
+        f##J = select(f##J, f_, f_ < f##J);                                            \
+    }
+// The axis of origin O and reciprocal I, its planes at words WLO (minima) and WHI (maxima).
+#define LANES_SLABS(WLO, WHI, O, I)                                                   \
+    {                                                                               \
+        lanes_f lo[4], hi[4];                                                       \
+        lanes_i pos = L->I >= zero;                                                 \
+        lanes_rows4(nw, off_, WLO, lo);                                             \
+        lanes_rows4(nw, off_, WHI, hi);                                             \
+        LANES_SLAB(0, O, I) LANES_SLAB(1, O, I) LANES_SLAB(2, O, I) LANES_SLAB(3, O, I) \
+    }
+            LANES_SLABS(4, 16, oy, iy)
+            LANES_SLABS(8, 20, oz, iz)
+#undef LANES_SLABS
+#undef LANES_SLAB
+            lanes_f W[8];
+            lanes_rows8(nw, off_, 24, W);
 #define LANES_CHILDREN(J)                                                                   \
-    LANES_CHILD(J, select(W[12 + J], W[J], px), select(W[16 + J], W[4 + J], py),            \
-                select(W[20 + J], W[8 + J], pz), select(W[J], W[12 + J], px),               \
-                select(W[4 + J], W[16 + J], py), select(W[8 + J], W[20 + J], pz),           \
-                as_lanes_i(W[24 + J]), as_lanes_i(W[28 + J]))
+    {                                                                                       \
+        lanes_f nr = select(d##J, zero, zero > d##J), fr = f##J * 1.00000024f;              \
+        lanes_i cw = as_lanes_i(W[J]), kw = as_lanes_i(W[4 + J]);                           \
+        lanes_i reach = mi & ((cw > izero) | (kw != izero)) & (nr <= fr) & (nr < L->tfar);  \
+        d##J = select(inf, nr, reach);                                                    \
+        c##J = lanes_pack(cw, kw);                                                        \
+    }
             LANES_CHILDREN(0)
             LANES_CHILDREN(1)
             LANES_CHILDREN(2)
