@@ -530,11 +530,14 @@ LANES_INLINE void lanes_set_segment(LaneMemory* M, int lane, float3 o, float3 d,
     LANES_SET_RAY_FIELDS(M, lane, o, d, tmax)
     M->kx[lane] = (int)r.perm.x;
     M->ky[lane] = (int)r.perm.y;
-    M->cur[lane] = 0;
     M->sp[lane] = 0;
-    M->live[lane] = -1;
-    M->has[lane] = -1;
     M->any[lane] = any_hit ? -1 : 0;
+    // The fields lanes_walk reads first, by vector: written by vector too (a vector load of
+    // words just stored one by one waits for the stores: no store-to-load forwarding).
+    lanes_i here = LANE_IDS == (lanes_i)(lane);
+    M->V.cur = select(M->V.cur, (lanes_i)(0), here);
+    M->V.live = M->V.live | here;
+    M->V.has = M->V.has | here;
 }
 
 // Lane `lane` takes the extension ray from o along d (the nearest hit).
@@ -928,33 +931,29 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 hits[p0 / LANES] = lanes_kmask(ok);
                 found |= hits[p0 / LANES];
             }
-            // No pair hit: the lanes' hits stand as they are.
+            // No pair hit: the lanes' hits stand as they are. Else each hit, in pair order,
+            // replaces its lane's if nearer, by selects (no branch on the distances, and no
+            // vector load of words just stored one by one, which waits for the stores).
             if (!by_k && found != 0u) {
-                float tf[LANES], hv[LANES], hw[LANES], hdet[LANES];
-                int prim[LANES];
-                lanes_vstore(L->tfar, 0, tf);
-                lanes_vstore(L->hv, 0, hv);
-                lanes_vstore(L->hw, 0, hw);
-                lanes_vstore(L->hdet, 0, hdet);
-                lanes_vstore(L->prim, 0, prim);
+                lanes_f tf = L->tfar, hv = L->hv, hw = L->hw, hdet = L->hdet;
+                lanes_i prim = L->prim;
                 for (int p0 = 0; p0 < pairs; p0 += LANES) {
                     for (uint h = hits[p0 / LANES]; h != 0u; h &= h - 1u) {
                         int i = p0 + (int)__builtin_ctz(h);
-                        int l = pl[i];
-                        if (rt[i] < tf[l]) {
-                            tf[l] = rt[i];
-                            hv[l] = rv[i];
-                            hw[l] = rw[i];
-                            hdet[l] = rdet[i];
-                            prim[l] = pt[i];
-                        }
+                        lanes_f t_ = (lanes_f)(rt[i]);
+                        lanes_i nearer = (lane == (lanes_i)(pl[i])) & (t_ < tf);
+                        tf = select(tf, t_, nearer);
+                        hv = select(hv, (lanes_f)(rv[i]), nearer);
+                        hw = select(hw, (lanes_f)(rw[i]), nearer);
+                        hdet = select(hdet, (lanes_f)(rdet[i]), nearer);
+                        prim = select(prim, (lanes_i)(pt[i]), nearer);
                     }
                 }
-                L->tfar = lanes_vload(0, tf);
-                L->hv = lanes_vload(0, hv);
-                L->hw = lanes_vload(0, hw);
-                L->hdet = lanes_vload(0, hdet);
-                L->prim = lanes_vload(0, prim);
+                L->tfar = tf;
+                L->hv = hv;
+                L->hw = hw;
+                L->hdet = hdet;
+                L->prim = prim;
             }
             if (!by_k) kmax = 0;  // done: no walk by triangle order
 #endif
