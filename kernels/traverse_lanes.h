@@ -29,6 +29,11 @@
 #endif
 #endif
 #define LANES_STACK (WIDE_STACK_SIZE + 1)
+// A lane's stack is LANES_STACK entries and three more, which a push of three entries in one
+// 32-byte store (LANES_PUSH3) may write past its top.
+#define LANES_STACK_STRIDE (LANES_STACK + 3)
+// The word offset of each lane's stack entry sp (a lane's entries side by side).
+#define LANES_ENTRY(sp) ((LANE_IDS * (lanes_i)(LANES_STACK_STRIDE) + (sp)) * (lanes_i)(2))
 #define LANES_INLINE inline __attribute__((always_inline))
 #if LANES == 16
 typedef float16 lanes_f;
@@ -407,14 +412,12 @@ LANES_INLINE void lanes_transpose4(const lanes_f* m, lanes_f* c) {
     c[3] = LANES_SHUFFLE(t1, t3, LANES_PAIRSHI);
 }
 
-// Words [w, w + 8) of the row at word offset off[l] of base, for each lane l, into c[0..8):
-// word w + i of lane l in lane l of c[i].
-LANES_INLINE void lanes_rows8(global const float* base, const int* off, int w, lanes_f* c) {
-    lanes_f m[8], s[8];
-#pragma unroll
-    for (int i = 0; i < 8; ++i) m[i] = LANES_ROW8(base, off, w, i);
-    // s[j]: word j of lanes 0-3 (and 8-11) in quarter 0 (and 2), word j + 4 in quarter 1 (and
-    // 3); s[j + 4] the same for lanes 4-7 (and 12-15). Then the quarters of each word together.
+// 8×8 transposes of words in each 256-bit half: word j of m[i]'s half h to word i of c[j]'s
+// half h (with eight lanes, the transpose of the eight vectors).
+LANES_INLINE void lanes_transpose8(const lanes_f* m, lanes_f* c) {
+    lanes_f s[8];
+    // s[j]: word j of rows 0-3 in quarter 0 (and 2), word j + 4 in quarter 1 (and 3); s[j + 4]
+    // the same for rows 4-7. Then the quarters of each word together.
     lanes_transpose4(m, s);
     lanes_transpose4(m + 4, s + 4);
 #pragma unroll
@@ -422,6 +425,15 @@ LANES_INLINE void lanes_rows8(global const float* base, const int* off, int w, l
         c[i] = LANES_SHUFFLE(s[i], s[i + 4], LANES_QUADSLO);
         c[i + 4] = LANES_SHUFFLE(s[i], s[i + 4], LANES_QUADSHI);
     }
+}
+
+// Words [w, w + 8) of the row at word offset off[l] of base, for each lane l, into c[0..8):
+// word w + i of lane l in lane l of c[i].
+LANES_INLINE void lanes_rows8(global const float* base, const int* off, int w, lanes_f* c) {
+    lanes_f m[8];
+#pragma unroll
+    for (int i = 0; i < 8; ++i) m[i] = LANES_ROW8(base, off, w, i);
+    lanes_transpose8(m, c);
 }
 
 // The same for words [w, w + 4), into c[0..4).
@@ -476,9 +488,9 @@ typedef struct {
 #undef LANES_ARRAY_I
         };
     };
-    // The stacks: entry k of lane l at word 2 (k LANES + l), its entry distance, then its item
-    // in lanes_pack form (as float bits).
-    float stack[2 * LANES_STACK * LANES];
+    // The stacks: entry k of lane l at word 2 (l LANES_STACK_STRIDE + k) (LANES_ENTRY), its entry
+    // distance, then its item in lanes_pack form (as float bits).
+    float stack[2 * LANES_STACK_STRIDE * LANES];
     float3 o[LANES], d[LANES];  // the rays, for the scalar test's rare cases
 } LaneMemory;
 
@@ -869,17 +881,41 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 L->has &= ~full;
             }
             // The reached children but the nearest pushed, farthest first; the nearest entered.
+#if LANES == 8
+            // Eight lanes: a lane's pushed entries are one 32-byte store at its stack pointer.
+            // The reached children are a prefix of 1, 2, 3 (sorted; the others at infinity),
+            // so the entries, farthest first, are selects: the top is child 1, below it 2, 3.
+            {
+                lanes_i p1 = mi & (d1 < inf), p2 = mi & (d2 < inf), p3 = mi & (d3 < inf);
+                lanes_f e[8];
+                e[0] = select(select(d1, d2, p2), d3, p3);
+                e[1] = as_lanes_f(select(select(c1, c2, p2), c3, p3));
+                e[2] = select(d1, d2, p3);
+                e[3] = as_lanes_f(select(c1, c2, p3));
+                e[4] = d1;
+                e[5] = as_lanes_f(c1);
+                e[6] = e[7] = zero;
+                lanes_f rows[8];
+                lanes_transpose8(e, rows);
+                int at_[LANES];
+                lanes_vstore(LANES_ENTRY(L->sp), 0, at_);
+#pragma unroll
+                for (int l = 0; l < LANES; ++l) vstore8(rows[l], 0, M->stack + at_[l]);
+                L->sp -= p1 + p2 + p3;
+            }
+#else
 #define LANES_PUSH(J)                                                              \
     {                                                                              \
         lanes_i p = mi & (d##J < inf);                                               \
-        lanes_i at = (L->sp * (lanes_i)(LANES) + lane) * (lanes_i)(2);                   \
-        LANES_PUSH_PAIR(M->stack, at, lanes_kmask(p), d##J, as_lanes_f(c##J));    \
+        LANES_PUSH_PAIR(M->stack, LANES_ENTRY(L->sp), lanes_kmask(p), d##J,        \
+                        as_lanes_f(c##J));                                         \
         L->sp -= p;                                                                \
     }
             LANES_PUSH(3)
             LANES_PUSH(2)
             LANES_PUSH(1)
 #undef LANES_PUSH
+#endif
             lanes_i enter = mi & (d0 < inf);
             arrived |= enter & (c0 < izero);
             L->cur = select(L->cur, c0, enter);
@@ -993,7 +1029,7 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             done |= pm & ~m;
             if (!lanes_any(m)) break;
             L->sp += m;
-            lanes_i at = (L->sp * (lanes_i)(LANES) + lane) * (lanes_i)(2);
+            lanes_i at = LANES_ENTRY(L->sp);
             lanes_f d, itemf;
             LANES_POP_PAIR(M->stack, at, lanes_kmask(m), d, itemf)
             lanes_i keep = m & (d < L->tfar);
