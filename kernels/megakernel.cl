@@ -92,17 +92,27 @@ inline GpuHit mega_nearest_emitter(const GpuFrame* frame, const ShadeScene* sc, 
 // With MEGA_LANES a work item renders a square of LANES_TILE² pixels in two shapes of walk:
 //   - a chunk of a pixel's samples (sixteen at a time) or, below sixteen samples, of a 4×4
 //     block's, starts together: their camera rays walk the tree as one packet
-//     (traverse_packet.h), their first vertices are shaded by shade_vertex, and their light
-//     samples, which start close together and go to one light, walk as a packet too;
-//   - the paths that go on are taken by sixteen lanes (traverse_lanes.h), one path a lane, whose
-//     extension rays walk together, each at its own node: when some are done, their vertices are
-//     shaded, the light sample of each walks in its lane next (an any-hit ray), and then each
-//     lane takes its path's next ray, or the next path of a chunk.
+//     (traverse_packet.h), their first vertices are shaded (by shade_vertex, or together by
+//     lanes_shade), and their light samples, which start close together and go to one light,
+//     walk as a packet too;
+//   - the paths that go on take turns in sixteen lanes (traverse_lanes.h), one ray a lane, whose
+//     rays walk together, each at its own node: when some are done, their vertices are shaded
+//     (at once, or with LANES_SHADE in batches of sixteen, shade_lanes.h), the light sample of
+//     each walks next (an any-hit ray), then the path's next ray; a lane whose ray is done takes
+//     the next ray waiting, or the next path of a chunk.
 // A chunk's results wait in its record until all its paths are done; then they are added to
 // their pixels' film sums in sample order, and a pixel has one chunk in flight at a time, so
 // each pixel sums its samples in the order the one-pixel kernel below does: the same image,
 // bit for bit (but for rays meeting two triangles at the same distance).
-#define MEGA_CHUNKS 20  // records: a chunk a lane in flight, and the queue's, cannot starve
+// Paths in flight: one a lane, or with vertices shaded in batches (shade_lanes.h) twice as many,
+// so that the lanes walk other paths' rays while a batch fills.
+#ifdef LANES_SHADE
+#define MEGA_SLOTS (2 * LANES)
+#else
+#define MEGA_SLOTS LANES
+#endif
+// Records: a chunk a path in flight, and the queue's, cannot starve.
+#define MEGA_CHUNKS (MEGA_SLOTS + 4)
 
 typedef struct {
     uint pixel[LANES];    // entry e's pixel (a pixel's entries follow each other, in sample order)
@@ -229,8 +239,18 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
     ShadowQuery q[LANES];
     bool alive[LANES];
     int shadow[LANES];
+#ifdef LANES_SHADE
+    // The camera hits shaded together (shade_lanes.h).
+    ShadeBatch B;
+    for (uint e = 0u; e < n; ++e) shade_batch_put(&B, (int)e, &s[e], 0u, packet_hit(&P, (int)e));
+    lanes_shade(frame, sc, &B, (int)n);
+#endif
     for (uint e = 0u; e < n; ++e) {
+#ifdef LANES_SHADE
+        alive[e] = shade_batch_get(&B, (int)e, &s[e], &q[e]);
+#else
         alive[e] = shade_vertex(frame, 0u, sc, packet_hit(&P, (int)e), &s[e], &q[e]);
+#endif
         shadow[e] = q[e].valid ? -1 : 0;
         if (q[e].valid) packet_set_ray(&P, (int)e, q[e].origin, q[e].direction, q[e].tmax);
     }
@@ -269,6 +289,11 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
     return true;
 }
 
+// The lanes' loop: MEGA_SLOTS paths in flight, each in a lane (its ray walking), ready (its
+// next ray, or its light sample's segment, waiting for a lane), free, or with LANES_SHADE in
+// the batch (its vertex waiting to be shaded with others; shade_lanes.h). A path traces one
+// ray at a time, its light sample before its next ray, so each path adds its light in the
+// order of the one-pixel kernel below: the same image.
 kernel void megakernel(MEGAKERNEL_PARAMS) {
     // The work item's square of pixels, LANES_TILE on a side.
     uint tiles_x = (frame.width + LANES_TILE - 1u) / LANES_TILE;
@@ -289,123 +314,187 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
     LaneMemory M;
     lanes_init(&M);
-    PathState s[LANES];
-    uint bounce[LANES], chunk[LANES], entry[LANES];
-    bool busy[LANES];
-    // A lane walking its vertex's light sample: the sample, and whether the path goes on after.
-    ShadowQuery sample[LANES];
-    bool in_shadow[LANES], goes_on[LANES];
+    PathState s[MEGA_SLOTS];
+    uint bounce[MEGA_SLOTS], chunk[MEGA_SLOTS], entry[MEGA_SLOTS];
+    // A path whose next ray is its vertex's light sample: the sample, and whether the path goes
+    // on after it.
+    ShadowQuery sample[MEGA_SLOTS];
+    bool in_shadow[MEGA_SLOTS], goes_on[MEGA_SLOTS];
 #ifdef LAST_RAY_EMITTERS
-    // A lane walking a last ray's segment to the emitter it meets: that hit.
-    bool to_emitter[LANES];
-    GpuHit emitter[LANES];
-    for (int l = 0; l < LANES; ++l) to_emitter[l] = false;
+    // A path whose next ray is its last ray's segment to the emitter it meets: that hit.
+    bool to_emitter[MEGA_SLOTS];
+    GpuHit emitter[MEGA_SLOTS];
     bool last_by_emitters = mega_last_ray_by_emitters(&frame);
 #endif
-    // A lane takes the next queued path (starting chunks while the queue is empty); with none
-    // left it stays idle.
-#define LANE_NEXT_PATH(l)                                                                    \
+    int lane_slot[LANES];  // the path of each lane's ray, -1: idle
+    int ready[MEGA_SLOTS], free_slot[MEGA_SLOTS];
+    uint ready_head = 0u, ready_count = 0u, free_count = MEGA_SLOTS;
+    for (int k = 0; k < MEGA_SLOTS; ++k) {
+        free_slot[k] = MEGA_SLOTS - 1 - k;
+#ifdef LAST_RAY_EMITTERS
+        to_emitter[k] = false;
+#endif
+    }
+    for (int l = 0; l < LANES; ++l) lane_slot[l] = -1;
+#ifdef LANES_SHADE
+    ShadeBatch B;
+    int batch_slot[LANES];
+#endif
+    int batch_n = 0;  // vertices in the batch
+#define SLOT_READY(k) ready[(ready_head + ready_count++) % MEGA_SLOTS] = (k);
+    // A path's next ray, or its end (the last ray first tested against the emitters).
+#define SLOT_NEXT(k, alive_)                                                                \
     {                                                                                        \
-        while (W.queue_head == W.queue_end &&                                                \
-               mega_chunk_start(&W, &frame, &camera, &sc, nodes, instances, object_tris,     \
-                                film, overflow)) {                                           \
-        }                                                                                    \
-        if (W.queue_head < W.queue_end) {                                                    \
-            uint k = W.queue_head++;                                                         \
-            s[l] = W.queued[k];                                                              \
-            chunk[l] = W.queued_chunk[k];                                                    \
-            entry[l] = W.queued_entry[k];                                                    \
-            bounce[l] = 1u;                                                                  \
-            busy[l] = true;                                                                  \
-            in_shadow[l] = false;                                                            \
-            lanes_set_ray(&M, l, s[l].origin, s[l].direction);                               \
+        bool a_ = (alive_);                                                                  \
+        SLOT_NEXT_LAST_RAY(k, a_)                                                            \
+        if (a_) {                                                                            \
+            SLOT_READY(k)                                                                    \
+        } else {                                                                             \
+            mega_path_done(&W, &frame, film, chunk[k], entry[k], &s[k]);                     \
+            free_slot[free_count++] = (k);                                                   \
         }                                                                                    \
     }
-    bool idle = false;
-    for (int l = 0; l < LANES; ++l) {
-        busy[l] = false;
-        LANE_NEXT_PATH(l)
-        idle |= !busy[l];
+#ifdef LAST_RAY_EMITTERS
+#define SLOT_NEXT_LAST_RAY(k, a_)                                                            \
+    if (a_ && last_by_emitters && bounce[k] == frame.max_bounces + 1u) {                     \
+        GpuHit e_ = mega_nearest_emitter(&frame, &sc, s[k].origin, s[k].direction);         \
+        if (e_.prim != NO_HIT) {                                                             \
+            to_emitter[k] = true;                                                            \
+            emitter[k] = e_;                                                                 \
+        } else {                                                                             \
+            a_ = false; /* it meets no emitter: it would add nothing */                      \
+        }                                                                                    \
     }
+#else
+#define SLOT_NEXT_LAST_RAY(k, a_)
+#endif
+    // Path k's vertex shaded (alive_: whether the path goes on): its light sample, else its
+    // next ray, is ready.
+#define SLOT_SHADED(k, alive_)                                                               \
+    {                                                                                        \
+        bool al_ = (alive_) && ++bounce[k] <= frame.max_bounces + 1u;                        \
+        if (sample[k].valid) {                                                               \
+            ++W.shadow_rays;                                                                 \
+            in_shadow[k] = true;                                                             \
+            goes_on[k] = al_;                                                                \
+            SLOT_READY(k)                                                                    \
+        } else {                                                                             \
+            SLOT_NEXT(k, al_)                                                                \
+        }                                                                                    \
+    }
+#ifdef LANES_SHADE
+#define SHADE_BATCH                                                                          \
+    {                                                                                        \
+        lanes_shade(&frame, &sc, &B, batch_n);                                               \
+        for (int e = 0; e < batch_n; ++e) {                                                  \
+            int k = batch_slot[e];                                                           \
+            SLOT_SHADED(k, shade_batch_get(&B, e, &s[k], &sample[k]))                        \
+        }                                                                                    \
+        batch_n = 0;                                                                         \
+    }
+#else
+#define SHADE_BATCH
+#endif
     for (;;) {
+        // Idle lanes take ready rays, then new paths (starting chunks while the queue is
+        // empty); lanes left idle with vertices waiting have the batch shaded at once.
+        bool idle = false;
+        for (int l = 0; l < LANES; ++l) {
+            if (lane_slot[l] >= 0) continue;
+            int k = -1;
+            if (ready_count > 0u) {
+                k = ready[ready_head];
+                ready_head = (ready_head + 1u) % MEGA_SLOTS;
+                --ready_count;
+            } else if (free_count > 0u) {
+                while (W.queue_head == W.queue_end &&
+                       mega_chunk_start(&W, &frame, &camera, &sc, nodes, instances, object_tris,
+                                        film, overflow)) {
+                }
+                if (W.queue_head < W.queue_end) {
+                    uint q = W.queue_head++;
+                    k = free_slot[--free_count];
+                    s[k] = W.queued[q];
+                    chunk[k] = W.queued_chunk[q];
+                    entry[k] = W.queued_entry[q];
+                    bounce[k] = 1u;
+                    in_shadow[k] = false;
+                }
+            }
+            if (k < 0) {
+                idle = true;
+                continue;
+            }
+            lane_slot[l] = k;
+#ifdef LAST_RAY_EMITTERS
+            if (to_emitter[k]) {
+                lanes_set_segment(&M, l, s[k].origin, s[k].direction, emitter[k].t, true);
+                continue;
+            }
+#endif
+            if (in_shadow[k]) {
+                lanes_set_segment(&M, l, sample[k].origin, sample[k].direction, sample[k].tmax,
+                                  true);
+            } else {
+                lanes_set_ray(&M, l, s[k].origin, s[k].direction);
+            }
+        }
+        if (idle && batch_n > 0) {
+            SHADE_BATCH
+            continue;
+        }
         lanes_i done = lanes_walk(&M, nodes, tris, &sc.surf, overflow);
         if (!lanes_any(done)) break;
         // The lanes done, in order (lowest first).
         for (uint bits = lanes_kmask(done); bits != 0u; bits &= bits - 1u) {
             int l = (int)__builtin_ctz(bits);
-            bool alive;
+            int k = lane_slot[l];
+            lane_slot[l] = -1;
 #ifdef LAST_RAY_EMITTERS
-            if (to_emitter[l]) {
-                // The last ray's segment to its emitter walked: unblocked, the emitter is
-                // its closest hit. The path ends.
-                to_emitter[l] = false;
+            if (to_emitter[k]) {
+                // The last ray's segment to its emitter walked: unblocked, the emitter is its
+                // closest hit. The path ends.
+                to_emitter[k] = false;
                 ++W.extension_rays;
                 if (M.prim[l] < 0) {
-                    shade_vertex(&frame, bounce[l], &sc, emitter[l], &s[l], &sample[l]);
+                    shade_vertex(&frame, bounce[k], &sc, emitter[k], &s[k], &sample[k]);
                 }
-                alive = false;
-            } else
-#endif
-            if (in_shadow[l]) {
-                // The vertex's light sample walked: its light is added (unless blocked, perhaps
-                // only by thin walls, which the scalar test passes) before the path goes on.
-                in_shadow[l] = false;
-                alive = goes_on[l];
-                if (M.prim[l] < 0) {
-                    s[l].radiance += sample[l].contribution;
-                } else {
-#ifdef HAS_THIN_WALLS
-                    s[l].radiance += shadow_pass_wide(nodes, tris, instances, object_tris,
-                                                      &sc.surf, &sample[l], overflow);
-#endif
-                }
-            } else {
-                ++W.extension_rays;
-                alive = shade_vertex(&frame, bounce[l], &sc, lanes_hit(&M, l), &s[l], &sample[l]);
-                alive = alive && ++bounce[l] <= frame.max_bounces + 1u;
-                if (sample[l].valid) {
-                    // The light sample walks in the lane first, an any-hit ray.
-                    ++W.shadow_rays;
-                    in_shadow[l] = true;
-                    goes_on[l] = alive;
-                    lanes_set_segment(&M, l, sample[l].origin, sample[l].direction,
-                                      sample[l].tmax, true);
-                    continue;
-                }
-            }
-            // The path goes on, or the lane takes the next one.
-#ifdef LAST_RAY_EMITTERS
-            if (alive && last_by_emitters && bounce[l] == frame.max_bounces + 1u) {
-                GpuHit e = mega_nearest_emitter(&frame, &sc, s[l].origin, s[l].direction);
-                if (e.prim != NO_HIT) {
-                    to_emitter[l] = true;
-                    emitter[l] = e;
-                    lanes_set_segment(&M, l, s[l].origin, s[l].direction, e.t, true);
-                    continue;
-                }
-                alive = false;  // it meets no emitter: it would add nothing
-            }
-#endif
-            if (alive) {
-                lanes_set_ray(&M, l, s[l].origin, s[l].direction);
+                SLOT_NEXT(k, false)
                 continue;
             }
-            mega_path_done(&W, &frame, film, chunk[l], entry[l], &s[l]);
-            busy[l] = false;
-            LANE_NEXT_PATH(l)
-            idle |= !busy[l];
-        }
-        // Lanes left idle while every pixel with samples left had a chunk in flight take
-        // work again once one is done.
-        if (idle) {
-            idle = false;
-            for (int l = 0; l < LANES; ++l) {
-                if (!busy[l]) LANE_NEXT_PATH(l)
-                idle |= !busy[l];
+#endif
+            if (in_shadow[k]) {
+                // The vertex's light sample walked: its light is added (unless blocked, perhaps
+                // only by thin walls, which the scalar test passes) before the path goes on.
+                in_shadow[k] = false;
+                if (M.prim[l] < 0) {
+                    s[k].radiance += sample[k].contribution;
+                } else {
+#ifdef HAS_THIN_WALLS
+                    s[k].radiance += shadow_pass_wide(nodes, tris, instances, object_tris,
+                                                      &sc.surf, &sample[k], overflow);
+#endif
+                }
+                SLOT_NEXT(k, goes_on[k])
+                continue;
             }
+            // The vertex the extension ray found: shaded at once, or with LANES_SHADE once the
+            // batch is full.
+            ++W.extension_rays;
+#ifdef LANES_SHADE
+            shade_batch_put(&B, batch_n, &s[k], bounce[k], lanes_hit(&M, l));
+            batch_slot[batch_n++] = k;
+            if (batch_n == LANES) SHADE_BATCH
+#else
+            SLOT_SHADED(k, shade_vertex(&frame, bounce[k], &sc, lanes_hit(&M, l), &s[k], &sample[k]))
+#endif
         }
     }
-#undef LANE_NEXT_PATH
+#undef SHADE_BATCH
+#undef SLOT_SHADED
+#undef SLOT_NEXT_LAST_RAY
+#undef SLOT_NEXT
+#undef SLOT_READY
     mega_count(counters, W.extension_rays, W.shadow_rays, W.nonfinite);
 }
 #else

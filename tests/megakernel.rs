@@ -358,29 +358,47 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
     // partial), at 5 samples (three pixels a chunk) and 21 (a pixel's chunks of 16 and 5); lit
     // by the default light rig, and by an emissive panel (light samples that end on a
     // triangle, walked in lanes as any-hit rays, and extension rays that find the light).
+    // Every material is Lambertian, so under the panel the lanes shade their vertices in
+    // batches, in vectors (kernels/shade_lanes.h), and with PENUMBRA_LANES_SHADE=0 one by one:
+    // the same image both ways; with the background cut out too (camera rays that escape are
+    // marked, not lit).
     let dir = tempfile::tempdir().unwrap();
     let (rings, segments) = (128, 136);
     assert!((2 * rings * segments) as usize >= penumbra::cl::LANES_MIN_TRIANGLES);
     let rig = common::white_sphere_of(dir.path(), true, rings, segments);
     let panel = common::white_sphere_under_panel(dir.path(), rings, segments);
-    for (scene, spp) in [(&rig, "5"), (&rig, "21"), (&panel, "5"), (&panel, "21")] {
+    for (scene, spp, cutout) in [
+        (&rig, "5", false),
+        (&rig, "21", false),
+        (&panel, "5", false),
+        (&panel, "21", false),
+        (&panel, "5", true),
+    ] {
         let name = scene.file_stem().unwrap().to_str().unwrap();
-        let args = lanes_image_args(spp, "4");
-        let (b, pb) = render_exr_env(
-            scene,
-            &dir.path().join(format!("one-{name}-{spp}.exr")),
-            &args,
-            &[("PENUMBRA_LANES", "0")],
-        );
+        let mut args = lanes_image_args(spp, "4");
+        if cutout {
+            args.extend(["--background", "transparent"]);
+        }
+        let one = dir.path().join(format!("one-{name}-{spp}-{cutout}.exr"));
+        let (b, pb) = render_exr_env(scene, &one, &args, &[("PENUMBRA_LANES", "0")]);
         assert_eq!(b["lanes"], false, "PENUMBRA_LANES=0 left lanes on");
-        // The lanes load their nodes and triangles as rows (AMD's default) or by gathers.
-        for load in ["rows", "gathers"] {
+        assert_eq!(b["lanes_shade"], false, "lanes_shade without lanes");
+        // The lanes load their nodes and triangles as rows (AMD's default) or by gathers, and
+        // shade in batches or (PENUMBRA_LANES_SHADE=0) one vertex at a time.
+        for (load, shade) in [("rows", "1"), ("gathers", "1"), ("rows", "0")] {
+            let out = dir
+                .path()
+                .join(format!("lanes-{load}-{shade}-{name}-{spp}-{cutout}.exr"));
             let (a, pa) = render_exr_env(
                 scene,
-                &dir.path().join(format!("lanes-{load}-{name}-{spp}.exr")),
+                &out,
                 &args,
-                &[("PENUMBRA_LANES_LOAD", load)],
+                &[
+                    ("PENUMBRA_LANES_LOAD", load),
+                    ("PENUMBRA_LANES_SHADE", shade),
+                ],
             );
+            let load = format!("{load}, shading {shade}, cutout {cutout}");
             #[cfg(target_arch = "x86_64")]
             if common::test_device() == "cpu"
                 && (std::arch::is_x86_feature_detected!("avx512f")
@@ -391,8 +409,16 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
                     "a CPU with AVX-512 or AVX2 did not walk in lanes"
                 );
                 assert_eq!(
-                    a["lanes_load"], load,
+                    a["lanes_load"],
+                    load.split(',').next().unwrap(),
                     "PENUMBRA_LANES_LOAD={load} not taken"
+                );
+                // The default light rig's environment map (the sphere without lights) takes
+                // the scalar shading.
+                assert_eq!(
+                    a["lanes_shade"],
+                    shade == "1" && scene == &panel,
+                    "{name}, {load}: the lanes did not shade as asked"
                 );
             }
             assert!(
@@ -407,8 +433,10 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
                 a["shadow_rays"], b["shadow_rays"],
                 "{name}, {spp} spp, {load}"
             );
+            // The files too: with the background cut out, their alpha (the camera rays that
+            // hit) as well.
             assert!(
-                pa == pb,
+                pa == pb && std::fs::read(&out).unwrap() == std::fs::read(&one).unwrap(),
                 "{name}, {spp} spp, {load}: the lanes' image differs from one ray at a time's"
             );
         }

@@ -32,6 +32,10 @@ const SOURCES: &[(&str, &str)] = &[
     ("kernels/env.h", include_str!("../../kernels/env.h")),
     ("kernels/lights.h", include_str!("../../kernels/lights.h")),
     ("kernels/path.h", include_str!("../../kernels/path.h")),
+    (
+        "kernels/shade_lanes.h",
+        include_str!("../../kernels/shade_lanes.h"),
+    ),
     ("kernels/stages.cl", include_str!("../../kernels/stages.cl")),
     (
         "kernels/megakernel.cl",
@@ -103,6 +107,9 @@ pub struct KernelFeatures {
     /// kernels/traverse_lanes.h): a flat scene that is not small, without alpha, on a CPU
     /// device with AVX-512 or AVX2 (see [`lanes_megakernel`]).
     pub lanes: bool,
+    /// The megakernel's lanes shade their paths' vertices in batches, in vectors
+    /// (`LANES_SHADE`, kernels/shade_lanes.h; see [`lanes_shade`]).
+    pub lanes_shade: bool,
 }
 
 /// The fewest triangles for which the megakernel walks its rays in lanes: below, the tree fits
@@ -149,6 +156,35 @@ pub fn lanes_megakernel(
     {
         false
     }
+}
+
+/// Whether the megakernel's lanes shade their vertices in batches of LANES, in vectors
+/// (`KernelFeatures::lanes_shade`): with lanes, where shading is simplest (every material
+/// Lambertian, no textures, normal maps, environment map, unlit materials, thin walls or two
+/// levels), unless `PENUMBRA_LANES_SHADE` is `0`. It is path.h's `shade_vertex` lane by lane,
+/// the same image; 12 % fewer instructions and about 6 % less time on the 1 M-triangle room
+/// (docs/benchmarks.md, "Twenty-fifth session").
+pub fn lanes_shade(f: &KernelFeatures) -> bool {
+    f.lanes
+        && f.lambert_only
+        && f.small_scene == 0
+        && !(f.textures
+            || f.normal_maps
+            || f.two_level
+            || f.env_map
+            || f.unlit
+            || f.thin_walls
+            || f.transmission
+            || f.clearcoat
+            || f.sheen
+            || f.diffuse_transmission
+            || f.iridescence
+            || f.anisotropy
+            || f.dispersion)
+        && std::env::var("PENUMBRA_LANES_SHADE")
+            .as_deref()
+            .map(str::trim)
+            != Ok("0")
 }
 
 /// Whether the lanes (`MEGA_LANES`) load their nodes and triangles as rows, transposed into
@@ -223,6 +259,7 @@ impl KernelFeatures {
             (self.two_level, "TWO_LEVEL"),
             (self.triangle_pieces, "HAS_TRIANGLE_PIECES"),
             (self.lanes, "MEGA_LANES"),
+            (self.lanes_shade, "LANES_SHADE"),
         ] {
             if on {
                 d.push_str(" -D");

@@ -182,6 +182,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "gathers"
     };
     summary["lanes_load"] = serde_json::json!(renderer.walks_in_lanes().then_some(load));
+    // Whether the lanes shaded their vertices in batches, in vectors (kernels/shade_lanes.h).
+    summary["lanes_shade"] = serde_json::json!(renderer.shades_in_lanes());
     summary["cpu_seconds"] = serde_json::json!(cpu_seconds);
     summary["samples_per_cpu_second"] = serde_json::json!(cpu_seconds.map(|c| samples / c));
     // Added after the literal, which is at serde_json's macro recursion limit.

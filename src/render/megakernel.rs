@@ -59,6 +59,16 @@ impl Renderer {
         self.megakernel && self.program.as_ref().is_some_and(|p| p.features.lanes)
     }
 
+    /// Whether the megakernel's lanes shade their vertices in batches, in vectors
+    /// (`KernelFeatures::lanes_shade`).
+    pub fn shades_in_lanes(&self) -> bool {
+        self.megakernel
+            && self
+                .program
+                .as_ref()
+                .is_some_and(|p| p.features.lanes_shade)
+    }
+
     /// The kernels in use (never `Auto`).
     pub fn kernel(&self) -> KernelChoice {
         if self.megakernel {

@@ -107,6 +107,7 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         lambert_only: materials().all(|m| m.is_lambertian()),
         small_scene: 0,
         lanes: false,
+        lanes_shade: false,
     }
 }
 
@@ -727,10 +728,11 @@ impl Renderer {
     /// Builds the kernels when the scene's features (with the environment's) changed; returns
     /// the build time in milliseconds (0 when the kernels were reused).
     fn ensure_program(&mut self) -> Result<f64, ClError> {
-        let features = KernelFeatures {
+        let mut features = KernelFeatures {
             env_map: self.environment.is_some(),
             ..self.scene_features
         };
+        features.lanes_shade = crate::cl::lanes_shade(&features);
         if self
             .program
             .as_ref()
