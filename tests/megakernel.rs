@@ -361,34 +361,36 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
     // Every material is Lambertian, so under the panel the lanes shade their vertices in
     // batches, in vectors (kernels/shade_lanes.h), and with PENUMBRA_LANES_SHADE=0 one by one:
     // the same image both ways; with the background cut out too (camera rays that escape are
-    // marked, not lit).
+    // marked, not lit), and under a sky with light sampling alone (escapes lit by the sky, the
+    // last rays traced).
     let dir = tempfile::tempdir().unwrap();
     let (rings, segments) = (128, 136);
     assert!((2 * rings * segments) as usize >= penumbra::cl::LANES_MIN_TRIANGLES);
     let rig = common::white_sphere_of(dir.path(), true, rings, segments);
     let panel = common::white_sphere_under_panel(dir.path(), rings, segments);
-    for (scene, spp, cutout) in [
-        (&rig, "5", false),
-        (&rig, "21", false),
-        (&panel, "5", false),
-        (&panel, "21", false),
-        (&panel, "5", true),
-    ] {
+    let sky: &[&str] = &["--sky", "0.2,0.3,0.4", "--strategy", "lights"];
+    for (case, (scene, spp, extra)) in [
+        (&rig, "5", &[][..]),
+        (&rig, "21", &[]),
+        (&panel, "5", &[]),
+        (&panel, "21", &[]),
+        (&panel, "5", &["--background", "transparent"]),
+        (&panel, "5", sky),
+    ]
+    .into_iter()
+    .enumerate()
+    {
         let name = scene.file_stem().unwrap().to_str().unwrap();
         let mut args = lanes_image_args(spp, "4");
-        if cutout {
-            args.extend(["--background", "transparent"]);
-        }
-        let one = dir.path().join(format!("one-{name}-{spp}-{cutout}.exr"));
+        args.extend(extra);
+        let one = dir.path().join(format!("one-{case}.exr"));
         let (b, pb) = render_exr_env(scene, &one, &args, &[("PENUMBRA_LANES", "0")]);
         assert_eq!(b["lanes"], false, "PENUMBRA_LANES=0 left lanes on");
         assert_eq!(b["lanes_shade"], false, "lanes_shade without lanes");
         // The lanes load their nodes and triangles as rows (AMD's default) or by gathers, and
         // shade in batches or (PENUMBRA_LANES_SHADE=0) one vertex at a time.
         for (load, shade) in [("rows", "1"), ("gathers", "1"), ("rows", "0")] {
-            let out = dir
-                .path()
-                .join(format!("lanes-{load}-{shade}-{name}-{spp}-{cutout}.exr"));
+            let out = dir.path().join(format!("lanes-{load}-{shade}-{case}.exr"));
             let (a, pa) = render_exr_env(
                 scene,
                 &out,
@@ -398,7 +400,7 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
                     ("PENUMBRA_LANES_SHADE", shade),
                 ],
             );
-            let load = format!("{load}, shading {shade}, cutout {cutout}");
+            let load = format!("{load}, shading {shade}, {}", extra.join(" "));
             #[cfg(target_arch = "x86_64")]
             if common::test_device() == "cpu"
                 && (std::arch::is_x86_feature_detected!("avx512f")
