@@ -8,12 +8,14 @@
 //
 // It is path.h's shade_vertex for the scenes whose shading is simplest: every material
 // Lambertian, no textures, environment map, unlit materials, thin walls or two levels
-// (LANES_SHADE, set by the host: cl::lanes_shade in src/cl/program.rs). Each lane computes what shade_vertex computes, operation for operation
-// in the same order (the OpenCL library's dot, cross and length spelled out as it computes
-// them; PoCL's compiler fuses scalar products into sums but not vector ones, so the few that it
-// fuses in the scalar form are written fma() here), draws the same random numbers, and samples
-// its light with the scalar sample_light: the same paths, bit for bit (tests/megakernel.rs
-// compares the images). A chunk's camera hits, LANES or fewer at once, are shaded here too.
+// (LANES_SHADE, set by the host: cl::lanes_shade in src/cl/program.rs). Each lane computes what
+// shade_vertex computes, operation for operation in the same order (the OpenCL library's dot,
+// cross and length spelled out as it computes them; PoCL's compiler fuses scalar products into
+// sums but not vector ones, so the few that it fuses in the scalar form are written fma()
+// here), draws the same random numbers, and samples an emissive triangle as sample_light does
+// (other lights by sample_light itself, lane by lane): the same paths, bit for bit
+// (tests/megakernel.rs compares the images). A chunk's camera hits, LANES or fewer at once, are
+// shaded here too.
 // docs/benchmarks.md, "Twenty-fifth session", has what it measured;
 // scripts/experiments/lanes-shade.patch was its first form, shading the lanes done at each
 // return (too few to fill the vectors).

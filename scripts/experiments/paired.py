@@ -21,8 +21,10 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import kernel_blocks  # noqa: E402  (its render(): the same command line)
 
 
 def main():
@@ -43,14 +45,7 @@ def main():
         for kv in spec.split():
             k, v = kv.split("=", 1)
             env[k] = v
-        cmd = [args.penumbra, "render", args.scene, "-o", f"{args.out}-{tag}.exr", "--spp",
-               str(args.spp), "--width", str(args.size), "--height", str(args.size),
-               "--bounces", str(args.bounces), "--no-russian-roulette", "--hard-shadows",
-               "--device", "cpu"]
-        r = subprocess.run(cmd, env=env, capture_output=True, text=True)
-        if r.returncode:
-            sys.exit(f"paired: {tag} failed: {r.stderr.strip()[-500:]}")
-        d = json.loads([line for line in r.stdout.splitlines() if line.startswith("{")][-1])
+        d = kernel_blocks.render(args, env, args.size, args.spp, f"{args.out}-{tag}.exr")
         return d["cpu_seconds"], d["seconds"]
 
     render(args.a, "a")
