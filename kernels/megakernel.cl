@@ -232,11 +232,14 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
     uint n = c->count;
     W->extension_rays += n;
     Packet P;
+    LanesRays R;
+    lanes_rays_init(&R);
     PathState* s = W->queued;
     for (uint e = 0u; e < n; ++e) {
         s[e] = camera_path(frame, camera, c->pixel[e], frame->first_sample + sample0[e]);
-        packet_set_ray(&P, (int)e, s[e].origin, s[e].direction, INFINITY);
+        packet_take_ray(&P, &R, (int)e, s[e].origin, s[e].direction, INFINITY);
     }
+    packet_set_rays(&P, &R);
     lanes_i lanes = LANE_IDS < (lanes_i)((int)n);
     packet_walk(&P, lanes, false, nodes, sc->tris, &sc->surf, overflow);
     ShadowQuery q[LANES];
@@ -255,11 +258,12 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
         alive[e] = shade_vertex(frame, 0u, sc, packet_hit(&P, (int)e), &s[e], &q[e]);
 #endif
         shadow[e] = q[e].valid ? -1 : 0;
-        if (q[e].valid) packet_set_ray(&P, (int)e, q[e].origin, q[e].direction, q[e].tmax);
+        if (q[e].valid) packet_take_ray(&P, &R, (int)e, q[e].origin, q[e].direction, q[e].tmax);
     }
     for (uint e = n; e < (uint)LANES; ++e) shadow[e] = 0;
     lanes_i shadows = lanes_vload(0, shadow);
     if (lanes_any(shadows)) {
+        packet_set_rays(&P, &R);
         W->shadow_rays += (uint)lanes_count(shadows);
         packet_walk(&P, shadows, true, nodes, sc->tris, &sc->surf, overflow);
         for (uint e = 0u; e < n; ++e) {
@@ -402,6 +406,8 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         // Idle lanes take ready rays, then new paths (starting chunks while the queue is
         // empty); lanes left idle with vertices waiting have the batch shaded at once.
         bool idle = false;
+        LanesRays R;
+        lanes_rays_init(&R);
         for (int l = 0; l < LANES; ++l) {
             if (lane_slot[l] >= 0) continue;
             int k = -1;
@@ -431,17 +437,18 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             lane_slot[l] = k;
 #ifdef LAST_RAY_EMITTERS
             if (to_emitter[k]) {
-                lanes_set_segment(&M, l, s[k].origin, s[k].direction, emitter[k].t, true);
+                lanes_take_ray(&M, &R, l, s[k].origin, s[k].direction, emitter[k].t, true);
                 continue;
             }
 #endif
             if (in_shadow[k]) {
-                lanes_set_segment(&M, l, sample[k].origin, sample[k].direction, sample[k].tmax,
-                                  true);
+                lanes_take_ray(&M, &R, l, sample[k].origin, sample[k].direction, sample[k].tmax,
+                               true);
             } else {
-                lanes_set_ray(&M, l, s[k].origin, s[k].direction);
+                lanes_take_ray(&M, &R, l, s[k].origin, s[k].direction, INFINITY, false);
             }
         }
+        if (lanes_any(R.m)) lanes_set_rays(&M, &R);
         if (idle && batch_n > 0) {
             SHADE_BATCH
             continue;

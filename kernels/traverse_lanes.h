@@ -505,56 +505,105 @@ LANES_INLINE void lanes_init(LaneMemory* M) {
     }
 }
 
-// A ray's fields in lane `lane` of S, a LaneMemory or traverse_packet.h's Packet (which name
-// them alike): the ray from o along d, to tmax, with no hit yet (prepare_ray's values, the
-// origin in the permuted axes, the dominant axis kz naming the permutation) and the ray itself
-// for the scalar test's rare cases. Declares r, prepare_ray's RayPrep.
-#define LANES_SET_RAY_FIELDS(S, lane, o, d, tmax)                  \
-    RayPrep r = prepare_ray(o, d);                                 \
-    {                                                              \
-        float4 p_ = ray_permute((float4)(o, 0.0f), r.perm);        \
-        (S)->ox[lane] = (o).x;                                     \
-        (S)->oy[lane] = (o).y;                                     \
-        (S)->oz[lane] = (o).z;                                     \
-        (S)->ix[lane] = r.inv.x;                                   \
-        (S)->iy[lane] = r.inv.y;                                   \
-        (S)->iz[lane] = r.inv.z;                                   \
-        (S)->px[lane] = p_.x;                                      \
-        (S)->py[lane] = p_.y;                                      \
-        (S)->pz[lane] = p_.z;                                      \
-        (S)->sx[lane] = r.shear.x;                                 \
-        (S)->sy[lane] = r.shear.y;                                 \
-        (S)->sz[lane] = r.shear.z;                                 \
-        (S)->kz[lane] = (int)r.perm.z;                             \
-        (S)->tfar[lane] = (tmax);                                  \
-        (S)->hv[lane] = 0.0f;                                      \
-        (S)->hw[lane] = 0.0f;                                      \
-        (S)->hdet[lane] = 1.0f;                                    \
-        (S)->prim[lane] = -1;                                      \
-        (S)->o[lane] = (o);                                        \
-        (S)->d[lane] = (d);                                        \
-    }
+// Rays gathered for the lanes, a ray a lane, as vectors (lanes_take_ray puts a ray in its lane
+// by selects, with no trip through memory): origins, directions, each ray's end (tmax), whether
+// it is a shadow ray (any: done at its first hit) and the lanes that took one (m).
+typedef struct {
+    lanes_f ox, oy, oz, dx, dy, dz, tmax;
+    lanes_i any, m;
+} LanesRays;
 
-// Lane `lane` takes the ray from o along d, to tmax; any_hit: a shadow ray, done at its first
-// hit (any one: a hit says the segment is blocked).
-LANES_INLINE void lanes_set_segment(LaneMemory* M, int lane, float3 o, float3 d, float tmax,
-                                    bool any_hit) {
-    LANES_SET_RAY_FIELDS(M, lane, o, d, tmax)
-    M->kx[lane] = (int)r.perm.x;
-    M->ky[lane] = (int)r.perm.y;
-    M->sp[lane] = 0;
-    M->any[lane] = any_hit ? -1 : 0;
-    // The fields lanes_walk reads first, by vector: written by vector too (a vector load of
-    // words just stored one by one waits for the stores: no store-to-load forwarding).
-    lanes_i here = LANE_IDS == (lanes_i)(lane);
-    M->V.cur = select(M->V.cur, (lanes_i)(0), here);
-    M->V.live = M->V.live | here;
-    M->V.has = M->V.has | here;
+LANES_INLINE void lanes_rays_init(LanesRays* R) {
+    R->ox = R->oy = R->oz = R->dx = R->dy = R->dz = R->tmax = (lanes_f)(0.0f);
+    R->any = R->m = (lanes_i)(0);
 }
 
-// Lane `lane` takes the extension ray from o along d (the nearest hit).
-LANES_INLINE void lanes_set_ray(LaneMemory* M, int lane, float3 o, float3 d) {
-    lanes_set_segment(M, lane, o, d, INFINITY, false);
+// Lane `lane` of R takes the ray from o along d, to tmax (any_hit: a shadow ray).
+LANES_INLINE void lanes_rays_put(LanesRays* R, int lane, float3 o, float3 d, float tmax,
+                                 bool any_hit) {
+    lanes_i here = LANE_IDS == (lanes_i)(lane);
+    R->ox = select(R->ox, (lanes_f)(o.x), here);
+    R->oy = select(R->oy, (lanes_f)(o.y), here);
+    R->oz = select(R->oz, (lanes_f)(o.z), here);
+    R->dx = select(R->dx, (lanes_f)(d.x), here);
+    R->dy = select(R->dy, (lanes_f)(d.y), here);
+    R->dz = select(R->dz, (lanes_f)(d.z), here);
+    R->tmax = select(R->tmax, (lanes_f)(tmax), here);
+    R->any = select(R->any, (lanes_i)(any_hit ? -1 : 0), here);
+    R->m |= here;
+}
+
+// A component of each lane's vector (X, Y, Z) picked by the lane's axis K (0, 1, 2).
+#define LANES_PICK(X, Y, Z, K) select(select(X, Y, (K) == (lanes_i)(1)), Z, (K) == (lanes_i)(2))
+
+// prepare_ray lane by lane on R's rays, by selects (no branch on the dominant axis; one division
+// an axis for all the lanes): declares ix iy iz (the safe reciprocal direction), kx ky kz (the
+// permutation: z the dominant axis), px py pz (the origin in the permuted axes) and sx sy sz
+// (the shear), prepare_ray's values bit for bit.
+#define LANES_PREPARE_RAYS(R)                                                                 \
+    lanes_f ix, iy, iz, px, py, pz, sx, sy, sz;                                               \
+    lanes_i kx, ky, kz;                                                                       \
+    {                                                                                         \
+        const lanes_f tiny_ = (lanes_f)(1e-20f), one_ = (lanes_f)(1.0f);                      \
+        lanes_f ax_ = fabs((R)->dx), ay_ = fabs((R)->dy), az_ = fabs((R)->dz);                \
+        ix = one_ / select(copysign(tiny_, (R)->dx), (R)->dx, ax_ > tiny_);                   \
+        iy = one_ / select(copysign(tiny_, (R)->dy), (R)->dy, ay_ > tiny_);                   \
+        iz = one_ / select(copysign(tiny_, (R)->dz), (R)->dz, az_ > tiny_);                   \
+        const lanes_i two_ = (lanes_i)(2);                                                    \
+        kz = select(select(two_, (lanes_i)(1), ay_ > az_), select(two_, (lanes_i)(0), ax_ > az_), \
+                    ax_ > ay_);                                                               \
+        kx = select(select((lanes_i)(1), two_, kz == (lanes_i)(1)), (lanes_i)(0), kz == two_);  \
+        ky = select(select(two_, (lanes_i)(0), kz == (lanes_i)(1)), (lanes_i)(1), kz == two_);  \
+        lanes_f rz_ = LANES_PICK(ix, iy, iz, kz);                                             \
+        sx = LANES_PICK((R)->dx, (R)->dy, (R)->dz, kx) * rz_;                                 \
+        sy = LANES_PICK((R)->dx, (R)->dy, (R)->dz, ky) * rz_;                                 \
+        sz = rz_;                                                                             \
+        px = LANES_PICK((R)->ox, (R)->oy, (R)->oz, kx);                                       \
+        py = LANES_PICK((R)->ox, (R)->oy, (R)->oz, ky);                                       \
+        pz = LANES_PICK((R)->ox, (R)->oy, (R)->oz, kz);                                       \
+    }
+
+// Lane `lane` will take the ray from o along d, to tmax (any_hit: a shadow ray, done at its
+// first hit: any one, a hit says the segment is blocked); lanes_set_rays gives it the ray.
+LANES_INLINE void lanes_take_ray(LaneMemory* M, LanesRays* R, int lane, float3 o, float3 d,
+                                 float tmax, bool any_hit) {
+    lanes_rays_put(R, lane, o, d, tmax, any_hit);
+    M->o[lane] = o;
+    M->d[lane] = d;
+}
+
+// The lanes of R->m take their rays, with no hit yet, written by vector (the walk reads them by
+// vector: a vector load of words just stored one by one would wait for the stores, and the ray's
+// set-up lane by lane cost 100 scalar instructions, with a branch on its dominant axis).
+LANES_INLINE void lanes_set_rays(LaneMemory* M, const LanesRays* R) {
+    Lanes* L = &M->V;
+    const lanes_i m = R->m;
+    LANES_PREPARE_RAYS(R)
+    L->ox = select(L->ox, R->ox, m);
+    L->oy = select(L->oy, R->oy, m);
+    L->oz = select(L->oz, R->oz, m);
+    L->ix = select(L->ix, ix, m);
+    L->iy = select(L->iy, iy, m);
+    L->iz = select(L->iz, iz, m);
+    L->px = select(L->px, px, m);
+    L->py = select(L->py, py, m);
+    L->pz = select(L->pz, pz, m);
+    L->sx = select(L->sx, sx, m);
+    L->sy = select(L->sy, sy, m);
+    L->sz = select(L->sz, sz, m);
+    L->kx = select(L->kx, kx, m);
+    L->ky = select(L->ky, ky, m);
+    L->kz = select(L->kz, kz, m);
+    L->tfar = select(L->tfar, R->tmax, m);
+    L->hv = select(L->hv, (lanes_f)(0.0f), m);
+    L->hw = select(L->hw, (lanes_f)(0.0f), m);
+    L->hdet = select(L->hdet, (lanes_f)(1.0f), m);
+    L->prim = select(L->prim, (lanes_i)(-1), m);
+    L->sp = select(L->sp, (lanes_i)(0), m);
+    L->any = select(L->any, R->any, m);
+    L->cur = select(L->cur, (lanes_i)(0), m);
+    L->live |= m;
+    L->has |= m;
 }
 
 // A lane's hit from its fields: distance, triangle (NO_HIT: none), edge functions v, w and

@@ -30,9 +30,36 @@ typedef struct {
     float3 o[LANES], d[LANES];  // the rays, for the scalar test's rare cases
 } Packet;
 
-// Lane `lane` of the packet takes the ray from o along d, to tmax.
-LANES_INLINE void packet_set_ray(Packet* P, int lane, float3 o, float3 d, float tmax) {
-    LANES_SET_RAY_FIELDS(P, lane, o, d, tmax)
+// Lane `lane` of the packet will take the ray from o along d, to tmax (packet_set_rays gives it).
+LANES_INLINE void packet_take_ray(Packet* P, LanesRays* R, int lane, float3 o, float3 d,
+                                  float tmax) {
+    lanes_rays_put(R, lane, o, d, tmax, false);
+    P->o[lane] = o;
+    P->d[lane] = d;
+}
+
+// The packet's lanes take R's rays (all of them: the walk's mask says which it walks), with no
+// hit yet.
+LANES_INLINE void packet_set_rays(Packet* P, const LanesRays* R) {
+    LANES_PREPARE_RAYS(R)
+    lanes_vstore(R->ox, 0, P->ox);
+    lanes_vstore(R->oy, 0, P->oy);
+    lanes_vstore(R->oz, 0, P->oz);
+    lanes_vstore(ix, 0, P->ix);
+    lanes_vstore(iy, 0, P->iy);
+    lanes_vstore(iz, 0, P->iz);
+    lanes_vstore(px, 0, P->px);
+    lanes_vstore(py, 0, P->py);
+    lanes_vstore(pz, 0, P->pz);
+    lanes_vstore(sx, 0, P->sx);
+    lanes_vstore(sy, 0, P->sy);
+    lanes_vstore(sz, 0, P->sz);
+    lanes_vstore(kz, 0, P->kz);
+    lanes_vstore(R->tmax, 0, P->tfar);
+    lanes_vstore((lanes_f)(0.0f), 0, P->hv);
+    lanes_vstore((lanes_f)(0.0f), 0, P->hw);
+    lanes_vstore((lanes_f)(1.0f), 0, P->hdet);
+    lanes_vstore((lanes_i)(-1), 0, P->prim);
 }
 
 // The hit of a lane after a closest-hit walk.
