@@ -321,6 +321,8 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
     LaneMemory M;
     lanes_init(&M);
+    LanesRays R;  // rays given to lanes, set in their fields together
+    lanes_rays_init(&R);
     PathState s[MEGA_SLOTS];
     uint bounce[MEGA_SLOTS], chunk[MEGA_SLOTS], entry[MEGA_SLOTS];
     // A path whose next ray is its vertex's light sample: the sample, and whether the path goes
@@ -406,8 +408,6 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         // Idle lanes take ready rays, then new paths (starting chunks while the queue is
         // empty); lanes left idle with vertices waiting have the batch shaded at once.
         bool idle = false;
-        LanesRays R;
-        lanes_rays_init(&R);
         for (int l = 0; l < LANES; ++l) {
             if (lane_slot[l] >= 0) continue;
             int k = -1;
@@ -448,7 +448,10 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
                 lanes_take_ray(&M, &R, l, s[k].origin, s[k].direction, INFINITY, false);
             }
         }
-        if (lanes_any(R.m)) lanes_set_rays(&M, &R);
+        if (R.taken != 0u) {
+            lanes_set_rays(&M, &R);
+            R.taken = 0u;
+        }
         if (idle && batch_n > 0) {
             SHADE_BATCH
             continue;

@@ -505,32 +505,38 @@ LANES_INLINE void lanes_init(LaneMemory* M) {
     }
 }
 
-// Rays gathered for the lanes, a ray a lane, as vectors (lanes_take_ray puts a ray in its lane
-// by selects, with no trip through memory): origins, directions, each ray's end (tmax), whether
-// it is a shadow ray (any: done at its first hit) and the lanes that took one (m).
+// Rays given to lanes, lane by lane (scalar stores, which lanes_set_rays and packet_set_rays
+// then load by vector: one wait for the stores a batch of rays, where a vector a field put
+// together by selects lived on the stack, three instructions a field a ray): origins,
+// directions, each ray's end (tmax), whether it is a shadow ray (any: done at its first hit),
+// and the lanes that took one (bit l of `taken`). Lanes that took none keep stale values, which
+// are computed on and discarded.
 typedef struct {
-    lanes_f ox, oy, oz, dx, dy, dz, tmax;
-    lanes_i any, m;
+    float ox[LANES], oy[LANES], oz[LANES], dx[LANES], dy[LANES], dz[LANES], tmax[LANES];
+    int any[LANES];
+    uint taken;
 } LanesRays;
 
 LANES_INLINE void lanes_rays_init(LanesRays* R) {
-    R->ox = R->oy = R->oz = R->dx = R->dy = R->dz = R->tmax = (lanes_f)(0.0f);
-    R->any = R->m = (lanes_i)(0);
+    for (int l = 0; l < LANES; ++l) {
+        R->ox[l] = R->oy[l] = R->oz[l] = R->dx[l] = R->dy[l] = R->dz[l] = R->tmax[l] = 0.0f;
+        R->any[l] = 0;
+    }
+    R->taken = 0u;
 }
 
 // Lane `lane` of R takes the ray from o along d, to tmax (any_hit: a shadow ray).
 LANES_INLINE void lanes_rays_put(LanesRays* R, int lane, float3 o, float3 d, float tmax,
                                  bool any_hit) {
-    lanes_i here = LANE_IDS == (lanes_i)(lane);
-    R->ox = select(R->ox, (lanes_f)(o.x), here);
-    R->oy = select(R->oy, (lanes_f)(o.y), here);
-    R->oz = select(R->oz, (lanes_f)(o.z), here);
-    R->dx = select(R->dx, (lanes_f)(d.x), here);
-    R->dy = select(R->dy, (lanes_f)(d.y), here);
-    R->dz = select(R->dz, (lanes_f)(d.z), here);
-    R->tmax = select(R->tmax, (lanes_f)(tmax), here);
-    R->any = select(R->any, (lanes_i)(any_hit ? -1 : 0), here);
-    R->m |= here;
+    R->ox[lane] = o.x;
+    R->oy[lane] = o.y;
+    R->oz[lane] = o.z;
+    R->dx[lane] = d.x;
+    R->dy[lane] = d.y;
+    R->dz[lane] = d.z;
+    R->tmax[lane] = tmax;
+    R->any[lane] = any_hit ? -1 : 0;
+    R->taken |= 1u << lane;
 }
 
 // A component of each lane's vector (X, Y, Z) picked by the lane's axis K (0, 1, 2).
@@ -540,28 +546,36 @@ LANES_INLINE void lanes_rays_put(LanesRays* R, int lane, float3 o, float3 d, flo
 // an axis for all the lanes): declares ix iy iz (the safe reciprocal direction), kx ky kz (the
 // permutation: z the dominant axis), px py pz (the origin in the permuted axes) and sx sy sz
 // (the shear), prepare_ray's values bit for bit.
-#define LANES_PREPARE_RAYS(R)                                                                 \
+#define LANES_PREPARE_RAYS(OX, OY, OZ, DX, DY, DZ)                                            \
     lanes_f ix, iy, iz, px, py, pz, sx, sy, sz;                                               \
     lanes_i kx, ky, kz;                                                                       \
     {                                                                                         \
         const lanes_f tiny_ = (lanes_f)(1e-20f), one_ = (lanes_f)(1.0f);                      \
-        lanes_f ax_ = fabs((R)->dx), ay_ = fabs((R)->dy), az_ = fabs((R)->dz);                \
-        ix = one_ / select(copysign(tiny_, (R)->dx), (R)->dx, ax_ > tiny_);                   \
-        iy = one_ / select(copysign(tiny_, (R)->dy), (R)->dy, ay_ > tiny_);                   \
-        iz = one_ / select(copysign(tiny_, (R)->dz), (R)->dz, az_ > tiny_);                   \
+        lanes_f ax_ = fabs(DX), ay_ = fabs(DY), az_ = fabs(DZ);                               \
+        ix = one_ / select(copysign(tiny_, DX), DX, ax_ > tiny_);                             \
+        iy = one_ / select(copysign(tiny_, DY), DY, ay_ > tiny_);                             \
+        iz = one_ / select(copysign(tiny_, DZ), DZ, az_ > tiny_);                             \
         const lanes_i two_ = (lanes_i)(2);                                                    \
         kz = select(select(two_, (lanes_i)(1), ay_ > az_), select(two_, (lanes_i)(0), ax_ > az_), \
                     ax_ > ay_);                                                               \
         kx = select(select((lanes_i)(1), two_, kz == (lanes_i)(1)), (lanes_i)(0), kz == two_);  \
         ky = select(select(two_, (lanes_i)(0), kz == (lanes_i)(1)), (lanes_i)(1), kz == two_);  \
         lanes_f rz_ = LANES_PICK(ix, iy, iz, kz);                                             \
-        sx = LANES_PICK((R)->dx, (R)->dy, (R)->dz, kx) * rz_;                                 \
-        sy = LANES_PICK((R)->dx, (R)->dy, (R)->dz, ky) * rz_;                                 \
+        sx = LANES_PICK(DX, DY, DZ, kx) * rz_;                                                \
+        sy = LANES_PICK(DX, DY, DZ, ky) * rz_;                                                \
         sz = rz_;                                                                             \
-        px = LANES_PICK((R)->ox, (R)->oy, (R)->oz, kx);                                       \
-        py = LANES_PICK((R)->ox, (R)->oy, (R)->oz, ky);                                       \
-        pz = LANES_PICK((R)->ox, (R)->oy, (R)->oz, kz);                                       \
+        px = LANES_PICK(OX, OY, OZ, kx);                                                      \
+        py = LANES_PICK(OX, OY, OZ, ky);                                                      \
+        pz = LANES_PICK(OX, OY, OZ, kz);                                                      \
     }
+
+// R's rays as vectors: declares ox oy oz (origins), dx dy dz (directions), then
+// LANES_PREPARE_RAYS's values.
+#define LANES_LOAD_RAYS(R)                                                                    \
+    lanes_f ox = lanes_vload(0, (R)->ox), oy = lanes_vload(0, (R)->oy);                       \
+    lanes_f oz = lanes_vload(0, (R)->oz), dx = lanes_vload(0, (R)->dx);                       \
+    lanes_f dy = lanes_vload(0, (R)->dy), dz = lanes_vload(0, (R)->dz);                       \
+    LANES_PREPARE_RAYS(ox, oy, oz, dx, dy, dz)
 
 // Lane `lane` will take the ray from o along d, to tmax (any_hit: a shadow ray, done at its
 // first hit: any one, a hit says the segment is blocked); lanes_set_rays gives it the ray.
@@ -572,16 +586,17 @@ LANES_INLINE void lanes_take_ray(LaneMemory* M, LanesRays* R, int lane, float3 o
     M->d[lane] = d;
 }
 
-// The lanes of R->m take their rays, with no hit yet, written by vector (the walk reads them by
+// The lanes that took rays in R take them, with no hit yet, written by vector (the walk reads them by
 // vector: a vector load of words just stored one by one would wait for the stores, and the ray's
 // set-up lane by lane cost 100 scalar instructions, with a branch on its dominant axis).
 LANES_INLINE void lanes_set_rays(LaneMemory* M, const LanesRays* R) {
     Lanes* L = &M->V;
-    const lanes_i m = R->m;
-    LANES_PREPARE_RAYS(R)
-    L->ox = select(L->ox, R->ox, m);
-    L->oy = select(L->oy, R->oy, m);
-    L->oz = select(L->oz, R->oz, m);
+    const lanes_i m =
+        ((lanes_i)((int)R->taken) >> LANE_IDS & (lanes_i)(1)) != (lanes_i)(0);
+    LANES_LOAD_RAYS(R)
+    L->ox = select(L->ox, ox, m);
+    L->oy = select(L->oy, oy, m);
+    L->oz = select(L->oz, oz, m);
     L->ix = select(L->ix, ix, m);
     L->iy = select(L->iy, iy, m);
     L->iz = select(L->iz, iz, m);
@@ -594,13 +609,13 @@ LANES_INLINE void lanes_set_rays(LaneMemory* M, const LanesRays* R) {
     L->kx = select(L->kx, kx, m);
     L->ky = select(L->ky, ky, m);
     L->kz = select(L->kz, kz, m);
-    L->tfar = select(L->tfar, R->tmax, m);
+    L->tfar = select(L->tfar, lanes_vload(0, R->tmax), m);
     L->hv = select(L->hv, (lanes_f)(0.0f), m);
     L->hw = select(L->hw, (lanes_f)(0.0f), m);
     L->hdet = select(L->hdet, (lanes_f)(1.0f), m);
     L->prim = select(L->prim, (lanes_i)(-1), m);
     L->sp = select(L->sp, (lanes_i)(0), m);
-    L->any = select(L->any, R->any, m);
+    L->any = select(L->any, lanes_vload(0, R->any), m);
     L->cur = select(L->cur, (lanes_i)(0), m);
     L->live |= m;
     L->has |= m;

@@ -41,10 +41,10 @@ LANES_INLINE void packet_take_ray(Packet* P, LanesRays* R, int lane, float3 o, f
 // The packet's lanes take R's rays (all of them: the walk's mask says which it walks), with no
 // hit yet.
 LANES_INLINE void packet_set_rays(Packet* P, const LanesRays* R) {
-    LANES_PREPARE_RAYS(R)
-    lanes_vstore(R->ox, 0, P->ox);
-    lanes_vstore(R->oy, 0, P->oy);
-    lanes_vstore(R->oz, 0, P->oz);
+    LANES_LOAD_RAYS(R)
+    lanes_vstore(ox, 0, P->ox);
+    lanes_vstore(oy, 0, P->oy);
+    lanes_vstore(oz, 0, P->oz);
     lanes_vstore(ix, 0, P->ix);
     lanes_vstore(iy, 0, P->iy);
     lanes_vstore(iz, 0, P->iz);
@@ -55,7 +55,7 @@ LANES_INLINE void packet_set_rays(Packet* P, const LanesRays* R) {
     lanes_vstore(sy, 0, P->sy);
     lanes_vstore(sz, 0, P->sz);
     lanes_vstore(kz, 0, P->kz);
-    lanes_vstore(R->tmax, 0, P->tfar);
+    lanes_vstore(lanes_vload(0, R->tmax), 0, P->tfar);
     lanes_vstore((lanes_f)(0.0f), 0, P->hv);
     lanes_vstore((lanes_f)(0.0f), 0, P->hw);
     lanes_vstore((lanes_f)(1.0f), 0, P->hdet);
