@@ -336,6 +336,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     bool last_by_emitters = mega_last_ray_by_emitters(&frame);
 #endif
     int lane_slot[LANES];  // the path of each lane's ray, -1: idle
+    uint idle_lanes = (1u << LANES) - 1u;  // bit l: lane l idle
     int ready[MEGA_SLOTS], free_slot[MEGA_SLOTS];
     uint ready_head = 0u, ready_count = 0u, free_count = MEGA_SLOTS;
     for (int k = 0; k < MEGA_SLOTS; ++k) {
@@ -408,8 +409,8 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         // Idle lanes take ready rays, then new paths (starting chunks while the queue is
         // empty); lanes left idle with vertices waiting have the batch shaded at once.
         bool idle = false;
-        for (int l = 0; l < LANES; ++l) {
-            if (lane_slot[l] >= 0) continue;
+        for (uint bits = idle_lanes; bits != 0u; bits &= bits - 1u) {
+            int l = (int)__builtin_ctz(bits);
             int k = -1;
             if (ready_count > 0u) {
                 k = ready[ready_head];
@@ -435,6 +436,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
                 continue;
             }
             lane_slot[l] = k;
+            idle_lanes &= ~(1u << l);
 #ifdef LAST_RAY_EMITTERS
             if (to_emitter[k]) {
                 lanes_take_ray(&M, &R, l, s[k].origin, s[k].direction, emitter[k].t, true);
@@ -463,6 +465,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             int l = (int)__builtin_ctz(bits);
             int k = lane_slot[l];
             lane_slot[l] = -1;
+            idle_lanes |= 1u << l;
 #ifdef LAST_RAY_EMITTERS
             if (to_emitter[k]) {
                 // The last ray's segment to its emitter walked: unblocked, the emitter is its

@@ -610,9 +610,7 @@ LANES_INLINE void lanes_set_rays(LaneMemory* M, const LanesRays* R) {
     L->ky = select(L->ky, ky, m);
     L->kz = select(L->kz, kz, m);
     L->tfar = select(L->tfar, lanes_vload(0, R->tmax), m);
-    L->hv = select(L->hv, (lanes_f)(0.0f), m);
-    L->hw = select(L->hw, (lanes_f)(0.0f), m);
-    L->hdet = select(L->hdet, (lanes_f)(1.0f), m);
+    // No hit: hv, hw and hdet are read only with a hit, which sets them.
     L->prim = select(L->prim, (lanes_i)(-1), m);
     L->sp = select(L->sp, (lanes_i)(0), m);
     L->any = select(L->any, lanes_vload(0, R->any), m);
