@@ -8,18 +8,18 @@
 //! object is a TLAS rebuild and a few transforms written in place
 //! (`Renderer::move_instances`).
 //!
-//! The automatic choice (`--bvh auto`) depends on the device, as measured on each
-//! (docs/benchmarks.md, 2026-11-30). On a CPU device two levels are taken when the scene is
-//! large and instancing saves most of the flat BVH (at least 1 M triangles over all instances
-//! and at least 4 times the triangles of the distinct meshes): on PoCL, on the 1 M rooms of
-//! `bench generate` with the same rays and denormals flushed, the two-level kernels trace within
-//! +7 % of the flat BVH (faster on diffuse rays) with the binary kernels and within −10 … +17 %
-//! with the wide ones, whole frames run 1.2–1.4 times the flat BVH's speed, and the flat form
-//! takes 8–13 times as long to build (3 s against 0.2–0.4 s on 2 cores) and 7–50 times the
-//! device memory (219 MB against 31 and 4.4 MB). On a GPU (H200) the same rooms' frames run at
-//! 0.82 of the flat BVH's speed on two levels, so only scenes of at least 4 M triangles that
-//! instancing shrinks eightfold take them. A small scene is flattened: its flat BVH is built in
-//! well under a second and tests no transforms.
+//! The automatic choice (`--bvh auto`) takes two levels only for scenes of at least 4 M
+//! triangles over all instances that instancing shrinks eightfold (and for any scene of
+//! [`HUGE_SCENE`] triangles), on every device, as measured on each. On a GPU (H200) the 1 M
+//! rooms of `bench generate` run at 0.82 of the flat BVH's speed on two levels
+//! (docs/benchmarks.md, 2026-11-30). On a CPU the flat BVH is walked by the megakernel's vector
+//! lanes, which two levels do not have: the same rooms render 1.5–1.7 times as fast flat, for
+//! 0.5–0.6 s more building on 2 cores and 100 MB of device memory against 2.5–15
+//! (docs/benchmarks.md, "Twenty-sixth session"; until then CPUs took two levels from 1 M
+//! triangles shrunk fourfold, when the kernels walked one ray at a time and two levels ran
+//! frames 1.2–1.4 times as fast). A flat scene reloads where two levels would move, hide or
+//! show an object in place. A small scene is flattened: its flat BVH is built in well under a
+//! second and tests no transforms.
 
 use crate::bvh::{Blas, TwoLevel, quick_blas_shared};
 use crate::scene::{Mesh, Object, RenderFrame, Scene, distinct_meshes};
@@ -42,10 +42,10 @@ pub struct AutoRule {
     pub small_mesh: usize,
 }
 
-/// CPU devices, where two levels trace about as fast as flat and frames run faster.
+/// CPU devices, where the flat BVH is walked in vector lanes and two levels one ray at a time.
 pub const AUTO_CPU: AutoRule = AutoRule {
-    min_triangles: 1_000_000,
-    min_saving: 4,
+    min_triangles: 4_000_000,
+    min_saving: 8,
     small_mesh: crate::bvh::SMALL_MESH,
 };
 
@@ -238,16 +238,17 @@ mod tests {
 
     #[test]
     fn auto_takes_two_levels_for_large_heavily_instanced_scenes() {
-        // The rooms of `bench generate`: 7 bunnies and 49 icospheres, 1 M triangles each: two
-        // levels on a CPU, flat on a GPU.
-        for (total, unique) in [(1_008_336, 144_060), (1_003_534, 20_494)] {
-            assert!(auto_takes_two_levels(total, unique, AUTO_CPU));
-            assert!(!auto_takes_two_levels(total, unique, AUTO_GPU));
-        }
-        // 16 M triangles of one 144 k mesh: two levels on both.
-        assert!(auto_takes_two_levels(16_000_000, 144_000, AUTO_GPU));
-        // Small, or hardly instanced: flat.
         for rule in [AUTO_CPU, AUTO_GPU] {
+            // The rooms of `bench generate`: 7 bunnies and 49 icospheres, 1 M triangles each:
+            // flat (on a CPU its lanes walk them 1.5-1.7 times as fast as two levels).
+            for (total, unique) in [(1_008_336, 144_060), (1_003_534, 20_494)] {
+                assert!(!auto_takes_two_levels(total, unique, rule));
+            }
+            // 4 M triangles of one 144 k mesh, and 16 M: two levels.
+            assert!(auto_takes_two_levels(4_000_000, 144_000, rule));
+            assert!(auto_takes_two_levels(16_000_000, 144_000, rule));
+            // Small, or hardly instanced: flat.
+            assert!(!auto_takes_two_levels(4_000_000, 600_000, rule));
             assert!(!auto_takes_two_levels(500_000, 10_000, rule));
             assert!(!auto_takes_two_levels(4_000_000, 2_000_000, rule));
             assert!(!auto_takes_two_levels(0, 0, rule));
