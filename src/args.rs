@@ -339,8 +339,8 @@ pub struct CommonArgs {
     #[arg(long, value_name = "NAME")]
     pub variant: Option<String>,
     /// Acceleration structure: flat (one BVH over every triangle), two-level (a BLAS per
-    /// distinct mesh under a TLAS of instances) or auto (two levels for scenes that instancing
-    /// shrinks: from 1 M triangles shrunk fourfold on a CPU, 4 M shrunk eightfold on a GPU).
+    /// distinct mesh under a TLAS of instances) or auto (two levels for scenes of 4 M triangles
+    /// or more that instancing shrinks eightfold, and for any of 16 M or more).
     #[arg(long, default_value = "auto")]
     pub bvh: BvhChoice,
 }

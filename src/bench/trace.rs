@@ -60,8 +60,8 @@ pub struct TraceArgs {
     #[arg(long)]
     pub wide: bool,
     /// The acceleration structure: flat, two-level (a BLAS per distinct mesh under a TLAS of
-    /// instances) or auto (two levels for scenes that instancing shrinks: from 1 M triangles
-    /// shrunk fourfold on a CPU, 4 M shrunk eightfold on a GPU).
+    /// instances) or auto (two levels for scenes of 4 M triangles or more that instancing
+    /// shrinks eightfold, and for any of 16 M or more).
     #[arg(long, default_value = "auto")]
     pub bvh: BvhChoice,
 }
