@@ -134,18 +134,16 @@ pub fn lanes_megakernel(
     triangles: usize,
     largest_leaf: u32,
 ) -> bool {
-    if !cpu
-        || alpha
-        || small_scene > 0
-        || !(LANES_MIN_TRIANGLES..1 << 27).contains(&triangles)
-        || largest_leaf > 15
-    {
+    if !cpu || alpha || small_scene > 0 || triangles >= 1 << 27 || largest_leaf > 15 {
         return false;
     }
     match std::env::var("PENUMBRA_LANES").as_deref().map(str::trim) {
         Ok("0") => return false,
         Ok("1") => return true,
         _ => {}
+    }
+    if triangles < LANES_MIN_TRIANGLES {
+        return false;
     }
     #[cfg(target_arch = "x86_64")]
     {

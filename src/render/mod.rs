@@ -152,6 +152,9 @@ pub struct Renderer {
     light_count: u32,
     /// Features of the loaded scene (without the environment map's).
     scene_features: KernelFeatures,
+    /// The scene could walk in lanes but has fewer than `cl::LANES_MIN_TRIANGLES`: it takes
+    /// them where their vertices are shaded in batches (`ensure_program`).
+    lanes_below_min: bool,
     /// The lights as last given, to rebuild the light table.
     lights: Vec<Light>,
     environment: Option<(Arc<EnvMap>, EnvSampling)>,
@@ -223,6 +226,7 @@ impl Renderer {
             camera: GpuCamera::default(),
             light_count: 0,
             scene_features: KernelFeatures::default(),
+            lanes_below_min: false,
             lights: Vec::new(),
             environment: None,
             env,
@@ -488,16 +492,20 @@ impl Renderer {
             host.triangles.len(),
             self.scene_features.alpha,
         );
-        self.scene_features.lanes = match &host.accel {
+        let lanes = |triangles| match &host.accel {
             Accel::Flat(bvh) => crate::cl::lanes_megakernel(
                 self.gpu.is_cpu(),
                 self.scene_features.alpha,
                 self.scene_features.small_scene,
-                host.triangles.len(),
+                triangles,
                 bvh.largest_leaf(),
             ),
             Accel::TwoLevel(_) => false,
         };
+        self.scene_features.lanes = lanes(host.triangles.len());
+        self.lanes_below_min = !self.scene_features.lanes
+            && host.triangles.len() < crate::cl::LANES_MIN_TRIANGLES
+            && lanes(crate::cl::LANES_MIN_TRIANGLES);
         let budget = self
             .gpu
             .device
@@ -732,6 +740,17 @@ impl Renderer {
             env_map: self.environment.is_some(),
             ..self.scene_features
         };
+        // Below the lanes' fewest triangles, a scene whose vertices the lanes would shade in
+        // batches takes them all the same: batched shading pays at any size.
+        if !features.lanes && self.lanes_below_min {
+            let with = KernelFeatures {
+                lanes: true,
+                ..features
+            };
+            if crate::cl::lanes_shade(&with) {
+                features = with;
+            }
+        }
         features.lanes_shade = crate::cl::lanes_shade(&features);
         if self
             .program
