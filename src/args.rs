@@ -493,7 +493,7 @@ impl CommonArgs {
             _ => self.environment()?,
         };
         if environment.is_some() {
-            scene.light_by_environment();
+            scene.drop_default_rig();
         }
         if env_arg == first_image::EnvArg::Auto {
             if let Some(preset) = first.environment {
@@ -502,6 +502,10 @@ impl CommonArgs {
                     scene.source,
                     preset.name()
                 );
+            }
+            if !first.lights.is_empty() {
+                // The rig is placed for a view from outside; a room's lamps replace it.
+                scene.drop_default_rig();
             }
             scene.lights.extend(first.lights.iter().cloned());
         }
@@ -581,7 +585,7 @@ pub fn prepare(
     }
     let camera = camera.choose(&scene)?;
     if environment {
-        scene.light_by_environment();
+        scene.drop_default_rig();
     }
     Ok(finish(scene, camera, shadows, load_ms))
 }

@@ -13,7 +13,7 @@
 mod common;
 
 use common::stats::chi2;
-use common::{Gltf, Prim, horizontal_square, output_dir, render_exr, sphere};
+use common::{Gltf, Prim, cuboid, horizontal_square, output_dir, render_exr, sphere};
 use penumbra::cl::types::GpuMaterial;
 use penumbra::cl::{DeviceChoice, Gpu, KernelFeatures, Program};
 use penumbra::scene::Material;
@@ -2810,31 +2810,6 @@ fn light_sampling_reaches_through_thin_windows() {
             "{kernel}: the pane passes {ratio:.3} of the light"
         );
     }
-}
-
-/// An axis-aligned box from `lo` to `hi` (outward winding, no normals).
-fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> (Vec<[f32; 3]>, Vec<u32>) {
-    let mut p = vec![];
-    for i in 0..8 {
-        p.push([
-            if i & 1 == 0 { lo[0] } else { hi[0] },
-            if i & 2 == 0 { lo[1] } else { hi[1] },
-            if i & 4 == 0 { lo[2] } else { hi[2] },
-        ]);
-    }
-    let quads = [
-        [0, 4, 6, 2], // -x
-        [1, 3, 7, 5], // +x
-        [0, 1, 5, 4], // -y
-        [2, 6, 7, 3], // +y
-        [0, 2, 3, 1], // -z
-        [4, 5, 7, 6], // +z
-    ];
-    let idx = quads
-        .iter()
-        .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
-        .collect();
-    (p, idx)
 }
 
 /// An 8×8 render of `scene` at 4 spp and 4 bounces under a uniform sky of radiance `sky`.

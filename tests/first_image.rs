@@ -212,3 +212,94 @@ fn auto_exposure_yields_to_exposure_and_ev100() {
         assert!(String::from_utf8_lossy(&o.stderr).contains("render 100%"));
     }
 }
+
+/// A closed room 6 × 2.7 × 4 m (the inside of a box, faces inward) seen from inside by its own
+/// camera, looking at the far wall; `spot` adds a narrow spot light that lights a disc of that
+/// wall (a room partly lit by its own lights); `open_top` leaves out the
+/// ceiling (the sky reaches in).
+fn room_glb(dir: &std::path::Path, name: &str, spot: bool, open_top: bool) -> PathBuf {
+    let mut g = common::Gltf::default();
+    let white = g.lambert([0.8; 3], [0.0; 3], 1.0, false);
+    let (positions, outward) = common::cuboid([-3.0, 0.0, -2.0], [3.0, 2.7, 2.0]);
+    let mut indices: Vec<u32> = outward.chunks(3).flat_map(|t| [t[0], t[2], t[1]]).collect();
+    if open_top {
+        // The +y quad is the fourth: its two triangles.
+        indices.drain(18..24);
+    }
+    let mesh = g.mesh(vec![common::Prim::triangles(positions, indices, white)]);
+    g.node(serde_json::json!({"mesh": mesh}));
+    g.cameras.push(
+        serde_json::json!({"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.01}}),
+    );
+    g.node(serde_json::json!({"camera": 0, "translation": [0.0, 1.4, 1.8]}));
+    if spot {
+        g.lights
+            .push(serde_json::json!({"type": "spot", "intensity": 40.0,
+            "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.3}}));
+        // In the middle of the room, facing the far wall (a light looks down −z).
+        g.node(
+            serde_json::json!({"extensions": {"KHR_lights_punctual": {"light": 0}},
+            "translation": [0.0, 1.4, 0.0]}),
+        );
+    }
+    g.write_glb(dir, name)
+}
+
+#[test]
+fn an_environment_is_added_only_where_the_sky_reaches() {
+    let dir = output_dir("first_image_closed_rooms");
+    let run = |name: &str, spot: bool, open_top: bool, extra: &[&str]| {
+        let glb = room_glb(&dir, name, spot, open_top);
+        let png = dir.join(format!("{name}.png"));
+        let o = render_small(&glb, &png, extra);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (summary, png)
+    };
+    // A dark closed room: no environment (it could not get in; the image stayed black), but
+    // the interior's lamps, which replace the default rig (placed outside) and light it.
+    let (s, png) = run("dark", false, false, &[]);
+    let (median, _, black) = png_stats(&png);
+    assert_eq!(s["first_view"]["sky_fraction"], 0.0, "{s}");
+    assert!(s["environment"].is_null(), "{s}");
+    assert_eq!(s["default_light_rig"], false, "{s}");
+    assert_eq!(s["lights"], 2, "{s}");
+    assert!(
+        black < 0.1 && median > 0.15,
+        "the dark room renders {black:.2} black, at median {median:.3}"
+    );
+    // A closed room that its own spot light lights in part keeps that light alone, and the
+    // studio environment, asked for, would have added nothing to it.
+    let (s, _) = run("spot", true, false, &[]);
+    let lit = s["first_view"]["lit_fraction"].as_f64().unwrap();
+    assert!(lit > 0.0 && lit < 0.25, "{s}");
+    assert!(s["environment"].is_null(), "{s}");
+    assert_eq!(s["lights"], 1, "{s}");
+    // Converged enough (linear, 64 spp) to show that the environment adds nothing.
+    let glb = dir.join("spot.glb");
+    let mean = |extra: &[&str]| {
+        let exr = dir.join("spot.exr");
+        let args = [
+            &["--width", "48", "--height", "36", "--spp", "64"][..],
+            extra,
+        ]
+        .concat();
+        let (s, px) = common::render_exr(&glb, &exr, &args);
+        let sum: f64 = px.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum();
+        (s, sum / px.len() as f64)
+    };
+    let (_, alone) = mean(&[]);
+    let (s, with_env) = mean(&["--env", "studio"]);
+    assert_eq!(s["environment"], "studio", "{s}");
+    assert!(
+        alone > 0.0 && (with_env / alone - 1.0).abs() < 0.05,
+        "the spot-lit room's mean: {alone:.4} alone, {with_env:.4} with the environment"
+    );
+    // Without a ceiling the sky gets in: the studio environment lights the room.
+    let (s, _) = run("open", false, true, &[]);
+    assert!(
+        s["first_view"]["sky_fraction"].as_f64().unwrap() > 0.05,
+        "{s}"
+    );
+    assert_eq!(s["environment"], "studio", "{s}");
+}

@@ -2,7 +2,7 @@
 """penumbra against Mitsuba 3's CPU path tracer (llvm_ad_rgb), side by side, in one run on one
 machine: the same scene, resolution, path depth and samples per pixel.
 
-Two scenes, each defined once here as plain data and given to both renderers:
+The scenes, each defined once here as plain data and given to both renderers:
 
   cornell  the bundled Lambertian Cornell box (assets/cornell-box.glb, built by
            scripts/cornell_box.py; the Mitsuba side is scripts/mitsuba_reference.py's
@@ -20,6 +20,11 @@ Two scenes, each defined once here as plain data and given to both renderers:
   bunnies-room  the seven bunnies in a closed room (side and front walls, a ceiling) lit only
            by an emissive panel under the ceiling: no path escapes, every one can find the
            light (1 M triangles, long paths).
+  terrain-room  a 709x709 heightfield (a smooth procedural terrain, 1,002,540 triangles) in
+           the same closed room: one large, well-behaved mesh.
+  spheres-room  357 UV spheres of random sizes and places (seed 13, overlapping, 1,002,470
+           triangles) in the same closed room: many objects whose boxes overlap, the hard
+           case for a BVH.
 
 Settings on both sides: --size x --size pixels, box pixel filter, penumbra --bounces B =
 Mitsuba max_depth B + 2, Russian roulette off, hard shadows (point light radius 0), MIS.
@@ -34,7 +39,7 @@ Measured (wall clock, on this machine, one after the other, nothing else of ours
     progressive; Mitsuba: an independent render per spp count), and the time each needs to
     reach the relMSE Mitsuba reaches at S spp (log-log interpolation on each curve).
 
-    python3 scripts/peers/mitsuba_compare.py                      # both scenes, defaults
+    python3 scripts/peers/mitsuba_compare.py                      # cornell and bunny, defaults
     python3 scripts/peers/mitsuba_compare.py --scenes cornell --spp 64 --max-spp 256
     python3 scripts/peers/mitsuba_compare.py --timing-only --rounds 5 --scenes bunnies,bunnies-room \
         --size 256 --bounces 6 --spp 16    # medians of 5 interleaved renders a side
@@ -116,24 +121,9 @@ def bunny_scene(glb_path, copies=1, room=False):
     meshes = [_flat_mesh(f"Bunny{i}" if i else "Bunny", 0,
                          [(p[0] + o[0], p[1] + o[1], p[2] + o[2]) for p in positions], tris)
               for i, o in enumerate(offsets)]
-    parts = [("Floor", 1, [floor]), ("Wall", 2, [wall])]
-    if room:
-        # Closed: side walls, a front wall behind the camera and a ceiling with a panel light
-        # under it (facing down), so that no path escapes and every one can find the light.
-        top = 4.0
-        parts[1] = ("Wall", 2, [
-            wall,
-            cornell_box._quad([(-3.0, y0, -1.5), (-3.0, y0, 4.0), (-3.0, top, 4.0),
-                               (-3.0, top, -1.5)], (1, 0, 0)),
-            cornell_box._quad([(3.0, y0, -1.5), (3.0, y0, 4.0), (3.0, top, 4.0),
-                               (3.0, top, -1.5)], (-1, 0, 0)),
-            cornell_box._quad([(-3.0, y0, 4.0), (3.0, y0, 4.0), (3.0, top, 4.0),
-                               (-3.0, top, 4.0)], (0, 0, -1)),
-            cornell_box._quad([(-3.0, top, -1.5), (3.0, top, -1.5), (3.0, top, 4.0),
-                               (-3.0, top, 4.0)], (0, -1, 0))])
-        parts.append(("Panel", 3, [cornell_box._quad(
-            [(-1.0, top - 0.001, 0.0), (1.0, top - 0.001, 0.0), (1.0, top - 0.001, 2.0),
-             (-1.0, top - 0.001, 2.0)], (0, -1, 0))]))
+    # Closed: side walls, a front wall behind the camera and a ceiling with a panel light under
+    # it (facing down), so that no path escapes and every one can find the light.
+    parts = [("Floor", 1, [floor])] + (_room(y0) if room else [("Wall", 2, [wall])])
     for name, mat, quads in parts:
         p, n, i = cornell_box._merge(quads)
         meshes.append({"name": name, "material": mat, "positions": p, "normals": n,
@@ -143,6 +133,84 @@ def bunny_scene(glb_path, copies=1, room=False):
                 "camera": BUNNY_CAMERA, "point_lights": []}
     return {"meshes": meshes, "materials": BUNNY_MATERIALS, "camera": BUNNY_CAMERA,
             "point_lights": [BUNNY_LIGHT]}
+
+
+def _room(y0, top=4.0):
+    """The closed room of bunnies-room (back, side and front walls, a ceiling) and its panel
+    light under the ceiling, as (name, material, quads) parts; the floor is the caller's."""
+    walls = [
+        cornell_box._quad([(-3.0, y0, -1.5), (3.0, y0, -1.5), (3.0, top, -1.5),
+                           (-3.0, top, -1.5)], (0, 0, 1)),
+        cornell_box._quad([(-3.0, y0, -1.5), (-3.0, y0, 4.0), (-3.0, top, 4.0),
+                           (-3.0, top, -1.5)], (1, 0, 0)),
+        cornell_box._quad([(3.0, y0, -1.5), (3.0, y0, 4.0), (3.0, top, 4.0),
+                           (3.0, top, -1.5)], (-1, 0, 0)),
+        cornell_box._quad([(-3.0, y0, 4.0), (3.0, y0, 4.0), (3.0, top, 4.0),
+                           (-3.0, top, 4.0)], (0, 0, -1)),
+        cornell_box._quad([(-3.0, top, -1.5), (3.0, top, -1.5), (3.0, top, 4.0),
+                           (-3.0, top, 4.0)], (0, -1, 0))]
+    panel = cornell_box._quad([(-1.0, top - 0.001, 0.0), (1.0, top - 0.001, 0.0),
+                               (1.0, top - 0.001, 2.0), (-1.0, top - 0.001, 2.0)], (0, -1, 0))
+    return [("Wall", 2, walls), ("Panel", 3, [panel])]
+
+
+def _scene_in_room(meshes, y0, floor=True):
+    parts = _room(y0)
+    if floor:
+        parts.insert(0, ("Floor", 1, [cornell_box._quad(
+            [(-3.0, y0, -1.5), (3.0, y0, -1.5), (3.0, y0, 4.0), (-3.0, y0, 4.0)], (0, 1, 0))]))
+    for name, mat, quads in parts:
+        p, n, i = cornell_box._merge(quads)
+        meshes.append({"name": name, "material": mat, "positions": p, "normals": n,
+                       "indices": i})
+    return {"meshes": meshes, "materials": BUNNY_MATERIALS + [BUNNY_PANEL],
+            "camera": BUNNY_CAMERA, "point_lights": []}
+
+
+def terrain_room_scene(n=709):
+    """A rolling heightfield of 2 (n-1)^2 triangles (1,002,528 for n = 709: one dense mesh,
+    no copies) as the floor of bunnies-room's closed room, lit by its panel: 1 M triangles
+    unlike the bunnies' (no instancing to find, small triangles everywhere the camera looks)."""
+    def h(x, z):
+        return (0.35 + 0.25 * math.sin(2.1 * x) * math.cos(1.7 * z)
+                + 0.1 * math.sin(5.3 * x + 1.3 * z) + 0.04 * math.sin(13.0 * x) * math.sin(11.0 * z))
+    xs = [-3.0 + 6.0 * i / (n - 1) for i in range(n)]
+    zs = [-1.5 + 5.5 * j / (n - 1) for j in range(n)]
+    positions = [(x, h(x, z), z) for z in zs for x in xs]
+    tris = []
+    for j in range(n - 1):
+        for i in range(n - 1):
+            a = j * n + i
+            tris += [(a, a + n, a + 1), (a + 1, a + n, a + n + 1)]
+    return _scene_in_room([_flat_mesh("Terrain", 0, positions, tris)], 0.0, floor=False)
+
+
+def spheres_room_scene(count=357, stacks=27, slices=54):
+    """`count` UV spheres of 2 slices (stacks - 1) triangles each (2,808; 1,002,456 in all),
+    of random radii at random places in bunnies-room's room (a fixed seed): many separate
+    objects, some overlapping, each its own mesh."""
+    import random
+    rng = random.Random(13)
+    unit = [(math.sin(math.pi * t / stacks) * math.cos(2 * math.pi * s / slices),
+             math.cos(math.pi * t / stacks),
+             math.sin(math.pi * t / stacks) * math.sin(2 * math.pi * s / slices))
+            for t in range(stacks + 1) for s in range(slices)]
+    tris = []
+    for t in range(stacks):
+        for s in range(slices):
+            a, b = t * slices + s, t * slices + (s + 1) % slices
+            c, d = a + slices, b + slices
+            if t > 0:
+                tris.append((a, b, c))
+            if t < stacks - 1:
+                tris.append((b, d, c))
+    meshes = []
+    for k in range(count):
+        r = rng.uniform(0.08, 0.28)
+        o = (rng.uniform(-2.7, 2.7), rng.uniform(r, 3.2), rng.uniform(-1.3, 1.8))
+        pts = [(o[0] + r * u[0], o[1] + r * u[1], o[2] + r * u[2]) for u in unit]
+        meshes.append(_flat_mesh(f"Sphere{k}", 0, pts, tris))
+    return _scene_in_room(meshes, 0.0)
 
 
 def closed_box_scene(splits=0):
@@ -334,6 +402,19 @@ def compare(name, glb, msc, reference, args, results):
           f"{args.spp} spp", file=sys.stderr)
 
 
+
+def cached_reference(args, name, msc):
+    """The Mitsuba reference of scene `name` (Mitsuba scene dict `msc`) at --ref-spp, rendered
+    into --work unless it is there already (or --timing-only, which needs none)."""
+    reference = os.path.join(args.work,
+                             f"{name}-mitsuba-{args.size}-{args.bounces}-{args.ref_spp}.exr")
+    if not os.path.exists(reference) and not args.timing_only:
+        print(f"rendering {reference} ({args.ref_spp} spp)", file=sys.stderr)
+        t = time.perf_counter()
+        mi.Bitmap(mitsuba_reference_image(msc, args.ref_spp, 1000, 256)).write(reference)
+        print(f"   {time.perf_counter() - t:.0f} s", file=sys.stderr)
+    return reference
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--penumbra", default=os.path.join(ROOT, "target", "release", "penumbra"))
@@ -392,18 +473,16 @@ def main(argv=None):
             glb = os.path.join(args.work, f"{name}-lambert.glb")
             cornell_box.write_glb(glb, *cornell_box.build_gltf(sc))
             msc = mitsuba_scene(sc, args.size, args.size, args.bounces, twosided=True)
-            reference = os.path.join(args.work,
-                                     f"{name}-mitsuba-{args.size}-{args.bounces}-"
-                                     f"{args.ref_spp}.exr")
-            if not os.path.exists(reference) and not args.timing_only:
-                print(f"rendering {reference} ({args.ref_spp} spp)", file=sys.stderr)
-                t = time.perf_counter()
-                mi.Bitmap(mitsuba_reference_image(msc, args.ref_spp, 1000, 256)).write(
-                    reference)
-                print(f"   {time.perf_counter() - t:.0f} s", file=sys.stderr)
+            reference = cached_reference(args, name, msc)
+        elif name in ("terrain-room", "spheres-room"):
+            sc = terrain_room_scene() if name == "terrain-room" else spheres_room_scene()
+            glb = os.path.join(args.work, f"{name}-lambert.glb")
+            cornell_box.write_glb(glb, *cornell_box.build_gltf(sc))
+            msc = mitsuba_scene(sc, args.size, args.size, args.bounces, twosided=True)
+            reference = cached_reference(args, name, msc)
         else:
             sys.exit(f"unknown scene '{name}' (cornell, cornell36, cornell144, cornell576, bunny, "
-                     "bunnies, bunnies-room)")
+                     "bunnies, bunnies-room, terrain-room, spheres-room)")
         compare(name, glb, msc, reference, args, results)
 
     cpu = platform.processor() or platform.machine()

@@ -82,7 +82,7 @@ impl App {
         match result {
             Ok((mut scene, ms)) => {
                 if self.env_lights {
-                    scene.light_by_environment();
+                    scene.drop_default_rig();
                 }
                 self.autofocus = self.model.view.aperture > 0.0;
                 if let Some(auto) = self.model.view.auto_exposure.as_mut() {

@@ -119,40 +119,52 @@ pub struct KernelFeatures {
 /// docs/benchmarks.md, "Fourteenth session", "Fifteenth session").
 pub const LANES_MIN_TRIANGLES: usize = 32_768;
 
-/// Whether the megakernel should walk a flat scene's rays in lanes (`KernelFeatures::lanes`) on
-/// a CPU device: no alpha, not a small scene, [`LANES_MIN_TRIANGLES`] or more and fewer than
-/// 2^27 triangles in leaves of at most 15 (a lane's stack entry packs both in a word), the host
-/// CPU (PoCL's device) has AVX-512 (whose gathers, scatters and compresses the walk uses) or
-/// AVX2 (eight lanes: gathers, table-driven compresses, stores for scatters; 17-25 % less time
-/// than one ray at a time on AMD's Zen 3, docs/benchmarks.md, "Twenty-third session"), and
-/// `PENUMBRA_LANES` is not `0` (docs/benchmarks.md, "Fourteenth session"). `PENUMBRA_LANES=1`
-/// walks in lanes on any CPU device (lane by lane where the CPU has neither: for measurements).
+/// Whether the megakernel walks a flat scene's rays in lanes (`KernelFeatures::lanes`): the
+/// answer of [`lanes_megakernel`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lanes {
+    /// One ray at a time.
+    Never,
+    /// In lanes.
+    Always,
+    /// In lanes where they shade their vertices in batches ([`lanes_shade`]), which pays at any
+    /// size: the scene has fewer than [`LANES_MIN_TRIANGLES`], where the walk alone does not.
+    WhenBatched,
+}
+
+/// Whether the megakernel should walk a flat scene's rays in lanes on a CPU device: no alpha, not
+/// a small scene, fewer than 2^27 triangles in leaves of at most 15 (a lane's stack entry packs
+/// both in a word), the host CPU (PoCL's device) has AVX-512 (whose gathers, scatters and
+/// compresses the walk uses) or AVX2 (eight lanes: gathers, table-driven compresses, stores for
+/// scatters; 17-25 % less time than one ray at a time on AMD's Zen 3, docs/benchmarks.md,
+/// "Twenty-third session"), and `PENUMBRA_LANES` is not `0` (docs/benchmarks.md, "Fourteenth
+/// session"); below [`LANES_MIN_TRIANGLES`] only where the vertices are shaded in batches.
+/// `PENUMBRA_LANES=1` walks in lanes on any CPU device at any size (lane by lane where the CPU
+/// has neither: for measurements).
 pub fn lanes_megakernel(
     cpu: bool,
     alpha: bool,
     small_scene: u32,
     triangles: usize,
     largest_leaf: u32,
-) -> bool {
+) -> Lanes {
     if !cpu || alpha || small_scene > 0 || triangles >= 1 << 27 || largest_leaf > 15 {
-        return false;
+        return Lanes::Never;
     }
     match std::env::var("PENUMBRA_LANES").as_deref().map(str::trim) {
-        Ok("0") => return false,
-        Ok("1") => return true,
+        Ok("0") => return Lanes::Never,
+        Ok("1") => return Lanes::Always,
         _ => {}
     }
-    if triangles < LANES_MIN_TRIANGLES {
-        return false;
-    }
     #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx512f")
-            || std::arch::is_x86_feature_detected!("avx2")
-    }
+    let vectors = std::arch::is_x86_feature_detected!("avx512f")
+        || std::arch::is_x86_feature_detected!("avx2");
     #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
+    let vectors = false;
+    match (vectors, triangles >= LANES_MIN_TRIANGLES) {
+        (false, _) => Lanes::Never,
+        (true, true) => Lanes::Always,
+        (true, false) => Lanes::WhenBatched,
     }
 }
 

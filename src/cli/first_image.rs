@@ -1,6 +1,6 @@
 //! The defaults that make the first image of any scene readable: the first view (a scene's own
-//! camera wins), an environment when the scene's own lights do not light that view, and lights
-//! inside an interior that nothing lights.
+//! camera wins), an environment when the scene's own lights do not light that view and the sky
+//! can reach it, and lights inside an interior that nothing lights.
 
 use crate::args::EnvChoice;
 use crate::scene::framing::{self, FirstView};
@@ -48,10 +48,16 @@ pub struct FirstImage {
 /// `camera` is the camera in use when the scene (or the command line) chose one.
 pub fn decide(scene: &Scene, lights: &[Light], camera: Option<&Camera>, aspect: f64) -> FirstImage {
     let view = framing::first_view(scene, lights, camera, aspect);
-    let environment = (!view.lit).then_some(EnvPreset::Studio);
+    // An environment lights only what the sky reaches: never the inside of a closed room, where
+    // it would add a light sample and a shadow ray to every path vertex and nothing to the image.
+    let reaches = view.environment_reaches();
+    let environment = (!view.lit && reaches).then_some(EnvPreset::Studio);
     // Inside a room, daylight through the windows is not enough: add a ceiling lamp and a light
-    // at the camera unless the scene's own lights reach the view.
-    let added = if view.interior && !view.lit {
+    // at the camera unless the scene's own lights reach the view; so too in a closed room that
+    // no light reaches directly. A closed room partly lit by its own lights keeps them alone:
+    // their light fills it by bounces.
+    let dark_and_closed = !reaches && view.lit_fraction == 0.0;
+    let added = if !view.lit && (view.interior || dark_and_closed) {
         framing::interior_lights(&view)
     } else {
         Vec::new()

@@ -123,6 +123,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let samples = settings.width as f64 * settings.height as f64 * spp as f64;
     let rays = (stats.extension_rays + stats.shadow_rays) as f64;
+    let first_view = prepared.first_view.as_ref().map(|f| {
+        serde_json::json!({
+            "interior": f.view.interior,
+            "lights_light_view": f.view.lit,
+            "lit_fraction": f.view.lit_fraction,
+            "coverage": f.view.coverage,
+            "sky_fraction": f.view.sky_fraction,
+        })
+    });
     let mut summary = serde_json::json!({
         "scene": args.scene.display().to_string(),
         "output": args.output.display().to_string(),
@@ -163,12 +172,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "forward": prepared.camera.forward.to_array(),
             "yfov_degrees": prepared.camera.yfov.to_degrees(),
         },
-        "first_view": prepared.first_view.as_ref().map(|f| serde_json::json!({
-            "interior": f.view.interior,
-            "lights_light_view": f.view.lit,
-            "lit_fraction": f.view.lit_fraction,
-            "coverage": f.view.coverage,
-        })),
+        "first_view": first_view,
         "aperture": renderer.settings().lens_radius,
         "focus_distance": renderer.settings().focus_distance,
         "kernel_ms": stats.stage_ms,

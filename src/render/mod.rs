@@ -27,7 +27,9 @@ use crate::bvh::{Ray, WideBvh};
 pub use crate::cl::kernels::NodeForms;
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program, SMALL_SCENE_MAX};
+use crate::cl::{
+    Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Lanes, Program, SMALL_SCENE_MAX,
+};
 use crate::scene::{AlphaMode, Camera, EnvMap, EnvSampling, Light, RenderFrame, Scene};
 use std::sync::Arc;
 use std::time::Instant;
@@ -152,9 +154,9 @@ pub struct Renderer {
     light_count: u32,
     /// Features of the loaded scene (without the environment map's).
     scene_features: KernelFeatures,
-    /// The scene could walk in lanes but has fewer than `cl::LANES_MIN_TRIANGLES`: it takes
-    /// them where their vertices are shaded in batches (`ensure_program`).
-    lanes_below_min: bool,
+    /// Whether the loaded scene walks in lanes; `ensure_program` settles `Lanes::WhenBatched`
+    /// once it knows the environment.
+    lanes: Lanes,
     /// The lights as last given, to rebuild the light table.
     lights: Vec<Light>,
     environment: Option<(Arc<EnvMap>, EnvSampling)>,
@@ -226,7 +228,7 @@ impl Renderer {
             camera: GpuCamera::default(),
             light_count: 0,
             scene_features: KernelFeatures::default(),
-            lanes_below_min: false,
+            lanes: Lanes::Never,
             lights: Vec::new(),
             environment: None,
             env,
@@ -492,20 +494,16 @@ impl Renderer {
             host.triangles.len(),
             self.scene_features.alpha,
         );
-        let lanes = |triangles| match &host.accel {
+        self.lanes = match &host.accel {
             Accel::Flat(bvh) => crate::cl::lanes_megakernel(
                 self.gpu.is_cpu(),
                 self.scene_features.alpha,
                 self.scene_features.small_scene,
-                triangles,
+                host.triangles.len(),
                 bvh.largest_leaf(),
             ),
-            Accel::TwoLevel(_) => false,
+            Accel::TwoLevel(_) => Lanes::Never,
         };
-        self.scene_features.lanes = lanes(host.triangles.len());
-        self.lanes_below_min = !self.scene_features.lanes
-            && host.triangles.len() < crate::cl::LANES_MIN_TRIANGLES
-            && lanes(crate::cl::LANES_MIN_TRIANGLES);
         let budget = self
             .gpu
             .device
@@ -740,17 +738,14 @@ impl Renderer {
             env_map: self.environment.is_some(),
             ..self.scene_features
         };
-        // Below the lanes' fewest triangles, a scene whose vertices the lanes would shade in
-        // batches takes them all the same: batched shading pays at any size.
-        if !features.lanes && self.lanes_below_min {
-            let with = KernelFeatures {
+        features.lanes = match self.lanes {
+            Lanes::Never => false,
+            Lanes::Always => true,
+            Lanes::WhenBatched => crate::cl::lanes_shade(&KernelFeatures {
                 lanes: true,
                 ..features
-            };
-            if crate::cl::lanes_shade(&with) {
-                features = with;
-            }
-        }
+            }),
+        };
         features.lanes_shade = crate::cl::lanes_shade(&features);
         if self
             .program

@@ -42,6 +42,11 @@ pub const MAX_EMITTERS: usize = 64;
 pub const MIN_LIT_FRACTION: f64 = 0.25;
 /// How far (in stops) the lit subject may lie below the directly seen emitters.
 pub const MAX_STOPS_BELOW_EMITTERS: f64 = 10.0;
+/// Rays from each subject point over its hemisphere, to find whether the sky reaches it.
+pub const SKY_RAYS: usize = 16;
+/// The share of those rays that must leave the scene for an environment to light the view: a
+/// room with a window lets out a few percent; cracks in a closed model far fewer.
+pub const MIN_SKY_FRACTION: f64 = 0.002;
 /// Share of the rays from the middle of the bounds that must hit front faces for an interior.
 pub const INTERIOR_HIT_FRACTION: f64 = 0.6;
 /// Share of escaping rays from which a one-sided opening makes an open box (the Cornell box
@@ -120,6 +125,27 @@ pub struct FirstView {
     pub subject_radiance: f64,
     /// L_e: 90th percentile radiance of the emitters seen directly (0 when none is).
     pub emitter_radiance: f64,
+    /// The share of rays from the subject points over their hemispheres that leave the scene:
+    /// 0 in a closed room, which an environment cannot light.
+    pub sky_fraction: f64,
+}
+
+impl FirstView {
+    /// Whether an environment would show in the view or light it: the camera sees past the
+    /// geometry, or at least [`MIN_SKY_FRACTION`] of the subject's hemisphere rays leave.
+    pub fn environment_reaches(&self) -> bool {
+        self.coverage < 1.0 || self.sky_fraction >= MIN_SKY_FRACTION
+    }
+}
+
+/// What [`light_test`] finds from a camera (the [`FirstView`] fields of the same names).
+struct LightTest {
+    lit: bool,
+    coverage: f64,
+    lit_fraction: f64,
+    subject_radiance: f64,
+    emitter_radiance: f64,
+    sky_fraction: f64,
 }
 
 /// The visible objects' world triangles in scene order (as [`Scene::flatten`] keeps them),
@@ -1071,17 +1097,15 @@ fn irradiance(
     e
 }
 
-/// The rule of the module docs, evaluated from `camera`: (lit, coverage, lit fraction, L_s, L_e).
-fn light_test(
-    probe: &Probe,
-    lights: &[Light],
-    camera: &Camera,
-    aspect: f64,
-) -> (bool, f64, f64, f64, f64) {
+/// The rule of the module docs, evaluated from `camera`, and how much sky the subject sees.
+fn light_test(probe: &Probe, lights: &[Light], camera: &Camera, aspect: f64) -> LightTest {
     use rayon::prelude::*;
     let emitters = emitters(probe);
     let far = probe.scale() * 100.0 + (camera.eye - probe.bounds.center()).length() * 4.0;
-    let samples: Vec<(Option<f64>, Option<f64>)> = (0..PROBE_COLUMNS * PROBE_ROWS)
+    let sky: Vec<DVec3> = sphere_directions(SKY_RAYS).collect();
+    // (direct irradiance and escaping hemisphere rays at a subject point, emitter radiance)
+    type Sample = (Option<(f64, usize)>, Option<f64>);
+    let samples: Vec<Sample> = (0..PROBE_COLUMNS * PROBE_ROWS)
         .into_par_iter()
         .map(|i| {
             let fx = ((i % PROBE_COLUMNS) as f64 + 0.5) / PROBE_COLUMNS as f64;
@@ -1097,18 +1121,36 @@ fn light_test(
             if n.dot(d) > 0.0 {
                 n = -n;
             }
+            let point = camera.eye + d * t;
+            let origin = point + n * (1e-4 * probe.scale());
+            let escaping = sky
+                .iter()
+                .filter(|&&s| {
+                    let s = if s.dot(n) < 0.0 { -s } else { s };
+                    probe.hit(origin, s, far).is_none()
+                })
+                .count();
             (
-                Some(irradiance(probe, lights, &emitters, camera.eye + d * t, n)),
+                Some((irradiance(probe, lights, &emitters, point, n), escaping)),
                 None,
             )
         })
         .collect();
-    let mut subject: Vec<f64> = samples.iter().filter_map(|s| s.0).collect();
+    let escaping: usize = samples.iter().filter_map(|s| s.0).map(|(_, k)| k).sum();
+    let mut subject: Vec<f64> = samples.iter().filter_map(|s| s.0).map(|(e, _)| e).collect();
     let mut seen: Vec<f64> = samples.iter().filter_map(|s| s.1).collect();
     let coverage = (subject.len() + seen.len()) as f64 / samples.len() as f64;
     if subject.is_empty() {
-        return (false, coverage, 0.0, 0.0, 0.0);
+        return LightTest {
+            lit: false,
+            coverage,
+            lit_fraction: 0.0,
+            subject_radiance: 0.0,
+            emitter_radiance: 0.0,
+            sky_fraction: 0.0,
+        };
     }
+    let sky_fraction = escaping as f64 / (subject.len() * SKY_RAYS) as f64;
     let lit_fraction = subject.iter().filter(|&&e| e > 0.0).count() as f64 / subject.len() as f64;
     subject.sort_by(f64::total_cmp);
     seen.sort_by(f64::total_cmp);
@@ -1121,13 +1163,14 @@ fn light_test(
     let lit = lit_fraction >= MIN_LIT_FRACTION
         && subject_radiance > 0.0
         && subject_radiance >= emitter_radiance * 2f64.powf(-MAX_STOPS_BELOW_EMITTERS);
-    (
+    LightTest {
         lit,
         coverage,
         lit_fraction,
         subject_radiance,
         emitter_radiance,
-    )
+        sky_fraction,
+    }
 }
 
 /// The first view of `scene` lit by `lights` (the scene's own, without a default rig), for an
@@ -1175,8 +1218,14 @@ pub fn first_view_with(
             }
         }
     };
-    let (lit, coverage, lit_fraction, subject_radiance, emitter_radiance) =
-        light_test(probe, lights, &camera, aspect);
+    let LightTest {
+        lit,
+        coverage,
+        lit_fraction,
+        subject_radiance,
+        emitter_radiance,
+        sky_fraction,
+    } = light_test(probe, lights, &camera, aspect);
     FirstView {
         camera,
         bounds,
@@ -1186,6 +1235,7 @@ pub fn first_view_with(
         lit_fraction,
         subject_radiance,
         emitter_radiance,
+        sky_fraction,
     }
 }
 
@@ -1467,6 +1517,37 @@ mod tests {
         let view = first_view(&scene_of(&[(closed, Material::default())]), &[], None, 1.6);
         assert!(!view.interior);
         assert!(view.camera.eye.z > 4.0, "{}", view.camera.eye);
+    }
+
+    #[test]
+    fn the_sky_reaches_into_a_room_without_a_ceiling_and_not_into_a_closed_one() {
+        let camera = Camera::look_at(
+            "inside",
+            DVec3::new(0.5, 1.4, 1.5),
+            DVec3::new(-0.5, 1.0, -2.0),
+            0.9,
+        );
+        let mut room = cuboid(Vec3::new(-3.0, 0.0, -2.0), Vec3::new(3.0, 2.7, 2.0), true);
+        let closed = first_view(
+            &scene_of(&[(room.clone(), Material::default())]),
+            &[],
+            Some(&camera),
+            1.5,
+        );
+        assert!(
+            closed.coverage == 1.0 && closed.sky_fraction == 0.0,
+            "{closed:?}"
+        );
+        assert!(!closed.environment_reaches());
+        room.truncate(10); // the ceiling (+Y) is the last quad
+        let open = first_view(
+            &scene_of(&[(room, Material::default())]),
+            &[],
+            Some(&camera),
+            1.5,
+        );
+        assert!(open.sky_fraction > 0.05, "{open:?}");
+        assert!(open.environment_reaches());
     }
 
     #[test]

@@ -115,9 +115,10 @@ pub fn default_light_rig(bounds: &Bounds) -> Vec<Light> {
 }
 
 impl Scene {
-    /// An environment light (`--env`) lights the scene instead of the default rig: a scene
-    /// that only has the rig loses it; a scene with its own lights keeps them.
-    pub fn light_by_environment(&mut self) {
+    /// Other lighting (an environment, `--env`, or the lamps of a room seen from inside)
+    /// replaces the default rig: a scene that only has the rig loses it; a scene with its own
+    /// lights keeps them.
+    pub fn drop_default_rig(&mut self) {
         if self.default_rig {
             self.lights.clear();
             self.default_rig = false;
@@ -231,13 +232,13 @@ mod tests {
             default_rig: true,
             ..Scene::default()
         };
-        lit_by_rig.light_by_environment();
+        lit_by_rig.drop_default_rig();
         assert!(lit_by_rig.lights.is_empty() && !lit_by_rig.default_rig);
         let mut own_lights = Scene {
             lights: rig.clone(),
             ..Scene::default()
         };
-        own_lights.light_by_environment();
+        own_lights.drop_default_rig();
         assert_eq!(own_lights.lights, rig);
     }
 

@@ -467,6 +467,31 @@ pub fn mean_gray(px: &[[f32; 3]]) -> f64 {
         / px.len() as f64
 }
 
+/// An axis-aligned box from `lo` to `hi` (outward winding, no normals).
+pub fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> (Vec<[f32; 3]>, Vec<u32>) {
+    let mut p = vec![];
+    for i in 0..8 {
+        p.push([
+            if i & 1 == 0 { lo[0] } else { hi[0] },
+            if i & 2 == 0 { lo[1] } else { hi[1] },
+            if i & 4 == 0 { lo[2] } else { hi[2] },
+        ]);
+    }
+    let quads = [
+        [0, 4, 6, 2], // -x
+        [1, 3, 7, 5], // +x
+        [0, 1, 5, 4], // -y
+        [2, 6, 7, 3], // +y
+        [0, 2, 3, 1], // -z
+        [4, 5, 7, 6], // +z
+    ];
+    let idx = quads
+        .iter()
+        .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+        .collect();
+    (p, idx)
+}
+
 /// A white (albedo 1) Lambertian sphere of radius 1 at the origin seen from z = 4; a floor
 /// below it when `floor`.
 pub fn white_sphere(dir: &Path, floor: bool) -> PathBuf {
