@@ -53,10 +53,11 @@ pub fn decide(scene: &Scene, lights: &[Light], camera: Option<&Camera>, aspect: 
     let reaches = view.environment_reaches();
     let environment = (!view.lit && reaches).then_some(EnvPreset::Studio);
     // Inside a room, daylight through the windows is not enough: add a ceiling lamp and a light
-    // at the camera unless the scene's own lights reach the view; so too in a closed room that
-    // no light reaches directly. A closed room partly lit by its own lights keeps them alone:
-    // their light fills it by bounces.
-    let dark_and_closed = !reaches && view.lit_fraction == 0.0;
+    // at the camera unless the scene's own lights reach the view; so too in a closed room
+    // without lights of its own. A closed room with lights of its own keeps them alone, lit
+    // in part or not at all (a furnace, an emitter turned away): their light is the scene's.
+    let own_light = !lights.is_empty() || scene.materials.iter().any(|m| m.is_emissive());
+    let dark_and_closed = !reaches && !own_light;
     let added = if !view.lit && (view.interior || dark_and_closed) {
         framing::interior_lights(&view)
     } else {
