@@ -223,11 +223,10 @@ fn the_same_seed_traces_the_same_paths_in_both_kernels() {
     assert!((ma - mb).abs() <= 1e-3 * ma, "mean {ma} against {mb}");
 }
 
-#[test]
-fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
-    // The bundled box (32 triangles) is tested whole on CPU devices (`SMALL_SCENE`), with
-    // kernels built for two batches of sixteen: hiding the tall block (22 left) changes the
-    // count the frame carries, not the kernels, and the block is gone from the image.
+/// Renders the bundled box (32 triangles) as `scene` says, hides its tall block (22 left) and
+/// shows it again: no kernels are built after the first, the block is gone from the image and
+/// back, the same image again. Returns the kernels' features.
+fn hide_and_show_the_tall_block(mut scene: penumbra::scene::Scene) -> penumbra::cl::KernelFeatures {
     use penumbra::render::{RenderSettings, Renderer};
     use penumbra::scene::RenderFrame;
     let choice = common::test_device().parse().unwrap();
@@ -239,7 +238,6 @@ fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
         ..Default::default()
     })
     .unwrap();
-    let mut scene = penumbra::scene::load_or_bundled(None).unwrap();
     let camera = scene.cameras[0].clone();
     let lights = scene.lights.clone();
     let render = |r: &mut Renderer, scene: &penumbra::scene::Scene| {
@@ -253,9 +251,6 @@ fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
     let (first, whole) = render(&mut r, &scene);
     assert!(first.kernels_built);
     let features = r.program().unwrap().features;
-    if r.gpu.is_cpu() {
-        assert_eq!(features.small_scene, 32);
-    }
     let tall = scene
         .objects
         .iter()
@@ -279,6 +274,32 @@ fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
     let (shown, again) = render(&mut r, &scene);
     assert!(!shown.kernels_built);
     assert_eq!(again, whole);
+    features
+}
+
+#[test]
+fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
+    // A small scene the lanes cannot shade in batches (a glossy floor) is tested whole on CPU
+    // devices (`SMALL_SCENE`), with kernels built for two batches of sixteen: hiding a block
+    // changes the count the frame carries, not the kernels.
+    let mut glossy = penumbra::scene::load_or_bundled(None).unwrap();
+    glossy.materials[0].specular_factor = 1.0;
+    let features = hide_and_show_the_tall_block(glossy);
+    let cpu = common::test_device() == "cpu";
+    if cpu {
+        assert_eq!((features.small_scene, features.lanes), (32, false));
+    }
+    // The Lambertian box walks in lanes that shade in batches where the CPU has them (faster
+    // than testing it whole, docs/benchmarks.md, "Twenty-eighth session"), and hiding a block
+    // builds nothing there either.
+    let lambert = penumbra::scene::load_or_bundled(None).unwrap();
+    let features = hide_and_show_the_tall_block(lambert);
+    let lanes = penumbra::cl::lanes_megakernel(true, false, 32, 1) != penumbra::cl::Lanes::Never;
+    if cpu {
+        assert_eq!(features.lanes, lanes, "{features:?}");
+        assert_eq!(features.lanes_shade, lanes, "{features:?}");
+        assert_eq!(features.small_scene, if lanes { 0 } else { 32 });
+    }
 }
 
 #[test]

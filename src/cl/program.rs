@@ -132,23 +132,19 @@ pub enum Lanes {
     WhenBatched,
 }
 
-/// Whether the megakernel should walk a flat scene's rays in lanes on a CPU device: no alpha, not
-/// a small scene, fewer than 2^27 triangles in leaves of at most 15 (a lane's stack entry packs
+/// Whether the megakernel should walk a flat scene's rays in lanes on a CPU device: no alpha,
+/// fewer than 2^27 triangles in leaves of at most 15 (a lane's stack entry packs
 /// both in a word), the host CPU (PoCL's device) has AVX-512 (whose gathers, scatters and
 /// compresses the walk uses) or AVX2 (eight lanes: gathers, table-driven compresses, stores for
 /// scatters; 17-25 % less time than one ray at a time on AMD's Zen 3, docs/benchmarks.md,
 /// "Twenty-third session"), and `PENUMBRA_LANES` is not `0` (docs/benchmarks.md, "Fourteenth
-/// session"); below [`LANES_MIN_TRIANGLES`] only where the vertices are shaded in batches.
-/// `PENUMBRA_LANES=1` walks in lanes on any CPU device at any size (lane by lane where the CPU
-/// has neither: for measurements).
-pub fn lanes_megakernel(
-    cpu: bool,
-    alpha: bool,
-    small_scene: u32,
-    triangles: usize,
-    largest_leaf: u32,
-) -> Lanes {
-    if !cpu || alpha || small_scene > 0 || triangles >= 1 << 27 || largest_leaf > 15 {
+/// session"); below [`LANES_MIN_TRIANGLES`] only where the vertices are shaded in batches,
+/// and then a small scene too walks in lanes instead of testing all its triangles one ray at a
+/// time (`SMALL_SCENE`): the bundled box 12 % faster at 64 bounces, its viewer 1.3× on Zen 3
+/// (docs/benchmarks.md, "Twenty-eighth session"). `PENUMBRA_LANES=1` walks in lanes on any CPU
+/// device at any size (lane by lane where the CPU has neither: for measurements).
+pub fn lanes_megakernel(cpu: bool, alpha: bool, triangles: usize, largest_leaf: u32) -> Lanes {
+    if !cpu || alpha || triangles >= 1 << 27 || largest_leaf > 15 {
         return Lanes::Never;
     }
     match std::env::var("PENUMBRA_LANES").as_deref().map(str::trim) {

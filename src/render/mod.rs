@@ -117,6 +117,8 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
 /// every triangle of a small flat scene without alpha for every ray, sixteen at a time. The
 /// kernels are built for the count rounded up to a whole sixteen (the count itself comes with
 /// each frame), so that hiding or showing an object of such a scene mostly builds nothing.
+/// Where the megakernel's lanes can shade the scene in batches, they take it instead
+/// ([`Renderer::ensure_program`]; [`crate::cl::lanes_megakernel`]).
 fn small_scene(cpu: bool, flat: bool, triangles: usize, alpha: bool) -> u32 {
     let small = cpu && flat && !alpha && (1..=small_scene_limit()).contains(&triangles);
     if small {
@@ -498,7 +500,6 @@ impl Renderer {
             Accel::Flat(bvh) => crate::cl::lanes_megakernel(
                 self.gpu.is_cpu(),
                 self.scene_features.alpha,
-                self.scene_features.small_scene,
                 host.triangles.len(),
                 bvh.largest_leaf(),
             ),
@@ -743,9 +744,14 @@ impl Renderer {
             Lanes::Always => true,
             Lanes::WhenBatched => crate::cl::lanes_shade(&KernelFeatures {
                 lanes: true,
+                small_scene: 0,
                 ..features
             }),
         };
+        // Lanes that shade in batches beat testing a small scene whole, one ray at a time.
+        if features.lanes {
+            features.small_scene = 0;
+        }
         features.lanes_shade = crate::cl::lanes_shade(&features);
         if self
             .program
