@@ -233,7 +233,8 @@ inline void lanes_scatter_f(float* base, lanes_i idx, lanes_f v, ushort km) {
     }
 #endif
 
-#if defined(__AVX2__) && !defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+#if defined(__AVX2__) && (LANES == 8 || !defined(__AVX512F__)) && defined(__x86_64__) && \
+    !defined(LANES_ELEMENTWISE)
 // For eight mask bits, the indices of the set ones in order, four bits each (others 0).
 constant uint LANES_COMPRESS8[256] = {
     0x00000000u, 0x00000000u, 0x00000001u, 0x00000010u, 0x00000002u, 0x00000020u, 0x00000021u, 0x00000210u,
