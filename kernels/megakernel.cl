@@ -321,6 +321,10 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
     LaneMemory M;
     lanes_init(&M);
+#ifdef LANES_SMALL
+    uint small_first[4], small_end[4];
+    lanes_small_ranges(nodes, frame.triangles, small_first, small_end);
+#endif
     LanesRays R;  // rays given to lanes, set in their fields together
     lanes_rays_init(&R);
     PathState s[MEGA_SLOTS];
@@ -458,7 +462,11 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             SHADE_BATCH
             continue;
         }
+#ifdef LANES_SMALL
+        lanes_i done = lanes_walk_small(&M, nodes, tris, small_first, small_end, &sc.surf);
+#else
         lanes_i done = lanes_walk(&M, nodes, tris, &sc.surf, overflow);
+#endif
         if (!lanes_any(done)) break;
         // The lanes done, in order (lowest first).
         for (uint bits = lanes_kmask(done); bits != 0u; bits &= bits - 1u) {

@@ -675,6 +675,24 @@ LANES_INLINE void lanes_rare_cases(lanes_i special, lanes_i tri, const float3* o
     *prim = lanes_vload(0, prim_);
 }
 
+// After LANE_HITS_T (t, v, w, det, ok, special): triangle I's hits kept in the lanes of ok,
+// nearer than their hits so far (tfar, hv, hw, hdet, prim), the scalar test deciding the
+// lanes of special (whose rays are O[l], D[l]).
+#define LANES_KEEP_HITS(I, O, D, ANY_HIT)                                                    \
+    {                                                                                        \
+        const lanes_i i_ = (lanes_i)(I);                                                     \
+        ok &= ~special;                                                                      \
+        tfar = select(tfar, t, ok);                                                          \
+        hv = select(hv, v, ok);                                                              \
+        hw = select(hw, w, ok);                                                              \
+        hdet = select(hdet, det, ok);                                                        \
+        prim = select(prim, i_, ok);                                                         \
+        if (lanes_any(special)) {                                                            \
+            lanes_rare_cases(special, i_, O, D, tris, surf, ANY_HIT, &tfar, &hv, &hw, &hdet, \
+                             &prim);                                                         \
+        }                                                                                    \
+    }
+
 // Lanes at a leaf are tested together once at least this many are (the others wait at it).
 // (Six of sixteen, three of eight: docs/benchmarks.md, "Twenty-third session".)
 #ifndef LANES_LEAF_MIN
@@ -1119,5 +1137,119 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
     }
     return (lanes_i)(0);
 }
+
+#ifdef LANES_SMALL
+// A small scene (LANES_SMALL: at most SMALL_SCENE_MAX triangles) is tested whole rather than
+// walked: the root's four child boxes against every live lane, then each reached child's
+// triangles against the lanes that reach it, all of them, with no stack and no turns at nodes,
+// leaves and pops. A triangle's words are the same in every lane (loaded once, no gather), and
+// every lane is done in one call. A subtree's triangles are a range in the tree's order; a
+// ray that leaves the scene from a surface (an open scene's sky) still skips the children it
+// does not reach.
+
+// The triangles under each of the root's children: [first[j], end[j]) (empty for an empty
+// slot), found once a work item by a walk of the small tree. A range covers its subtree's
+// leaves (were they not contiguous, it would cover triangles of other children too, which are
+// then tested twice, with the same verdicts).
+LANES_INLINE void lanes_small_ranges(global const GpuWideNode* nodes, uint count, uint* first,
+                                     uint* end) {
+    for (int j = 0; j < 4; ++j) {
+        first[j] = count;
+        end[j] = 0u;
+        int stack[LANES_STACK];
+        int sp = 0;
+        int c = ((global const int*)&nodes[0].child)[j];
+        uint k = ((global const uint*)&nodes[0].count)[j];
+        for (;;) {
+            if (k != 0u) {
+                first[j] = min(first[j], (uint)~c);
+                end[j] = max(end[j], (uint)~c + k);
+            } else if (c > 0) {
+                if (sp + 4 > LANES_STACK) {
+                    // Deeper than a tree of so few triangles can be: all of them.
+                    first[j] = 0u;
+                    end[j] = count;
+                    break;
+                }
+                for (int i = 0; i < 4; ++i) {
+                    int ci = ((global const int*)&nodes[c].child)[i];
+                    uint ki = ((global const uint*)&nodes[c].count)[i];
+                    if (ki != 0u || ci > 0) {
+                        stack[sp] = ci;
+                        stack[sp + 1] = (int)ki;
+                        sp += 2;
+                    }
+                }
+            }
+            if (sp == 0) break;
+            sp -= 2;
+            c = stack[sp];
+            k = (uint)stack[sp + 1];
+        }
+        end[j] = min(end[j], count);
+    }
+}
+
+// Every live lane's ray against the triangles of the root's children it reaches (ranges:
+// lanes_small_ranges's), each child's in order; the nearest hit is kept, the first of equally
+// near ones (the verdicts are the leaf steps': LANE_EDGES, LANE_HITS_T, the scalar test's rare
+// cases). Returns the lanes done: all that were live.
+LANES_INLINE lanes_i lanes_walk_small(LaneMemory* M, global const GpuWideNode* nodes,
+                                      global const GpuTriangle* tris, const uint* first,
+                                      const uint* end, const SceneSurfaces* surf) {
+    Lanes* L = &M->V;
+    const lanes_i live = L->live;
+    if (!lanes_any(live)) return (lanes_i)(0);
+    const lanes_f zero = (lanes_f)(0.0f);
+    global const float4* tv = (global const float4*)tris;
+    const lanes_i kx1_ = L->kx == (lanes_i)(1), kx2_ = L->kx == (lanes_i)(2);
+    const lanes_i ky1_ = L->ky == (lanes_i)(1), ky2_ = L->ky == (lanes_i)(2);
+    const lanes_i kz1_ = L->kz == (lanes_i)(1), kz2_ = L->kz == (lanes_i)(2);
+    const lanes_f ox = L->ox, oy = L->oy, oz = L->oz, ix = L->ix, iy = L->iy, iz = L->iz;
+    const lanes_f px = L->px, py = L->py, pz = L->pz, sx = L->sx, sy = L->sy, sz = L->sz;
+    lanes_f tfar = L->tfar, hv = L->hv, hw = L->hw, hdet = L->hdet;
+    lanes_i prim = L->prim;
+    global const GpuWideNode* root = nodes;
+    for (int j = 0; j < 4; ++j) {
+        if (first[j] >= end[j]) continue;
+        // The child's slab test (traverse_packet.h's, near and far by the lesser and greater).
+        float lx = ((global const float*)&root->min_x)[j], hx = ((global const float*)&root->max_x)[j];
+        float ly = ((global const float*)&root->min_y)[j], hy = ((global const float*)&root->max_y)[j];
+        float lz = ((global const float*)&root->min_z)[j], hz = ((global const float*)&root->max_z)[j];
+        lanes_f x0 = ((lanes_f)(lx) - ox) * ix, x1 = ((lanes_f)(hx) - ox) * ix;
+        lanes_f y0 = ((lanes_f)(ly) - oy) * iy, y1 = ((lanes_f)(hy) - oy) * iy;
+        lanes_f z0 = ((lanes_f)(lz) - oz) * iz, z1 = ((lanes_f)(hz) - oz) * iz;
+        lanes_f near = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)),
+                                WIDE_MAX(WIDE_MIN(z0, z1), zero));
+        lanes_f far = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)), WIDE_MAX(z0, z1)) *
+                      1.00000024f;
+        const lanes_i m = live & (near <= far) & (near < tfar);
+        if (!lanes_any(m)) continue;
+        for (uint i = first[j]; i < end[j]; ++i) {
+            float4 a = tv[3u * i], b = tv[3u * i + 1u], c = tv[3u * i + 2u];
+#define LANES_SMALL_AXIS(V, K) \
+    select(select((lanes_f)(V.x), (lanes_f)(V.y), K##1_), (lanes_f)(V.z), K##2_)
+            lanes_f aX = LANES_SMALL_AXIS(a, kx) - px, aY = LANES_SMALL_AXIS(a, ky) - py;
+            lanes_f aZ = LANES_SMALL_AXIS(a, kz) - pz, bX = LANES_SMALL_AXIS(b, kx) - px;
+            lanes_f bY = LANES_SMALL_AXIS(b, ky) - py, bZ = LANES_SMALL_AXIS(b, kz) - pz;
+            lanes_f cX = LANES_SMALL_AXIS(c, kx) - px, cY = LANES_SMALL_AXIS(c, ky) - py;
+            lanes_f cZ = LANES_SMALL_AXIS(c, kz) - pz;
+#undef LANES_SMALL_AXIS
+            LANE_EDGES(lanes_f)
+            LANE_HITS_T(lanes_f, lanes_i, m, zero, tfar)
+            LANES_KEEP_HITS((int)i, M->o, M->d, false)
+        }
+    }
+    L->tfar = tfar;
+    L->hv = hv;
+    L->hw = hw;
+    L->hdet = hdet;
+    L->prim = prim;
+    L->has &= ~live;
+    L->live = (lanes_i)(0);
+    L->fin = (lanes_i)(0);
+    return live;
+}
+#endif
 
 #endif  // MEGA_LANES

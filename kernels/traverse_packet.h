@@ -192,16 +192,7 @@ LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
 #undef PACKET_VERTEX
                 LANE_EDGES(lanes_f)
                 LANE_HITS_T(lanes_f, lanes_i, m, zero, tfar)
-                ok &= ~special;
-                tfar = select(tfar, t, ok);
-                hv = select(hv, v, ok);
-                hw = select(hw, w, ok);
-                hdet = select(hdet, det, ok);
-                prim = select(prim, (lanes_i)(first + k), ok);
-                if (lanes_any(special)) {
-                    lanes_rare_cases(special, (lanes_i)(first + k), P->o, P->d, tris, surf, any_hit,
-                                     &tfar, &hv, &hw, &hdet, &prim);
-                }
+                LANES_KEEP_HITS(first + k, P->o, P->d, any_hit)
                 if (any_hit) {
                     // A blocked lane is done.
                     open &= prim < izero;

@@ -286,19 +286,74 @@ fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
     glossy.materials[0].specular_factor = 1.0;
     let features = hide_and_show_the_tall_block(glossy);
     let cpu = common::test_device() == "cpu";
+    // Where the CPU has vector lanes, they test its triangles whole (`LANES_SMALL`, the count
+    // with the frame), sixteen rays at a time.
+    let lanes = penumbra::cl::lanes_megakernel(true, false, 32, 1) != penumbra::cl::Lanes::Never;
     if cpu {
-        assert_eq!((features.small_scene, features.lanes), (32, false));
+        assert_eq!(
+            (features.small_scene, features.lanes, features.lanes_small),
+            if lanes {
+                (0, true, true)
+            } else {
+                (32, false, false)
+            },
+            "{features:?}"
+        );
+        assert!(!features.lanes_shade, "{features:?}");
     }
-    // The Lambertian box walks in lanes that shade in batches where the CPU has them (faster
-    // than testing it whole, docs/benchmarks.md, "Twenty-eighth session"), and hiding a block
-    // builds nothing there either.
+    // The Lambertian box: its lanes shade in batches too, and hiding a block builds nothing
+    // there either.
     let lambert = penumbra::scene::load_or_bundled(None).unwrap();
     let features = hide_and_show_the_tall_block(lambert);
-    let lanes = penumbra::cl::lanes_megakernel(true, false, 32, 1) != penumbra::cl::Lanes::Never;
     if cpu {
         assert_eq!(features.lanes, lanes, "{features:?}");
         assert_eq!(features.lanes_shade, lanes, "{features:?}");
+        assert_eq!(features.lanes_small, lanes, "{features:?}");
         assert_eq!(features.small_scene, if lanes { 0 } else { 32 });
+    }
+}
+
+#[test]
+fn a_small_scene_tested_whole_in_lanes_makes_the_image_of_its_tree() {
+    // A small scene's lanes test its triangles whole (`LANES_SMALL`: the root's four children,
+    // then the triangles under those each lane reaches) instead of walking its tree: the same
+    // hits, so the image of the tree in lanes (PENUMBRA_LANES_SMALL=0) and of one ray at a
+    // time testing it whole (PENUMBRA_LANES=0, `SMALL_SCENE`), bit for bit. The bundled box
+    // (closed, Lambertian: shaded in batches) and a sphere of 48 triangles on a floor under the
+    // default light rig (open: most rays leave it for the sky, past children they miss).
+    let dir = tempfile::tempdir().unwrap();
+    let bundled = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell-box.glb");
+    let sphere = common::white_sphere_of(dir.path(), true, 3, 8);
+    let vectors = penumbra::cl::lanes_megakernel(true, false, 50, 1) != penumbra::cl::Lanes::Never;
+    for (case, scene) in [&bundled, &sphere].into_iter().enumerate() {
+        let args = lanes_image_args("5", "6");
+        let whole = dir.path().join(format!("whole-{case}.exr"));
+        let (a, pa) = render_exr_env(scene, &whole, &args, &[]);
+        assert!(a["triangles"].as_u64().unwrap() <= penumbra::cl::SMALL_SCENE_MAX as u64);
+        if common::test_device() == "cpu" {
+            assert_eq!(a["lanes_small"], vectors, "{scene:?}: {a}");
+        }
+        assert!(pa.iter().any(|p| p[0] > 0.0), "{scene:?}: a black image");
+        for (what, env) in [
+            (
+                "the tree in lanes",
+                [("PENUMBRA_LANES", "1"), ("PENUMBRA_LANES_SMALL", "0")],
+            ),
+            (
+                "one ray at a time",
+                [("PENUMBRA_LANES", "0"), ("PENUMBRA_LANES_SMALL", "1")],
+            ),
+        ] {
+            let out = dir.path().join(format!("{what}-{case}.exr"));
+            let (b, pb) = render_exr_env(scene, &out, &args, &env);
+            assert_eq!(b["lanes_small"], false, "{scene:?}, {what}: {b}");
+            assert_eq!(
+                a["extension_rays"], b["extension_rays"],
+                "{scene:?}, {what}"
+            );
+            assert_eq!(a["shadow_rays"], b["shadow_rays"], "{scene:?}, {what}");
+            assert!(pa == pb, "{scene:?}: the image differs from {what}'s");
+        }
     }
 }
 

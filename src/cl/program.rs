@@ -110,6 +110,10 @@ pub struct KernelFeatures {
     /// The megakernel's lanes shade their paths' vertices in batches, in vectors
     /// (`LANES_SHADE`, kernels/shade_lanes.h; see [`lanes_shade`]).
     pub lanes_shade: bool,
+    /// The megakernel's lanes test every triangle of a small scene (one that would be
+    /// `small_scene` one ray at a time) instead of walking the tree (`LANES_SMALL`,
+    /// kernels/traverse_lanes.h; the count comes with each frame).
+    pub lanes_small: bool,
 }
 
 /// The fewest triangles for which the megakernel walks its rays in lanes: below, the tree fits
@@ -128,7 +132,9 @@ pub enum Lanes {
     /// In lanes.
     Always,
     /// In lanes where they shade their vertices in batches ([`lanes_shade`]), which pays at any
-    /// size: the scene has fewer than [`LANES_MIN_TRIANGLES`], where the walk alone does not.
+    /// size, or where the scene is small enough to be tested whole in lanes
+    /// (`KernelFeatures::lanes_small`): the scene has fewer than [`LANES_MIN_TRIANGLES`], where
+    /// the walk alone does not pay.
     WhenBatched,
 }
 
@@ -138,11 +144,12 @@ pub enum Lanes {
 /// compresses the walk uses) or AVX2 (eight lanes: gathers, table-driven compresses, stores for
 /// scatters; 17-25 % less time than one ray at a time on AMD's Zen 3, docs/benchmarks.md,
 /// "Twenty-third session"), and `PENUMBRA_LANES` is not `0` (docs/benchmarks.md, "Fourteenth
-/// session"); below [`LANES_MIN_TRIANGLES`] only where the vertices are shaded in batches,
-/// and then a small scene too walks in lanes instead of testing all its triangles one ray at a
-/// time (`SMALL_SCENE`): the bundled box 12 % faster at 64 bounces, its viewer 1.3× on Zen 3
-/// (docs/benchmarks.md, "Twenty-eighth session"). `PENUMBRA_LANES=1` walks in lanes on any CPU
-/// device at any size (lane by lane where the CPU has neither: for measurements).
+/// session"); below [`LANES_MIN_TRIANGLES`] only where the vertices are shaded in batches
+/// (the bundled box 12 % faster at 64 bounces, its viewer 1.3× on Zen 3: docs/benchmarks.md,
+/// "Twenty-eighth session") or the scene is small (`SMALL_SCENE`'s sizes), whose lanes then
+/// test its triangles whole (`KernelFeatures::lanes_small`; "Thirty-first session").
+/// `PENUMBRA_LANES=1` walks in lanes on any CPU device at any size (lane by lane where the CPU
+/// has neither: for measurements).
 pub fn lanes_megakernel(cpu: bool, alpha: bool, triangles: usize, largest_leaf: u32) -> Lanes {
     if !cpu || alpha || triangles >= 1 << 27 || largest_leaf > 15 {
         return Lanes::Never;
@@ -266,6 +273,7 @@ impl KernelFeatures {
             (self.triangle_pieces, "HAS_TRIANGLE_PIECES"),
             (self.lanes, "MEGA_LANES"),
             (self.lanes_shade, "LANES_SHADE"),
+            (self.lanes_small, "LANES_SMALL"),
         ] {
             if on {
                 d.push_str(" -D");

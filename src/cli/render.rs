@@ -188,6 +188,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     summary["lanes_load"] = serde_json::json!(renderer.walks_in_lanes().then_some(load));
     // Whether the lanes shaded their vertices in batches, in vectors (kernels/shade_lanes.h).
     summary["lanes_shade"] = serde_json::json!(renderer.shades_in_lanes());
+    // Whether the lanes tested a small scene's triangles whole (no tree).
+    summary["lanes_small"] = serde_json::json!(renderer.tests_small_scene_in_lanes());
     summary["cpu_seconds"] = serde_json::json!(cpu_seconds);
     summary["samples_per_cpu_second"] = serde_json::json!(cpu_seconds.map(|c| samples / c));
     // Added after the literal, which is at serde_json's macro recursion limit.

@@ -69,6 +69,16 @@ impl Renderer {
                 .is_some_and(|p| p.features.lanes_shade)
     }
 
+    /// Whether the megakernel's lanes test a small scene's triangles whole instead of walking
+    /// its tree (`KernelFeatures::lanes_small`).
+    pub fn tests_small_scene_in_lanes(&self) -> bool {
+        self.megakernel
+            && self
+                .program
+                .as_ref()
+                .is_some_and(|p| p.features.lanes_small)
+    }
+
     /// The kernels in use (never `Auto`).
     pub fn kernel(&self) -> KernelChoice {
         if self.megakernel {
@@ -113,7 +123,7 @@ impl Renderer {
         // The small-scene test (kernels built for whole batches of triangles) takes the count
         // here, so that a scene's hidden objects need no other kernels.
         let frame = &GpuFrame {
-            triangles: if program.features.small_scene > 0 {
+            triangles: if program.features.small_scene > 0 || program.features.lanes_small {
                 scene.triangles.len() as u32
             } else {
                 0

@@ -110,6 +110,7 @@ fn scene_features(scene: &Scene, triangle_lights: bool, tangents: bool) -> Kerne
         small_scene: 0,
         lanes: false,
         lanes_shade: false,
+        lanes_small: false,
     }
 }
 
@@ -739,16 +740,27 @@ impl Renderer {
             env_map: self.environment.is_some(),
             ..self.scene_features
         };
+        // A small scene's triangles tested whole in lanes (`LANES_SMALL`) beat its tree in
+        // lanes and testing them whole one ray at a time (docs/benchmarks.md, "Thirty-first
+        // session"), unless PENUMBRA_LANES_SMALL is 0.
+        let small_in_lanes = features.small_scene > 0
+            && std::env::var("PENUMBRA_LANES_SMALL")
+                .as_deref()
+                .map(str::trim)
+                != Ok("0");
         features.lanes = match self.lanes {
             Lanes::Never => false,
             Lanes::Always => true,
-            Lanes::WhenBatched => crate::cl::lanes_shade(&KernelFeatures {
-                lanes: true,
-                small_scene: 0,
-                ..features
-            }),
+            Lanes::WhenBatched => {
+                small_in_lanes
+                    || crate::cl::lanes_shade(&KernelFeatures {
+                        lanes: true,
+                        small_scene: 0,
+                        ..features
+                    })
+            }
         };
-        // Lanes that shade in batches beat testing a small scene whole, one ray at a time.
+        features.lanes_small = features.lanes && small_in_lanes;
         if features.lanes {
             features.small_scene = 0;
         }
