@@ -543,6 +543,22 @@ LANES_INLINE void lanes_rays_put(LanesRays* R, int lane, float3 o, float3 d, flo
 // A component of each lane's vector (X, Y, Z) picked by the lane's axis K (0, 1, 2).
 #define LANES_PICK(X, Y, Z, K) select(select(X, Y, (K) == (lanes_i)(1)), Z, (K) == (lanes_i)(2))
 
+// traverse_wide.h's slab test of one box (its planes LX .. HZ, scalars) in every lane, from the
+// lanes' origins ox, oy, oz and reciprocal directions ix, iy, iz: declares NEAR (the entry
+// distance, at least 0) and FAR. With lo <= hi the near plane's distance is the lesser of the
+// two, bit for bit (rounding is monotonic), so no plane is picked by the direction's sign.
+#define LANES_BOX(LX, LY, LZ, HX, HY, HZ, NEAR, FAR)                                         \
+    lanes_f NEAR, FAR;                                                                      \
+    {                                                                                       \
+        lanes_f x0_ = ((lanes_f)(LX) - ox) * ix, x1_ = ((lanes_f)(HX) - ox) * ix;           \
+        lanes_f y0_ = ((lanes_f)(LY) - oy) * iy, y1_ = ((lanes_f)(HY) - oy) * iy;           \
+        lanes_f z0_ = ((lanes_f)(LZ) - oz) * iz, z1_ = ((lanes_f)(HZ) - oz) * iz;           \
+        NEAR = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0_, x1_), WIDE_MIN(y0_, y1_)),                   \
+                        WIDE_MAX(WIDE_MIN(z0_, z1_), (lanes_f)(0.0f)));                     \
+        FAR = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0_, x1_), WIDE_MAX(y0_, y1_)), WIDE_MAX(z0_, z1_)) * \
+              1.00000024f;                                                                  \
+    }
+
 // prepare_ray lane by lane on R's rays, by selects (no branch on the dominant axis; one division
 // an axis for all the lanes): declares ix iy iz (the safe reciprocal direction), kx ky kz (the
 // permutation: z the dominant axis), px py pz (the origin in the permuted axes) and sx sy sz
@@ -1153,41 +1169,37 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
 // then tested twice, with the same verdicts).
 LANES_INLINE void lanes_small_ranges(global const GpuWideNode* nodes, uint count, uint* first,
                                      uint* end) {
+    // Child i of node n: a leaf widens the range, an interior node is walked later.
+#define LANES_SMALL_CHILD(n, i)                                                        \
+    {                                                                                  \
+        int c_ = ((global const int*)&nodes[n].child)[i];                              \
+        uint k_ = ((global const uint*)&nodes[n].count)[i];                            \
+        if (k_ != 0u) {                                                                \
+            first[j] = min(first[j], (uint)~c_);                                       \
+            end[j] = max(end[j], (uint)~c_ + k_);                                      \
+        } else if (c_ > 0) {                                                           \
+            stack[sp++] = c_;                                                          \
+        }                                                                              \
+    }
     for (int j = 0; j < 4; ++j) {
         first[j] = count;
         end[j] = 0u;
         int stack[LANES_STACK];
         int sp = 0;
-        int c = ((global const int*)&nodes[0].child)[j];
-        uint k = ((global const uint*)&nodes[0].count)[j];
-        for (;;) {
-            if (k != 0u) {
-                first[j] = min(first[j], (uint)~c);
-                end[j] = max(end[j], (uint)~c + k);
-            } else if (c > 0) {
-                if (sp + 4 > LANES_STACK) {
-                    // Deeper than a tree of so few triangles can be: all of them.
-                    first[j] = 0u;
-                    end[j] = count;
-                    break;
-                }
-                for (int i = 0; i < 4; ++i) {
-                    int ci = ((global const int*)&nodes[c].child)[i];
-                    uint ki = ((global const uint*)&nodes[c].count)[i];
-                    if (ki != 0u || ci > 0) {
-                        stack[sp] = ci;
-                        stack[sp + 1] = (int)ki;
-                        sp += 2;
-                    }
-                }
+        LANES_SMALL_CHILD(0, j)
+        while (sp > 0) {
+            if (sp + 4 > LANES_STACK) {
+                // Deeper than a tree of so few triangles can be: all of them.
+                first[j] = 0u;
+                end[j] = count;
+                break;
             }
-            if (sp == 0) break;
-            sp -= 2;
-            c = stack[sp];
-            k = (uint)stack[sp + 1];
+            int n = stack[--sp];
+            for (int i = 0; i < 4; ++i) LANES_SMALL_CHILD(n, i)
         }
         end[j] = min(end[j], count);
     }
+#undef LANES_SMALL_CHILD
 }
 
 // Every live lane's ray against the triangles of the root's children it reaches (ranges:
@@ -1202,38 +1214,27 @@ LANES_INLINE lanes_i lanes_walk_small(LaneMemory* M, global const GpuWideNode* n
     if (!lanes_any(live)) return (lanes_i)(0);
     const lanes_f zero = (lanes_f)(0.0f);
     global const float4* tv = (global const float4*)tris;
-    const lanes_i kx1_ = L->kx == (lanes_i)(1), kx2_ = L->kx == (lanes_i)(2);
-    const lanes_i ky1_ = L->ky == (lanes_i)(1), ky2_ = L->ky == (lanes_i)(2);
-    const lanes_i kz1_ = L->kz == (lanes_i)(1), kz2_ = L->kz == (lanes_i)(2);
+    const lanes_i kx = L->kx, ky = L->ky, kz = L->kz;
     const lanes_f ox = L->ox, oy = L->oy, oz = L->oz, ix = L->ix, iy = L->iy, iz = L->iz;
     const lanes_f px = L->px, py = L->py, pz = L->pz, sx = L->sx, sy = L->sy, sz = L->sz;
     lanes_f tfar = L->tfar, hv = L->hv, hw = L->hw, hdet = L->hdet;
     lanes_i prim = L->prim;
-    global const GpuWideNode* root = nodes;
+    global const float* r = (global const float*)nodes;  // the root: min_x .. max_z, 4 words each
     for (int j = 0; j < 4; ++j) {
         if (first[j] >= end[j]) continue;
-        // The child's slab test (traverse_packet.h's, near and far by the lesser and greater).
-        float lx = ((global const float*)&root->min_x)[j], hx = ((global const float*)&root->max_x)[j];
-        float ly = ((global const float*)&root->min_y)[j], hy = ((global const float*)&root->max_y)[j];
-        float lz = ((global const float*)&root->min_z)[j], hz = ((global const float*)&root->max_z)[j];
-        lanes_f x0 = ((lanes_f)(lx) - ox) * ix, x1 = ((lanes_f)(hx) - ox) * ix;
-        lanes_f y0 = ((lanes_f)(ly) - oy) * iy, y1 = ((lanes_f)(hy) - oy) * iy;
-        lanes_f z0 = ((lanes_f)(lz) - oz) * iz, z1 = ((lanes_f)(hz) - oz) * iz;
-        lanes_f near = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)),
-                                WIDE_MAX(WIDE_MIN(z0, z1), zero));
-        lanes_f far = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)), WIDE_MAX(z0, z1)) *
-                      1.00000024f;
+        LANES_BOX(r[j], r[4 + j], r[8 + j], r[12 + j], r[16 + j], r[20 + j], near, far)
         const lanes_i m = live & (near <= far) & (near < tfar);
         if (!lanes_any(m)) continue;
         for (uint i = first[j]; i < end[j]; ++i) {
             float4 a = tv[3u * i], b = tv[3u * i + 1u], c = tv[3u * i + 2u];
-#define LANES_SMALL_AXIS(V, K) \
-    select(select((lanes_f)(V.x), (lanes_f)(V.y), K##1_), (lanes_f)(V.z), K##2_)
-            lanes_f aX = LANES_SMALL_AXIS(a, kx) - px, aY = LANES_SMALL_AXIS(a, ky) - py;
-            lanes_f aZ = LANES_SMALL_AXIS(a, kz) - pz, bX = LANES_SMALL_AXIS(b, kx) - px;
-            lanes_f bY = LANES_SMALL_AXIS(b, ky) - py, bZ = LANES_SMALL_AXIS(b, kz) - pz;
-            lanes_f cX = LANES_SMALL_AXIS(c, kx) - px, cY = LANES_SMALL_AXIS(c, ky) - py;
-            lanes_f cZ = LANES_SMALL_AXIS(c, kz) - pz;
+            // Vertex V's axis K (the lane's permutation), relative to the lane's origin.
+#define LANES_SMALL_AXIS(V, K, P) \
+    (LANES_PICK((lanes_f)(V.x), (lanes_f)(V.y), (lanes_f)(V.z), K) - (P))
+            lanes_f aX = LANES_SMALL_AXIS(a, kx, px), aY = LANES_SMALL_AXIS(a, ky, py);
+            lanes_f aZ = LANES_SMALL_AXIS(a, kz, pz), bX = LANES_SMALL_AXIS(b, kx, px);
+            lanes_f bY = LANES_SMALL_AXIS(b, ky, py), bZ = LANES_SMALL_AXIS(b, kz, pz);
+            lanes_f cX = LANES_SMALL_AXIS(c, kx, px), cY = LANES_SMALL_AXIS(c, ky, py);
+            lanes_f cZ = LANES_SMALL_AXIS(c, kz, pz);
 #undef LANES_SMALL_AXIS
             LANE_EDGES(lanes_f)
             LANE_HITS_T(lanes_f, lanes_i, m, zero, tfar)

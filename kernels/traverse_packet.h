@@ -113,19 +113,10 @@ LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
             lanes_f dv[4];
             float key[4];
             int cv[4];
-            // Child J (component C): traverse_wide.h's slab test in every lane of m. With lo <=
-            // hi the near plane's distance is the lesser of the two, bit for bit (rounding is
-            // monotonic), so no plane is picked by the direction's sign.
+            // Child J (component C): the slab test in every lane of m (LANES_BOX).
 #define PACKET_CHILD(J, C)                                                                   \
     {                                                                                        \
-        lanes_f x0 = ((lanes_f)(lx.C) - ox) * ix, x1 = ((lanes_f)(hx.C) - ox) * ix;          \
-        lanes_f y0 = ((lanes_f)(ly.C) - oy) * iy, y1 = ((lanes_f)(hy.C) - oy) * iy;          \
-        lanes_f z0_ = ((lanes_f)(lz.C) - oz) * iz, z1_ = ((lanes_f)(hz.C) - oz) * iz;        \
-        lanes_f near = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)),                \
-                                WIDE_MAX(WIDE_MIN(z0_, z1_), zero));                         \
-        lanes_f far = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)),                 \
-                               WIDE_MAX(z0_, z1_)) *                                         \
-                      1.00000024f;                                                           \
+        LANES_BOX(lx.C, ly.C, lz.C, hx.C, hy.C, hz.C, near, far)                             \
         lanes_i reach = m & (near <= far) & (near < tfar);                                     \
         if (ch.C <= 0 && ct.C == 0) reach = izero;                                           \
         dv[J] = select(inf, near, reach);                                                    \

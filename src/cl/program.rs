@@ -200,6 +200,19 @@ pub fn lanes_shade(f: &KernelFeatures) -> bool {
             != Ok("0")
 }
 
+/// Whether a small scene's lanes, where it walks in lanes, test its triangles whole
+/// (`KernelFeatures::lanes_small`, `LANES_SMALL`, kernels/traverse_lanes.h) instead of walking
+/// its tree: a scene the megakernel would test whole one ray at a time (`small_scene`), unless
+/// `PENUMBRA_LANES_SMALL` is `0`. Faster than both the tree in lanes and `SMALL_SCENE`
+/// (docs/benchmarks.md, "Thirty-first session"); the same image.
+pub fn lanes_small(f: &KernelFeatures) -> bool {
+    f.small_scene > 0
+        && std::env::var("PENUMBRA_LANES_SMALL")
+            .as_deref()
+            .map(str::trim)
+            != Ok("0")
+}
+
 /// Whether the lanes (`MEGA_LANES`) load their nodes and triangles as rows, transposed into
 /// vectors by shuffles, rather than by gathers (`LANES_GATHERS`, kernels/traverse_lanes.h). On
 /// AMD's Zen 5 a gather loads about one element a cycle from L2, and rows make the walk 1.3–1.8×

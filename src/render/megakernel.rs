@@ -53,30 +53,27 @@ impl Renderer {
         self.reset()
     }
 
+    /// Whether the megakernel runs with kernels built for a feature `f` picks out.
+    fn megakernel_has(&self, f: impl Fn(&crate::cl::KernelFeatures) -> bool) -> bool {
+        self.megakernel && self.program.as_ref().is_some_and(|p| f(&p.features))
+    }
+
     /// Whether the megakernel walks its extension rays sixteen at a time in vector lanes
     /// (`KernelFeatures::lanes`, kernels/traverse_lanes.h) for the loaded scene.
     pub fn walks_in_lanes(&self) -> bool {
-        self.megakernel && self.program.as_ref().is_some_and(|p| p.features.lanes)
+        self.megakernel_has(|f| f.lanes)
     }
 
     /// Whether the megakernel's lanes shade their vertices in batches, in vectors
     /// (`KernelFeatures::lanes_shade`).
     pub fn shades_in_lanes(&self) -> bool {
-        self.megakernel
-            && self
-                .program
-                .as_ref()
-                .is_some_and(|p| p.features.lanes_shade)
+        self.megakernel_has(|f| f.lanes_shade)
     }
 
     /// Whether the megakernel's lanes test a small scene's triangles whole instead of walking
     /// its tree (`KernelFeatures::lanes_small`).
     pub fn tests_small_scene_in_lanes(&self) -> bool {
-        self.megakernel
-            && self
-                .program
-                .as_ref()
-                .is_some_and(|p| p.features.lanes_small)
+        self.megakernel_has(|f| f.lanes_small)
     }
 
     /// The kernels in use (never `Auto`).

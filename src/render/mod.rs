@@ -740,14 +740,7 @@ impl Renderer {
             env_map: self.environment.is_some(),
             ..self.scene_features
         };
-        // A small scene's triangles tested whole in lanes (`LANES_SMALL`) beat its tree in
-        // lanes and testing them whole one ray at a time (docs/benchmarks.md, "Thirty-first
-        // session"), unless PENUMBRA_LANES_SMALL is 0.
-        let small_in_lanes = features.small_scene > 0
-            && std::env::var("PENUMBRA_LANES_SMALL")
-                .as_deref()
-                .map(str::trim)
-                != Ok("0");
+        let small_in_lanes = crate::cl::lanes_small(&features);
         features.lanes = match self.lanes {
             Lanes::Never => false,
             Lanes::Always => true,
