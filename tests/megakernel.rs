@@ -288,7 +288,7 @@ fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
     let cpu = common::test_device() == "cpu";
     // Where the CPU has vector lanes, they test its triangles whole (`LANES_SMALL`, the count
     // with the frame), sixteen rays at a time.
-    let lanes = penumbra::cl::lanes_megakernel(true, false, 32, 1) != penumbra::cl::Lanes::Never;
+    let lanes = penumbra::render::strategy::DeviceFacts::of(true).vectors;
     if cpu {
         assert_eq!(
             (features.small_scene, features.lanes, features.lanes_small),
@@ -314,6 +314,40 @@ fn hiding_an_object_of_a_small_scene_builds_no_kernels() {
 }
 
 #[test]
+fn the_wavefront_on_a_cpu_compiles_no_lanes() {
+    // The kernel strategy (small scenes, lanes) is the megakernel's: the wavefront's kernels
+    // are built without it, and switching kernels with a scene loaded builds them for the new
+    // ones.
+    use penumbra::render::{KernelChoice, Renderer};
+    use penumbra::scene::RenderFrame;
+    let choice = common::test_device().parse().unwrap();
+    let scene = penumbra::scene::load_or_bundled(None).unwrap();
+    let mut r = Renderer::new(&choice).unwrap();
+    r.set_kernel(KernelChoice::Wavefront).unwrap();
+    r.load_scene_in(&scene, &scene.lights, RenderFrame::default())
+        .unwrap();
+    let strategy = |r: &Renderer| {
+        let f = r.program().unwrap().features;
+        (f.small_scene, f.lanes, f.lanes_small, f.lanes_shade)
+    };
+    assert_eq!(strategy(&r), (0, false, false, false));
+    r.set_kernel(KernelChoice::Megakernel).unwrap();
+    if common::test_device() == "cpu" {
+        // The bundled box: 32 Lambertian triangles, tested whole and shaded in batches in
+        // lanes, or tested whole one ray at a time.
+        let lanes = penumbra::render::strategy::DeviceFacts::of(true).vectors;
+        let expected = if lanes {
+            (0, true, true, true)
+        } else {
+            (32, false, false, false)
+        };
+        assert_eq!(strategy(&r), expected);
+    }
+    r.set_kernel(KernelChoice::Wavefront).unwrap();
+    assert_eq!(strategy(&r), (0, false, false, false));
+}
+
+#[test]
 fn a_small_scene_tested_whole_in_lanes_makes_the_image_of_its_tree() {
     // A small scene's lanes test its triangles whole (`LANES_SMALL`: the root's four children,
     // then the triangles under those each lane reaches) instead of walking its tree: the same
@@ -324,12 +358,14 @@ fn a_small_scene_tested_whole_in_lanes_makes_the_image_of_its_tree() {
     let dir = tempfile::tempdir().unwrap();
     let bundled = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell-box.glb");
     let sphere = common::white_sphere_of(dir.path(), true, 3, 8);
-    let vectors = penumbra::cl::lanes_megakernel(true, false, 50, 1) != penumbra::cl::Lanes::Never;
+    let vectors = penumbra::render::strategy::DeviceFacts::of(true).vectors;
     for (case, scene) in [&bundled, &sphere].into_iter().enumerate() {
         let args = lanes_image_args("5", "6");
         let whole = dir.path().join(format!("whole-{case}.exr"));
         let (a, pa) = render_exr_env(scene, &whole, &args, &[]);
-        assert!(a["triangles"].as_u64().unwrap() <= penumbra::cl::SMALL_SCENE_MAX as u64);
+        assert!(
+            a["triangles"].as_u64().unwrap() <= penumbra::render::strategy::SMALL_SCENE_MAX as u64
+        );
         if common::test_device() == "cpu" {
             assert_eq!(a["lanes_small"], vectors, "{scene:?}: {a}");
         }
@@ -441,7 +477,7 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
     // last rays traced).
     let dir = tempfile::tempdir().unwrap();
     let (rings, segments) = (128, 136);
-    assert!((2 * rings * segments) as usize >= penumbra::cl::LANES_MIN_TRIANGLES);
+    assert!((2 * rings * segments) as usize >= penumbra::render::strategy::LANES_MIN_TRIANGLES);
     let rig = common::white_sphere_of(dir.path(), true, rings, segments);
     let panel = common::white_sphere_under_panel(dir.path(), rings, segments);
     let sky: &[&str] = &["--sky", "0.2,0.3,0.4", "--strategy", "lights"];

@@ -297,7 +297,7 @@ impl Tracer<'_> {
 
 /// With `PENUMBRA_DUMP_TRACE=DIR` (flat BVH only): the wide nodes, the triangles (vertices only)
 /// and each ray set with the device's hits, as raw little-endian arrays in DIR, for timing the
-/// same traversal outside OpenCL (scripts/experiments/native_trace/).
+/// same traversal outside OpenCL (`scripts/experiments/native_trace/` at commit b156327).
 fn dump_trace(dir: &str, host: &HostScene, sets: &[(&str, &[GpuRay], &[GpuHit])]) -> Result<()> {
     use crate::cl::types::GpuTriangle;
     let Accel::Flat(bvh) = &host.accel else {

@@ -13,10 +13,7 @@ pub(crate) static CL_SETUP: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 pub use device::{DeviceChoice, DeviceInfo, Gpu, list_devices};
 pub use kernels::{Buffer, Program, Stage};
-pub use program::{
-    KernelFeatures, LANES_MIN_TRIANGLES, Lanes, SMALL_SCENE_MAX, build_program, build_test_program,
-    lanes_load_rows, lanes_megakernel, lanes_shade, lanes_small,
-};
+pub use program::{KernelFeatures, build_program, build_test_program};
 
 /// Errors from OpenCL: no usable device, a failed build, a failed launch.
 #[derive(Debug, thiserror::Error)]

@@ -100,166 +100,22 @@ pub struct KernelFeatures {
     pub triangle_pieces: bool,
     /// The scene's triangles rounded up to a multiple of 16 when the megakernel tests them all
     /// for every ray instead of walking the BVH (`SMALL_SCENE`, kernels/traverse_wide.h; the
-    /// count itself comes with each frame): a flat scene of at most [`SMALL_SCENE_MAX`]
-    /// triangles without alpha, on a CPU device; 0 otherwise.
+    /// count itself comes with each frame); 0 otherwise. This and the lanes' fields below are
+    /// the CPU strategy, decided by [`crate::render::strategy::kernel_strategy`].
     pub small_scene: u32,
     /// The megakernel walks sixteen paths' rays together in vector lanes (`MEGA_LANES`,
-    /// kernels/traverse_lanes.h): a flat scene that is not small, without alpha, on a CPU
-    /// device with AVX-512 or AVX2 (see [`lanes_megakernel`]).
+    /// kernels/traverse_lanes.h).
     pub lanes: bool,
     /// The megakernel's lanes shade their paths' vertices in batches, in vectors
-    /// (`LANES_SHADE`, kernels/shade_lanes.h; see [`lanes_shade`]).
+    /// (`LANES_SHADE`, kernels/shade_lanes.h).
     pub lanes_shade: bool,
-    /// The megakernel's lanes test every triangle of a small scene (one that would be
-    /// `small_scene` one ray at a time) instead of walking the tree (`LANES_SMALL`,
-    /// kernels/traverse_lanes.h; the count comes with each frame).
+    /// The megakernel's lanes test every triangle of a small scene instead of walking the tree
+    /// (`LANES_SMALL`, kernels/traverse_lanes.h; the count comes with each frame).
     pub lanes_small: bool,
+    /// The lanes load their nodes and triangles by gathers (`LANES_GATHERS`,
+    /// kernels/traverse_lanes.h) rather than as rows transposed by shuffles.
+    pub lanes_gathers: bool,
 }
-
-/// The fewest triangles for which the megakernel walks its rays in lanes: below, the tree fits
-/// the caches, a walk seldom waits on memory, and the lanes measured 1–4 % slower on the shared
-/// scenes of about 10,000 triangles (6–9 % after the fifteenth session's changes); from 41,000
-/// on they were 2–6 % faster, and 17 % on the 1 M-triangle bunnies (27 % after;
-/// docs/benchmarks.md, "Fourteenth session", "Fifteenth session").
-pub const LANES_MIN_TRIANGLES: usize = 32_768;
-
-/// Whether the megakernel walks a flat scene's rays in lanes (`KernelFeatures::lanes`): the
-/// answer of [`lanes_megakernel`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Lanes {
-    /// One ray at a time.
-    Never,
-    /// In lanes.
-    Always,
-    /// In lanes where they shade their vertices in batches ([`lanes_shade`]), which pays at any
-    /// size, or where the scene is small enough to be tested whole in lanes
-    /// (`KernelFeatures::lanes_small`): the scene has fewer than [`LANES_MIN_TRIANGLES`], where
-    /// the walk alone does not pay.
-    WhenBatched,
-}
-
-/// Whether the megakernel should walk a flat scene's rays in lanes on a CPU device: no alpha,
-/// fewer than 2^27 triangles in leaves of at most 15 (a lane's stack entry packs
-/// both in a word), the host CPU (PoCL's device) has AVX-512 (whose gathers, scatters and
-/// compresses the walk uses) or AVX2 (eight lanes: gathers, table-driven compresses, stores for
-/// scatters; 17-25 % less time than one ray at a time on AMD's Zen 3, docs/benchmarks.md,
-/// "Twenty-third session"), and `PENUMBRA_LANES` is not `0` (docs/benchmarks.md, "Fourteenth
-/// session"); below [`LANES_MIN_TRIANGLES`] only where the vertices are shaded in batches
-/// (the bundled box 12 % faster at 64 bounces, its viewer 1.3× on Zen 3: docs/benchmarks.md,
-/// "Twenty-eighth session") or the scene is small (`SMALL_SCENE`'s sizes), whose lanes then
-/// test its triangles whole (`KernelFeatures::lanes_small`; "Thirty-first session").
-/// `PENUMBRA_LANES=1` walks in lanes on any CPU device at any size (lane by lane where the CPU
-/// has neither: for measurements).
-pub fn lanes_megakernel(cpu: bool, alpha: bool, triangles: usize, largest_leaf: u32) -> Lanes {
-    if !cpu || alpha || triangles >= 1 << 27 || largest_leaf > 15 {
-        return Lanes::Never;
-    }
-    match std::env::var("PENUMBRA_LANES").as_deref().map(str::trim) {
-        Ok("0") => return Lanes::Never,
-        Ok("1") => return Lanes::Always,
-        _ => {}
-    }
-    #[cfg(target_arch = "x86_64")]
-    let vectors = std::arch::is_x86_feature_detected!("avx512f")
-        || std::arch::is_x86_feature_detected!("avx2");
-    #[cfg(not(target_arch = "x86_64"))]
-    let vectors = false;
-    match (vectors, triangles >= LANES_MIN_TRIANGLES) {
-        (false, _) => Lanes::Never,
-        (true, true) => Lanes::Always,
-        (true, false) => Lanes::WhenBatched,
-    }
-}
-
-/// Whether the megakernel's lanes shade their vertices in batches of LANES, in vectors
-/// (`KernelFeatures::lanes_shade`): with lanes, where shading is simplest (every material
-/// Lambertian, no textures, normal maps, environment map, unlit materials, thin walls or two
-/// levels), unless `PENUMBRA_LANES_SHADE` is `0`. It is path.h's `shade_vertex` lane by lane,
-/// the same image; 12 % fewer instructions and about 6 % less time on the 1 M-triangle room
-/// (docs/benchmarks.md, "Twenty-fifth session").
-pub fn lanes_shade(f: &KernelFeatures) -> bool {
-    f.lanes
-        && f.lambert_only
-        && f.small_scene == 0
-        && !(f.textures
-            || f.normal_maps
-            || f.two_level
-            || f.env_map
-            || f.unlit
-            || f.thin_walls
-            || f.transmission
-            || f.clearcoat
-            || f.sheen
-            || f.diffuse_transmission
-            || f.iridescence
-            || f.anisotropy
-            || f.dispersion)
-        && std::env::var("PENUMBRA_LANES_SHADE")
-            .as_deref()
-            .map(str::trim)
-            != Ok("0")
-}
-
-/// Whether a small scene's lanes, where it walks in lanes, test its triangles whole
-/// (`KernelFeatures::lanes_small`, `LANES_SMALL`, kernels/traverse_lanes.h) instead of walking
-/// its tree: a scene the megakernel would test whole one ray at a time (`small_scene`), unless
-/// `PENUMBRA_LANES_SMALL` is `0`. Faster than both the tree in lanes and `SMALL_SCENE`
-/// (docs/benchmarks.md, "Thirty-first session"); the same image.
-pub fn lanes_small(f: &KernelFeatures) -> bool {
-    f.small_scene > 0
-        && std::env::var("PENUMBRA_LANES_SMALL")
-            .as_deref()
-            .map(str::trim)
-            != Ok("0")
-}
-
-/// Whether the lanes (`MEGA_LANES`) load their nodes and triangles as rows, transposed into
-/// vectors by shuffles, rather than by gathers (`LANES_GATHERS`, kernels/traverse_lanes.h). On
-/// AMD's Zen 5 a gather loads about one element a cycle from L2, and rows make the walk 1.3–1.8×
-/// faster natively; on an Intel Xeon (the H200 machine's host) gathers are 3–7 % faster
-/// (docs/benchmarks.md, "Seventeenth session"). So rows on AMD CPUs, gathers elsewhere;
-/// `PENUMBRA_LANES_LOAD=rows` or `gathers` chooses.
-pub fn lanes_load_rows() -> bool {
-    static ROWS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    *ROWS.get_or_init(|| {
-        match std::env::var("PENUMBRA_LANES_LOAD")
-            .as_deref()
-            .map(str::trim)
-        {
-            Ok("rows") => return true,
-            Ok("gathers") => return false,
-            Ok(other) => {
-                log::warn!("PENUMBRA_LANES_LOAD={other:?} is neither rows nor gathers: ignored")
-            }
-            Err(_) => {}
-        }
-        host_cpu_is_amd()
-    })
-}
-
-/// Whether the host CPU (PoCL's device) is AMD's, by its CPUID vendor string.
-fn host_cpu_is_amd() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        let r = std::arch::x86_64::__cpuid(0);
-        let mut vendor = [0u8; 12];
-        vendor[..4].copy_from_slice(&r.ebx.to_le_bytes());
-        vendor[4..8].copy_from_slice(&r.edx.to_le_bytes());
-        vendor[8..].copy_from_slice(&r.ecx.to_le_bytes());
-        &vendor == b"AuthenticAMD"
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
-/// The most triangles a scene may have for the megakernel to test them all for every ray
-/// (`KernelFeatures::small_scene`): up to this many, sixteen at a time in vector lanes, cost
-/// less than walking the 4-wide BVH on PoCL (docs/benchmarks.md, "Eighth session"; a box of
-/// 36 triangles 7.5–7.8 against the tree's 8.7–8.8 CPU s, one of 144 12.6–13.0 against 11.9–12.2:
-/// "Ninth session").
-pub const SMALL_SCENE_MAX: usize = 64;
 
 impl KernelFeatures {
     /// The `-D` options for these features.
@@ -296,7 +152,7 @@ impl KernelFeatures {
         if self.small_scene > 0 {
             d.push_str(&format!(" -DSMALL_SCENE={}", self.small_scene));
         }
-        if self.lanes && !lanes_load_rows() {
+        if self.lanes_gathers {
             d.push_str(" -DLANES_GATHERS");
         }
         d
@@ -406,8 +262,8 @@ pub(crate) fn build_source(
     // is made, and the kernels make many: the .w lanes of vertices and nodes hold index bits,
     // which read as denormals, and every float4 operation computes them too. Flushing them to
     // zero, as Embree's and Cycles' CPU threads do, makes the megakernel about 1.35 times as
-    // fast on PoCL (docs/benchmarks.md). No coordinate, colour or weight a scene means is that
-    // small; GPUs keep their own default.
+    // fast on PoCL. No coordinate, colour or weight a scene means is that small; GPUs keep
+    // their own default.
     if gpu.is_cpu() {
         options.push_str(" -cl-denorms-are-zero");
     } else {
@@ -440,50 +296,19 @@ pub(crate) fn build_source(
             log::debug!("kernel build log ({options}):\n{log}");
         }
     }
-    dump_binary(&program);
     Ok(program)
 }
 
 /// The register cap for NVIDIA's compiler, where it pays. The two-level traversal needs a few
 /// registers more than flat's (the instance's tmin, the stack height of its walk): `extend`
 /// and `trace_closest` take 72 against flat's 64 and 62. The cap of 72 keeps ptxas from
-/// taking more, so that as many warps fit on a multiprocessor to hide the node loads; it once
-/// took two-level frames on an H200 from 0.82 to 0.90 of flat's, when they took 89-94 (sixth
-/// session), and 64 made frames 2-4 % slower in the eighth. Flat programs stay under the cap
-/// and the cap does not change them (docs/benchmarks.md).
-/// `PENUMBRA_NV_MAXRREG` sets another cap for measuring (0: none).
+/// taking more, so that as many warps fit on a multiprocessor to hide the node loads; it took
+/// two-level frames on an H200 from 0.82 to 0.90 of flat's when they took 89-94, and a cap of
+/// 64 made frames 2-4 % slower. Flat programs stay under the cap and the cap does not change
+/// them.
 fn register_cap(gpu: &Gpu, features: KernelFeatures) -> Option<u32> {
-    if !features.two_level || !gpu.has_extension("cl_nv_compiler_options") {
-        return None;
-    }
-    let cap = match std::env::var("PENUMBRA_NV_MAXRREG") {
-        Ok(v) => v.trim().parse().unwrap_or(TWO_LEVEL_REGISTERS),
-        Err(_) => TWO_LEVEL_REGISTERS,
-    };
-    (cap > 0).then_some(cap)
-}
-
-/// For measuring: with `PENUMBRA_DUMP_BINARY=PREFIX` every program built is written to
-/// `PREFIX.N.bin` (N counting the builds of the process). NVIDIA's binary is its PTX, which
-/// CUDA's `ptxas` and `cuobjdump` turn into the machine code and its register count
-/// (docs/benchmarks.md, seventh and eighth sessions).
-fn dump_binary(program: &opencl3::program::Program) {
-    static BUILDS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let Some(prefix) = std::env::var_os("PENUMBRA_DUMP_BINARY") else {
-        return;
-    };
-    let n = BUILDS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let path = format!("{}.{n}.bin", prefix.to_string_lossy());
-    match program.get_binaries() {
-        Ok(binaries) => {
-            for binary in binaries {
-                if let Err(e) = std::fs::write(&path, binary) {
-                    log::warn!("cannot write {path}: {e}");
-                }
-            }
-        }
-        Err(e) => log::warn!("cannot read the program binary: {e}"),
-    }
+    (features.two_level && gpu.has_extension("cl_nv_compiler_options"))
+        .then_some(TWO_LEVEL_REGISTERS)
 }
 
 /// NVIDIA's register cap for two-level programs (see [`register_cap`]).

@@ -180,12 +180,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // Whether the megakernel walked its rays in vector lanes (CPU devices with AVX-512 or AVX2).
     summary["lanes"] = serde_json::json!(renderer.walks_in_lanes());
     // How the lanes loaded their nodes and triangles: "rows" or "gathers" (null without lanes).
-    let load = if crate::cl::lanes_load_rows() {
-        "rows"
-    } else {
-        "gathers"
-    };
-    summary["lanes_load"] = serde_json::json!(renderer.walks_in_lanes().then_some(load));
+    summary["lanes_load"] = serde_json::json!(renderer.lanes_load());
     // Whether the lanes shaded their vertices in batches, in vectors (kernels/shade_lanes.h).
     summary["lanes_shade"] = serde_json::json!(renderer.shades_in_lanes());
     // Whether the lanes tested a small scene's triangles whole (no tree).

@@ -41,16 +41,28 @@ impl FromStr for KernelChoice {
 const MAX_RAYS_PER_LAUNCH: u64 = 1 << 31;
 
 impl Renderer {
-    /// Chooses the kernels (resolving `Auto` by the device type). Resets the film.
+    /// Chooses the kernels (resolving `Auto` by the device type); with a scene loaded, builds
+    /// the kernels again where the strategy for the new ones differs. Resets the film.
     pub fn set_kernel(&mut self, choice: KernelChoice) -> Result<(), ClError> {
-        self.megakernel = match choice {
-            KernelChoice::Auto => self.gpu.is_cpu(),
-            KernelChoice::Wavefront => false,
-            KernelChoice::Megakernel => true,
-        };
+        self.megakernel = super::strategy::runs_megakernel(&self.device, choice);
+        if self.scene.is_some() {
+            self.ensure_program()?;
+        }
         // The loaded scene's node arrays are those of the kernels it was loaded for.
         self.ensure_node_forms()?;
         self.reset()
+    }
+
+    /// How the megakernel's lanes load their nodes and triangles, `"rows"` or `"gathers"`;
+    /// `None` where it does not walk in lanes.
+    pub fn lanes_load(&self) -> Option<&'static str> {
+        self.walks_in_lanes().then(|| {
+            if self.megakernel_has(|f| f.lanes_gathers) {
+                "gathers"
+            } else {
+                "rows"
+            }
+        })
     }
 
     /// Whether the megakernel runs with kernels built for a feature `f` picks out.

@@ -1,0 +1,79 @@
+//! Reading the film back: the image as linear RGB and each pixel's coverage.
+
+use super::Renderer;
+use crate::cl::ClError;
+
+impl Renderer {
+    /// The film as linear RGB (the mean of the samples), row by row from the top.
+    pub fn image(&mut self) -> Result<Vec<[f32; 3]>, ClError> {
+        let mut image = Vec::new();
+        self.image_into(&mut image, None)?;
+        Ok(image)
+    }
+
+    /// [`Renderer::image`] into `image`, and [`Renderer::coverage`] into `coverage`, from one
+    /// read of the film: their allocations and the renderer's readback buffer are reused, so
+    /// the viewer's frames allocate no film-sized memory.
+    pub fn image_into(
+        &mut self,
+        image: &mut Vec<[f32; 3]>,
+        coverage: Option<&mut Vec<f32>>,
+    ) -> Result<(), ClError> {
+        let read = self.read_film()?;
+        let n = (self.settings.width * self.settings.height) as usize;
+        let counted = self.settings.cutout || self.settings.count_coverage;
+        let samples = self.samples.max(1) as f32;
+        image.clear();
+        if !read {
+            image.resize(n, [0.0; 3]);
+        } else if counted {
+            // `.w` counts the samples whose camera ray hit: the mean is over all samples.
+            image.extend(
+                self.readback
+                    .iter()
+                    .map(|p| [p[0] / samples, p[1] / samples, p[2] / samples]),
+            );
+        } else {
+            image.extend(self.readback.iter().map(|p| {
+                let n = p[3].max(1.0);
+                [p[0] / n, p[1] / n, p[2] / n]
+            }));
+        }
+        if let Some(coverage) = coverage {
+            coverage.clear();
+            if read && counted {
+                coverage.extend(
+                    self.readback
+                        .iter()
+                        .map(|p| (p[3] / samples).clamp(0.0, 1.0)),
+                );
+            } else {
+                coverage.resize(n, 1.0);
+            }
+        }
+        Ok(())
+    }
+
+    /// Each pixel's coverage: the share of its samples whose camera ray hit the scene, with
+    /// [`RenderSettings::cutout`](super::RenderSettings::cutout) or
+    /// [`RenderSettings::count_coverage`](super::RenderSettings::count_coverage) (else all 1); with the
+    /// image, [`Renderer::image_into`] reads it from the same read of the film.
+    pub fn coverage(&mut self) -> Result<Vec<f32>, ClError> {
+        let (mut image, mut coverage) = (Vec::new(), Vec::new());
+        self.image_into(&mut image, Some(&mut coverage))?;
+        Ok(coverage)
+    }
+
+    /// Finishes the pending launches and reads the film into [`Renderer::readback`]; false
+    /// when no frame exists yet.
+    fn read_film(&mut self) -> Result<bool, ClError> {
+        if !self.pending.is_empty() {
+            self.finish()?;
+        }
+        let Some(f) = self.frame.as_ref() else {
+            return Ok(false);
+        };
+        f.film.read_into(&self.gpu, &mut self.readback)?;
+        Ok(true)
+    }
+}
