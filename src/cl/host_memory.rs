@@ -12,13 +12,14 @@ pub(super) const HUGE_PAGE: usize = 2 << 20;
 /// Host memory for a CPU device's buffer, aligned to and advised for transparent huge pages.
 /// PoCL runs kernels on a `CL_MEM_USE_HOST_PTR` buffer's own memory, and with 4 KiB pages the
 /// traversal of a large scene misses the TLB on nearly every node and triangle it reads: the
-/// 1 M-triangle bunnies render about 6 % faster per CPU second with huge pages. Linux gives huge pages to advised memory when
-/// /sys/kernel/mm/transparent_hugepage/enabled is `madvise` (Debian's default) or `always`;
-/// with `never` this is ordinary aligned memory.
+/// 1 M-triangle bunnies render about 6 % faster per CPU second with huge pages. Linux gives
+/// huge pages to advised memory when /sys/kernel/mm/transparent_hugepage/enabled is `madvise`
+/// (Debian's default) or `always`; with `never` this is ordinary aligned memory.
 /// Only the first [`HUGE_BUDGET`] bytes of live buffers are advised: on a machine whose memory
 /// is fragmented Linux compacts memory to fault a huge page in (`defrag` `madvise`, Debian's
 /// default), which cost about 4 s a GB on the development VM against 0.7 s for small pages, and
-/// a 16 M-triangle scene's upload took 14 s instead of 5 s. Scenes of up to about two million triangles keep their huge pages.
+/// a 16 M-triangle scene's upload took 14 s instead of 5 s. Scenes of up to about two million
+/// triangles keep their huge pages.
 pub(super) struct HostPages {
     /// The first byte, aligned to a huge page.
     pub(super) ptr: *mut u8,
@@ -176,7 +177,7 @@ const OPENING_MMAP_THRESHOLD: i32 = 2 << 20;
 const OPENING_TRIM_THRESHOLD: i32 = 128 << 10;
 
 /// Between openings: glibc's own ceiling for its dynamic threshold (32 MiB on 64-bit), which its
-/// default reaches as a session goes on, so that what frames allocate and free again (display
+/// default reaches as the program runs on, so that what frames allocate and free again (display
 /// images, the driver's own blocks) is reused from the heap rather than faulted in afresh.
 const STEADY_MMAP_THRESHOLD: i32 = 32 << 20;
 
