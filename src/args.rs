@@ -14,6 +14,8 @@ use anyhow::{Result, bail};
 use clap::Args;
 use std::path::Path;
 
+pub use crate::cli::first_image::EnvChoice;
+
 /// The largest image side accepted.
 pub const MAX_SIDE: u32 = 16384;
 /// The most bounces accepted.
@@ -204,14 +206,6 @@ pub struct EnvArgs {
         value_parser = parse_finite
     )]
     pub env_rotation: f32,
-}
-
-/// What `--env` asked for.
-pub enum EnvChoice {
-    /// A uniform radiance.
-    Color([f32; 3]),
-    /// An environment image.
-    Map(EnvMap),
 }
 
 impl EnvArgs {

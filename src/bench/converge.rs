@@ -6,7 +6,8 @@
 //! reference are recorded. An unbiased estimator's MSE falls as 1/time: slope −1 on log–log
 //! axes. A curve that flattens is bias (or a reference that does not match the render).
 
-use super::stats::{ImageError, image_error, log_log_slope};
+use super::curve::{Curve, Step};
+use super::stats::{ImageError, image_error};
 use super::{device_json, device_line, plot};
 use crate::args::CommonArgs;
 use crate::date::today;
@@ -108,70 +109,6 @@ fn parse_config(s: &str) -> Result<Config, String> {
         .ok_or_else(|| {
             format!("'{s}' is not a configuration (mis, bsdf, lights, each optionally +rr)")
         })
-}
-
-/// One recorded step.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct Step {
-    /// Samples per pixel in the film.
-    pub spp: u32,
-    /// Wall time of the renders so far (blocking calls; read-back and metrics excluded).
-    pub seconds: f64,
-    /// Kernel time of the renders so far, from profiling events.
-    pub kernel_seconds: f64,
-    /// Root mean squared error against the reference.
-    pub rmse: f64,
-    /// Mean of (x − r)² / (r² + 0.01) over pixels and channels.
-    pub relmse: f64,
-}
-
-/// The steps of one configuration and what is fitted to them.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct Curve {
-    /// Configuration name.
-    pub config: String,
-    /// Steps, in order.
-    pub steps: Vec<Step>,
-    /// Slope of ln relMSE against ln wall time over the fitted steps that took at least 1/64
-    /// of the last step's time (−1: unbiased).
-    pub slope_time: Option<f64>,
-    /// Slope of ln relMSE against ln spp over the fitted steps (not a timing).
-    pub slope_spp: Option<f64>,
-    /// 1 / (relMSE × seconds) at the last step.
-    pub efficiency: f64,
-}
-
-impl Curve {
-    fn fit(config: String, steps: Vec<Step>, fit_from: u32) -> Self {
-        let fitted: Vec<&Step> = steps.iter().filter(|s| s.spp >= fit_from).collect();
-        // Steps shorter than 1/64 of the last are left out of the time fit: there, fixed costs
-        // per call (launch latency, a wave that does not fill the device) outweigh the
-        // samples and would steepen the slope.
-        let last_seconds = steps.last().map_or(0.0, |s| s.seconds);
-        let slope_time = log_log_slope(
-            &fitted
-                .iter()
-                .filter(|s| s.seconds >= last_seconds / 64.0)
-                .map(|s| (s.seconds, s.relmse))
-                .collect::<Vec<_>>(),
-        );
-        let slope_spp = log_log_slope(
-            &fitted
-                .iter()
-                .map(|s| (s.spp as f64, s.relmse))
-                .collect::<Vec<_>>(),
-        );
-        let efficiency = steps
-            .last()
-            .map_or(0.0, |s| 1.0 / (s.relmse * s.seconds).max(1e-300));
-        Self {
-            config,
-            steps,
-            slope_time,
-            slope_spp,
-            efficiency,
-        }
-    }
 }
 
 /// Runs the benchmark.
@@ -375,25 +312,5 @@ mod tests {
         for c in Config::ALL {
             assert_eq!(parse_config(&c.name()), Ok(c));
         }
-    }
-
-    #[test]
-    fn a_one_over_n_curve_fits_slope_minus_one() {
-        let steps = (0..8)
-            .map(|i| {
-                let spp = 1 << i;
-                Step {
-                    spp,
-                    seconds: 0.01 * spp as f64,
-                    kernel_seconds: 0.0,
-                    rmse: 0.0,
-                    relmse: 0.5 / spp as f64,
-                }
-            })
-            .collect();
-        let c = Curve::fit("mis".into(), steps, 4);
-        assert!((c.slope_time.unwrap() + 1.0).abs() < 1e-9);
-        assert!((c.slope_spp.unwrap() + 1.0).abs() < 1e-9);
-        assert!((c.efficiency - 1.0 / (0.5 / 128.0 * 1.28)).abs() < 1e-6);
     }
 }

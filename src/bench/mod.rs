@@ -5,6 +5,7 @@
 
 mod bvh;
 mod converge;
+mod curve;
 mod frame;
 pub mod generate;
 mod plot;

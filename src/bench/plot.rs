@@ -1,7 +1,7 @@
 //! The convergence plot: relMSE against wall time on log–log axes, one curve per
 //! configuration, with its fitted slope, and a slope −1 guide.
 
-use super::converge::Curve;
+use super::curve::Curve;
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 use plotters::style::FontStyle;

@@ -1,19 +1,30 @@
-//! OpenCL on the host: device choice, the context and queue, program builds with scene-feature
-//! defines and line-mapped errors, typed buffers, and the typed kernel wrappers (`kernels`), the
-//! one place with `unsafe` code and positional kernel arguments.
+//! OpenCL on the host: device choice, the context and queue (`device`), program builds with
+//! scene-feature defines and line-mapped errors (`program`), the structs shared with the kernels
+//! (`types`), typed buffers (`buffer`) and the scene's (`scene_buffers`), the host memory policy
+//! (`host_memory`), the path tracer's stages (`stage`), and the typed kernel wrappers
+//! (`kernels`), the one place with positional kernel arguments. `buffer`, `host_memory` and
+//! `kernels` are the only modules with `unsafe` code.
 
+mod buffer;
 mod device;
+mod host_memory;
 pub mod kernels;
 mod program;
+mod scene_buffers;
+mod stage;
 pub mod types;
 
 /// Serialises device opening and program builds within a process: PoCL (3.x, Debian 12) can
 /// crash when two threads create contexts or compile at the same time, as test binaries do.
 pub(crate) static CL_SETUP: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
+pub use buffer::Buffer;
 pub use device::{DeviceChoice, DeviceInfo, Gpu, list_devices};
-pub use kernels::{Buffer, Program, Stage};
+pub use host_memory::{OpeningMemory, map_file};
+pub use kernels::{Launch, Program};
 pub use program::{KernelFeatures, build_program, build_test_program};
+pub use scene_buffers::{EnvBuffers, NodeForms, SceneBuffers};
+pub use stage::Stage;
 
 /// Errors from OpenCL: no usable device, a failed build, a failed launch.
 #[derive(Debug, thiserror::Error)]

@@ -1,10 +1,10 @@
 //! The defaults that make the first image of any scene readable: the first view (a scene's own
 //! camera wins), an environment when the scene's own lights do not light that view and the sky
-//! can reach it, and lights inside an interior that nothing lights.
+//! can reach it, and lights inside an interior that nothing lights; and what `--env` names
+//! ([`EnvArg`]) and chooses ([`EnvChoice`]).
 
-use crate::args::EnvChoice;
 use crate::scene::framing::{self, FirstView};
-use crate::scene::{Camera, EnvPreset, Light, Scene};
+use crate::scene::{Camera, EnvMap, EnvPreset, Light, Scene};
 
 /// What `--env` names.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,6 +30,14 @@ impl EnvArg {
                 .unwrap_or_else(|| EnvArg::Other(name.to_string())),
         }
     }
+}
+
+/// What `--env` asked for.
+pub enum EnvChoice {
+    /// A uniform radiance.
+    Color([f32; 3]),
+    /// An environment image.
+    Map(EnvMap),
 }
 
 /// The defaults chosen for a scene.

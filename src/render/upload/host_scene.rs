@@ -1,0 +1,426 @@
+//! The scene as uploaded ([`HostScene`]): its device structs in BVH order (flat: world space,
+//! one per placed triangle; two levels: object space, one per mesh triangle), the emissive
+//! triangles of the light table, and the host reference traversal for picking and tests.
+
+use super::accel::{Accel, InstanceLayout};
+use super::structs::{gpu_material, luminance, samples_textures};
+use super::triangles::{
+    FlatStructs, emissive_triangles, object_triangles, split_by, triangle_area,
+};
+use crate::bvh::{Ray, TwoLevel};
+use crate::cl::types::*;
+use crate::scene::{Material, Mesh, RenderFrame, Scene, WorldTriangle, robust_bounds_of};
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+/// An emissive triangle of the light table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Emitter {
+    /// Its index in the device triangles (flat: BVH order; two levels: the mesh triangle).
+    pub prim: u32,
+    /// Its instance's index (two levels; 0 when flat).
+    pub instance: u32,
+    /// World (render space) area.
+    pub area: f32,
+    /// Emitted power, for light selection.
+    pub power: f32,
+    /// Centroid in render space.
+    pub centroid: Vec3,
+    /// Its material (index in the scene's materials).
+    pub material: u32,
+}
+
+/// The scene as uploaded, kept on the host for picking and for tests.
+pub struct HostScene {
+    /// The acceleration structure.
+    pub accel: Accel,
+    /// Two levels: where the instances' parts sit on the device (empty when flat).
+    pub layout: InstanceLayout,
+    /// Triangles as the device has them: the flat BVH's world triangles in BVH order; moved
+    /// to the device by `Renderer::load_scene` (empty after). Two levels: only the small
+    /// instances' world-space copies that follow the meshes' object-space triangles on the
+    /// device (mesh after mesh in BLAS order, written straight into the device buffer by
+    /// [`HostScene::fill_meshes`]).
+    pub triangles: Vec<GpuTriangle>,
+    /// Flat: each triangle's object (index in `Scene::objects`) in BVH order, for picking
+    /// (4 bytes a triangle where `triangles` holds 48); empty with two levels.
+    pub objects: Vec<u32>,
+    /// Flat: world vertices in BVH order (for the host traversal); empty with two levels,
+    /// whose BLASes hold their triangles.
+    pub vertices: Vec<[Vec3; 3]>,
+    /// Corner normals, indexed as `triangles`; moved to the device by `Renderer::load_scene`
+    /// (empty after; two levels: always, [`HostScene::fill_meshes`]).
+    pub shading: Vec<GpuTriShading>,
+    /// Texture coordinates, indexed as `triangles`; empty when no material samples a texture
+    /// ([`samples_textures`]), with two levels, and after `Renderer::load_scene` moved them.
+    pub uvs: Vec<GpuTriUvs>,
+    /// Tangents, indexed as `triangles`; empty when no triangle is normal-mapped, with two
+    /// levels, and after `Renderer::load_scene` moved them to the device.
+    pub tangents: Vec<GpuTriTangents>,
+    /// Materials.
+    pub materials: Vec<GpuMaterial>,
+    /// Emissive triangles, in light-table order.
+    pub emissive: Vec<Emitter>,
+    /// The map from world space to the render space the triangles are in.
+    pub space: RenderFrame,
+    /// The middle and the diagonal of the robust bounds of the triangles.
+    middle: (Vec3, f32),
+}
+
+impl HostScene {
+    /// The flat form of `world` (render space, in object order): converted to the device
+    /// structs and dropped before the BVH is built, then the structs are put in BVH order one
+    /// array at a time, so that the large intermediate triangles and two orders of the same
+    /// data are never held together.
+    pub fn flat(world: Vec<WorldTriangle>, materials: &[Material]) -> Self {
+        let normal_mapped = world.iter().any(|t| t.tangents.is_some());
+        let mut structs = FlatStructs::new(world.len(), normal_mapped, samples_textures(materials));
+        structs.add(world);
+        let middle = middle_of(1, &|_| {
+            structs.vertices.iter().map(|v| v.map(Vec3::as_dvec3))
+        });
+        Self::flat_from(structs, materials, middle)
+    }
+
+    /// [`HostScene::flat`] of `scene`'s visible objects in render space `space`, converted to
+    /// the device structs one object at a time (never the whole scene's [`WorldTriangle`]s
+    /// at once), and the number of triangles dropped ([`Scene::flatten`]).
+    pub fn flatten(scene: &Scene, space: &RenderFrame, materials: &[Material]) -> (Self, usize) {
+        let visible = || scene.objects.iter().filter(|o| o.visible);
+        // Tangents are kept when some kept triangle has them (as `flat` decides).
+        let maybe_mapped = visible().any(|o| !o.mesh.tangents.is_empty());
+        let textured = samples_textures(materials);
+        let mut structs = FlatStructs::new(scene.triangle_count(), maybe_mapped, textured);
+        let dropped = scene.flatten_each(space, |world| structs.add(world));
+        if !structs.mapped {
+            structs.tangents = Vec::new();
+        }
+        (
+            Self::flat_from(structs, materials, render_middle(scene, space)),
+            dropped,
+        )
+    }
+
+    fn flat_from(structs: FlatStructs, materials: &[Material], middle: (Vec3, f32)) -> Self {
+        let FlatStructs {
+            triangles,
+            shading,
+            uvs,
+            tangents,
+            vertices,
+            ..
+        } = structs;
+        let normal_mapped = !tangents.is_empty();
+        let bvh = crate::bvh::build(&vertices);
+        fn gather<T: Copy + Send + Sync>(v: Vec<T>, order: &[u32]) -> Vec<T> {
+            order.par_iter().map(|&i| v[i as usize]).collect()
+        }
+        let vertices = gather(vertices, &bvh.tri_indices);
+        let mut triangles = gather(triangles, &bvh.tri_indices);
+        let shading = gather(shading, &bvh.tri_indices);
+        let uvs = if uvs.is_empty() {
+            uvs
+        } else {
+            gather(uvs, &bvh.tri_indices)
+        };
+        let tangents = if normal_mapped {
+            gather(tangents, &bvh.tri_indices)
+        } else {
+            tangents
+        };
+        let mut emissive = Vec::new();
+        for (order, (tri, v)) in triangles.iter_mut().zip(&vertices).enumerate() {
+            let m = &materials[tri.v0[3].to_bits() as usize];
+            let area = triangle_area(v);
+            if m.is_emissive() && area > 0.0 {
+                let sides = if m.double_sided { 2.0 } else { 1.0 };
+                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
+                tri.v1[3] = f32::from_bits(emissive.len() as u32);
+                emissive.push(Emitter {
+                    prim: order as u32,
+                    instance: 0,
+                    area,
+                    power,
+                    centroid: v.iter().sum::<Vec3>() / 3.0,
+                    material: tri.v0[3].to_bits(),
+                });
+            }
+        }
+        let objects = triangles.par_iter().map(|t| t.v2[3].to_bits()).collect();
+        Self {
+            vertices,
+            objects,
+            uvs,
+            ..Self::assemble(
+                Accel::Flat(bvh),
+                InstanceLayout::default(),
+                (triangles, shading, tangents),
+                materials,
+                emissive,
+                middle,
+            )
+        }
+    }
+
+    /// The scene of `accel` with its device structs, in render space yet to be set.
+    fn assemble(
+        accel: Accel,
+        layout: InstanceLayout,
+        (triangles, shading, tangents): (Vec<GpuTriangle>, Vec<GpuTriShading>, Vec<GpuTriTangents>),
+        materials: &[Material],
+        emissive: Vec<Emitter>,
+        middle: (Vec3, f32),
+    ) -> Self {
+        Self {
+            accel,
+            layout,
+            triangles,
+            objects: vec![],
+            vertices: vec![],
+            shading,
+            uvs: vec![],
+            tangents,
+            materials: materials.iter().map(gpu_material).collect(),
+            emissive,
+            space: RenderFrame::default(),
+            middle,
+        }
+    }
+
+    /// Fills the device structs of a two-level scene: every mesh's triangles and shading data
+    /// once, in object space and BLAS order (`meshes[b]` is BLAS b's mesh), and the light
+    /// table's emissive triangles instance by instance (each instance's first light is kept in
+    /// `layout.light_bases`). `two`'s instances are in render space; `middle` is the
+    /// scene's robust middle and diagonal there ([`render_middle`]).
+    pub fn two_level(
+        two: TwoLevel,
+        meshes: &[&Mesh],
+        materials: &[Material],
+        middle: (Vec3, f32),
+    ) -> Self {
+        // Each mesh's emissive triangles (index among the meshes' triangles, material); the
+        // device structs themselves are written at the upload (`HostScene::fill_meshes`).
+        let mesh_emitters: Vec<Vec<(u32, u32)>> = meshes
+            .par_iter()
+            .zip(&two.blases)
+            .enumerate()
+            .map(|(b, (m, blas))| {
+                emissive_triangles(m, &blas.bvh.tri_indices, materials)
+                    .into_iter()
+                    .map(|(k, material)| (two.firsts[b] + k, material))
+                    .collect()
+            })
+            .collect();
+        // A small mesh's object-space device triangles, for its instances' world-space copies.
+        let small_meshes = meshes
+            .iter()
+            .zip(&two.blases)
+            .map(|(m, blas)| {
+                if !two.is_small(blas) {
+                    return Vec::new();
+                }
+                let n = blas.bvh.tri_indices.len();
+                let mut tris = vec![GpuTriangle::default(); n];
+                let mut shading = vec![GpuTriShading::default(); n];
+                let out = (
+                    (&mut tris[..], &mut shading[..]),
+                    (&mut [][..], &mut [][..]),
+                );
+                object_triangles(m, &blas.bvh.tri_indices, materials, out);
+                tris
+            })
+            .collect();
+        let mut emissive = vec![];
+        let mut light_bases = vec![];
+        for (i, inst) in two.instances.iter().enumerate() {
+            light_bases.push(emissive.len() as i32);
+            for &(prim, material) in &mesh_emitters[inst.blas as usize] {
+                let v = two.hit_triangle(prim, i as u32);
+                let m = &materials[material as usize];
+                emissive.push(emitter(prim, i as u32, &v, material, m));
+            }
+        }
+        Self::assemble(
+            Accel::TwoLevel(two),
+            InstanceLayout {
+                light_bases,
+                small_meshes,
+                ..InstanceLayout::default()
+            },
+            (vec![], vec![], vec![]),
+            materials,
+            emissive,
+            middle,
+        )
+    }
+
+    /// Two levels: writes every mesh's device structs, once, in object space and BLAS order
+    /// (`meshes[b]` is BLAS b's mesh) to the front of `triangles` and `shading` (and of `uvs`
+    /// and `tangents` when not empty), each mesh its own range, in parallel. The renderer writes
+    /// them straight into the device buffers ([`crate::cl::Buffer::fill_mapped`]): on a CPU
+    /// device no host copy of these arrays (144 bytes a triangle) is made beside them.
+    pub fn fill_meshes(
+        two: &TwoLevel,
+        meshes: &[&Mesh],
+        materials: &[Material],
+        (triangles, shading, uvs, tangents): (
+            &mut [GpuTriangle],
+            &mut [GpuTriShading],
+            &mut [GpuTriUvs],
+            &mut [GpuTriTangents],
+        ),
+    ) {
+        let sizes: Vec<usize> = two.blases.iter().map(|b| b.bvh.tri_indices.len()).collect();
+        let sizes_if = |full: bool| {
+            if full {
+                sizes.clone()
+            } else {
+                vec![0; sizes.len()]
+            }
+        };
+        let (uv_sizes, tangent_sizes) = (sizes_if(!uvs.is_empty()), sizes_if(!tangents.is_empty()));
+        let parts = split_by(triangles, &sizes)
+            .into_iter()
+            .zip(split_by(shading, &sizes))
+            .zip(
+                split_by(uvs, &uv_sizes)
+                    .into_iter()
+                    .zip(split_by(tangents, &tangent_sizes)),
+            );
+        meshes
+            .par_iter()
+            .zip(&two.blases)
+            .zip(parts.collect::<Vec<_>>())
+            .for_each(|((m, blas), out)| {
+                object_triangles(m, &blas.bvh.tri_indices, materials, out);
+            });
+    }
+
+    /// Triangles over all placed meshes.
+    pub fn triangle_count(&self) -> usize {
+        match &self.accel {
+            Accel::Flat(_) => self.vertices.len(),
+            Accel::TwoLevel(t) => t.triangle_count(),
+        }
+    }
+
+    /// Scales each emissive triangle's selection power by its material's factor in
+    /// `per_material` (see [`emissive_texture_means`]).
+    pub fn scale_emitter_power(&mut self, per_material: &[f32]) {
+        for e in &mut self.emissive {
+            e.power *= per_material
+                .get(e.material as usize)
+                .copied()
+                .unwrap_or(1.0);
+        }
+    }
+
+    /// The middle and the diagonal of the scene's robust box (a lone far-away object does not
+    /// count, see [`robust_bounds`]), in render space.
+    pub fn bounds(&self) -> (Vec3, f32) {
+        self.middle
+    }
+
+    /// Two levels: recomputes the emissive triangles of instance `i` after it moved (area,
+    /// power and centroid).
+    pub fn replace_emitters(&mut self, i: u32) {
+        let Accel::TwoLevel(two) = &self.accel else {
+            return;
+        };
+        for e in self.emissive.iter_mut().filter(|e| e.instance == i) {
+            let v = two.hit_triangle(e.prim, i);
+            let area = triangle_area(&v);
+            e.power = if e.area > 0.0 {
+                e.power * area / e.area
+            } else {
+                0.0
+            };
+            e.area = area;
+            e.centroid = v.iter().sum::<Vec3>() / 3.0;
+        }
+    }
+
+    /// The closest hit along `ray` (render space), as the device reports it.
+    pub fn intersect(&self, ray: &Ray) -> Option<GpuHit> {
+        match &self.accel {
+            Accel::Flat(b) => b.intersect(ray, &self.vertices).map(|h| GpuHit {
+                t: h.t,
+                u: h.u,
+                v: h.v,
+                prim: h.prim,
+                instance: 0,
+            }),
+            Accel::TwoLevel(t) => t.device_hit(ray),
+        }
+    }
+
+    /// Whether anything blocks `ray` within its interval.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        match &self.accel {
+            Accel::Flat(b) => b.occluded(ray, &self.vertices),
+            Accel::TwoLevel(t) => t.occluded(ray),
+        }
+    }
+
+    /// The object (index in `Scene::objects`) a device hit is on.
+    pub fn object_of(&self, hit: &GpuHit) -> u32 {
+        match &self.accel {
+            Accel::Flat(_) => self.objects[hit.prim as usize],
+            Accel::TwoLevel(t) => {
+                self.layout.objects[t.tlas.tri_indices[hit.instance as usize] as usize]
+            }
+        }
+    }
+
+    /// The world (render space) vertices of a device hit's triangle.
+    pub fn hit_triangle(&self, hit: &GpuHit) -> [Vec3; 3] {
+        match &self.accel {
+            Accel::Flat(_) => self.vertices[hit.prim as usize],
+            Accel::TwoLevel(t) => {
+                t.hit_triangle(hit.prim, t.tlas.tri_indices[hit.instance as usize])
+            }
+        }
+    }
+}
+
+/// The light-table entry of an emissive triangle with world vertices `v`.
+fn emitter(prim: u32, instance: u32, v: &[Vec3; 3], material: u32, m: &Material) -> Emitter {
+    let area = triangle_area(v);
+    let sides = if m.double_sided { 2.0 } else { 1.0 };
+    Emitter {
+        prim,
+        instance,
+        area,
+        power: luminance(m.emission) * area * std::f32::consts::PI * sides,
+        centroid: v.iter().sum::<Vec3>() / 3.0,
+        material,
+    }
+}
+
+/// The middle and the diagonal of the visible objects' robust bounds in render space `space`:
+/// those of [`Scene::bounds`] (world space, computed once and cached) carried over, not
+/// computed again over every placed triangle (1.8 s of a 64 M-triangle scene's opening). The
+/// robust box does not depend on the frame (a translation and a power-of-two scale) but for
+/// rounding.
+pub fn render_middle(scene: &Scene, space: &RenderFrame) -> (Vec3, f32) {
+    let b = scene.bounds();
+    if b.is_empty() {
+        (Vec3::ZERO, 1.0)
+    } else {
+        (space.point(b.center()), space.length(b.diagonal()))
+    }
+}
+
+/// The middle and the diagonal of the robust bounds of the parts' triangles (see
+/// [`robust_bounds_of`]).
+fn middle_of<I: Iterator<Item = [DVec3; 3]>>(
+    parts: usize,
+    part: &(dyn Fn(usize) -> I + Sync),
+) -> (Vec3, f32) {
+    let b = robust_bounds_of(parts, part);
+    if b.is_empty() {
+        (Vec3::ZERO, 1.0)
+    } else {
+        (b.center().as_vec3(), b.diagonal() as f32)
+    }
+}

@@ -1,0 +1,209 @@
+//! Mesh triangles into the device's structs: vertices (with material, light and object in
+//! their .w lanes), corner normals, texture coordinates and tangents; flat (world space, a list
+//! of placed triangles at a time) or per mesh (object space, in its BLAS's order).
+
+use super::structs::f4;
+use crate::cl::types::*;
+use crate::scene::{Material, Mesh, WorldTriangle};
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+/// The area of the triangle with vertices `v`.
+pub(super) fn triangle_area(v: &[Vec3; 3]) -> f32 {
+    0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length()
+}
+
+/// `v` cut into consecutive parts of `sizes` elements (empty parts once `v` runs out: the
+/// tangents of a scene without normal maps, the texture coordinates of one without textures).
+pub(super) fn split_by<'a, T>(mut v: &'a mut [T], sizes: &[usize]) -> Vec<&'a mut [T]> {
+    sizes
+        .iter()
+        .map(|&n| {
+            let n = n.min(v.len());
+            let (part, rest) = std::mem::take(&mut v).split_at_mut(n);
+            v = rest;
+            part
+        })
+        .collect()
+}
+
+/// One mesh's device structs for [`object_triangles`] to fill: triangles, corner normals,
+/// texture coordinates (empty when no material samples a texture) and tangents (empty when no
+/// mesh is normal-mapped).
+pub(super) type MeshStructs<'a> = (
+    (&'a mut [GpuTriangle], &'a mut [GpuTriShading]),
+    (&'a mut [GpuTriUvs], &'a mut [GpuTriTangents]),
+);
+
+/// Whether triangle `ti` of `m` (vertices `v`) is a light: an emissive material and a
+/// nonzero object-space area.
+fn emits(m: &Mesh, ti: u32, v: &[Vec3; 3], materials: &[Material]) -> bool {
+    materials[m.materials[ti as usize] as usize].is_emissive() && triangle_area(v) > 0.0
+}
+
+/// One mesh's emissive triangles in the order `order` (index in that order, material), as
+/// [`object_triangles`] finds them.
+pub(super) fn emissive_triangles(
+    m: &Mesh,
+    order: &[u32],
+    materials: &[Material],
+) -> Vec<(u32, u32)> {
+    if !m
+        .materials
+        .iter()
+        .any(|&i| materials[i as usize].is_emissive())
+    {
+        return vec![];
+    }
+    order
+        .iter()
+        .enumerate()
+        .filter(|&(_, &ti)| {
+            let v = m.indices[ti as usize].map(|i| m.positions[i as usize]);
+            emits(m, ti, &v, materials)
+        })
+        .map(|(k, &ti)| (k as u32, m.materials[ti as usize]))
+        .collect()
+}
+
+/// Writes the device structs of one mesh's triangles in object space, in the order `order`,
+/// to `out` (texture coordinates and tangents unless their slices are empty); an emissive triangle's `v1.w` counts the
+/// mesh's emissive triangles ([`emissive_triangles`]).
+pub(super) fn object_triangles(
+    m: &Mesh,
+    order: &[u32],
+    materials: &[Material],
+    ((tris, shading), (uvs, tangents)): MeshStructs,
+) {
+    let normal_mapped = !tangents.is_empty();
+    let textured = !uvs.is_empty();
+    let mut emitters = 0;
+    let corner = |a: &[Vec2], i: u32| a.get(i as usize).copied().unwrap_or(Vec2::ZERO);
+    for (k, &ti) in order.iter().enumerate() {
+        let idx = m.indices[ti as usize];
+        let material = m.materials[ti as usize];
+        let v = idx.map(|i| m.positions[i as usize]);
+        let mut light = -1i32;
+        if emits(m, ti, &v, materials) {
+            light = emitters;
+            emitters += 1;
+        }
+        let geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+        let smooth = !m.normals.is_empty();
+        let n = if smooth {
+            idx.map(|i| {
+                let n = m.normals[i as usize].normalize_or_zero();
+                if n == Vec3::ZERO { geometric } else { n }
+            })
+        } else {
+            [geometric; 3]
+        };
+        let t = WorldTriangle {
+            v,
+            n,
+            smooth,
+            uv: idx.map(|i| corner(&m.uvs, i)),
+            uv1: idx.map(|i| corner(&m.uvs1, i)),
+            tangents: m.tangents.get(ti as usize).copied(),
+            material,
+            object: 0,
+        };
+        let (tri, sh) = device_triangle(&t, light);
+        tris[k] = tri;
+        shading[k] = sh;
+        if textured {
+            uvs[k] = device_uvs(&t);
+        }
+        if normal_mapped {
+            tangents[k] = device_tangents(&t);
+        }
+    }
+}
+
+/// The flat form's device structs in object order, filled a list of [`WorldTriangle`]s at a
+/// time.
+pub(super) struct FlatStructs {
+    pub(super) triangles: Vec<GpuTriangle>,
+    pub(super) shading: Vec<GpuTriShading>,
+    /// Filled when some material samples a texture (`keep_uvs`).
+    pub(super) uvs: Vec<GpuTriUvs>,
+    /// Filled when tangents may be needed (`keep_tangents`).
+    pub(super) tangents: Vec<GpuTriTangents>,
+    pub(super) vertices: Vec<[Vec3; 3]>,
+    keep_uvs: bool,
+    keep_tangents: bool,
+    /// Whether some triangle added had tangents.
+    pub(super) mapped: bool,
+}
+
+impl FlatStructs {
+    pub(super) fn new(capacity: usize, keep_tangents: bool, keep_uvs: bool) -> Self {
+        let if_kept = |keep: bool| if keep { capacity } else { 0 };
+        Self {
+            triangles: Vec::with_capacity(capacity),
+            shading: Vec::with_capacity(capacity),
+            uvs: Vec::with_capacity(if_kept(keep_uvs)),
+            tangents: Vec::with_capacity(if_kept(keep_tangents)),
+            vertices: Vec::with_capacity(capacity),
+            keep_uvs,
+            keep_tangents,
+            mapped: false,
+        }
+    }
+
+    pub(super) fn add(&mut self, world: Vec<WorldTriangle>) {
+        use std::mem::take;
+        self.mapped |= world.iter().any(|t| t.tangents.is_some());
+        // Each triangle's structs made once, and unzipped into the lists in order.
+        let structs = world.par_iter().map(|t| device_triangle(t, -1));
+        let mut lists = (take(&mut self.triangles), take(&mut self.shading));
+        lists.par_extend(structs);
+        (self.triangles, self.shading) = lists;
+        if self.keep_uvs {
+            self.uvs.par_extend(world.par_iter().map(device_uvs));
+        }
+        if self.keep_tangents {
+            self.tangents
+                .par_extend(world.par_iter().map(device_tangents));
+        }
+        self.vertices.par_extend(world.par_iter().map(|t| t.v));
+    }
+}
+
+/// A triangle's vertices and corner normals on the device; `light` is its index among the
+/// emissive triangles (-1: none). A flat-shaded triangle's normals are zero (the kernels then
+/// take its geometric normal).
+fn device_triangle(t: &WorldTriangle, light: i32) -> (GpuTriangle, GpuTriShading) {
+    let n = if t.smooth {
+        t.n.map(|n| n.to_array())
+    } else {
+        [[0.0; 3]; 3]
+    };
+    (
+        GpuTriangle {
+            v0: f4(t.v[0], f32::from_bits(t.material)),
+            v1: f4(t.v[1], f32::from_bits(light as u32)),
+            v2: f4(t.v[2], f32::from_bits(t.object)),
+        },
+        GpuTriShading { n },
+    )
+}
+
+/// A triangle's texture coordinates on the device.
+fn device_uvs(t: &WorldTriangle) -> GpuTriUvs {
+    GpuTriUvs {
+        uv01: [t.uv[0].x, t.uv[0].y, t.uv[1].x, t.uv[1].y],
+        uv2: [t.uv[2].x, t.uv[2].y, t.uv1[0].x, t.uv1[0].y],
+        uv1_12: [t.uv1[1].x, t.uv1[1].y, t.uv1[2].x, t.uv1[2].y],
+    }
+}
+
+/// A triangle's tangents on the device (zero without).
+fn device_tangents(t: &WorldTriangle) -> GpuTriTangents {
+    let c = t.tangents.unwrap_or_default().map(|v| v.to_array());
+    GpuTriTangents {
+        t0: c[0],
+        t1: c[1],
+        t2: c[2],
+    }
+}
