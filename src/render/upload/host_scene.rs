@@ -305,7 +305,7 @@ impl HostScene {
     }
 
     /// Scales each emissive triangle's selection power by its material's factor in
-    /// `per_material` (see [`emissive_texture_means`]).
+    /// `per_material` (see `lights::emissive_texture_means`).
     pub fn scale_emitter_power(&mut self, per_material: &[f32]) {
         for e in &mut self.emissive {
             e.power *= per_material
@@ -316,7 +316,7 @@ impl HostScene {
     }
 
     /// The middle and the diagonal of the scene's robust box (a lone far-away object does not
-    /// count, see [`robust_bounds`]), in render space.
+    /// count, see [`crate::scene::robust_bounds`]), in render space.
     pub fn bounds(&self) -> (Vec3, f32) {
         self.middle
     }
