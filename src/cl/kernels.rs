@@ -872,7 +872,7 @@ impl Program {
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
-        // With lanes a work item takes a LANES_TILE-square of pixels (kernels/megakernel.cl).
+        // With lanes a work item takes a LANES_TILE-square of pixels (kernels/cpu/megakernel_lanes.cl).
         let items = if self.features.lanes {
             (frame.width as usize).div_ceil(LANES_TILE)
                 * (frame.height as usize).div_ceil(LANES_TILE)
@@ -912,7 +912,7 @@ impl Program {
     }
 
     /// `sample_texture_test` (test program): texture lookups; query .xy = uv, .z = footprint level (see
-    /// kernels/tests.cl), .w = texture reference (i32 bits). Zeros without `HAS_TEXTURES`.
+    /// kernels/test/tests.cl), .w = texture reference (i32 bits). Zeros without `HAS_TEXTURES`.
     pub fn sample_texture_test(
         &self,
         gpu: &Gpu,
@@ -1112,7 +1112,7 @@ unsafe fn set_geometry(e: &mut ExecuteKernel, nodes: opencl3::types::cl_mem, sce
 }
 
 /// Sets the seven surface arguments every traversing kernel takes after the triangles, in the
-/// order of `SceneSurfaces` (kernels/textures.h).
+/// order of `SceneSurfaces` (kernels/shared/textures.h).
 ///
 /// # Safety
 /// Only for kernels whose next seven parameters are exactly those.

@@ -5,6 +5,7 @@
 mod device;
 pub mod kernels;
 mod program;
+mod source;
 pub mod types;
 
 /// Serialises device opening and program builds within a process: PoCL (3.x, Debian 12) can

@@ -4,6 +4,18 @@
 //   - the wavefront (stages.cl) keeps the state in GpuPath slots between kernels and traces
 //     the light sample later in `connect`;
 //   - the megakernel (megakernel.cl) keeps it in registers and traces the light sample at once.
+#ifndef SHARED_PATH_H
+#define SHARED_PATH_H
+
+#include "shared/types.h"
+#include "shared/rng.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
+#include "shared/traverse_wide.h"
+#include "shared/bsdf.h"
+#include "shared/surface.h"
+#include "shared/env.h"
+#include "shared/lights.h"
 
 // Whether the uniform sky is black: an escaped ray then adds nothing.
 inline bool frame_sky_black(const GpuFrame* frame) {
@@ -434,3 +446,5 @@ DEFINE_SHADOW_TEST(shadow_pass_wide, global const GpuWideNode*, trace_scene_wide
 #ifdef SMALL_SCENE
 DEFINE_SHADOW_TEST(shadow_pass_small, local const SmallScene*, trace_small_scene)
 #endif
+
+#endif  // SHARED_PATH_H

@@ -1,6 +1,11 @@
 // Kernels only the tests use (built into the test program, src/cl/program.rs): the layout
 // probe, texture lookups and environment samples. kernels/bsdf_test.cl holds the BSDF ones.
 
+#include "shared/types.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
+#include "shared/env.h"
+
 // Writes, per shared struct, its size then each field's offset, in the order of
 // src/cl/types.rs::layouts().
 #define PROBE_SIZE(T) out[n++] = (uint)sizeof(T)

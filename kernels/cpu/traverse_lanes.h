@@ -15,6 +15,13 @@
 // go to intersect_leaf itself. Leaves are stack items, as in Embree's walk, tested once enough
 // lanes have reached one; a node's reached children are sorted by entry distance in every
 // lane, the nearest entered and the others pushed farthest first.
+#ifndef CPU_TRAVERSE_LANES_H
+#define CPU_TRAVERSE_LANES_H
+
+#include "shared/types.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
+#include "shared/traverse_wide.h"
 
 #ifdef MEGA_LANES
 // The lanes: sixteen, or eight where the CPU has AVX2 but not AVX-512 (-DLANES=16 or 8 chooses):
@@ -1254,3 +1261,5 @@ LANES_INLINE lanes_i lanes_walk_small(LaneMemory* M, global const GpuWideNode* n
 #endif
 
 #endif  // MEGA_LANES
+
+#endif  // CPU_TRAVERSE_LANES_H

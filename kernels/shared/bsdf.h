@@ -42,6 +42,11 @@
 // it makes none; for a delta lobe it sets *specular and returns the lobe's weight divided by its
 // selection probability, which is then the pdf. Reflection is reciprocal; refraction carries
 // radiance (wo is the side the path came from, towards the camera).
+#ifndef SHARED_BSDF_H
+#define SHARED_BSDF_H
+
+#include "shared/types.h"
+#include "shared/rng.h"
 
 // The functions shading calls at every vertex (shade_vertex in path.h, sample_light in
 // lights.h, bsdf_sample here) are inlined into their callers in the CPU megakernel with lanes
@@ -2400,3 +2405,5 @@ SHADE_INLINE float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_wo
     return f / *pdf;
 }
 #endif  // LAMBERT_ONLY
+
+#endif  // SHARED_BSDF_H
