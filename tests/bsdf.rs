@@ -1286,9 +1286,12 @@ fn energy_table_row(r: usize) -> (Vec<f64>, Vec<f64>, f64, f64) {
     (e, es, avg, avg_s)
 }
 
-/// A table of kernels/shared/bsdf.h by its name.
+/// A table of kernels/shared/bsdf_tables.h by its name.
 fn kernel_table(name: &str) -> Vec<f64> {
-    let src = include_str!("../kernels/shared/bsdf.h");
+    // Read when the test runs, so that scripts/bsdf_tables.sh, which runs this file's print_*
+    // tests, can write the header even when it is missing or stale.
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/kernels/shared/bsdf_tables.h");
+    let src = std::fs::read_to_string(path).expect(path);
     let key = format!("{name}[");
     let start = src.find(&key).expect("the table");
     let start = start + src[start..].find('{').unwrap() + 1;
@@ -1381,7 +1384,7 @@ fn ggx_energy_tables_match_monte_carlo() {
     assert!(e[..33].iter().all(|&v| v == 1.0) && avg[0] == 1.0);
 }
 
-/// Prints the tables for kernels/shared/bsdf.h: `cargo test --release --test bsdf -- --ignored --nocapture`.
+/// Prints the tables for kernels/shared/bsdf_tables.h (scripts/bsdf_tables.sh writes the file).
 #[test]
 #[ignore]
 fn print_energy_tables() {
@@ -1395,7 +1398,7 @@ fn print_energy_tables() {
     print_table("GGX_E_SCHLICK_AVG", rows.iter().map(|r| r.3).collect());
 }
 
-/// Prints a table as kernels/shared/bsdf.h declares it.
+/// Prints a table as kernels/shared/bsdf_tables.h declares it.
 fn print_table(name: &str, values: Vec<f64>) {
     println!("constant float {name}[{}] = {{", values.len());
     for line in values.chunks(11) {
@@ -1595,8 +1598,7 @@ fn aniso_tables() -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     (e, es, avg, avg_s)
 }
 
-/// Prints the anisotropic tables for kernels/shared/bsdf.h:
-/// `cargo test --release --test bsdf print_aniso_tables -- --ignored --nocapture`.
+/// Prints the anisotropic tables for kernels/shared/bsdf_tables.h (scripts/bsdf_tables.sh).
 #[test]
 #[ignore]
 fn print_aniso_tables() {
@@ -1833,8 +1835,7 @@ fn sheen_tables() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     (charlie, bounded, avg)
 }
 
-/// Prints the sheen tables for kernels/shared/bsdf.h:
-/// `cargo test --release --test bsdf print_sheen_tables -- --ignored --nocapture`.
+/// Prints the sheen tables for kernels/shared/bsdf_tables.h (scripts/bsdf_tables.sh).
 #[test]
 #[ignore]
 fn print_sheen_tables() {

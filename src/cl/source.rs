@@ -48,6 +48,10 @@ const KERNELS: &[(&str, &str)] = &[
         include_str!("../../kernels/shared/bsdf.h"),
     ),
     (
+        "kernels/shared/bsdf_tables.h",
+        include_str!("../../kernels/shared/bsdf_tables.h"),
+    ),
+    (
         "kernels/shared/surface.h",
         include_str!("../../kernels/shared/surface.h"),
     ),
@@ -180,8 +184,30 @@ impl Expander<'_> {
         })?;
         self.included.push(name.clone());
         self.out.push_str(&format!("#line 1 \"{name}\"\n"));
+        // How deep in #if blocks each line is, and how deep an include may be: a header's guard
+        // (its first directive, an #ifndef) is the one block around it allowed.
+        let mut depth = 0usize;
+        let mut guarded = None;
         for (i, line) in text.lines().enumerate() {
+            match directive(line) {
+                Some(d @ ("if" | "ifdef" | "ifndef")) => {
+                    guarded.get_or_insert(name.ends_with(".h") && d == "ifndef");
+                    depth += 1;
+                }
+                Some("endif") => depth = depth.saturating_sub(1),
+                Some(_) => {
+                    guarded.get_or_insert(false);
+                }
+                None => {}
+            }
             match included_path(line) {
+                Some(_) if depth > usize::from(guarded == Some(true)) => {
+                    return Err(format!(
+                        "{name}:{}: error: an #include under a condition (a file is expanded \
+                         once, where it is first included)",
+                        i + 1
+                    ));
+                }
                 Some(path) => {
                     let before = self.out.len();
                     self.include(path, Some((&name, i + 1)))?;
@@ -218,6 +244,12 @@ impl Expander<'_> {
         let text = KERNELS.iter().find(|(n, _)| *n == name)?.1;
         Some(text.to_string())
     }
+}
+
+/// The directive of a preprocessor line (`ifdef` of `#ifdef X`).
+fn directive(line: &str) -> Option<&str> {
+    let rest = line.trim_start().strip_prefix('#')?.trim_start();
+    rest.split(|c: char| !c.is_ascii_alphabetic()).next()
 }
 
 /// The path of an `#include "path"` line.
@@ -294,6 +326,50 @@ mod tests {
             err,
             "kernels/root.cl:2: error: cannot find \"shared/nowhere.h\""
         );
+    }
+
+    #[test]
+    fn an_include_under_a_condition_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let kernels = dir.path().join("kernels");
+        std::fs::create_dir_all(&kernels).unwrap();
+        std::fs::write(kernels.join("a.h"), "#define A 1\n").unwrap();
+        let guarded = "#ifndef B_H\n#define B_H\n#include \"a.h\"\n#endif\n";
+        std::fs::write(kernels.join("b.h"), guarded).unwrap();
+        assert!(
+            expand("b.h", Some(dir.path())).is_ok(),
+            "a guard is no condition"
+        );
+        std::fs::write(
+            kernels.join("root.cl"),
+            "#ifdef X\n#include \"a.h\"\n#endif\n",
+        )
+        .unwrap();
+        let err = expand("root.cl", Some(dir.path())).unwrap_err();
+        assert!(err.starts_with("kernels/root.cl:2: error:"), "{err}");
+    }
+
+    #[test]
+    fn a_build_error_names_the_included_file_and_line() {
+        let gpu =
+            crate::cl::Gpu::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
+        let dir = tempfile::tempdir().unwrap();
+        let kernels = dir.path().join("kernels");
+        std::fs::create_dir_all(&kernels).unwrap();
+        let root = "// root\n#include \"a.h\"\nkernel void f(global int* x) { x[0] = A; }\n";
+        std::fs::write(kernels.join("root.cl"), root).unwrap();
+        let error = |a_h: &str| {
+            std::fs::write(kernels.join("a.h"), a_h).unwrap();
+            let (source, _) = expand("root.cl", Some(dir.path())).unwrap();
+            let features = super::super::KernelFeatures::default();
+            super::super::program::build_source(&gpu, &source, features)
+                .expect_err("the source does not compile")
+                .to_string()
+        };
+        let err = error("#define A 1\nint g(void) { return undeclared; }\n");
+        assert!(err.contains("kernels/a.h:2"), "{err}");
+        let err = error("#define B 1\n");
+        assert!(err.contains("kernels/root.cl:3"), "{err}");
     }
 
     #[test]
