@@ -263,13 +263,20 @@ fn included_path(line: &str) -> Option<&str> {
 mod tests {
     use super::*;
 
+    /// A folder holding `files` under kernels/, as PENUMBRA_KERNEL_DIR would name it.
+    fn kernel_dir(files: &[(&str, &str)]) -> tempfile::TempDir {
+        let dir = tempfile::tempdir().unwrap();
+        for (name, text) in files {
+            let path = dir.path().join("kernels").join(name);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, text).unwrap();
+        }
+        dir
+    }
+
     #[test]
     fn a_kernel_folder_replaces_only_the_files_it_holds() {
-        let dir = tempfile::tempdir().unwrap();
-        let name = "kernels/shared/rng.h";
-        let path = dir.path().join(name);
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, "// edited\n").unwrap();
+        let dir = kernel_dir(&[("shared/rng.h", "// edited\n")]);
         let (s, found) = expand(PROGRAM_ROOT, Some(dir.path())).unwrap();
         assert_eq!(found, 1);
         assert!(s.contains("// edited"));
@@ -297,15 +304,8 @@ mod tests {
 
     #[test]
     fn an_inclusion_is_followed_by_the_includer_s_next_line() {
-        let dir = tempfile::tempdir().unwrap();
-        let kernels = dir.path().join("kernels");
-        std::fs::create_dir_all(&kernels).unwrap();
-        std::fs::write(
-            kernels.join("root.cl"),
-            "// root\n#include \"a.h\"\n#include \"a.h\"\nkernel void f() {}\n",
-        )
-        .unwrap();
-        std::fs::write(kernels.join("a.h"), "#define A 1\n").unwrap();
+        let root = "// root\n#include \"a.h\"\n#include \"a.h\"\nkernel void f() {}\n";
+        let dir = kernel_dir(&[("root.cl", root), ("a.h", "#define A 1\n")]);
         let (s, _) = expand("root.cl", Some(dir.path())).unwrap();
         assert_eq!(
             s,
@@ -317,10 +317,7 @@ mod tests {
 
     #[test]
     fn a_missing_include_names_the_including_file_and_line() {
-        let dir = tempfile::tempdir().unwrap();
-        let kernels = dir.path().join("kernels");
-        std::fs::create_dir_all(&kernels).unwrap();
-        std::fs::write(kernels.join("root.cl"), "\n#include \"shared/nowhere.h\"\n").unwrap();
+        let dir = kernel_dir(&[("root.cl", "\n#include \"shared/nowhere.h\"\n")]);
         let err = expand("root.cl", Some(dir.path())).unwrap_err();
         assert_eq!(
             err,
@@ -330,21 +327,18 @@ mod tests {
 
     #[test]
     fn an_include_under_a_condition_is_an_error() {
-        let dir = tempfile::tempdir().unwrap();
-        let kernels = dir.path().join("kernels");
-        std::fs::create_dir_all(&kernels).unwrap();
-        std::fs::write(kernels.join("a.h"), "#define A 1\n").unwrap();
-        let guarded = "#ifndef B_H\n#define B_H\n#include \"a.h\"\n#endif\n";
-        std::fs::write(kernels.join("b.h"), guarded).unwrap();
+        let dir = kernel_dir(&[
+            ("a.h", "#define A 1\n"),
+            (
+                "b.h",
+                "#ifndef B_H\n#define B_H\n#include \"a.h\"\n#endif\n",
+            ),
+            ("root.cl", "#ifdef X\n#include \"a.h\"\n#endif\n"),
+        ]);
         assert!(
             expand("b.h", Some(dir.path())).is_ok(),
             "a guard is no condition"
         );
-        std::fs::write(
-            kernels.join("root.cl"),
-            "#ifdef X\n#include \"a.h\"\n#endif\n",
-        )
-        .unwrap();
         let err = expand("root.cl", Some(dir.path())).unwrap_err();
         assert!(err.starts_with("kernels/root.cl:2: error:"), "{err}");
     }
@@ -353,13 +347,10 @@ mod tests {
     fn a_build_error_names_the_included_file_and_line() {
         let gpu =
             crate::cl::Gpu::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
-        let dir = tempfile::tempdir().unwrap();
-        let kernels = dir.path().join("kernels");
-        std::fs::create_dir_all(&kernels).unwrap();
         let root = "// root\n#include \"a.h\"\nkernel void f(global int* x) { x[0] = A; }\n";
-        std::fs::write(kernels.join("root.cl"), root).unwrap();
+        let dir = kernel_dir(&[("root.cl", root)]);
         let error = |a_h: &str| {
-            std::fs::write(kernels.join("a.h"), a_h).unwrap();
+            std::fs::write(dir.path().join("kernels/a.h"), a_h).unwrap();
             let (source, _) = expand("root.cl", Some(dir.path())).unwrap();
             let features = super::super::KernelFeatures::default();
             super::super::program::build_source(&gpu, &source, features)
