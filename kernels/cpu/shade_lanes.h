@@ -1,4 +1,4 @@
-// Path vertices shaded LANES at a time, for the CPU megakernel's lanes (megakernel.cl): the
+// Path vertices shaded LANES at a time, for the CPU megakernel's lanes (megakernel_lanes.cl): the
 // vertices that the lanes' extension rays found wait in a batch, and a full batch is shaded in
 // vectors, one vertex a lane, instead of one shade_vertex call after another. A scalar vertex
 // costs about 700 instructions; the same work in eight- or sixteen-wide vectors is a fraction of

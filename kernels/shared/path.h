@@ -1,9 +1,10 @@
 // One path vertex at a time: the camera ray, and the shading of the vertex a ray found
 // (emission with MIS, one light sample, the BSDF sample and Russian roulette). Both execution
 // shapes call these, so they compute the same estimator with the same random numbers:
-//   - the wavefront (stages.cl) keeps the state in GpuPath slots between kernels and traces
+//   - the wavefront (gpu/stages.cl) keeps the state in GpuPath slots between kernels and traces
 //     the light sample later in `connect`;
-//   - the megakernel (megakernel.cl) keeps it in registers and traces the light sample at once.
+//   - the megakernels (cpu/megakernel.cl, cpu/megakernel_lanes.cl) keep it in registers and
+//     trace the light sample at once.
 #ifndef SHARED_PATH_H
 #define SHARED_PATH_H
 

@@ -1,5 +1,5 @@
 // Kernels only the tests use (built into the test program, src/cl/program.rs): the layout
-// probe, texture lookups and environment samples. kernels/bsdf_test.cl holds the BSDF ones.
+// probe, texture lookups and environment samples. kernels/test/bsdf_test.cl holds the BSDF ones.
 
 #include "shared/types.h"
 #include "shared/textures.h"
