@@ -1,5 +1,10 @@
 // Traversal alone, for `bench trace` and the device agreement tests.
 
+#include "shared/types.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
+#include "shared/traverse_wide.h"
+
 // Closest hits and occlusion of arbitrary rays through the binary BVH (traverse.h) and the
 // 4-wide one (traverse_wide.h); one definition for both.
 #define TRACE_KERNELS(SUFFIX, NODE, TRAVERSE)                                                   \

@@ -1,5 +1,5 @@
-//! The scattering model (kernels/bsdf.h) on the test device (PoCL in CI), through the test
-//! kernels of kernels/bsdf_test.cl and through whole renders:
+//! The scattering model (kernels/shared/bsdf.h) on the test device (PoCL in CI), through the test
+//! kernels of kernels/test/bsdf_test.cl and through whole renders:
 //! - χ² goodness of fit of every sampling routine against its pdf (pbrt and Mitsuba style:
 //!   directions binned on a sphere grid, expected counts by integrating the pdf, low bins
 //!   pooled, Šidák-corrected significance), with the sampled pdf and weight checked per sample;
@@ -784,7 +784,7 @@ fn sampling_matches_pdf_chi_square() {
 // ---------------------------------------------------------------------------------------------
 // Exact properties
 
-/// INV_PI_F of kernels/rng.h.
+/// INV_PI_F of kernels/shared/rng.h.
 const INV_PI_F: f32 = std::f32::consts::FRAC_1_PI;
 
 /// Scenes whose materials are all Lambertian build the BSDF as base color / pi (LAMBERT_ONLY):
@@ -1286,9 +1286,12 @@ fn energy_table_row(r: usize) -> (Vec<f64>, Vec<f64>, f64, f64) {
     (e, es, avg, avg_s)
 }
 
-/// A table of kernels/bsdf.h by its name.
+/// A table of kernels/shared/bsdf_tables.h by its name.
 fn kernel_table(name: &str) -> Vec<f64> {
-    let src = include_str!("../kernels/bsdf.h");
+    // Read when the test runs, so that scripts/bsdf_tables.sh, which runs this file's print_*
+    // tests, can write the header even when it is missing or stale.
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/kernels/shared/bsdf_tables.h");
+    let src = std::fs::read_to_string(path).expect(path);
     let key = format!("{name}[");
     let start = src.find(&key).expect("the table");
     let start = start + src[start..].find('{').unwrap() + 1;
@@ -1381,7 +1384,7 @@ fn ggx_energy_tables_match_monte_carlo() {
     assert!(e[..33].iter().all(|&v| v == 1.0) && avg[0] == 1.0);
 }
 
-/// Prints the tables for kernels/bsdf.h: `cargo test --release --test bsdf -- --ignored --nocapture`.
+/// Prints the tables for kernels/shared/bsdf_tables.h (scripts/bsdf_tables.sh writes the file).
 #[test]
 #[ignore]
 fn print_energy_tables() {
@@ -1395,7 +1398,7 @@ fn print_energy_tables() {
     print_table("GGX_E_SCHLICK_AVG", rows.iter().map(|r| r.3).collect());
 }
 
-/// Prints a table as kernels/bsdf.h declares it.
+/// Prints a table as kernels/shared/bsdf_tables.h declares it.
 fn print_table(name: &str, values: Vec<f64>) {
     println!("constant float {name}[{}] = {{", values.len());
     for line in values.chunks(11) {
@@ -1418,7 +1421,7 @@ const ANISO_R: usize = 9;
 const ANISO_U: usize = 5;
 
 /// The lobe's (alpha_x, alpha_y) at base perceptual roughness r and stretch u (both alphas at
-/// least 1e-3, as kernels/bsdf.h clamps them).
+/// least 1e-3, as kernels/shared/bsdf.h clamps them).
 fn aniso_alphas(r: f64, u: f64) -> (f64, f64) {
     let rx = r + u * (1.0 - r);
     ((rx * rx).max(1e-3), (r * r).max(1e-3))
@@ -1595,8 +1598,7 @@ fn aniso_tables() -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     (e, es, avg, avg_s)
 }
 
-/// Prints the anisotropic tables for kernels/bsdf.h:
-/// `cargo test --release --test bsdf print_aniso_tables -- --ignored --nocapture`.
+/// Prints the anisotropic tables for kernels/shared/bsdf_tables.h (scripts/bsdf_tables.sh).
 #[test]
 #[ignore]
 fn print_aniso_tables() {
@@ -1717,7 +1719,7 @@ fn aniso_energy_tables_match_monte_carlo() {
 // ---------------------------------------------------------------------------------------------
 // Sheen (KHR_materials_sheen): the Charlie distribution's albedo table
 
-/// Charlie sheen: D(h) for cos(theta_h) = `cos_h` and alpha = roughness², as kernels/bsdf.h.
+/// Charlie sheen: D(h) for cos(theta_h) = `cos_h` and alpha = roughness², as kernels/shared/bsdf.h.
 fn charlie_d(cos_h: f64, alpha: f64) -> f64 {
     let inv = 1.0 / alpha;
     let sin2 = (1.0 - cos_h * cos_h).max(0.0);
@@ -1758,7 +1760,7 @@ fn sheen_f_cos(wo: V, wi: V, roughness: f64) -> f64 {
 }
 
 /// A sheen table (rows roughness 0, 1/32 .. 1, columns cos (0/32)², (1/32)² .. 1) at
-/// (mu, roughness), bilinear in (sqrt(mu), roughness) as kernels/bsdf.h reads it.
+/// (mu, roughness), bilinear in (sqrt(mu), roughness) as kernels/shared/bsdf.h reads it.
 fn table_at(table: &[f64], mu: f64, roughness: f64) -> f64 {
     let x = mu.clamp(0.0, 1.0).sqrt() * 32.0;
     let y = roughness.clamp(0.0, 1.0) * 32.0;
@@ -1833,8 +1835,7 @@ fn sheen_tables() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     (charlie, bounded, avg)
 }
 
-/// Prints the sheen tables for kernels/bsdf.h:
-/// `cargo test --release --test bsdf print_sheen_tables -- --ignored --nocapture`.
+/// Prints the sheen tables for kernels/shared/bsdf_tables.h (scripts/bsdf_tables.sh).
 #[test]
 #[ignore]
 fn print_sheen_tables() {

@@ -461,8 +461,8 @@ fn lanes_image_args<'a>(spp: &'a str, bounces: &'a str) -> Vec<&'a str> {
 fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
     // On a CPU with AVX-512 or AVX2 the megakernel starts sixteen paths at a time (a pixel's samples,
     // or a few pixels' below sixteen), their camera rays and first light samples walked as
-    // packets (kernels/traverse_packet.h), and walks the later extension rays sixteen at a
-    // time in vector lanes (kernels/traverse_lanes.h), a work item taking 256 pixels: the same
+    // packets (kernels/cpu/traverse_packet.h), and walks the later extension rays sixteen at a
+    // time in vector lanes (kernels/cpu/traverse_lanes.h), a work item taking 256 pixels: the same
     // hits, the same samples added in the same order, so the image is the one-ray-at-a-time
     // kernel's bit for bit (but for rays that meet two triangles at exactly the same distance,
     // of which each walk may keep another). A sphere of 34,816 triangles (lanes are for scenes
@@ -471,7 +471,7 @@ fn rays_in_lanes_make_the_image_of_one_ray_at_a_time() {
     // by the default light rig, and by an emissive panel (light samples that end on a
     // triangle, walked in lanes as any-hit rays, and extension rays that find the light).
     // Every material is Lambertian, so under the panel the lanes shade their vertices in
-    // batches, in vectors (kernels/shade_lanes.h), and with PENUMBRA_LANES_SHADE=0 one by one:
+    // batches, in vectors (kernels/cpu/shade_lanes.h), and with PENUMBRA_LANES_SHADE=0 one by one:
     // the same image both ways; with the background cut out too (camera rays that escape are
     // marked, not lit), and under a sky with light sampling alone (escapes lit by the sky, the
     // last rays traced).

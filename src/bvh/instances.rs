@@ -8,7 +8,7 @@
 //! spawned off a surface cannot find that surface again in object space.
 //!
 //! This is also the host reference of the device's two-level traversal
-//! (`traverse_two_level` in kernels/traverse.h): the transform and its error bound are computed
+//! (`traverse_two_level` in kernels/shared/traverse.h): the transform and its error bound are computed
 //! here with the kernels' f32 operations in the kernels' order. Hits name the object-space
 //! triangle (meshes one after the other, each in its BLAS's order) and the instance, as the
 //! device reports them: the device keeps each mesh's triangles and shading data once, in

@@ -104,7 +104,7 @@ fn intersect_sheared(ray: &Ray, sh: &Shear, tri: &[Vec3; 3]) -> Option<(f32, f32
         return None;
     }
     // pbrt-v4's conservative bound on t's rounding error (as `triangle_t_error` in
-    // kernels/traverse.h): a hit closer than its own error could lie behind the origin.
+    // kernels/shared/traverse.h): a hit closer than its own error could lie behind the origin.
     let t_error = {
         let gamma = |n: f32| (n * 5.960_464_5e-8) / (1.0 - n * 5.960_464_5e-8);
         let max_z = az.abs().max(bz.abs()).max(cz.abs());

@@ -1,7 +1,7 @@
 //! The 4-wide BVH for SIMD traversal on CPU devices: the binary BVH collapsed so that each node
 //! holds up to four children whose boxes are laid out by coordinate (structure of arrays), one
 //! `float4` per box plane, so a kernel tests a ray against all four boxes with a few vector
-//! operations (kernels/traverse_wide.h). The boxes and leaves are the binary BVH's own, so the
+//! operations (kernels/shared/traverse_wide.h). The boxes and leaves are the binary BVH's own, so the
 //! same triangles are found; only the order of the tests changes.
 
 use super::traverse::{box_entry, safe_inverse};
@@ -165,7 +165,7 @@ impl WideBvh {
     }
 
     /// The closest hit along `ray` among `tris` (in BVH order), visiting children nearest
-    /// first as the kernels do: the host reference of kernels/traverse_wide.h.
+    /// first as the kernels do: the host reference of kernels/shared/traverse_wide.h.
     pub fn intersect(&self, ray: &Ray, tris: &[[Vec3; 3]]) -> Option<Hit> {
         let inv = safe_inverse(ray.direction);
         let mut tmax = ray.tmax;

@@ -411,7 +411,7 @@ impl Program {
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
-        // With lanes a work item takes a LANES_TILE-square of pixels (kernels/megakernel.cl).
+        // With lanes a work item takes a LANES_TILE-square of pixels (kernels/cpu/megakernel_lanes.cl).
         let items = if self.features.lanes {
             (frame.width as usize).div_ceil(LANES_TILE)
                 * (frame.height as usize).div_ceil(LANES_TILE)
@@ -468,7 +468,7 @@ unsafe fn set_geometry(e: &mut ExecuteKernel, nodes: opencl3::types::cl_mem, sce
 }
 
 /// Sets the seven surface arguments every traversing kernel takes after the triangles, in the
-/// order of `SceneSurfaces` (kernels/textures.h).
+/// order of `SceneSurfaces` (kernels/shared/textures.h).
 ///
 /// # Safety
 /// Only for kernels whose next seven parameters are exactly those.

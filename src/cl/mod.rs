@@ -11,6 +11,7 @@ mod host_memory;
 pub mod kernels;
 mod program;
 mod scene_buffers;
+mod source;
 mod stage;
 pub mod types;
 

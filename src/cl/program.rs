@@ -1,57 +1,7 @@
-//! Kernel sources (embedded at compile time) and their run-time build with feature defines.
+//! The kernels' build at run time with the scene's feature defines (their source: `source.rs`).
 
 use super::{ClError, Gpu};
 use opencl3::device::CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT;
-
-/// Kernel sources in the order they are concatenated; headers first.
-const SOURCES: &[(&str, &str)] = &[
-    ("kernels/types.h", include_str!("../../kernels/types.h")),
-    ("kernels/rng.h", include_str!("../../kernels/rng.h")),
-    (
-        "kernels/textures.h",
-        include_str!("../../kernels/textures.h"),
-    ),
-    (
-        "kernels/traverse.h",
-        include_str!("../../kernels/traverse.h"),
-    ),
-    (
-        "kernels/traverse_wide.h",
-        include_str!("../../kernels/traverse_wide.h"),
-    ),
-    (
-        "kernels/traverse_lanes.h",
-        include_str!("../../kernels/traverse_lanes.h"),
-    ),
-    (
-        "kernels/traverse_packet.h",
-        include_str!("../../kernels/traverse_packet.h"),
-    ),
-    ("kernels/bsdf.h", include_str!("../../kernels/bsdf.h")),
-    ("kernels/surface.h", include_str!("../../kernels/surface.h")),
-    ("kernels/env.h", include_str!("../../kernels/env.h")),
-    ("kernels/lights.h", include_str!("../../kernels/lights.h")),
-    ("kernels/path.h", include_str!("../../kernels/path.h")),
-    (
-        "kernels/shade_lanes.h",
-        include_str!("../../kernels/shade_lanes.h"),
-    ),
-    ("kernels/stages.cl", include_str!("../../kernels/stages.cl")),
-    (
-        "kernels/megakernel.cl",
-        include_str!("../../kernels/megakernel.cl"),
-    ),
-    ("kernels/tools.cl", include_str!("../../kernels/tools.cl")),
-];
-
-/// Kernels only the tests use; [`build_test_program`] adds them after [`SOURCES`].
-const TEST_SOURCES: &[(&str, &str)] = &[
-    ("kernels/tests.cl", include_str!("../../kernels/tests.cl")),
-    (
-        "kernels/bsdf_test.cl",
-        include_str!("../../kernels/bsdf_test.cl"),
-    ),
-];
 
 /// The scene features that decide which kernel code is compiled in.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -99,21 +49,21 @@ pub struct KernelFeatures {
     /// (`HAS_TRIANGLE_PIECES`, with `TWO_LEVEL`).
     pub triangle_pieces: bool,
     /// The scene's triangles rounded up to a multiple of 16 when the megakernel tests them all
-    /// for every ray instead of walking the BVH (`SMALL_SCENE`, kernels/traverse_wide.h; the
+    /// for every ray instead of walking the BVH (`SMALL_SCENE`, kernels/shared/traverse_wide.h; the
     /// count itself comes with each frame); 0 otherwise. This and the lanes' fields below are
     /// the CPU strategy, decided by [`crate::render::strategy::kernel_strategy`].
     pub small_scene: u32,
     /// The megakernel walks sixteen paths' rays together in vector lanes (`MEGA_LANES`,
-    /// kernels/traverse_lanes.h).
+    /// kernels/cpu/traverse_lanes.h).
     pub lanes: bool,
     /// The megakernel's lanes shade their paths' vertices in batches, in vectors
-    /// (`LANES_SHADE`, kernels/shade_lanes.h).
+    /// (`LANES_SHADE`, kernels/cpu/shade_lanes.h).
     pub lanes_shade: bool,
     /// The megakernel's lanes test every triangle of a small scene instead of walking the tree
-    /// (`LANES_SMALL`, kernels/traverse_lanes.h; the count comes with each frame).
+    /// (`LANES_SMALL`, kernels/cpu/traverse_lanes.h; the count comes with each frame).
     pub lanes_small: bool,
     /// The lanes load their nodes and triangles by gathers (`LANES_GATHERS`,
-    /// kernels/traverse_lanes.h) rather than as rows transposed by shuffles.
+    /// kernels/cpu/traverse_lanes.h) rather than as rows transposed by shuffles.
     pub lanes_gathers: bool,
 }
 
@@ -159,80 +109,13 @@ impl KernelFeatures {
     }
 }
 
-/// The name the generated constants header goes by in compiler messages.
-const DEFINES_NAME: &str = "generated/constants.h";
-
-/// The full program source: the constants shared with the host (generated from
-/// `cl/types.rs`), then every file, each behind a `#line` directive so the compiler's messages
-/// name the file and line.
-pub fn program_source() -> String {
-    let mut s = format!(
-        "#line 1 \"{DEFINES_NAME}\"\n{}",
-        super::types::kernel_defines()
-    );
-
-    append_sources(&mut s, SOURCES);
-    s
-}
-
-/// [`program_source`] followed by the test-only kernels.
-pub fn test_program_source() -> String {
-    let mut s = program_source();
-    append_sources(&mut s, TEST_SOURCES);
-    s
-}
-
-/// Appends each source behind its `#line` directive. With `PENUMBRA_KERNEL_DIR` set (for
-/// working on the kernels without rebuilding the binary), a file of that name found under
-/// the directory (e.g. `PENUMBRA_KERNEL_DIR=.` for `kernels/path.h`) replaces the built-in text.
-fn append_sources(s: &mut String, sources: &[(&str, &str)]) {
-    let dir = std::env::var_os("PENUMBRA_KERNEL_DIR").map(std::path::PathBuf::from);
-    let found = with_overrides(s, sources, dir.as_deref());
-    if let Some(dir) = dir.filter(|_| found == 0) {
-        // Without this, an experiment run with the wrong folder silently measures the
-        // built-in kernels (the names carry their `kernels/` folder).
-        static WARNED: std::sync::Once = std::sync::Once::new();
-        WARNED.call_once(|| {
-            log::warn!(
-                "PENUMBRA_KERNEL_DIR={}: no kernel file there (it must hold kernels/{}); \
-                 the built-in kernels are used",
-                dir.display(),
-                sources.first().map_or("", |(name, _)| {
-                    name.strip_prefix("kernels/").unwrap_or(name)
-                })
-            )
-        });
-    }
-}
-
-/// [`append_sources`] with the override folder given: returns how many files it replaced.
-fn with_overrides(
-    s: &mut String,
-    sources: &[(&str, &str)],
-    dir: Option<&std::path::Path>,
-) -> usize {
-    let mut found = 0;
-    for (name, text) in sources {
-        s.push_str(&format!("#line 1 \"{name}\"\n"));
-        match dir.and_then(|d| std::fs::read_to_string(d.join(name)).ok()) {
-            Some(edited) => {
-                found += 1;
-                s.push_str(&edited);
-            }
-            None => s.push_str(text),
-        }
-        s.push('\n');
-    }
-    found
-}
-
 /// Builds the program for `features` on the device. A failure returns the compiler's first
 /// error line, which names the kernel file and line.
 pub fn build_program(
     gpu: &Gpu,
     features: KernelFeatures,
 ) -> Result<opencl3::program::Program, ClError> {
-    build_source(gpu, &program_source(), features)
+    build_source(gpu, &super::source::program_source()?, features)
 }
 
 /// Builds the production kernels together with the test-only ones (layout probe, texture,
@@ -241,7 +124,7 @@ pub fn build_test_program(
     gpu: &Gpu,
     features: KernelFeatures,
 ) -> Result<opencl3::program::Program, ClError> {
-    build_source(gpu, &test_program_source(), features)
+    build_source(gpu, &super::source::test_program_source()?, features)
 }
 
 pub(crate) fn build_source(
@@ -267,7 +150,7 @@ pub(crate) fn build_source(
     if gpu.is_cpu() {
         options.push_str(" -cl-denorms-are-zero");
     } else {
-        // The watertight test's axis permutation by selects, not shuffle() (kernels/traverse.h,
+        // The watertight test's axis permutation by selects, not shuffle() (kernels/shared/traverse.h,
         // `ray_permute`): faster on an H200, while a CPU does a shuffle in one instruction.
         options.push_str(" -DPERMUTE_BY_SELECT");
     }
@@ -341,69 +224,6 @@ mod tests {
     }
 
     #[test]
-    fn a_kernel_folder_replaces_only_the_files_it_holds() {
-        let dir = tempfile::tempdir().unwrap();
-        let (name, _) = SOURCES[1];
-        let path = dir.path().join(name);
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, "// edited\n").unwrap();
-        let mut s = String::new();
-        assert_eq!(with_overrides(&mut s, SOURCES, Some(dir.path())), 1);
-        assert!(s.contains("// edited"));
-        assert!(s.contains(SOURCES[0].1), "the other files stay built in");
-        assert!(!s.contains(SOURCES[1].1));
-        // The files themselves, without their kernels/ folder, are not found.
-        let flat = tempfile::tempdir().unwrap();
-        std::fs::write(
-            flat.path()
-                .join(std::path::Path::new(name).file_name().unwrap()),
-            "x",
-        )
-        .unwrap();
-        assert_eq!(
-            with_overrides(&mut String::new(), SOURCES, Some(flat.path())),
-            0
-        );
-        assert_eq!(with_overrides(&mut String::new(), SOURCES, None), 0);
-    }
-
-    #[test]
-    fn every_source_is_marked_with_its_file() {
-        let s = test_program_source();
-        for (name, _) in SOURCES.iter().chain(TEST_SOURCES) {
-            assert!(s.contains(&format!("#line 1 \"{name}\"")), "{name}");
-        }
-    }
-
-    #[test]
-    fn the_production_program_has_no_test_kernels() {
-        let s = program_source();
-        for (name, _) in TEST_SOURCES {
-            assert!(!s.contains(name), "{name}");
-        }
-        assert!(!s.contains("probe_layout") && !s.contains("_test("));
-        assert!(
-            s.contains("kernel void trace_closest"),
-            "bench trace uses it"
-        );
-    }
-
-    #[test]
-    fn the_shared_constants_are_generated_once_before_the_kernels() {
-        let s = program_source();
-        let defines = s.find(DEFINES_NAME).expect("the generated header");
-        assert!(defines < s.find("kernels/types.h").unwrap());
-        assert!(s.contains("#define LIGHT_ENVIRONMENT 4u\n"), "{s:.2000}");
-        assert!(s.contains("#define WRAP_MIRROR 2\n"));
-        assert!(s.contains("#define COUNT_OVERFLOW 4\n"));
-        for line in super::super::types::kernel_defines().lines() {
-            let name = line.split_whitespace().nth(1).unwrap();
-            let written = format!("#define {name} ");
-            assert_eq!(s.matches(&written).count(), 1, "{name} is defined once");
-        }
-    }
-
-    #[test]
     fn a_build_error_names_the_kernel_file_and_line() {
         let gpu = Gpu::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
         let source = "#line 1 \"kernels/broken.cl\"\nkernel void f(global int* x) {\n  x[0] = undeclared;\n}\n";
@@ -416,10 +236,10 @@ mod tests {
 
     #[test]
     fn first_error_picks_the_error_line() {
-        let log = "warning: x\nkernels/stages.cl:12:5: error: use of undeclared identifier\n";
+        let log = "warning: x\nkernels/gpu/stages.cl:12:5: error: use of undeclared identifier\n";
         assert_eq!(
             first_error(log),
-            "kernels/stages.cl:12:5: error: use of undeclared identifier"
+            "kernels/gpu/stages.cl:12:5: error: use of undeclared identifier"
         );
     }
 }

@@ -1,6 +1,6 @@
 //! Structs shared between the host and the kernels.
 //!
-//! Each struct here is mirrored field for field in `kernels/types.h`; the layout probe test
+//! Each struct here is mirrored field for field in `kernels/shared/types.h`; the layout probe test
 //! (`layout_probe_agrees_with_every_shared_rust_struct` in `tests/device.rs`) runs a kernel that reports
 //! `sizeof` and field offsets on the device and compares them with [`layouts`]. A bare `float3`
 //! never appears: it is 16 bytes in OpenCL, so three-component payloads travel as `float4` with
@@ -80,7 +80,7 @@ kernel_constants! {
     /// leaves apart by the leaf itself (`TwoLevel::device_tlas`).
     TLAS_LEAF: u32 = 0x8000_0000;
 
-    /// The megakernel's small-scene test (`SMALL_SCENE`, kernels/traverse_wide.h) takes the
+    /// The megakernel's small-scene test (`SMALL_SCENE`, kernels/shared/traverse_wide.h) takes the
     /// triangles this many at a time, in vector lanes; its kernels are built for a whole number
     /// of such batches.
     SMALL_LANES: usize = 16;
@@ -207,7 +207,7 @@ const _: () = assert!(size_of::<GpuWideNode>() == 128);
 /// One placed mesh of a two-level scene (112 bytes): object from world as
 /// `p_object = L (p_world - T)` for traversal, world from object as `p_world = M p_object + T`
 /// for shading (the mesh's triangles and shading data stay in object space on the device),
-/// bottom-level roots, and the instance's index and first light; see `kernels/types.h` and
+/// bottom-level roots, and the instance's index and first light; see `kernels/shared/types.h` and
 /// `bvh::instances`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]

@@ -181,7 +181,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     summary["lanes"] = serde_json::json!(renderer.walks_in_lanes());
     // How the lanes loaded their nodes and triangles: "rows" or "gathers" (null without lanes).
     summary["lanes_load"] = serde_json::json!(renderer.lanes_load());
-    // Whether the lanes shaded their vertices in batches, in vectors (kernels/shade_lanes.h).
+    // Whether the lanes shaded their vertices in batches, in vectors (kernels/cpu/shade_lanes.h).
     summary["lanes_shade"] = serde_json::json!(renderer.shades_in_lanes());
     // Whether the lanes tested a small scene's triangles whole (no tree).
     summary["lanes_small"] = serde_json::json!(renderer.tests_small_scene_in_lanes());

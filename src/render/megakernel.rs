@@ -1,6 +1,6 @@
 //! The megakernel: on CPU devices a frame is one kernel launch in which each work item traces
-//! whole paths for one pixel (kernels/megakernel.cl). It computes the wavefront's estimator
-//! (the same shading function, kernels/path.h) without its queues, path buffers and per-bounce
+//! whole paths for one pixel (kernels/cpu/megakernel.cl). It computes the wavefront's estimator
+//! (the same shading function, kernels/shared/path.h) without its queues, path buffers and per-bounce
 //! launches, which cost more than they save where there are only a few cores.
 
 use super::Renderer;
@@ -71,7 +71,7 @@ impl Renderer {
     }
 
     /// Whether the megakernel walks its extension rays sixteen at a time in vector lanes
-    /// (`KernelFeatures::lanes`, kernels/traverse_lanes.h) for the loaded scene.
+    /// (`KernelFeatures::lanes`, kernels/cpu/traverse_lanes.h) for the loaded scene.
     pub fn walks_in_lanes(&self) -> bool {
         self.megakernel_has(|f| f.lanes)
     }

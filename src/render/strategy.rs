@@ -245,7 +245,7 @@ pub fn kernel_strategy(
 }
 
 /// Whether the lanes can shade a scene of features `f` in batches (`LANES_SHADE`,
-/// kernels/shade_lanes.h, path.h's `shade_vertex` lane by lane): every material Lambertian and
+/// kernels/cpu/shade_lanes.h, path.h's `shade_vertex` lane by lane): every material Lambertian and
 /// no textures, normal maps, environment map, unlit materials, thin walls, transmission, coats,
 /// sheen, iridescence, anisotropy or dispersion. The batches take 12 % fewer instructions and
 /// about 6 % less time on the 1 M-triangle room; they make the bundled box 12 % faster at 64

@@ -1047,7 +1047,7 @@ fn import_mesh(
                 let set_uvs = if set == 1 { &uvs1 } else { &uvs };
                 if set_uvs.is_empty() {
                     // An anisotropic material without texture coordinates takes an arbitrary
-                    // frame about the normal (kernels/path.h).
+                    // frame about the normal (kernels/shared/path.h).
                     if normal_map {
                         warnings.push(format!(
                             "{what}: the normal map's TEXCOORD_{set} is missing, normal map ignored"

@@ -46,7 +46,7 @@ impl Program {
     }
 
     /// `sample_texture_test` (test program): texture lookups; query .xy = uv, .z = footprint level (see
-    /// kernels/tests.cl), .w = texture reference (i32 bits). Zeros without `HAS_TEXTURES`.
+    /// kernels/test/tests.cl), .w = texture reference (i32 bits). Zeros without `HAS_TEXTURES`.
     pub fn sample_texture_test(
         &self,
         gpu: &Gpu,

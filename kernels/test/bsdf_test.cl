@@ -1,6 +1,10 @@
 // Kernels that run the BSDF on given inputs for tests/bsdf.rs (χ² tests of sampling against the
 // pdf, and albedo checks).
 
+#include "shared/types.h"
+#include "shared/rng.h"
+#include "shared/bsdf.h"
+
 inline SurfaceMaterial bsdf_test_material(global const GpuMaterial* material, uint inside) {
     SurfaceMaterial m = surface_material(material);
     if (inside != 0u) material_from_inside(&m);

@@ -1,4 +1,15 @@
 // Next-event estimation: pick a light by the host's power table, then a point or direction on it.
+#ifndef SHARED_LIGHTS_H
+#define SHARED_LIGHTS_H
+
+#include "shared/types.h"
+#include "shared/rng.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
+#include "shared/traverse_wide.h"
+#include "shared/bsdf.h"
+#include "shared/surface.h"
+#include "shared/env.h"
 
 typedef struct {
     float3 wi;          // unit direction towards the light
@@ -143,3 +154,5 @@ SHADE_INLINE LightSample sample_light(global const GpuLight* lights,
     }
     return s;
 }
+
+#endif  // SHARED_LIGHTS_H

@@ -1,4 +1,4 @@
-// Path vertices shaded LANES at a time, for the CPU megakernel's lanes (megakernel.cl): the
+// Path vertices shaded LANES at a time, for the CPU megakernel's lanes (megakernel_lanes.cl): the
 // vertices that the lanes' extension rays found wait in a batch, and a full batch is shaded in
 // vectors, one vertex a lane, instead of one shade_vertex call after another. A scalar vertex
 // costs about 700 instructions; the same work in eight- or sixteen-wide vectors is a fraction of
@@ -19,6 +19,15 @@
 // docs/benchmarks.md, "Twenty-fifth session", has what it measured;
 // scripts/experiments/lanes-shade.patch was its first form, shading the lanes done at each
 // return (too few to fill the vectors).
+#ifndef CPU_SHADE_LANES_H
+#define CPU_SHADE_LANES_H
+
+#include "shared/types.h"
+#include "shared/rng.h"
+#include "shared/textures.h"
+#include "cpu/traverse_lanes.h"
+#include "shared/lights.h"
+#include "shared/path.h"
 
 #ifdef LANES_SHADE
 #if !defined(MEGA_LANES) || !defined(LAMBERT_ONLY) || defined(HAS_TEXTURES) ||              \
@@ -581,3 +590,5 @@ LANES_INLINE void lanes_shade(const GpuFrame* frame, const ShadeScene* sc, Shade
     lanes_vstore(valid, 0, B->valid);
 }
 #endif
+
+#endif  // CPU_SHADE_LANES_H

@@ -1,8 +1,12 @@
 // Structs shared with the host. Each mirrors one in src/cl/types.rs field for field; the layout
 // probe test checks sizes and offsets. No bare float3: payloads ride in .w of a float4.
 // The constants named in comments here (TEXTURE_*, WRAP_*, TEXREF_*, MATERIAL_*, ALPHA_*,
-// LIGHT_*, STRATEGY_*, PATH_*, COUNT_*, STAT_*) are defined once in src/cl/types.rs and
-// generated in front of these sources (src/cl/program.rs).
+// LIGHT_*, STRATEGY_*, PATH_*, COUNT_*, STAT_*) are defined once in src/cl/types.rs, from which
+// the host generates generated/constants.h (src/cl/source.rs).
+#ifndef SHARED_TYPES_H
+#define SHARED_TYPES_H
+
+#include "generated/constants.h"
 
 typedef struct {
     float4 left_min;   // .w = left child (int bits): node index, or ~first triangle for a leaf
@@ -166,3 +170,5 @@ typedef struct {
     float4 origin;     // .w = tmin
     float4 direction;  // .w = tmax
 } GpuRay;
+
+#endif  // SHARED_TYPES_H

@@ -3,6 +3,11 @@
 // Lookups are bilinear within one mip level; the level comes from the ray cone's footprint
 // (Akenine-Moller et al., Ray Tracing Gems ch. 20), rounded up or down at random in proportion
 // to the fraction, which averages to trilinear filtering over the samples of a pixel.
+#ifndef SHARED_TEXTURES_H
+#define SHARED_TEXTURES_H
+
+#include "shared/types.h"
+#include "shared/rng.h"
 
 // What traversal and shading read about surfaces besides the triangles themselves.
 typedef struct {
@@ -213,3 +218,5 @@ inline bool alpha_passes(const SceneSurfaces* s, uint prim, uint material, float
     return (float)(h >> 8) * (1.0f / 16777216.0f) >= alpha;
 }
 #endif
+
+#endif  // SHARED_TEXTURES_H

@@ -1,92 +1,17 @@
-// The path tracer as one kernel, for CPU devices: a work item follows the paths of one pixel
-// from the camera to their end, `frame.samples_in_wave` samples one after the other, with the
-// path state in registers: no queues, no path buffers, one launch per pass. Each vertex is
-// shaded by path.h's shade_vertex, as the wavefront's `shade` does, and its light sample is
-// traced at once (the wavefront's `connect`), so both compute the same estimator from the
-// same random numbers. The samples of a pixel are added to its film sum in order, one by one.
-//
-// Rays are traced through the 4-wide BVH (traverse_wide.h), whose box tests use the CPU's
-// vector lanes.
+// The path tracer as one kernel with its rays in vector lanes, for CPU devices with AVX-512 or
+// AVX2 (MEGA_LANES, set by the host: cl::lanes_megakernel in src/cl/program.rs): megakernel.cl's
+// estimator from the same random numbers, with the paths of a tile of pixels walking the 4-wide
+// BVH together, a ray a lane (traverse_lanes.h) or as packets (traverse_packet.h), and with
+// LANES_SHADE their vertices shaded in batches (shade_lanes.h). Each pixel sums its samples in
+// megakernel.cl's order: the same image.
 
-// The kernel's parameters, in both forms below.
-#define MEGAKERNEL_PARAMS                                                                   \
-    GpuFrame frame, GpuCamera camera, GpuEnvironment environment,                           \
-        global const GpuWideNode *nodes, global const GpuTriangle *tris,                    \
-        global const GpuInstance *instances, global const GpuTriangle *object_tris,         \
-        global const GpuTriShading *shading, global const GpuTriUvs *uvs,                   \
-        global const GpuTriTangents *tangents, global const GpuMaterial *materials,         \
-        global const GpuTexRef *tex_refs, global const GpuTexture *textures,                \
-        global const uint *texels, global const float *env_texels,                          \
-        global const float *env_marginal, global const float *env_conditional,              \
-        global const GpuLight *lights, global const float *light_cdf, global float4 *film, \
-        volatile global uint *counters
-
-// What shading reads of the scene, from the kernel's parameters.
-#define MEGA_SHADE_SCENE(sc)                                                                \
-    ShadeScene sc = {tris,                                                                  \
-                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances}, \
-                     {environment, env_texels, env_marginal, env_conditional},              \
-                     lights,                                                                \
-                     light_cdf}
-
-// A finished sample: its radiance added to the pixel's sum (a non-finite one dropped and
-// counted), and counted in the film's .w when its camera ray hit.
-inline void mega_add_sample(const PathState* s, float3* sum, uint* counted, uint* nonfinite) {
-    *counted += (s->flags & PATH_ESCAPED) == 0u;
-    if (all(isfinite(s->radiance))) {
-        *sum += s->radiance;
-    } else {
-        ++*nonfinite;
-    }
-}
-
-// A work item's statistics, one atomic each; `advance` moves them into the totals.
-inline void mega_count(volatile global uint* counters, uint extension_rays, uint shadow_rays,
-                       uint nonfinite) {
-    atomic_add(&counters[COUNT_IN], extension_rays);
-    atomic_add(&counters[COUNT_SHADOW], shadow_rays);
-    if (nonfinite > 0u) atomic_add(&counters[COUNT_NONFINITE], nonfinite);
-}
-
-// The last extension ray (bounce max_bounces + 1) only looks for emitters: with the lights'
-// triangles the only surfaces that add anything there (no environment map, no unlit
-// materials, a black sky, no alpha), and few of them, the ray is tested against those
-// triangles first, by the traversal's own watertight test. When it meets none, it would add
-// nothing and is not traced; when it meets one at t, only an any-hit ray over (0, t) is
-// traced, and an unblocked ray shades that hit as the closest-hit ray would have found it.
-// The same estimator, the same image (docs/benchmarks.md, "Twenty-first session");
-// -DLAST_RAY_TRACED traces it as before.
-#if defined(HAS_TRIANGLE_LIGHTS) && !defined(HAS_ENV_MAP) && !defined(HAS_UNLIT) && \
-    !defined(HAS_ALPHA) && !defined(TWO_LEVEL) && !defined(LAST_RAY_TRACED)
-#define LAST_RAY_EMITTERS
-// The most lights for which the last ray tests their triangles one by one.
-#define LAST_RAY_LIGHTS_MAX 16u
-
-inline bool mega_last_ray_by_emitters(const GpuFrame* frame) {
-    return frame->light_count <= LAST_RAY_LIGHTS_MAX && frame_sky_black(frame);
-}
-
-// The nearest of the lights' triangles along the ray from o along d, or NO_HIT.
-inline GpuHit mega_nearest_emitter(const GpuFrame* frame, const ShadeScene* sc, float3 o,
-                                   float3 d) {
-    RayPrep r = prepare_ray(o, d);
-    GpuHit hit = no_hit(INFINITY);
-    for (uint i = 0u; i < frame->light_count; ++i) {
-        global const GpuLight* l = &sc->lights[i];
-        if (as_uint(l->position.w) != LIGHT_TRIANGLE) continue;
-        uint prim = as_uint(l->spot.x);
-        GpuTriangle t = sc->tris[prim];
-        float t_hit = hit.t, bu, bv;
-        if (intersect_triangle(&r, t.v0, t.v1, t.v2, 0.0f, &t_hit, &bu, &bv)) {
-            hit.t = t_hit;
-            hit.u = bu;
-            hit.v = bv;
-            hit.prim = prim;
-        }
-    }
-    return hit;
-}
-#endif
+#include "shared/types.h"
+#include "shared/traverse.h"
+#include "cpu/traverse_lanes.h"
+#include "cpu/traverse_packet.h"
+#include "shared/path.h"
+#include "cpu/shade_lanes.h"
+#include "cpu/megakernel.h"
 
 #ifdef MEGA_LANES
 // With MEGA_LANES a work item renders a square of LANES_TILE² pixels in two shapes of walk:
@@ -102,7 +27,7 @@ inline GpuHit mega_nearest_emitter(const GpuFrame* frame, const ShadeScene* sc, 
 //     the next ray waiting, or the next path of a chunk.
 // A chunk's results wait in its record until all its paths are done; then they are added to
 // their pixels' film sums in sample order, and a pixel has one chunk in flight at a time, so
-// each pixel sums its samples in the order the one-pixel kernel below does: the same image,
+// each pixel sums its samples in the order megakernel.cl's one-pixel kernel does: the same image,
 // bit for bit (but for rays meeting two triangles at the same distance).
 // Paths in flight: one a lane, or with vertices shaded in batches (shade_lanes.h) twice as many,
 // so that the lanes walk other paths' rays while a batch fills (-DMEGA_SLOTS=n measures others:
@@ -300,7 +225,7 @@ inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera
 // next ray, or its light sample's segment, waiting for a lane), free, or with LANES_SHADE in
 // the batch (its vertex waiting to be shaded with others; shade_lanes.h). A path traces one
 // ray at a time, its light sample before its next ray, so each path adds its light in the
-// order of the one-pixel kernel below: the same image.
+// order of megakernel.cl's one-pixel kernel: the same image.
 kernel void megakernel(MEGAKERNEL_PARAMS) {
     // The work item's square of pixels, LANES_TILE on a side.
     uint tiles_x = (frame.width + LANES_TILE - 1u) / LANES_TILE;
@@ -521,70 +446,4 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #undef SLOT_READY
     mega_count(counters, W.extension_rays, W.shadow_rays, W.nonfinite);
 }
-#else
-kernel void megakernel(MEGAKERNEL_PARAMS) {
-#ifdef SMALL_SCENE
-    local SmallScene small;
-    // Before any work item returns: it waits for the group.
-    small_scene_load(tris, frame.triangles, &small);
-#endif
-    uint pixel = get_global_id(0);
-    uint pixels = frame.width * frame.height;
-    if (pixel >= pixels) return;
-    MEGA_SHADE_SCENE(sc);
-    volatile global uint* overflow = &counters[COUNT_OVERFLOW];
-    // The samples are added to the film's sum one by one, so that the image does not depend
-    // on how many samples each launch took (a float sum depends on its order).
-    float4 pixel_film = film[pixel];
-    float3 sum = pixel_film.xyz;
-    uint extension_rays = 0;
-    uint shadow_rays = 0;
-    uint nonfinite = 0;
-    uint counted = 0;  // samples whose camera ray hit (the film's .w with the background cut out)
-#ifdef SMALL_SCENE
-    sc.surf.small = &small;
-#define MEGA_TRACE_TO(o, d, tmax, any_hit) \
-    trace_small(&small, tris, &sc.surf, o, d, 0.0f, tmax, any_hit)
-#define MEGA_SHADOW(q) shadow_pass_small(&small, tris, instances, object_tris, &sc.surf, q, overflow)
-#else
-#define MEGA_TRACE_TO(o, d, tmax, any_hit)                                                 \
-    trace_scene_wide(nodes, tris, instances, object_tris, &sc.surf, o, d, 0.0f, tmax, any_hit, \
-                     overflow)
-#define MEGA_SHADOW(q) shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, q, overflow)
-#endif
-#define MEGA_TRACE(o, d, any_hit) MEGA_TRACE_TO(o, d, INFINITY, any_hit)
-#ifdef LAST_RAY_EMITTERS
-    bool last_by_emitters = mega_last_ray_by_emitters(&frame);
-#endif
-    for (uint j = 0; j < frame.samples_in_wave; ++j) {
-        PathState s = camera_path(&frame, &camera, pixel, frame.first_sample + j);
-        for (uint bounce = 0; bounce <= frame.max_bounces + 1u; ++bounce) {
-            GpuHit hit;
-#ifdef LAST_RAY_EMITTERS
-            if (last_by_emitters && bounce == frame.max_bounces + 1u) {
-                // The last ray: the emitter it meets, if nothing is in the way (see above).
-                hit = mega_nearest_emitter(&frame, &sc, s.origin, s.direction);
-                if (hit.prim == NO_HIT) break;
-                ++extension_rays;
-                if (MEGA_TRACE_TO(s.origin, s.direction, hit.t, true).prim != NO_HIT) break;
-            } else
-#endif
-            {
-                hit = MEGA_TRACE(s.origin, s.direction, false);
-                ++extension_rays;
-            }
-            ShadowQuery q;
-            bool alive = shade_vertex(&frame, bounce, &sc, hit, &s, &q);
-            if (q.valid) {
-                ++shadow_rays;
-                s.radiance += MEGA_SHADOW(&q);
-            }
-            if (!alive) break;
-        }
-        mega_add_sample(&s, &sum, &counted, &nonfinite);
-    }
-    if (frame.background == BACKGROUND_ENV) counted = frame.samples_in_wave;
-    film[pixel] = (float4)(sum, pixel_film.w + (float)counted);
-    mega_count(counters, extension_rays, shadow_rays, nonfinite);
-}
-#endif
+#endif  // MEGA_LANES

@@ -1,6 +1,12 @@
 // BVH traversal: watertight ray-triangle test (Woop, Benthin, Wald 2013) over the flat node array.
 // The host reference (src/bvh/traverse.rs) follows these steps exactly; contraction into fused
 // multiply-adds is off so both sides round the same way.
+#ifndef SHARED_TRAVERSE_H
+#define SHARED_TRAVERSE_H
+
+#include "shared/types.h"
+#include "shared/textures.h"
+
 #pragma OPENCL FP_CONTRACT OFF
 
 #define STACK_SIZE 64
@@ -507,3 +513,5 @@ inline float3 offset_ray(float3 p, float3 err, float3 n) {
     stepped = select(stepped, select((int3)(0x80000001), (int3)(1), offset > 0.0f), po == 0.0f);
     return select(po, as_float3(stepped), offset != 0.0f);
 }
+
+#endif  // SHARED_TRAVERSE_H

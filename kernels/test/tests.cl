@@ -1,5 +1,10 @@
 // Kernels only the tests use (built into the test program, src/cl/program.rs): the layout
-// probe, texture lookups and environment samples. kernels/bsdf_test.cl holds the BSDF ones.
+// probe, texture lookups and environment samples. kernels/test/bsdf_test.cl holds the BSDF ones.
+
+#include "shared/types.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
+#include "shared/env.h"
 
 // Writes, per shared struct, its size then each field's offset, in the order of
 // src/cl/types.rs::layouts().

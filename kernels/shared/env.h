@@ -2,6 +2,11 @@
 // by a 2D table over luminance x sin(theta) (src/scene/environment.rs builds it and states the
 // direction convention). Radiance is looked up at the nearest texel, so the sampling pdf,
 // constant per texel in (u, v), is exactly f(texel) * norm / sin(theta) per solid angle.
+#ifndef SHARED_ENV_H
+#define SHARED_ENV_H
+
+#include "shared/types.h"
+#include "shared/rng.h"
 
 typedef struct {
     GpuEnvironment info;
@@ -96,3 +101,5 @@ inline float3 env_sample(const EnvMap* e, float u1, float u2, float3* radiance, 
 }
 
 #endif
+
+#endif  // SHARED_ENV_H

@@ -1,6 +1,13 @@
 // What a hit's textures do to its material: base color, metallic-roughness, transmission and
 // emission, and the shading normal from a tangent-space normal map; with two levels, the hit's
 // object-space triangle and shading data carried to world space by its instance.
+#ifndef SHARED_SURFACE_H
+#define SHARED_SURFACE_H
+
+#include "shared/types.h"
+#include "shared/rng.h"
+#include "shared/textures.h"
+#include "shared/bsdf.h"
 
 #ifdef TWO_LEVEL
 // M v: a vector to world space (src/bvh/instances.rs keeps M's rows in world0..2).
@@ -165,3 +172,5 @@ inline float3 anisotropy_direction(const SceneSurfaces* s, uint prim, float u, f
     return dir.x * t + dir.y * b;
 }
 #endif
+
+#endif  // SHARED_SURFACE_H

@@ -15,6 +15,13 @@
 // go to intersect_leaf itself. Leaves are stack items, as in Embree's walk, tested once enough
 // lanes have reached one; a node's reached children are sorted by entry distance in every
 // lane, the nearest entered and the others pushed farthest first.
+#ifndef CPU_TRAVERSE_LANES_H
+#define CPU_TRAVERSE_LANES_H
+
+#include "shared/types.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
+#include "shared/traverse_wide.h"
 
 #ifdef MEGA_LANES
 // The lanes: sixteen, or eight where the CPU has AVX2 but not AVX-512 (-DLANES=16 or 8 chooses):
@@ -114,9 +121,8 @@ inline int lanes_max(lanes_i x) {
 #endif
 
 // Gathers and scatters: base[idx] in each lane of a mask (others 0); with AVX-512 one
-// instruction, with AVX2 two gathers or a loop over the mask's lanes (below), else (or with
-// LANES_ELEMENTWISE, to check these forms against it: scripts/experiments/lanes) lane by lane.
-#if LANES == 16 && defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+// instruction, with AVX2 two gathers or a loop over the mask's lanes (below), else lane by lane.
+#if LANES == 16 && defined(__AVX512F__) && defined(__x86_64__)
 inline ushort lanes_kmask(lanes_i m) {
     return __builtin_ia32_cmpd512_mask(m, (lanes_i)(0), 4, (ushort)0xffff);  // m != 0
 }
@@ -141,7 +147,7 @@ inline ushort lanes_kmask(lanes_i m) {
         __builtin_ia32_scattersiv8di((void*)(base), (uchar)((km) >> 8), (idx).hi, as_long8(hi_),  \
                                      4);                                                         \
     }
-#elif defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+#elif defined(__AVX2__) && defined(__x86_64__)
 // AVX2 (no AVX-512): masks by movmskps, gathers by AVX2's eight-lane gathers (pairs of words by
 // its four-lane 8-byte ones); AVX2 has no scatter.
 inline ushort lanes_kmask(lanes_i m) {
@@ -233,8 +239,7 @@ inline void lanes_scatter_f(float* base, lanes_i idx, lanes_f v, ushort km) {
     }
 #endif
 
-#if defined(__AVX2__) && (LANES == 8 || !defined(__AVX512F__)) && defined(__x86_64__) && \
-    !defined(LANES_ELEMENTWISE)
+#if defined(__AVX2__) && (LANES == 8 || !defined(__AVX512F__)) && defined(__x86_64__)
 // For eight mask bits, the indices of the set ones in order, four bits each (others 0).
 constant uint LANES_COMPRESS8[256] = {
     0x00000000u, 0x00000000u, 0x00000001u, 0x00000010u, 0x00000002u, 0x00000020u, 0x00000021u, 0x00000210u,
@@ -284,9 +289,8 @@ inline int8 lanes_compress8_index(uint km8) {
 
 // A pop, the words at idx and idx + 1 of each lane into A and B (lanes outside km read their
 // entry too, which no walk uses): with eight lanes by one 8-byte load a lane, which took 1-4 %
-// less time than AVX2's two four-lane 8-byte gathers on Zen 3 (docs/benchmarks.md,
-// "Twenty-fourth session"; -DLANES_POP_GATHERS to measure them); else a gather.
-#if LANES == 8 && !defined(LANES_POP_GATHERS)
+// less time than AVX2's two four-lane 8-byte gathers on Zen 3; else a gather.
+#if LANES == 8
 #define LANES_POP_PAIR(base, idx, km, A, B)                                            \
     {                                                                                  \
         int i_[LANES];                                                                 \
@@ -303,11 +307,11 @@ inline int8 lanes_compress8_index(uint km8) {
 
 // The lanes of mask km of v, in order, in the first lanes (the others 0); and the lanes of v
 // named by idx.
-#if LANES == 16 && defined(__AVX512F__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+#if LANES == 16 && defined(__AVX512F__) && defined(__x86_64__)
 #define lanes_compress(v, km) __builtin_ia32_compresssi512_mask((v), (lanes_i)(0), (km))
 #define lanes_permute(v, idx) __builtin_ia32_permvarsf512((v), (idx))
 #define lanes_permute_i(v, idx) __builtin_ia32_permvarsi512((v), (idx))
-#elif LANES == 16 && defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+#elif LANES == 16 && defined(__AVX2__) && defined(__x86_64__)
 // Each half compressed by a table-driven permute, the high half's lanes then moved up past the
 // low half's n.
 inline lanes_i lanes_compress(lanes_i v, ushort km) {
@@ -334,7 +338,7 @@ inline lanes_f lanes_permute(lanes_f v, lanes_i idx) {
 inline lanes_i lanes_permute_i(lanes_i v, lanes_i idx) {
     return as_lanes_i(lanes_permute(as_lanes_f(v), idx));
 }
-#elif LANES == 8 && defined(__AVX2__) && defined(__x86_64__) && !defined(LANES_ELEMENTWISE)
+#elif LANES == 8 && defined(__AVX2__) && defined(__x86_64__)
 inline lanes_i lanes_compress(lanes_i v, ushort km) {
     return select((int8)(0), __builtin_ia32_permvarsi256(v, lanes_compress8_index(km)),
                   LANE_IDS < (int8)(popcount((uint)km & 255u)));
@@ -737,13 +741,10 @@ LANES_INLINE lanes_i lanes_pack(lanes_i c, lanes_i k) {
 // element may straddle one more line than the loop reaches; elements of whole lines (the
 // nodes, 128 bytes, in buffers aligned to pages) need no such fetch, and after inlining the
 // test folds away.
-// With eight lanes (LANES_PREFETCH_ALL) every lane prefetches, those outside m element 0 (the
-// root node, the first triangle: cached), with no branch but the mask's test: the loop over m's
-// lanes took 6 % more time on the 1 M-triangle scenes on Zen 3 (docs/benchmarks.md,
-// "Twenty-third session"); sixteen lanes keep the loop (not measured where they run).
-#if LANES == 8 && !defined(LANES_PREFETCH_MASKED)
-#define LANES_PREFETCH_ALL
-#endif
+// With eight lanes every lane prefetches, those outside m element 0 (the root node, the first
+// triangle: cached), with no branch but the mask's test: the loop over m's lanes took 6 % more
+// time on the 1 M-triangle scenes on Zen 3; sixteen lanes keep the loop (not measured where
+// they run).
 
 // lanes_prefetch's loads of one element, at a.
 LANES_INLINE void lanes_prefetch_element(ulong a, uint size, uint bytes) {
@@ -755,7 +756,7 @@ LANES_INLINE void lanes_prefetch_element(ulong a, uint size, uint bytes) {
 LANES_INLINE void lanes_prefetch(ulong base, lanes_i first, uint size, uint bytes, lanes_i m) {
     uint bits = lanes_kmask(m);
     if (bits == 0u) return;
-#ifdef LANES_PREFETCH_ALL
+#if LANES == 8
     // The lanes' byte offsets as one vector of 64-bit words (one shift or multiply for all
     // lanes, 10-25 % fewer instructions in the prefetches than offsets lane by lane).
     long at_[LANES];
@@ -781,15 +782,10 @@ LANES_INLINE void lanes_prefetch(ulong base, lanes_i first, uint size, uint byte
 
 // The node of NODES each lane of M goes to next (ITEM, if a node): its two cache lines are
 // fetched as the lane takes it, a node step's leaves and pops before the step loads it, so the
-// sixteen lanes' misses overlap that work (4-8 % of the 1 M-triangle scenes' time on Zen 4:
-// docs/benchmarks.md, "Twenty-second session"; -DLANES_NO_NODE_PREFETCH to measure without).
-#ifndef LANES_NO_NODE_PREFETCH
+// sixteen lanes' misses overlap that work (4-8 % of the 1 M-triangle scenes' time on Zen 4).
 #define LANES_PREFETCH_NODE(NODES, ITEM, M)                                                 \
     lanes_prefetch((ulong)(NODES), (ITEM), sizeof(GpuWideNode), sizeof(GpuWideNode),       \
                    (M) & ((ITEM) >= (lanes_i)(0)));
-#else
-#define LANES_PREFETCH_NODE(NODES, ITEM, M)
-#endif
 
 // Triangle TRI of each lane of mask M (tw: the triangles as words), its vertices relative to
 // the lane's origin in its permuted axes (KX, KY, KZ: 0, 1 or 2; PX, PY, PZ): declares aX ..
@@ -1025,7 +1021,6 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             lanes_i first = L->cur & (lanes_i)(LANES_FIRST_MASK);
             lanes_i cnt = (L->cur >> (lanes_i)(27)) & (lanes_i)(15);
             int kmax = lanes_max(select(izero, cnt, ml));
-#ifndef LANES_LEAF_BY_K
             // The leaves' (lane, triangle) pairs in order, each lane's first triangle before its
             // second (pl, pt): sixteen pairs a test, not one triangle of every lane a test, of
             // which the lanes whose leaves are done (or that wait at a node) would take no part.
@@ -1091,7 +1086,6 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 L->prim = prim;
             }
             if (!by_k) kmax = 0;  // done: no walk by triangle order
-#endif
             // The leaves one triangle of every lane at a time, in order, each lane's hit updated
             // as it goes; the scalar test's rare cases in turn.
             for (int k = 0; k < kmax; ++k) {
@@ -1254,3 +1248,5 @@ LANES_INLINE lanes_i lanes_walk_small(LaneMemory* M, global const GpuWideNode* n
 #endif
 
 #endif  // MEGA_LANES
+
+#endif  // CPU_TRAVERSE_LANES_H

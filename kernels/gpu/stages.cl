@@ -3,6 +3,11 @@
 // Paths live in `paths` by slot (pixel + sample_in_wave * pixels); queues hold the slots of the
 // live paths, compacted by atomic counters, so later bounces only touch live paths.
 
+#include "shared/types.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
+#include "shared/path.h"
+
 kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, global uint* queue,
                      global uint* counters, global float2* cones) {
     uint slot = get_global_id(0);

@@ -1,4 +1,6 @@
 // Random numbers (PCG-style hash chain) and sampling warps.
+#ifndef SHARED_RNG_H
+#define SHARED_RNG_H
 
 #define PI_F 3.14159265358979f
 #define INV_PI_F 0.318309886183791f
@@ -90,3 +92,5 @@ inline uint cdf_search(global const float* cdf, uint n, float u) {
     }
     return lo;
 }
+
+#endif  // SHARED_RNG_H

@@ -1,9 +1,22 @@
 // One path vertex at a time: the camera ray, and the shading of the vertex a ray found
 // (emission with MIS, one light sample, the BSDF sample and Russian roulette). Both execution
 // shapes call these, so they compute the same estimator with the same random numbers:
-//   - the wavefront (stages.cl) keeps the state in GpuPath slots between kernels and traces
+//   - the wavefront (gpu/stages.cl) keeps the state in GpuPath slots between kernels and traces
 //     the light sample later in `connect`;
-//   - the megakernel (megakernel.cl) keeps it in registers and traces the light sample at once.
+//   - the megakernels (cpu/megakernel.cl, cpu/megakernel_lanes.cl) keep it in registers and
+//     trace the light sample at once.
+#ifndef SHARED_PATH_H
+#define SHARED_PATH_H
+
+#include "shared/types.h"
+#include "shared/rng.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
+#include "shared/traverse_wide.h"
+#include "shared/bsdf.h"
+#include "shared/surface.h"
+#include "shared/env.h"
+#include "shared/lights.h"
 
 // Whether the uniform sky is black: an escaped ray then adds nothing.
 inline bool frame_sky_black(const GpuFrame* frame) {
@@ -434,3 +447,5 @@ DEFINE_SHADOW_TEST(shadow_pass_wide, global const GpuWideNode*, trace_scene_wide
 #ifdef SMALL_SCENE
 DEFINE_SHADOW_TEST(shadow_pass_small, local const SmallScene*, trace_small_scene)
 #endif
+
+#endif  // SHARED_PATH_H

@@ -2,6 +2,12 @@
 // four child boxes in a handful of vector instructions (SSE/AVX lanes on a CPU). The boxes,
 // slab test and triangle test are traverse.h's, so the same hits are found; children are
 // visited nearest first. src/bvh/wide.rs (WideBvh::intersect) is the host reference.
+#ifndef SHARED_TRAVERSE_WIDE_H
+#define SHARED_TRAVERSE_WIDE_H
+
+#include "shared/types.h"
+#include "shared/textures.h"
+#include "shared/traverse.h"
 
 #define WIDE_STACK_SIZE 144  // (4 - 1) x the builder's depth limit of 48
 
@@ -584,3 +590,5 @@ inline float3 flat_normal(const SceneSurfaces* surf, uint prim, GpuTriangle t) {
 #endif
     return triangle_normal(t.v0.xyz, t.v1.xyz, t.v2.xyz);
 }
+
+#endif  // SHARED_TRAVERSE_WIDE_H

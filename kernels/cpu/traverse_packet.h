@@ -13,6 +13,13 @@
 // traverse_lanes.h. A stack entry holds an item (lanes_pack form: a node, or a leaf) and the
 // entry distance of each lane that reached it (infinity for the others), so a popped entry
 // is visited by exactly the lanes that reached it and whose hit is not nearer.
+#ifndef CPU_TRAVERSE_PACKET_H
+#define CPU_TRAVERSE_PACKET_H
+
+#include "shared/types.h"
+#include "shared/textures.h"
+#include "shared/traverse_wide.h"
+#include "cpu/traverse_lanes.h"
 
 #ifdef MEGA_LANES
 #define PACKET_STACK (WIDE_STACK_SIZE + 1)
@@ -214,3 +221,5 @@ LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
 }
 
 #endif  // MEGA_LANES
+
+#endif  // CPU_TRAVERSE_PACKET_H
