@@ -335,7 +335,9 @@ impl TwoLevel {
             firsts,
             small_mesh,
         };
-        two.max_pieces = two.piece_budget(rebraid_budget());
+        // No BLAS is opened: opening the bunny room's BLASes measured no faster on PoCL (16 to
+        // 1024 more pieces than instances) and slower on the H200 (256 more; 2026-11-30).
+        two.max_pieces = two.piece_budget(0);
         two.rebuild_tlas();
         two
     }
@@ -351,7 +353,7 @@ impl TwoLevel {
     }
 
     /// Sets how many pieces beyond one per instance (and per small mesh's triangle) the TLAS
-    /// may be re-braided into ([`rebraid_budget`]) and rebuilds it; before the device is
+    /// may be re-braided into and rebuilds it; before the device is
     /// given the scene (its buffers are sized for [`TwoLevel::max_pieces`]).
     pub fn set_rebraid_budget(&mut self, extra: usize) {
         self.max_pieces = self.piece_budget(extra);
@@ -653,7 +655,7 @@ impl TwoLevel {
         // The BLASes are collapsed in parallel, a batch of about COLLAPSE_BATCH triangles at a
         // time, and appended in order (in parallel too): only one batch's nodes wait beside the
         // array, so the collapse touches little fresh memory beyond the array itself (a 64
-        // M-triangle scene of 3,125 meshes: 5.6 s one BLAS after another, docs/benchmarks.md).
+        // M-triangle scene of 3,125 meshes: 5.6 s one BLAS after another).
         const COLLAPSE_BATCH: usize = 1 << 20;
         let mut rest = &self.blases[..];
         while !rest.is_empty() {
@@ -712,17 +714,6 @@ pub const FRONTIER: usize = 32;
 
 /// A piece's mark for one triangle (its index in the BLAS in the other bits), else a BLAS node.
 pub const PIECE_TRIANGLE: u32 = 1 << 31;
-
-/// Pieces beyond one per instance (and one per small mesh's triangle) that re-braiding may
-/// open BLASes into: 0, none, by default, since opening the bunny room's BLASes measured no
-/// faster on PoCL (docs/benchmarks.md, 2026-11-30); `PENUMBRA_REBRAID=n` sets it for
-/// experiments (the H200's figures are still to be measured).
-pub fn rebraid_budget() -> usize {
-    std::env::var("PENUMBRA_REBRAID")
-        .ok()
-        .and_then(|v| v.trim().parse().ok())
-        .unwrap_or(0)
-}
 
 /// Splits every TLAS leaf of several pieces into leaves of one, so that a ray tests each
 /// piece's box before it is carried into the instance: entering a piece costs a transform and

@@ -2,15 +2,14 @@
 
 use super::accessor::{self, Attributes, BufferData};
 use super::compression;
-use super::pose::{Pose, apply_morph_targets, apply_skin, node_pose, rest_worlds};
+use super::pose::{Pose, apply_morph_targets, apply_skin, node_matrix, node_pose, rest_worlds};
 use super::textures::{Image, MaterialTextures, TexTransform, TextureRef, Wrap, to_rgba8};
-use super::validate::PreciseNode;
 use super::variants::{self, VariantRange};
 use super::{
     AlphaMode, Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError,
     default_light_rig, limits, sources, validate,
 };
-use glam::{DMat4, DQuat, DVec3, Vec2, Vec3, Vec4};
+use glam::{DMat4, DVec3, Vec2, Vec3, Vec4};
 use gltf::json::validation::Checked;
 use gltf::mesh::Mode;
 use rayon::prelude::*;
@@ -45,7 +44,7 @@ pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Resul
 
 /// [`load_owned`] of bytes with no external files (for tests of [`sources::Bytes`]).
 #[cfg(test)]
-pub(super) fn load_bytes(bytes: sources::Bytes) -> Result<Scene, String> {
+fn load_bytes(bytes: sources::Bytes) -> Result<Scene, String> {
     load_owned(bytes, None, "test")
 }
 
@@ -365,45 +364,6 @@ fn warn_once(warnings: &mut Vec<String>, warning: String) {
         warnings.push(warning);
     }
 }
-
-/// The node's local transform, or why it cannot be used: a non-finite value, a zero
-/// quaternion or a singular matrix. `precise` holds the values as written, in f64, when the
-/// file could be read that way; otherwise gltf-json's f32 values are used.
-pub(super) fn node_matrix(
-    node: &gltf::Node,
-    precise: Option<&PreciseNode>,
-) -> Result<DMat4, &'static str> {
-    let f32_matrix = match node.transform() {
-        gltf::scene::Transform::Matrix { matrix } => Some(matrix.map(|c| c.map(f64::from))),
-        _ => None,
-    };
-    if let Some(matrix) = f32_matrix {
-        let m = match precise.and_then(|p| p.matrix) {
-            Some(m) => DMat4::from_cols_array(&m),
-            None => DMat4::from_cols_array_2d(&matrix),
-        };
-        if !m.is_finite() {
-            return Err("matrix is not finite");
-        }
-        if !m.inverse().is_finite() || m.determinant() == 0.0 {
-            return Err("matrix is singular");
-        }
-        return Ok(m);
-    }
-    let (t, r, s) = node.transform().decomposed();
-    let p = precise.cloned().unwrap_or_default();
-    let t = DVec3::from(p.translation.unwrap_or(t.map(f64::from)));
-    let r = DQuat::from_array(p.rotation.unwrap_or(r.map(f64::from)));
-    let s = DVec3::from(p.scale.unwrap_or(s.map(f64::from)));
-    if !(t.is_finite() && r.is_finite() && s.is_finite()) {
-        return Err("translation, rotation or scale is not finite");
-    }
-    if r.length_squared() < 1e-24 {
-        return Err("rotation is a zero quaternion");
-    }
-    Ok(DMat4::from_scale_rotation_translation(s, r.normalize(), t))
-}
-
 /// A perspective camera placed by `world`, or a warning saying why it is left out.
 fn import_camera(camera: &gltf::Camera, world: &DMat4) -> Result<Camera, String> {
     let at = format!("cameras[{}]", camera.index());
@@ -1107,5 +1067,25 @@ fn pad_attribute<T: Copy + Default>(dst: &mut Vec<T>, old_len: usize, new: Vec<T
         dst.extend(std::iter::repeat_n(T::default(), new_len));
     } else {
         append(dst, new);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scene loaded from the mapped bundled box is the one loaded from its bytes.
+    #[test]
+    fn a_mapped_file_loads_as_its_bytes() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell-box.glb");
+        let read = std::fs::read(&path).unwrap();
+        let from_map = load_bytes(sources::Bytes::of_file_mapped_from(&path, 0).unwrap()).unwrap();
+        let from_read = load_from_bytes(&read, None, "box").unwrap();
+        assert_eq!(from_map.objects.len(), from_read.objects.len());
+        for (a, b) in from_map.objects.iter().zip(&from_read.objects) {
+            assert_eq!(a.mesh.positions, b.mesh.positions);
+            assert_eq!(a.mesh.indices, b.mesh.indices);
+            assert_eq!(a.world_from_object, b.world_from_object);
+        }
     }
 }
