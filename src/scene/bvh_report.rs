@@ -205,7 +205,7 @@ mod tests {
 
     #[test]
     fn the_bundled_scene_is_measured() {
-        let scene = super::load_or_bundled(None).expect("the bundled scene loads");
+        let scene = crate::scene::load_or_bundled(None).expect("the bundled scene loads");
         let r = report(&scene, 2, true);
         assert_eq!(r.triangles, scene.triangle_count());
         assert_eq!(
@@ -234,7 +234,7 @@ mod tests {
 
     #[test]
     fn copies_of_one_mesh_count_once() {
-        let mut scene = super::load_or_bundled(None).expect("the bundled scene loads");
+        let mut scene = crate::scene::load_or_bundled(None).expect("the bundled scene loads");
         let copy = scene.objects[0].clone();
         let before = report(&scene, 1, false);
         scene.objects.push(copy);
