@@ -10,9 +10,7 @@
 #   OUT=/some/dir scripts/two_level_bench.sh
 #
 # Environment: DEVICE (default gpu; `cpu` measures PoCL at a smaller size), PENUMBRA (binary),
-# SCENES (folder), ROUNDS (default 2: flat and two-level alternate, ROUNDS times each),
-# PENUMBRA_REBRAID (unset: none; n opens the two-level form's BLASes into up to n more TLAS
-# pieces, an experiment, see docs/architecture.md; run once without and once with it).
+# SCENES (folder), ROUNDS (default 2: flat and two-level alternate, ROUNDS times each).
 # Writes to $OUT:
 #   log.txt       devices and every table as printed
 #   trace.jsonl   bench trace --json, one line per scene, form and round (`bvh_levels` names
@@ -35,8 +33,8 @@ if [ "$DEVICE" = cpu ]; then
     TRACE_SIZE=(--width 640 --height 360 --runs 3 --warmup 1)
     FRAME_SIZE=(--width 320 --height 180 --spp 4)
 else
-    # The settings of the H200 figures in docs/benchmarks.md (third session): trace at the
-    # default 1280x720, frames at 1024x1024 with 6 bounces.
+    # The settings of the H200 figures: trace at the default 1280x720, frames at 1024x1024
+    # with 6 bounces.
     TRACE_SIZE=(--width 1280 --height 720 --runs 10 --warmup 3)
     FRAME_SIZE=(--width 1024 --height 1024 --bounces 6 --spp 64)
 fi
@@ -51,12 +49,11 @@ run() {
 
 log "== penumbra flat against two levels, $(date -u +%Y-%m-%dT%H:%M:%SZ)"
 log "commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)"
-log "PENUMBRA_REBRAID=${PENUMBRA_REBRAID:-unset}"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version \
     --format=csv >>"$LOG" 2>&1
 "$P" devices >>"$LOG" 2>&1
 
-# The rooms of docs/benchmarks.md: 7 bunnies (9 instances of 3 meshes) and 49 icospheres (51
+# Two rooms: 7 bunnies (9 instances of 3 meshes) and 49 icospheres (51
 # instances of 3 meshes), 1 M triangles each.
 run "$LOG" "$P" bench generate --from "$S/StanfordBunny/bunny.glb" --triangles 1000000 \
     -o "$TMP/bunnies.glb"

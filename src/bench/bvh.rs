@@ -1,5 +1,5 @@
 //! `penumbra bench bvh SCENE`: how long the host takes to build the scene's BVH and to update
-//! it when one instance moves (see `bvh::report`).
+//! it when one instance moves (see `scene::bvh_report`).
 
 use super::thousands;
 use crate::date::today;
@@ -41,7 +41,7 @@ pub fn run(args: &BvhArgs) -> Result<()> {
     // code these steps run is paged in and the threads are started (2.8 MB on the 2-core
     // machine, whatever the scene) before the scene's own memory is counted.
     if let Ok(bundled) = crate::scene::load_or_bundled(None) {
-        crate::bvh::report(&bundled, 1, false);
+        crate::scene::bvh_report::report(&bundled, 1, false);
     }
     // Every step measured is part of opening a scene, under its allocator policy.
     let _memory = crate::cl::kernels::OpeningMemory::begin();
@@ -50,7 +50,7 @@ pub fn run(args: &BvhArgs) -> Result<()> {
     let scene = load(&args.scene)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     let loaded = peak_rss_bytes();
-    let r = crate::bvh::report(&scene, args.runs, !args.two_level_only);
+    let r = crate::scene::bvh_report::report(&scene, args.runs, !args.two_level_only);
     let peak = peak_rss_bytes();
     // The first view (framing probe) as `render` and the viewer decide it before the upload:
     // part of opening a scene without a camera, and of any scene's light test.

@@ -15,117 +15,12 @@
 //! object space, and shading carries a hit to world space through the instance's transform.
 
 use super::wide::{frontier, merge_limit};
-use super::{Aabb, Bvh, Child, Hit, Ray, WIDTH, WideBvh, build, build_boxes, build_indexed};
-use crate::cl::types::{GpuBvhNode, GpuHit, GpuWideNode};
-use crate::scene::Mesh;
+use super::{Aabb, Blas, Bvh, Child, Hit, Ray, WIDTH, build_boxes};
+use crate::cl::types::{GpuBvhNode, GpuHit};
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
-use std::sync::Arc;
-
-/// A mesh's BVH and its object-space triangles in BVH order.
-#[derive(Clone, Debug)]
-pub struct Blas {
-    /// The tree.
-    pub bvh: Bvh,
-    /// Triangles in BVH order (object space); read them with [`Blas::triangle`].
-    triangles: BlasTriangles,
-}
-
-/// Where a [`Blas`] finds its triangles.
-#[derive(Clone, Debug)]
-enum BlasTriangles {
-    /// Copies in BVH order.
-    Copied(Vec<[Vec3; 3]>),
-    /// The mesh the tree was built over, read through the tree's `tri_indices`: no copy
-    /// (36 B a triangle, 2.3 GB of a 64 M-triangle scene, which only host traversal reads).
-    Mesh(Arc<Mesh>),
-}
-
-impl Blas {
-    /// Builds the BLAS of `triangles` (object space, any order).
-    pub fn new(triangles: &[[Vec3; 3]]) -> Self {
-        let bvh = build(triangles);
-        let triangles = bvh
-            .tri_indices
-            .iter()
-            .map(|&i| triangles[i as usize])
-            .collect();
-        Self::copied(bvh, triangles)
-    }
-
-    /// A BLAS of `bvh` over its triangles in BVH order.
-    pub fn copied(bvh: Bvh, triangles: Vec<[Vec3; 3]>) -> Self {
-        debug_assert_eq!(bvh.tri_indices.len(), triangles.len());
-        Self {
-            bvh,
-            triangles: BlasTriangles::Copied(triangles),
-        }
-    }
-
-    /// A BLAS of `bvh`, built over `mesh`, that reads the mesh's triangles where it needs them.
-    pub fn over_mesh(bvh: Bvh, mesh: &Arc<Mesh>) -> Self {
-        debug_assert_eq!(bvh.tri_indices.len(), mesh.indices.len());
-        Self {
-            bvh,
-            triangles: BlasTriangles::Mesh(mesh.clone()),
-        }
-    }
-
-    /// Builds the BLAS of an indexed mesh (object space): the same as [`Blas::new`] over its
-    /// triangles, without a copy of them in mesh order.
-    pub fn of_mesh(positions: &[Vec3], indices: &[[u32; 3]]) -> Self {
-        let bvh = build_indexed(positions, indices);
-        let triangles = bvh
-            .tri_indices
-            .par_iter()
-            .map(|&i| indices[i as usize].map(|v| positions[v as usize]))
-            .collect();
-        Self::copied(bvh, triangles)
-    }
-
-    /// [`Blas::of_mesh`] of a scene's mesh, which the BLAS keeps and reads its triangles from
-    /// (no copy of them in BVH order either): the same tree.
-    pub fn of_shared_mesh(mesh: &Arc<Mesh>) -> Self {
-        Self::over_mesh(build_indexed(&mesh.positions, &mesh.indices), mesh)
-    }
-
-    /// Triangles.
-    pub fn len(&self) -> usize {
-        self.bvh.tri_indices.len()
-    }
-
-    /// Whether the BLAS has no triangles.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Triangle `k` in BVH order (object space).
-    pub fn triangle(&self, k: usize) -> [Vec3; 3] {
-        match &self.triangles {
-            BlasTriangles::Copied(t) => t[k],
-            BlasTriangles::Mesh(m) => {
-                m.indices[self.bvh.tri_indices[k] as usize].map(|v| m.positions[v as usize])
-            }
-        }
-    }
-
-    /// The triangles in BVH order.
-    pub fn triangles(&self) -> impl Iterator<Item = [Vec3; 3]> + '_ {
-        (0..self.len()).map(|k| self.triangle(k))
-    }
-
-    /// [`Bvh::traverse`] of this BLAS's tree over its triangles.
-    pub fn traverse(&self, root: u32, ray: &Ray, any: bool) -> Option<Hit> {
-        self.bvh.traverse_by(root, ray, any, |k| self.triangle(k))
-    }
-
-    /// The object-space box of the whole mesh.
-    pub fn bounds(&self) -> Aabb {
-        self.bvh.child(0, 0).0.union(self.bvh.child(0, 1).0)
-    }
-}
 
 /// One placed mesh.
 #[derive(Clone, Copy, Debug)]
@@ -284,8 +179,8 @@ pub struct TwoLevel {
     /// a TLAS piece of its own (see [`TwoLevel::braid`]; 0: none).
     pub small_mesh: usize,
     /// The largest leaf the wide BLASes merge small subtrees into (0: none): as the CPU's flat
-    /// BVH does ([`WideBvh::collapse_for_cpu`]), by the meshes' triangles ([`merge_limit`]), so
-    /// that both levels' bottoms are walked as fast as the flat tree.
+    /// BVH does ([`super::WideBvh::collapse_for_cpu`]), by the meshes' triangles
+    /// ([`merge_limit`]), so that both levels' bottoms are walked as fast as the flat tree.
     pub merge: u32,
 }
 
@@ -335,7 +230,9 @@ impl TwoLevel {
             firsts,
             small_mesh,
         };
-        two.max_pieces = two.piece_budget(rebraid_budget());
+        // No BLAS is opened: opening the bunny room's BLASes measured no faster on PoCL (16 to
+        // 1024 more pieces than instances) and slower on the H200 (256 more; 2026-11-30).
+        two.max_pieces = two.piece_budget(0);
         two.rebuild_tlas();
         two
     }
@@ -351,7 +248,7 @@ impl TwoLevel {
     }
 
     /// Sets how many pieces beyond one per instance (and per small mesh's triangle) the TLAS
-    /// may be re-braided into ([`rebraid_budget`]) and rebuilds it; before the device is
+    /// may be re-braided into and rebuilds it; before the device is
     /// given the scene (its buffers are sized for [`TwoLevel::max_pieces`]).
     pub fn set_rebraid_budget(&mut self, extra: usize) {
         self.max_pieces = self.piece_budget(extra);
@@ -372,7 +269,7 @@ impl TwoLevel {
 
     /// The most pieces the TLAS may be re-braided into: a small mesh's triangles each, one for
     /// any other instance, and `extra` more for opening BLASes.
-    fn piece_budget(&self, extra: usize) -> usize {
+    pub(super) fn piece_budget(&self, extra: usize) -> usize {
         let base: usize = self
             .instances
             .iter()
@@ -555,152 +452,6 @@ impl TwoLevel {
             })
         })
     }
-
-    /// Nodes the device reserves for the TLAS at the front of its node arrays (binary and
-    /// wide): as many as a TLAS of [`TwoLevel::max_pieces`] leaves can take, so that a rebuilt
-    /// TLAS is written over the old one in place and the BLASes behind it stay where they are.
-    pub fn tlas_slots(&self) -> usize {
-        self.max_pieces.saturating_sub(1).max(1)
-    }
-
-    /// The device form: the TLAS's nodes (padded to [`TwoLevel::tlas_slots`]) followed by every
-    /// BLAS's (child indices and leaf triangles rebased: BLAS leaves index the object triangles
-    /// of all meshes one after the other, TLAS leaves the instances in TLAS order), each BLAS's
-    /// root, and each mesh's first object triangle.
-    pub fn device_nodes(&self) -> (Vec<GpuBvhNode>, Vec<u32>, Vec<u32>) {
-        let mut nodes = self.device_tlas();
-        let roots = self.device_roots();
-        let mut firsts = vec![];
-        let mut tri_base = 0u32;
-        for b in &self.blases {
-            debug_assert_eq!(roots[firsts.len()], nodes.len() as u32);
-            firsts.push(tri_base);
-            let base = nodes.len() as i32;
-            nodes.extend(b.bvh.nodes.iter().map(|&n| {
-                let mut n = n;
-                for (lo, hi) in [
-                    (&mut n.left_min, n.left_max),
-                    (&mut n.right_min, n.right_max),
-                ] {
-                    let r = lo[3].to_bits() as i32;
-                    let r = if r >= 0 {
-                        r + base
-                    } else if hi[3].to_bits() > 0 {
-                        !((!r) + tri_base as i32)
-                    } else {
-                        r
-                    };
-                    lo[3] = f32::from_bits(r as u32);
-                }
-                n
-            }));
-            tri_base += b.len() as u32;
-        }
-        (nodes, roots, firsts)
-    }
-
-    /// The TLAS's binary nodes in the device's form, padded to [`TwoLevel::tlas_slots`]: each
-    /// leaf (one piece, [`split_instance_leaves`]) has [`crate::cl::types::TLAS_LEAF`] set in
-    /// its count.
-    pub fn device_tlas(&self) -> Vec<GpuBvhNode> {
-        let mut nodes = self.tlas.nodes.clone();
-        for n in &mut nodes {
-            for (lo, hi) in [
-                (n.left_min, &mut n.left_max),
-                (n.right_min, &mut n.right_max),
-            ] {
-                let count = hi[3].to_bits();
-                if (lo[3].to_bits() as i32) < 0 && count > 0 {
-                    debug_assert_eq!(count, 1, "a TLAS leaf holds one piece");
-                    hi[3] = f32::from_bits(count | crate::cl::types::TLAS_LEAF);
-                }
-            }
-        }
-        nodes.resize(self.tlas_slots(), GpuBvhNode::default());
-        nodes
-    }
-
-    /// Where [`TwoLevel::device_nodes`] puts each BLAS's root: after the TLAS's slots, the
-    /// BLASes one after the other.
-    pub fn device_roots(&self) -> Vec<u32> {
-        let mut at = self.tlas_slots() as u32;
-        self.blases
-            .iter()
-            .map(|b| {
-                at += b.bvh.nodes.len() as u32;
-                at - b.bvh.nodes.len() as u32
-            })
-            .collect()
-    }
-
-    /// [`TwoLevel::device_nodes`] for the 4-wide form: the collapsed TLAS, then every
-    /// collapsed BLAS, rebased alike; each BLAS's root; and per BLAS, each binary node's wide
-    /// node (`u32::MAX` for one inside a wide node), where a piece enters the wide BLAS (only
-    /// the root's, `[0]`, when [`TwoLevel::max_pieces`] opens no BLAS).
-    pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>, Vec<Vec<u32>>) {
-        // Every wide node is made of a distinct binary node, so the binary nodes bound the
-        // array: reserved at once (address space; only the pages written are touched), it is
-        // never moved while it grows.
-        let bound =
-            self.tlas_slots() + self.blases.iter().map(|b| b.bvh.nodes.len()).sum::<usize>();
-        let mut nodes = Vec::with_capacity(bound);
-        nodes.extend(WideBvh::collapse(&self.tlas).nodes);
-        nodes.resize(self.tlas_slots(), GpuWideNode::default());
-        let mut roots = vec![];
-        let mut wide_of = vec![];
-        let mut tri_base = 0i32;
-        let opens = self.max_pieces > self.piece_budget(0);
-        // The BLASes are collapsed in parallel, a batch of about COLLAPSE_BATCH triangles at a
-        // time, and appended in order (in parallel too): only one batch's nodes wait beside the
-        // array, so the collapse touches little fresh memory beyond the array itself (a 64
-        // M-triangle scene of 3,125 meshes: 5.6 s one BLAS after another, docs/benchmarks.md).
-        const COLLAPSE_BATCH: usize = 1 << 20;
-        let mut rest = &self.blases[..];
-        while !rest.is_empty() {
-            let mut take = 0;
-            let mut triangles = 0;
-            while take < rest.len() && (take == 0 || triangles < COLLAPSE_BATCH) {
-                triangles += rest[take].len();
-                take += 1;
-            }
-            let (batch, after) = rest.split_at(take);
-            rest = after;
-            let collapsed: Vec<(WideBvh, Vec<u32>)> = batch
-                .par_iter()
-                .map(|b| WideBvh::collapse_mapped(&b.bvh, self.merge))
-                .collect();
-            for (b, (wide, binaries)) in batch.iter().zip(collapsed) {
-                let base = nodes.len() as i32;
-                roots.push(base as u32);
-                // Without re-braiding every piece enters its BLAS at the root (binary node 0,
-                // wide node 0): the map of every binary node (4 B each, 250 MB at 64 M
-                // triangles) is made only where pieces may enter below it.
-                let map = if opens {
-                    let mut map = vec![u32::MAX; b.bvh.nodes.len()];
-                    for (w, &n) in binaries.iter().enumerate() {
-                        map[n as usize] = w as u32;
-                    }
-                    map
-                } else {
-                    vec![0]
-                };
-                wide_of.push(map);
-                nodes.par_extend(wide.nodes.into_par_iter().map(|mut n| {
-                    for i in 0..super::WIDTH {
-                        if n.count[i] > 0 {
-                            n.child[i] = !((!n.child[i]) + tri_base);
-                        } else if n.child[i] > 0 {
-                            n.child[i] += base;
-                        }
-                    }
-                    n
-                }));
-                tri_base += b.len() as i32;
-            }
-        }
-        nodes.shrink_to_fit();
-        (nodes, roots, wide_of)
-    }
 }
 
 /// Meshes of at most this many triangles are small by default (see [`TwoLevel::small_mesh`]).
@@ -712,17 +463,6 @@ pub const FRONTIER: usize = 32;
 
 /// A piece's mark for one triangle (its index in the BLAS in the other bits), else a BLAS node.
 pub const PIECE_TRIANGLE: u32 = 1 << 31;
-
-/// Pieces beyond one per instance (and one per small mesh's triangle) that re-braiding may
-/// open BLASes into: 0, none, by default, since opening the bunny room's BLASes measured no
-/// faster on PoCL (docs/benchmarks.md, 2026-11-30); `PENUMBRA_REBRAID=n` sets it for
-/// experiments (the H200's figures are still to be measured).
-pub fn rebraid_budget() -> usize {
-    std::env::var("PENUMBRA_REBRAID")
-        .ok()
-        .and_then(|v| v.trim().parse().ok())
-        .unwrap_or(0)
-}
 
 /// Splits every TLAS leaf of several pieces into leaves of one, so that a ray tests each
 /// piece's box before it is carried into the instance: entering a piece costs a transform and

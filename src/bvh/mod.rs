@@ -2,21 +2,22 @@
 //! array of [`GpuBvhNode`]s with children referenced by index, and traversed on the host by the
 //! same rules the kernels use (the reference the device is tested against).
 
+mod blas;
 mod build;
 mod instances;
 mod quick;
 mod refit;
-mod stats;
+mod sah_split;
 mod traverse;
+mod two_level_device;
 mod wide;
 
-pub use build::{MAX_DEPTH, build, build_boxes, build_indexed};
-pub use instances::{
-    Blas, Instance, InstanceHit, PIECE_TRIANGLE, SMALL_MESH, TwoLevel, closed_cube,
-};
+pub use blas::{Blas, IndexedMesh};
+pub use build::{build, build_boxes, build_indexed};
+pub use instances::{Instance, InstanceHit, PIECE_TRIANGLE, SMALL_MESH, TwoLevel, closed_cube};
 pub use quick::{build_quick, build_quick_ordered, quick_blas, quick_blas_shared};
 pub use refit::{REFIT_MAX_GROWTH, Update};
-pub use stats::{BvhReport, report};
+pub use sah_split::MAX_DEPTH;
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};
 pub use wide::{CollapseCost, MERGE_MIN_TRIANGLES, MERGED_LEAF, WIDE_STACK_SIZE, WIDTH, WideBvh};
 

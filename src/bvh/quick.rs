@@ -77,11 +77,11 @@ pub fn quick_blas(positions: &[Vec3], indices: &[[u32; 3]]) -> super::Blas {
     super::Blas::copied(bvh, triangles)
 }
 
-/// [`quick_blas`] of a scene's mesh, which the BLAS keeps and reads its triangles from: the
+/// [`quick_blas`] of a shared mesh, which the BLAS keeps and reads its triangles from: the
 /// triangles in BVH order the build needs are freed once the tree is made, so that a scene's
 /// BLASes hold no copy of them (a 64 M-triangle scene's 2.3 GB).
-pub fn quick_blas_shared(mesh: &std::sync::Arc<crate::scene::Mesh>) -> super::Blas {
-    super::Blas::over_mesh(quick_blas(&mesh.positions, &mesh.indices).bvh, mesh)
+pub fn quick_blas_shared<M: super::IndexedMesh + 'static>(mesh: &std::sync::Arc<M>) -> super::Blas {
+    super::Blas::over_mesh(quick_blas(mesh.positions(), mesh.indices()).bvh, mesh)
 }
 
 /// The triangles `triangle(i)` for i in `order`.
@@ -437,13 +437,19 @@ mod tests {
         check_tree(&quick.bvh, &mesh_order);
         let quick_tris: Vec<[Vec3; 3]> = quick.triangles().collect();
         assert_eq!(quick_tris, ordered(&quick.bvh, &mesh_order));
-        // The BLASes that read a scene's mesh instead of copying its triangles: the same trees,
+        // The BLASes that read a shared mesh instead of copying its triangles: the same trees,
         // triangles and hits.
-        let mesh = std::sync::Arc::new(crate::scene::Mesh {
-            positions: positions.clone(),
-            indices: indices.clone(),
-            ..Default::default()
-        });
+        #[derive(Debug)]
+        struct Shared(Vec<Vec3>, Vec<[u32; 3]>);
+        impl super::super::IndexedMesh for Shared {
+            fn positions(&self) -> &[Vec3] {
+                &self.0
+            }
+            fn indices(&self) -> &[[u32; 3]] {
+                &self.1
+            }
+        }
+        let mesh = std::sync::Arc::new(Shared(positions.clone(), indices.clone()));
         let (quick_shared, sah_shared) = (
             quick_blas_shared(&mesh),
             super::super::Blas::of_shared_mesh(&mesh),

@@ -2,7 +2,7 @@
 //! recomputed bottom up with the topology kept, and the tree is rebuilt instead when that has
 //! made it too slow to traverse.
 
-use super::build::TRAVERSAL_COST;
+use super::sah_split::TRAVERSAL_COST;
 use super::{Aabb, Bvh, Child, build};
 use crate::cl::types::GpuBvhNode;
 use glam::Vec3;

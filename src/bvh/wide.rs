@@ -19,8 +19,7 @@ pub const MERGED_LEAF: u32 = 4;
 /// The fewest triangles for which [`WideBvh::collapse_for_cpu`] merges small subtrees: below
 /// this the wide nodes fit a core's L2 cache (2 MB: 16 K nodes of 128 bytes, from about 30 K
 /// triangles), traversal is bound by arithmetic rather than memory, and the builder's own
-/// leaves measured faster (Cornell box 7–10 % slower merged; docs/benchmarks.md, "Sixth
-/// session").
+/// leaves measured faster (Cornell box 7–10 % slower merged).
 pub const MERGE_MIN_TRIANGLES: usize = 65_536;
 
 /// The largest leaf the CPU's wide trees over `triangles` triangles merge small subtrees into
@@ -57,11 +56,10 @@ impl WideBvh {
     /// leaves: the binary builder's leaves hold 1–2 triangles, so without merging 44 % of the
     /// 1 M-triangle bunnies' wide nodes have only two children, both leaves, while
     /// traverse_wide.h tests a leaf of three or four triangles in the four lanes of one
-    /// `float4` test (docs/benchmarks.md, "Sixth session"). Which subtrees become leaves and
-    /// which binary nodes become wide nodes is [`WideBvh::collapse_optimal`]'s choice (with
-    /// [`CollapseCost::CPU`]): on the bunnies 18 % fewer nodes than merging every small subtree
-    /// and opening the largest child, for 1.3 % less expected cost and 1 % fewer visits
-    /// (docs/benchmarks.md, "Ninth session"). The same triangles are tested, in BVH order
+    /// `float4` test. Which subtrees become leaves and which binary nodes become wide nodes is
+    /// [`WideBvh::collapse_optimal`]'s choice (with [`CollapseCost::CPU`]): on the bunnies 18 %
+    /// fewer nodes than merging every small subtree and opening the largest child, for 1.3 %
+    /// less expected cost and 1 % fewer visits. The same triangles are tested, in BVH order
     /// within a merged leaf, so the closest hit is the same (short of exact ties in t). Small
     /// scenes get [`WideBvh::collapse`].
     pub fn collapse_for_cpu(bvh: &Bvh) -> Self {

@@ -352,12 +352,21 @@ fn read<T: bytemuck::Pod + Default, const N: usize>(
     Ok(out)
 }
 
+/// A primitive decoded from `KHR_draco_mesh_compression`.
+pub struct DracoPrimitive {
+    /// Triangle corners as point indices.
+    pub indices: Vec<u32>,
+    /// Attribute values by glTF semantic (`POSITION`, `JOINTS_0` …), as floats (integers
+    /// converted, normalized per the glTF accessor), four per point, unused lanes zero.
+    pub attributes: HashMap<String, Vec<[f32; 4]>>,
+}
+
 /// The vertex attributes of one primitive, from its accessors or its Draco data.
 pub struct Attributes<'a> {
     pub root: &'a gltf::json::Root,
     pub data: &'a BufferData<'a>,
     pub accessors: HashMap<String, usize>,
-    pub draco: Option<super::compression::DracoPrimitive>,
+    pub draco: Option<DracoPrimitive>,
     pub path: String,
 }
 

@@ -15,7 +15,7 @@
 //! limits, the level and its slices against the bytes that exist, the Zstandard output against
 //! the size UASTC needs.
 
-use super::sources::check_image_size;
+use super::limits::check_image_size;
 use basis_universal::{TranscodeParameters, Transcoder, TranscoderTextureFormat};
 use ktx2::{ColorModel, SupercompressionScheme};
 use std::io::Read;

@@ -2,6 +2,7 @@
 //! decoders and filters) and `KHR_draco_mesh_compression` primitives (the pure-Rust
 //! `draco-core` decoder).
 
+use super::accessor::{BufferData, DracoPrimitive};
 use draco_core::draco_types::DataType;
 use draco_core::geometry_indices::PointIndex;
 use serde_json::Value;
@@ -221,20 +222,11 @@ fn write_back(bytes: &mut [u8], values: impl Iterator<Item = u8>) {
     }
 }
 
-/// A primitive decoded from `KHR_draco_mesh_compression`.
-pub struct DracoPrimitive {
-    /// Triangle corners as point indices.
-    pub indices: Vec<u32>,
-    /// Attribute values by glTF semantic (`POSITION`, `JOINTS_0` …), as floats (integers
-    /// converted, normalized per the glTF accessor), four per point, unused lanes zero.
-    pub attributes: HashMap<String, Vec<[f32; 4]>>,
-}
-
 /// Decodes the Draco data of primitive `path` (`meshes[m].primitives[p]`) whose extension
 /// object is `ext`.
 pub fn decode_draco(
     root: &gltf::json::Root,
-    data: &super::accessor::BufferData,
+    data: &BufferData,
     primitive: &gltf::json::mesh::Primitive,
     path: &str,
 ) -> Result<Option<DracoPrimitive>, String> {

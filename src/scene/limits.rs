@@ -10,7 +10,7 @@ pub const MAX_NODE_INSTANCES: usize = 200_000;
 
 /// The most triangles over all placed mesh instances (after instancing): 67 M, room for issue
 /// 14's 64 M-triangle scenes. Loading and building keep about 110 bytes a unique triangle on
-/// the host (docs/benchmarks.md), about 7.5 GB at the limit.
+/// the host, about 7.5 GB at the limit.
 pub const MAX_TRIANGLES: usize = 1 << 26;
 
 /// The farthest a placed vertex may lie from the origin along any axis, in scene units. Past
@@ -45,3 +45,22 @@ pub const MAX_ENV_PIXELS: u64 = 1 << 26;
 /// The largest light intensity and emissive strength accepted; larger values are clamped with
 /// a warning, so that sums of samples stay finite in f32.
 pub const MAX_INTENSITY: f32 = 1e12;
+
+/// Checks a texture image's header size against [`MAX_IMAGE_SIDE`] and [`MAX_IMAGE_PIXELS`].
+pub fn check_image_size(width: u32, height: u32) -> Result<(), String> {
+    check_size(width, height, MAX_IMAGE_SIDE, MAX_IMAGE_PIXELS)
+}
+
+/// Checks an image's header size against a side and pixel limit.
+pub fn check_size(width: u32, height: u32, max_side: u32, max_pixels: u64) -> Result<(), String> {
+    if width == 0 || height == 0 {
+        return Err(format!("the image is empty ({width}×{height})"));
+    }
+    if width > max_side || height > max_side || width as u64 * height as u64 > max_pixels {
+        return Err(format!(
+            "{width}×{height} pixels is more than the limit ({max_side} per side, \
+             {max_pixels} pixels)"
+        ));
+    }
+    Ok(())
+}

@@ -6,6 +6,7 @@
 mod accessor;
 mod basisu;
 mod bounds;
+pub mod bvh_report;
 mod compression;
 mod env_presets;
 mod environment;
@@ -86,6 +87,16 @@ pub struct Mesh {
     pub tangents: Vec<[Vec4; 3]>,
     /// The triangles whose material a `KHR_materials_variants` variant changes.
     pub variants: Vec<VariantRange>,
+}
+
+impl crate::bvh::IndexedMesh for Mesh {
+    fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    fn indices(&self) -> &[[u32; 3]] {
+        &self.indices
+    }
 }
 
 impl Mesh {

@@ -3,9 +3,8 @@
 //! bind matrix) blended per vertex.
 
 use super::accessor::{self, Attributes, BufferData};
-use super::gltf_import::node_matrix;
 use super::validate::PreciseNode;
-use glam::{DMat4, Vec3, Vec4};
+use glam::{DMat4, DQuat, DVec3, Vec3, Vec4};
 
 /// The pose a mesh is drawn in: morph target weights and skin joint matrices.
 #[derive(Default)]
@@ -216,4 +215,42 @@ pub fn apply_skin(
         }
     }
     Ok(())
+}
+
+/// The node's local transform, or why it cannot be used: a non-finite value, a zero
+/// quaternion or a singular matrix. `precise` holds the values as written, in f64, when the
+/// file could be read that way; otherwise gltf-json's f32 values are used.
+pub fn node_matrix(
+    node: &gltf::Node,
+    precise: Option<&PreciseNode>,
+) -> Result<DMat4, &'static str> {
+    let f32_matrix = match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => Some(matrix.map(|c| c.map(f64::from))),
+        _ => None,
+    };
+    if let Some(matrix) = f32_matrix {
+        let m = match precise.and_then(|p| p.matrix) {
+            Some(m) => DMat4::from_cols_array(&m),
+            None => DMat4::from_cols_array_2d(&matrix),
+        };
+        if !m.is_finite() {
+            return Err("matrix is not finite");
+        }
+        if !m.inverse().is_finite() || m.determinant() == 0.0 {
+            return Err("matrix is singular");
+        }
+        return Ok(m);
+    }
+    let (t, r, s) = node.transform().decomposed();
+    let p = precise.cloned().unwrap_or_default();
+    let t = DVec3::from(p.translation.unwrap_or(t.map(f64::from)));
+    let r = DQuat::from_array(p.rotation.unwrap_or(r.map(f64::from)));
+    let s = DVec3::from(p.scale.unwrap_or(s.map(f64::from)));
+    if !(t.is_finite() && r.is_finite() && s.is_finite()) {
+        return Err("translation, rotation or scale is not finite");
+    }
+    if r.length_squared() < 1e-24 {
+        return Err("rotation is a zero quaternion");
+    }
+    Ok(DMat4::from_scale_rotation_translation(s, r.normalize(), t))
 }

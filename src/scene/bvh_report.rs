@@ -1,8 +1,8 @@
 //! What `penumbra bench bvh` measures: the cost of building and updating the BVH of a scene on
 //! the host, without a device.
 
-use super::{Blas, TwoLevel, build};
-use crate::scene::{Object, Scene};
+use super::{Object, Scene};
+use crate::bvh::{Blas, TwoLevel, build};
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -78,7 +78,7 @@ pub fn report(scene: &Scene, runs: usize, flat: bool) -> BvhReport {
     // The two-level form: one BLAS per distinct mesh, instances placed by their transforms.
     // Each BLAS is built from a transient copy of its mesh's triangles, as the renderer does.
     let objects: Vec<&Object> = visible.iter().map(|(_, o)| *o).collect();
-    let (first, mesh_of) = crate::scene::distinct_meshes(&objects);
+    let (first, mesh_of) = super::distinct_meshes(&objects);
     let placed: Vec<(u32, DMat4)> = objects
         .iter()
         .zip(&mesh_of)

@@ -1,0 +1,155 @@
+//! The two-level form in the device's layout: the TLAS's nodes in slots reserved at the front
+//! of the node arrays (so that a rebuilt TLAS is written over the old one in place), then every
+//! BLAS's, rebased, in the binary and the 4-wide forms.
+
+use super::{TwoLevel, WideBvh};
+use crate::cl::types::{GpuBvhNode, GpuWideNode};
+use rayon::prelude::*;
+
+impl TwoLevel {
+    /// Nodes the device reserves for the TLAS at the front of its node arrays (binary and
+    /// wide): as many as a TLAS of [`TwoLevel::max_pieces`] leaves can take, so that a rebuilt
+    /// TLAS is written over the old one in place and the BLASes behind it stay where they are.
+    pub fn tlas_slots(&self) -> usize {
+        self.max_pieces.saturating_sub(1).max(1)
+    }
+
+    /// The device form: the TLAS's nodes (padded to [`TwoLevel::tlas_slots`]) followed by every
+    /// BLAS's (child indices and leaf triangles rebased: BLAS leaves index the object triangles
+    /// of all meshes one after the other, TLAS leaves the instances in TLAS order), each BLAS's
+    /// root, and each mesh's first object triangle.
+    pub fn device_nodes(&self) -> (Vec<GpuBvhNode>, Vec<u32>, Vec<u32>) {
+        let mut nodes = self.device_tlas();
+        let roots = self.device_roots();
+        let mut firsts = vec![];
+        let mut tri_base = 0u32;
+        for b in &self.blases {
+            debug_assert_eq!(roots[firsts.len()], nodes.len() as u32);
+            firsts.push(tri_base);
+            let base = nodes.len() as i32;
+            nodes.extend(b.bvh.nodes.iter().map(|&n| {
+                let mut n = n;
+                for (lo, hi) in [
+                    (&mut n.left_min, n.left_max),
+                    (&mut n.right_min, n.right_max),
+                ] {
+                    let r = lo[3].to_bits() as i32;
+                    let r = if r >= 0 {
+                        r + base
+                    } else if hi[3].to_bits() > 0 {
+                        !((!r) + tri_base as i32)
+                    } else {
+                        r
+                    };
+                    lo[3] = f32::from_bits(r as u32);
+                }
+                n
+            }));
+            tri_base += b.len() as u32;
+        }
+        (nodes, roots, firsts)
+    }
+
+    /// The TLAS's binary nodes in the device's form, padded to [`TwoLevel::tlas_slots`]: each
+    /// leaf (one piece, [`split_instance_leaves`]) has [`crate::cl::types::TLAS_LEAF`] set in
+    /// its count.
+    pub fn device_tlas(&self) -> Vec<GpuBvhNode> {
+        let mut nodes = self.tlas.nodes.clone();
+        for n in &mut nodes {
+            for (lo, hi) in [
+                (n.left_min, &mut n.left_max),
+                (n.right_min, &mut n.right_max),
+            ] {
+                let count = hi[3].to_bits();
+                if (lo[3].to_bits() as i32) < 0 && count > 0 {
+                    debug_assert_eq!(count, 1, "a TLAS leaf holds one piece");
+                    hi[3] = f32::from_bits(count | crate::cl::types::TLAS_LEAF);
+                }
+            }
+        }
+        nodes.resize(self.tlas_slots(), GpuBvhNode::default());
+        nodes
+    }
+
+    /// Where [`TwoLevel::device_nodes`] puts each BLAS's root: after the TLAS's slots, the
+    /// BLASes one after the other.
+    pub fn device_roots(&self) -> Vec<u32> {
+        let mut at = self.tlas_slots() as u32;
+        self.blases
+            .iter()
+            .map(|b| {
+                at += b.bvh.nodes.len() as u32;
+                at - b.bvh.nodes.len() as u32
+            })
+            .collect()
+    }
+
+    /// [`TwoLevel::device_nodes`] for the 4-wide form: the collapsed TLAS, then every
+    /// collapsed BLAS, rebased alike; each BLAS's root; and per BLAS, each binary node's wide
+    /// node (`u32::MAX` for one inside a wide node), where a piece enters the wide BLAS (only
+    /// the root's, `[0]`, when [`TwoLevel::max_pieces`] opens no BLAS).
+    pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>, Vec<Vec<u32>>) {
+        // Every wide node is made of a distinct binary node, so the binary nodes bound the
+        // array: reserved at once (address space; only the pages written are touched), it is
+        // never moved while it grows.
+        let bound =
+            self.tlas_slots() + self.blases.iter().map(|b| b.bvh.nodes.len()).sum::<usize>();
+        let mut nodes = Vec::with_capacity(bound);
+        nodes.extend(WideBvh::collapse(&self.tlas).nodes);
+        nodes.resize(self.tlas_slots(), GpuWideNode::default());
+        let mut roots = vec![];
+        let mut wide_of = vec![];
+        let mut tri_base = 0i32;
+        let opens = self.max_pieces > self.piece_budget(0);
+        // The BLASes are collapsed in parallel, a batch of about COLLAPSE_BATCH triangles at a
+        // time, and appended in order (in parallel too): only one batch's nodes wait beside the
+        // array, so the collapse touches little fresh memory beyond the array itself (a 64
+        // M-triangle scene of 3,125 meshes: 5.6 s one BLAS after another).
+        const COLLAPSE_BATCH: usize = 1 << 20;
+        let mut rest = &self.blases[..];
+        while !rest.is_empty() {
+            let mut take = 0;
+            let mut triangles = 0;
+            while take < rest.len() && (take == 0 || triangles < COLLAPSE_BATCH) {
+                triangles += rest[take].len();
+                take += 1;
+            }
+            let (batch, after) = rest.split_at(take);
+            rest = after;
+            let collapsed: Vec<(WideBvh, Vec<u32>)> = batch
+                .par_iter()
+                .map(|b| WideBvh::collapse_mapped(&b.bvh, self.merge))
+                .collect();
+            for (b, (wide, binaries)) in batch.iter().zip(collapsed) {
+                let base = nodes.len() as i32;
+                roots.push(base as u32);
+                // Without re-braiding every piece enters its BLAS at the root (binary node 0,
+                // wide node 0): the map of every binary node (4 B each, 250 MB at 64 M
+                // triangles) is made only where pieces may enter below it.
+                let map = if opens {
+                    let mut map = vec![u32::MAX; b.bvh.nodes.len()];
+                    for (w, &n) in binaries.iter().enumerate() {
+                        map[n as usize] = w as u32;
+                    }
+                    map
+                } else {
+                    vec![0]
+                };
+                wide_of.push(map);
+                nodes.par_extend(wide.nodes.into_par_iter().map(|mut n| {
+                    for i in 0..super::WIDTH {
+                        if n.count[i] > 0 {
+                            n.child[i] = !((!n.child[i]) + tri_base);
+                        } else if n.child[i] > 0 {
+                            n.child[i] += base;
+                        }
+                    }
+                    n
+                }));
+                tri_base += b.len() as i32;
+            }
+        }
+        nodes.shrink_to_fit();
+        (nodes, roots, wide_of)
+    }
+}

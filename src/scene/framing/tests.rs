@@ -1,0 +1,481 @@
+//! Tests of the first view: the robust bounds, the probe's two tracers, the view of an object,
+//! of a room and of a lit scene, and the lights added to a view.
+
+use super::probe::{Tracer, sphere_directions};
+use super::subject_bounds::{centroid_percentiles, regular_sample_of, robust_bounds_windowed};
+use super::*;
+use crate::bvh::Ray;
+use crate::scene::{Material, Mesh, Object};
+use glam::DMat4;
+use std::sync::Arc;
+
+/// A box from `lo` to `hi` as 12 triangles; `inward` makes the faces look inside.
+fn cuboid(lo: Vec3, hi: Vec3, inward: bool) -> Vec<[Vec3; 3]> {
+    let c = |i: usize| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    // Quads as corner indices, counter-clockwise seen from outside.
+    let quads = [
+        [0, 2, 3, 1], // −Z
+        [4, 5, 7, 6], // +Z
+        [0, 4, 6, 2], // −X
+        [1, 3, 7, 5], // +X
+        [0, 1, 5, 4], // −Y
+        [2, 6, 7, 3], // +Y
+    ];
+    let mut out = Vec::new();
+    for q in quads {
+        let (a, b, cc, d) = (c(q[0]), c(q[1]), c(q[2]), c(q[3]));
+        if inward {
+            out.push([a, cc, b]);
+            out.push([a, d, cc]);
+        } else {
+            out.push([a, b, cc]);
+            out.push([a, cc, d]);
+        }
+    }
+    out
+}
+
+fn scene_of(parts: &[(Vec<[Vec3; 3]>, Material)]) -> Scene {
+    let mut scene = Scene::default();
+    for (i, (tris, material)) in parts.iter().enumerate() {
+        let mut mesh = Mesh::default();
+        for t in tris {
+            let base = mesh.positions.len() as u32;
+            mesh.positions.extend_from_slice(t);
+            mesh.indices.push([base, base + 1, base + 2]);
+            mesh.materials.push(i as u32);
+        }
+        scene.objects.push(Object {
+            name: format!("part {i}"),
+            world_from_object: DMat4::IDENTITY,
+            visible: true,
+            mesh: mesh.into(),
+        });
+        scene.materials.push(material.clone());
+    }
+    scene
+}
+
+fn point(position: DVec3, intensity: f32) -> Light {
+    Light {
+        name: "lamp".into(),
+        kind: LightKind::Point,
+        position,
+        direction: DVec3::NEG_Y,
+        color: [1.0; 3],
+        intensity,
+        light_radius: 0.0,
+    }
+}
+
+/// A finely split unit cube (so percentiles see many triangles) at the origin.
+fn subject() -> Vec<[Vec3; 3]> {
+    let mut tris = Vec::new();
+    for i in 0..4 {
+        for k in 0..4 {
+            let lo = Vec3::new(i as f32 * 0.25 - 0.5, -0.5, k as f32 * 0.25 - 0.5);
+            tris.extend(cuboid(lo, lo + Vec3::new(0.25, 1.0, 0.25), false));
+        }
+    }
+    tris
+}
+
+#[test]
+fn robust_bounds_ignore_a_stray_far_object() {
+    let mut tris = subject();
+    tris.extend(cuboid(Vec3::splat(1000.0), Vec3::splat(1000.1), false));
+    let b = robust_bounds(&WorldTris::soup(&tris));
+    assert!((b.min - DVec3::splat(-0.5)).length() < 1e-6, "{b:?}");
+    assert!((b.max - DVec3::splat(0.5)).length() < 1e-6, "{b:?}");
+}
+
+/// A large scene's window placed from a regular sample gives the bounds that all the
+/// triangles give: a floor of 20,000 triangles with a far-away speck, sampled down to 500
+/// (and, as a check that the sample matters, the window of the first 500 alone is wrong).
+#[test]
+fn a_sampled_window_gives_the_bounds_of_all_triangles() {
+    let mut tris = vec![];
+    for i in 0..100 {
+        for j in 0..100 {
+            let (x, z) = (i as f32 * 0.1, j as f32 * 0.1 + 0.02 * (i % 3) as f32);
+            let (a, b) = (Vec3::new(x, 0.0, z), Vec3::new(x + 0.1, 0.0, z));
+            let (c, d) = (Vec3::new(x, 0.0, z + 0.1), Vec3::new(x + 0.1, 0.3, z + 0.1));
+            tris.push([a, b, c]);
+            tris.push([b, d, c]);
+        }
+    }
+    tris.push([
+        Vec3::splat(1e6),
+        Vec3::splat(1e6) + Vec3::X,
+        Vec3::splat(1e6) + Vec3::Y,
+    ]);
+    let all = WorldTris::soup(&tris);
+    assert!(regular_sample_of(&all, all.len(), 500).is_none());
+    let sample = regular_sample_of(&all, 1000, 500).unwrap();
+    assert!(sample.len() <= 500 && sample.len() >= 450);
+    let exact = robust_bounds(&all);
+    assert!(exact.max.x < 11.0 && exact.min.x == 0.0);
+    assert_eq!(robust_bounds_windowed(&all, &sample), exact);
+    let first = WorldTris::soup(&tris[..500]);
+    assert_ne!(robust_bounds_windowed(&all, &first), exact);
+}
+
+/// The percentiles by histograms are those of sorting (value, weight) pairs and scanning
+/// them (how they were found before), ties, signs and zeros of both signs included.
+#[test]
+fn centroid_percentiles_are_those_of_a_sort() {
+    fn by_sort(tris: &[[Vec3; 3]], axis: usize, q: f64) -> f32 {
+        let mut v: Vec<(f32, f32)> = tris
+            .iter()
+            .map(|t| (((t[0] + t[1] + t[2]) / 3.0)[axis], area(t).sqrt() + 1e-12))
+            .collect();
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let total: f64 = v.iter().map(|v| v.1 as f64).sum();
+        let mut acc = 0.0;
+        for &(x, w) in &v {
+            acc += w as f64;
+            if acc >= q * total {
+                return x;
+            }
+        }
+        v.last().unwrap().0
+    }
+    // A fixed scramble of (triangle, draw) to [0, 1).
+    let r = |i: usize, k: usize| ((i * 2654435761 + k * 40503) % 997) as f32 / 997.0;
+    for n in [8, 100, 5000] {
+        let tris: Vec<[Vec3; 3]> = (0..n)
+            .map(|i| {
+                // Centroids on a coarse grid (many ties), some negative, some at ±0.
+                let y = if i % 7 == 0 {
+                    -0.0
+                } else {
+                    (r(i, 1) * 3.0).floor()
+                };
+                let c = Vec3::new((r(i, 0) * 8.0).floor() - 4.0, y, r(i, 2) * 1e3 - 500.0);
+                let a = Vec3::new((r(i, 3) * 4.0).floor() + 1.0, 0.0, (r(i, 4) * 2.0).floor());
+                let b = Vec3::new(0.0, (r(i, 5) * 4.0).floor() + 1.0, 1.0);
+                [c + a, c + b, c - a - b]
+            })
+            .collect();
+        let soup = WorldTris::soup(&tris);
+        for (axis, p) in centroid_percentiles(&soup).into_iter().enumerate() {
+            for (k, q) in [0.05, 0.95].into_iter().enumerate() {
+                let expect = by_sort(&tris, axis, q);
+                assert_eq!(p[k].to_bits(), expect.to_bits(), "n {n} axis {axis} q {q}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_small_model_fills_the_frame() {
+    for size in [0.01f32, 1.0, 300.0] {
+        let tris: Vec<[Vec3; 3]> = subject().iter().map(|t| t.map(|v| v * size)).collect();
+        let b = robust_bounds(&WorldTris::soup(&tris));
+        let cam = fit(&b, &[], DVec3::new(0.3, 0.4, 1.0).normalize(), 0.8, 1.6);
+        // Project the corners: the widest one reaches 80–100% of the half-frame.
+        let right = cam.forward.cross(cam.up);
+        let tan_y = (cam.yfov * 0.5).tan();
+        let mut fill = 0.0f64;
+        for i in 0..8 {
+            let p = DVec3::new(
+                if i & 1 == 0 { b.min.x } else { b.max.x },
+                if i & 2 == 0 { b.min.y } else { b.max.y },
+                if i & 4 == 0 { b.min.z } else { b.max.z },
+            ) - cam.eye;
+            let z = p.dot(cam.forward);
+            assert!(z > 0.0);
+            fill = fill
+                .max(p.dot(cam.up).abs() / (z * tan_y))
+                .max(p.dot(right).abs() / (z * tan_y * 1.6));
+        }
+        assert!((0.8..=0.901).contains(&fill), "size {size}: fill {fill}");
+    }
+}
+
+#[test]
+fn the_view_faces_the_light() {
+    let scene = scene_of(&[(subject(), Material::default())]);
+    let probe = Probe::new(&scene);
+    for light_dir in [DVec3::X, DVec3::NEG_Z, DVec3::new(-1.0, 0.5, 0.2)] {
+        let lamp = point(light_dir.normalize() * 5.0, 25.0);
+        let d = lit_side(&probe, &[lamp]);
+        assert!(
+            d.dot(light_dir.normalize()) > 0.6,
+            "light from {light_dir}, view from {d}"
+        );
+    }
+}
+
+#[test]
+fn a_room_is_seen_from_inside_and_an_object_from_outside() {
+    // A 6 × 2.7 × 4 m room with a table in it.
+    let mut room = cuboid(Vec3::ZERO, Vec3::new(6.0, 2.7, 4.0), true);
+    room.extend(cuboid(
+        Vec3::new(2.5, 0.0, 1.5),
+        Vec3::new(3.5, 0.75, 2.5),
+        false,
+    ));
+    let scene = scene_of(&[(room, Material::default())]);
+    let view = first_view(&scene, &[], None, 1.6);
+    assert!(view.interior);
+    let eye = view.camera.eye;
+    assert!(
+        (eye.y - EYE_HEIGHT).abs() < 1e-6 && eye.x > 0.0 && eye.x < 6.0 && eye.z > 0.0,
+        "{eye} in {:?}",
+        view.bounds
+    );
+    // It looks along the long (x) side of the room.
+    assert!(
+        view.camera.forward.x.abs() > 0.9,
+        "{:?}",
+        view.camera.forward
+    );
+    // The same box with faces out is a closed object: framed from outside.
+    let closed = cuboid(Vec3::ZERO, Vec3::new(6.0, 2.7, 4.0), false);
+    let view = first_view(&scene_of(&[(closed, Material::default())]), &[], None, 1.6);
+    assert!(!view.interior);
+    assert!(view.camera.eye.z > 4.0, "{}", view.camera.eye);
+}
+
+#[test]
+fn the_sky_reaches_into_a_room_without_a_ceiling_and_not_into_a_closed_one() {
+    let camera = Camera::look_at(
+        "inside",
+        DVec3::new(0.5, 1.4, 1.5),
+        DVec3::new(-0.5, 1.0, -2.0),
+        0.9,
+    );
+    let mut room = cuboid(Vec3::new(-3.0, 0.0, -2.0), Vec3::new(3.0, 2.7, 2.0), true);
+    let closed = first_view(
+        &scene_of(&[(room.clone(), Material::default())]),
+        &[],
+        Some(&camera),
+        1.5,
+    );
+    assert!(
+        closed.coverage == 1.0 && closed.sky_fraction == 0.0,
+        "{closed:?}"
+    );
+    assert!(!closed.environment_reaches());
+    room.truncate(10); // the ceiling (+Y) is the last quad
+    let open = first_view(
+        &scene_of(&[(room, Material::default())]),
+        &[],
+        Some(&camera),
+        1.5,
+    );
+    assert!(open.sky_fraction > 0.05, "{open:?}");
+    assert!(open.environment_reaches());
+}
+
+#[test]
+fn a_lamp_over_the_subject_lights_the_view_and_a_tiny_glow_does_not() {
+    let floor = vec![
+        [
+            Vec3::new(-5.0, -0.5, -5.0),
+            Vec3::new(-5.0, -0.5, 5.0),
+            Vec3::new(5.0, -0.5, 5.0),
+        ],
+        [
+            Vec3::new(-5.0, -0.5, -5.0),
+            Vec3::new(5.0, -0.5, 5.0),
+            Vec3::new(5.0, -0.5, -5.0),
+        ],
+    ];
+    let parts = [
+        (subject(), Material::default()),
+        (floor, Material::default()),
+    ];
+    let scene = scene_of(&parts);
+    let lamp = point(DVec3::new(1.0, 4.0, 2.0), 20.0);
+    let view = first_view(&scene, &[lamp], None, 1.5);
+    assert!(view.lit, "{view:?}");
+    assert!(view.coverage > 0.3, "{view:?}");
+    let view = first_view(&scene, &[], None, 1.5);
+    assert!(!view.lit && view.lit_fraction == 0.0, "{view:?}");
+
+    // A small, very bright glowing cube inside a closed housing lights nothing.
+    let glow_material = Material {
+        emission: [500.0; 3],
+        ..Material::default()
+    };
+    let glow = cuboid(Vec3::new(0.55, 0.2, 0.55), Vec3::new(0.6, 0.25, 0.6), false);
+    let housing = cuboid(
+        Vec3::new(0.52, 0.17, 0.52),
+        Vec3::new(0.63, 0.28, 0.63),
+        true,
+    );
+    let mut parts = parts.to_vec();
+    parts.push((glow, glow_material));
+    parts.push((
+        housing.iter().map(|t| [t[0], t[2], t[1]]).collect(),
+        Material::default(),
+    ));
+    let view = first_view(&scene_of(&parts), &[], None, 1.5);
+    assert!(!view.lit, "{view:?}");
+}
+
+/// A room of shared meshes: a table mesh placed four times (scaled, rotated, mirrored),
+/// a glass pane, a glowing panel and a lamp-lit subject, with the placed objects' meshes
+/// shared as the importer shares them.
+fn instanced_room() -> Scene {
+    let mut room = cuboid(Vec3::ZERO, Vec3::new(6.0, 2.7, 4.0), true);
+    room.extend(cuboid(
+        Vec3::new(0.2, 0.0, 0.2),
+        Vec3::new(0.4, 2.0, 0.4),
+        false,
+    ));
+    let table = cuboid(Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 0.75, 0.5), false);
+    let pane = cuboid(Vec3::new(4.0, 0.5, 3.0), Vec3::new(5.0, 2.0, 3.02), false);
+    let panel = cuboid(Vec3::new(2.5, 2.6, 1.5), Vec3::new(3.5, 2.65, 2.5), false);
+    let glass = Material {
+        transmission: 1.0,
+        ..Material::default()
+    };
+    let glow = Material {
+        emission: [4.0; 3],
+        ..Material::default()
+    };
+    let mut scene = scene_of(&[
+        (room, Material::default()),
+        (pane, glass),
+        (panel, glow),
+        (table, Material::default()),
+    ]);
+    let table = scene.objects[3].clone();
+    let placements = [
+        DMat4::from_translation(DVec3::new(1.5, 0.0, 1.0)),
+        DMat4::from_translation(DVec3::new(4.5, 0.0, 1.2))
+            * DMat4::from_rotation_y(0.7)
+            * DMat4::from_scale(DVec3::new(1.3, 0.8, 0.6)),
+        // Mirrored: its triangles' corners swap in world space.
+        DMat4::from_translation(DVec3::new(2.0, 0.0, 3.0))
+            * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+    ];
+    scene.objects[3].world_from_object = DMat4::from_translation(DVec3::new(3.0, 0.0, 2.0));
+    for (i, m) in placements.into_iter().enumerate() {
+        scene.objects.push(Object {
+            name: format!("table {i}"),
+            world_from_object: m,
+            ..table.clone()
+        });
+    }
+    // A hidden one is left out of both.
+    scene.objects.push(Object {
+        name: "hidden".into(),
+        world_from_object: DMat4::from_translation(DVec3::new(3.0, 1.5, 2.0)),
+        visible: false,
+        ..table
+    });
+    scene
+}
+
+/// The probe over quick BLASes and a top level finds, ray for ray, the triangle and
+/// distance that one tree over the world triangles finds (closest and any hit, with and
+/// without glass), and the same first view.
+#[test]
+fn the_two_level_probe_finds_what_one_tree_over_the_world_finds() {
+    let scene = instanced_room();
+    let two = Probe::new(&scene);
+    let flat = Probe::flat(&scene);
+    assert!(matches!(two.tracer, Tracer::TwoLevel { .. }));
+    assert!(matches!(flat.tracer, Tracer::Flat { .. }));
+    assert_eq!(two.tris.to_vecs(), flat.tris.to_vecs());
+    let centre = DVec3::new(3.0, 1.2, 2.0);
+    let mut hits = 0;
+    for (k, d) in sphere_directions(2000).enumerate() {
+        // From points all over the room, some inside the tables.
+        let o = centre
+            + DVec3::new(
+                (k % 7) as f64 - 3.0,
+                (k % 5) as f64 * 0.3 - 0.6,
+                (k % 3) as f64 - 1.0,
+            ) * 0.5;
+        let ray = Ray {
+            origin: o.as_vec3(),
+            direction: d.as_vec3(),
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        };
+        for (any, opaque) in [(false, false), (false, true), (true, true)] {
+            let (a, b) = (two.trace(&ray, any, opaque), flat.trace(&ray, any, opaque));
+            if any {
+                assert_eq!(a.is_some(), b.is_some(), "ray {k}");
+            } else {
+                assert_eq!(a, b, "ray {k} opaque {opaque}");
+                hits += a.is_some() as usize;
+            }
+        }
+    }
+    assert!(hits > 3000, "{hits}");
+    let lamp = point(DVec3::new(3.0, 2.2, 2.0), 5.0);
+    for lights in [vec![], vec![lamp]] {
+        let a = first_view_with(&two, &lights, None, 1.6);
+        let b = first_view_with(&flat, &lights, None, 1.6);
+        assert_eq!(format!("{a:?}"), format!("{b:?}"));
+    }
+    assert!(first_view_with(&two, &[], None, 1.6).interior);
+}
+
+/// The probe's world triangles, read from each object's vertices, are those of
+/// [`Scene::flatten`] one by one (vertices, material, order), mirrored and hidden objects
+/// and a dropped triangle (an absurd vertex) included; reads by index and by range agree.
+#[test]
+fn world_triangles_are_the_flattened_ones() {
+    let mut scene = instanced_room();
+    let mut far = (*scene.objects[1].mesh).clone();
+    far.positions[0] = Vec3::splat(1e38);
+    scene.objects[1].mesh = Arc::new(far);
+    scene.objects[1].world_from_object = DMat4::from_scale(DVec3::splat(1e10));
+    let frame = crate::scene::RenderFrame::default();
+    let flat = scene.flatten(&frame);
+    assert!(flat.dropped > 0);
+    let world = WorldTris::new(scene.world_objects(&frame));
+    let (tris, materials) = world.to_vecs();
+    assert_eq!(tris.len(), flat.triangles.len());
+    for (i, t) in flat.triangles.iter().enumerate() {
+        assert_eq!((tris[i], materials[i]), (t.v, t.material), "triangle {i}");
+        assert_eq!((world.get(i), world.material(i)), (t.v, t.material));
+    }
+    let mut seen = vec![];
+    world.visit(5..tris.len() - 3, |i, t, _| seen.push((i, t)));
+    let expect: Vec<_> = (5..tris.len() - 3).map(|i| (i, tris[i])).collect();
+    assert_eq!(seen, expect);
+}
+
+/// The first view leaves its quick BLASes in the scene, one per distinct visible mesh,
+/// and the renderer's plan takes them for those meshes.
+#[test]
+fn the_first_view_leaves_its_quick_blases_for_the_renderer() {
+    let scene = instanced_room();
+    first_view(&scene, &[], None, 1.6);
+    let kept = scene.take_quick_blases();
+    assert_eq!(kept.len(), 4);
+    for (mesh, blas) in &kept {
+        let fresh = crate::bvh::quick_blas(&mesh.positions, &mesh.indices);
+        assert!(blas.triangles().eq(fresh.triangles()));
+        assert!(scene.objects.iter().any(|o| Arc::ptr_eq(&o.mesh, mesh)));
+    }
+    assert!(scene.take_quick_blases().is_empty());
+}
+
+#[test]
+fn an_added_light_shows_in_view_near_the_camera() {
+    let cam = Camera::look_at("c", DVec3::new(0.0, 0.0, 10.0), DVec3::ZERO, 0.8);
+    let l = light_near_camera(&cam, 10.0, "added");
+    let p = l.position - cam.eye;
+    let z = p.dot(cam.forward);
+    assert!(z > 0.0 && z < 5.0, "{p}");
+    // Inside the field of view.
+    assert!(p.dot(cam.up).abs() / z < (0.4f64).tan(), "{p}");
+    // Irradiance about 1 at the subject.
+    let d2 = (l.position - DVec3::ZERO).length_squared();
+    assert!((l.intensity as f64 / d2 - 1.0).abs() < 1e-3);
+}
