@@ -136,7 +136,8 @@ fn gltf_load(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    // No HTML plots: plotters is built here without system fonts (see docs/benchmarks.md).
+    // No HTML plots: plotters is built here without system fonts (the machines have none;
+    // `bench converge`'s plot brings its own font).
     config = Criterion::default().without_plots();
     targets = bvh_build, gltf_load
 }

@@ -12,10 +12,10 @@
 //! triangles over all instances that instancing shrinks eightfold (and for any scene of
 //! [`HUGE_SCENE`] triangles), on every device, as measured on each. On a GPU (H200) the 1 M
 //! rooms of `bench generate` run at 0.82 of the flat BVH's speed on two levels
-//! (docs/benchmarks.md, 2026-11-30). On a CPU the flat BVH is walked by the megakernel's vector
+//! (2026-11-30). On a CPU the flat BVH is walked by the megakernel's vector
 //! lanes, which two levels do not have: the same rooms render 1.5–1.7 times as fast flat, for
 //! 0.5–0.6 s more building on 2 cores and 100 MB of device memory against 2.5–15
-//! (docs/benchmarks.md, "Twenty-sixth session"; until then CPUs took two levels from 1 M
+//! (AMD Zen 3, 2026-12-04; until then CPUs took two levels from 1 M
 //! triangles shrunk fourfold, when the kernels walked one ray at a time and two levels ran
 //! frames 1.2–1.4 times as fast). A flat scene reloads where two levels would move, hide or
 //! show an object in place. A small scene is flattened: its flat BVH is built in well under a
@@ -54,7 +54,7 @@ pub const AUTO_GPU: AutoRule = AutoRule {
     min_triangles: 4_000_000,
     min_saving: 8,
     // On an H200 triangle pieces made two levels slower (bunny room frames 0.81 -> 0.75 of
-    // flat, spheres 0.82 -> 0.70; docs/benchmarks.md, fifth session), while on PoCL they made
+    // flat, spheres 0.82 -> 0.70; 2026-11-30), while on PoCL they made
     // shadow rays as fast as flat: GPUs keep each small instance whole.
     small_mesh: 0,
 };
@@ -207,7 +207,7 @@ pub fn auto_takes_two_levels(total: usize, unique: usize, rule: AutoRule) -> boo
 /// little instancing saves: the flat form's host build needs about 280 bytes a triangle
 /// (64 M triangles: 18 GB, against the 150 a distinct triangle that issue 14 allows) and
 /// 34 s for 16 M distinct triangles on the 2-core machine, against 108 bytes and a few
-/// seconds for two levels (docs/benchmarks.md, "Opening large unique scenes").
+/// seconds for two levels (2026-12-01).
 pub const HUGE_SCENE: usize = 16_000_000;
 
 /// The render frame's map, (p - origin) * scale, as a matrix: render from object is this times
