@@ -64,7 +64,7 @@ impl Instance {
 
     /// An object-space triangle in world space as the device carries it, `M v + T` in f32
     /// (the kernels' `instance_to_world`, operation for operation): a small mesh's triangle
-    /// is tested so ([`TwoLevel::braid`]), and shading finds the same vertices.
+    /// is tested so (`TwoLevel::braid`), and shading finds the same vertices.
     pub fn device_triangle(&self, t: &[Vec3; 3]) -> [Vec3; 3] {
         let m = self.world_rows();
         let at = Vec3::new(self.rows[0][3], self.rows[1][3], self.rows[2][3]);
@@ -166,7 +166,7 @@ pub struct TwoLevel {
     pub tlas: Bvh,
     /// Each TLAS leaf's (slot's) piece of its instance: the BLAS node it enters at (0 for the
     /// whole BLAS, else a subtree that re-braiding opened into the TLAS), or a small mesh's
-    /// triangle (`PIECE_TRIANGLE | k`, tested in world space; see [`TwoLevel::braid`]).
+    /// triangle (`PIECE_TRIANGLE | k`, tested in world space; see `TwoLevel::braid`).
     pub pieces: Vec<u32>,
     /// The most pieces the TLAS may hold: fixed for the scene, so that the device's TLAS and
     /// instance buffers, sized for it, hold any later TLAS.
@@ -176,11 +176,11 @@ pub struct TwoLevel {
     /// Hidden instances are left out of the TLAS (they keep their place among the instances).
     pub hidden: Vec<bool>,
     /// Meshes of at most this many triangles are small: each of their instances' triangles is
-    /// a TLAS piece of its own (see [`TwoLevel::braid`]; 0: none).
+    /// a TLAS piece of its own (see `TwoLevel::braid`; 0: none).
     pub small_mesh: usize,
     /// The largest leaf the wide BLASes merge small subtrees into (0: none): as the CPU's flat
     /// BVH does ([`super::WideBvh::collapse_for_cpu`]), by the meshes' triangles
-    /// ([`merge_limit`]), so that both levels' bottoms are walked as fast as the flat tree.
+    /// (`merge_limit`), so that both levels' bottoms are walked as fast as the flat tree.
     pub merge: u32,
 }
 
@@ -301,7 +301,7 @@ impl TwoLevel {
     /// over the pieces. A world box of a whole instance is loose (a rotated object's box grows,
     /// and a room's box holds everything in it) and overlaps its neighbours', so every ray
     /// would enter most instances; the pieces' boxes are tight where the flat BVH's are.
-    /// See [`TwoLevel::braid`] for which nodes are opened.
+    /// See `TwoLevel::braid` for which nodes are opened.
     pub fn rebuild_tlas(&mut self) {
         let pieces = self.braid();
         let boxes: Vec<Aabb> = pieces.iter().map(|p| p.2).collect();

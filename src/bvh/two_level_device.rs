@@ -51,7 +51,7 @@ impl TwoLevel {
     }
 
     /// The TLAS's binary nodes in the device's form, padded to [`TwoLevel::tlas_slots`]: each
-    /// leaf (one piece, [`split_instance_leaves`]) has [`crate::cl::types::TLAS_LEAF`] set in
+    /// leaf (one piece, `split_instance_leaves`) has [`crate::cl::types::TLAS_LEAF`] set in
     /// its count.
     pub fn device_tlas(&self) -> Vec<GpuBvhNode> {
         let mut nodes = self.tlas.nodes.clone();

@@ -51,7 +51,7 @@ impl WideBvh {
         Self::collapse_mapped(bvh, 0).0
     }
 
-    /// The wide tree of the CPU megakernel's flat scenes. In large scenes ([`merge_limit`])
+    /// The wide tree of the CPU megakernel's flat scenes. In large scenes (`merge_limit`)
     /// subtrees of at most [`MERGED_LEAF`] triangles (one range in BVH order) may become
     /// leaves: the binary builder's leaves hold 1–2 triangles, so without merging 44 % of the
     /// 1 M-triangle bunnies' wide nodes have only two children, both leaves, while

@@ -19,7 +19,7 @@ pub struct Buffer<T: Pod> {
 
 impl<T: Pod> Buffer<T> {
     /// An uninitialised buffer of `len` elements. On a CPU device a buffer of a huge page or
-    /// more lives in host memory advised for huge pages (see [`HostPages`]).
+    /// more lives in host memory advised for huge pages (see `HostPages`).
     pub fn new(gpu: &Gpu, len: usize) -> Result<Self, ClError> {
         let bytes = len.max(1) * std::mem::size_of::<T>();
         let host = if bytes >= HUGE_PAGE && gpu.is_cpu() {

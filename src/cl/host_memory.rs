@@ -202,8 +202,8 @@ fn set_malloc_thresholds(mmap: i32, trim: i32) {
 
 /// The allocator's policy while a scene opens (loading, the framing probe, BVH builds, the
 /// upload), held as a guard, nested or on several threads: large blocks are mapped while any
-/// opening runs ([`OPENING_MMAP_THRESHOLD`]); when the last one ends the steady policy returns
-/// ([`STEADY_MMAP_THRESHOLD`], the heap trimmed above twice that, as glibc's dynamic rule
+/// opening runs (`OPENING_MMAP_THRESHOLD`); when the last one ends the steady policy returns
+/// (`STEADY_MMAP_THRESHOLD`, the heap trimmed above twice that, as glibc's dynamic rule
 /// does) and what the allocator holds free is given back (`malloc_trim`).
 pub struct OpeningMemory(());
 

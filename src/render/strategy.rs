@@ -13,7 +13,7 @@
 //! | CPU megakernel | flat, no alpha, 1 to [`SMALL_SCENE_MAX`] triangles, no lanes | `SMALL_SCENE`: every ray tests every triangle (count rounded up to 16) |
 //! | CPU megakernel | flat, no alpha, under 2^27 triangles, leaves of at most 15 | lanes (`MEGA_LANES`) when `PENUMBRA_LANES=1`; never when `=0`; else with AVX-512 or AVX2 from [`LANES_MIN_TRIANGLES`] on, and below where the lanes test a small scene whole or shade in batches |
 //! | lanes | small (as `SMALL_SCENE`), `PENUMBRA_LANES_SMALL` not `0` | `LANES_SMALL`: the lanes test the triangles whole |
-//! | lanes | every material Lambertian, none of the features [`shades_simply`] excludes, `PENUMBRA_LANES_SHADE` not `0` | `LANES_SHADE`: vertices shaded in batches |
+//! | lanes | every material Lambertian, none of the features `shades_simply` excludes, `PENUMBRA_LANES_SHADE` not `0` | `LANES_SHADE`: vertices shaded in batches |
 //! | lanes | | nodes and triangles loaded as rows on AMD CPUs, else `LANES_GATHERS`; `PENUMBRA_LANES_LOAD=rows\|gathers` chooses |
 
 use super::KernelChoice;

@@ -246,7 +246,7 @@ impl Renderer {
 
     /// Renders `spp` more samples per pixel into the film and waits for them.
     ///
-    /// The samples go in batches of at most [`MAX_WAVES_PER_BATCH`] waves: every launch holds
+    /// The samples go in batches of at most `MAX_WAVES_PER_BATCH` waves: every launch holds
     /// an event on the host until the queue finishes, so one batch of any `spp` would grow host
     /// memory with it. Batches are whole waves, so the image is the same as in one batch.
     pub fn render(&mut self, spp: u32) -> Result<(), ClError> {

@@ -191,7 +191,7 @@ impl HostScene {
     /// once, in object space and BLAS order (`meshes[b]` is BLAS b's mesh), and the light
     /// table's emissive triangles instance by instance (each instance's first light is kept in
     /// `layout.light_bases`). `two`'s instances are in render space; `middle` is the
-    /// scene's robust middle and diagonal there ([`render_middle`]).
+    /// scene's robust middle and diagonal there (`render_middle`).
     pub fn two_level(
         two: TwoLevel,
         meshes: &[&Mesh],

@@ -57,7 +57,7 @@ pub(super) enum Tracer {
 
 impl Probe {
     /// Builds the probe for the visible geometry of `scene`: over quick BLASes of its distinct
-    /// meshes and a top level ([`Tracer::TwoLevel`]), which [`Probe::keep_blases`] leaves in
+    /// meshes and a top level (`Tracer::TwoLevel`), which [`Probe::keep_blases`] leaves in
     /// the scene for the renderer. Glass and blended surfaces
     /// are passed by the rays that light passes; they still count for the bounds and for
     /// telling an interior.
@@ -101,7 +101,7 @@ impl Probe {
         Self::with_tracer(scene, Tracer::TwoLevel { two, meshes }, tris)
     }
 
-    /// The probe over one quick tree of the world triangles ([`Tracer::Flat`]): how the first
+    /// The probe over one quick tree of the world triangles (`Tracer::Flat`): how the first
     /// view was found before the two levels, and what it falls back to.
     pub fn flat(scene: &Scene) -> Self {
         Self::with_flat(

@@ -146,7 +146,7 @@ pub fn robust_bounds(tris: &WorldTris) -> Bounds {
 }
 
 /// Scenes of more triangles than this place [`robust_bounds`]'s window and pick their fit
-/// points from a regular sample of [`SAMPLE`] of their triangles ([`regular_sample`]): at
+/// points from a regular sample of `SAMPLE` of their triangles (`regular_sample`): at
 /// 64 M triangles the four passes over every triangle that the window's percentiles and the
 /// fit points take cost 1.5–2.5 s of the opening. The exact bounds and the triangles in the
 /// window are still found over all of them.
@@ -155,13 +155,13 @@ pub const SAMPLE_FROM: usize = 1 << 22;
 /// Triangles in the sample of a scene of more than [`SAMPLE_FROM`].
 const SAMPLE: usize = 1 << 20;
 
-/// Every step-th triangle of `tris` from the first, at most [`SAMPLE`] of them, where `tris`
+/// Every step-th triangle of `tris` from the first, at most `SAMPLE` of them, where `tris`
 /// has more than [`SAMPLE_FROM`]; else `None` (all of them count).
 pub(super) fn regular_sample(tris: &WorldTris) -> Option<WorldTris> {
     regular_sample_of(tris, SAMPLE_FROM, SAMPLE)
 }
 
-/// [`regular_sample`] with its two sizes.
+/// `regular_sample` with its two sizes.
 pub(super) fn regular_sample_of(tris: &WorldTris, from: usize, size: usize) -> Option<WorldTris> {
     let n = tris.len();
     if n <= from {

@@ -7,8 +7,8 @@ use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::Arc;
 
-/// The visible objects' world triangles in scene order (as [`Scene::flatten`] keeps them),
-/// read from each object's vertices ([`Scene::world_objects`]) instead of a copy of every
+/// The visible objects' world triangles in scene order (as [`Scene::flatten`](crate::scene::Scene::flatten) keeps them),
+/// read from each object's vertices ([`Scene::world_objects`](crate::scene::Scene::world_objects)) instead of a copy of every
 /// triangle: a 64 M-triangle scene's copy was 2.3 GB and seconds to write.
 #[derive(Clone, Debug)]
 pub struct WorldTris {
