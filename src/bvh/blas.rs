@@ -109,9 +109,9 @@ impl Blas {
         (0..self.len()).map(|k| self.triangle(k))
     }
 
-    /// [`Bvh::traverse`] of this BLAS's tree over its triangles.
-    pub fn traverse(&self, root: u32, ray: &Ray, any: bool) -> Option<Hit> {
-        self.bvh.traverse_by(root, ray, any, |k| self.triangle(k))
+    /// [`Bvh::traverse`] of this BLAS's tree (from its root) over its triangles.
+    pub fn traverse(&self, ray: &Ray, any: bool) -> Option<Hit> {
+        self.bvh.traverse_by(0, ray, any, |k| self.triangle(k))
     }
 
     /// The object-space box of the whole mesh.

@@ -15,12 +15,10 @@
 //! object space, and shading carries a hit to world space through the instance's transform.
 
 use super::wide::{frontier, merge_limit};
-use super::{Aabb, Blas, Bvh, Child, Hit, Ray, WIDTH, build_boxes};
+use super::{Aabb, Blas, Bvh, Child, Hit, Ray, build_boxes};
 use crate::cl::types::{GpuBvhNode, GpuHit};
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 /// One placed mesh.
 #[derive(Clone, Copy, Debug)]
@@ -106,13 +104,13 @@ impl Instance {
         }
     }
 
-    /// The world box of the triangles below node `node` of `bvh` under this instance: the
-    /// union of the world boxes ([`Instance::world_box`]) of up to [`FRONTIER`] boxes below
-    /// the node, opened largest first. A rotated object's world box grows with its box's
-    /// corners; its parts' boxes grow with theirs, which are smaller, so the union hugs the
-    /// object and fewer rays enter an instance only to miss it.
-    fn node_world_box(&self, bvh: &Bvh, node: u32) -> Aabb {
-        frontier(bvh, node, FRONTIER, 0)
+    /// The world box of the triangles of `bvh` under this instance: the union of the world
+    /// boxes ([`Instance::world_box`]) of up to [`FRONTIER`] boxes below the root, opened
+    /// largest first. A rotated object's world box grows with its box's corners; its parts'
+    /// boxes grow with theirs, which are smaller, so the union hugs the object and fewer rays
+    /// enter an instance only to miss it.
+    fn bvh_world_box(&self, bvh: &Bvh) -> Aabb {
+        frontier(bvh, 0, FRONTIER, 0)
             .into_iter()
             // A leaf of no triangles (a one-leaf tree's other side) has the empty box, whose
             // infinite corners would carry to NaN.
@@ -164,9 +162,9 @@ pub struct TwoLevel {
     /// Over the pieces' world boxes, one piece a leaf; its `tri_indices` are the pieces'
     /// instance indices (see [`TwoLevel::rebuild_tlas`]).
     pub tlas: Bvh,
-    /// Each TLAS leaf's (slot's) piece of its instance: the BLAS node it enters at (0 for the
-    /// whole BLAS, else a subtree that re-braiding opened into the TLAS), or a small mesh's
-    /// triangle (`PIECE_TRIANGLE | k`, tested in world space; see `TwoLevel::braid`).
+    /// Each TLAS leaf's (slot's) piece of its instance: 0 for the whole BLAS, entered at its
+    /// root, or a small mesh's triangle (`PIECE_TRIANGLE | k`, tested in world space; see
+    /// `TwoLevel::braid`).
     pub pieces: Vec<u32>,
     /// The most pieces the TLAS may hold: fixed for the scene, so that the device's TLAS and
     /// instance buffers, sized for it, hold any later TLAS.
@@ -230,9 +228,7 @@ impl TwoLevel {
             firsts,
             small_mesh,
         };
-        // No BLAS is opened: opening the bunny room's BLASes measured no faster on PoCL (16 to
-        // 1024 more pieces than instances) and slower on the H200 (256 more; 2026-11-30).
-        two.max_pieces = two.piece_budget(0);
+        two.max_pieces = two.piece_budget();
         two.rebuild_tlas();
         two
     }
@@ -247,14 +243,6 @@ impl TwoLevel {
             .sum()
     }
 
-    /// Sets how many pieces beyond one per instance (and per small mesh's triangle) the TLAS
-    /// may be re-braided into and rebuilds it; before the device is
-    /// given the scene (its buffers are sized for [`TwoLevel::max_pieces`]).
-    pub fn set_rebraid_budget(&mut self, extra: usize) {
-        self.max_pieces = self.piece_budget(extra);
-        self.rebuild_tlas();
-    }
-
     /// Whether some instance's mesh is small (its triangles are pieces of the TLAS).
     pub fn has_small_meshes(&self) -> bool {
         self.instances
@@ -267,18 +255,16 @@ impl TwoLevel {
         blas.len() <= self.small_mesh
     }
 
-    /// The most pieces the TLAS may be re-braided into: a small mesh's triangles each, one for
-    /// any other instance, and `extra` more for opening BLASes.
-    pub(super) fn piece_budget(&self, extra: usize) -> usize {
-        let base: usize = self
-            .instances
+    /// The most pieces the TLAS may hold, hidden instances' included (so that showing one
+    /// fits): a small mesh's triangles each and one for any other instance.
+    fn piece_budget(&self) -> usize {
+        self.instances
             .iter()
             .map(|i| {
                 let b = &self.blases[i.blas as usize];
                 if self.is_small(b) { b.len() } else { 1 }
             })
-            .sum();
-        base + extra
+            .sum()
     }
 
     /// Moves instance `i` and rebuilds the TLAS.
@@ -294,14 +280,8 @@ impl TwoLevel {
         *inst = Instance::new(inst.blas, world_from_object);
     }
 
-    /// Builds the TLAS over the shown instances' current world boxes, partially re-braided
-    /// (Benthin, Woop, Wald et al., "Improved Two-Level BVHs using Partial Re-Braiding", HPG
-    /// 2017): the instances' BLASes are opened from the top into pieces, each a BLAS subtree
-    /// under its instance's transform with the subtree box's world box, and the TLAS is built
-    /// over the pieces. A world box of a whole instance is loose (a rotated object's box grows,
-    /// and a room's box holds everything in it) and overlaps its neighbours', so every ray
-    /// would enter most instances; the pieces' boxes are tight where the flat BVH's are.
-    /// See `TwoLevel::braid` for which nodes are opened.
+    /// Builds the TLAS over the pieces of the shown instances (`TwoLevel::braid`) at their
+    /// current world boxes.
     pub fn rebuild_tlas(&mut self) {
         let pieces = self.braid();
         let boxes: Vec<Aabb> = pieces.iter().map(|p| p.2).collect();
@@ -323,11 +303,11 @@ impl TwoLevel {
     /// the traversal tests in world space, carried there as shading carries it
     /// ([`Instance::device_triangle`]), without entering the instance: a room of a few large
     /// quads would otherwise be one piece whose box holds the whole scene, entered by every
-    /// ray. Any other instance is its whole BLAS (node 0), then greedily the piece of the
-    /// largest world surface area is replaced by its children in the BLAS's 4-wide tree
-    /// (`WideBvh::collapse`'s nodes, so that the binary and the wide kernels enter at the
-    /// same subtree) while the pieces stay within [`TwoLevel::max_pieces`]; a node with a
-    /// leaf among those children is not opened (a piece enters a node).
+    /// ray. Any other instance is one piece, its whole BLAS (0). No BLAS is opened into pieces
+    /// of its subtrees (partial re-braiding; Benthin, Woop, Wald et al., HPG 2017): opening the
+    /// bunny room's BLASes measured no faster on PoCL (16 to 1024 more pieces than instances)
+    /// and slower on the H200 (256 more; 2026-11-30). Commit 7bfae20 is the last with the
+    /// switch, `PENUMBRA_REBRAID`.
     fn braid(&self) -> Vec<(u32, u32, Aabb)> {
         let mut pieces: Vec<(u32, u32, Aabb)> = vec![];
         for i in 0..self.instances.len() as u32 {
@@ -337,44 +317,13 @@ impl TwoLevel {
                 continue;
             }
             if !self.is_small(blas) {
-                pieces.push((i, 0, inst.node_world_box(&blas.bvh, 0)));
+                pieces.push((i, 0, inst.bvh_world_box(&blas.bvh)));
                 continue;
             }
             for (k, t) in blas.triangles().enumerate() {
                 let world = inst.device_triangle(&t);
                 let b = world.iter().fold(Aabb::EMPTY, |b, &v| b.grow(v));
                 pieces.push((i, PIECE_TRIANGLE | k as u32, b));
-            }
-        }
-        // Largest area first, then the earliest piece (areas are not negative, so their bits
-        // order as they do).
-        let mut heap: BinaryHeap<(u32, Reverse<usize>)> = pieces
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| p.1 & PIECE_TRIANGLE == 0)
-            .map(|(k, p)| (p.2.area().to_bits(), Reverse(k)))
-            .collect();
-        while let Some((_, Reverse(k))) = heap.pop() {
-            let (i, node, _) = pieces[k];
-            let inst = &self.instances[i as usize];
-            let blas = &self.blases[inst.blas as usize];
-            let children = frontier(&blas.bvh, node, WIDTH, self.merge);
-            if pieces.len() + children.len() - 1 > self.max_pieces
-                || children.iter().any(|c| !matches!(c.1, Child::Node(_)))
-            {
-                continue;
-            }
-            for (j, (_, child)) in children.into_iter().enumerate() {
-                let Child::Node(n) = child else { continue };
-                let piece = (i, n, inst.node_world_box(&blas.bvh, n));
-                let at = if j == 0 {
-                    pieces[k] = piece;
-                    k
-                } else {
-                    pieces.push(piece);
-                    pieces.len() - 1
-                };
-                heap.push((piece.2.area().to_bits(), Reverse(at)));
             }
         }
         pieces
@@ -429,15 +378,15 @@ impl TwoLevel {
             let instance = self.tlas.tri_indices[leaf as usize];
             let inst = &self.instances[instance as usize];
             let blas = &self.blases[inst.blas as usize];
-            let root = self.pieces[leaf as usize];
-            let hit = if root & PIECE_TRIANGLE != 0 {
+            let piece = self.pieces[leaf as usize];
+            let hit = if piece & PIECE_TRIANGLE != 0 {
                 // A small mesh's triangle, tested in world space (see `braid`).
-                let prim = root & !PIECE_TRIANGLE;
+                let prim = piece & !PIECE_TRIANGLE;
                 let world = inst.device_triangle(&blas.triangle(prim as usize));
                 super::intersect_triangle(r, &world).map(|(t, u, v)| Hit { t, u, v, prim })
             } else {
                 let local = inst.to_object(r);
-                blas.traverse(root, &local, any)
+                blas.traverse(&local, any)
             };
             let hit = hit.map(|h| if any { Hit { t: r.tmax, ..h } } else { h });
             hit.map(|hit| {
@@ -457,8 +406,7 @@ impl TwoLevel {
 /// Meshes of at most this many triangles are small by default (see [`TwoLevel::small_mesh`]).
 pub const SMALL_MESH: usize = 64;
 
-/// How many of a BLAS's boxes bound an instance (or a piece) in the TLAS
-/// ([`Instance::node_world_box`]).
+/// How many of a BLAS's boxes bound an instance in the TLAS ([`Instance::bvh_world_box`]).
 pub const FRONTIER: usize = 32;
 
 /// A piece's mark for one triangle (its index in the BLAS in the other bits), else a BLAS node.
@@ -777,8 +725,8 @@ mod tests {
     }
 
     /// A big mesh and a small one (its instances' triangles are TLAS pieces of their own)
-    /// placed by every placement, with the BLASes opened into `extra` more pieces.
-    fn braided(extra: usize, moved: Option<DMat4>) -> TwoLevel {
+    /// placed by every placement, the first of each moved to `moved`.
+    fn big_and_small(moved: Option<DMat4>) -> TwoLevel {
         let meshes = vec![random_triangles(3000, 7), closed_cube(2)];
         assert!(meshes[0].len() > SMALL_MESH && meshes[1].len() <= SMALL_MESH);
         let mut placed: Vec<(u32, DMat4)> = placements()
@@ -796,12 +744,10 @@ mod tests {
             placed[0].1 = m;
             placed[1].1 = m;
         }
-        let mut two = TwoLevel::new(&meshes, &placed);
-        two.set_rebraid_budget(extra);
-        two
+        TwoLevel::new(&meshes, &placed)
     }
 
-    /// Rays through the scene of [`braided`]: from around it towards random points in it.
+    /// Rays through the scene of [`big_and_small`]: from around it towards random points in it.
     fn rays_through(two: &TwoLevel, n: usize) -> Vec<Ray> {
         let b = two.tlas.child(0, 0).0.union(two.tlas.child(0, 1).0);
         let mut s = 11u64;
@@ -818,70 +764,41 @@ mod tests {
     }
 
     #[test]
-    fn re_braided_pieces_find_the_unopened_and_flattened_hits() {
-        let (plain, opened) = (braided(0, None), braided(300, None));
-        // Each small instance is one piece per triangle; the big ones are opened.
+    fn a_small_instance_is_a_piece_per_triangle_and_no_blas_is_opened() {
+        let two = big_and_small(None);
         let pieces =
             |two: &TwoLevel, i: u32| two.tlas.tri_indices.iter().filter(|&&k| k == i).count();
-        for i in 0..plain.instances.len() as u32 {
+        for i in 0..two.instances.len() as u32 {
             let small = i % 2 == 1;
-            assert_eq!(
-                pieces(&plain, i),
-                if small { 48 } else { 1 },
-                "instance {i}"
-            );
-            assert_eq!(
-                pieces(&opened, i) == pieces(&plain, i),
-                small,
-                "instance {i}"
-            );
+            assert_eq!(pieces(&two, i), if small { 48 } else { 1 }, "instance {i}");
         }
-        assert!(opened.pieces.len() > plain.pieces.len() + 250);
-        assert!(opened.pieces.len() <= opened.max_pieces);
-        assert_eq!(opened.tlas.nodes.len(), opened.pieces.len() - 1);
-        let world: Vec<[Vec3; 3]> = (0..plain.instances.len())
-            .flat_map(|i| {
-                let inst = &plain.instances[i];
-                let b = &plain.blases[inst.blas as usize];
-                b.triangles().map(move |t| t.map(|v| inst.to_world(v)))
-            })
-            .collect();
-        let mut hits = 0;
-        for (k, r) in rays_through(&plain, 3000).iter().enumerate() {
-            let (a, b) = (plain.intersect(r), opened.intersect(r));
-            // Entering a subtree of a BLAS tests what entering its root would: the same hit.
-            assert_eq!(
-                a.map(|h| (h.instance, h.hit)),
-                b.map(|h| (h.instance, h.hit)),
-                "ray {k}"
-            );
-            assert_eq!(plain.occluded(r), opened.occluded(r), "ray {k}");
-            assert_eq!(a.is_some(), plain.occluded(r), "ray {k}");
-            // The flattened scene (world triangles carried in f64) agrees up to rounding.
-            let flat = world
+        assert_eq!(two.pieces.len(), two.max_pieces);
+        // Hiding instances leaves room in the TLAS's slots; still every BLAS is entered whole.
+        let mut hidden = two.clone();
+        (hidden.hidden[1], hidden.hidden[2]) = (true, true);
+        hidden.rebuild_tlas();
+        assert_eq!(hidden.pieces.len(), two.max_pieces - 49);
+        assert!(
+            hidden
+                .pieces
                 .iter()
-                .filter_map(|t| intersect_triangle(r, t).map(|h| h.0))
-                .fold(f32::INFINITY, f32::min);
-            let t = a.map_or(f32::INFINITY, |h| h.hit.t);
-            assert!(
-                t == flat || (t - flat).abs() <= 1e-4 * flat.max(1.0),
-                "ray {k}: {t} vs {flat}"
-            );
-            hits += a.is_some() as usize;
-        }
-        assert!(hits > 500, "the rays hit something ({hits})");
+                .all(|&p| p == 0 || p & PIECE_TRIANGLE != 0),
+            "every big piece is a whole BLAS"
+        );
+        assert!(hidden.tlas.tri_indices.iter().all(|&i| i != 1 && i != 2));
     }
 
     #[test]
     fn moving_an_instance_moves_all_its_pieces() {
         let to =
             DMat4::from_translation(glam::DVec3::new(3.0, -5.0, 1.0)) * DMat4::from_rotation_y(0.7);
-        let mut two = braided(300, None);
-        // Instances 0 and 1 (a big, opened one and a small one) move as in a scene built so.
+        let mut two = big_and_small(None);
+        // Instances 0 and 1 (a big one and a small one of 48 pieces) move as in a scene built
+        // so.
         two.place(0, to);
         two.place(1, to);
         two.rebuild_tlas();
-        let built = braided(300, Some(to));
+        let built = big_and_small(Some(to));
         assert_eq!(two.pieces, built.pieces);
         assert_eq!(two.tlas.tri_indices, built.tlas.tri_indices);
         let mut moved_hits = 0;

@@ -460,23 +460,16 @@ mod tests {
         assert!(sah_shared.triangles().eq(sah.triangles()));
         let mut hits = 0;
         for ray in &random_rays(3000, 5) {
-            let a = quick.traverse(0, ray, false);
-            let b = sah.traverse(0, ray, false);
+            let a = quick.traverse(ray, false);
+            let b = sah.traverse(ray, false);
             for (shared, copied) in [(&quick_shared, &quick), (&sah_shared, &sah)] {
-                let (s, c) = (
-                    shared.traverse(0, ray, false),
-                    copied.traverse(0, ray, false),
-                );
+                let (s, c) = (shared.traverse(ray, false), copied.traverse(ray, false));
                 assert_eq!(
                     s.map(|h| (h.t, h.prim)),
                     c.map(|h| (h.t, h.prim)),
                     "{ray:?}"
                 );
-                assert_eq!(
-                    shared.traverse(0, ray, true).is_some(),
-                    c.is_some(),
-                    "{ray:?}"
-                );
+                assert_eq!(shared.traverse(ray, true).is_some(), c.is_some(), "{ray:?}");
             }
             assert_eq!(a.map(|h| h.t), b.map(|h| h.t), "{ray:?}");
             assert_eq!(

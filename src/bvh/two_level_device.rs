@@ -85,10 +85,8 @@ impl TwoLevel {
     }
 
     /// [`TwoLevel::device_nodes`] for the 4-wide form: the collapsed TLAS, then every
-    /// collapsed BLAS, rebased alike; each BLAS's root; and per BLAS, each binary node's wide
-    /// node (`u32::MAX` for one inside a wide node), where a piece enters the wide BLAS (only
-    /// the root's, `[0]`, when [`TwoLevel::max_pieces`] opens no BLAS).
-    pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>, Vec<Vec<u32>>) {
+    /// collapsed BLAS, rebased alike; and each BLAS's root (where its pieces enter it).
+    pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>) {
         // Every wide node is made of a distinct binary node, so the binary nodes bound the
         // array: reserved at once (address space; only the pages written are touched), it is
         // never moved while it grows.
@@ -98,9 +96,7 @@ impl TwoLevel {
         nodes.extend(WideBvh::collapse(&self.tlas).nodes);
         nodes.resize(self.tlas_slots(), GpuWideNode::default());
         let mut roots = vec![];
-        let mut wide_of = vec![];
         let mut tri_base = 0i32;
-        let opens = self.max_pieces > self.piece_budget(0);
         // The BLASes are collapsed in parallel, a batch of about COLLAPSE_BATCH triangles at a
         // time, and appended in order (in parallel too): only one batch's nodes wait beside the
         // array, so the collapse touches little fresh memory beyond the array itself (a 64
@@ -116,26 +112,13 @@ impl TwoLevel {
             }
             let (batch, after) = rest.split_at(take);
             rest = after;
-            let collapsed: Vec<(WideBvh, Vec<u32>)> = batch
+            let collapsed: Vec<WideBvh> = batch
                 .par_iter()
-                .map(|b| WideBvh::collapse_mapped(&b.bvh, self.merge))
+                .map(|b| WideBvh::collapse_merging(&b.bvh, self.merge))
                 .collect();
-            for (b, (wide, binaries)) in batch.iter().zip(collapsed) {
+            for (b, wide) in batch.iter().zip(collapsed) {
                 let base = nodes.len() as i32;
                 roots.push(base as u32);
-                // Without re-braiding every piece enters its BLAS at the root (binary node 0,
-                // wide node 0): the map of every binary node (4 B each, 250 MB at 64 M
-                // triangles) is made only where pieces may enter below it.
-                let map = if opens {
-                    let mut map = vec![u32::MAX; b.bvh.nodes.len()];
-                    for (w, &n) in binaries.iter().enumerate() {
-                        map[n as usize] = w as u32;
-                    }
-                    map
-                } else {
-                    vec![0]
-                };
-                wide_of.push(map);
                 nodes.par_extend(wide.nodes.into_par_iter().map(|mut n| {
                     for i in 0..super::WIDTH {
                         if n.count[i] > 0 {
@@ -150,6 +133,6 @@ impl TwoLevel {
             }
         }
         nodes.shrink_to_fit();
-        (nodes, roots, wide_of)
+        (nodes, roots)
     }
 }

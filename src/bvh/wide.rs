@@ -48,7 +48,7 @@ impl WideBvh {
     /// Collapses `bvh`: each wide node takes its binary node's two children and keeps opening
     /// the interior child with the largest surface area until it has four (or only leaves).
     pub fn collapse(bvh: &Bvh) -> Self {
-        Self::collapse_mapped(bvh, 0).0
+        Self::collapse_merging(bvh, 0)
     }
 
     /// The wide tree of the CPU megakernel's flat scenes. In large scenes (`merge_limit`)
@@ -90,24 +90,15 @@ impl WideBvh {
     }
 
     /// [`WideBvh::collapse`] with each interior child of at most `limit` triangles (in one
-    /// range) made a leaf.
+    /// range) made a leaf (`limit` 0: none).
     pub fn collapse_merging(bvh: &Bvh, limit: u32) -> Self {
-        Self::collapse_mapped(bvh, limit).0
-    }
-
-    /// [`WideBvh::collapse_merging`] (`merge` 0: [`WideBvh::collapse`]), and the binary node
-    /// each wide node collapses (the root of the same subtree; two-level re-braiding enters
-    /// BLASes at such nodes, see `bvh::instances`). Binary nodes inside a wide node or a merged
-    /// leaf have none.
-    pub fn collapse_mapped(bvh: &Bvh, merge: u32) -> (Self, Vec<u32>) {
-        Self::assemble(|binary, slots| *slots = frontier(bvh, binary, WIDTH, merge))
+        Self::assemble(|binary, slots| *slots = frontier(bvh, binary, WIDTH, limit))
     }
 
     /// The wide nodes from the root's binary node down, `slots_of` giving the children of
-    /// the wide node made of a binary node; with the binary node of each wide node.
-    fn assemble(mut slots_of: impl FnMut(u32, &mut Vec<(Aabb, Child)>)) -> (Self, Vec<u32>) {
+    /// the wide node made of a binary node.
+    fn assemble(mut slots_of: impl FnMut(u32, &mut Vec<(Aabb, Child)>)) -> Self {
         let mut nodes = vec![GpuWideNode::default()];
-        let mut binaries = vec![0u32];
         let mut work = vec![(0u32, 0usize)]; // (binary node, wide node)
         let mut slots = Vec::with_capacity(WIDTH);
         while let Some((binary, wide)) = work.pop() {
@@ -129,7 +120,6 @@ impl WideBvh {
                     Child::Node(n) => {
                         let index = nodes.len();
                         nodes.push(GpuWideNode::default());
-                        binaries.push(n);
                         out.child[i] = index as i32;
                         work.push((n, index));
                     }
@@ -137,7 +127,7 @@ impl WideBvh {
             }
             nodes[wide] = out;
         }
-        (Self { nodes }, binaries)
+        Self { nodes }
     }
 
     /// The decoded children of `node` (empty slots left out).
@@ -357,7 +347,6 @@ impl WideBvh {
             place(bvh, &plan, bvh.child(binary, 0), j, slots);
             place(bvh, &plan, bvh.child(binary, 1), WIDTH - j, slots);
         })
-        .0
     }
 }
 

@@ -94,9 +94,8 @@ fn device_nodes(
                 None
             };
             let wide = forms.wide.then(|| {
-                let (wide, wide_roots, wide_of) = two.device_wide_nodes();
+                let (wide, wide_roots) = two.device_wide_nodes();
                 host.layout.wide_roots = wide_roots;
-                host.layout.wide_of = wide_of;
                 wide
             });
             (nodes, wide)

@@ -70,10 +70,6 @@ pub struct InstanceLayout {
     pub roots: Vec<u32>,
     /// Each BLAS's root in the wide node array (empty while the device has no wide nodes).
     pub wide_roots: Vec<u32>,
-    /// Per BLAS, each binary node's wide node (relative to its root; `u32::MAX` for one inside
-    /// a wide node): where a re-braided piece enters the wide BLAS (empty while the device has
-    /// no wide nodes).
-    pub wide_of: Vec<Vec<u32>>,
     /// Each instance's first light (the light index of its first emissive triangle).
     pub light_bases: Vec<i32>,
     /// Each small instance's first world-space triangle copy in the device triangles (see
@@ -104,27 +100,27 @@ impl InstanceLayout {
         copies
     }
 
-    /// The device instances of `two` in TLAS order, one per TLAS slot (a re-braided piece of
-    /// an instance: the instance's transforms and the BLAS node it enters at), padded to
-    /// [`TwoLevel::max_pieces`] so that the buffer holds any later TLAS's.
+    /// The device instances of `two` in TLAS order, one per TLAS slot (a piece of an
+    /// instance: the instance's transforms and its BLAS's roots, or one triangle of a small
+    /// mesh), padded to [`TwoLevel::max_pieces`] so that the buffer holds any later TLAS's.
     pub fn gpu_instances(&self, two: &TwoLevel) -> Vec<GpuInstance> {
         let mut out: Vec<GpuInstance> = two
             .tlas
             .tri_indices
             .iter()
             .zip(&two.pieces)
-            .map(|(&i, &node)| {
+            .map(|(&i, &piece)| {
                 let inst = &two.instances[i as usize];
                 let b = inst.blas as usize;
                 // A piece of one triangle names it (among the meshes' triangles) in both.
-                let triangle = node & PIECE_TRIANGLE != 0;
+                let triangle = piece & PIECE_TRIANGLE != 0;
                 let (root, wide_root) = if triangle {
-                    let k = node & !PIECE_TRIANGLE;
+                    let k = piece & !PIECE_TRIANGLE;
                     (self.copy_bases[i as usize] + k, two.firsts[b] + k)
                 } else {
-                    // Without the wide nodes on the device (`NodeForms`), no wide root.
-                    let wide = |m: &Vec<u32>| self.wide_roots[b] + m[node as usize];
-                    (self.roots[b] + node, self.wide_of.get(b).map_or(0, wide))
+                    // Any other piece is the whole BLAS. Without the wide nodes on the device
+                    // (`NodeForms`), no wide root.
+                    (self.roots[b], self.wide_roots.get(b).copied().unwrap_or(0))
                 };
                 let mut world = inst.world_rows();
                 world[0][3] = f32::from_bits(self.light_bases[i as usize] as u32);
