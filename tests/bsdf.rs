@@ -14,8 +14,8 @@ mod common;
 
 use common::stats::chi2;
 use common::{Gltf, Prim, cuboid, horizontal_square, output_dir, render_exr, sphere};
-use penumbra::cl::types::GpuMaterial;
-use penumbra::cl::{DeviceChoice, Gpu, KernelFeatures, Program};
+use penumbra::cl::types::DeviceMaterial;
+use penumbra::cl::{DeviceChoice, Device, KernelFeatures, Program};
 use penumbra::scene::Material;
 use serde_json::json;
 use std::f64::consts::PI;
@@ -23,7 +23,7 @@ use std::f64::consts::PI;
 // ---------------------------------------------------------------------------------------------
 // Materials and the device
 
-/// A material as the kernels take it (the GpuMaterial lanes bsdf.h reads).
+/// A material as the kernels take it (the DeviceMaterial lanes bsdf.h reads).
 #[derive(Clone, Copy, Debug)]
 struct Mat {
     base: [f32; 3],
@@ -144,7 +144,7 @@ impl Mat {
     }
 
     /// The device form, packed as the renderer packs a scene's material.
-    fn gpu(&self) -> GpuMaterial {
+    fn gpu(&self) -> DeviceMaterial {
         let b = self.base;
         penumbra::render::gpu_material(&Material {
             base_color: [b[0], b[1], b[2], 1.0],
@@ -173,7 +173,7 @@ impl Mat {
 }
 
 struct Device {
-    gpu: Gpu,
+    gpu: Device,
     program: Program,
 }
 
@@ -192,7 +192,7 @@ impl Device {
 
     fn with(features: KernelFeatures) -> Self {
         let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
-        let gpu = Gpu::open(&choice).expect("the test's OpenCL device is available");
+        let gpu = Device::open(&choice).expect("the test's OpenCL device is available");
         let program = Program::build(&gpu, features).expect("kernels build");
         Self { gpu, program }
     }

@@ -6,7 +6,7 @@ mod common;
 use common::{Gltf, Prim, render_exr, sphere};
 use glam::{DMat4, Vec3};
 use penumbra::bvh::Ray;
-use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay, layouts};
+use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, DeviceHit, DeviceRay, layouts};
 use penumbra::cl::{Buffer, DeviceChoice};
 use penumbra::render::Renderer;
 use penumbra::scene::{Material, Mesh, Object, RenderFrame, Scene};
@@ -138,15 +138,15 @@ fn check_kernel_traversal(n: usize) {
         // Short rays that end before the first hit.
         rays.push((Vec3::new(x, 5.0, 5.0), Vec3::NEG_Y, 0.0, 0.5 + x * 0.1));
     }
-    let gpu_rays: Vec<GpuRay> = rays
+    let gpu_rays: Vec<DeviceRay> = rays
         .iter()
-        .map(|(o, d, tmin, tmax)| GpuRay {
+        .map(|(o, d, tmin, tmax)| DeviceRay {
             origin: [o.x, o.y, o.z, *tmin],
             direction: [d.x, d.y, d.z, *tmax],
         })
         .collect();
     let ray_buf = Buffer::from_slice(&r.gpu, &gpu_rays).unwrap();
-    let hits = Buffer::<GpuHit>::new(&r.gpu, rays.len()).unwrap();
+    let hits = Buffer::<DeviceHit>::new(&r.gpu, rays.len()).unwrap();
     let occluded = Buffer::<u32>::new(&r.gpu, rays.len()).unwrap();
     let mut counters = Buffer::<u32>::new(&r.gpu, COUNTER_SLOTS).unwrap();
     counters.clear(&r.gpu).unwrap();
@@ -159,7 +159,7 @@ fn check_kernel_traversal(n: usize) {
         .trace_any(&r.gpu, scene, &ray_buf, &occluded, &counters)
         .unwrap();
     // The 4-wide BVH (the megakernel's) must find the same hits.
-    let wide_hits = Buffer::<GpuHit>::new(&r.gpu, rays.len()).unwrap();
+    let wide_hits = Buffer::<DeviceHit>::new(&r.gpu, rays.len()).unwrap();
     let wide_occluded = Buffer::<u32>::new(&r.gpu, rays.len()).unwrap();
     program
         .trace_closest_wide(&r.gpu, scene, &ray_buf, &wide_hits, &counters)

@@ -21,7 +21,7 @@ pub use generate::GenerateArgs;
 pub use stress::StressArgs;
 pub use trace::TraceArgs;
 
-use crate::cl::Gpu;
+use crate::cl::Device;
 use anyhow::Result;
 use clap::Subcommand;
 
@@ -63,7 +63,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
 }
 
 /// The device as benchmark outputs describe it.
-fn device_json(gpu: &Gpu) -> serde_json::Value {
+fn device_json(gpu: &Device) -> serde_json::Value {
     let i = &gpu.info;
     serde_json::json!({
         "name": i.name,
@@ -76,7 +76,7 @@ fn device_json(gpu: &Gpu) -> serde_json::Value {
 }
 
 /// One line naming the device, its platform and driver.
-fn device_line(gpu: &Gpu) -> String {
+fn device_line(gpu: &Device) -> String {
     let i = &gpu.info;
     format!(
         "{} ({}), driver {}, {}, {} compute units",

@@ -13,7 +13,7 @@
 //! - [`acne`]: a plane lit by a sun at a grazing angle must be lit evenly (no dark pixels).
 
 use super::device_line;
-use crate::cl::types::{COUNTER_SLOTS, GpuHit, GpuRay};
+use crate::cl::types::{COUNTER_SLOTS, DeviceHit, DeviceRay};
 use crate::cl::{Buffer, DeviceChoice};
 use crate::date::today;
 use crate::render::{RenderSettings, Renderer};
@@ -266,11 +266,11 @@ pub fn leaks(
     renderer.set_node_forms(crate::render::NodeForms::BOTH)?;
     renderer.load_scene_in(&scene, &[], space)?;
     let mut rng = Rng::new(rays as u64 ^ center.x.to_bits());
-    let gpu_rays: Vec<GpuRay> = (0..rays)
+    let gpu_rays: Vec<DeviceRay> = (0..rays)
         .map(|_| {
             let o = space.point(center + rng.direction() * (0.5 * radius * rng.uniform()));
             let d = rng.direction().as_vec3();
-            GpuRay {
+            DeviceRay {
                 origin: [o.x, o.y, o.z, 0.0],
                 direction: [d.x, d.y, d.z, f32::INFINITY],
             }
@@ -291,7 +291,7 @@ pub fn leaks(
         .count();
     let gpu = &renderer.gpu;
     let ray_buf = Buffer::from_slice(gpu, &gpu_rays)?;
-    let hits = Buffer::<GpuHit>::new(gpu, rays)?;
+    let hits = Buffer::<DeviceHit>::new(gpu, rays)?;
     let mut counters = Buffer::<u32>::new(gpu, COUNTER_SLOTS)?;
     counters.clear(gpu)?;
     let program = renderer.program().expect("the kernels were built");

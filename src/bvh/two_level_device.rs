@@ -3,7 +3,7 @@
 //! BLAS's, rebased, in the binary and the 4-wide forms.
 
 use super::{TwoLevel, WideBvh};
-use crate::cl::types::{GpuBvhNode, GpuWideNode};
+use crate::cl::types::{DeviceBvhNode, DeviceWideNode};
 use rayon::prelude::*;
 
 impl TwoLevel {
@@ -18,7 +18,7 @@ impl TwoLevel {
     /// BLAS's (child indices and leaf triangles rebased: BLAS leaves index the object triangles
     /// of all meshes one after the other, TLAS leaves the instances in TLAS order), each BLAS's
     /// root, and each mesh's first object triangle.
-    pub fn device_nodes(&self) -> (Vec<GpuBvhNode>, Vec<u32>, Vec<u32>) {
+    pub fn device_nodes(&self) -> (Vec<DeviceBvhNode>, Vec<u32>, Vec<u32>) {
         let mut nodes = self.device_tlas();
         let roots = self.device_roots();
         let mut firsts = vec![];
@@ -53,7 +53,7 @@ impl TwoLevel {
     /// The TLAS's binary nodes in the device's form, padded to [`TwoLevel::tlas_slots`]: each
     /// leaf (one piece, [`split_instance_leaves`]) has [`crate::cl::types::TLAS_LEAF`] set in
     /// its count.
-    pub fn device_tlas(&self) -> Vec<GpuBvhNode> {
+    pub fn device_tlas(&self) -> Vec<DeviceBvhNode> {
         let mut nodes = self.tlas.nodes.clone();
         for n in &mut nodes {
             for (lo, hi) in [
@@ -67,7 +67,7 @@ impl TwoLevel {
                 }
             }
         }
-        nodes.resize(self.tlas_slots(), GpuBvhNode::default());
+        nodes.resize(self.tlas_slots(), DeviceBvhNode::default());
         nodes
     }
 
@@ -88,7 +88,7 @@ impl TwoLevel {
     /// collapsed BLAS, rebased alike; each BLAS's root; and per BLAS, each binary node's wide
     /// node (`u32::MAX` for one inside a wide node), where a piece enters the wide BLAS (only
     /// the root's, `[0]`, when [`TwoLevel::max_pieces`] opens no BLAS).
-    pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>, Vec<Vec<u32>>) {
+    pub fn device_wide_nodes(&self) -> (Vec<DeviceWideNode>, Vec<u32>, Vec<Vec<u32>>) {
         // Every wide node is made of a distinct binary node, so the binary nodes bound the
         // array: reserved at once (address space; only the pages written are touched), it is
         // never moved while it grows.
@@ -96,7 +96,7 @@ impl TwoLevel {
             self.tlas_slots() + self.blases.iter().map(|b| b.bvh.nodes.len()).sum::<usize>();
         let mut nodes = Vec::with_capacity(bound);
         nodes.extend(WideBvh::collapse(&self.tlas).nodes);
-        nodes.resize(self.tlas_slots(), GpuWideNode::default());
+        nodes.resize(self.tlas_slots(), DeviceWideNode::default());
         let mut roots = vec![];
         let mut wide_of = vec![];
         let mut tri_base = 0i32;

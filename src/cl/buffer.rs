@@ -4,7 +4,7 @@
 #![allow(unsafe_code)]
 
 use super::host_memory::{HUGE_PAGE, HostPages};
-use super::{ClError, Gpu, call_err};
+use super::{ClError, Device, call_err};
 use bytemuck::Pod;
 use opencl3::memory::{CL_MEM_READ_WRITE, CL_MEM_USE_HOST_PTR, ClMem};
 use opencl3::types::CL_BLOCKING;
@@ -20,7 +20,7 @@ pub struct Buffer<T: Pod> {
 impl<T: Pod> Buffer<T> {
     /// An uninitialised buffer of `len` elements. On a CPU device a buffer of a huge page or
     /// more lives in host memory advised for huge pages (see [`HostPages`]).
-    pub fn new(gpu: &Gpu, len: usize) -> Result<Self, ClError> {
+    pub fn new(gpu: &Device, len: usize) -> Result<Self, ClError> {
         let bytes = len.max(1) * std::mem::size_of::<T>();
         let host = if bytes >= HUGE_PAGE && gpu.is_cpu() {
             HostPages::new(bytes)
@@ -47,7 +47,7 @@ impl<T: Pod> Buffer<T> {
     }
 
     /// A buffer holding a copy of `data`.
-    pub fn from_slice(gpu: &Gpu, data: &[T]) -> Result<Self, ClError> {
+    pub fn from_slice(gpu: &Device, data: &[T]) -> Result<Self, ClError> {
         let mut b = Self::new(gpu, data.len())?;
         b.write(gpu, data)?;
         Ok(b)
@@ -69,13 +69,13 @@ impl<T: Pod> Buffer<T> {
     }
 
     /// Copies `data` to the start of the buffer (blocking).
-    pub fn write(&mut self, gpu: &Gpu, data: &[T]) -> Result<(), ClError> {
+    pub fn write(&mut self, gpu: &Device, data: &[T]) -> Result<(), ClError> {
         self.write_at(gpu, 0, data)
     }
 
     /// Copies `data` into the buffer from element `at` on (blocking): an update in place, no
     /// new allocation.
-    pub fn write_at(&mut self, gpu: &Gpu, at: usize, data: &[T]) -> Result<(), ClError> {
+    pub fn write_at(&mut self, gpu: &Device, at: usize, data: &[T]) -> Result<(), ClError> {
         assert!(
             at + data.len() <= self.len.max(1),
             "write past the end of a buffer"
@@ -99,7 +99,7 @@ impl<T: Pod> Buffer<T> {
     /// with no host copy of it beside the buffer.
     pub fn fill_mapped<R>(
         &mut self,
-        gpu: &Gpu,
+        gpu: &Device,
         fill: impl FnOnce(&mut [T]) -> R,
     ) -> Result<R, ClError> {
         let bytes = self.bytes();
@@ -132,7 +132,7 @@ impl<T: Pod> Buffer<T> {
     }
 
     /// Reads the whole buffer back (blocking).
-    pub fn read(&self, gpu: &Gpu) -> Result<Vec<T>, ClError> {
+    pub fn read(&self, gpu: &Device) -> Result<Vec<T>, ClError> {
         let mut out = Vec::new();
         self.read_into(gpu, &mut out)?;
         Ok(out)
@@ -140,7 +140,7 @@ impl<T: Pod> Buffer<T> {
 
     /// [`Buffer::read`] into `out`, whose allocation is reused when it is large enough (a
     /// frame's film read back without a fresh allocation).
-    pub fn read_into(&self, gpu: &Gpu, out: &mut Vec<T>) -> Result<(), ClError> {
+    pub fn read_into(&self, gpu: &Device, out: &mut Vec<T>) -> Result<(), ClError> {
         out.truncate(self.len);
         out.resize(self.len, T::zeroed());
         if self.len == 0 {
@@ -156,7 +156,7 @@ impl<T: Pod> Buffer<T> {
     }
 
     /// Sets every element to zero.
-    pub fn clear(&mut self, gpu: &Gpu) -> Result<(), ClError> {
+    pub fn clear(&mut self, gpu: &Device) -> Result<(), ClError> {
         let bytes = self.bytes();
         // SAFETY: fills the whole allocation with a zero pattern of one element.
         unsafe {
@@ -180,7 +180,7 @@ mod tests {
 
     #[test]
     fn a_cpu_devices_large_buffer_keeps_what_is_written() {
-        let Ok(gpu) = Gpu::open(&DeviceChoice::Cpu) else {
+        let Ok(gpu) = Device::open(&DeviceChoice::Cpu) else {
             return; // no CPU device here (a GPU-only machine)
         };
         let len = HUGE_PAGE; // 8 MiB of u32: in host pages
@@ -202,7 +202,7 @@ mod tests {
 
     #[test]
     fn reading_into_a_kept_vector_reuses_its_memory_and_reads_every_element() {
-        let Ok(gpu) = Gpu::open(&DeviceChoice::Cpu) else {
+        let Ok(gpu) = Device::open(&DeviceChoice::Cpu) else {
             return; // no CPU device here (a GPU-only machine)
         };
         let data: Vec<u32> = (0..1000u32).map(|i| i * 3 + 1).collect();

@@ -7,7 +7,7 @@
 mod test_program;
 
 use super::types::*;
-use super::{Buffer, ClError, Gpu, KernelFeatures, Stage, build_program, call_err};
+use super::{Buffer, ClError, Device, KernelFeatures, Stage, build_program, call_err};
 use bytemuck::Pod;
 use opencl3::event::Event;
 use opencl3::kernel::{ExecuteKernel, Kernel};
@@ -68,7 +68,7 @@ fn global_size(n: usize, local: usize) -> usize {
 
 impl Program {
     /// Builds the kernels for `features`.
-    pub fn build(gpu: &Gpu, features: KernelFeatures) -> Result<Self, ClError> {
+    pub fn build(gpu: &Device, features: KernelFeatures) -> Result<Self, ClError> {
         let program = build_program(gpu, features)?;
         let k = |stage: Stage| kernel(&program, stage.name());
         let max_group = gpu.device.max_work_group_size().unwrap_or(64).max(1);
@@ -93,7 +93,7 @@ impl Program {
 
     fn run(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         stage: &'static str,
         kernel: &Kernel,
         n: usize,
@@ -104,7 +104,7 @@ impl Program {
 
     fn run_local(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         stage: &'static str,
         kernel: &Kernel,
         n: usize,
@@ -126,10 +126,10 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn generate(
         &self,
-        gpu: &Gpu,
-        frame: &GpuFrame,
-        camera: &GpuCamera,
-        paths: &Buffer<GpuPath>,
+        gpu: &Device,
+        frame: &DeviceFrame,
+        camera: &DeviceCamera,
+        paths: &Buffer<DevicePath>,
         queue: &Buffer<u32>,
         counters: &Buffer<u32>,
         cones: &Buffer<[f32; 2]>,
@@ -155,12 +155,12 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn extend(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         scene: &SceneBuffers,
-        paths: &Buffer<GpuPath>,
+        paths: &Buffer<DevicePath>,
         queue: &Buffer<u32>,
         counters: &Buffer<u32>,
-        hits: &Buffer<GpuHit>,
+        hits: &Buffer<DeviceHit>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(gpu, Stage::Extend.name(), &self.extend, slots, |e| unsafe {
@@ -177,15 +177,15 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn shade(
         &self,
-        gpu: &Gpu,
-        frame: &GpuFrame,
+        gpu: &Device,
+        frame: &DeviceFrame,
         env: &EnvBuffers,
         scene: &SceneBuffers,
-        paths: &Buffer<GpuPath>,
+        paths: &Buffer<DevicePath>,
         queue_in: &Buffer<u32>,
-        hits: &Buffer<GpuHit>,
+        hits: &Buffer<DeviceHit>,
         queue_out: &Buffer<u32>,
-        shadow_rays: &Buffer<GpuShadowRay>,
+        shadow_rays: &Buffer<DeviceShadowRay>,
         counters: &Buffer<u32>,
         cones: &Buffer<[f32; 2]>,
         slots: usize,
@@ -214,11 +214,11 @@ impl Program {
     /// `connect`: traces the queued shadow rays (any hit) and adds the visible contributions.
     pub fn connect(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         scene: &SceneBuffers,
-        shadow_rays: &Buffer<GpuShadowRay>,
+        shadow_rays: &Buffer<DeviceShadowRay>,
         counters: &Buffer<u32>,
-        paths: &Buffer<GpuPath>,
+        paths: &Buffer<DevicePath>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(
@@ -239,7 +239,7 @@ impl Program {
     /// `advance`: counts this bounce's rays and turns the output queue into the next input.
     pub fn advance(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         counters: &Buffer<u32>,
         stats: &Buffer<u64>,
     ) -> Result<Launch, ClError> {
@@ -251,9 +251,9 @@ impl Program {
     /// `accumulate`: adds the wave's finished samples to the film.
     pub fn accumulate(
         &self,
-        gpu: &Gpu,
-        frame: &GpuFrame,
-        paths: &Buffer<GpuPath>,
+        gpu: &Device,
+        frame: &DeviceFrame,
+        paths: &Buffer<DevicePath>,
         film: &Buffer<[f32; 4]>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
@@ -275,10 +275,10 @@ impl Program {
     /// `trace_closest`: closest hits of arbitrary rays (tests and `bench trace`).
     pub fn trace_closest(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
-        hits: &Buffer<GpuHit>,
+        rays: &Buffer<DeviceRay>,
+        hits: &Buffer<DeviceHit>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_closest", &self.trace_closest);
@@ -297,9 +297,9 @@ impl Program {
     /// `trace_any`: occlusion of arbitrary rays (tests and `bench trace`).
     pub fn trace_any(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
+        rays: &Buffer<DeviceRay>,
         occluded: &Buffer<u32>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
@@ -319,10 +319,10 @@ impl Program {
     /// `trace_closest_wide`: as `trace_closest`, through the 4-wide BVH.
     pub fn trace_closest_wide(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
-        hits: &Buffer<GpuHit>,
+        rays: &Buffer<DeviceRay>,
+        hits: &Buffer<DeviceHit>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_closest_wide", &self.trace_closest_wide);
@@ -341,9 +341,9 @@ impl Program {
     /// `trace_any_wide`: as `trace_any`, through the 4-wide BVH.
     pub fn trace_any_wide(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
+        rays: &Buffer<DeviceRay>,
         occluded: &Buffer<u32>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
@@ -365,12 +365,12 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     fn trace<T: Pod>(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         stage: &'static str,
         kernel: &Kernel,
         nodes: opencl3::types::cl_mem,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
+        rays: &Buffer<DeviceRay>,
         out: &Buffer<T>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
@@ -402,9 +402,9 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn megakernel(
         &self,
-        gpu: &Gpu,
-        frame: &GpuFrame,
-        camera: &GpuCamera,
+        gpu: &Device,
+        frame: &DeviceFrame,
+        camera: &DeviceCamera,
         env: &EnvBuffers,
         scene: &SceneBuffers,
         film: &Buffer<[f32; 4]>,

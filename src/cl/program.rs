@@ -1,6 +1,6 @@
 //! The kernels' build at run time with the scene's feature defines (their source: `source.rs`).
 
-use super::{ClError, Gpu};
+use super::{ClError, Device};
 use opencl3::device::CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT;
 
 /// The scene features that decide which kernel code is compiled in.
@@ -112,7 +112,7 @@ impl KernelFeatures {
 /// Builds the program for `features` on the device. A failure returns the compiler's first
 /// error line, which names the kernel file and line.
 pub fn build_program(
-    gpu: &Gpu,
+    gpu: &Device,
     features: KernelFeatures,
 ) -> Result<opencl3::program::Program, ClError> {
     build_source(gpu, &super::source::program_source()?, features)
@@ -121,14 +121,14 @@ pub fn build_program(
 /// Builds the production kernels together with the test-only ones (layout probe, texture,
 /// environment and BSDF test kernels); only tests reach it, through `Program`'s test wrappers.
 pub fn build_test_program(
-    gpu: &Gpu,
+    gpu: &Device,
     features: KernelFeatures,
 ) -> Result<opencl3::program::Program, ClError> {
     build_source(gpu, &super::source::test_program_source()?, features)
 }
 
 pub(crate) fn build_source(
-    gpu: &Gpu,
+    gpu: &Device,
     source: &str,
     features: KernelFeatures,
 ) -> Result<opencl3::program::Program, ClError> {
@@ -189,7 +189,7 @@ pub(crate) fn build_source(
 /// two-level frames on an H200 from 0.82 to 0.90 of flat's when they took 89-94, and a cap of
 /// 64 made frames 2-4 % slower. Flat programs stay under the cap and the cap does not change
 /// them.
-fn register_cap(gpu: &Gpu, features: KernelFeatures) -> Option<u32> {
+fn register_cap(gpu: &Device, features: KernelFeatures) -> Option<u32> {
     (features.two_level && gpu.has_extension("cl_nv_compiler_options"))
         .then_some(TWO_LEVEL_REGISTERS)
 }
@@ -225,7 +225,7 @@ mod tests {
 
     #[test]
     fn a_build_error_names_the_kernel_file_and_line() {
-        let gpu = Gpu::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
+        let gpu = Device::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
         let source = "#line 1 \"kernels/broken.cl\"\nkernel void f(global int* x) {\n  x[0] = undeclared;\n}\n";
         let err = build_source(&gpu, source, KernelFeatures::default())
             .expect_err("the source does not compile")

@@ -11,7 +11,7 @@ use super::{
 };
 use crate::cl::kernels::SceneBuffers;
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, Gpu, KernelFeatures};
+use crate::cl::{Buffer, ClError, Device, KernelFeatures};
 use crate::scene::{AlphaMode, Light, Material, Mesh, RenderFrame, Scene};
 use std::sync::Arc;
 use std::time::Instant;
@@ -45,18 +45,18 @@ impl Planned<'_> {
 
 /// The per-triangle buffers of a scene on the device.
 struct TriangleBuffers {
-    triangles: Buffer<GpuTriangle>,
-    shading: Buffer<GpuTriShading>,
-    uvs: Buffer<GpuTriUvs>,
-    tangents: Buffer<GpuTriTangents>,
+    triangles: Buffer<DeviceTriangle>,
+    shading: Buffer<DeviceTriShading>,
+    uvs: Buffer<DeviceTriUvs>,
+    tangents: Buffer<DeviceTriTangents>,
 }
 
 /// The per-triangle buffers of a scene replaced, to be written again in place.
 type OldTriangleBuffers = (
-    Option<Buffer<GpuTriangle>>,
-    Option<Buffer<GpuTriShading>>,
-    Option<Buffer<GpuTriUvs>>,
-    Option<Buffer<GpuTriTangents>>,
+    Option<Buffer<DeviceTriangle>>,
+    Option<Buffer<DeviceTriShading>>,
+    Option<Buffer<DeviceTriUvs>>,
+    Option<Buffer<DeviceTriTangents>>,
 );
 
 impl Renderer {
@@ -205,7 +205,7 @@ impl Renderer {
         planned: &mut Planned,
         materials: &[Material],
         pack: &TexturePack,
-        (glights, cdf): (&[GpuLight], &[f32]),
+        (glights, cdf): (&[DeviceLight], &[f32]),
         reuse: Option<SceneBuffers>,
         since: Instant,
     ) -> Result<SceneBuffers, ClError> {
@@ -241,7 +241,7 @@ impl Renderer {
         );
         // Two levels trace the meshes' object-space triangles in `triangles`: the separate
         // object-triangle buffer is a placeholder either way.
-        let object_tris = [GpuTriangle::default()];
+        let object_tris = [DeviceTriangle::default()];
         let bytes = |n: usize, size: usize| n.max(1) * size;
         let sizes = [
             ("BVH nodes", std::mem::size_of_val(nodes.as_slice())),
@@ -249,13 +249,13 @@ impl Renderer {
                 "wide BVH nodes",
                 std::mem::size_of_val(wide_nodes.as_slice()),
             ),
-            ("triangles", lengths.0 * std::mem::size_of::<GpuTriangle>()),
+            ("triangles", lengths.0 * std::mem::size_of::<DeviceTriangle>()),
             ("instances", std::mem::size_of_val(instances.as_slice())),
-            ("shading", lengths.1 * std::mem::size_of::<GpuTriShading>()),
-            ("uvs", lengths.3 * std::mem::size_of::<GpuTriUvs>()),
+            ("shading", lengths.1 * std::mem::size_of::<DeviceTriShading>()),
+            ("uvs", lengths.3 * std::mem::size_of::<DeviceTriUvs>()),
             (
                 "tangents",
-                lengths.2 * std::mem::size_of::<GpuTriTangents>(),
+                lengths.2 * std::mem::size_of::<DeviceTriTangents>(),
             ),
             ("texels", bytes(pack.texels.len(), 4)),
         ];
@@ -314,10 +314,10 @@ impl Renderer {
                                 HostScene::fill_meshes(two, meshes, materials, out);
                                 tris[n..].copy_from_slice(&triangles);
                                 if !mesh_tangents {
-                                    tan.fill(GpuTriTangents::default());
+                                    tan.fill(DeviceTriTangents::default());
                                 }
                                 if !mesh_uvs {
-                                    uv.fill(GpuTriUvs::default());
+                                    uv.fill(DeviceTriUvs::default());
                                 }
                             })
                         })
@@ -358,24 +358,24 @@ impl Renderer {
 /// coordinates, tangents; the last two a placeholder of one when empty), each array freed as
 /// soon as its buffer is made; `old`'s buffers written again where the length is the same.
 fn flat_buffers(
-    gpu: &Gpu,
+    gpu: &Device,
     (o_tri, o_sh, o_uv, o_tan): OldTriangleBuffers,
     (triangles, shading, mut uvs, mut tangents): (
-        Vec<GpuTriangle>,
-        Vec<GpuTriShading>,
-        Vec<GpuTriUvs>,
-        Vec<GpuTriTangents>,
+        Vec<DeviceTriangle>,
+        Vec<DeviceTriShading>,
+        Vec<DeviceTriUvs>,
+        Vec<DeviceTriTangents>,
     ),
 ) -> Result<TriangleBuffers, ClError> {
     let shading_buffer = put(gpu, o_sh, &shading)?;
     drop(shading);
     if uvs.is_empty() {
-        uvs.push(GpuTriUvs::default());
+        uvs.push(DeviceTriUvs::default());
     }
     let uvs_buffer = put(gpu, o_uv, &uvs)?;
     drop(uvs);
     if tangents.is_empty() {
-        tangents.push(GpuTriTangents::default());
+        tangents.push(DeviceTriTangents::default());
     }
     let tangents_buffer = put(gpu, o_tan, &tangents)?;
     drop(tangents);
@@ -461,7 +461,7 @@ pub(super) fn scene_features(
 /// A buffer holding `data`: `old` written again when it has `data`'s length, else a new one
 /// (`old` freed first).
 fn put<T: bytemuck::Pod>(
-    gpu: &Gpu,
+    gpu: &Device,
     old: Option<Buffer<T>>,
     data: &[T],
 ) -> Result<Buffer<T>, ClError> {
@@ -480,7 +480,7 @@ fn put<T: bytemuck::Pod>(
 /// A buffer of `len` elements: `old` when it has that length (its memory written again in
 /// place, no fresh pages to fault in), else a new one (contents undefined either way).
 fn sized<T: bytemuck::Pod>(
-    gpu: &Gpu,
+    gpu: &Device,
     old: Option<Buffer<T>>,
     len: usize,
 ) -> Result<Buffer<T>, ClError> {

@@ -5,7 +5,7 @@
 
 use super::Renderer;
 use crate::cl::kernels::Launch;
-use crate::cl::types::GpuFrame;
+use crate::cl::types::DeviceFrame;
 use crate::cl::{ClError, Stage};
 use std::str::FromStr;
 use std::time::Instant;
@@ -120,7 +120,7 @@ impl Renderer {
 
     /// One megakernel launch for `frame`, then `advance` to move its ray counts into the
     /// totals.
-    fn launch_megakernel(&self, frame: &GpuFrame) -> Result<[(Stage, Launch); 2], ClError> {
+    fn launch_megakernel(&self, frame: &DeviceFrame) -> Result<[(Stage, Launch); 2], ClError> {
         let (Some(program), Some((scene, _)), Some(f)) = (
             self.program.as_ref(),
             self.scene.as_ref(),
@@ -131,7 +131,7 @@ impl Renderer {
         let (gpu, counters) = (&self.gpu, &self.counters);
         // The small-scene test (kernels built for whole batches of triangles) takes the count
         // here, so that a scene's hidden objects need no other kernels.
-        let frame = &GpuFrame {
+        let frame = &DeviceFrame {
             triangles: if program.features.small_scene > 0 || program.features.lanes_small {
                 scene.triangles.len() as u32
             } else {

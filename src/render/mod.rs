@@ -32,7 +32,7 @@ use crate::bvh::Ray;
 pub use crate::cl::kernels::NodeForms;
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
+use crate::cl::{Buffer, ClError, DeviceChoice, Device, KernelFeatures, Program};
 use crate::scene::{Camera, EnvMap, EnvSampling, Light, RenderFrame, Scene};
 use sah::SahBuild;
 use std::sync::Arc;
@@ -82,7 +82,7 @@ pub struct SceneStats {
 /// The path tracer on one OpenCL device.
 pub struct Renderer {
     /// The device, context and queue.
-    pub gpu: Gpu,
+    pub gpu: Device,
     program: Option<Program>,
     scene: Option<(SceneBuffers, HostScene)>,
     frame: Option<Frame>,
@@ -91,7 +91,7 @@ pub struct Renderer {
     settings: RenderSettings,
     /// The world camera as last given (the device's is in render space).
     world_camera: Option<Camera>,
-    camera: GpuCamera,
+    camera: DeviceCamera,
     light_count: u32,
     /// What the kernel strategy knows of the device.
     device: DeviceFacts,
@@ -132,12 +132,12 @@ pub struct Renderer {
 impl Renderer {
     /// Opens the device.
     pub fn new(choice: &DeviceChoice) -> Result<Self, ClError> {
-        let gpu = Gpu::open(choice)?;
+        let gpu = Device::open(choice)?;
         let device = DeviceFacts::of(gpu.is_cpu());
         let counters = Buffer::new(&gpu, COUNTER_SLOTS)?;
         let stats_buffer = Buffer::new(&gpu, STAT_SLOTS)?;
         let env = EnvBuffers {
-            info: GpuEnvironment::default(),
+            info: DeviceEnvironment::default(),
             texels: Buffer::from_slice(&gpu, &[0.0; 3])?,
             marginal: Buffer::from_slice(&gpu, &[1.0])?,
             conditional: Buffer::from_slice(&gpu, &[1.0])?,
@@ -151,7 +151,7 @@ impl Renderer {
             stats_buffer,
             settings: RenderSettings::default(),
             world_camera: None,
-            camera: GpuCamera::default(),
+            camera: DeviceCamera::default(),
             light_count: 0,
             device,
             overrides: Overrides::from_env(),

@@ -8,7 +8,7 @@ use super::upload::piece_copies;
 use super::{Accel, Renderer};
 use crate::bvh::WideBvh;
 use crate::cl::ClError;
-use crate::cl::types::GpuWideNode;
+use crate::cl::types::DeviceWideNode;
 use crate::scene::{Scene, is_sane};
 use std::time::Instant;
 
@@ -95,7 +95,7 @@ impl Renderer {
         }
         if buffers.forms.wide {
             let mut wide = WideBvh::collapse(&two.tlas).nodes;
-            wide.resize(slots, GpuWideNode::default());
+            wide.resize(slots, DeviceWideNode::default());
             buffers.wide_nodes.write_at(gpu, 0, &wide)?;
             bytes += std::mem::size_of_val(wide.as_slice());
         }

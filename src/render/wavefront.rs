@@ -7,7 +7,7 @@ use super::Renderer;
 pub use crate::cl::Stage;
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, Gpu, Program};
+use crate::cl::{Buffer, ClError, Device, Program};
 
 /// Kernel time per stage, in launch order ([`Stage::ALL`]); empty until a frame ran.
 #[derive(Clone, Debug, Default)]
@@ -86,10 +86,10 @@ pub(super) struct Frame {
     pub(super) height: u32,
     pub(super) slots: usize,
     pub(super) film: Buffer<[f32; 4]>,
-    pub(super) paths: Buffer<GpuPath>,
+    pub(super) paths: Buffer<DevicePath>,
     pub(super) queues: [Buffer<u32>; 2],
-    pub(super) hits: Buffer<GpuHit>,
-    pub(super) shadow_rays: Buffer<GpuShadowRay>,
+    pub(super) hits: Buffer<DeviceHit>,
+    pub(super) shadow_rays: Buffer<DeviceShadowRay>,
     /// Ray cone (width, spread angle) per slot, for texture filtering.
     pub(super) cones: Buffer<[f32; 2]>,
 }
@@ -100,11 +100,11 @@ const WAVE_PATHS_CPU: usize = 1 << 16;
 
 /// One wave's launches: the device state every stage reads, and one method per stage.
 struct Wave<'a> {
-    gpu: &'a Gpu,
+    gpu: &'a Device,
     program: &'a Program,
     scene: &'a SceneBuffers,
     env: &'a EnvBuffers,
-    camera: &'a GpuCamera,
+    camera: &'a DeviceCamera,
     frame: &'a Frame,
     counters: &'a Buffer<u32>,
     stats: &'a Buffer<u64>,
@@ -118,7 +118,7 @@ impl Wave<'_> {
         self.launches.push((stage, launch));
     }
 
-    fn generate(&mut self, frame: &GpuFrame) -> Result<(), ClError> {
+    fn generate(&mut self, frame: &DeviceFrame) -> Result<(), ClError> {
         let f = self.frame;
         let l = self.program.generate(
             self.gpu,
@@ -151,7 +151,7 @@ impl Wave<'_> {
 
     fn shade(
         &mut self,
-        frame: &GpuFrame,
+        frame: &DeviceFrame,
         queue_in: usize,
         queue_out: usize,
     ) -> Result<(), ClError> {
@@ -194,7 +194,7 @@ impl Wave<'_> {
         Ok(())
     }
 
-    fn accumulate(&mut self, frame: &GpuFrame) -> Result<(), ClError> {
+    fn accumulate(&mut self, frame: &DeviceFrame) -> Result<(), ClError> {
         let f = self.frame;
         let l = self
             .program

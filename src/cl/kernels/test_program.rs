@@ -3,7 +3,7 @@
 
 use super::{Program, kernel};
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, EnvBuffers, Gpu, SceneBuffers, build_test_program};
+use crate::cl::{Buffer, ClError, EnvBuffers, Device, SceneBuffers, build_test_program};
 use opencl3::kernel::Kernel;
 
 /// The kernels only tests use, from their own program (`build_test_program`).
@@ -18,7 +18,7 @@ pub(super) struct TestKernels {
 
 impl Program {
     /// The test-only kernels for the same features, built the first time a test asks.
-    fn tests(&self, gpu: &Gpu) -> Result<&TestKernels, ClError> {
+    fn tests(&self, gpu: &Device) -> Result<&TestKernels, ClError> {
         if let Some(t) = self.tests.get() {
             return Ok(t);
         }
@@ -36,7 +36,7 @@ impl Program {
     }
 
     /// `probe_layout` (test program): sizes and offsets of the shared structs as the device compiler sees them.
-    pub fn probe_layout(&self, gpu: &Gpu) -> Result<Vec<u32>, ClError> {
+    pub fn probe_layout(&self, gpu: &Device) -> Result<Vec<u32>, ClError> {
         let tests = self.tests(gpu)?;
         let out = Buffer::<u32>::new(gpu, 256)?;
         self.run(gpu, "probe_layout", &tests.probe_layout, 1, |e| unsafe {
@@ -49,7 +49,7 @@ impl Program {
     /// kernels/test/tests.cl), .w = texture reference (i32 bits). Zeros without `HAS_TEXTURES`.
     pub fn sample_texture_test(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         scene: &SceneBuffers,
         queries: &[[f32; 4]],
     ) -> Result<Vec<[f32; 4]>, ClError> {
@@ -79,7 +79,7 @@ impl Program {
     #[allow(clippy::type_complexity)]
     pub fn sample_env_test(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         env: &EnvBuffers,
         u: &[[f32; 2]],
     ) -> Result<(Vec<[f32; 4]>, Vec<f32>), ClError> {
@@ -113,7 +113,7 @@ impl Program {
     /// triangles from `groups[i][1]` (`groups[i][3]` is unused).
     pub fn spawn_test(
         &self,
-        gpu: &Gpu,
+        gpu: &Device,
         verts: &[[f32; 4]],
         groups: &[[u32; 4]],
         bary: &[[f32; 2]],
@@ -148,8 +148,8 @@ impl Program {
     #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     pub fn bsdf_sample_test(
         &self,
-        gpu: &Gpu,
-        material: &GpuMaterial,
+        gpu: &Device,
+        material: &DeviceMaterial,
         wo: [f32; 4],
         n: [f32; 4],
         inside: bool,
@@ -184,8 +184,8 @@ impl Program {
     /// `bsdf_eval_test` (test program): (f·|cos|, pdf) of `material` at (`wo`, `n`) for each direction of `wi`.
     pub fn bsdf_eval_test(
         &self,
-        gpu: &Gpu,
-        material: &GpuMaterial,
+        gpu: &Device,
+        material: &DeviceMaterial,
         wo: [f32; 4],
         n: [f32; 4],
         inside: bool,
