@@ -75,29 +75,29 @@ fn cube_scene(n: usize) -> Scene {
 /// Traces `rays` with the four tracing kernels: (closest binary, any binary, closest wide,
 /// any wide), and the overflow count.
 fn trace_all(r: &Renderer, rays: &[DeviceRay]) -> ([Vec<DeviceHit>; 2], [Vec<u32>; 2], u32) {
-    let ray_buf = Buffer::from_slice(&r.gpu, rays).unwrap();
-    let mut counters = Buffer::<u32>::new(&r.gpu, COUNTER_SLOTS).unwrap();
-    counters.clear(&r.gpu).unwrap();
+    let ray_buf = Buffer::from_slice(&r.device, rays).unwrap();
+    let mut counters = Buffer::<u32>::new(&r.device, COUNTER_SLOTS).unwrap();
+    counters.clear(&r.device).unwrap();
     let program = r.program().unwrap();
     let scene = r.scene_buffers().unwrap();
-    let hits = [(); 2].map(|_| Buffer::<DeviceHit>::new(&r.gpu, rays.len()).unwrap());
-    let occluded = [(); 2].map(|_| Buffer::<u32>::new(&r.gpu, rays.len()).unwrap());
+    let hits = [(); 2].map(|_| Buffer::<DeviceHit>::new(&r.device, rays.len()).unwrap());
+    let occluded = [(); 2].map(|_| Buffer::<u32>::new(&r.device, rays.len()).unwrap());
     program
-        .trace_closest(&r.gpu, scene, &ray_buf, &hits[0], &counters)
+        .trace_closest(&r.device, scene, &ray_buf, &hits[0], &counters)
         .unwrap();
     program
-        .trace_any(&r.gpu, scene, &ray_buf, &occluded[0], &counters)
+        .trace_any(&r.device, scene, &ray_buf, &occluded[0], &counters)
         .unwrap();
     program
-        .trace_closest_wide(&r.gpu, scene, &ray_buf, &hits[1], &counters)
+        .trace_closest_wide(&r.device, scene, &ray_buf, &hits[1], &counters)
         .unwrap();
     program
-        .trace_any_wide(&r.gpu, scene, &ray_buf, &occluded[1], &counters)
+        .trace_any_wide(&r.device, scene, &ray_buf, &occluded[1], &counters)
         .unwrap();
-    let overflow = counters.read(&r.gpu).unwrap()[COUNT_OVERFLOW];
+    let overflow = counters.read(&r.device).unwrap()[COUNT_OVERFLOW];
     (
-        hits.map(|h| h.read(&r.gpu).unwrap()),
-        occluded.map(|o| o.read(&r.gpu).unwrap()),
+        hits.map(|h| h.read(&r.device).unwrap()),
+        occluded.map(|o| o.read(&r.device).unwrap()),
         overflow,
     )
 }
@@ -553,17 +553,17 @@ fn a_device_gets_the_node_array_its_kernels_traverse() {
             origin: [0.0, 0.0, 30.0, 0.0],
             direction: [0.0, 0.0, -1.0, f32::INFINITY],
         };
-        let rays = Buffer::from_slice(&lean.gpu, &[ray]).unwrap();
-        let hits = Buffer::<DeviceHit>::new(&lean.gpu, 1).unwrap();
-        let counters = Buffer::<u32>::new(&lean.gpu, COUNTER_SLOTS).unwrap();
+        let rays = Buffer::from_slice(&lean.device, &[ray]).unwrap();
+        let hits = Buffer::<DeviceHit>::new(&lean.device, 1).unwrap();
+        let counters = Buffer::<u32>::new(&lean.device, COUNTER_SLOTS).unwrap();
         let program = lean.program().unwrap();
         assert!(
             program
-                .trace_closest(&lean.gpu, l, &rays, &hits, &counters)
+                .trace_closest(&lean.device, l, &rays, &hits, &counters)
                 .is_err()
         );
         program
-            .trace_closest_wide(&lean.gpu, l, &rays, &hits, &counters)
+            .trace_closest_wide(&lean.device, l, &rays, &hits, &counters)
             .unwrap();
         if bvh == BvhChoice::TwoLevel {
             // A moved instance's TLAS goes to the wide nodes alone.

@@ -317,7 +317,7 @@ fn place(
     let Built::Top { children, .. } = node else {
         unreachable!("place is only called on split nodes")
     };
-    let mut gpu = DeviceBvhNode::default();
+    let mut device = DeviceBvhNode::default();
     let mut pending = [None, None];
     for (side, child) in children.iter().enumerate() {
         match child {
@@ -325,15 +325,15 @@ fn place(
                 bounds,
                 first,
                 count,
-            } => write_leaf(&mut gpu, side, *bounds, *first, *count),
+            } => write_leaf(&mut device, side, *bounds, *first, *count),
             Built::Tree { .. } | Built::Top { .. } => {
-                write_interior(&mut gpu, side, child.bounds(), *end as u32);
+                write_interior(&mut device, side, child.bounds(), *end as u32);
                 pending[side] = Some(*end);
                 *end += 1;
             }
         }
     }
-    tops.push((slot, gpu));
+    tops.push((slot, device));
     let [left, right] = *children;
     for (child, index) in [left, right].into_iter().zip(pending) {
         let Some(index) = index else { continue };

@@ -68,10 +68,10 @@ fn global_size(n: usize, local: usize) -> usize {
 
 impl Program {
     /// Builds the kernels for `features`.
-    pub fn build(gpu: &Device, features: KernelFeatures) -> Result<Self, ClError> {
-        let program = build_program(gpu, features)?;
+    pub fn build(device: &Device, features: KernelFeatures) -> Result<Self, ClError> {
+        let program = build_program(device, features)?;
         let k = |stage: Stage| kernel(&program, stage.name());
-        let max_group = gpu.device.max_work_group_size().unwrap_or(64).max(1);
+        let max_group = device.device.max_work_group_size().unwrap_or(64).max(1);
         Ok(Self {
             generate: k(Stage::Generate)?,
             extend: k(Stage::Extend)?,
@@ -93,18 +93,18 @@ impl Program {
 
     fn run(
         &self,
-        gpu: &Device,
+        device: &Device,
         stage: &'static str,
         kernel: &Kernel,
         n: usize,
         set: impl FnOnce(&mut ExecuteKernel),
     ) -> Result<Launch, ClError> {
-        self.run_local(gpu, stage, kernel, n, self.local_size, set)
+        self.run_local(device, stage, kernel, n, self.local_size, set)
     }
 
     fn run_local(
         &self,
-        gpu: &Device,
+        device: &Device,
         stage: &'static str,
         kernel: &Kernel,
         n: usize,
@@ -118,7 +118,7 @@ impl Program {
         // SAFETY: every wrapper below sets exactly the kernel's arguments, in order, with the
         // types the kernel declares; buffers outlive the launch because the queue is in order
         // and every reader of results waits on it.
-        let event = unsafe { exec.enqueue_nd_range(&gpu.queue) }.map_err(call_err(stage))?;
+        let event = unsafe { exec.enqueue_nd_range(&device.queue) }.map_err(call_err(stage))?;
         Ok(Launch { stage, event })
     }
 
@@ -126,7 +126,7 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn generate(
         &self,
-        gpu: &Device,
+        device: &Device,
         frame: &DeviceFrame,
         camera: &DeviceCamera,
         paths: &Buffer<DevicePath>,
@@ -136,7 +136,7 @@ impl Program {
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(
-            gpu,
+            device,
             Stage::Generate.name(),
             &self.generate,
             slots,
@@ -155,7 +155,7 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn extend(
         &self,
-        gpu: &Device,
+        device: &Device,
         scene: &SceneBuffers,
         paths: &Buffer<DevicePath>,
         queue: &Buffer<u32>,
@@ -163,21 +163,27 @@ impl Program {
         hits: &Buffer<DeviceHit>,
         slots: usize,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, Stage::Extend.name(), &self.extend, slots, |e| unsafe {
-            set_geometry(e, scene.nodes.mem(), scene);
-            set_surfaces(e, scene);
-            e.set_arg(&paths.mem())
-                .set_arg(&queue.mem())
-                .set_arg(&counters.mem())
-                .set_arg(&hits.mem());
-        })
+        self.run(
+            device,
+            Stage::Extend.name(),
+            &self.extend,
+            slots,
+            |e| unsafe {
+                set_geometry(e, scene.nodes.mem(), scene);
+                set_surfaces(e, scene);
+                e.set_arg(&paths.mem())
+                    .set_arg(&queue.mem())
+                    .set_arg(&counters.mem())
+                    .set_arg(&hits.mem());
+            },
+        )
     }
 
     /// `shade`: emission, a light sample (queued for `connect`) and the next bounce.
     #[allow(clippy::too_many_arguments)]
     pub fn shade(
         &self,
-        gpu: &Device,
+        device: &Device,
         frame: &DeviceFrame,
         env: &EnvBuffers,
         scene: &SceneBuffers,
@@ -190,31 +196,37 @@ impl Program {
         cones: &Buffer<[f32; 2]>,
         slots: usize,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, Stage::Shade.name(), &self.shade, slots, |e| unsafe {
-            e.set_arg(frame)
-                .set_arg(&env.info)
-                .set_arg(&scene.triangles.mem())
-                .set_arg(&scene.instances.mem());
-            set_surfaces(e, scene);
-            e.set_arg(&env.texels.mem())
-                .set_arg(&env.marginal.mem())
-                .set_arg(&env.conditional.mem())
-                .set_arg(&scene.lights.mem())
-                .set_arg(&scene.light_cdf.mem())
-                .set_arg(&paths.mem())
-                .set_arg(&queue_in.mem())
-                .set_arg(&hits.mem())
-                .set_arg(&queue_out.mem())
-                .set_arg(&shadow_rays.mem())
-                .set_arg(&counters.mem())
-                .set_arg(&cones.mem());
-        })
+        self.run(
+            device,
+            Stage::Shade.name(),
+            &self.shade,
+            slots,
+            |e| unsafe {
+                e.set_arg(frame)
+                    .set_arg(&env.info)
+                    .set_arg(&scene.triangles.mem())
+                    .set_arg(&scene.instances.mem());
+                set_surfaces(e, scene);
+                e.set_arg(&env.texels.mem())
+                    .set_arg(&env.marginal.mem())
+                    .set_arg(&env.conditional.mem())
+                    .set_arg(&scene.lights.mem())
+                    .set_arg(&scene.light_cdf.mem())
+                    .set_arg(&paths.mem())
+                    .set_arg(&queue_in.mem())
+                    .set_arg(&hits.mem())
+                    .set_arg(&queue_out.mem())
+                    .set_arg(&shadow_rays.mem())
+                    .set_arg(&counters.mem())
+                    .set_arg(&cones.mem());
+            },
+        )
     }
 
     /// `connect`: traces the queued shadow rays (any hit) and adds the visible contributions.
     pub fn connect(
         &self,
-        gpu: &Device,
+        device: &Device,
         scene: &SceneBuffers,
         shadow_rays: &Buffer<DeviceShadowRay>,
         counters: &Buffer<u32>,
@@ -222,7 +234,7 @@ impl Program {
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(
-            gpu,
+            device,
             Stage::Connect.name(),
             &self.connect,
             slots,
@@ -239,19 +251,25 @@ impl Program {
     /// `advance`: counts this bounce's rays and turns the output queue into the next input.
     pub fn advance(
         &self,
-        gpu: &Device,
+        device: &Device,
         counters: &Buffer<u32>,
         stats: &Buffer<u64>,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, Stage::Advance.name(), &self.advance, 1, |e| unsafe {
-            e.set_arg(&counters.mem()).set_arg(&stats.mem());
-        })
+        self.run(
+            device,
+            Stage::Advance.name(),
+            &self.advance,
+            1,
+            |e| unsafe {
+                e.set_arg(&counters.mem()).set_arg(&stats.mem());
+            },
+        )
     }
 
     /// `accumulate`: adds the wave's finished samples to the film.
     pub fn accumulate(
         &self,
-        gpu: &Device,
+        device: &Device,
         frame: &DeviceFrame,
         paths: &Buffer<DevicePath>,
         film: &Buffer<[f32; 4]>,
@@ -259,7 +277,7 @@ impl Program {
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
         self.run(
-            gpu,
+            device,
             Stage::Accumulate.name(),
             &self.accumulate,
             pixels,
@@ -275,7 +293,7 @@ impl Program {
     /// `trace_closest`: closest hits of arbitrary rays (tests and `bench trace`).
     pub fn trace_closest(
         &self,
-        gpu: &Device,
+        device: &Device,
         bvh: &SceneBuffers,
         rays: &Buffer<DeviceRay>,
         hits: &Buffer<DeviceHit>,
@@ -283,7 +301,7 @@ impl Program {
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_closest", &self.trace_closest);
         self.trace(
-            gpu,
+            device,
             stage,
             kernel,
             bvh.nodes.mem(),
@@ -297,7 +315,7 @@ impl Program {
     /// `trace_any`: occlusion of arbitrary rays (tests and `bench trace`).
     pub fn trace_any(
         &self,
-        gpu: &Device,
+        device: &Device,
         bvh: &SceneBuffers,
         rays: &Buffer<DeviceRay>,
         occluded: &Buffer<u32>,
@@ -305,7 +323,7 @@ impl Program {
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_any", &self.trace_any);
         self.trace(
-            gpu,
+            device,
             stage,
             kernel,
             bvh.nodes.mem(),
@@ -319,7 +337,7 @@ impl Program {
     /// `trace_closest_wide`: as `trace_closest`, through the 4-wide BVH.
     pub fn trace_closest_wide(
         &self,
-        gpu: &Device,
+        device: &Device,
         bvh: &SceneBuffers,
         rays: &Buffer<DeviceRay>,
         hits: &Buffer<DeviceHit>,
@@ -327,7 +345,7 @@ impl Program {
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_closest_wide", &self.trace_closest_wide);
         self.trace(
-            gpu,
+            device,
             stage,
             kernel,
             bvh.wide_nodes.mem(),
@@ -341,7 +359,7 @@ impl Program {
     /// `trace_any_wide`: as `trace_any`, through the 4-wide BVH.
     pub fn trace_any_wide(
         &self,
-        gpu: &Device,
+        device: &Device,
         bvh: &SceneBuffers,
         rays: &Buffer<DeviceRay>,
         occluded: &Buffer<u32>,
@@ -349,7 +367,7 @@ impl Program {
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_any_wide", &self.trace_any_wide);
         self.trace(
-            gpu,
+            device,
             stage,
             kernel,
             bvh.wide_nodes.mem(),
@@ -365,7 +383,7 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     fn trace<T: Pod>(
         &self,
-        gpu: &Device,
+        device: &Device,
         stage: &'static str,
         kernel: &Kernel,
         nodes: opencl3::types::cl_mem,
@@ -387,7 +405,7 @@ impl Program {
             )));
         }
         let count = rays.len() as u32;
-        self.run(gpu, stage, kernel, rays.len(), |e| unsafe {
+        self.run(device, stage, kernel, rays.len(), |e| unsafe {
             set_geometry(e, nodes, bvh);
             set_surfaces(e, bvh);
             e.set_arg(&rays.mem())
@@ -402,7 +420,7 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn megakernel(
         &self,
-        gpu: &Device,
+        device: &Device,
         frame: &DeviceFrame,
         camera: &DeviceCamera,
         env: &EnvBuffers,
@@ -420,7 +438,7 @@ impl Program {
         };
         let local = self.mega_local_size;
         self.run_local(
-            gpu,
+            device,
             Stage::Megakernel.name(),
             &self.megakernel,
             items,

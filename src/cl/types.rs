@@ -549,7 +549,15 @@ pub fn layouts() -> Vec<StructLayout> {
         layout!(DeviceTriTangents, t0, t1, t2),
         layout!(DeviceTexture, offset, width, height, flags),
         layout!(DeviceTexRef, m0, m1, info),
-        layout!(DeviceEnvironment, scale, rotation, width, height, light, pad),
+        layout!(
+            DeviceEnvironment,
+            scale,
+            rotation,
+            width,
+            height,
+            light,
+            pad
+        ),
         layout!(
             DeviceMaterial,
             base_color,

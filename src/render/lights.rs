@@ -198,8 +198,8 @@ impl Renderer {
         let Some((buffers, _)) = self.scene.as_mut() else {
             return Ok(());
         };
-        buffers.lights = Buffer::from_slice(&self.gpu, &glights)?;
-        buffers.light_cdf = Buffer::from_slice(&self.gpu, &cdf)?;
+        buffers.lights = Buffer::from_slice(&self.device, &glights)?;
+        buffers.light_cdf = Buffer::from_slice(&self.device, &cdf)?;
         self.light_count = glights.len() as u32;
         self.update_env_info(&glights);
         Ok(())

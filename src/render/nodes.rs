@@ -36,15 +36,15 @@ impl Renderer {
         }
         let (nodes, wide) = device_nodes(host, add);
         if let Some(nodes) = nodes {
-            buffers.nodes = Buffer::from_slice(&self.gpu, &nodes)?;
+            buffers.nodes = Buffer::from_slice(&self.device, &nodes)?;
         }
         if let Some(wide) = wide {
-            buffers.wide_nodes = Buffer::from_slice(&self.gpu, &wide)?;
+            buffers.wide_nodes = Buffer::from_slice(&self.device, &wide)?;
         }
         buffers.forms = buffers.forms.with(add);
         if let Accel::TwoLevel(two) = &host.accel {
             let instances = host.layout.gpu_instances(two);
-            buffers.instances.write_at(&self.gpu, 0, &instances)?;
+            buffers.instances.write_at(&self.device, 0, &instances)?;
         }
         Ok(())
     }

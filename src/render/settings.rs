@@ -1,8 +1,8 @@
 //! What the user controls about a render.
 
 use crate::cl::types::{
-    BACKGROUND_COUNT, BACKGROUND_CUTOUT, BACKGROUND_ENV, DeviceFrame, STRATEGY_BSDF, STRATEGY_LIGHTS,
-    STRATEGY_MIS,
+    BACKGROUND_COUNT, BACKGROUND_CUTOUT, BACKGROUND_ENV, DeviceFrame, STRATEGY_BSDF,
+    STRATEGY_LIGHTS, STRATEGY_MIS,
 };
 
 /// Which estimator feeds direct light.

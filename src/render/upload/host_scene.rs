@@ -166,7 +166,11 @@ impl HostScene {
     fn assemble(
         accel: Accel,
         layout: InstanceLayout,
-        (triangles, shading, tangents): (Vec<DeviceTriangle>, Vec<DeviceTriShading>, Vec<DeviceTriTangents>),
+        (triangles, shading, tangents): (
+            Vec<DeviceTriangle>,
+            Vec<DeviceTriShading>,
+            Vec<DeviceTriTangents>,
+        ),
         materials: &[Material],
         emissive: Vec<Emitter>,
         middle: (Vec3, f32),
