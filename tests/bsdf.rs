@@ -14,8 +14,8 @@ mod common;
 
 use common::stats::chi2;
 use common::{Gltf, Prim, cuboid, horizontal_square, output_dir, render_exr, sphere};
-use penumbra::cl::types::GpuMaterial;
-use penumbra::cl::{DeviceChoice, Gpu, KernelFeatures, Program};
+use penumbra::cl::types::DeviceMaterial;
+use penumbra::cl::{Device, DeviceChoice, KernelFeatures, Program};
 use penumbra::scene::Material;
 use serde_json::json;
 use std::f64::consts::PI;
@@ -23,7 +23,7 @@ use std::f64::consts::PI;
 // ---------------------------------------------------------------------------------------------
 // Materials and the device
 
-/// A material as the kernels take it (the GpuMaterial lanes bsdf.h reads).
+/// A material as the kernels take it (the DeviceMaterial lanes bsdf.h reads).
 #[derive(Clone, Copy, Debug)]
 struct Mat {
     base: [f32; 3],
@@ -144,7 +144,7 @@ impl Mat {
     }
 
     /// The device form, packed as the renderer packs a scene's material.
-    fn gpu(&self) -> GpuMaterial {
+    fn device(&self) -> DeviceMaterial {
         let b = self.base;
         penumbra::render::gpu_material(&Material {
             base_color: [b[0], b[1], b[2], 1.0],
@@ -172,12 +172,13 @@ impl Mat {
     }
 }
 
-struct Device {
-    gpu: Gpu,
+/// The BSDF test kernels built on the test device.
+struct BsdfKernels {
+    device: Device,
     program: Program,
 }
 
-impl Device {
+impl BsdfKernels {
     fn new() -> Self {
         // Every lobe compiled in; a material without them reduces to the plain BSDF.
         Self::with(KernelFeatures {
@@ -192,16 +193,24 @@ impl Device {
 
     fn with(features: KernelFeatures) -> Self {
         let choice: DeviceChoice = common::test_device().parse().expect("a valid test device");
-        let gpu = Gpu::open(&choice).expect("the test's OpenCL device is available");
-        let program = Program::build(&gpu, features).expect("kernels build");
-        Self { gpu, program }
+        let device = Device::open(&choice).expect("the test's OpenCL device is available");
+        let program = Program::build(&device, features).expect("kernels build");
+        Self { device, program }
     }
 
     /// `count` samples: (wi, pdf) and (weight, delta flag).
     fn sample(&self, m: &Mat, wo: V, n: V, inside: bool, count: usize, seed: u32) -> Samples {
         let (wi, w) = self
             .program
-            .bsdf_sample_test(&self.gpu, &m.gpu(), f4(wo), f4(n), inside, count, seed)
+            .bsdf_sample_test(
+                &self.device,
+                &m.device(),
+                f4(wo),
+                f4(n),
+                inside,
+                count,
+                seed,
+            )
             .unwrap();
         Samples { wi, w }
     }
@@ -212,7 +221,7 @@ impl Device {
         for chunk in wi.chunks(1 << 20) {
             out.extend(
                 self.program
-                    .bsdf_eval_test(&self.gpu, &m.gpu(), f4(wo), f4(n), inside, chunk)
+                    .bsdf_eval_test(&self.device, &m.device(), f4(wo), f4(n), inside, chunk)
                     .unwrap(),
             );
         }
@@ -441,7 +450,7 @@ fn case(name: &str, mat: Mat, theta_o: f64, inside: bool) -> Case {
 /// Checks per sample that the pdf and weight bsdf_sample returns match bsdf_eval for the same
 /// direction; returns the number of samples that made a direction by a non-delta lobe. Only a
 /// smooth clear coat over a rough base may add delta samples.
-fn check_samples(d: &Device, c: &Case, s: &Samples) -> Result<usize, String> {
+fn check_samples(d: &BsdfKernels, c: &Case, s: &Samples) -> Result<usize, String> {
     let evals = d.eval(&c.mat, c.wo, c.n, c.inside, &s.wi);
     let mut made = 0;
     for (k, ((wi, w), e)) in s.wi.iter().zip(&s.w).zip(&evals).enumerate() {
@@ -483,7 +492,12 @@ fn check_samples(d: &Device, c: &Case, s: &Samples) -> Result<usize, String> {
 }
 
 /// Runs a case; returns (χ², dof, p) or why it failed outright.
-fn run_case(d: &Device, c: &Case, count: usize, seed: u32) -> Result<(f64, usize, f64), String> {
+fn run_case(
+    d: &BsdfKernels,
+    c: &Case,
+    count: usize,
+    seed: u32,
+) -> Result<(f64, usize, f64), String> {
     let s = d.sample(&c.mat, c.wo, c.n, c.inside, count, seed);
     let made = check_samples(d, c, &s)?;
     let mut observed = vec![0u64; c.grid.bins()];
@@ -539,7 +553,7 @@ fn write_table(c: &Case, observed: &[u64], expected: &[f64]) {
 
 #[test]
 fn sampling_matches_pdf_chi_square() {
-    let d = Device::new();
+    let d = BsdfKernels::new();
     let white = [1.0f32; 3];
     let mut cases = vec![case("diffuse", Mat::lambert([0.8, 0.5, 0.3]), 45.0, false)];
     // The GGX visible-normal sampling alone (a white metal), narrow lobes on a grid about the
@@ -791,8 +805,8 @@ const INV_PI_F: f32 = std::f32::consts::FRAC_1_PI;
 /// it must sample the same directions with the same weights and pdfs as the general BSDF.
 #[test]
 fn lambert_only_build_matches_the_general_bsdf() {
-    let general = Device::new();
-    let lambert = Device::with(KernelFeatures {
+    let general = BsdfKernels::new();
+    let lambert = BsdfKernels::with(KernelFeatures {
         lambert_only: true,
         ..KernelFeatures::default()
     });
@@ -845,7 +859,7 @@ fn lambert_only_build_matches_the_general_bsdf() {
 
 #[test]
 fn specular_factor_zero_is_exactly_lambertian() {
-    let d = Device::new();
+    let d = BsdfKernels::new();
     let m = Mat::lambert([0.8, 0.5, 0.3]);
     let n = [0.0, 0.0, 1.0];
     for theta in [0.0, 30.0, 60.0, 85.0, 89.9] {
@@ -870,7 +884,7 @@ fn specular_factor_zero_is_exactly_lambertian() {
 
 #[test]
 fn delta_lobes_reflect_and_refract_exactly() {
-    let d = Device::new();
+    let d = BsdfKernels::new();
     let n = [0.0, 0.0, 1.0];
     let close = |a: V, b: V| (0..3).all(|i| (a[i] - b[i]).abs() < 2e-6);
     let schlick = |f0: f64, c: f64| f0 + (1.0 - f0) * (1.0 - c).powi(5);
@@ -970,7 +984,7 @@ fn delta_lobes_reflect_and_refract_exactly() {
 
 #[test]
 fn directional_albedo_never_exceeds_one() {
-    let d = Device::new();
+    let d = BsdfKernels::new();
     let n = [0.0, 0.0, 1.0];
     let white = [1.0f32; 3];
     let mut materials = vec![];
@@ -1185,7 +1199,7 @@ fn directional_albedo_never_exceeds_one() {
 /// albedo E), and never more than all of it.
 #[test]
 fn white_under_a_clear_coat_loses_at_most_what_the_spec_loses() {
-    let d = Device::new();
+    let d = BsdfKernels::new();
     let n = [0.0, 0.0, 1.0];
     let count = 1 << 17;
     for c in [0.5f32, 1.0] {
@@ -1221,7 +1235,7 @@ fn white_under_a_clear_coat_loses_at_most_what_the_spec_loses() {
 /// error there): it neither loses more nor gains.
 #[test]
 fn white_under_a_sheen_keeps_what_the_spec_keeps() {
-    let d = Device::new();
+    let d = BsdfKernels::new();
     let charlie = kernel_table("SHEEN_E_CHARLIE");
     let n = [0.0, 0.0, 1.0];
     let count = 1 << 17;
@@ -2167,7 +2181,7 @@ fn white_furnace_spheres_keep_their_energy() {
             sphere_mean(&px, &pixels)
         })
         .collect();
-    let d = Device::new();
+    let d = BsdfKernels::new();
     let mut report = vec![];
     for (k, ((name, m, low), (mean, err))) in cases.iter().zip(renders).enumerate() {
         // The directional albedo A(cos theta_o) from the sampling kernel; on a convex object
@@ -2562,7 +2576,7 @@ fn a_dispersive_prism_separates_colours() {
 /// from the back (the sheet's normal turned over).
 #[test]
 fn diffuse_transmission_is_reciprocal() {
-    let d = Device::new();
+    let d = BsdfKernels::new();
     let n = [0.0, 0.0, 1.0];
     let back = [0.0, 0.0, -1.0];
     let materials = [
@@ -2605,7 +2619,7 @@ fn diffuse_transmission_is_reciprocal() {
 
 #[test]
 fn reflection_is_reciprocal() {
-    let d = Device::new();
+    let d = BsdfKernels::new();
     let n = [0.0, 0.0, 1.0];
     let mut plastic = Mat::dielectric([0.8, 0.4, 0.2], 0.5);
     plastic.specular_color = [1.0, 0.7, 1.2];

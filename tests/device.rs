@@ -6,7 +6,7 @@ mod common;
 use common::{Gltf, Prim, render_exr, sphere};
 use glam::{DMat4, Vec3};
 use penumbra::bvh::Ray;
-use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay, layouts};
+use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, DeviceHit, DeviceRay, layouts};
 use penumbra::cl::{Buffer, DeviceChoice};
 use penumbra::render::Renderer;
 use penumbra::scene::{Material, Mesh, Object, RenderFrame, Scene};
@@ -66,7 +66,7 @@ fn random_scene(n: usize) -> Scene {
 fn layout_probe_agrees_with_every_shared_rust_struct() {
     let mut r = renderer();
     r.load_scene(&random_scene(4), &[]).unwrap();
-    let probed = r.program().unwrap().probe_layout(&r.gpu).unwrap();
+    let probed = r.program().unwrap().probe_layout(&r.device).unwrap();
     let mut at = 0;
     for (name, size, fields) in layouts() {
         assert_eq!(probed[at] as usize, size, "sizeof({name}) on the device");
@@ -138,41 +138,41 @@ fn check_kernel_traversal(n: usize) {
         // Short rays that end before the first hit.
         rays.push((Vec3::new(x, 5.0, 5.0), Vec3::NEG_Y, 0.0, 0.5 + x * 0.1));
     }
-    let gpu_rays: Vec<GpuRay> = rays
+    let gpu_rays: Vec<DeviceRay> = rays
         .iter()
-        .map(|(o, d, tmin, tmax)| GpuRay {
+        .map(|(o, d, tmin, tmax)| DeviceRay {
             origin: [o.x, o.y, o.z, *tmin],
             direction: [d.x, d.y, d.z, *tmax],
         })
         .collect();
-    let ray_buf = Buffer::from_slice(&r.gpu, &gpu_rays).unwrap();
-    let hits = Buffer::<GpuHit>::new(&r.gpu, rays.len()).unwrap();
-    let occluded = Buffer::<u32>::new(&r.gpu, rays.len()).unwrap();
-    let mut counters = Buffer::<u32>::new(&r.gpu, COUNTER_SLOTS).unwrap();
-    counters.clear(&r.gpu).unwrap();
+    let ray_buf = Buffer::from_slice(&r.device, &gpu_rays).unwrap();
+    let hits = Buffer::<DeviceHit>::new(&r.device, rays.len()).unwrap();
+    let occluded = Buffer::<u32>::new(&r.device, rays.len()).unwrap();
+    let mut counters = Buffer::<u32>::new(&r.device, COUNTER_SLOTS).unwrap();
+    counters.clear(&r.device).unwrap();
     let program = r.program().unwrap();
     let scene = r.scene_buffers().unwrap();
     program
-        .trace_closest(&r.gpu, scene, &ray_buf, &hits, &counters)
+        .trace_closest(&r.device, scene, &ray_buf, &hits, &counters)
         .unwrap();
     program
-        .trace_any(&r.gpu, scene, &ray_buf, &occluded, &counters)
+        .trace_any(&r.device, scene, &ray_buf, &occluded, &counters)
         .unwrap();
     // The 4-wide BVH (the megakernel's) must find the same hits.
-    let wide_hits = Buffer::<GpuHit>::new(&r.gpu, rays.len()).unwrap();
-    let wide_occluded = Buffer::<u32>::new(&r.gpu, rays.len()).unwrap();
+    let wide_hits = Buffer::<DeviceHit>::new(&r.device, rays.len()).unwrap();
+    let wide_occluded = Buffer::<u32>::new(&r.device, rays.len()).unwrap();
     program
-        .trace_closest_wide(&r.gpu, scene, &ray_buf, &wide_hits, &counters)
+        .trace_closest_wide(&r.device, scene, &ray_buf, &wide_hits, &counters)
         .unwrap();
     program
-        .trace_any_wide(&r.gpu, scene, &ray_buf, &wide_occluded, &counters)
+        .trace_any_wide(&r.device, scene, &ray_buf, &wide_occluded, &counters)
         .unwrap();
-    let hits = hits.read(&r.gpu).unwrap();
-    let occluded = occluded.read(&r.gpu).unwrap();
-    let wide_hits = wide_hits.read(&r.gpu).unwrap();
-    let wide_occluded = wide_occluded.read(&r.gpu).unwrap();
+    let hits = hits.read(&r.device).unwrap();
+    let occluded = occluded.read(&r.device).unwrap();
+    let wide_hits = wide_hits.read(&r.device).unwrap();
+    let wide_occluded = wide_occluded.read(&r.device).unwrap();
     assert_eq!(
-        counters.read(&r.gpu).unwrap()[COUNT_OVERFLOW],
+        counters.read(&r.device).unwrap()[COUNT_OVERFLOW],
         0,
         "no stack overflow"
     );

@@ -95,7 +95,7 @@ fn environment_sampling_matches_its_pdf_chi_square() {
         let program = r.program().unwrap();
         assert!(program.features.env_map);
         let (samples, eval) = program
-            .sample_env_test(&r.gpu, r.env_buffers(), &u)
+            .sample_env_test(&r.device, r.env_buffers(), &u)
             .unwrap();
         // Back into the map's frame: undo the rotation about +Y.
         let (sin, cos) = rotation.to_radians().sin_cos();

@@ -8,7 +8,7 @@ mod common;
 use common::{Gltf, Prim, render_exr, sphere};
 use glam::{DMat4, DQuat, DVec3, Vec3};
 use penumbra::bvh::{Ray, SMALL_MESH};
-use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay};
+use penumbra::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, DeviceHit, DeviceRay};
 use penumbra::cl::{Buffer, DeviceChoice};
 use penumbra::render::{BvhChoice, KernelChoice, NodeForms, Renderer};
 use penumbra::scene::{Material, Mesh, Object, RenderFrame, Scene};
@@ -74,30 +74,30 @@ fn cube_scene(n: usize) -> Scene {
 
 /// Traces `rays` with the four tracing kernels: (closest binary, any binary, closest wide,
 /// any wide), and the overflow count.
-fn trace_all(r: &Renderer, rays: &[GpuRay]) -> ([Vec<GpuHit>; 2], [Vec<u32>; 2], u32) {
-    let ray_buf = Buffer::from_slice(&r.gpu, rays).unwrap();
-    let mut counters = Buffer::<u32>::new(&r.gpu, COUNTER_SLOTS).unwrap();
-    counters.clear(&r.gpu).unwrap();
+fn trace_all(r: &Renderer, rays: &[DeviceRay]) -> ([Vec<DeviceHit>; 2], [Vec<u32>; 2], u32) {
+    let ray_buf = Buffer::from_slice(&r.device, rays).unwrap();
+    let mut counters = Buffer::<u32>::new(&r.device, COUNTER_SLOTS).unwrap();
+    counters.clear(&r.device).unwrap();
     let program = r.program().unwrap();
     let scene = r.scene_buffers().unwrap();
-    let hits = [(); 2].map(|_| Buffer::<GpuHit>::new(&r.gpu, rays.len()).unwrap());
-    let occluded = [(); 2].map(|_| Buffer::<u32>::new(&r.gpu, rays.len()).unwrap());
+    let hits = [(); 2].map(|_| Buffer::<DeviceHit>::new(&r.device, rays.len()).unwrap());
+    let occluded = [(); 2].map(|_| Buffer::<u32>::new(&r.device, rays.len()).unwrap());
     program
-        .trace_closest(&r.gpu, scene, &ray_buf, &hits[0], &counters)
+        .trace_closest(&r.device, scene, &ray_buf, &hits[0], &counters)
         .unwrap();
     program
-        .trace_any(&r.gpu, scene, &ray_buf, &occluded[0], &counters)
+        .trace_any(&r.device, scene, &ray_buf, &occluded[0], &counters)
         .unwrap();
     program
-        .trace_closest_wide(&r.gpu, scene, &ray_buf, &hits[1], &counters)
+        .trace_closest_wide(&r.device, scene, &ray_buf, &hits[1], &counters)
         .unwrap();
     program
-        .trace_any_wide(&r.gpu, scene, &ray_buf, &occluded[1], &counters)
+        .trace_any_wide(&r.device, scene, &ray_buf, &occluded[1], &counters)
         .unwrap();
-    let overflow = counters.read(&r.gpu).unwrap()[COUNT_OVERFLOW];
+    let overflow = counters.read(&r.device).unwrap()[COUNT_OVERFLOW];
     (
-        hits.map(|h| h.read(&r.gpu).unwrap()),
-        occluded.map(|o| o.read(&r.gpu).unwrap()),
+        hits.map(|h| h.read(&r.device).unwrap()),
+        occluded.map(|o| o.read(&r.device).unwrap()),
         overflow,
     )
 }
@@ -119,7 +119,7 @@ fn assert_no_leaks(r: &Renderer, placements: &[DMat4], n: usize) {
                 for target in [a, (a + b) * 0.5] {
                     let d = (m.transform_point3(target) - centre).as_vec3();
                     let o = centre.as_vec3();
-                    rays.push(GpuRay {
+                    rays.push(DeviceRay {
                         origin: [o.x, o.y, o.z, 0.0],
                         direction: [d.x, d.y, d.z, f32::INFINITY],
                     });
@@ -215,7 +215,7 @@ fn moving_instances_updates_the_device_in_place() {
         .expect("hiding an instance needs no reload");
     assert_eq!(hidden.moved, 1);
     assert_eq!(r.scene_buffers().unwrap().bytes(), stats.device_bytes);
-    let ray = GpuRay {
+    let ray = DeviceRay {
         origin: [0.0; 4],
         direction: [1.0, 0.0, 0.0, f32::INFINITY],
     };
@@ -293,7 +293,7 @@ fn same_hits_both_ways(n: usize) {
     for _ in 0..20000 {
         let o = Vec3::new(rnd(), rnd(), rnd()) * 24.0 - 12.0;
         let d = (Vec3::new(rnd(), rnd(), rnd()) - 0.5).normalize();
-        rays.push(GpuRay {
+        rays.push(DeviceRay {
             origin: [o.x, o.y, o.z, 0.0],
             direction: [d.x, d.y, d.z, f32::INFINITY],
         });
@@ -549,21 +549,21 @@ fn a_device_gets_the_node_array_its_kernels_traverse() {
         assert!(f.nodes.len() > 1);
         assert_eq!(l.bytes() + f.nodes.bytes() - l.nodes.bytes(), f.bytes());
         // Nothing traces through the missing array.
-        let ray = GpuRay {
+        let ray = DeviceRay {
             origin: [0.0, 0.0, 30.0, 0.0],
             direction: [0.0, 0.0, -1.0, f32::INFINITY],
         };
-        let rays = Buffer::from_slice(&lean.gpu, &[ray]).unwrap();
-        let hits = Buffer::<GpuHit>::new(&lean.gpu, 1).unwrap();
-        let counters = Buffer::<u32>::new(&lean.gpu, COUNTER_SLOTS).unwrap();
+        let rays = Buffer::from_slice(&lean.device, &[ray]).unwrap();
+        let hits = Buffer::<DeviceHit>::new(&lean.device, 1).unwrap();
+        let counters = Buffer::<u32>::new(&lean.device, COUNTER_SLOTS).unwrap();
         let program = lean.program().unwrap();
         assert!(
             program
-                .trace_closest(&lean.gpu, l, &rays, &hits, &counters)
+                .trace_closest(&lean.device, l, &rays, &hits, &counters)
                 .is_err()
         );
         program
-            .trace_closest_wide(&lean.gpu, l, &rays, &hits, &counters)
+            .trace_closest_wide(&lean.device, l, &rays, &hits, &counters)
             .unwrap();
         if bvh == BvhChoice::TwoLevel {
             // A moved instance's TLAS goes to the wide nodes alone.

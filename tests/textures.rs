@@ -315,7 +315,7 @@ fn lookups_wrap_filter_decode_srgb_and_transform_like_the_gltf_sampler() {
         }
     }
     let got = program
-        .sample_texture_test(&r.gpu, buffers, &queries)
+        .sample_texture_test(&r.device, buffers, &queries)
         .unwrap();
     for (i, (g, e)) in got.iter().zip(&expect).enumerate() {
         for c in 0..4 {
@@ -379,7 +379,7 @@ fn nearest_samplers_read_one_texel_and_mipless_ones_stay_at_level_0() {
     let got = r
         .program()
         .unwrap()
-        .sample_texture_test(&r.gpu, r.scene_buffers().unwrap(), &queries)
+        .sample_texture_test(&r.device, r.scene_buffers().unwrap(), &queries)
         .unwrap();
     for (i, (g, e)) in got.iter().zip(&expect).enumerate() {
         // Nearest reads are exact texel values; bilinear ones round a little.
@@ -409,7 +409,7 @@ fn mip_levels_follow_the_footprint_and_average_in_linear_space() {
         .program()
         .unwrap()
         .sample_texture_test(
-            &r.gpu,
+            &r.device,
             r.scene_buffers().unwrap(),
             &[q(-9.0), q(-3.0), q(-2.5), q(-2.0), q(0.0), q(9.0)],
         )
@@ -926,12 +926,13 @@ fn anisotropy_strength_rotation_and_texture_are_read() {
         world.iter().all(|t| t.tangents.is_some()),
         "tangents for the anisotropy direction"
     );
-    let gpu = penumbra::render::gpu_material(mat);
-    assert_eq!(gpu.aniso[0], 0.6);
+    let device = penumbra::render::gpu_material(mat);
+    assert_eq!(device.aniso[0], 0.6);
     assert!(
-        (gpu.aniso[1] - 1.25f32.cos()).abs() < 1e-6 && (gpu.aniso[2] - 1.25f32.sin()).abs() < 1e-6
+        (device.aniso[1] - 1.25f32.cos()).abs() < 1e-6
+            && (device.aniso[2] - 1.25f32.sin()).abs() < 1e-6
     );
-    assert_eq!(gpu.textures4[0], mat.textures.anisotropy.unwrap() as i32);
+    assert_eq!(device.textures4[0], mat.textures.anisotropy.unwrap() as i32);
 }
 
 /// `KHR_materials_iridescence` is read: factor, film IOR, thickness range and both textures
@@ -991,11 +992,14 @@ fn iridescence_factors_and_textures_are_read() {
         ),
         (1.0, 1.3, [100.0, 400.0])
     );
-    let gpu = penumbra::render::gpu_material(mat);
-    assert_eq!(gpu.iridescence, [0.8, 1.6, 150.0, 650.0]);
-    assert_eq!(gpu.textures4[1], mat.textures.iridescence.unwrap() as i32);
+    let device = penumbra::render::gpu_material(mat);
+    assert_eq!(device.iridescence, [0.8, 1.6, 150.0, 650.0]);
     assert_eq!(
-        gpu.textures4[2],
+        device.textures4[1],
+        mat.textures.iridescence.unwrap() as i32
+    );
+    assert_eq!(
+        device.textures4[2],
         mat.textures.iridescence_thickness.unwrap() as i32
     );
 }
@@ -1088,14 +1092,14 @@ fn diffuse_transmission_factors_and_textures_are_read() {
     assert!(!refs(mat.textures.diffuse_transmission).srgb);
     let c = refs(mat.textures.diffuse_transmission_color);
     assert!(c.srgb && c.tex_coord == 1);
-    let gpu = penumbra::render::gpu_material(mat);
-    assert_eq!(gpu.diffuse_transmission, [0.9, 0.5, 1.0, 0.35]);
+    let device = penumbra::render::gpu_material(mat);
+    assert_eq!(device.diffuse_transmission, [0.9, 0.5, 1.0, 0.35]);
     assert_eq!(
-        gpu.textures4[3],
+        device.textures4[3],
         mat.textures.diffuse_transmission.unwrap() as i32
     );
     assert_eq!(
-        gpu.textures5[0],
+        device.textures5[0],
         mat.textures.diffuse_transmission_color.unwrap() as i32
     );
 }

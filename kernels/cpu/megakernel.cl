@@ -53,7 +53,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     for (uint j = 0; j < frame.samples_in_wave; ++j) {
         PathState s = camera_path(&frame, &camera, pixel, frame.first_sample + j);
         for (uint bounce = 0; bounce <= frame.max_bounces + 1u; ++bounce) {
-            GpuHit hit;
+            DeviceHit hit;
 #ifdef LAST_RAY_EMITTERS
             if (last_by_emitters && bounce == frame.max_bounces + 1u) {
                 // The last ray: the emitter it meets, if nothing is in the way (megakernel.h).

@@ -10,15 +10,15 @@
 
 // The kernel's parameters, in both megakernels.
 #define MEGAKERNEL_PARAMS                                                                   \
-    GpuFrame frame, GpuCamera camera, GpuEnvironment environment,                           \
-        global const GpuWideNode *nodes, global const GpuTriangle *tris,                    \
-        global const GpuInstance *instances, global const GpuTriangle *object_tris,         \
-        global const GpuTriShading *shading, global const GpuTriUvs *uvs,                   \
-        global const GpuTriTangents *tangents, global const GpuMaterial *materials,         \
-        global const GpuTexRef *tex_refs, global const GpuTexture *textures,                \
+    DeviceFrame frame, DeviceCamera camera, DeviceEnvironment environment,                           \
+        global const DeviceWideNode *nodes, global const DeviceTriangle *tris,                    \
+        global const DeviceInstance *instances, global const DeviceTriangle *object_tris,         \
+        global const DeviceTriShading *shading, global const DeviceTriUvs *uvs,                   \
+        global const DeviceTriTangents *tangents, global const DeviceMaterial *materials,         \
+        global const DeviceTexRef *tex_refs, global const DeviceTexture *textures,                \
         global const uint *texels, global const float *env_texels,                          \
         global const float *env_marginal, global const float *env_conditional,              \
-        global const GpuLight *lights, global const float *light_cdf, global float4 *film, \
+        global const DeviceLight *lights, global const float *light_cdf, global float4 *film, \
         volatile global uint *counters
 
 // What shading reads of the scene, from the kernel's parameters.
@@ -62,20 +62,20 @@ inline void mega_count(volatile global uint* counters, uint extension_rays, uint
 // The most lights for which the last ray tests their triangles one by one.
 #define LAST_RAY_LIGHTS_MAX 16u
 
-inline bool mega_last_ray_by_emitters(const GpuFrame* frame) {
+inline bool mega_last_ray_by_emitters(const DeviceFrame* frame) {
     return frame->light_count <= LAST_RAY_LIGHTS_MAX && frame_sky_black(frame);
 }
 
 // The nearest of the lights' triangles along the ray from o along d, or NO_HIT.
-inline GpuHit mega_nearest_emitter(const GpuFrame* frame, const ShadeScene* sc, float3 o,
+inline DeviceHit mega_nearest_emitter(const DeviceFrame* frame, const ShadeScene* sc, float3 o,
                                    float3 d) {
     RayPrep r = prepare_ray(o, d);
-    GpuHit hit = no_hit(INFINITY);
+    DeviceHit hit = no_hit(INFINITY);
     for (uint i = 0u; i < frame->light_count; ++i) {
-        global const GpuLight* l = &sc->lights[i];
+        global const DeviceLight* l = &sc->lights[i];
         if (as_uint(l->position.w) != LIGHT_TRIANGLE) continue;
         uint prim = as_uint(l->spot.x);
-        GpuTriangle t = sc->tris[prim];
+        DeviceTriangle t = sc->tris[prim];
         float t_hit = hit.t, bu, bv;
         if (intersect_triangle(&r, t.v0, t.v1, t.v2, 0.0f, &t_hit, &bu, &bv)) {
             hit.t = t_hit;

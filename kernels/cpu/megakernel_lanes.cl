@@ -65,7 +65,7 @@ typedef struct {
 
 // The tile's pixel `i` in the order of 4×4 blocks (16 of them, row by row), or -1 outside the
 // image.
-inline int mega_tile_pixel(const MegaWork* W, const GpuFrame* frame, uint i) {
+inline int mega_tile_pixel(const MegaWork* W, const DeviceFrame* frame, uint i) {
     uint x = i / 16u % 4u * 4u + i % 4u;
     uint y = i / 64u * 4u + i % 16u / 4u;
     if (x >= W->tile_w || y >= W->tile_h) return -1;
@@ -73,7 +73,7 @@ inline int mega_tile_pixel(const MegaWork* W, const GpuFrame* frame, uint i) {
 }
 
 // A record's chunk done: its results added to the film, pixel by pixel in sample order.
-inline void mega_chunk_done(MegaWork* W, const GpuFrame* frame, global float4* film,
+inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global float4* film,
                             MegaChunk* c) {
     uint e = 0u;
     while (e < c->count) {
@@ -95,7 +95,7 @@ inline void mega_chunk_done(MegaWork* W, const GpuFrame* frame, global float4* f
 }
 
 // A path done: its radiance into its chunk's record.
-inline void mega_path_done(MegaWork* W, const GpuFrame* frame, global float4* film, uint chunk,
+inline void mega_path_done(MegaWork* W, const DeviceFrame* frame, global float4* film, uint chunk,
                            uint entry, const PathState* s) {
     MegaChunk* c = &W->chunk[chunk];
     c->result[entry] = s->radiance;
@@ -106,10 +106,10 @@ inline void mega_path_done(MegaWork* W, const GpuFrame* frame, global float4* fi
 // Starts the next chunk: its camera rays as a packet, their vertices shaded, their light
 // samples as a packet; the paths that go on are queued. Returns false when no chunk can start
 // (the tile's pixels all started, and no pixel with samples left is free of chunks in flight).
-inline bool mega_chunk_start(MegaWork* W, const GpuFrame* frame, const GpuCamera* camera,
-                             const ShadeScene* sc, global const GpuWideNode* nodes,
-                             global const GpuInstance* instances,
-                             global const GpuTriangle* object_tris, global float4* film,
+inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const DeviceCamera* camera,
+                             const ShadeScene* sc, global const DeviceWideNode* nodes,
+                             global const DeviceInstance* instances,
+                             global const DeviceTriangle* object_tris, global float4* film,
                              volatile global uint* overflow) {
     uint spp = frame->samples_in_wave;
     // A pixel with samples left whose last chunk is done; else a free record for new pixels.
@@ -261,7 +261,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #ifdef LAST_RAY_EMITTERS
     // A path whose next ray is its last ray's segment to the emitter it meets: that hit.
     bool to_emitter[MEGA_SLOTS];
-    GpuHit emitter[MEGA_SLOTS];
+    DeviceHit emitter[MEGA_SLOTS];
     bool last_by_emitters = mega_last_ray_by_emitters(&frame);
 #endif
     int lane_slot[LANES];  // the path of each lane's ray, -1: idle
@@ -296,7 +296,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #ifdef LAST_RAY_EMITTERS
 #define SLOT_NEXT_LAST_RAY(k, a_)                                                            \
     if (a_ && last_by_emitters && bounce[k] == frame.max_bounces + 1u) {                     \
-        GpuHit e_ = mega_nearest_emitter(&frame, &sc, s[k].origin, s[k].direction);         \
+        DeviceHit e_ = mega_nearest_emitter(&frame, &sc, s[k].origin, s[k].direction);         \
         if (e_.prim != NO_HIT) {                                                             \
             to_emitter[k] = true;                                                            \
             emitter[k] = e_;                                                                 \

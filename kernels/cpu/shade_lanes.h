@@ -73,7 +73,7 @@ typedef struct {
 
 // Entry e of the batch: a path's state and the hit of its last ray.
 LANES_INLINE void shade_batch_put(ShadeBatch* B, int e, const PathState* s, uint bounce,
-                                  GpuHit hit) {
+                                  DeviceHit hit) {
     B->dx[e] = s->direction.x;
     B->dy[e] = s->direction.y;
     B->dz[e] = s->direction.z;
@@ -274,9 +274,9 @@ LANES_INLINE LaneVec lanes_triangle_normal(LaneVec v0, LaneVec v1, LaneVec v2, l
     return lv_select(c, n, mc > 0.0f);
 }
 
-// A triangle's vertices (words 0-11 of each lane's GpuTriangle at word offset off[l]) and its
+// A triangle's vertices (words 0-11 of each lane's DeviceTriangle at word offset off[l]) and its
 // words 3 and 7 (material, light index).
-LANES_INLINE void lanes_triangle_rows(global const GpuTriangle* tris, const int* off, LaneVec* v0,
+LANES_INLINE void lanes_triangle_rows(global const DeviceTriangle* tris, const int* off, LaneVec* v0,
                                       LaneVec* v1, LaneVec* v2, lanes_i* w3, lanes_i* w7) {
     lanes_f T[12];
     global const float* tw = (global const float*)tris;
@@ -291,7 +291,7 @@ LANES_INLINE void lanes_triangle_rows(global const GpuTriangle* tris, const int*
 
 // Shades entries [0, n) of the batch, as shade_vertex does (see above): emission with MIS, the
 // light sample, the BSDF sample of the next ray.
-LANES_INLINE void lanes_shade(const GpuFrame* frame, const ShadeScene* sc, ShadeBatch* B,
+LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, ShadeBatch* B,
                               int n) {
     const lanes_f zero = (lanes_f)(0.0f);
     const SceneSurfaces* surf = &sc->surf;
@@ -340,7 +340,7 @@ LANES_INLINE void lanes_shade(const GpuFrame* frame, const ShadeScene* sc, Shade
         lanes_i front = lv_dot(ng, wo) > 0.0f;
         // The material's base color and emission (lanes outside m read material 0).
         int moff[LANES];
-        lanes_vstore(select((lanes_i)(0), mat * (lanes_i)(sizeof(GpuMaterial) / 4), m), 0, moff);
+        lanes_vstore(select((lanes_i)(0), mat * (lanes_i)(sizeof(DeviceMaterial) / 4), m), 0, moff);
         lanes_f MB[8];
         lanes_rows8((global const float*)surf->materials, moff, 0, MB);
 #ifdef HAS_TRIANGLE_LIGHTS
@@ -358,7 +358,7 @@ LANES_INLINE void lanes_shade(const GpuFrame* frame, const ShadeScene* sc, Shade
                     int li_[LANES];
                     lanes_vstore(select((lanes_i)(0), light_index, w_mis), 0, li_);
                     for (int l = 0; l < LANES; ++l) {
-                        global const GpuLight* lt = &sc->lights[li_[l]];
+                        global const DeviceLight* lt = &sc->lights[li_[l]];
                         sel_[l] = lt->extra.y;
                         area_[l] = lt->spot.y;
                     }
@@ -422,7 +422,7 @@ LANES_INLINE void lanes_shade(const GpuFrame* frame, const ShadeScene* sc, Shade
                 int l = (int)__builtin_ctz(bits);
                 uint index = cdf_search(sc->light_cdf, frame->light_count, ui_[l]);
 #ifdef HAS_TRIANGLE_LIGHTS
-                global const GpuLight* lt = &sc->lights[index];
+                global const DeviceLight* lt = &sc->lights[index];
                 if (as_uint(lt->position.w) == LIGHT_TRIANGLE) {
                     tri_light[l] = -1;
                     lprim[l] = (int)as_uint(lt->spot.x) * 12;
@@ -473,7 +473,7 @@ LANES_INLINE void lanes_shade(const GpuFrame* frame, const ShadeScene* sc, Shade
                 LaneVec ltarget =
                     lanes_offset_ray(q, q_err, lv_select(lv_neg(lng), lng, lv_dot(lng, pq) > 0.0f));
                 int loff[LANES];
-                lanes_vstore(select((lanes_i)(0), lmat * (lanes_i)(sizeof(GpuMaterial) / 4), far),
+                lanes_vstore(select((lanes_i)(0), lmat * (lanes_i)(sizeof(DeviceMaterial) / 4), far),
                              0, loff);
                 lanes_f E[4];
                 lanes_rows4((global const float*)surf->materials, loff, 4, E);

@@ -449,8 +449,8 @@ LANES_INLINE void lanes_rows4(global const float* base, const int* off, int w, l
     lanes_transpose4(m, c);
 }
 
-// The lanes' rays and walks, one field a lane (offsets are in 4-byte words: a GpuWideNode is 32,
-// min_x, min_y, min_z, max_x, max_y, max_z, child, count, 4 each; a GpuTriangle 12):
+// The lanes' rays and walks, one field a lane (offsets are in 4-byte words: a DeviceWideNode is 32,
+// min_x, min_y, min_z, max_x, max_y, max_z, child, count, 4 each; a DeviceTriangle 12):
 //   ox oy oz     origin                      ix iy iz   safe reciprocal direction (prepare_ray's)
 //   px py pz     origin in the permuted axes sx sy sz   shear (prepare_ray's)
 //   kx ky kz     the permutation, as word offsets in a vertex
@@ -642,8 +642,8 @@ LANES_INLINE void lanes_set_rays(LaneMemory* M, const LanesRays* R) {
 
 // A lane's hit from its fields: distance, triangle (NO_HIT: none), edge functions v, w and
 // their sum.
-LANES_INLINE GpuHit lanes_hit_from(float t, int prim, float v, float w, float det) {
-    GpuHit h;
+LANES_INLINE DeviceHit lanes_hit_from(float t, int prim, float v, float w, float det) {
+    DeviceHit h;
     h.t = t;
     h.prim = (uint)prim;
     h.u = h.prim == NO_HIT ? 0.0f : v / det;
@@ -653,7 +653,7 @@ LANES_INLINE GpuHit lanes_hit_from(float t, int prim, float v, float w, float de
 }
 
 // The hit of a lane whose walk is done.
-LANES_INLINE GpuHit lanes_hit(const LaneMemory* M, int lane) {
+LANES_INLINE DeviceHit lanes_hit(const LaneMemory* M, int lane) {
     return lanes_hit_from(M->tfar[lane], M->prim[lane], M->hv[lane], M->hw[lane],
                           M->hdet[lane]);
 }
@@ -663,7 +663,7 @@ LANES_INLINE GpuHit lanes_hit(const LaneMemory* M, int lane) {
 // precision edge functions, the error bound) decides triangle tri of that lane's ray o, d,
 // with the lane's hit so far in *t, *v, *w, *det, *prim, which it updates.
 LANES_INLINE void lanes_rare_cases(lanes_i special, lanes_i tri, const float3* o, const float3* d,
-                                   global const GpuTriangle* tris, const SceneSurfaces* surf,
+                                   global const DeviceTriangle* tris, const SceneSurfaces* surf,
                                    bool any_hit, lanes_f* t, lanes_f* v, lanes_f* w,
                                    lanes_f* det, lanes_i* prim) {
     int sp_[LANES], tri_[LANES], prim_[LANES];
@@ -678,7 +678,7 @@ LANES_INLINE void lanes_rare_cases(lanes_i special, lanes_i tri, const float3* o
     for (int l = 0; l < LANES; ++l) {
         if (!sp_[l]) continue;
         RayPrep r = prepare_ray(o[l], d[l]);
-        GpuHit h = no_hit(t_[l]);
+        DeviceHit h = no_hit(t_[l]);
         intersect_leaf(&r, tris, surf, (uint)tri_[l], 1u, 0.0f, o[l], d[l], any_hit, &h);
         if (h.prim != NO_HIT) {
             t_[l] = h.t;
@@ -784,7 +784,7 @@ LANES_INLINE void lanes_prefetch(ulong base, lanes_i first, uint size, uint byte
 // fetched as the lane takes it, a node step's leaves and pops before the step loads it, so the
 // sixteen lanes' misses overlap that work (4-8 % of the 1 M-triangle scenes' time on Zen 4).
 #define LANES_PREFETCH_NODE(NODES, ITEM, M)                                                 \
-    lanes_prefetch((ulong)(NODES), (ITEM), sizeof(GpuWideNode), sizeof(GpuWideNode),       \
+    lanes_prefetch((ulong)(NODES), (ITEM), sizeof(DeviceWideNode), sizeof(DeviceWideNode),       \
                    (M) & ((ITEM) >= (lanes_i)(0)));
 
 // Triangle TRI of each lane of mask M (tw: the triangles as words), its vertices relative to
@@ -845,8 +845,8 @@ LANES_INLINE void lanes_prefetch(ulong base, lanes_i first, uint size, uint byte
 
 // Walks the lanes' rays until LANES_DONE_MIN are done or none is left walking; returns the
 // mask of those done (their `live` lanes cleared). No lane live: returns an empty mask.
-LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
-                              global const GpuTriangle* tris, const SceneSurfaces* surf,
+LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const DeviceWideNode* nodes,
+                              global const DeviceTriangle* tris, const SceneSurfaces* surf,
                               volatile global uint* overflow) {
     const lanes_f inf = (lanes_f)(INFINITY), zero = (lanes_f)(0.0f);
     const lanes_i izero = (lanes_i)(0), lane = LANE_IDS;
@@ -1131,11 +1131,11 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             LANES_PREFETCH_NODE(nodes, item, keep)
         }
         // A leaf waits for other lanes to reach theirs: its triangles are fetched meanwhile.
-        lanes_prefetch((ulong)tris, L->cur & (lanes_i)(LANES_FIRST_MASK), sizeof(GpuTriangle),
-                       LANES_PREFETCH_TRIS * sizeof(GpuTriangle), arrived & L->has);
+        lanes_prefetch((ulong)tris, L->cur & (lanes_i)(LANES_FIRST_MASK), sizeof(DeviceTriangle),
+                       LANES_PREFETCH_TRIS * sizeof(DeviceTriangle), arrived & L->has);
         done &= L->live;
         // What shading reads of the hit (the triangle was just read).
-        lanes_prefetch((ulong)surf->shading, L->prim, sizeof(GpuTriShading), sizeof(GpuTriShading),
+        lanes_prefetch((ulong)surf->shading, L->prim, sizeof(DeviceTriShading), sizeof(DeviceTriShading),
                        done & (L->prim >= izero));
         L->live &= ~done;
         L->fin |= done;
@@ -1161,7 +1161,7 @@ LANES_INLINE lanes_i lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
 // slot), found once a work item by a walk of the small tree. A range covers its subtree's
 // leaves (were they not contiguous, it would cover triangles of other children too, which are
 // then tested twice, with the same verdicts).
-LANES_INLINE void lanes_small_ranges(global const GpuWideNode* nodes, uint count, uint* first,
+LANES_INLINE void lanes_small_ranges(global const DeviceWideNode* nodes, uint count, uint* first,
                                      uint* end) {
     // Child i of node n: a leaf widens the range, an interior node is walked later.
 #define LANES_SMALL_CHILD(n, i)                                                        \
@@ -1200,8 +1200,8 @@ LANES_INLINE void lanes_small_ranges(global const GpuWideNode* nodes, uint count
 // lanes_small_ranges's), each child's in order; the nearest hit is kept, the first of equally
 // near ones (the verdicts are the leaf steps': LANE_EDGES, LANE_HITS_T, the scalar test's rare
 // cases). Returns the lanes done: all that were live.
-LANES_INLINE lanes_i lanes_walk_small(LaneMemory* M, global const GpuWideNode* nodes,
-                                      global const GpuTriangle* tris, const uint* first,
+LANES_INLINE lanes_i lanes_walk_small(LaneMemory* M, global const DeviceWideNode* nodes,
+                                      global const DeviceTriangle* tris, const uint* first,
                                       const uint* end, const SceneSurfaces* surf) {
     Lanes* L = &M->V;
     const lanes_i live = L->live;

@@ -70,7 +70,7 @@ LANES_INLINE void packet_set_rays(Packet* P, const LanesRays* R) {
 }
 
 // The hit of a lane after a closest-hit walk.
-LANES_INLINE GpuHit packet_hit(const Packet* P, int lane) {
+LANES_INLINE DeviceHit packet_hit(const Packet* P, int lane) {
     return lanes_hit_from(P->tfar[lane], P->prim[lane], P->hv[lane], P->hw[lane],
                           P->hdet[lane]);
 }
@@ -91,7 +91,7 @@ inline float packet_min(lanes_f x) {
 // or with any_hit for some hit each (a lane's prim >= 0 after it: occluded), writing the hits
 // to P. A packet whose stack would overflow ends with the hits so far (counted).
 LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
-                              global const GpuWideNode* nodes, global const GpuTriangle* tris,
+                              global const DeviceWideNode* nodes, global const DeviceTriangle* tris,
                               const SceneSurfaces* surf, volatile global uint* overflow) {
     const lanes_f inf = (lanes_f)(INFINITY), zero = (lanes_f)(0.0f);
     const lanes_i izero = (lanes_i)(0);
@@ -112,7 +112,7 @@ LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
     lanes_i open = live;  // the lanes still looking (with any_hit: not yet blocked)
     for (;;) {
         if (item >= 0) {
-            global const GpuWideNode* n = &nodes[item];
+            global const DeviceWideNode* n = &nodes[item];
             float4 lx = n->min_x, ly = n->min_y, lz = n->min_z;
             float4 hx = n->max_x, hy = n->max_y, hz = n->max_z;
             int4 ch = n->child;
@@ -175,7 +175,7 @@ LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
             int first = item & LANES_FIRST_MASK;
             int count = (item >> 27) & 15;
             for (int k = 0; k < count; ++k) {
-                GpuTriangle tri = tris[first + k];
+                DeviceTriangle tri = tris[first + k];
 #define PACKET_VERTEX(V, X, Y, Z)                                                     \
     lanes_f X, Y, Z;                                                                  \
     {                                                                                 \

@@ -8,7 +8,7 @@
 #include "shared/traverse.h"
 #include "shared/path.h"
 
-kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, global uint* queue,
+kernel void generate(DeviceFrame frame, DeviceCamera camera, global DevicePath* paths, global uint* queue,
                      global uint* counters, global float2* cones) {
     uint slot = get_global_id(0);
     uint pixels = frame.width * frame.height;
@@ -20,7 +20,7 @@ kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, gl
     }
     if (slot >= total) return;
     PathState s = camera_path(&frame, &camera, slot % pixels, frame.first_sample + slot / pixels);
-    GpuPath p;
+    DevicePath p;
     p.origin = (float4)(s.origin, 0.0f);
     p.direction = (float4)(s.direction, as_float(0u));
     p.throughput = (float4)(s.throughput, as_float(slot));
@@ -30,38 +30,38 @@ kernel void generate(GpuFrame frame, GpuCamera camera, global GpuPath* paths, gl
     cones[slot] = s.cone;
 }
 
-kernel void extend(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
-                   global const GpuInstance* instances, global const GpuTriangle* object_tris,
-                   global const GpuTriShading* shading, global const GpuTriUvs* uvs,
-                   global const GpuTriTangents* tangents,
-                   global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
-                   global const GpuTexture* textures, global const uint* texels,
-                   global const GpuPath* paths, global const uint* queue,
-                   volatile global uint* counters, global GpuHit* hits) {
+kernel void extend(global const DeviceBvhNode* nodes, global const DeviceTriangle* tris,
+                   global const DeviceInstance* instances, global const DeviceTriangle* object_tris,
+                   global const DeviceTriShading* shading, global const DeviceTriUvs* uvs,
+                   global const DeviceTriTangents* tangents,
+                   global const DeviceMaterial* materials, global const DeviceTexRef* tex_refs,
+                   global const DeviceTexture* textures, global const uint* texels,
+                   global const DevicePath* paths, global const uint* queue,
+                   volatile global uint* counters, global DeviceHit* hits) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_IN]) return;
     SceneSurfaces surf = {shading,  uvs,      tangents, materials,
                           tex_refs, textures, texels,   instances};
-    global const GpuPath* p = &paths[queue[i]];
+    global const DevicePath* p = &paths[queue[i]];
     hits[i] = trace_scene(nodes, tris, instances, object_tris, &surf, p->origin.xyz,
                           p->direction.xyz, 0.0f, INFINITY, false, &counters[COUNT_OVERFLOW]);
 }
 
-kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTriangle* tris,
-                  global const GpuInstance* instances, global const GpuTriShading* shading,
-                  global const GpuTriUvs* uvs, global const GpuTriTangents* tangents,
-                  global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
-                  global const GpuTexture* textures, global const uint* texels,
+kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const DeviceTriangle* tris,
+                  global const DeviceInstance* instances, global const DeviceTriShading* shading,
+                  global const DeviceTriUvs* uvs, global const DeviceTriTangents* tangents,
+                  global const DeviceMaterial* materials, global const DeviceTexRef* tex_refs,
+                  global const DeviceTexture* textures, global const uint* texels,
                   global const float* env_texels, global const float* env_marginal,
                   global const float* env_conditional,
-                  global const GpuLight* lights, global const float* light_cdf,
-                  global GpuPath* paths, global const uint* queue_in, global const GpuHit* hits,
-                  global uint* queue_out, global GpuShadowRay* shadow_rays,
+                  global const DeviceLight* lights, global const float* light_cdf,
+                  global DevicePath* paths, global const uint* queue_in, global const DeviceHit* hits,
+                  global uint* queue_out, global DeviceShadowRay* shadow_rays,
                   volatile global uint* counters, global float2* cones) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_IN]) return;
     uint slot = queue_in[i];
-    GpuPath path = paths[slot];
+    DevicePath path = paths[slot];
     ShadeScene sc = {tris,
                      {shading, uvs, tangents, materials, tex_refs, textures, texels, instances},
                      {environment, env_texels, env_marginal, env_conditional},
@@ -81,7 +81,7 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     ShadowQuery q;
     bool alive = shade_vertex(&frame, frame.bounce, &sc, hits[i], &s, &q);
     if (q.valid) {
-        GpuShadowRay ray;
+        DeviceShadowRay ray;
         ray.origin = (float4)(q.origin, q.tmax);
         ray.direction = (float4)(q.direction, as_float(slot));
         ray.contribution = (float4)(q.contribution, q.unweight);
@@ -102,19 +102,19 @@ kernel void shade(GpuFrame frame, GpuEnvironment environment, global const GpuTr
     paths[slot] = path;
 }
 
-kernel void connect(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
-                    global const GpuInstance* instances, global const GpuTriangle* object_tris,
-                    global const GpuTriShading* shading, global const GpuTriUvs* uvs,
-                    global const GpuTriTangents* tangents,
-                    global const GpuMaterial* materials, global const GpuTexRef* tex_refs,
-                    global const GpuTexture* textures, global const uint* texels,
-                    global const GpuShadowRay* shadow_rays, volatile global uint* counters,
-                    global GpuPath* paths) {
+kernel void connect(global const DeviceBvhNode* nodes, global const DeviceTriangle* tris,
+                    global const DeviceInstance* instances, global const DeviceTriangle* object_tris,
+                    global const DeviceTriShading* shading, global const DeviceTriUvs* uvs,
+                    global const DeviceTriTangents* tangents,
+                    global const DeviceMaterial* materials, global const DeviceTexRef* tex_refs,
+                    global const DeviceTexture* textures, global const uint* texels,
+                    global const DeviceShadowRay* shadow_rays, volatile global uint* counters,
+                    global DevicePath* paths) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_SHADOW]) return;
     SceneSurfaces surf = {shading,  uvs,      tangents, materials,
                           tex_refs, textures, texels,   instances};
-    GpuShadowRay r = shadow_rays[i];
+    DeviceShadowRay r = shadow_rays[i];
     ShadowQuery q;
     q.origin = r.origin.xyz;
     q.direction = r.direction.xyz;
@@ -139,7 +139,7 @@ kernel void advance(global uint* counters, global ulong* stats) {
 // Adds every finished sample of the wave to the film (.xyz radiance sum, .w sample count; with
 // coverage counted, .w counts the samples whose camera ray hit), in a fixed order per pixel
 // so the result does not depend on the queues' order. Non-finite samples are counted and dropped.
-kernel void accumulate(GpuFrame frame, global const GpuPath* paths, global float4* film,
+kernel void accumulate(DeviceFrame frame, global const DevicePath* paths, global float4* film,
                        volatile global uint* counters) {
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;

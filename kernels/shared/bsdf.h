@@ -98,7 +98,7 @@ typedef struct {
 } SurfaceMaterial;
 
 // The untextured material.
-inline SurfaceMaterial surface_material(global const GpuMaterial* m) {
+inline SurfaceMaterial surface_material(global const DeviceMaterial* m) {
     SurfaceMaterial s;
     s.base_color = m->base_color.xyz;
     s.metallic = m->params.x;

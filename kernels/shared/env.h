@@ -9,7 +9,7 @@
 #include "shared/rng.h"
 
 typedef struct {
-    GpuEnvironment info;
+    DeviceEnvironment info;
     global const float* texels;       // RGB triples, row 0 at the top
     global const float* marginal;     // cumulative row probabilities
     global const float* conditional;  // cumulative column probabilities per row

@@ -22,7 +22,7 @@ typedef struct {
 } LightSample;
 
 // Spot cone attenuation as the glTF KHR_lights_punctual specification writes it.
-inline float spot_falloff(global const GpuLight* l, float3 to_point) {
+inline float spot_falloff(global const DeviceLight* l, float3 to_point) {
     float cos_outer = l->spot.w;
     float cos_inner = l->extra.x;
     float scale = 1.0f / fmax(0.001f, cos_inner - cos_outer);
@@ -35,12 +35,12 @@ inline float spot_falloff(global const GpuLight* l, float3 to_point) {
 // Samples light `index` from point p. Punctual lights with radius r > 0 become spheres of the
 // same power (radiance I / (pi r^2)); directional lights with angular radius a > 0 become discs
 // of directions (radiance E / (pi sin^2 a)).
-SHADE_INLINE LightSample sample_light(global const GpuLight* lights,
-                                      global const GpuTriangle* tris,
-                                      global const GpuMaterial* materials,
+SHADE_INLINE LightSample sample_light(global const DeviceLight* lights,
+                                      global const DeviceTriangle* tris,
+                                      global const DeviceMaterial* materials,
                                       const SceneSurfaces* surf, const EnvMap* env, uint index,
                                       float3 p, float u1, float u2) {
-    global const GpuLight* l = &lights[index];
+    global const DeviceLight* l = &lights[index];
     float select = l->extra.y;
     uint kind = as_uint(l->position.w);
     float radius = l->intensity.w;
@@ -86,10 +86,10 @@ SHADE_INLINE LightSample sample_light(global const GpuLight* lights,
     if (kind == LIGHT_TRIANGLE) {
         uint prim = as_uint(l->spot.x);
         float area = l->spot.y;
-        GpuTriangle t = tris[prim];
+        DeviceTriangle t = tris[prim];
 #ifdef TWO_LEVEL
         // Two levels: the mesh's object-space triangle, placed by the light's instance.
-        GpuInstance inst = surf->instances[as_uint(l->spot.z)];
+        DeviceInstance inst = surf->instances[as_uint(l->spot.z)];
         float3 world_err;
         t = instance_triangle(&inst, t, &world_err);
 #endif
@@ -110,7 +110,7 @@ SHADE_INLINE LightSample sample_light(global const GpuLight* lights,
         // can neither hit the light itself nor stop short of an occluder, at any scale.
         s.target = offset_ray(q, q_err, dot(ng, p - q) > 0.0f ? ng : -ng);
         s.on_surface = true;
-        global const GpuMaterial* m = &materials[as_uint(t.v0.w)];
+        global const DeviceMaterial* m = &materials[as_uint(t.v0.w)];
         float cos_l = -dot(ng, s.wi);
         bool two_sided = (as_uint(m->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
         if (!two_sided && cos_l <= 0.0f) return s;

@@ -1,7 +1,7 @@
 // One path vertex at a time: the camera ray, and the shading of the vertex a ray found
 // (emission with MIS, one light sample, the BSDF sample and Russian roulette). Both execution
 // shapes call these, so they compute the same estimator with the same random numbers:
-//   - the wavefront (gpu/stages.cl) keeps the state in GpuPath slots between kernels and traces
+//   - the wavefront (gpu/stages.cl) keeps the state in DevicePath slots between kernels and traces
 //     the light sample later in `connect`;
 //   - the megakernels (cpu/megakernel.cl, cpu/megakernel_lanes.cl) keep it in registers and
 //     trace the light sample at once.
@@ -19,7 +19,7 @@
 #include "shared/lights.h"
 
 // Whether the uniform sky is black: an escaped ray then adds nothing.
-inline bool frame_sky_black(const GpuFrame* frame) {
+inline bool frame_sky_black(const DeviceFrame* frame) {
     return frame->sky.x <= 0.0f && frame->sky.y <= 0.0f && frame->sky.z <= 0.0f;
 }
 
@@ -56,16 +56,16 @@ typedef struct {
 
 // What shading reads of the scene.
 typedef struct {
-    global const GpuTriangle* tris;
+    global const DeviceTriangle* tris;
     SceneSurfaces surf;
     EnvMap env;
-    global const GpuLight* lights;
+    global const DeviceLight* lights;
     global const float* light_cdf;
 } ShadeScene;
 
 // The camera ray of sample `sample` of `pixel` (box filter, pinhole or thin lens), with the
 // random state seeded from (pixel, sample, seed).
-inline PathState camera_path(const GpuFrame* frame, const GpuCamera* camera, uint pixel,
+inline PathState camera_path(const DeviceFrame* frame, const DeviceCamera* camera, uint pixel,
                              uint sample) {
     uint rng = hash_u32(hash_u32(pixel ^ hash_u32(frame->seed)) ^
                         hash_u32(sample * 0x9e3779b9u + 1u));
@@ -101,7 +101,7 @@ inline PathState camera_path(const GpuFrame* frame, const GpuCamera* camera, uin
 // Shades the vertex that the path's ray found at `bounce` (hit.prim == NO_HIT: it escaped).
 // Adds emission to s->radiance, fills *shadow with the light sample to test (valid = false
 // when there is none) and, when the path goes on, sets the next ray. Returns whether it does.
-SHADE_INLINE bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeScene* sc, GpuHit hit,
+SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const ShadeScene* sc, DeviceHit hit,
                                PathState* s, ShadowQuery* shadow) {
     shadow->valid = false;
     float3 throughput = s->throughput;
@@ -120,7 +120,7 @@ SHADE_INLINE bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeSc
     bool light_sampled_only = false;
 #endif
     const SceneSurfaces* surf = &sc->surf;
-    global const GpuMaterial* materials = surf->materials;
+    global const DeviceMaterial* materials = surf->materials;
 
     if (hit.prim == NO_HIT) {
         // An escaped camera ray is marked for the film's coverage count (the film's .w then
@@ -146,10 +146,10 @@ SHADE_INLINE bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeSc
         return false;
     }
 
-    GpuTriangle tri = sc->tris[hit.prim];
+    DeviceTriangle tri = sc->tris[hit.prim];
 #ifdef TWO_LEVEL
     // The mesh's object-space triangle, carried to world space by the hit's instance.
-    GpuInstance inst = surf->instances[hit.instance];
+    DeviceInstance inst = surf->instances[hit.instance];
     float3 world_err;
     tri = instance_triangle(&inst, tri, &world_err);
 #endif
@@ -161,10 +161,10 @@ SHADE_INLINE bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeSc
     p_err += world_err;
     ng *= instance_normal_sign(&inst);
 #endif
-    global const GpuMaterial* mat = &materials[as_uint(tri.v0.w)];
+    global const DeviceMaterial* mat = &materials[as_uint(tri.v0.w)];
     bool front = dot(ng, wo) > 0.0f;
 #ifdef HAS_TEXTURES
-    GpuTriUvs uvs = surf->uvs[hit.prim];
+    DeviceTriUvs uvs = surf->uvs[hit.prim];
     TexCoords tc = texcoords_at(uvs, hit.u, hit.v);
     // The ray cone's footprint picks the mip levels; it widens by the roughness at each bounce.
     float2 cone = s->cone;
@@ -184,7 +184,7 @@ SHADE_INLINE bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeSc
     if (light_index >= 0 && (front || two_sided) && counts_emission) {
         float weight = 1.0f;
         if (mis) {
-            global const GpuLight* l = &sc->lights[light_index];
+            global const DeviceLight* l = &sc->lights[light_index];
             float cos_l = fabs(dot(ng, wo));
             float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
             weight = power_heuristic(prev_pdf, light_pdf);
@@ -390,11 +390,11 @@ SHADE_INLINE bool shade_vertex(const GpuFrame* frame, uint bounce, const ShadeSc
 
 // Whether the surface hit by a shadow ray along dir is a smooth thin wall; if so, multiplies
 // *tint by what it lets through. Without thin walls in the scene, nothing is.
-inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* surf, GpuHit hit,
+inline bool thin_wall_tint(global const DeviceTriangle* tris, const SceneSurfaces* surf, DeviceHit hit,
                            float3 dir, float3* tint) {
 #ifdef HAS_THIN_WALLS
-    GpuTriangle tri = tris[hit.prim];
-    global const GpuMaterial* mat = &surf->materials[as_uint(tri.v0.w)];
+    DeviceTriangle tri = tris[hit.prim];
+    global const DeviceMaterial* mat = &surf->materials[as_uint(tri.v0.w)];
     SurfaceMaterial m = surface_material(mat);
 #ifdef HAS_TEXTURES
     TexCoords tc = texcoords_at(surf->uvs[hit.prim], hit.u, hit.v);
@@ -403,7 +403,7 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
     if (!bsdf_passes_straight(&m)) return false;
     float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
 #ifdef TWO_LEVEL
-    GpuInstance inst = surf->instances[hit.instance];
+    DeviceInstance inst = surf->instances[hit.instance];
     ng = instance_normal(&inst, ng);  // object-space triangle: its normal to world space
 #endif
     *tint *= thin_wall_transmittance(&m, fabs(dot(ng, dir)));
@@ -419,11 +419,11 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
 // sample (the MIS weight undone: BSDF samples through walls leave such lights to light
 // sampling). The wavefront's `connect` and the megakernel use the same test this way.
 #define DEFINE_SHADOW_TEST(NAME, NODES, TRACE)                                               \
-    inline float3 NAME(NODES nodes, global const GpuTriangle* tris,                            \
-                       global const GpuInstance* instances,                                    \
-                       global const GpuTriangle* object_tris, const SceneSurfaces* surf,        \
+    inline float3 NAME(NODES nodes, global const DeviceTriangle* tris,                            \
+                       global const DeviceInstance* instances,                                    \
+                       global const DeviceTriangle* object_tris, const SceneSurfaces* surf,        \
                        const ShadowQuery* q, volatile global uint* overflow) {                 \
-        GpuHit hit = TRACE(nodes, tris, instances, object_tris, surf, q->origin, q->direction, \
+        DeviceHit hit = TRACE(nodes, tris, instances, object_tris, surf, q->origin, q->direction, \
                            0.0f, q->tmax, true, overflow);                                     \
         if (hit.prim == NO_HIT) return q->contribution;                                        \
         float3 tint = (float3)(1.0f);                                                          \
@@ -442,8 +442,8 @@ inline bool thin_wall_tint(global const GpuTriangle* tris, const SceneSurfaces* 
         }                                                                                      \
         return q->contribution * tint;                                                         \
     }
-DEFINE_SHADOW_TEST(shadow_pass, global const GpuBvhNode*, trace_scene)
-DEFINE_SHADOW_TEST(shadow_pass_wide, global const GpuWideNode*, trace_scene_wide)
+DEFINE_SHADOW_TEST(shadow_pass, global const DeviceBvhNode*, trace_scene)
+DEFINE_SHADOW_TEST(shadow_pass_wide, global const DeviceWideNode*, trace_scene_wide)
 #ifdef SMALL_SCENE
 DEFINE_SHADOW_TEST(shadow_pass_small, local const SmallScene*, trace_small_scene)
 #endif

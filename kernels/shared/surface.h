@@ -11,14 +11,14 @@
 
 #ifdef TWO_LEVEL
 // M v: a vector to world space (src/bvh/instances.rs keeps M's rows in world0..2).
-inline float3 instance_vector_to_world(const GpuInstance* inst, float3 v) {
+inline float3 instance_vector_to_world(const DeviceInstance* inst, float3 v) {
     return (float3)(inst->world0.x * v.x + inst->world0.y * v.y + inst->world0.z * v.z,
                     inst->world1.x * v.x + inst->world1.y * v.y + inst->world1.z * v.z,
                     inst->world2.x * v.x + inst->world2.y * v.y + inst->world2.z * v.z);
 }
 
 // p_world = M p + T (T in row0..2.w).
-inline float3 instance_to_world(const GpuInstance* inst, float3 p) {
+inline float3 instance_to_world(const DeviceInstance* inst, float3 p) {
     return instance_vector_to_world(inst, p) + (float3)(inst->row0.w, inst->row1.w, inst->row2.w);
 }
 
@@ -26,13 +26,13 @@ inline float3 instance_to_world(const GpuInstance* inst, float3 p) {
 // rounding of its world vertices: gamma(4) (|M| |v| + |T|) for the largest |v| per coordinate.
 // Vertices keep their order, so a mirrored instance's triangle winds the other way: callers
 // flip its geometric normal (`instance_normal_sign`).
-inline GpuTriangle instance_triangle(const GpuInstance* inst, GpuTriangle t, float3* err) {
+inline DeviceTriangle instance_triangle(const DeviceInstance* inst, DeviceTriangle t, float3* err) {
     const float gamma4 = 4.0f * 0x1p-24f / (1.0f - 4.0f * 0x1p-24f);
     float3 a = fmax(fmax(fabs(t.v0.xyz), fabs(t.v1.xyz)), fabs(t.v2.xyz));
     float3 m0 = fabs(inst->world0.xyz), m1 = fabs(inst->world1.xyz), m2 = fabs(inst->world2.xyz);
     float3 origin = fabs((float3)(inst->row0.w, inst->row1.w, inst->row2.w));
     *err = gamma4 * ((float3)(dot(m0, a), dot(m1, a), dot(m2, a)) + origin);
-    GpuTriangle w;
+    DeviceTriangle w;
     w.v0 = (float4)(instance_to_world(inst, t.v0.xyz), t.v0.w);
     w.v1 = (float4)(instance_to_world(inst, t.v1.xyz), t.v1.w);
     w.v2 = (float4)(instance_to_world(inst, t.v2.xyz), t.v2.w);
@@ -40,12 +40,12 @@ inline GpuTriangle instance_triangle(const GpuInstance* inst, GpuTriangle t, flo
 }
 
 // -1 for a mirrored instance (its world triangles wind the other way), else 1.
-inline float instance_normal_sign(const GpuInstance* inst) {
+inline float instance_normal_sign(const DeviceInstance* inst) {
     return (inst->flags & INSTANCE_MIRRORED) != 0u ? -1.0f : 1.0f;
 }
 
 // A normal to world space: L^T n (the inverse transpose of M), unit; 0 stays 0.
-inline float3 instance_normal(const GpuInstance* inst, float3 n) {
+inline float3 instance_normal(const DeviceInstance* inst, float3 n) {
     float3 w = inst->row0.xyz * n.x + inst->row1.xyz * n.y + inst->row2.xyz * n.z;
     float len = length(w);
     return len > 0.0f ? w / len : w;
@@ -54,10 +54,10 @@ inline float3 instance_normal(const GpuInstance* inst, float3 n) {
 
 // The tangents at the corners of a hit's triangle in world space (w: bitangent sign). With two
 // levels they are the mesh's, carried by M and with the sign flipped in a mirrored instance.
-inline GpuTriTangents hit_tangents(const SceneSurfaces* s, GpuHit hit) {
-    GpuTriTangents tt = s->tangents[hit.prim];
+inline DeviceTriTangents hit_tangents(const SceneSurfaces* s, DeviceHit hit) {
+    DeviceTriTangents tt = s->tangents[hit.prim];
 #ifdef TWO_LEVEL
-    GpuInstance inst = s->instances[hit.instance];
+    DeviceInstance inst = s->instances[hit.instance];
     float sign = instance_normal_sign(&inst);
     tt.t0 = (float4)(instance_vector_to_world(&inst, tt.t0.xyz), tt.t0.w * sign);
     tt.t1 = (float4)(instance_vector_to_world(&inst, tt.t1.xyz), tt.t1.w * sign);
@@ -68,7 +68,7 @@ inline GpuTriTangents hit_tangents(const SceneSurfaces* s, GpuHit hit) {
 
 #ifdef HAS_TEXTURES
 // Multiplies the material's factors by its textures at the hit.
-inline void apply_textures(SurfaceMaterial* m, global const GpuMaterial* mat,
+inline void apply_textures(SurfaceMaterial* m, global const DeviceMaterial* mat,
                            const SceneSurfaces* s, const TexCoords* tc) {
     if (mat->textures.x >= 0) m->base_color *= texture_sample(s, mat->textures.x, tc).xyz;
     if (mat->textures.y >= 0) {
@@ -114,7 +114,7 @@ inline void apply_textures(SurfaceMaterial* m, global const GpuMaterial* mat,
 }
 
 // Emitted radiance at the hit: the factor times the emissive texture.
-inline float3 textured_emission(global const GpuMaterial* mat, const SceneSurfaces* s,
+inline float3 textured_emission(global const DeviceMaterial* mat, const SceneSurfaces* s,
                                 const TexCoords* tc) {
     float3 e = mat->emission.xyz;
     if (mat->textures.w >= 0) e *= texture_sample(s, mat->textures.w, tc).xyz;
@@ -130,7 +130,7 @@ inline float3 textured_emission(global const GpuMaterial* mat, const SceneSurfac
 // materials); `tt` are the triangle's world-space tangents (`hit_tangents`). The result is
 // bent to stay above the geometric surface.
 inline float3 normal_map(const SceneSurfaces* s, int tex, float scale, const TexCoords* tc,
-                         GpuTriTangents tt, float u, float v, float3 ns, float3 ng, bool front) {
+                         DeviceTriTangents tt, float u, float v, float3 ns, float3 ng, bool front) {
     float w0 = 1.0f - u - v;
     float3 t = w0 * tt.t0.xyz + u * tt.t1.xyz + v * tt.t2.xyz;
     float3 n = front ? ns : -ns;
@@ -160,7 +160,7 @@ inline float3 anisotropy_direction(const SceneSurfaces* s, uint prim, float u, f
     float3 t, b;
     onb(n, &t, &b);
 #ifdef HAS_TANGENTS
-    GpuTriTangents tt = s->tangents[prim];
+    DeviceTriTangents tt = s->tangents[prim];
     float3 tg = (1.0f - u - v) * tt.t0.xyz + u * tt.t1.xyz + v * tt.t2.xyz;
     tg -= n * dot(n, tg);
     float len = length(tg);

@@ -1,5 +1,5 @@
-// Textures: RGBA8 mip chains packed in one uint buffer (GpuTexture describes each), looked up
-// through a material's GpuTexRef (sampler wrap modes, texture coordinate set, KHR_texture_transform).
+// Textures: RGBA8 mip chains packed in one uint buffer (DeviceTexture describes each), looked up
+// through a material's DeviceTexRef (sampler wrap modes, texture coordinate set, KHR_texture_transform).
 // Lookups are bilinear within one mip level; the level comes from the ray cone's footprint
 // (Akenine-Moller et al., Ray Tracing Gems ch. 20), rounded up or down at random in proportion
 // to the fraction, which averages to trilinear filtering over the samples of a pixel.
@@ -11,16 +11,16 @@
 
 // What traversal and shading read about surfaces besides the triangles themselves.
 typedef struct {
-    global const GpuTriShading* shading;
-    global const GpuTriUvs* uvs;  // a placeholder without HAS_TEXTURES
-    global const GpuTriTangents* tangents;
-    global const GpuMaterial* materials;
-    global const GpuTexRef* refs;
-    global const GpuTexture* textures;
+    global const DeviceTriShading* shading;
+    global const DeviceTriUvs* uvs;  // a placeholder without HAS_TEXTURES
+    global const DeviceTriTangents* tangents;
+    global const DeviceMaterial* materials;
+    global const DeviceTexRef* refs;
+    global const DeviceTexture* textures;
     global const uint* texels;
     // Two levels: the instances, whose transforms carry object-space hits to world space for
     // shading (unused with the flat BVH; kernels that only trace may leave it out).
-    global const GpuInstance* instances;
+    global const DeviceInstance* instances;
 #ifdef SMALL_SCENE
     // The megakernel's copy of a small scene's triangles and normals (traverse_wide.h), in
     // local memory; 0 in other kernels, which leave it out.
@@ -111,7 +111,7 @@ inline int wrap_texel(int i, int n, int mode) {
 
 // Bilinear (or with `nearest`, nearest-texel) lookup of level `level` at texture coordinate st
 // (texel centres at half-integers).
-inline float4 texture_level(const SceneSurfaces* s, GpuTexture t, int wrap_s, int wrap_t,
+inline float4 texture_level(const SceneSurfaces* s, DeviceTexture t, int wrap_s, int wrap_t,
                             float2 st, uint level, bool nearest) {
     uint offset = t.offset;
     uint w = t.width;
@@ -149,11 +149,11 @@ inline float4 texture_level(const SceneSurfaces* s, GpuTexture t, int wrap_s, in
 
 // Looks up texture reference `ref` at a hit.
 inline float4 texture_sample(const SceneSurfaces* s, int ref, const TexCoords* tc) {
-    GpuTexRef r = s->refs[ref];
+    DeviceTexRef r = s->refs[ref];
     bool second = as_uint(r.m0.w) == 1u;
     float3 uv = (float3)(second ? tc->uv1 : tc->uv0, 1.0f);
     float2 st = (float2)(dot(r.m0.xyz, uv), dot(r.m1.xyz, uv));
-    GpuTexture t = s->textures[r.info.x];
+    DeviceTexture t = s->textures[r.info.x];
     uint levels = t.flags & TEXTURE_LEVELS_MASK;
     float lod = (second ? tc->lod1 : tc->lod0) + r.m1.w +
                 0.5f * log2((float)t.width * (float)t.height);
@@ -168,7 +168,7 @@ inline float4 texture_sample(const SceneSurfaces* s, int ref, const TexCoords* t
 
 // Interpolated texture coordinates at barycentrics (u, v) with the finest level everywhere
 // (alpha tests and light sampling, where footprints are unknown).
-inline TexCoords texcoords_at(GpuTriUvs sh, float u, float v) {
+inline TexCoords texcoords_at(DeviceTriUvs sh, float u, float v) {
     float w0 = 1.0f - u - v;
     TexCoords tc;
     tc.uv0 = w0 * sh.uv01.xy + u * sh.uv01.zw + v * sh.uv2.xy;
@@ -181,7 +181,7 @@ inline TexCoords texcoords_at(GpuTriUvs sh, float u, float v) {
 
 // The ray-cone level of detail at a hit: a cone of `width` meets the triangle (edges e1, e2)
 // at cosine `cos_i`; each set's level adds half the log of its texture-to-world area ratio.
-inline void texcoords_footprint(TexCoords* tc, GpuTriUvs sh, float3 e1, float3 e2,
+inline void texcoords_footprint(TexCoords* tc, DeviceTriUvs sh, float3 e1, float3 e2,
                                 float width, float cos_i) {
     float world = fmax(length(cross(e1, e2)), 1e-30f);
     float2 a0 = sh.uv01.zw - sh.uv01.xy;
@@ -201,7 +201,7 @@ inline void texcoords_footprint(TexCoords* tc, GpuTriUvs sh, float3 e1, float3 e
 // that extension and shadow rays alike see a consistent stochastic surface.
 inline bool alpha_passes(const SceneSurfaces* s, uint prim, uint material, float u, float v,
                          float3 o, float3 d) {
-    global const GpuMaterial* m = &s->materials[material];
+    global const DeviceMaterial* m = &s->materials[material];
     uint mode = as_uint(m->alpha.y);
     if (mode == ALPHA_OPAQUE) return false;
     float alpha = m->base_color.w;

@@ -140,11 +140,11 @@ inline float box_entry(float4 lo, float4 hi, const RayPrep* r, float tmin, float
 // (with HAS_ALPHA, hits the material's alpha cuts out or lets through are skipped). Returns
 // true when any_hit and a hit was found: the traversal can stop. `o` and `d` are the ray in
 // world space (the alpha hash reads them).
-inline bool intersect_leaf(const RayPrep* r, global const GpuTriangle* tris,
+inline bool intersect_leaf(const RayPrep* r, global const DeviceTriangle* tris,
                            const SceneSurfaces* surf, uint first, uint count, float tmin,
-                           float3 o, float3 d, bool any_hit, GpuHit* hit) {
+                           float3 o, float3 d, bool any_hit, DeviceHit* hit) {
     for (uint p = first; p < first + count; ++p) {
-        GpuTriangle t = tris[p];
+        DeviceTriangle t = tris[p];
         float t_hit = hit->t;
         float bu, bv;
         if (!intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv)) continue;
@@ -164,10 +164,10 @@ inline bool intersect_leaf(const RayPrep* r, global const GpuTriangle* tris,
 // with any_hit the first) in *hit; leaves index `tris`. Returns true when the walk must end
 // the whole traversal: an any-hit was found, or the stack overflowed (which the builder's depth
 // limit rules out; the overflow counter is raised instead of failing silently).
-inline bool traverse_bvh(global const GpuBvhNode* nodes, uint root,
-                         global const GpuTriangle* tris, const SceneSurfaces* surf,
+inline bool traverse_bvh(global const DeviceBvhNode* nodes, uint root,
+                         global const DeviceTriangle* tris, const SceneSurfaces* surf,
                          const RayPrep* r, float3 o, float3 d, float tmin, bool any_hit,
-                         GpuHit* hit,
+                         DeviceHit* hit,
                          volatile global uint* overflow) {
     // Written out in one loop, without helper functions taking pointers: compilers keep this
     // form's state in registers (the flat BVH's rays on an H200 lost 8 % to a version through
@@ -176,7 +176,7 @@ inline bool traverse_bvh(global const GpuBvhNode* nodes, uint root,
     uint sp = 0;
     uint node = root;
     for (;;) {
-        GpuBvhNode n = nodes[node];
+        DeviceBvhNode n = nodes[node];
         float dist[2];
         int child[2];
         for (int side = 0; side < 2; ++side) {
@@ -216,8 +216,8 @@ inline bool traverse_bvh(global const GpuBvhNode* nodes, uint root,
     }
 }
 
-inline GpuHit no_hit(float tmax) {
-    GpuHit hit;
+inline DeviceHit no_hit(float tmax) {
+    DeviceHit hit;
     hit.t = tmax;
     hit.u = 0.0f;
     hit.v = 0.0f;
@@ -229,11 +229,11 @@ inline GpuHit no_hit(float tmax) {
 // Closest hit (any_hit = false) or first hit (any_hit = true) in the flat BVH. With HAS_ALPHA,
 // hits that the material's alpha cuts out (MASK) or lets through (BLEND, at random) are
 // skipped; `surf` is read only then.
-inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
+inline DeviceHit traverse(global const DeviceBvhNode* nodes, global const DeviceTriangle* tris,
                        const SceneSurfaces* surf, float3 o, float3 d, float tmin, float tmax,
                        bool any_hit, volatile global uint* overflow) {
     RayPrep r = prepare_ray(o, d);
-    GpuHit hit = no_hit(tmax);
+    DeviceHit hit = no_hit(tmax);
     traverse_bvh(nodes, 0u, tris, surf, &r, o, d, tmin, any_hit, &hit, overflow);
     return hit;
 }
@@ -249,21 +249,21 @@ inline GpuHit traverse(global const GpuBvhNode* nodes, global const GpuTriangle*
 // rounding's bound to the hit point's error (`instance_triangle` in surface.h), so the
 // offset_ray a spawned ray leaves its surface by covers it: a ray cannot find its own surface
 // again in object space.
-inline float3 instance_point(const GpuInstance* inst, float3 p) {
+inline float3 instance_point(const DeviceInstance* inst, float3 p) {
     float3 q = p - (float3)(inst->row0.w, inst->row1.w, inst->row2.w);
     return (float3)(inst->row0.x * q.x + inst->row0.y * q.y + inst->row0.z * q.z,
                     inst->row1.x * q.x + inst->row1.y * q.y + inst->row1.z * q.z,
                     inst->row2.x * q.x + inst->row2.y * q.y + inst->row2.z * q.z);
 }
 
-inline float3 instance_vector(const GpuInstance* inst, float3 v) {
+inline float3 instance_vector(const DeviceInstance* inst, float3 v) {
     return (float3)(inst->row0.x * v.x + inst->row0.y * v.y + inst->row0.z * v.z,
                     inst->row1.x * v.x + inst->row1.y * v.y + inst->row1.z * v.z,
                     inst->row2.x * v.x + inst->row2.y * v.y + inst->row2.z * v.z);
 }
 
 // The tmin of the object-space ray (o', d') of world ray origin o (see above).
-inline float instance_tmin(const GpuInstance* inst, float3 o, float3 od, float tmin) {
+inline float instance_tmin(const DeviceInstance* inst, float3 o, float3 od, float tmin) {
     const float gamma8 = 8.0f * 0x1p-24f / (1.0f - 8.0f * 0x1p-24f);
     float3 a = fabs(o - (float3)(inst->row0.w, inst->row1.w, inst->row2.w));
     float3 m0 = fabs(inst->row0.xyz), m1 = fabs(inst->row1.xyz), m2 = fabs(inst->row2.xyz);
@@ -282,10 +282,10 @@ inline float instance_tmin(const GpuInstance* inst, float3 o, float3 od, float t
 // instance. A hit names the mesh's triangle (`prim`) and the slot as a bottom-level hit does.
 // Returns true when an any-hit ends the traversal.
 inline bool intersect_piece_triangle(uint copy, uint prim, uint slot,
-                                     global const GpuTriangle* tris, const SceneSurfaces* surf,
+                                     global const DeviceTriangle* tris, const SceneSurfaces* surf,
                                      const RayPrep* r, float3 o, float3 d, float tmin,
-                                     bool any_hit, GpuHit* hit) {
-    GpuTriangle t = tris[copy];
+                                     bool any_hit, DeviceHit* hit) {
+    DeviceTriangle t = tris[copy];
     float t_hit = hit->t;
     float bu, bv;
     if (!intersect_triangle(r, t.v0, t.v1, t.v2, tmin, &t_hit, &bu, &bv)) return false;
@@ -329,9 +329,9 @@ inline float3 stack_float3(const uint* s, uint i) {
 // the stack's first slots, the instance's slot under its walk (a hit found there names it as
 // INSTANCE_PENDING until the walk ends). With the fewer registers, more rays run at once to
 // hide the node loads (docs/benchmarks.md, eighth session).
-inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
-                                 global const GpuInstance* instances,
-                                 global const GpuTriangle* object_tris,
+inline DeviceHit traverse_two_level(global const DeviceBvhNode* nodes,
+                                 global const DeviceInstance* instances,
+                                 global const DeviceTriangle* object_tris,
                                  const SceneSurfaces* surf, float3 o, float3 d, float tmin,
                                  float tmax, bool any_hit, volatile global uint* overflow) {
     RayPrep r = prepare_ray(o, d);
@@ -341,7 +341,7 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
     const RayPrep world = r;
 #endif
     float rtmin = tmin;
-    GpuHit hit = no_hit(tmax);
+    DeviceHit hit = no_hit(tmax);
     uint stack[TWO_LEVEL_STACK + WORLD_SLOTS];
     stack[0] = as_uint(o.x);
     stack[1] = as_uint(o.y);
@@ -362,7 +362,7 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
             // A piece: tested on the spot when it is one triangle (HAS_TRIANGLE_PIECES: small
             // meshes on CPUs), else entered.
             uint slot = node & ~INSTANCE_BIT;
-            global const GpuInstance* piece = &instances[slot];
+            global const DeviceInstance* piece = &instances[slot];
 #ifdef HAS_TRIANGLE_PIECES
             if (piece->flags & INSTANCE_PIECE_TRIANGLE) {
                 if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris,
@@ -380,14 +380,14 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
             }
             stack[sp++] = slot;
             base = sp;
-            GpuInstance inst = *piece;
+            DeviceInstance inst = *piece;
             float3 wo = stack_float3(stack, 0u);
             float3 od = instance_vector(&inst, stack_float3(stack, 3u));
             r = prepare_ray(instance_point(&inst, wo), od);
             rtmin = instance_tmin(&inst, wo, od, as_float(stack[9]));
             node = inst.root;
         }
-        GpuBvhNode n = nodes[node];
+        DeviceBvhNode n = nodes[node];
         float dist[2];
         uint child[2];
         for (int side = 0; side < 2; ++side) {
@@ -446,9 +446,9 @@ inline GpuHit traverse_two_level(global const GpuBvhNode* nodes,
 }
 
 // The scene's traversal: the flat BVH, or with TWO_LEVEL the instances' two levels.
-inline GpuHit trace_scene(global const GpuBvhNode* nodes, global const GpuTriangle* tris,
-                          global const GpuInstance* instances,
-                          global const GpuTriangle* object_tris, const SceneSurfaces* surf,
+inline DeviceHit trace_scene(global const DeviceBvhNode* nodes, global const DeviceTriangle* tris,
+                          global const DeviceInstance* instances,
+                          global const DeviceTriangle* object_tris, const SceneSurfaces* surf,
                           float3 o, float3 d, float tmin, float tmax, bool any_hit,
                           volatile global uint* overflow) {
 #ifdef TWO_LEVEL

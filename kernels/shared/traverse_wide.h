@@ -12,7 +12,7 @@
 #define WIDE_STACK_SIZE 144  // (4 - 1) x the builder's depth limit of 48
 
 // The ray in four lanes: origin and safe reciprocal direction, one coordinate per vector, and
-// for each axis the byte offsets in a GpuWideNode of the box planes the ray meets first (min_*
+// for each axis the byte offsets in a DeviceWideNode of the box planes the ray meets first (min_*
 // where the direction is positive, max_* where negative) and last, so that a node's entry and
 // exit distances need no minimum and maximum per axis.
 typedef struct {
@@ -50,7 +50,7 @@ inline WideRay wide_ray(const RayPrep* r) {
 // images bit for bit. (traverse_packet.h's slab test uses them too.)
 #define WIDE_MIN(a, b) select(b, a, a < b)
 #define WIDE_MAX(a, b) select(b, a, a > b)
-inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin, float tmax,
+inline int4 wide_reach(global const DeviceWideNode* n, const WideRay* w, float tmin, float tmax,
                        float4* near) {
     // With lo <= hi, (lo - o) * inv <= (hi - o) * inv where inv > 0 (rounding is monotonic) and
     // >= where inv < 0: the near plane's distance is the minimum of the two, bit for bit.
@@ -108,12 +108,12 @@ inline int4 wide_reach(global const GpuWideNode* n, const WideRay* w, float tmin
 // for one or two, the scalar tests measured as fast or faster (docs/benchmarks.md, "Sixth
 // session").
 #ifndef HAS_ALPHA
-inline bool intersect_leaf4(const RayPrep* r, global const GpuTriangle* tris,
+inline bool intersect_leaf4(const RayPrep* r, global const DeviceTriangle* tris,
                             const SceneSurfaces* surf, uint first, uint count, float tmin,
-                            float3 o, float3 d, bool any_hit, GpuHit* hit) {
+                            float3 o, float3 d, bool any_hit, DeviceHit* hit) {
     uint last = first + count - 1u;
-    GpuTriangle t0 = tris[first], t1 = tris[min(first + 1u, last)];
-    GpuTriangle t2 = tris[min(first + 2u, last)], t3 = tris[min(first + 3u, last)];
+    DeviceTriangle t0 = tris[first], t1 = tris[min(first + 1u, last)];
+    DeviceTriangle t2 = tris[min(first + 2u, last)], t3 = tris[min(first + 3u, last)];
     float4 o4 = (float4)(r->origin, 0.0f);
 #define LEAF4_VERTEX(V, X, Y, Z)                                                     \
     float4 X, Y, Z;                                                                \
@@ -244,10 +244,10 @@ inline uint wide_bits(int4 mask) {
 // any_hit the children are not sorted (WIDE_ANY): bunnies' shadow rays ran 20-25 % faster
 // (docs/benchmarks.md, "Seventh session"), and a shadow test's result does not depend on which
 // hit is found first (path.h's shadow tests walk thin walls again nearest first).
-inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
-                              global const GpuTriangle* tris, const SceneSurfaces* surf,
+inline bool traverse_wide_bvh(global const DeviceWideNode* nodes, uint root,
+                              global const DeviceTriangle* tris, const SceneSurfaces* surf,
                               const RayPrep* r, float3 o, float3 d, float tmin, bool any_hit,
-                              GpuHit* hit,
+                              DeviceHit* hit,
                               volatile global uint* overflow) {
     uint stack[WIDE_STACK_SIZE + 1];
     float stack_d[WIDE_STACK_SIZE + 1];
@@ -255,7 +255,7 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
     uint node = root;
     WideRay w = wide_ray(r);
     for (;;) {
-        global const GpuWideNode* n = &nodes[node];
+        global const DeviceWideNode* n = &nodes[node];
         float4 near;
         int4 mask = wide_reach(n, &w, tmin, hit->t, &near);
         uint bits = wide_bits(mask);
@@ -312,11 +312,11 @@ inline bool traverse_wide_bvh(global const GpuWideNode* nodes, uint root,
 #undef INTERSECT_LEAF
 
 // Closest hit (any_hit = false) or first hit (any_hit = true), as traverse() in traverse.h.
-inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTriangle* tris,
+inline DeviceHit traverse_wide(global const DeviceWideNode* nodes, global const DeviceTriangle* tris,
                             const SceneSurfaces* surf, float3 o, float3 d, float tmin,
                             float tmax, bool any_hit, volatile global uint* overflow) {
     RayPrep r = prepare_ray(o, d);
-    GpuHit hit = no_hit(tmax);
+    DeviceHit hit = no_hit(tmax);
     traverse_wide_bvh(nodes, 0u, tris, surf, &r, o, d, tmin, any_hit, &hit, overflow);
     return hit;
 }
@@ -350,7 +350,7 @@ inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTri
 #define TOP_WIDE_TRIANGLE(D, S)                                                           \
     if (D < hit.t && counts[S] == 1u) {                                                   \
         uint slot = (uint)(~children[S]);                                                 \
-        global const GpuInstance* piece = &instances[slot];                               \
+        global const DeviceInstance* piece = &instances[slot];                               \
         if (piece->flags & INSTANCE_PIECE_TRIANGLE) {                                     \
             if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris, \
                                          surf, &world, o, d, tmin, any_hit, &hit)) {      \
@@ -372,15 +372,15 @@ inline GpuHit traverse_wide(global const GpuWideNode* nodes, global const GpuTri
 // traverse_wide_bvh itself, the flat BVH's loop, with a stack of its own. On a CPU this is faster than one loop over both levels (traverse.h's form, which
 // GPUs keep for their binary nodes): the bottom levels, where rays spend nearly all their
 // visits, run the flat loop's code with its registers.
-inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
-                                      global const GpuInstance* instances,
-                                      global const GpuTriangle* object_tris,
+inline DeviceHit traverse_wide_two_level(global const DeviceWideNode* nodes,
+                                      global const DeviceInstance* instances,
+                                      global const DeviceTriangle* object_tris,
                                       const SceneSurfaces* surf, float3 o, float3 d,
                                       float tmin, float tmax, bool any_hit,
                                       volatile global uint* overflow) {
     const RayPrep world = prepare_ray(o, d);
     const WideRay w = wide_ray(&world);
-    GpuHit hit = no_hit(tmax);
+    DeviceHit hit = no_hit(tmax);
     uint stack[TOP_WIDE_STACK];
     float stack_d[TOP_WIDE_STACK];
     uint sp = 0;
@@ -388,7 +388,7 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
     for (;;) {
         if (node & INSTANCE_BIT) {
             uint slot = node & ~INSTANCE_BIT;
-            global const GpuInstance* piece = &instances[slot];
+            global const DeviceInstance* piece = &instances[slot];
 #ifdef HAS_TRIANGLE_PIECES
             if (piece->flags & INSTANCE_PIECE_TRIANGLE) {
                 if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris,
@@ -398,7 +398,7 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
             } else
 #endif
             {
-                GpuInstance inst = *piece;
+                DeviceInstance inst = *piece;
                 float3 od = instance_vector(&inst, d);
                 RayPrep r = prepare_ray(instance_point(&inst, o), od);
                 float before = hit.t;
@@ -409,7 +409,7 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
                 if (stop) return hit;
             }
         } else {
-            global const GpuWideNode* n = &nodes[node];
+            global const DeviceWideNode* n = &nodes[node];
             float4 near;
             int4 mask = wide_reach(n, &w, tmin, hit.t, &near);
             if (wide_bits(mask) != 0u) {
@@ -445,9 +445,9 @@ inline GpuHit traverse_wide_two_level(global const GpuWideNode* nodes,
 #undef TOP_WIDE_TRIANGLE
 
 // The scene's traversal through wide nodes: flat, or with TWO_LEVEL two levels.
-inline GpuHit trace_scene_wide(global const GpuWideNode* nodes, global const GpuTriangle* tris,
-                               global const GpuInstance* instances,
-                               global const GpuTriangle* object_tris, const SceneSurfaces* surf,
+inline DeviceHit trace_scene_wide(global const DeviceWideNode* nodes, global const DeviceTriangle* tris,
+                               global const DeviceInstance* instances,
+                               global const DeviceTriangle* object_tris, const SceneSurfaces* surf,
                                float3 o, float3 d, float tmin, float tmax, bool any_hit,
                                volatile global uint* overflow) {
 #ifdef TWO_LEVEL
@@ -477,12 +477,12 @@ typedef struct SmallScene {
 
 // The work group's copy of the scene, in local memory (written once a launch for all of the
 // group's paths: a work item, one or a few samples, would not repay it alone).
-inline void small_scene_load(global const GpuTriangle* tris, uint count, local SmallScene* s) {
+inline void small_scene_load(global const DeviceTriangle* tris, uint count, local SmallScene* s) {
     count = clamp(count, 1u, (uint)SMALL_SCENE);
     if (get_local_id(0) == 0u) s->count = count;
     for (uint i = get_local_id(0); i < SMALL_BATCHES * SMALL_LANES; i += get_local_size(0)) {
         // Lanes past the last triangle repeat it (and are masked out).
-        GpuTriangle t = tris[min(i, count - 1u)];
+        DeviceTriangle t = tris[min(i, count - 1u)];
         s->c[0][i] = t.v0.x;
         s->c[1][i] = t.v0.y;
         s->c[2][i] = t.v0.z;
@@ -512,11 +512,11 @@ inline int small_min(int16 x) {
 // (a later batch's only when strictly nearer), and the lanes' nearest with the lowest index
 // wins, the hit the triangles tested one by one in order would keep. The rare rays that need
 // the scalar test's double precision or error bound somewhere are tested by it throughout.
-inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* tris,
+inline DeviceHit trace_small(local const SmallScene* s, global const DeviceTriangle* tris,
                           const SceneSurfaces* surf, float3 o, float3 d, float tmin, float tmax,
                           bool any_hit) {
     RayPrep r = prepare_ray(o, d);
-    GpuHit hit = no_hit(tmax);
+    DeviceHit hit = no_hit(tmax);
     float4 op = ray_permute((float4)(o, 0.0f), r.perm);
     uint kx = r.perm.x, ky = r.perm.y, kz = r.perm.z;
     float16 sx = (float16)(r.shear.x), sy = (float16)(r.shear.y), sz = (float16)(r.shear.z);
@@ -573,9 +573,9 @@ inline GpuHit trace_small(local const SmallScene* s, global const GpuTriangle* t
 }
 
 // trace_small in trace_scene_wide's form (the tree's arguments unused).
-inline GpuHit trace_small_scene(local const SmallScene* s, global const GpuTriangle* tris,
-                                global const GpuInstance* instances,
-                                global const GpuTriangle* object_tris, const SceneSurfaces* surf,
+inline DeviceHit trace_small_scene(local const SmallScene* s, global const DeviceTriangle* tris,
+                                global const DeviceInstance* instances,
+                                global const DeviceTriangle* object_tris, const SceneSurfaces* surf,
                                 float3 o, float3 d, float tmin, float tmax, bool any_hit,
                                 volatile global uint* overflow) {
     return trace_small(s, tris, surf, o, d, tmin, tmax, any_hit);
@@ -584,7 +584,7 @@ inline GpuHit trace_small_scene(local const SmallScene* s, global const GpuTrian
 
 // triangle_normal of triangle `prim`, t, read from the megakernel's copy of a small scene
 // where there is one.
-inline float3 flat_normal(const SceneSurfaces* surf, uint prim, GpuTriangle t) {
+inline float3 flat_normal(const SceneSurfaces* surf, uint prim, DeviceTriangle t) {
 #ifdef SMALL_SCENE
     if (surf->small) return surf->small->normal[prim].xyz;
 #endif

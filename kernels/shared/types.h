@@ -13,7 +13,7 @@ typedef struct {
     float4 left_max;   // .w = left leaf triangle count (uint bits), 0 for an interior child
     float4 right_min;  // .w = right child (int bits)
     float4 right_max;  // .w = right leaf triangle count (uint bits)
-} GpuBvhNode;
+} DeviceBvhNode;
 
 // A node of the 4-wide BVH: the children's boxes by coordinate (lane i = child i). A child is
 // an interior node (child > 0, count 0), a leaf (child = ~first triangle, count > 0) or an
@@ -23,7 +23,7 @@ typedef struct {
     float4 max_x, max_y, max_z;
     int4 child;
     uint4 count;
-} GpuWideNode;
+} DeviceWideNode;
 
 // One placed mesh of a two-level scene (src/bvh/instances.rs): object_from_world as
 // p_object = L (p_world - T), the rows of L with T in .w (T: the world position of the object's
@@ -41,7 +41,7 @@ typedef struct {
     uint wide_root;    // bottom-level root in the wide nodes
     uint id;           // the instance's index in the scene (host bookkeeping)
     uint flags;        // INSTANCE_MIRRORED, INSTANCE_PIECE_TRIANGLE
-} GpuInstance;
+} DeviceInstance;
 
 // World space in BVH order; with TWO_LEVEL object space, once per mesh (then v1.w counts the
 // mesh's emissive triangles from the instance's first light, and v2.w is 0).
@@ -49,14 +49,14 @@ typedef struct {
     float4 v0;  // .w = material index (uint bits)
     float4 v1;  // .w = emissive light index (int bits), -1 when not emissive
     float4 v2;  // .w = object index (uint bits)
-} GpuTriangle;
+} DeviceTriangle;
 
 // Per-corner normals of a triangle (36 bytes; float3 would pad to 48): n[3c..3c+2] is corner
 // c's. A flat-shaded triangle's are all 0, whose interpolation, of length 0, leaves the
 // geometric normal (path.h), as a flag would.
 typedef struct {
     float n[9];
-} GpuTriShading;
+} DeviceTriShading;
 
 // TEXCOORD_0 and TEXCOORD_1 of a triangle's corners (48 bytes); on the device only when some
 // material samples a texture (HAS_TEXTURES), else a one-element placeholder that is never read.
@@ -64,26 +64,26 @@ typedef struct {
     float4 uv01;  // TEXCOORD_0 of vertices 0 (.xy) and 1 (.zw)
     float4 uv2;   // TEXCOORD_0 of vertex 2 (.xy); TEXCOORD_1 of vertex 0 (.zw)
     float4 uv1_12;  // TEXCOORD_1 of vertices 1 (.xy) and 2 (.zw)
-} GpuTriUvs;
+} DeviceTriUvs;
 
 typedef struct {
     float4 t0;  // unit tangent at vertex 0; .w = bitangent sign
     float4 t1;
     float4 t2;
-} GpuTriTangents;
+} DeviceTriTangents;
 
 typedef struct {
     uint offset;  // first texel of level 0; levels follow, level l is max(1, w >> l) x max(1, h >> l)
     uint width;   // of level 0
     uint height;
     uint flags;   // mip level count (TEXTURE_LEVELS_MASK bits) | TEXTURE_SRGB
-} GpuTexture;
+} DeviceTexture;
 
 typedef struct {
     float4 m0;  // first row of the UV transform; .w = texture coordinate set (uint bits)
     float4 m1;  // second row; .w = 0.5 * log2 |det| (mip bias)
     int4 info;  // .x texture index, .y wrap S, .z wrap T (WRAP_*), .w flags (TEXREF_*)
-} GpuTexRef;
+} DeviceTexRef;
 
 typedef struct {
     float4 scale;     // .x intensity, .y pdf normalization W*H / (sum f * 2 pi^2), .z NEE pick probability
@@ -92,7 +92,7 @@ typedef struct {
     uint height;
     uint light;       // index in the light list
     uint pad;
-} GpuEnvironment;
+} DeviceEnvironment;
 
 typedef struct {
     float4 base_color;  // linear base color; .w = alpha
@@ -112,7 +112,7 @@ typedef struct {
     int4 textures4;     // texture refs: .x anisotropy, .y iridescence (R), .z iridescence
                         // thickness (G), .w diffuse transmission (A); -1 none
     int4 textures5;     // texture refs: .x diffuse transmission color; -1 none
-} GpuMaterial;
+} DeviceMaterial;
 
 typedef struct {
     float4 position;   // position, or travel direction (directional); .w = kind (uint bits)
@@ -120,14 +120,14 @@ typedef struct {
     float4 spot;       // spot axis; .w = cos outer angle. Triangle: .x = index bits, .y = area,
                        // .z = instance slot (uint bits, two levels)
     float4 extra;      // .x = cos inner angle, .y = selection probability
-} GpuLight;
+} DeviceLight;
 
 typedef struct {
     float4 origin;   // eye; .w = lens radius
     float4 forward;  // unit view direction; .w = focus distance
     float4 right;    // right * tan(fov/2) * aspect
     float4 up;       // up * tan(fov/2)
-} GpuCamera;
+} DeviceCamera;
 
 typedef struct {
     uint width;
@@ -143,14 +143,14 @@ typedef struct {
     uint bounce;
     uint background;  // BACKGROUND_*: what an escaped camera ray adds
     uint triangles;   // the scene's, for SMALL_SCENE (traverse_wide.h); 0 elsewhere
-} GpuFrame;
+} DeviceFrame;
 
 typedef struct {
     float4 origin;      // .w = pdf of the BSDF sample that made this ray (0: camera ray)
     float4 direction;   // .w = flags (uint bits): PATH_SPECULAR, PATH_ESCAPED, PATH_THROUGH_WALL
     float4 throughput;  // .w = slot (uint bits): pixel + sample_in_wave * pixels
     float4 radiance;    // .w = random state (uint bits)
-} GpuPath;
+} DevicePath;
 
 typedef struct {
     float t;
@@ -158,17 +158,17 @@ typedef struct {
     float v;      // weight of vertex 2
     uint prim;    // triangle in BVH order (two levels: object-space triangle), 0xffffffff on a miss
     uint instance;  // the instance hit: its slot in the instance buffer (two levels; 0 when flat)
-} GpuHit;
+} DeviceHit;
 
 typedef struct {
     float4 origin;        // .w = maximum distance
     float4 direction;     // .w = path slot (uint bits)
     float4 contribution;  // radiance added to the path when the light is visible
-} GpuShadowRay;
+} DeviceShadowRay;
 
 typedef struct {
     float4 origin;     // .w = tmin
     float4 direction;  // .w = tmax
-} GpuRay;
+} DeviceRay;
 
 #endif  // SHARED_TYPES_H

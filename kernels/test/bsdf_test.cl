@@ -5,7 +5,7 @@
 #include "shared/rng.h"
 #include "shared/bsdf.h"
 
-inline SurfaceMaterial bsdf_test_material(global const GpuMaterial* material, uint inside) {
+inline SurfaceMaterial bsdf_test_material(global const DeviceMaterial* material, uint inside) {
     SurfaceMaterial m = surface_material(material);
     if (inside != 0u) material_from_inside(&m);
 #ifdef HAS_ANISOTROPY
@@ -22,7 +22,7 @@ inline SurfaceMaterial bsdf_test_material(global const GpuMaterial* material, ui
 
 // `count` samples of the BSDF at (wo, n) with random numbers drawn as the shade kernel draws them.
 // Writes (wi, pdf) and (weight, 1 for a delta lobe else 0).
-kernel void bsdf_sample_test(global const GpuMaterial* material, float4 wo, float4 n, uint inside,
+kernel void bsdf_sample_test(global const DeviceMaterial* material, float4 wo, float4 n, uint inside,
                              uint count, uint seed, global float4* wi_pdf,
                              global float4* weight_specular) {
     uint i = get_global_id(0);
@@ -41,7 +41,7 @@ kernel void bsdf_sample_test(global const GpuMaterial* material, float4 wo, floa
 }
 
 // bsdf_eval at (wo, n) for `count` directions wi: writes (f * |cos|, pdf).
-kernel void bsdf_eval_test(global const GpuMaterial* material, float4 wo, float4 n, uint inside,
+kernel void bsdf_eval_test(global const DeviceMaterial* material, float4 wo, float4 n, uint inside,
                            uint count, global const float4* wi, global float4* value_pdf) {
     uint i = get_global_id(0);
     if (i >= count) return;

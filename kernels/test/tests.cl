@@ -13,79 +13,79 @@
 kernel void probe_layout(global uint* out) {
     if (get_global_id(0) != 0) return;
     uint n = 0;
-    PROBE_SIZE(GpuBvhNode);
-    PROBE_FIELD(GpuBvhNode, left_min); PROBE_FIELD(GpuBvhNode, left_max);
-    PROBE_FIELD(GpuBvhNode, right_min); PROBE_FIELD(GpuBvhNode, right_max);
-    PROBE_SIZE(GpuTriangle);
-    PROBE_FIELD(GpuTriangle, v0); PROBE_FIELD(GpuTriangle, v1); PROBE_FIELD(GpuTriangle, v2);
-    PROBE_SIZE(GpuInstance);
-    PROBE_FIELD(GpuInstance, row0); PROBE_FIELD(GpuInstance, row1);
-    PROBE_FIELD(GpuInstance, row2); PROBE_FIELD(GpuInstance, world0);
-    PROBE_FIELD(GpuInstance, world1); PROBE_FIELD(GpuInstance, world2);
-    PROBE_FIELD(GpuInstance, root); PROBE_FIELD(GpuInstance, wide_root);
-    PROBE_FIELD(GpuInstance, id); PROBE_FIELD(GpuInstance, flags);
-    PROBE_SIZE(GpuTriShading);
-    PROBE_FIELD(GpuTriShading, n);
-    PROBE_SIZE(GpuTriUvs);
-    PROBE_FIELD(GpuTriUvs, uv01); PROBE_FIELD(GpuTriUvs, uv2); PROBE_FIELD(GpuTriUvs, uv1_12);
-    PROBE_SIZE(GpuTriTangents);
-    PROBE_FIELD(GpuTriTangents, t0); PROBE_FIELD(GpuTriTangents, t1);
-    PROBE_FIELD(GpuTriTangents, t2);
-    PROBE_SIZE(GpuTexture);
-    PROBE_FIELD(GpuTexture, offset); PROBE_FIELD(GpuTexture, width);
-    PROBE_FIELD(GpuTexture, height); PROBE_FIELD(GpuTexture, flags);
-    PROBE_SIZE(GpuTexRef);
-    PROBE_FIELD(GpuTexRef, m0); PROBE_FIELD(GpuTexRef, m1); PROBE_FIELD(GpuTexRef, info);
-    PROBE_SIZE(GpuEnvironment);
-    PROBE_FIELD(GpuEnvironment, scale); PROBE_FIELD(GpuEnvironment, rotation);
-    PROBE_FIELD(GpuEnvironment, width); PROBE_FIELD(GpuEnvironment, height);
-    PROBE_FIELD(GpuEnvironment, light); PROBE_FIELD(GpuEnvironment, pad);
-    PROBE_SIZE(GpuMaterial);
-    PROBE_FIELD(GpuMaterial, base_color); PROBE_FIELD(GpuMaterial, emission);
-    PROBE_FIELD(GpuMaterial, params); PROBE_FIELD(GpuMaterial, specular);
-    PROBE_FIELD(GpuMaterial, volume); PROBE_FIELD(GpuMaterial, alpha);
-    PROBE_FIELD(GpuMaterial, textures); PROBE_FIELD(GpuMaterial, textures2);
-    PROBE_FIELD(GpuMaterial, coat); PROBE_FIELD(GpuMaterial, textures3);
-    PROBE_FIELD(GpuMaterial, sheen); PROBE_FIELD(GpuMaterial, aniso);
-    PROBE_FIELD(GpuMaterial, iridescence); PROBE_FIELD(GpuMaterial, diffuse_transmission);
-    PROBE_FIELD(GpuMaterial, textures4); PROBE_FIELD(GpuMaterial, textures5);
-    PROBE_SIZE(GpuLight);
-    PROBE_FIELD(GpuLight, position); PROBE_FIELD(GpuLight, intensity);
-    PROBE_FIELD(GpuLight, spot); PROBE_FIELD(GpuLight, extra);
-    PROBE_SIZE(GpuCamera);
-    PROBE_FIELD(GpuCamera, origin); PROBE_FIELD(GpuCamera, forward);
-    PROBE_FIELD(GpuCamera, right); PROBE_FIELD(GpuCamera, up);
-    PROBE_SIZE(GpuFrame);
-    PROBE_FIELD(GpuFrame, width); PROBE_FIELD(GpuFrame, height);
-    PROBE_FIELD(GpuFrame, samples_in_wave); PROBE_FIELD(GpuFrame, first_sample);
-    PROBE_FIELD(GpuFrame, seed); PROBE_FIELD(GpuFrame, max_bounces);
-    PROBE_FIELD(GpuFrame, rr_depth); PROBE_FIELD(GpuFrame, strategy);
-    PROBE_FIELD(GpuFrame, sky); PROBE_FIELD(GpuFrame, light_count);
-    PROBE_FIELD(GpuFrame, bounce); PROBE_FIELD(GpuFrame, background);
-    PROBE_FIELD(GpuFrame, triangles);
-    PROBE_SIZE(GpuPath);
-    PROBE_FIELD(GpuPath, origin); PROBE_FIELD(GpuPath, direction);
-    PROBE_FIELD(GpuPath, throughput); PROBE_FIELD(GpuPath, radiance);
-    PROBE_SIZE(GpuHit);
-    PROBE_FIELD(GpuHit, t); PROBE_FIELD(GpuHit, u); PROBE_FIELD(GpuHit, v); PROBE_FIELD(GpuHit, prim);
-    PROBE_FIELD(GpuHit, instance);
-    PROBE_SIZE(GpuShadowRay);
-    PROBE_FIELD(GpuShadowRay, origin); PROBE_FIELD(GpuShadowRay, direction);
-    PROBE_FIELD(GpuShadowRay, contribution);
-    PROBE_SIZE(GpuRay);
-    PROBE_FIELD(GpuRay, origin); PROBE_FIELD(GpuRay, direction);
-    PROBE_SIZE(GpuWideNode);
-    PROBE_FIELD(GpuWideNode, min_x); PROBE_FIELD(GpuWideNode, min_y);
-    PROBE_FIELD(GpuWideNode, min_z); PROBE_FIELD(GpuWideNode, max_x);
-    PROBE_FIELD(GpuWideNode, max_y); PROBE_FIELD(GpuWideNode, max_z);
-    PROBE_FIELD(GpuWideNode, child); PROBE_FIELD(GpuWideNode, count);
+    PROBE_SIZE(DeviceBvhNode);
+    PROBE_FIELD(DeviceBvhNode, left_min); PROBE_FIELD(DeviceBvhNode, left_max);
+    PROBE_FIELD(DeviceBvhNode, right_min); PROBE_FIELD(DeviceBvhNode, right_max);
+    PROBE_SIZE(DeviceTriangle);
+    PROBE_FIELD(DeviceTriangle, v0); PROBE_FIELD(DeviceTriangle, v1); PROBE_FIELD(DeviceTriangle, v2);
+    PROBE_SIZE(DeviceInstance);
+    PROBE_FIELD(DeviceInstance, row0); PROBE_FIELD(DeviceInstance, row1);
+    PROBE_FIELD(DeviceInstance, row2); PROBE_FIELD(DeviceInstance, world0);
+    PROBE_FIELD(DeviceInstance, world1); PROBE_FIELD(DeviceInstance, world2);
+    PROBE_FIELD(DeviceInstance, root); PROBE_FIELD(DeviceInstance, wide_root);
+    PROBE_FIELD(DeviceInstance, id); PROBE_FIELD(DeviceInstance, flags);
+    PROBE_SIZE(DeviceTriShading);
+    PROBE_FIELD(DeviceTriShading, n);
+    PROBE_SIZE(DeviceTriUvs);
+    PROBE_FIELD(DeviceTriUvs, uv01); PROBE_FIELD(DeviceTriUvs, uv2); PROBE_FIELD(DeviceTriUvs, uv1_12);
+    PROBE_SIZE(DeviceTriTangents);
+    PROBE_FIELD(DeviceTriTangents, t0); PROBE_FIELD(DeviceTriTangents, t1);
+    PROBE_FIELD(DeviceTriTangents, t2);
+    PROBE_SIZE(DeviceTexture);
+    PROBE_FIELD(DeviceTexture, offset); PROBE_FIELD(DeviceTexture, width);
+    PROBE_FIELD(DeviceTexture, height); PROBE_FIELD(DeviceTexture, flags);
+    PROBE_SIZE(DeviceTexRef);
+    PROBE_FIELD(DeviceTexRef, m0); PROBE_FIELD(DeviceTexRef, m1); PROBE_FIELD(DeviceTexRef, info);
+    PROBE_SIZE(DeviceEnvironment);
+    PROBE_FIELD(DeviceEnvironment, scale); PROBE_FIELD(DeviceEnvironment, rotation);
+    PROBE_FIELD(DeviceEnvironment, width); PROBE_FIELD(DeviceEnvironment, height);
+    PROBE_FIELD(DeviceEnvironment, light); PROBE_FIELD(DeviceEnvironment, pad);
+    PROBE_SIZE(DeviceMaterial);
+    PROBE_FIELD(DeviceMaterial, base_color); PROBE_FIELD(DeviceMaterial, emission);
+    PROBE_FIELD(DeviceMaterial, params); PROBE_FIELD(DeviceMaterial, specular);
+    PROBE_FIELD(DeviceMaterial, volume); PROBE_FIELD(DeviceMaterial, alpha);
+    PROBE_FIELD(DeviceMaterial, textures); PROBE_FIELD(DeviceMaterial, textures2);
+    PROBE_FIELD(DeviceMaterial, coat); PROBE_FIELD(DeviceMaterial, textures3);
+    PROBE_FIELD(DeviceMaterial, sheen); PROBE_FIELD(DeviceMaterial, aniso);
+    PROBE_FIELD(DeviceMaterial, iridescence); PROBE_FIELD(DeviceMaterial, diffuse_transmission);
+    PROBE_FIELD(DeviceMaterial, textures4); PROBE_FIELD(DeviceMaterial, textures5);
+    PROBE_SIZE(DeviceLight);
+    PROBE_FIELD(DeviceLight, position); PROBE_FIELD(DeviceLight, intensity);
+    PROBE_FIELD(DeviceLight, spot); PROBE_FIELD(DeviceLight, extra);
+    PROBE_SIZE(DeviceCamera);
+    PROBE_FIELD(DeviceCamera, origin); PROBE_FIELD(DeviceCamera, forward);
+    PROBE_FIELD(DeviceCamera, right); PROBE_FIELD(DeviceCamera, up);
+    PROBE_SIZE(DeviceFrame);
+    PROBE_FIELD(DeviceFrame, width); PROBE_FIELD(DeviceFrame, height);
+    PROBE_FIELD(DeviceFrame, samples_in_wave); PROBE_FIELD(DeviceFrame, first_sample);
+    PROBE_FIELD(DeviceFrame, seed); PROBE_FIELD(DeviceFrame, max_bounces);
+    PROBE_FIELD(DeviceFrame, rr_depth); PROBE_FIELD(DeviceFrame, strategy);
+    PROBE_FIELD(DeviceFrame, sky); PROBE_FIELD(DeviceFrame, light_count);
+    PROBE_FIELD(DeviceFrame, bounce); PROBE_FIELD(DeviceFrame, background);
+    PROBE_FIELD(DeviceFrame, triangles);
+    PROBE_SIZE(DevicePath);
+    PROBE_FIELD(DevicePath, origin); PROBE_FIELD(DevicePath, direction);
+    PROBE_FIELD(DevicePath, throughput); PROBE_FIELD(DevicePath, radiance);
+    PROBE_SIZE(DeviceHit);
+    PROBE_FIELD(DeviceHit, t); PROBE_FIELD(DeviceHit, u); PROBE_FIELD(DeviceHit, v); PROBE_FIELD(DeviceHit, prim);
+    PROBE_FIELD(DeviceHit, instance);
+    PROBE_SIZE(DeviceShadowRay);
+    PROBE_FIELD(DeviceShadowRay, origin); PROBE_FIELD(DeviceShadowRay, direction);
+    PROBE_FIELD(DeviceShadowRay, contribution);
+    PROBE_SIZE(DeviceRay);
+    PROBE_FIELD(DeviceRay, origin); PROBE_FIELD(DeviceRay, direction);
+    PROBE_SIZE(DeviceWideNode);
+    PROBE_FIELD(DeviceWideNode, min_x); PROBE_FIELD(DeviceWideNode, min_y);
+    PROBE_FIELD(DeviceWideNode, min_z); PROBE_FIELD(DeviceWideNode, max_x);
+    PROBE_FIELD(DeviceWideNode, max_y); PROBE_FIELD(DeviceWideNode, max_z);
+    PROBE_FIELD(DeviceWideNode, child); PROBE_FIELD(DeviceWideNode, count);
     out[n] = 0xffffffffu;
 }
 
 // Texture lookups for the tests: query i reads reference (int bits of .w) at uv .xy and level
 // of detail .z (the texel-footprint level before the texture's own size is added; -INFINITY
 // reads level 0, and a fractional level is rounded down).
-kernel void sample_texture_test(global const GpuTexRef* tex_refs, global const GpuTexture* textures,
+kernel void sample_texture_test(global const DeviceTexRef* tex_refs, global const DeviceTexture* textures,
                                 global const uint* texels, global const float4* queries,
                                 uint count, global float4* out) {
     uint i = get_global_id(0);
@@ -110,7 +110,7 @@ kernel void sample_texture_test(global const GpuTexRef* tex_refs, global const G
 
 // Environment samples for the tests: direction (.xyz) and pdf (.w) of sample i from the
 // uniform pair u[i], and the pdf that env_radiance gives the same direction.
-kernel void sample_env_test(GpuEnvironment environment, global const float* env_texels,
+kernel void sample_env_test(DeviceEnvironment environment, global const float* env_texels,
                             global const float* env_marginal, global const float* env_conditional,
                             global const float2* u, uint count, global float4* out,
                             global float* eval_pdf) {

@@ -181,7 +181,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         .unwrap_or_default();
     let mut app = App {
         size,
-        device: renderer.gpu.description(),
+        device: renderer.device.description(),
         frame_loop: FrameLoop::new(renderer),
         lights: view.lights(),
         model: Model::new(config.scene, view, camera),

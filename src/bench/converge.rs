@@ -194,7 +194,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
 
     let date = today();
-    let device = renderer.gpu.description();
+    let device = renderer.device.description();
     let scene_name = args
         .scene
         .as_ref()
@@ -218,7 +218,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             "date": date,
             "scene": source,
             "reference": args.reference.display().to_string(),
-            "device": device_json(&renderer.gpu),
+            "device": device_json(&renderer.device),
             "width": settings.width,
             "height": settings.height,
             "bounces": settings.bounces,
@@ -237,7 +237,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         "penumbra bench converge — {source} against {} — {date}",
         args.reference.display()
     );
-    println!("device   {}", device_line(&renderer.gpu));
+    println!("device   {}", device_line(&renderer.device));
     println!(
         "render   {}×{}, {} bounces, {} punctual light(s), up to {max_spp} spp or {} s per \
          configuration; slopes fitted from {} spp",

@@ -74,7 +74,7 @@ pub fn run(args: &FrameArgs) -> Result<()> {
             "benchmark": "frame",
             "date": today(),
             "scene": source,
-            "device": device_json(&renderer.gpu),
+            "device": device_json(&renderer.device),
             "kernel": renderer.kernel(),
             "width": settings.width,
             "height": settings.height,
@@ -102,7 +102,7 @@ pub fn run(args: &FrameArgs) -> Result<()> {
         return Ok(());
     }
     println!("penumbra bench frame — {source} — {}", today());
-    println!("device   {}", device_line(&renderer.gpu));
+    println!("device   {}", device_line(&renderer.device));
     println!(
         "scene    {} triangles, {} lights, {} emissive triangles; BVH build {:.0} ms, kernel \
          build {:.0} ms",

@@ -21,7 +21,7 @@ pub use generate::GenerateArgs;
 pub use stress::StressArgs;
 pub use trace::TraceArgs;
 
-use crate::cl::Gpu;
+use crate::cl::Device;
 use anyhow::Result;
 use clap::Subcommand;
 
@@ -63,8 +63,8 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
 }
 
 /// The device as benchmark outputs describe it.
-fn device_json(gpu: &Gpu) -> serde_json::Value {
-    let i = &gpu.info;
+fn device_json(device: &Device) -> serde_json::Value {
+    let i = &device.info;
     serde_json::json!({
         "name": i.name,
         "platform": i.platform,
@@ -76,8 +76,8 @@ fn device_json(gpu: &Gpu) -> serde_json::Value {
 }
 
 /// One line naming the device, its platform and driver.
-fn device_line(gpu: &Gpu) -> String {
-    let i = &gpu.info;
+fn device_line(device: &Device) -> String {
+    let i = &device.info;
     format!(
         "{} ({}), driver {}, {}, {} compute units",
         i.name, i.platform, i.driver, i.version, i.compute_units

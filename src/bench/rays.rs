@@ -3,16 +3,16 @@
 //! (the incoherent first bounce) and shadow rays from the primary hits to points on the lights.
 
 use crate::bvh::Ray;
-use crate::cl::types::{GpuCamera, GpuHit, GpuRay};
+use crate::cl::types::{DeviceCamera, DeviceHit, DeviceRay};
 use crate::render::camera::primary_ray;
 use glam::Vec3;
 use rayon::prelude::*;
 
-/// `GpuHit::prim` of a miss.
+/// `DeviceHit::prim` of a miss.
 pub const MISS: u32 = u32::MAX;
 
 /// The host form of a device ray.
-pub fn to_host(r: &GpuRay) -> Ray {
+pub fn to_host(r: &DeviceRay) -> Ray {
     Ray {
         origin: Vec3::new(r.origin[0], r.origin[1], r.origin[2]),
         direction: Vec3::new(r.direction[0], r.direction[1], r.direction[2]),
@@ -21,8 +21,8 @@ pub fn to_host(r: &GpuRay) -> Ray {
     }
 }
 
-fn gpu_ray(origin: Vec3, direction: Vec3, tmax: f32) -> GpuRay {
-    GpuRay {
+fn gpu_ray(origin: Vec3, direction: Vec3, tmax: f32) -> DeviceRay {
+    DeviceRay {
         origin: [origin.x, origin.y, origin.z, 0.0],
         direction: [direction.x, direction.y, direction.z, tmax],
     }
@@ -30,7 +30,7 @@ fn gpu_ray(origin: Vec3, direction: Vec3, tmax: f32) -> GpuRay {
 
 /// One ray through the centre of every pixel, row by row from the top, as the `generate`
 /// kernel forms them (pinhole; no jitter).
-pub fn primary_rays(camera: &GpuCamera, width: u32, height: u32) -> Vec<GpuRay> {
+pub fn primary_rays(camera: &DeviceCamera, width: u32, height: u32) -> Vec<DeviceRay> {
     (0..width * height)
         .into_par_iter()
         .map(|pixel| {
@@ -53,9 +53,9 @@ pub struct SurfacePoint {
 
 /// The surface points of every hit (misses are left out), offset as the `shade` kernel does.
 pub fn surface_points(
-    rays: &[GpuRay],
-    hits: &[GpuHit],
-    triangle: &(dyn Fn(&GpuHit) -> [Vec3; 3] + Sync),
+    rays: &[DeviceRay],
+    hits: &[DeviceHit],
+    triangle: &(dyn Fn(&DeviceHit) -> [Vec3; 3] + Sync),
 ) -> Vec<SurfacePoint> {
     rays.par_iter()
         .zip(hits)
@@ -122,7 +122,7 @@ fn basis(n: Vec3) -> (Vec3, Vec3) {
 
 /// `count` cosine-distributed rays, ray `i` into the hemisphere of point `i % points.len()`
 /// (so that the set is as large as the primary set even when some primary rays missed).
-pub fn diffuse_rays(points: &[SurfacePoint], count: usize, seed: u32) -> Vec<GpuRay> {
+pub fn diffuse_rays(points: &[SurfacePoint], count: usize, seed: u32) -> Vec<DeviceRay> {
     assert!(!points.is_empty(), "no surface points");
     (0..count)
         .into_par_iter()
@@ -165,7 +165,7 @@ pub fn shadow_rays(
     count: usize,
     lights: &LightTargets,
     seed: u32,
-) -> Vec<GpuRay> {
+) -> Vec<DeviceRay> {
     assert!(!points.is_empty(), "no surface points");
     let targets = lights.count();
     (0..count)

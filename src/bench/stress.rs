@@ -13,7 +13,7 @@
 //! - [`acne`]: a plane lit by a sun at a grazing angle must be lit evenly (no dark pixels).
 
 use super::device_line;
-use crate::cl::types::{COUNTER_SLOTS, GpuHit, GpuRay};
+use crate::cl::types::{COUNTER_SLOTS, DeviceHit, DeviceRay};
 use crate::cl::{Buffer, DeviceChoice};
 use crate::date::today;
 use crate::render::{RenderSettings, Renderer};
@@ -266,11 +266,11 @@ pub fn leaks(
     renderer.set_node_forms(crate::render::NodeForms::BOTH)?;
     renderer.load_scene_in(&scene, &[], space)?;
     let mut rng = Rng::new(rays as u64 ^ center.x.to_bits());
-    let gpu_rays: Vec<GpuRay> = (0..rays)
+    let gpu_rays: Vec<DeviceRay> = (0..rays)
         .map(|_| {
             let o = space.point(center + rng.direction() * (0.5 * radius * rng.uniform()));
             let d = rng.direction().as_vec3();
-            GpuRay {
+            DeviceRay {
                 origin: [o.x, o.y, o.z, 0.0],
                 direction: [d.x, d.y, d.z, f32::INFINITY],
             }
@@ -289,16 +289,16 @@ pub fn leaks(
             host.intersect(&ray).is_none()
         })
         .count();
-    let gpu = &renderer.gpu;
-    let ray_buf = Buffer::from_slice(gpu, &gpu_rays)?;
-    let hits = Buffer::<GpuHit>::new(gpu, rays)?;
-    let mut counters = Buffer::<u32>::new(gpu, COUNTER_SLOTS)?;
-    counters.clear(gpu)?;
+    let device = &renderer.device;
+    let ray_buf = Buffer::from_slice(device, &gpu_rays)?;
+    let hits = Buffer::<DeviceHit>::new(device, rays)?;
+    let mut counters = Buffer::<u32>::new(device, COUNTER_SLOTS)?;
+    counters.clear(device)?;
     let program = renderer.program().expect("the kernels were built");
     let scene = renderer.scene_buffers().expect("the sphere was loaded");
-    program.trace_closest(gpu, scene, &ray_buf, &hits, &counters)?;
+    program.trace_closest(device, scene, &ray_buf, &hits, &counters)?;
     let device_leaks = hits
-        .read(gpu)?
+        .read(device)?
         .iter()
         .filter(|h| h.prim == u32::MAX)
         .count();
@@ -327,7 +327,7 @@ pub fn reintersections(renderer: &Renderer, cases: usize) -> Result<Vec<(i32, us
     for e in -8..=8 {
         let c = reintersection_cases(&mut rng, e, cases);
         let program = renderer.program().expect("the kernels were built");
-        let hits = program.spawn_test(&renderer.gpu, &c.verts, &c.groups, &c.bary, &c.dirs)?;
+        let hits = program.spawn_test(&renderer.device, &c.verts, &c.groups, &c.bary, &c.dirs)?;
         out.push((e, hits.iter().filter(|&&h| h > 0).count()));
     }
     Ok(out)
@@ -455,7 +455,7 @@ pub fn grazing_occlusions(
         dirs.push([d.x, d.y, d.z, width as f32]);
     }
     let program = renderer.program().expect("the kernels were built");
-    let hits = program.spawn_test(&renderer.gpu, &verts, &groups, &bary, &dirs)?;
+    let hits = program.spawn_test(&renderer.device, &verts, &groups, &bary, &dirs)?;
     Ok(hits.iter().filter(|&&h| h > 0).count())
 }
 
@@ -521,7 +521,7 @@ pub fn run(args: &StressArgs) -> Result<()> {
     println!(
         "penumbra bench stress, {}, {}",
         today(),
-        device_line(&renderer.gpu)
+        device_line(&renderer.device)
     );
     println!();
     println!("| check | case | result |");

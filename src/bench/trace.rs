@@ -12,8 +12,8 @@ use super::stats::median;
 use super::{device_json, device_line, thousands};
 use crate::args::{CameraArgs, DeviceArgs, ShadowArgs, SizeArgs, prepare};
 use crate::cl::kernels::{Launch, SceneBuffers};
-use crate::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, GpuHit, GpuRay};
-use crate::cl::{Buffer, Gpu, Program, call_err};
+use crate::cl::types::{COUNT_OVERFLOW, COUNTER_SLOTS, DeviceHit, DeviceRay};
+use crate::cl::{Buffer, Device, Program, call_err};
 use crate::date::today;
 use crate::render::{
     Accel, BvhChoice, HostScene, InstanceUpdate, RenderSettings, Renderer, gpu_camera,
@@ -130,7 +130,7 @@ fn same_t(a: f32, b: f32) -> bool {
 }
 
 /// Compares closest hits with the host traversal.
-fn check_closest(host: &HostScene, rays: &[GpuRay], hits: &[GpuHit], want: usize) -> Check {
+fn check_closest(host: &HostScene, rays: &[DeviceRay], hits: &[DeviceHit], want: usize) -> Check {
     sample_indices(rays.len(), want)
         .into_par_iter()
         .map(|i| {
@@ -161,7 +161,7 @@ fn check_closest(host: &HostScene, rays: &[GpuRay], hits: &[GpuHit], want: usize
 }
 
 /// Compares occlusion with the host traversal.
-fn check_any(host: &HostScene, rays: &[GpuRay], occluded: &[u32], want: usize) -> Check {
+fn check_any(host: &HostScene, rays: &[DeviceRay], occluded: &[u32], want: usize) -> Check {
     sample_indices(rays.len(), want)
         .into_par_iter()
         .map(|i| {
@@ -187,7 +187,7 @@ struct Times {
 
 /// Launches `launch` `warmup` times untimed, then `runs` times; returns the kernel times.
 fn time_launches(
-    gpu: &Gpu,
+    device: &Device,
     warmup: usize,
     runs: usize,
     mut launch: impl FnMut() -> Result<Launch>,
@@ -199,7 +199,8 @@ fn time_launches(
             cpu_start = crate::cpu_time::process_cpu_seconds();
         }
         let l = launch()?;
-        gpu.queue
+        device
+            .queue
             .finish()
             .map_err(call_err("waiting for a traversal kernel"))?;
         if i >= warmup {
@@ -250,7 +251,7 @@ fn timed(check: impl FnOnce() -> Check) -> (Check, f64) {
 
 /// Everything a closest-hit run needs on the device.
 struct Tracer<'a> {
-    gpu: &'a Gpu,
+    device: &'a Device,
     program: &'a Program,
     scene: &'a SceneBuffers,
     counters: Buffer<u32>,
@@ -261,35 +262,35 @@ struct Tracer<'a> {
 
 impl Tracer<'_> {
     /// Times closest-hit traversal of `rays`; returns the hits and the times.
-    fn closest(&self, rays: &[GpuRay]) -> Result<(Vec<GpuHit>, Times)> {
-        let buf = Buffer::from_slice(self.gpu, rays)?;
-        let hits = Buffer::<GpuHit>::new(self.gpu, rays.len())?;
-        let times = time_launches(self.gpu, self.warmup, self.runs, || {
+    fn closest(&self, rays: &[DeviceRay]) -> Result<(Vec<DeviceHit>, Times)> {
+        let buf = Buffer::from_slice(self.device, rays)?;
+        let hits = Buffer::<DeviceHit>::new(self.device, rays.len())?;
+        let times = time_launches(self.device, self.warmup, self.runs, || {
             let (p, s, c) = (self.program, self.scene, &self.counters);
             Ok(if self.wide {
-                p.trace_closest_wide(self.gpu, s, &buf, &hits, c)?
+                p.trace_closest_wide(self.device, s, &buf, &hits, c)?
             } else {
-                p.trace_closest(self.gpu, s, &buf, &hits, c)?
+                p.trace_closest(self.device, s, &buf, &hits, c)?
             })
         })?;
-        let mut out = hits.read(self.gpu)?;
+        let mut out = hits.read(self.device)?;
         out.truncate(rays.len());
         Ok((out, times))
     }
 
     /// Times any-hit traversal of `rays`; returns the occlusion flags and the times.
-    fn any(&self, rays: &[GpuRay]) -> Result<(Vec<u32>, Times)> {
-        let buf = Buffer::from_slice(self.gpu, rays)?;
-        let occluded = Buffer::<u32>::new(self.gpu, rays.len())?;
-        let times = time_launches(self.gpu, self.warmup, self.runs, || {
+    fn any(&self, rays: &[DeviceRay]) -> Result<(Vec<u32>, Times)> {
+        let buf = Buffer::from_slice(self.device, rays)?;
+        let occluded = Buffer::<u32>::new(self.device, rays.len())?;
+        let times = time_launches(self.device, self.warmup, self.runs, || {
             let (p, s, c) = (self.program, self.scene, &self.counters);
             Ok(if self.wide {
-                p.trace_any_wide(self.gpu, s, &buf, &occluded, c)?
+                p.trace_any_wide(self.device, s, &buf, &occluded, c)?
             } else {
-                p.trace_any(self.gpu, s, &buf, &occluded, c)?
+                p.trace_any(self.device, s, &buf, &occluded, c)?
             })
         })?;
-        let mut out = occluded.read(self.gpu)?;
+        let mut out = occluded.read(self.device)?;
         out.truncate(rays.len());
         Ok((out, times))
     }
@@ -298,16 +299,20 @@ impl Tracer<'_> {
 /// With `PENUMBRA_DUMP_TRACE=DIR` (flat BVH only): the wide nodes, the triangles (vertices only)
 /// and each ray set with the device's hits, as raw little-endian arrays in DIR, for timing the
 /// same traversal outside OpenCL (`scripts/experiments/native_trace/` at commit b156327).
-fn dump_trace(dir: &str, host: &HostScene, sets: &[(&str, &[GpuRay], &[GpuHit])]) -> Result<()> {
-    use crate::cl::types::GpuTriangle;
+fn dump_trace(
+    dir: &str,
+    host: &HostScene,
+    sets: &[(&str, &[DeviceRay], &[DeviceHit])],
+) -> Result<()> {
+    use crate::cl::types::DeviceTriangle;
     let Accel::Flat(bvh) = &host.accel else {
         anyhow::bail!("PENUMBRA_DUMP_TRACE needs --bvh flat");
     };
     let nodes = crate::bvh::WideBvh::collapse_for_cpu(bvh).nodes;
-    let tris: Vec<GpuTriangle> = host
+    let tris: Vec<DeviceTriangle> = host
         .vertices
         .iter()
-        .map(|v| GpuTriangle {
+        .map(|v| DeviceTriangle {
             v0: v[0].extend(0.0).to_array(),
             v1: v[1].extend(0.0).to_array(),
             v2: v[2].extend(0.0).to_array(),
@@ -360,7 +365,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| source.clone())?;
     let instance_move = time_instance_move(&mut renderer, &prepared.scene)?;
-    let gpu = &renderer.gpu;
+    let device = &renderer.device;
     let (Some(program), Some(scene), Some(host)) = (
         renderer.program(),
         renderer.scene_buffers(),
@@ -368,10 +373,10 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     ) else {
         return Err(anyhow!("{source}: the scene did not load"));
     };
-    let mut counters = Buffer::<u32>::new(gpu, COUNTER_SLOTS)?;
-    counters.clear(gpu)?;
+    let mut counters = Buffer::<u32>::new(device, COUNTER_SLOTS)?;
+    counters.clear(device)?;
     let tracer = Tracer {
-        gpu,
+        device,
         program,
         scene,
         counters,
@@ -437,7 +442,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     }
     let overflows = tracer
         .counters
-        .read(gpu)?
+        .read(device)?
         .get(COUNT_OVERFLOW)
         .copied()
         .unwrap_or(0);
@@ -451,7 +456,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
             "bvh": if args.wide { "wide" } else { "binary" },
             "date": today(),
             "scene": source,
-            "device": device_json(gpu),
+            "device": device_json(device),
             "width": width,
             "height": height,
             "camera": prepared.camera.name,
@@ -481,7 +486,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
         println!("{summary}");
     } else {
         println!("penumbra bench trace — {source} — {}", today());
-        println!("device   {}", device_line(gpu));
+        println!("device   {}", device_line(device));
         println!(
             "scene    {} triangles, {} BVH ({} meshes, {} instances), {} nodes (depth {}), SAH \
              cost {:.2}; load {:.0} ms, BVH build {:.0} ms, kernel build {:.0} ms",
@@ -612,9 +617,9 @@ fn light_targets(lights: &[crate::scene::Light], host: &crate::render::HostScene
             .map(|e| match &host.accel {
                 // An emitter names its instance by index, not by TLAS slot as a hit does.
                 crate::render::Accel::TwoLevel(two) => two.hit_triangle(e.prim, e.instance),
-                crate::render::Accel::Flat(_) => host.hit_triangle(&GpuHit {
+                crate::render::Accel::Flat(_) => host.hit_triangle(&DeviceHit {
                     prim: e.prim,
-                    ..GpuHit::default()
+                    ..DeviceHit::default()
                 }),
             })
             .collect(),

@@ -12,7 +12,7 @@
 
 use super::sah_split::{NodeInfo, Prim, Split, decide};
 use super::{Aabb, Bvh};
-use crate::cl::types::GpuBvhNode;
+use crate::cl::types::DeviceBvhNode;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -65,7 +65,7 @@ fn build_prims(mut prims: Vec<Prim>) -> Bvh {
     // layout in place. The arena is allocated zeroed, so its pages cost memory only once
     // written: about the tree's own size, where per-task node lists and a final copy of them
     // cost twice that and left the lists' memory to the allocator.
-    let mut arena: Vec<GpuBvhNode> = bytemuck::zeroed_vec(2 * n.max(1) - 1);
+    let mut arena: Vec<DeviceBvhNode> = bytemuck::zeroed_vec(2 * n.max(1) - 1);
     let root = build_subtree(&mut prims, 0, 0, info, &mut arena[1..], 1);
     let tri_indices = prims.par_iter().map(Prim::index).collect();
     drop(prims);
@@ -75,7 +75,7 @@ fn build_prims(mut prims: Vec<Prim>) -> Bvh {
 /// The BVH of the subtree `root` built into `arena` (the root's interior nodes from index 1
 /// on, see [`build_subtree`]) over the triangles `tri_indices`: the nodes packed into the
 /// final layout, with the tree's SAH cost and depth.
-pub(super) fn finish(root: Built, mut arena: Vec<GpuBvhNode>, tri_indices: Vec<u32>) -> Bvh {
+pub(super) fn finish(root: Built, mut arena: Vec<DeviceBvhNode>, tri_indices: Vec<u32>) -> Bvh {
     let nodes = match root {
         Built::Tree { at, len, .. } => {
             // Local indices are final ones: the block moves to the front as it is.
@@ -91,7 +91,7 @@ pub(super) fn finish(root: Built, mut arena: Vec<GpuBvhNode>, tri_indices: Vec<u
             count,
         } => {
             // A root that is a leaf still needs a node: the leaf goes left, an empty leaf right.
-            let mut node = GpuBvhNode::default();
+            let mut node = DeviceBvhNode::default();
             write_leaf(&mut node, 0, bounds, first, count);
             write_leaf(&mut node, 1, Aabb::EMPTY, 0, 0);
             vec![node]
@@ -163,7 +163,7 @@ fn build_subtree(
     first: u32,
     depth: u32,
     info: NodeInfo,
-    space: &mut [GpuBvhNode],
+    space: &mut [DeviceBvhNode],
     at: usize,
 ) -> Built {
     let bounds = info.bounds.aabb();
@@ -212,7 +212,7 @@ fn emit(
     depth: u32,
     split: Split,
     slot: usize,
-    nodes: &mut [GpuBvhNode],
+    nodes: &mut [DeviceBvhNode],
     len: &mut usize,
 ) {
     let (left, right) = prims.split_at_mut(split.at);
@@ -221,7 +221,7 @@ fn emit(
         (left, first, split.left, None),
         (right, right_first, split.right, None),
     ];
-    let mut node = GpuBvhNode::default();
+    let mut node = DeviceBvhNode::default();
     for (side, (p, f, info, child)) in children.iter_mut().enumerate() {
         let bounds = info.bounds.aabb();
         match decide(p, *info, depth + 1) {
@@ -247,7 +247,7 @@ fn emit(
 /// moves to its final range, blocks in depth-first order (a block's final range starts at or
 /// before its provisional one and ends before the next block's, see `build_subtree`), and its
 /// child indices are shifted in parallel. The arena is cut to the tree's size.
-fn assemble(root: Built, mut arena: Vec<GpuBvhNode>) -> Vec<GpuBvhNode> {
+fn assemble(root: Built, mut arena: Vec<DeviceBvhNode>) -> Vec<DeviceBvhNode> {
     let total = root.node_count();
     let mut tops = Vec::new();
     let mut blocks = Vec::new();
@@ -255,12 +255,12 @@ fn assemble(root: Built, mut arena: Vec<GpuBvhNode>) -> Vec<GpuBvhNode> {
     place(root, 0, &mut end, &mut tops, &mut blocks);
     // A block's root goes to the slot its parent reserved, which may lie in a range that an
     // earlier block moves into: read them all first.
-    let roots: Vec<GpuBvhNode> = blocks.iter().map(|b| arena[b.at]).collect();
+    let roots: Vec<DeviceBvhNode> = blocks.iter().map(|b| arena[b.at]).collect();
     for b in &blocks {
         arena.copy_within(b.at + 1..b.at + b.len, b.start);
     }
     // Local index i >= 1 lands at start + i - 1.
-    let shift = |mut n: GpuBvhNode, start: usize| {
+    let shift = |mut n: DeviceBvhNode, start: usize| {
         let offset = start as u32 - 1;
         for lo in [&mut n.left_min, &mut n.right_min] {
             if (lo[3].to_bits() as i32) >= 0 {
@@ -311,13 +311,13 @@ fn place(
     node: Built,
     slot: usize,
     end: &mut usize,
-    tops: &mut Vec<(usize, GpuBvhNode)>,
+    tops: &mut Vec<(usize, DeviceBvhNode)>,
     blocks: &mut Vec<Block>,
 ) {
     let Built::Top { children, .. } = node else {
         unreachable!("place is only called on split nodes")
     };
-    let mut gpu = GpuBvhNode::default();
+    let mut device = DeviceBvhNode::default();
     let mut pending = [None, None];
     for (side, child) in children.iter().enumerate() {
         match child {
@@ -325,15 +325,15 @@ fn place(
                 bounds,
                 first,
                 count,
-            } => write_leaf(&mut gpu, side, *bounds, *first, *count),
+            } => write_leaf(&mut device, side, *bounds, *first, *count),
             Built::Tree { .. } | Built::Top { .. } => {
-                write_interior(&mut gpu, side, child.bounds(), *end as u32);
+                write_interior(&mut device, side, child.bounds(), *end as u32);
                 pending[side] = Some(*end);
                 *end += 1;
             }
         }
     }
-    tops.push((slot, gpu));
+    tops.push((slot, device));
     let [left, right] = *children;
     for (child, index) in [left, right].into_iter().zip(pending) {
         let Some(index) = index else { continue };
@@ -353,7 +353,7 @@ fn place(
     }
 }
 
-fn write_child(node: &mut GpuBvhNode, side: usize, b: Aabb, reference: i32, count: u32) {
+fn write_child(node: &mut DeviceBvhNode, side: usize, b: Aabb, reference: i32, count: u32) {
     let lo = [b.min.x, b.min.y, b.min.z, f32::from_bits(reference as u32)];
     let hi = [b.max.x, b.max.y, b.max.z, f32::from_bits(count)];
     if side == 0 {
@@ -365,11 +365,11 @@ fn write_child(node: &mut GpuBvhNode, side: usize, b: Aabb, reference: i32, coun
     }
 }
 
-pub(super) fn write_leaf(node: &mut GpuBvhNode, side: usize, b: Aabb, first: u32, count: u32) {
+pub(super) fn write_leaf(node: &mut DeviceBvhNode, side: usize, b: Aabb, first: u32, count: u32) {
     write_child(node, side, b, !(first as i32), count);
 }
 
-pub(super) fn write_interior(node: &mut GpuBvhNode, side: usize, b: Aabb, index: u32) {
+pub(super) fn write_interior(node: &mut DeviceBvhNode, side: usize, b: Aabb, index: u32) {
     write_child(node, side, b, index as i32, 0);
 }
 

@@ -16,7 +16,7 @@
 
 use super::wide::{frontier, merge_limit};
 use super::{Aabb, Blas, Bvh, Child, Hit, Ray, build_boxes};
-use crate::cl::types::{GpuBvhNode, GpuHit};
+use crate::cl::types::{DeviceBvhNode, DeviceHit};
 use glam::{DMat4, DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -341,10 +341,10 @@ impl TwoLevel {
 
     /// The closest hit as the device reports it: `prim` among the meshes' triangles one after
     /// the other (see [`TwoLevel::firsts`]) and the instance's TLAS slot.
-    pub fn device_hit(&self, ray: &Ray) -> Option<GpuHit> {
+    pub fn device_hit(&self, ray: &Ray) -> Option<DeviceHit> {
         self.intersect(ray).map(|h| {
             let inst = &self.instances[h.instance as usize];
-            GpuHit {
+            DeviceHit {
                 t: h.hit.t,
                 u: h.hit.u,
                 v: h.hit.v,
@@ -465,7 +465,7 @@ fn split_range(tlas: &mut Bvh, boxes: &[Aabb], first: u32, count: u32) -> u32 {
     }
     items.sort_by(|a, b| centre(a)[best.1].total_cmp(&centre(b)[best.1]));
     let index = tlas.nodes.len() as u32;
-    tlas.nodes.push(GpuBvhNode::default());
+    tlas.nodes.push(DeviceBvhNode::default());
     let half = best.2;
     for (side, (f, c)) in [(first, half), (first + half, count - half)]
         .into_iter()
@@ -486,7 +486,7 @@ fn split_range(tlas: &mut Bvh, boxes: &[Aabb], first: u32, count: u32) -> u32 {
 
 /// Writes child `side` of a node: its box, its reference (a node index, or `!first` of a leaf)
 /// and its leaf count (0 for a node), as the builder lays them out.
-fn set_child(node: &mut GpuBvhNode, side: usize, b: Aabb, reference: i32, count: u32) {
+fn set_child(node: &mut DeviceBvhNode, side: usize, b: Aabb, reference: i32, count: u32) {
     let lo = [b.min.x, b.min.y, b.min.z, f32::from_bits(reference as u32)];
     let hi = [b.max.x, b.max.y, b.max.z, f32::from_bits(count)];
     if side == 0 {

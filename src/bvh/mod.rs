@@ -1,5 +1,5 @@
 //! The bounding volume hierarchy: built on the host (binned SAH, rayon), flattened into one
-//! array of [`GpuBvhNode`]s with children referenced by index, and traversed on the host by the
+//! array of [`DeviceBvhNode`]s with children referenced by index, and traversed on the host by the
 //! same rules the kernels use (the reference the device is tested against).
 
 mod blas;
@@ -21,7 +21,7 @@ pub use sah_split::MAX_DEPTH;
 pub use traverse::{Hit, Ray, STACK_SIZE, intersect_triangle};
 pub use wide::{CollapseCost, MERGE_MIN_TRIANGLES, MERGED_LEAF, WIDE_STACK_SIZE, WIDTH, WideBvh};
 
-use crate::cl::types::GpuBvhNode;
+use crate::cl::types::DeviceBvhNode;
 use glam::Vec3;
 
 /// Axis-aligned box in f32.
@@ -71,8 +71,8 @@ impl Aabb {
 /// A flattened BVH over a triangle list.
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    /// Nodes; node 0 is the root. See [`GpuBvhNode`] for the child encoding.
-    pub nodes: Vec<GpuBvhNode>,
+    /// Nodes; node 0 is the root. See [`DeviceBvhNode`] for the child encoding.
+    pub nodes: Vec<DeviceBvhNode>,
     /// Original triangle index of each triangle in BVH order.
     pub tri_indices: Vec<u32>,
     /// The SAH cost of the tree (traversal cost 1, intersection cost 1 per triangle).

@@ -16,7 +16,7 @@
 
 use super::build::{Built, finish, write_interior, write_leaf};
 use super::{Aabb, Bvh, MAX_DEPTH};
-use crate::cl::types::GpuBvhNode;
+use crate::cl::types::DeviceBvhNode;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -210,7 +210,7 @@ fn tree(codes: Vec<u32>, tri_indices: Vec<u32>, ordered: &[[Vec3; 3]]) -> Bvh {
         // One task: the nodes are pushed in their final layout (a placeholder where a slot is
         // taken, filled when its subtree is done), no arena to zero and pack.
         let mut nodes = Vec::with_capacity(n - 1);
-        nodes.push(GpuBvhNode::default());
+        nodes.push(DeviceBvhNode::default());
         let mut len = 1;
         let bounds = emit(&codes, ordered, 0, 0, 0, &mut nodes, &mut len);
         drop(codes);
@@ -218,7 +218,7 @@ fn tree(codes: Vec<u32>, tri_indices: Vec<u32>, ordered: &[[Vec3; 3]]) -> Bvh {
     }
     // As `build`: interior nodes below the root go straight into a zeroed arena (pages cost
     // memory once written), packed into the final layout by `finish`.
-    let mut arena: Vec<GpuBvhNode> = bytemuck::zeroed_vec(2 * n.max(1) - 1);
+    let mut arena: Vec<DeviceBvhNode> = bytemuck::zeroed_vec(2 * n.max(1) - 1);
     let root = build_range(&codes, ordered, 0, 0, &mut arena[1..], 1);
     drop(codes);
     finish(root, arena, tri_indices)
@@ -256,7 +256,7 @@ fn build_range(
     tris: &[[Vec3; 3]],
     first: u32,
     depth: u32,
-    space: &mut [GpuBvhNode],
+    space: &mut [DeviceBvhNode],
     at: usize,
 ) -> Built {
     let count = codes.len();
@@ -320,7 +320,7 @@ fn emit(
             *len - 1
         })
     });
-    let mut node = GpuBvhNode::default();
+    let mut node = DeviceBvhNode::default();
     let mut bounds = Aabb::EMPTY;
     for (side, ((c, t, f), s)) in parts.into_iter().zip(slots).enumerate() {
         let b = match s {
@@ -347,24 +347,24 @@ trait Slots {
     /// Makes room for slot `slot`, the next one.
     fn take(&mut self, slot: usize);
     /// Writes the node of a slot taken.
-    fn put(&mut self, slot: usize, node: GpuBvhNode);
+    fn put(&mut self, slot: usize, node: DeviceBvhNode);
 }
 
-impl Slots for [GpuBvhNode] {
+impl Slots for [DeviceBvhNode] {
     fn take(&mut self, _: usize) {}
 
-    fn put(&mut self, slot: usize, node: GpuBvhNode) {
+    fn put(&mut self, slot: usize, node: DeviceBvhNode) {
         self[slot] = node;
     }
 }
 
-impl Slots for Vec<GpuBvhNode> {
+impl Slots for Vec<DeviceBvhNode> {
     fn take(&mut self, slot: usize) {
         debug_assert_eq!(slot, self.len());
-        self.push(GpuBvhNode::default());
+        self.push(DeviceBvhNode::default());
     }
 
-    fn put(&mut self, slot: usize, node: GpuBvhNode) {
+    fn put(&mut self, slot: usize, node: DeviceBvhNode) {
         self[slot] = node;
     }
 }

@@ -4,7 +4,7 @@
 
 use super::sah_split::TRAVERSAL_COST;
 use super::{Aabb, Bvh, Child, build};
-use crate::cl::types::GpuBvhNode;
+use crate::cl::types::DeviceBvhNode;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -142,7 +142,7 @@ impl Bvh {
 }
 
 /// The box of child `side` of `node`.
-fn child_box(node: &GpuBvhNode, side: usize) -> Aabb {
+fn child_box(node: &DeviceBvhNode, side: usize) -> Aabb {
     let (lo, hi) = if side == 0 {
         (node.left_min, node.left_max)
     } else {
@@ -155,7 +155,7 @@ fn child_box(node: &GpuBvhNode, side: usize) -> Aabb {
 }
 
 /// The min and max lanes of child `side`.
-fn lanes(node: &GpuBvhNode, side: usize) -> (&[f32; 4], &[f32; 4]) {
+fn lanes(node: &DeviceBvhNode, side: usize) -> (&[f32; 4], &[f32; 4]) {
     if side == 0 {
         (&node.left_min, &node.left_max)
     } else {
@@ -164,7 +164,7 @@ fn lanes(node: &GpuBvhNode, side: usize) -> (&[f32; 4], &[f32; 4]) {
 }
 
 /// The min and max lanes of child `side`, to write.
-fn sides(node: &mut GpuBvhNode, side: usize) -> (&mut [f32; 4], &mut [f32; 4]) {
+fn sides(node: &mut DeviceBvhNode, side: usize) -> (&mut [f32; 4], &mut [f32; 4]) {
     if side == 0 {
         (&mut node.left_min, &mut node.left_max)
     } else {

@@ -3,7 +3,7 @@
 //! BLAS's, rebased, in the binary and the 4-wide forms.
 
 use super::{TwoLevel, WideBvh};
-use crate::cl::types::{GpuBvhNode, GpuWideNode};
+use crate::cl::types::{DeviceBvhNode, DeviceWideNode};
 use rayon::prelude::*;
 
 impl TwoLevel {
@@ -18,7 +18,7 @@ impl TwoLevel {
     /// BLAS's (child indices and leaf triangles rebased: BLAS leaves index the object triangles
     /// of all meshes one after the other, TLAS leaves the instances in TLAS order), each BLAS's
     /// root, and each mesh's first object triangle.
-    pub fn device_nodes(&self) -> (Vec<GpuBvhNode>, Vec<u32>, Vec<u32>) {
+    pub fn device_nodes(&self) -> (Vec<DeviceBvhNode>, Vec<u32>, Vec<u32>) {
         let mut nodes = self.device_tlas();
         let roots = self.device_roots();
         let mut firsts = vec![];
@@ -53,7 +53,7 @@ impl TwoLevel {
     /// The TLAS's binary nodes in the device's form, padded to [`TwoLevel::tlas_slots`]: each
     /// leaf (one piece, `split_instance_leaves`) has [`crate::cl::types::TLAS_LEAF`] set in
     /// its count.
-    pub fn device_tlas(&self) -> Vec<GpuBvhNode> {
+    pub fn device_tlas(&self) -> Vec<DeviceBvhNode> {
         let mut nodes = self.tlas.nodes.clone();
         for n in &mut nodes {
             for (lo, hi) in [
@@ -67,7 +67,7 @@ impl TwoLevel {
                 }
             }
         }
-        nodes.resize(self.tlas_slots(), GpuBvhNode::default());
+        nodes.resize(self.tlas_slots(), DeviceBvhNode::default());
         nodes
     }
 
@@ -86,7 +86,7 @@ impl TwoLevel {
 
     /// [`TwoLevel::device_nodes`] for the 4-wide form: the collapsed TLAS, then every
     /// collapsed BLAS, rebased alike; and each BLAS's root (where its pieces enter it).
-    pub fn device_wide_nodes(&self) -> (Vec<GpuWideNode>, Vec<u32>) {
+    pub fn device_wide_nodes(&self) -> (Vec<DeviceWideNode>, Vec<u32>) {
         // Every wide node is made of a distinct binary node, so the binary nodes bound the
         // array: reserved at once (address space; only the pages written are touched), it is
         // never moved while it grows.
@@ -94,7 +94,7 @@ impl TwoLevel {
             self.tlas_slots() + self.blases.iter().map(|b| b.bvh.nodes.len()).sum::<usize>();
         let mut nodes = Vec::with_capacity(bound);
         nodes.extend(WideBvh::collapse(&self.tlas).nodes);
-        nodes.resize(self.tlas_slots(), GpuWideNode::default());
+        nodes.resize(self.tlas_slots(), DeviceWideNode::default());
         let mut roots = vec![];
         let mut tri_base = 0i32;
         // The BLASes are collapsed in parallel, a batch of about COLLAPSE_BATCH triangles at a

@@ -6,7 +6,7 @@
 
 use super::traverse::{box_entry, safe_inverse};
 use super::{Aabb, Bvh, Child, Hit, Ray, intersect_triangle};
-use crate::cl::types::GpuWideNode;
+use crate::cl::types::DeviceWideNode;
 use glam::Vec3;
 
 /// Children per wide node.
@@ -40,8 +40,8 @@ pub const WIDE_STACK_SIZE: usize = (WIDTH - 1) * super::MAX_DEPTH as usize;
 /// A collapsed BVH: node 0 is the root; triangles are the binary BVH's, in its order.
 #[derive(Clone, Debug)]
 pub struct WideBvh {
-    /// Nodes. See [`GpuWideNode`] for the child encoding.
-    pub nodes: Vec<GpuWideNode>,
+    /// Nodes. See [`DeviceWideNode`] for the child encoding.
+    pub nodes: Vec<DeviceWideNode>,
 }
 
 impl WideBvh {
@@ -98,13 +98,13 @@ impl WideBvh {
     /// The wide nodes from the root's binary node down, `slots_of` giving the children of
     /// the wide node made of a binary node.
     fn assemble(mut slots_of: impl FnMut(u32, &mut Vec<(Aabb, Child)>)) -> Self {
-        let mut nodes = vec![GpuWideNode::default()];
+        let mut nodes = vec![DeviceWideNode::default()];
         let mut work = vec![(0u32, 0usize)]; // (binary node, wide node)
         let mut slots = Vec::with_capacity(WIDTH);
         while let Some((binary, wide)) = work.pop() {
             slots.clear();
             slots_of(binary, &mut slots);
-            let mut out = GpuWideNode::default();
+            let mut out = DeviceWideNode::default();
             for (i, &(bounds, child)) in slots.iter().enumerate() {
                 out.min_x[i] = bounds.min.x;
                 out.min_y[i] = bounds.min.y;
@@ -119,7 +119,7 @@ impl WideBvh {
                     }
                     Child::Node(n) => {
                         let index = nodes.len();
-                        nodes.push(GpuWideNode::default());
+                        nodes.push(DeviceWideNode::default());
                         out.child[i] = index as i32;
                         work.push((n, index));
                     }
@@ -258,7 +258,7 @@ impl WideBvh {
         let n = bvh.nodes.len();
         if n == 0 {
             return Self {
-                nodes: vec![GpuWideNode::default()],
+                nodes: vec![DeviceWideNode::default()],
             };
         }
         let empty = Placement {

@@ -4,7 +4,7 @@
 #![allow(unsafe_code)]
 
 use super::host_memory::{HUGE_PAGE, HostPages};
-use super::{ClError, Gpu, call_err};
+use super::{ClError, Device, call_err};
 use bytemuck::Pod;
 use opencl3::memory::{CL_MEM_READ_WRITE, CL_MEM_USE_HOST_PTR, ClMem};
 use opencl3::types::CL_BLOCKING;
@@ -20,9 +20,9 @@ pub struct Buffer<T: Pod> {
 impl<T: Pod> Buffer<T> {
     /// An uninitialised buffer of `len` elements. On a CPU device a buffer of a huge page or
     /// more lives in host memory advised for huge pages (see `HostPages`).
-    pub fn new(gpu: &Gpu, len: usize) -> Result<Self, ClError> {
+    pub fn new(device: &Device, len: usize) -> Result<Self, ClError> {
         let bytes = len.max(1) * std::mem::size_of::<T>();
-        let host = if bytes >= HUGE_PAGE && gpu.is_cpu() {
+        let host = if bytes >= HUGE_PAGE && device.is_cpu() {
             HostPages::new(bytes)
         } else {
             None
@@ -34,7 +34,7 @@ impl<T: Pod> Buffer<T> {
         // SAFETY: the size is at least one element; a host pointer, when passed, points to
         // `bytes` bytes that live until the driver destroys the buffer (HostPages::free_with).
         let inner = unsafe {
-            opencl3::memory::Buffer::<T>::create(&gpu.context, flags, len.max(1), host_ptr)
+            opencl3::memory::Buffer::<T>::create(&device.context, flags, len.max(1), host_ptr)
         }
         .map_err(|e| ClError::Call {
             stage: format!("allocating {bytes} bytes"),
@@ -47,9 +47,9 @@ impl<T: Pod> Buffer<T> {
     }
 
     /// A buffer holding a copy of `data`.
-    pub fn from_slice(gpu: &Gpu, data: &[T]) -> Result<Self, ClError> {
-        let mut b = Self::new(gpu, data.len())?;
-        b.write(gpu, data)?;
+    pub fn from_slice(device: &Device, data: &[T]) -> Result<Self, ClError> {
+        let mut b = Self::new(device, data.len())?;
+        b.write(device, data)?;
         Ok(b)
     }
 
@@ -69,13 +69,13 @@ impl<T: Pod> Buffer<T> {
     }
 
     /// Copies `data` to the start of the buffer (blocking).
-    pub fn write(&mut self, gpu: &Gpu, data: &[T]) -> Result<(), ClError> {
-        self.write_at(gpu, 0, data)
+    pub fn write(&mut self, device: &Device, data: &[T]) -> Result<(), ClError> {
+        self.write_at(device, 0, data)
     }
 
     /// Copies `data` into the buffer from element `at` on (blocking): an update in place, no
     /// new allocation.
-    pub fn write_at(&mut self, gpu: &Gpu, at: usize, data: &[T]) -> Result<(), ClError> {
+    pub fn write_at(&mut self, device: &Device, at: usize, data: &[T]) -> Result<(), ClError> {
         assert!(
             at + data.len() <= self.len.max(1),
             "write past the end of a buffer"
@@ -86,7 +86,7 @@ impl<T: Pod> Buffer<T> {
         let offset = at * std::mem::size_of::<T>();
         // SAFETY: the slice fits the buffer from `at` on (checked above); the write is blocking.
         unsafe {
-            gpu.queue
+            device.queue
                 .enqueue_write_buffer(&mut self.inner, CL_BLOCKING, offset, data, &[])
                 .map_err(call_err("uploading a buffer"))?;
         }
@@ -99,7 +99,7 @@ impl<T: Pod> Buffer<T> {
     /// with no host copy of it beside the buffer.
     pub fn fill_mapped<R>(
         &mut self,
-        gpu: &Gpu,
+        device: &Device,
         fill: impl FnOnce(&mut [T]) -> R,
     ) -> Result<R, ClError> {
         let bytes = self.bytes();
@@ -108,7 +108,7 @@ impl<T: Pod> Buffer<T> {
         // it covers exactly `len.max(1)` elements of a `Pod` type (any bits are a value) and
         // is gone before the unmap below.
         let result = unsafe {
-            gpu.queue
+            device.queue
                 .enqueue_map_buffer(
                     &self.inner,
                     CL_BLOCKING,
@@ -121,7 +121,7 @@ impl<T: Pod> Buffer<T> {
                 .map_err(call_err("mapping a buffer"))?;
             let elements = std::slice::from_raw_parts_mut(ptr.cast::<T>(), self.len.max(1));
             let result = fill(elements);
-            gpu.queue
+            device.queue
                 .enqueue_unmap_mem_object(self.inner.get(), ptr, &[])
                 .map_err(call_err("unmapping a buffer"))?
                 .wait()
@@ -132,15 +132,15 @@ impl<T: Pod> Buffer<T> {
     }
 
     /// Reads the whole buffer back (blocking).
-    pub fn read(&self, gpu: &Gpu) -> Result<Vec<T>, ClError> {
+    pub fn read(&self, device: &Device) -> Result<Vec<T>, ClError> {
         let mut out = Vec::new();
-        self.read_into(gpu, &mut out)?;
+        self.read_into(device, &mut out)?;
         Ok(out)
     }
 
     /// [`Buffer::read`] into `out`, whose allocation is reused when it is large enough (a
     /// frame's film read back without a fresh allocation).
-    pub fn read_into(&self, gpu: &Gpu, out: &mut Vec<T>) -> Result<(), ClError> {
+    pub fn read_into(&self, device: &Device, out: &mut Vec<T>) -> Result<(), ClError> {
         out.truncate(self.len);
         out.resize(self.len, T::zeroed());
         if self.len == 0 {
@@ -148,7 +148,7 @@ impl<T: Pod> Buffer<T> {
         }
         // SAFETY: `out` has exactly the buffer's length; the read is blocking.
         unsafe {
-            gpu.queue
+            device.queue
                 .enqueue_read_buffer(&self.inner, CL_BLOCKING, 0, out, &[])
                 .map_err(call_err("reading a buffer back"))?;
         }
@@ -156,11 +156,11 @@ impl<T: Pod> Buffer<T> {
     }
 
     /// Sets every element to zero.
-    pub fn clear(&mut self, gpu: &Gpu) -> Result<(), ClError> {
+    pub fn clear(&mut self, device: &Device) -> Result<(), ClError> {
         let bytes = self.bytes();
         // SAFETY: fills the whole allocation with a zero pattern of one element.
         unsafe {
-            gpu.queue
+            device.queue
                 .enqueue_fill_buffer(&mut self.inner, &[T::zeroed()], 0, bytes, &[])
                 .map_err(call_err("clearing a buffer"))?;
         }
@@ -180,42 +180,42 @@ mod tests {
 
     #[test]
     fn a_cpu_devices_large_buffer_keeps_what_is_written() {
-        let Ok(gpu) = Gpu::open(&DeviceChoice::Cpu) else {
+        let Ok(device) = Device::open(&DeviceChoice::Cpu) else {
             return; // no CPU device here (a GPU-only machine)
         };
         let len = HUGE_PAGE; // 8 MiB of u32: in host pages
         let data: Vec<u32> = (0..len as u32)
             .map(|i| i.wrapping_mul(2654435761))
             .collect();
-        let mut b = Buffer::from_slice(&gpu, &data).expect("the buffer is made");
-        assert_eq!(b.read(&gpu).expect("it reads back"), data);
-        b.write_at(&gpu, 5, &[7, 8, 9]).expect("a write in place");
-        let back = b.read(&gpu).expect("it reads back");
+        let mut b = Buffer::from_slice(&device, &data).expect("the buffer is made");
+        assert_eq!(b.read(&device).expect("it reads back"), data);
+        b.write_at(&device, 5, &[7, 8, 9]).expect("a write in place");
+        let back = b.read(&device).expect("it reads back");
         assert_eq!(&back[4..9], &[data[4], 7, 8, 9, data[8]]);
-        b.clear(&gpu).expect("it clears");
-        assert!(b.read(&gpu).expect("it reads back").iter().all(|&x| x == 0));
+        b.clear(&device).expect("it clears");
+        assert!(b.read(&device).expect("it reads back").iter().all(|&x| x == 0));
         // Buffers come and go (the destructor callback frees each one's pages).
         for _ in 0..8 {
-            drop(Buffer::<u32>::new(&gpu, 3 * len).expect("a buffer"));
+            drop(Buffer::<u32>::new(&device, 3 * len).expect("a buffer"));
         }
     }
 
     #[test]
     fn reading_into_a_kept_vector_reuses_its_memory_and_reads_every_element() {
-        let Ok(gpu) = Gpu::open(&DeviceChoice::Cpu) else {
+        let Ok(device) = Device::open(&DeviceChoice::Cpu) else {
             return; // no CPU device here (a GPU-only machine)
         };
         let data: Vec<u32> = (0..1000u32).map(|i| i * 3 + 1).collect();
-        let b = Buffer::from_slice(&gpu, &data).expect("the buffer is made");
+        let b = Buffer::from_slice(&device, &data).expect("the buffer is made");
         // Longer than the buffer, with other contents: cut to its length and overwritten.
         let mut out = vec![9u32; 1500];
         let at = out.as_ptr();
-        b.read_into(&gpu, &mut out).expect("it reads back");
+        b.read_into(&device, &mut out).expect("it reads back");
         assert_eq!(out, data);
         assert_eq!(out.as_ptr(), at, "the vector's allocation is kept");
         // Shorter: grown to the buffer's length.
         let mut short = vec![5u32; 10];
-        b.read_into(&gpu, &mut short).expect("it reads back");
+        b.read_into(&device, &mut short).expect("it reads back");
         assert_eq!(short, data);
     }
 }

@@ -3,7 +3,7 @@
 use super::{ClError, call_err};
 use opencl3::command_queue::{CL_QUEUE_PROFILING_ENABLE, CommandQueue};
 use opencl3::context::Context;
-use opencl3::device::{CL_DEVICE_TYPE_ALL, CL_DEVICE_TYPE_GPU, Device};
+use opencl3::device::{CL_DEVICE_TYPE_ALL, CL_DEVICE_TYPE_GPU, Device as ClDevice};
 use opencl3::platform::get_platforms;
 use std::str::FromStr;
 
@@ -85,7 +85,7 @@ pub fn list_devices() -> Result<Vec<DeviceInfo>, ClError> {
             continue;
         };
         for id in ids {
-            let d = Device::new(id);
+            let d = ClDevice::new(id);
             out.push(DeviceInfo {
                 index: out.len(),
                 platform: pname.clone(),
@@ -108,18 +108,18 @@ pub fn list_devices() -> Result<Vec<DeviceInfo>, ClError> {
 }
 
 /// The chosen device with its context and in-order profiling queue.
-pub struct Gpu {
+pub struct Device {
     /// What was chosen.
     pub info: DeviceInfo,
     /// The device.
-    pub device: Device,
+    pub device: ClDevice,
     /// The context.
     pub context: Context,
     /// The in-order queue with profiling enabled.
     pub queue: CommandQueue,
 }
 
-impl Gpu {
+impl Device {
     /// Whether the device is a CPU (CL_DEVICE_TYPE_CPU): the megakernel, flushed denormals and
     /// the CPU's `--bvh auto` rule are chosen by it.
     pub fn is_cpu(&self) -> bool {
@@ -159,7 +159,7 @@ impl Gpu {
                 names.join(", ")
             ))
         })?;
-        let device = Device::new(info.id);
+        let device = ClDevice::new(info.id);
         let context = Context::from_device(&device).map_err(call_err("creating the context"))?;
         #[allow(deprecated)] // clCreateCommandQueue keeps OpenCL 1.2 devices working.
         let queue = CommandQueue::create_default(&context, CL_QUEUE_PROFILING_ENABLE)

@@ -7,7 +7,7 @@
 mod test_program;
 
 use super::types::*;
-use super::{Buffer, ClError, Gpu, KernelFeatures, Stage, build_program, call_err};
+use super::{Buffer, ClError, Device, KernelFeatures, Stage, build_program, call_err};
 use bytemuck::Pod;
 use opencl3::event::Event;
 use opencl3::kernel::{ExecuteKernel, Kernel};
@@ -68,10 +68,10 @@ fn global_size(n: usize, local: usize) -> usize {
 
 impl Program {
     /// Builds the kernels for `features`.
-    pub fn build(gpu: &Gpu, features: KernelFeatures) -> Result<Self, ClError> {
-        let program = build_program(gpu, features)?;
+    pub fn build(device: &Device, features: KernelFeatures) -> Result<Self, ClError> {
+        let program = build_program(device, features)?;
         let k = |stage: Stage| kernel(&program, stage.name());
-        let max_group = gpu.device.max_work_group_size().unwrap_or(64).max(1);
+        let max_group = device.device.max_work_group_size().unwrap_or(64).max(1);
         Ok(Self {
             generate: k(Stage::Generate)?,
             extend: k(Stage::Extend)?,
@@ -93,18 +93,18 @@ impl Program {
 
     fn run(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         stage: &'static str,
         kernel: &Kernel,
         n: usize,
         set: impl FnOnce(&mut ExecuteKernel),
     ) -> Result<Launch, ClError> {
-        self.run_local(gpu, stage, kernel, n, self.local_size, set)
+        self.run_local(device, stage, kernel, n, self.local_size, set)
     }
 
     fn run_local(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         stage: &'static str,
         kernel: &Kernel,
         n: usize,
@@ -118,7 +118,7 @@ impl Program {
         // SAFETY: every wrapper below sets exactly the kernel's arguments, in order, with the
         // types the kernel declares; buffers outlive the launch because the queue is in order
         // and every reader of results waits on it.
-        let event = unsafe { exec.enqueue_nd_range(&gpu.queue) }.map_err(call_err(stage))?;
+        let event = unsafe { exec.enqueue_nd_range(&device.queue) }.map_err(call_err(stage))?;
         Ok(Launch { stage, event })
     }
 
@@ -126,17 +126,17 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn generate(
         &self,
-        gpu: &Gpu,
-        frame: &GpuFrame,
-        camera: &GpuCamera,
-        paths: &Buffer<GpuPath>,
+        device: &Device,
+        frame: &DeviceFrame,
+        camera: &DeviceCamera,
+        paths: &Buffer<DevicePath>,
         queue: &Buffer<u32>,
         counters: &Buffer<u32>,
         cones: &Buffer<[f32; 2]>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(
-            gpu,
+            device,
             Stage::Generate.name(),
             &self.generate,
             slots,
@@ -155,74 +155,86 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn extend(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         scene: &SceneBuffers,
-        paths: &Buffer<GpuPath>,
+        paths: &Buffer<DevicePath>,
         queue: &Buffer<u32>,
         counters: &Buffer<u32>,
-        hits: &Buffer<GpuHit>,
+        hits: &Buffer<DeviceHit>,
         slots: usize,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, Stage::Extend.name(), &self.extend, slots, |e| unsafe {
-            set_geometry(e, scene.nodes.mem(), scene);
-            set_surfaces(e, scene);
-            e.set_arg(&paths.mem())
-                .set_arg(&queue.mem())
-                .set_arg(&counters.mem())
-                .set_arg(&hits.mem());
-        })
+        self.run(
+            device,
+            Stage::Extend.name(),
+            &self.extend,
+            slots,
+            |e| unsafe {
+                set_geometry(e, scene.nodes.mem(), scene);
+                set_surfaces(e, scene);
+                e.set_arg(&paths.mem())
+                    .set_arg(&queue.mem())
+                    .set_arg(&counters.mem())
+                    .set_arg(&hits.mem());
+            },
+        )
     }
 
     /// `shade`: emission, a light sample (queued for `connect`) and the next bounce.
     #[allow(clippy::too_many_arguments)]
     pub fn shade(
         &self,
-        gpu: &Gpu,
-        frame: &GpuFrame,
+        device: &Device,
+        frame: &DeviceFrame,
         env: &EnvBuffers,
         scene: &SceneBuffers,
-        paths: &Buffer<GpuPath>,
+        paths: &Buffer<DevicePath>,
         queue_in: &Buffer<u32>,
-        hits: &Buffer<GpuHit>,
+        hits: &Buffer<DeviceHit>,
         queue_out: &Buffer<u32>,
-        shadow_rays: &Buffer<GpuShadowRay>,
+        shadow_rays: &Buffer<DeviceShadowRay>,
         counters: &Buffer<u32>,
         cones: &Buffer<[f32; 2]>,
         slots: usize,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, Stage::Shade.name(), &self.shade, slots, |e| unsafe {
-            e.set_arg(frame)
-                .set_arg(&env.info)
-                .set_arg(&scene.triangles.mem())
-                .set_arg(&scene.instances.mem());
-            set_surfaces(e, scene);
-            e.set_arg(&env.texels.mem())
-                .set_arg(&env.marginal.mem())
-                .set_arg(&env.conditional.mem())
-                .set_arg(&scene.lights.mem())
-                .set_arg(&scene.light_cdf.mem())
-                .set_arg(&paths.mem())
-                .set_arg(&queue_in.mem())
-                .set_arg(&hits.mem())
-                .set_arg(&queue_out.mem())
-                .set_arg(&shadow_rays.mem())
-                .set_arg(&counters.mem())
-                .set_arg(&cones.mem());
-        })
+        self.run(
+            device,
+            Stage::Shade.name(),
+            &self.shade,
+            slots,
+            |e| unsafe {
+                e.set_arg(frame)
+                    .set_arg(&env.info)
+                    .set_arg(&scene.triangles.mem())
+                    .set_arg(&scene.instances.mem());
+                set_surfaces(e, scene);
+                e.set_arg(&env.texels.mem())
+                    .set_arg(&env.marginal.mem())
+                    .set_arg(&env.conditional.mem())
+                    .set_arg(&scene.lights.mem())
+                    .set_arg(&scene.light_cdf.mem())
+                    .set_arg(&paths.mem())
+                    .set_arg(&queue_in.mem())
+                    .set_arg(&hits.mem())
+                    .set_arg(&queue_out.mem())
+                    .set_arg(&shadow_rays.mem())
+                    .set_arg(&counters.mem())
+                    .set_arg(&cones.mem());
+            },
+        )
     }
 
     /// `connect`: traces the queued shadow rays (any hit) and adds the visible contributions.
     pub fn connect(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         scene: &SceneBuffers,
-        shadow_rays: &Buffer<GpuShadowRay>,
+        shadow_rays: &Buffer<DeviceShadowRay>,
         counters: &Buffer<u32>,
-        paths: &Buffer<GpuPath>,
+        paths: &Buffer<DevicePath>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(
-            gpu,
+            device,
             Stage::Connect.name(),
             &self.connect,
             slots,
@@ -239,27 +251,33 @@ impl Program {
     /// `advance`: counts this bounce's rays and turns the output queue into the next input.
     pub fn advance(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         counters: &Buffer<u32>,
         stats: &Buffer<u64>,
     ) -> Result<Launch, ClError> {
-        self.run(gpu, Stage::Advance.name(), &self.advance, 1, |e| unsafe {
-            e.set_arg(&counters.mem()).set_arg(&stats.mem());
-        })
+        self.run(
+            device,
+            Stage::Advance.name(),
+            &self.advance,
+            1,
+            |e| unsafe {
+                e.set_arg(&counters.mem()).set_arg(&stats.mem());
+            },
+        )
     }
 
     /// `accumulate`: adds the wave's finished samples to the film.
     pub fn accumulate(
         &self,
-        gpu: &Gpu,
-        frame: &GpuFrame,
-        paths: &Buffer<GpuPath>,
+        device: &Device,
+        frame: &DeviceFrame,
+        paths: &Buffer<DevicePath>,
         film: &Buffer<[f32; 4]>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
         self.run(
-            gpu,
+            device,
             Stage::Accumulate.name(),
             &self.accumulate,
             pixels,
@@ -275,15 +293,15 @@ impl Program {
     /// `trace_closest`: closest hits of arbitrary rays (tests and `bench trace`).
     pub fn trace_closest(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
-        hits: &Buffer<GpuHit>,
+        rays: &Buffer<DeviceRay>,
+        hits: &Buffer<DeviceHit>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_closest", &self.trace_closest);
         self.trace(
-            gpu,
+            device,
             stage,
             kernel,
             bvh.nodes.mem(),
@@ -297,15 +315,15 @@ impl Program {
     /// `trace_any`: occlusion of arbitrary rays (tests and `bench trace`).
     pub fn trace_any(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
+        rays: &Buffer<DeviceRay>,
         occluded: &Buffer<u32>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_any", &self.trace_any);
         self.trace(
-            gpu,
+            device,
             stage,
             kernel,
             bvh.nodes.mem(),
@@ -319,15 +337,15 @@ impl Program {
     /// `trace_closest_wide`: as `trace_closest`, through the 4-wide BVH.
     pub fn trace_closest_wide(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
-        hits: &Buffer<GpuHit>,
+        rays: &Buffer<DeviceRay>,
+        hits: &Buffer<DeviceHit>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_closest_wide", &self.trace_closest_wide);
         self.trace(
-            gpu,
+            device,
             stage,
             kernel,
             bvh.wide_nodes.mem(),
@@ -341,15 +359,15 @@ impl Program {
     /// `trace_any_wide`: as `trace_any`, through the 4-wide BVH.
     pub fn trace_any_wide(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
+        rays: &Buffer<DeviceRay>,
         occluded: &Buffer<u32>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let (stage, kernel) = ("trace_any_wide", &self.trace_any_wide);
         self.trace(
-            gpu,
+            device,
             stage,
             kernel,
             bvh.wide_nodes.mem(),
@@ -365,12 +383,12 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     fn trace<T: Pod>(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         stage: &'static str,
         kernel: &Kernel,
         nodes: opencl3::types::cl_mem,
         bvh: &SceneBuffers,
-        rays: &Buffer<GpuRay>,
+        rays: &Buffer<DeviceRay>,
         out: &Buffer<T>,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
@@ -387,7 +405,7 @@ impl Program {
             )));
         }
         let count = rays.len() as u32;
-        self.run(gpu, stage, kernel, rays.len(), |e| unsafe {
+        self.run(device, stage, kernel, rays.len(), |e| unsafe {
             set_geometry(e, nodes, bvh);
             set_surfaces(e, bvh);
             e.set_arg(&rays.mem())
@@ -402,9 +420,9 @@ impl Program {
     #[allow(clippy::too_many_arguments)]
     pub fn megakernel(
         &self,
-        gpu: &Gpu,
-        frame: &GpuFrame,
-        camera: &GpuCamera,
+        device: &Device,
+        frame: &DeviceFrame,
+        camera: &DeviceCamera,
         env: &EnvBuffers,
         scene: &SceneBuffers,
         film: &Buffer<[f32; 4]>,
@@ -420,7 +438,7 @@ impl Program {
         };
         let local = self.mega_local_size;
         self.run_local(
-            gpu,
+            device,
             Stage::Megakernel.name(),
             &self.megakernel,
             items,

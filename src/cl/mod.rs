@@ -20,7 +20,7 @@ pub mod types;
 pub(crate) static CL_SETUP: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 pub use buffer::Buffer;
-pub use device::{DeviceChoice, DeviceInfo, Gpu, list_devices};
+pub use device::{Device, DeviceChoice, DeviceInfo, list_devices};
 pub use host_memory::{OpeningMemory, map_file};
 pub use kernels::{Launch, Program};
 pub use program::{KernelFeatures, build_program, build_test_program};

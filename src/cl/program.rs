@@ -1,6 +1,6 @@
 //! The kernels' build at run time with the scene's feature defines (their source: `source.rs`).
 
-use super::{ClError, Gpu};
+use super::{ClError, Device};
 use opencl3::device::CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT;
 
 /// The scene features that decide which kernel code is compiled in.
@@ -112,29 +112,29 @@ impl KernelFeatures {
 /// Builds the program for `features` on the device. A failure returns the compiler's first
 /// error line, which names the kernel file and line.
 pub fn build_program(
-    gpu: &Gpu,
+    device: &Device,
     features: KernelFeatures,
 ) -> Result<opencl3::program::Program, ClError> {
-    build_source(gpu, &super::source::program_source()?, features)
+    build_source(device, &super::source::program_source()?, features)
 }
 
 /// Builds the production kernels together with the test-only ones (layout probe, texture,
 /// environment and BSDF test kernels); only tests reach it, through `Program`'s test wrappers.
 pub fn build_test_program(
-    gpu: &Gpu,
+    device: &Device,
     features: KernelFeatures,
 ) -> Result<opencl3::program::Program, ClError> {
-    build_source(gpu, &super::source::test_program_source()?, features)
+    build_source(device, &super::source::test_program_source()?, features)
 }
 
 pub(crate) fn build_source(
-    gpu: &Gpu,
+    device: &Device,
     source: &str,
     features: KernelFeatures,
 ) -> Result<opencl3::program::Program, ClError> {
     let mut options = String::new();
     // Correctly rounded division keeps the device's triangle tests identical to the host's.
-    if gpu
+    if device
         .device
         .single_fp_config()
         .is_ok_and(|c| c & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT != 0)
@@ -147,7 +147,7 @@ pub(crate) fn build_source(
     // zero, as Embree's and Cycles' CPU threads do, makes the megakernel about 1.35 times as
     // fast on PoCL. No coordinate, colour or weight a scene means is that small; GPUs keep
     // their own default.
-    if gpu.is_cpu() {
+    if device.is_cpu() {
         options.push_str(" -cl-denorms-are-zero");
     } else {
         // The watertight test's axis permutation by selects, not shuffle() (kernels/shared/traverse.h,
@@ -155,7 +155,7 @@ pub(crate) fn build_source(
         options.push_str(" -DPERMUTE_BY_SELECT");
     }
     options.push_str(&features.defines());
-    if let Some(cap) = register_cap(gpu, features) {
+    if let Some(cap) = register_cap(device, features) {
         options.push_str(&format!(" -cl-nv-maxrregcount={cap}"));
     }
     // Extra compiler options for experiments (e.g. `-cl-mad-enable`), space-separated.
@@ -164,17 +164,21 @@ pub(crate) fn build_source(
         options.push_str(&extra);
     }
     let _setup = super::CL_SETUP.lock().unwrap_or_else(|e| e.into_inner());
-    let mut program = opencl3::program::Program::create_from_source(&gpu.context, source)
+    let mut program = opencl3::program::Program::create_from_source(&device.context, source)
         .map_err(|e| ClError::Build(format!("cannot create the program: {e}")))?;
-    if program.build(&[gpu.device.id()], &options).is_err() {
-        let log = program.get_build_log(gpu.device.id()).unwrap_or_default();
+    if program.build(&[device.device.id()], &options).is_err() {
+        let log = program
+            .get_build_log(device.device.id())
+            .unwrap_or_default();
         log::debug!("kernel build log:\n{log}");
         return Err(ClError::Build(first_error(&log)));
     }
     // A successful build's log (warnings; with `PENUMBRA_CL_OPTIONS=-cl-nv-verbose`, NVIDIA's
     // registers and spills per kernel) for RUST_LOG=debug.
     if log::log_enabled!(log::Level::Debug) {
-        let log = program.get_build_log(gpu.device.id()).unwrap_or_default();
+        let log = program
+            .get_build_log(device.device.id())
+            .unwrap_or_default();
         if !log.trim().is_empty() {
             log::debug!("kernel build log ({options}):\n{log}");
         }
@@ -189,8 +193,8 @@ pub(crate) fn build_source(
 /// two-level frames on an H200 from 0.82 to 0.90 of flat's when they took 89-94, and a cap of
 /// 64 made frames 2-4 % slower. Flat programs stay under the cap and the cap does not change
 /// them.
-fn register_cap(gpu: &Gpu, features: KernelFeatures) -> Option<u32> {
-    (features.two_level && gpu.has_extension("cl_nv_compiler_options"))
+fn register_cap(device: &Device, features: KernelFeatures) -> Option<u32> {
+    (features.two_level && device.has_extension("cl_nv_compiler_options"))
         .then_some(TWO_LEVEL_REGISTERS)
 }
 
@@ -225,9 +229,9 @@ mod tests {
 
     #[test]
     fn a_build_error_names_the_kernel_file_and_line() {
-        let gpu = Gpu::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
+        let device = Device::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
         let source = "#line 1 \"kernels/broken.cl\"\nkernel void f(global int* x) {\n  x[0] = undeclared;\n}\n";
-        let err = build_source(&gpu, source, KernelFeatures::default())
+        let err = build_source(&device, source, KernelFeatures::default())
             .expect_err("the source does not compile")
             .to_string();
         assert!(err.contains("kernels/broken.cl:2"), "{err}");

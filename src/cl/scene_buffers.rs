@@ -7,7 +7,7 @@ use super::types::*;
 /// The environment map on the device (a 1×1 black placeholder when there is none).
 pub struct EnvBuffers {
     /// Constants.
-    pub info: GpuEnvironment,
+    pub info: DeviceEnvironment,
     /// RGB f32 texels.
     pub texels: Buffer<f32>,
     /// Cumulative row probabilities.
@@ -72,34 +72,34 @@ pub struct SceneBuffers {
     /// Which of the two node arrays are real (the other a placeholder).
     pub forms: NodeForms,
     /// BVH nodes (a placeholder unless `forms.binary`).
-    pub nodes: Buffer<GpuBvhNode>,
+    pub nodes: Buffer<DeviceBvhNode>,
     /// The same BVH collapsed to 4-wide nodes (the megakernel's; a placeholder unless
     /// `forms.wide`).
-    pub wide_nodes: Buffer<GpuWideNode>,
+    pub wide_nodes: Buffer<DeviceWideNode>,
     /// Triangles in shading order (the flat BVH's order, or instance by instance).
-    pub triangles: Buffer<GpuTriangle>,
+    pub triangles: Buffer<DeviceTriangle>,
     /// Two levels: the instances in top-level order (one placeholder when flat).
-    pub instances: Buffer<GpuInstance>,
+    pub instances: Buffer<DeviceInstance>,
     /// Two levels: every distinct mesh's object-space triangles in its bottom level's order
     /// (one placeholder when flat).
-    pub object_triangles: Buffer<GpuTriangle>,
+    pub object_triangles: Buffer<DeviceTriangle>,
     /// Corner normals in BVH order.
-    pub shading: Buffer<GpuTriShading>,
+    pub shading: Buffer<DeviceTriShading>,
     /// Texture coordinates in BVH order (one placeholder element when no material samples a
     /// texture).
-    pub uvs: Buffer<GpuTriUvs>,
+    pub uvs: Buffer<DeviceTriUvs>,
     /// Tangents in BVH order (one placeholder element without normal maps).
-    pub tangents: Buffer<GpuTriTangents>,
+    pub tangents: Buffer<DeviceTriTangents>,
     /// Texture references (materials index them).
-    pub tex_refs: Buffer<GpuTexRef>,
+    pub tex_refs: Buffer<DeviceTexRef>,
     /// Texture descriptors.
-    pub textures: Buffer<GpuTexture>,
+    pub textures: Buffer<DeviceTexture>,
     /// RGBA8 texels of every mip level of every texture.
     pub texels: Buffer<u32>,
     /// Materials.
-    pub materials: Buffer<GpuMaterial>,
+    pub materials: Buffer<DeviceMaterial>,
     /// Lights (emissive triangles first, then punctual lights, then the environment map).
-    pub lights: Buffer<GpuLight>,
+    pub lights: Buffer<DeviceLight>,
     /// Cumulative selection probabilities of the lights.
     pub light_cdf: Buffer<f32>,
 }

@@ -280,7 +280,10 @@ mod tests {
         let (s, found) = expand(PROGRAM_ROOT, Some(dir.path())).unwrap();
         assert_eq!(found, 1);
         assert!(s.contains("// edited"));
-        assert!(s.contains("} GpuBvhNode;"), "the other files stay built in");
+        assert!(
+            s.contains("} DeviceBvhNode;"),
+            "the other files stay built in"
+        );
         assert!(!s.contains("inline uint hash_u32(uint x)"));
         // The files themselves, without their kernels/ folder, are not found.
         let flat = tempfile::tempdir().unwrap();
@@ -345,15 +348,15 @@ mod tests {
 
     #[test]
     fn a_build_error_names_the_included_file_and_line() {
-        let gpu =
-            crate::cl::Gpu::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
+        let device =
+            crate::cl::Device::open(&crate::cl::DeviceChoice::Cpu).expect("an OpenCL CPU device");
         let root = "// root\n#include \"a.h\"\nkernel void f(global int* x) { x[0] = A; }\n";
         let dir = kernel_dir(&[("root.cl", root)]);
         let error = |a_h: &str| {
             std::fs::write(dir.path().join("kernels/a.h"), a_h).unwrap();
             let (source, _) = expand("root.cl", Some(dir.path())).unwrap();
             let features = super::super::KernelFeatures::default();
-            super::super::program::build_source(&gpu, &source, features)
+            super::super::program::build_source(&device, &source, features)
                 .expect_err("the source does not compile")
                 .to_string()
         };

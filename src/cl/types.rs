@@ -52,26 +52,26 @@ macro_rules! kernel_constants {
 }
 
 kernel_constants! {
-    /// `GpuTexture::flags`: the texels hold sRGB-encoded color (alpha stays linear).
+    /// `DeviceTexture::flags`: the texels hold sRGB-encoded color (alpha stays linear).
     TEXTURE_SRGB: u32 = 1 << 8;
-    /// `GpuTexture::flags`: the mip level count sits in these bits.
+    /// `DeviceTexture::flags`: the mip level count sits in these bits.
     TEXTURE_LEVELS_MASK: u32 = 0xff;
 
-    /// Sampler wrap modes in `GpuTexRef::info.yz`: repeat.
+    /// Sampler wrap modes in `DeviceTexRef::info.yz`: repeat.
     WRAP_REPEAT: i32 = 0;
     /// Clamp to the edge texel.
     WRAP_CLAMP: i32 = 1;
     /// Mirrored repeat.
     WRAP_MIRROR: i32 = 2;
 
-    /// `GpuTexRef::info.w` flag: nearest-texel lookups (sampler magFilter NEAREST).
+    /// `DeviceTexRef::info.w` flag: nearest-texel lookups (sampler magFilter NEAREST).
     TEXREF_NEAREST: i32 = 1;
-    /// `GpuTexRef::info.w` flag: the finest level only (minFilter NEAREST or LINEAR, no mipmaps).
+    /// `DeviceTexRef::info.w` flag: the finest level only (minFilter NEAREST or LINEAR, no mipmaps).
     TEXREF_NO_MIPS: i32 = 2;
 
-    /// `GpuInstance::flags`: the transform mirrors (negative determinant).
+    /// `DeviceInstance::flags`: the transform mirrors (negative determinant).
     INSTANCE_MIRRORED: u32 = 1;
-    /// `GpuInstance::flags`: a re-braided piece of one triangle of a small mesh (`root` and
+    /// `DeviceInstance::flags`: a re-braided piece of one triangle of a small mesh (`root` and
     /// `wide_root` name it among the meshes' triangles), tested in world space without
     /// entering the instance (`bvh::instances`, `TwoLevel::braid`).
     INSTANCE_PIECE_TRIANGLE: u32 = 2;
@@ -85,19 +85,19 @@ kernel_constants! {
     /// of such batches.
     SMALL_LANES: usize = 16;
 
-    /// Material flags in `GpuMaterial::emission.w`: both sides are front faces.
+    /// Material flags in `DeviceMaterial::emission.w`: both sides are front faces.
     MATERIAL_DOUBLE_SIDED: u32 = 1;
     /// `KHR_materials_unlit`: the surface shows its base color and ends the path.
     MATERIAL_UNLIT: u32 = 2;
 
-    /// Alpha modes in `GpuMaterial::alpha.y`: opaque.
+    /// Alpha modes in `DeviceMaterial::alpha.y`: opaque.
     ALPHA_OPAQUE: u32 = 0;
     /// Cut out below the cutoff.
     ALPHA_MASK: u32 = 1;
     /// Stochastic transparency.
     ALPHA_BLEND: u32 = 2;
 
-    /// Light kinds in `GpuLight::position.w`: a point light.
+    /// Light kinds in `DeviceLight::position.w`: a point light.
     LIGHT_POINT: u32 = 0;
     /// A spot light: a point light with a cone.
     LIGHT_SPOT: u32 = 1;
@@ -108,28 +108,28 @@ kernel_constants! {
     /// The environment map, sampled by its luminance table.
     LIGHT_ENVIRONMENT: u32 = 4;
 
-    /// `GpuFrame::strategy`: light and BSDF sampling combined by the power heuristic.
+    /// `DeviceFrame::strategy`: light and BSDF sampling combined by the power heuristic.
     STRATEGY_MIS: u32 = 0;
     /// BSDF sampling only.
     STRATEGY_BSDF: u32 = 1;
     /// Light sampling only.
     STRATEGY_LIGHTS: u32 = 2;
 
-    /// `GpuPath::direction.w` flag: the last bounce was specular.
+    /// `DevicePath::direction.w` flag: the last bounce was specular.
     PATH_SPECULAR: u32 = 1;
-    /// `GpuPath::direction.w` flag: the camera ray escaped (with coverage counted).
+    /// `DevicePath::direction.w` flag: the camera ray escaped (with coverage counted).
     PATH_ESCAPED: u32 = 2;
 
-    /// `GpuFrame::background`: escaped camera rays see the environment.
+    /// `DeviceFrame::background`: escaped camera rays see the environment.
     BACKGROUND_ENV: u32 = 0;
     /// Escaped camera rays add nothing and the film's `.w` counts the samples that hit.
     BACKGROUND_CUTOUT: u32 = 1;
     /// Escaped camera rays see the environment and the film's `.w` counts the samples that hit.
     BACKGROUND_COUNT: u32 = 2;
-    /// `GpuPath::direction.w` flag: went straight through a thin wall since the last
+    /// `DevicePath::direction.w` flag: went straight through a thin wall since the last
     /// scattering vertex.
     PATH_THROUGH_WALL: u32 = 4;
-    /// `GpuPath::direction.w`: the bits from here up hold the wavelength a path picked at its
+    /// `DevicePath::direction.w`: the bits from here up hold the wavelength a path picked at its
     /// first dispersive surface (`KHR_materials_dispersion`), in 1/64 nm; 0: none picked yet.
     PATH_WAVELENGTH_SHIFT: u32 = 8;
 
@@ -166,7 +166,7 @@ kernel_constants! {
 /// whose triangle count is in the matching `*_max.w` (as integer bits).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuBvhNode {
+pub struct DeviceBvhNode {
     /// Left child box minimum; `.w` = left child (i32 bits).
     pub left_min: [f32; 4],
     /// Left child box maximum; `.w` = left leaf triangle count (u32 bits, 0 for an interior child).
@@ -176,7 +176,7 @@ pub struct GpuBvhNode {
     /// Right child box maximum; `.w` = right leaf triangle count (u32 bits).
     pub right_max: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuBvhNode>() == 64);
+const _: () = assert!(size_of::<DeviceBvhNode>() == 64);
 
 /// A node of the 4-wide BVH (128 bytes): four child boxes by coordinate, one `float4` per box
 /// plane, so the kernels test a ray against all four at once. A child is an interior node
@@ -184,7 +184,7 @@ const _: () = assert!(size_of::<GpuBvhNode>() == 64);
 /// slot (`child <= 0`, `count == 0`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuWideNode {
+pub struct DeviceWideNode {
     /// Box minima, x coordinate of each child.
     pub min_x: [f32; 4],
     /// Box minima, y.
@@ -202,7 +202,7 @@ pub struct GpuWideNode {
     /// Leaf triangle count (0: interior or empty).
     pub count: [u32; 4],
 }
-const _: () = assert!(size_of::<GpuWideNode>() == 128);
+const _: () = assert!(size_of::<DeviceWideNode>() == 128);
 
 /// One placed mesh of a two-level scene (112 bytes): object from world as
 /// `p_object = L (p_world - T)` for traversal, world from object as `p_world = M p_object + T`
@@ -211,7 +211,7 @@ const _: () = assert!(size_of::<GpuWideNode>() == 128);
 /// `bvh::instances`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuInstance {
+pub struct DeviceInstance {
     /// First row of L; `.w` = T.x, the world position of the object's origin.
     pub row0: [f32; 4],
     /// Second row of L; `.w` = T.y.
@@ -235,13 +235,13 @@ pub struct GpuInstance {
     /// `INSTANCE_MIRRORED`, `INSTANCE_PIECE_TRIANGLE`.
     pub flags: u32,
 }
-const _: () = assert!(size_of::<GpuInstance>() == 112);
+const _: () = assert!(size_of::<DeviceInstance>() == 112);
 
 /// A triangle's vertices in world space, in BVH order (48 bytes); with two levels, in object
 /// space, once per mesh (mesh after mesh, each in its BLAS's order).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuTriangle {
+pub struct DeviceTriangle {
     /// Vertex 0; `.w` = material index (u32 bits).
     pub v0: [f32; 4],
     /// Vertex 1; `.w` = emissive light index (i32 bits, -1 when not emissive; two levels: the
@@ -250,24 +250,24 @@ pub struct GpuTriangle {
     /// Vertex 2; `.w` = object index (u32 bits; two levels: 0, the instance tells).
     pub v2: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuTriangle>() == 48);
+const _: () = assert!(size_of::<DeviceTriangle>() == 48);
 
 /// Per-corner normals of a triangle, in BVH order (36 bytes): `n[c]` is corner c's. A
 /// flat-shaded triangle's are all zero, which the kernels' interpolation turns into its
 /// geometric normal (a zero-length normal leaves it).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuTriShading {
+pub struct DeviceTriShading {
     /// The corners' normals.
     pub n: [[f32; 3]; 3],
 }
-const _: () = assert!(size_of::<GpuTriShading>() == 36);
+const _: () = assert!(size_of::<DeviceTriShading>() == 36);
 
 /// Texture coordinates of a triangle's corners, in BVH order (48 bytes); on the device only
 /// when some material samples a texture (else a one-element placeholder the kernels never read).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuTriUvs {
+pub struct DeviceTriUvs {
     /// `TEXCOORD_0` of vertices 0 and 1 (`.xy`, `.zw`).
     pub uv01: [f32; 4],
     /// `TEXCOORD_0` of vertex 2 (`.xy`); `TEXCOORD_1` of vertex 0 (`.zw`).
@@ -275,13 +275,13 @@ pub struct GpuTriUvs {
     /// `TEXCOORD_1` of vertices 1 and 2 (`.xy`, `.zw`).
     pub uv1_12: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuTriUvs>() == 48);
+const _: () = assert!(size_of::<DeviceTriUvs>() == 48);
 
 /// Per-vertex tangents of a triangle, in BVH order (48 bytes); uploaded only when the scene
 /// has normal maps.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuTriTangents {
+pub struct DeviceTriTangents {
     /// Unit tangent at vertex 0; `.w` = bitangent sign (±1).
     pub t0: [f32; 4],
     /// Tangent at vertex 1; `.w` = bitangent sign.
@@ -289,13 +289,13 @@ pub struct GpuTriTangents {
     /// Tangent at vertex 2; `.w` = bitangent sign.
     pub t2: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuTriTangents>() == 48);
+const _: () = assert!(size_of::<DeviceTriTangents>() == 48);
 
 /// One texture in the packed texel buffer (16 bytes). Its mip levels follow each other from
 /// `offset`, level `l` being `max(1, width >> l)` × `max(1, height >> l)` RGBA8 texels.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuTexture {
+pub struct DeviceTexture {
     /// Index of the first texel of level 0 in the texel buffer.
     pub offset: u32,
     /// Width of level 0.
@@ -305,13 +305,13 @@ pub struct GpuTexture {
     /// Mip level count (`TEXTURE_LEVELS_MASK` bits) and `TEXTURE_SRGB`.
     pub flags: u32,
 }
-const _: () = assert!(size_of::<GpuTexture>() == 16);
+const _: () = assert!(size_of::<DeviceTexture>() == 16);
 
 /// A material's use of a texture: which one, the sampler and the `KHR_texture_transform`
 /// (48 bytes). The lookup coordinate is `(dot(m0.xyz, (u, v, 1)), dot(m1.xyz, (u, v, 1)))`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuTexRef {
+pub struct DeviceTexRef {
     /// First row of the UV transform; `.w` = texture coordinate set (u32 bits, 0 or 1).
     pub m0: [f32; 4],
     /// Second row of the UV transform; `.w` = ½·log2 |det| of the transform (mip bias).
@@ -319,13 +319,13 @@ pub struct GpuTexRef {
     /// `.x` texture index, `.y` wrap S, `.z` wrap T (`WRAP_*`), `.w` filter flags (`TEXREF_*`).
     pub info: [i32; 4],
 }
-const _: () = assert!(size_of::<GpuTexRef>() == 48);
+const _: () = assert!(size_of::<DeviceTexRef>() == 48);
 
 /// The environment map's constants (48 bytes). Texels are RGB f32 triples, row 0 at the top
 /// (+Y); the map's centre column looks along −Z before rotation.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuEnvironment {
+pub struct DeviceEnvironment {
     /// `.x` radiance scale (intensity), `.y` pdf normalization W·H / (Σf · 2π²), `.z`
     /// probability that next-event estimation picks the environment, `.w` unused.
     pub scale: [f32; 4],
@@ -340,12 +340,12 @@ pub struct GpuEnvironment {
     /// Padding.
     pub pad: u32,
 }
-const _: () = assert!(size_of::<GpuEnvironment>() == 48);
+const _: () = assert!(size_of::<DeviceEnvironment>() == 48);
 
 /// A glTF material as the kernels see it (256 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuMaterial {
+pub struct DeviceMaterial {
     /// Linear base color; `.w` = alpha.
     pub base_color: [f32; 4],
     /// Emitted radiance (emissiveFactor × strength); `.w` = flags (u32 bits, `MATERIAL_*`).
@@ -388,12 +388,12 @@ pub struct GpuMaterial {
     /// absent.
     pub textures5: [i32; 4],
 }
-const _: () = assert!(size_of::<GpuMaterial>() == 256);
+const _: () = assert!(size_of::<DeviceMaterial>() == 256);
 
 /// One light for next-event estimation (64 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuLight {
+pub struct DeviceLight {
     /// Position (point/spot), or the direction light travels (directional); `.w` = kind (u32 bits).
     pub position: [f32; 4],
     /// Radiant intensity (point/spot) or irradiance (directional) per channel; `.w` = the light
@@ -407,13 +407,13 @@ pub struct GpuLight {
     /// `.x` = cos of the inner cone angle; `.y` = selection probability; `.zw` unused.
     pub extra: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuLight>() == 64);
+const _: () = assert!(size_of::<DeviceLight>() == 64);
 
 /// A pinhole camera (64 bytes). Rays leave `origin` towards
 /// `forward + (2u - 1)·right + (1 - 2v)·up` for film coordinates (u, v) in [0, 1]².
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuCamera {
+pub struct DeviceCamera {
     /// Eye position; `.w` = lens radius (0 for a pinhole).
     pub origin: [f32; 4],
     /// Unit view direction; `.w` = focus distance.
@@ -423,12 +423,12 @@ pub struct GpuCamera {
     /// Camera up scaled by tan(fov/2); `.w` unused.
     pub up: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuCamera>() == 64);
+const _: () = assert!(size_of::<DeviceCamera>() == 64);
 
 /// Per-frame constants of the path tracer (64 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuFrame {
+pub struct DeviceFrame {
     /// Film width in pixels.
     pub width: u32,
     /// Film height in pixels.
@@ -458,12 +458,12 @@ pub struct GpuFrame {
     /// scene does not build the kernels again; 0 elsewhere.
     pub triangles: u32,
 }
-const _: () = assert!(size_of::<GpuFrame>() == 64);
+const _: () = assert!(size_of::<DeviceFrame>() == 64);
 
 /// The state of one path between stages (64 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuPath {
+pub struct DevicePath {
     /// Ray origin; `.w` = pdf of the BSDF sample that made this ray (0 after a camera ray).
     pub origin: [f32; 4],
     /// Unit ray direction; `.w` = 1 when the last bounce was specular (u32 bits as flags).
@@ -473,12 +473,12 @@ pub struct GpuPath {
     /// Radiance gathered so far; `.w` = random state (u32 bits).
     pub radiance: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuPath>() == 64);
+const _: () = assert!(size_of::<DevicePath>() == 64);
 
 /// The closest hit of an extension ray (20 bytes). `prim` is `u32::MAX` on a miss.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuHit {
+pub struct DeviceHit {
     /// Hit distance along the ray.
     pub t: f32,
     /// Barycentric coordinate of vertex 1.
@@ -492,12 +492,12 @@ pub struct GpuHit {
     /// with the flat BVH).
     pub instance: u32,
 }
-const _: () = assert!(size_of::<GpuHit>() == 20);
+const _: () = assert!(size_of::<DeviceHit>() == 20);
 
 /// A shadow ray with the radiance it carries if unoccluded (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuShadowRay {
+pub struct DeviceShadowRay {
     /// Ray origin; `.w` = maximum distance.
     pub origin: [f32; 4],
     /// Unit direction; `.w` = path slot (u32 bits).
@@ -505,18 +505,18 @@ pub struct GpuShadowRay {
     /// Radiance to add to the path if the light is visible; `.w` unused.
     pub contribution: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuShadowRay>() == 48);
+const _: () = assert!(size_of::<DeviceShadowRay>() == 48);
 
 /// A ray for the traversal benchmark and the device agreement tests (32 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
-pub struct GpuRay {
+pub struct DeviceRay {
     /// Origin; `.w` = tmin.
     pub origin: [f32; 4],
     /// Direction (need not be unit); `.w` = tmax.
     pub direction: [f32; 4],
 }
-const _: () = assert!(size_of::<GpuRay>() == 32);
+const _: () = assert!(size_of::<DeviceRay>() == 32);
 
 /// A struct's name, size and (field, offset) list.
 pub type StructLayout = (&'static str, usize, Vec<(&'static str, usize)>);
@@ -529,10 +529,10 @@ pub fn layouts() -> Vec<StructLayout> {
         };
     }
     vec![
-        layout!(GpuBvhNode, left_min, left_max, right_min, right_max),
-        layout!(GpuTriangle, v0, v1, v2),
+        layout!(DeviceBvhNode, left_min, left_max, right_min, right_max),
+        layout!(DeviceTriangle, v0, v1, v2),
         layout!(
-            GpuInstance,
+            DeviceInstance,
             row0,
             row1,
             row2,
@@ -544,14 +544,22 @@ pub fn layouts() -> Vec<StructLayout> {
             id,
             flags
         ),
-        layout!(GpuTriShading, n),
-        layout!(GpuTriUvs, uv01, uv2, uv1_12),
-        layout!(GpuTriTangents, t0, t1, t2),
-        layout!(GpuTexture, offset, width, height, flags),
-        layout!(GpuTexRef, m0, m1, info),
-        layout!(GpuEnvironment, scale, rotation, width, height, light, pad),
+        layout!(DeviceTriShading, n),
+        layout!(DeviceTriUvs, uv01, uv2, uv1_12),
+        layout!(DeviceTriTangents, t0, t1, t2),
+        layout!(DeviceTexture, offset, width, height, flags),
+        layout!(DeviceTexRef, m0, m1, info),
         layout!(
-            GpuMaterial,
+            DeviceEnvironment,
+            scale,
+            rotation,
+            width,
+            height,
+            light,
+            pad
+        ),
+        layout!(
+            DeviceMaterial,
             base_color,
             emission,
             params,
@@ -569,10 +577,10 @@ pub fn layouts() -> Vec<StructLayout> {
             textures4,
             textures5
         ),
-        layout!(GpuLight, position, intensity, spot, extra),
-        layout!(GpuCamera, origin, forward, right, up),
+        layout!(DeviceLight, position, intensity, spot, extra),
+        layout!(DeviceCamera, origin, forward, right, up),
         layout!(
-            GpuFrame,
+            DeviceFrame,
             width,
             height,
             samples_in_wave,
@@ -587,12 +595,12 @@ pub fn layouts() -> Vec<StructLayout> {
             background,
             triangles
         ),
-        layout!(GpuPath, origin, direction, throughput, radiance),
-        layout!(GpuHit, t, u, v, prim, instance),
-        layout!(GpuShadowRay, origin, direction, contribution),
-        layout!(GpuRay, origin, direction),
+        layout!(DevicePath, origin, direction, throughput, radiance),
+        layout!(DeviceHit, t, u, v, prim, instance),
+        layout!(DeviceShadowRay, origin, direction, contribution),
+        layout!(DeviceRay, origin, direction),
         layout!(
-            GpuWideNode,
+            DeviceWideNode,
             min_x,
             min_y,
             min_z,

@@ -135,7 +135,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut summary = serde_json::json!({
         "scene": args.scene.display().to_string(),
         "output": args.output.display().to_string(),
-        "device": renderer.gpu.description(),
+        "device": renderer.device.description(),
         "kernel": renderer.kernel(),
         "width": settings.width,
         "height": settings.height,

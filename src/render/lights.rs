@@ -58,7 +58,7 @@ pub fn gpu_lights(
     lights: &[Light],
     host: &HostScene,
     env_luminance: Option<f32>,
-) -> (Vec<GpuLight>, Vec<f32>) {
+) -> (Vec<DeviceLight>, Vec<f32>) {
     let mut out = Vec::new();
     // (by irradiance at the middle, by power) per light.
     let mut weights: Vec<(f32, f32)> = Vec::new();
@@ -76,7 +76,7 @@ pub fn gpu_lights(
         let (area, centroid) = (e.area, e.centroid);
         let slot = slots.get(e.instance as usize).copied().unwrap_or(0);
         let power = if slot == u32::MAX { 0.0 } else { e.power };
-        out.push(GpuLight {
+        out.push(DeviceLight {
             position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_TRIANGLE)],
             intensity: [0.0; 4],
             spot: [f32::from_bits(e.prim), area, f32::from_bits(slot), 0.0],
@@ -115,7 +115,7 @@ pub fn gpu_lights(
             _ => (1.0, -1.0),
         };
         let d = l.direction.as_vec3().normalize_or(Vec3::NEG_Y);
-        out.push(GpuLight {
+        out.push(DeviceLight {
             position: f4(position.as_vec3(), f32::from_bits(kind)),
             intensity: [color[0], color[1], color[2], l.light_radius.max(0.0)],
             spot: f4(d, cos_outer),
@@ -126,9 +126,9 @@ pub fn gpu_lights(
     if let Some(l) = env_luminance {
         let irradiance = pi * l;
         if irradiance > 0.0 && irradiance.is_finite() {
-            out.push(GpuLight {
+            out.push(DeviceLight {
                 position: [0.0, 0.0, 0.0, f32::from_bits(LIGHT_ENVIRONMENT)],
-                ..GpuLight::default()
+                ..DeviceLight::default()
             });
             weights.push((irradiance, irradiance * disc));
         }
@@ -155,7 +155,7 @@ pub fn gpu_lights(
 
 impl Renderer {
     /// The light list and selection table for the current lights and environment.
-    pub(super) fn light_table(&self, host: &HostScene) -> (Vec<GpuLight>, Vec<f32>) {
+    pub(super) fn light_table(&self, host: &HostScene) -> (Vec<DeviceLight>, Vec<f32>) {
         let env_luminance = self
             .environment
             .as_ref()
@@ -164,16 +164,16 @@ impl Renderer {
     }
 
     /// Fills the environment constants from the settings and the light list.
-    pub(super) fn update_env_info(&mut self, lights: &[GpuLight]) {
+    pub(super) fn update_env_info(&mut self, lights: &[DeviceLight]) {
         let Some((map, table)) = self.environment.as_ref() else {
-            self.env.info = GpuEnvironment::default();
+            self.env.info = DeviceEnvironment::default();
             return;
         };
         let light = lights
             .iter()
             .position(|l| l.position[3].to_bits() == LIGHT_ENVIRONMENT);
         let (sin, cos) = self.settings.env_rotation.to_radians().sin_cos();
-        self.env.info = GpuEnvironment {
+        self.env.info = DeviceEnvironment {
             scale: [
                 self.settings.env_intensity,
                 table.norm,
@@ -198,8 +198,8 @@ impl Renderer {
         let Some((buffers, _)) = self.scene.as_mut() else {
             return Ok(());
         };
-        buffers.lights = Buffer::from_slice(&self.gpu, &glights)?;
-        buffers.light_cdf = Buffer::from_slice(&self.gpu, &cdf)?;
+        buffers.lights = Buffer::from_slice(&self.device, &glights)?;
+        buffers.light_cdf = Buffer::from_slice(&self.device, &cdf)?;
         self.light_count = glights.len() as u32;
         self.update_env_info(&glights);
         Ok(())

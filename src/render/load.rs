@@ -11,7 +11,7 @@ use super::{
 };
 use crate::cl::kernels::SceneBuffers;
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, Gpu, KernelFeatures};
+use crate::cl::{Buffer, ClError, Device, KernelFeatures};
 use crate::scene::{AlphaMode, Light, Material, Mesh, RenderFrame, Scene};
 use std::sync::Arc;
 use std::time::Instant;
@@ -45,18 +45,18 @@ impl Planned<'_> {
 
 /// The per-triangle buffers of a scene on the device.
 struct TriangleBuffers {
-    triangles: Buffer<GpuTriangle>,
-    shading: Buffer<GpuTriShading>,
-    uvs: Buffer<GpuTriUvs>,
-    tangents: Buffer<GpuTriTangents>,
+    triangles: Buffer<DeviceTriangle>,
+    shading: Buffer<DeviceTriShading>,
+    uvs: Buffer<DeviceTriUvs>,
+    tangents: Buffer<DeviceTriTangents>,
 }
 
 /// The per-triangle buffers of a scene replaced, to be written again in place.
 type OldTriangleBuffers = (
-    Option<Buffer<GpuTriangle>>,
-    Option<Buffer<GpuTriShading>>,
-    Option<Buffer<GpuTriUvs>>,
-    Option<Buffer<GpuTriTangents>>,
+    Option<Buffer<DeviceTriangle>>,
+    Option<Buffer<DeviceTriShading>>,
+    Option<Buffer<DeviceTriUvs>>,
+    Option<Buffer<DeviceTriTangents>>,
 );
 
 impl Renderer {
@@ -143,7 +143,7 @@ impl Renderer {
         how: instancing::Blases,
     ) -> Planned<'s> {
         let t = Instant::now();
-        let mut rule = if self.gpu.is_cpu() {
+        let mut rule = if self.device.is_cpu() {
             instancing::AUTO_CPU
         } else {
             instancing::AUTO_GPU
@@ -189,7 +189,7 @@ impl Renderer {
     /// Texel memory for a scene's textures: [`TEXTURE_BUDGET_BYTES`], or less where the
     /// device's largest buffer is smaller.
     fn texture_budget(&self) -> usize {
-        self.gpu
+        self.device
             .device
             .max_mem_alloc_size()
             .map_or(TEXTURE_BUDGET_BYTES, |m| {
@@ -205,7 +205,7 @@ impl Renderer {
         planned: &mut Planned,
         materials: &[Material],
         pack: &TexturePack,
-        (glights, cdf): (&[GpuLight], &[f32]),
+        (glights, cdf): (&[DeviceLight], &[f32]),
         reuse: Option<SceneBuffers>,
         since: Instant,
     ) -> Result<SceneBuffers, ClError> {
@@ -241,7 +241,7 @@ impl Renderer {
         );
         // Two levels trace the meshes' object-space triangles in `triangles`: the separate
         // object-triangle buffer is a placeholder either way.
-        let object_tris = [GpuTriangle::default()];
+        let object_tris = [DeviceTriangle::default()];
         let bytes = |n: usize, size: usize| n.max(1) * size;
         let sizes = [
             ("BVH nodes", std::mem::size_of_val(nodes.as_slice())),
@@ -249,13 +249,19 @@ impl Renderer {
                 "wide BVH nodes",
                 std::mem::size_of_val(wide_nodes.as_slice()),
             ),
-            ("triangles", lengths.0 * std::mem::size_of::<GpuTriangle>()),
+            (
+                "triangles",
+                lengths.0 * std::mem::size_of::<DeviceTriangle>(),
+            ),
             ("instances", std::mem::size_of_val(instances.as_slice())),
-            ("shading", lengths.1 * std::mem::size_of::<GpuTriShading>()),
-            ("uvs", lengths.3 * std::mem::size_of::<GpuTriUvs>()),
+            (
+                "shading",
+                lengths.1 * std::mem::size_of::<DeviceTriShading>(),
+            ),
+            ("uvs", lengths.3 * std::mem::size_of::<DeviceTriUvs>()),
             (
                 "tangents",
-                lengths.2 * std::mem::size_of::<GpuTriTangents>(),
+                lengths.2 * std::mem::size_of::<DeviceTriTangents>(),
             ),
             ("texels", bytes(pack.texels.len(), 4)),
         ];
@@ -269,8 +275,8 @@ impl Renderer {
         );
         fits_device(
             &sizes,
-            self.gpu.device.global_mem_size().ok(),
-            self.gpu.device.max_mem_alloc_size().ok(),
+            self.device.device.global_mem_size().ok(),
+            self.device.device.max_mem_alloc_size().ok(),
         )
         .map_err(ClError::Device)?;
         // The large buffers of the scene replaced (a swap to SAH BLASes), written again in
@@ -289,35 +295,35 @@ impl Renderer {
             ),
             None => Default::default(),
         };
-        let gpu = &self.gpu;
-        let nodes_buffer = put(gpu, old_nodes, &nodes)?;
+        let device = &self.device;
+        let nodes_buffer = put(device, old_nodes, &nodes)?;
         drop(nodes);
-        let wide_buffer = put(gpu, old_wide, &wide_nodes)?;
+        let wide_buffer = put(device, old_wide, &wide_nodes)?;
         drop(wide_nodes);
         let per_triangle = match &host.accel {
-            Accel::Flat(_) => flat_buffers(gpu, old, (triangles, shading, uvs, tangents))?,
+            Accel::Flat(_) => flat_buffers(device, old, (triangles, shading, uvs, tangents))?,
             Accel::TwoLevel(two) => {
                 let (o_tri, o_sh, o_uv, o_tan) = old;
-                let mut shading_buffer = sized(gpu, o_sh, lengths.1)?;
-                let mut uvs_buffer = sized(gpu, o_uv, lengths.3)?;
-                let mut tangents_buffer = sized(gpu, o_tan, lengths.2)?;
-                let mut triangles_buffer = sized(gpu, o_tri, lengths.0)?;
+                let mut shading_buffer = sized(device, o_sh, lengths.1)?;
+                let mut uvs_buffer = sized(device, o_uv, lengths.3)?;
+                let mut tangents_buffer = sized(device, o_tan, lengths.2)?;
+                let mut triangles_buffer = sized(device, o_tri, lengths.0)?;
                 let n = mesh_triangles;
                 let meshes = &planned.meshes;
-                triangles_buffer.fill_mapped(gpu, |tris| {
-                    shading_buffer.fill_mapped(gpu, |sh| {
-                        uvs_buffer.fill_mapped(gpu, |uv| {
-                            tangents_buffer.fill_mapped(gpu, |tan| {
+                triangles_buffer.fill_mapped(device, |tris| {
+                    shading_buffer.fill_mapped(device, |sh| {
+                        uvs_buffer.fill_mapped(device, |uv| {
+                            tangents_buffer.fill_mapped(device, |tan| {
                                 let tan_out = &mut tan[..if mesh_tangents { n } else { 0 }];
                                 let uv_out = &mut uv[..if mesh_uvs { n } else { 0 }];
                                 let out = (&mut tris[..n], &mut sh[..n], uv_out, tan_out);
                                 HostScene::fill_meshes(two, meshes, materials, out);
                                 tris[n..].copy_from_slice(&triangles);
                                 if !mesh_tangents {
-                                    tan.fill(GpuTriTangents::default());
+                                    tan.fill(DeviceTriTangents::default());
                                 }
                                 if !mesh_uvs {
-                                    uv.fill(GpuTriUvs::default());
+                                    uv.fill(DeviceTriUvs::default());
                                 }
                             })
                         })
@@ -331,23 +337,23 @@ impl Renderer {
                 }
             }
         };
-        let instances_buffer = put(gpu, old_instances, &instances)?;
+        let instances_buffer = put(device, old_instances, &instances)?;
         let buffers = SceneBuffers {
             forms,
             nodes: nodes_buffer,
             wide_nodes: wide_buffer,
             triangles: per_triangle.triangles,
             instances: instances_buffer,
-            object_triangles: Buffer::from_slice(gpu, &object_tris)?,
+            object_triangles: Buffer::from_slice(device, &object_tris)?,
             shading: per_triangle.shading,
             uvs: per_triangle.uvs,
             tangents: per_triangle.tangents,
-            tex_refs: Buffer::from_slice(gpu, &pack.refs)?,
-            textures: Buffer::from_slice(gpu, &pack.textures)?,
-            texels: Buffer::from_slice(gpu, &pack.texels)?,
-            materials: Buffer::from_slice(gpu, &host.materials)?,
-            lights: Buffer::from_slice(gpu, glights)?,
-            light_cdf: Buffer::from_slice(gpu, cdf)?,
+            tex_refs: Buffer::from_slice(device, &pack.refs)?,
+            textures: Buffer::from_slice(device, &pack.textures)?,
+            texels: Buffer::from_slice(device, &pack.texels)?,
+            materials: Buffer::from_slice(device, &host.materials)?,
+            lights: Buffer::from_slice(device, glights)?,
+            light_cdf: Buffer::from_slice(device, cdf)?,
         };
         drop(instances);
         Ok(buffers)
@@ -358,28 +364,28 @@ impl Renderer {
 /// coordinates, tangents; the last two a placeholder of one when empty), each array freed as
 /// soon as its buffer is made; `old`'s buffers written again where the length is the same.
 fn flat_buffers(
-    gpu: &Gpu,
+    device: &Device,
     (o_tri, o_sh, o_uv, o_tan): OldTriangleBuffers,
     (triangles, shading, mut uvs, mut tangents): (
-        Vec<GpuTriangle>,
-        Vec<GpuTriShading>,
-        Vec<GpuTriUvs>,
-        Vec<GpuTriTangents>,
+        Vec<DeviceTriangle>,
+        Vec<DeviceTriShading>,
+        Vec<DeviceTriUvs>,
+        Vec<DeviceTriTangents>,
     ),
 ) -> Result<TriangleBuffers, ClError> {
-    let shading_buffer = put(gpu, o_sh, &shading)?;
+    let shading_buffer = put(device, o_sh, &shading)?;
     drop(shading);
     if uvs.is_empty() {
-        uvs.push(GpuTriUvs::default());
+        uvs.push(DeviceTriUvs::default());
     }
-    let uvs_buffer = put(gpu, o_uv, &uvs)?;
+    let uvs_buffer = put(device, o_uv, &uvs)?;
     drop(uvs);
     if tangents.is_empty() {
-        tangents.push(GpuTriTangents::default());
+        tangents.push(DeviceTriTangents::default());
     }
-    let tangents_buffer = put(gpu, o_tan, &tangents)?;
+    let tangents_buffer = put(device, o_tan, &tangents)?;
     drop(tangents);
-    let triangles_buffer = put(gpu, o_tri, &triangles)?;
+    let triangles_buffer = put(device, o_tri, &triangles)?;
     Ok(TriangleBuffers {
         triangles: triangles_buffer,
         shading: shading_buffer,
@@ -461,18 +467,18 @@ pub(super) fn scene_features(
 /// A buffer holding `data`: `old` written again when it has `data`'s length, else a new one
 /// (`old` freed first).
 fn put<T: bytemuck::Pod>(
-    gpu: &Gpu,
+    device: &Device,
     old: Option<Buffer<T>>,
     data: &[T],
 ) -> Result<Buffer<T>, ClError> {
     match old {
         Some(mut b) if b.len() == data.len() && !data.is_empty() => {
-            b.write(gpu, data)?;
+            b.write(device, data)?;
             Ok(b)
         }
         old => {
             drop(old);
-            Buffer::from_slice(gpu, data)
+            Buffer::from_slice(device, data)
         }
     }
 }
@@ -480,7 +486,7 @@ fn put<T: bytemuck::Pod>(
 /// A buffer of `len` elements: `old` when it has that length (its memory written again in
 /// place, no fresh pages to fault in), else a new one (contents undefined either way).
 fn sized<T: bytemuck::Pod>(
-    gpu: &Gpu,
+    device: &Device,
     old: Option<Buffer<T>>,
     len: usize,
 ) -> Result<Buffer<T>, ClError> {
@@ -488,7 +494,7 @@ fn sized<T: bytemuck::Pod>(
         Some(b) if b.len() == len => Ok(b),
         old => {
             drop(old);
-            Buffer::new(gpu, len)
+            Buffer::new(device, len)
         }
     }
 }

@@ -5,7 +5,7 @@
 
 use super::Renderer;
 use crate::cl::kernels::Launch;
-use crate::cl::types::GpuFrame;
+use crate::cl::types::DeviceFrame;
 use crate::cl::{ClError, Stage};
 use std::str::FromStr;
 use std::time::Instant;
@@ -44,7 +44,7 @@ impl Renderer {
     /// Chooses the kernels (resolving `Auto` by the device type); with a scene loaded, builds
     /// the kernels again where the strategy for the new ones differs. Resets the film.
     pub fn set_kernel(&mut self, choice: KernelChoice) -> Result<(), ClError> {
-        self.megakernel = super::strategy::runs_megakernel(&self.device, choice);
+        self.megakernel = super::strategy::runs_megakernel(&self.device_facts, choice);
         if self.scene.is_some() {
             self.ensure_program()?;
         }
@@ -111,7 +111,7 @@ impl Renderer {
         let mut frame = self.settings.gpu_frame(self.light_count);
         frame.samples_in_wave = 0;
         self.launch_megakernel(&frame)?;
-        self.gpu
+        self.device
             .queue
             .finish()
             .map_err(crate::cl::call_err("building the megakernel"))?;
@@ -120,7 +120,7 @@ impl Renderer {
 
     /// One megakernel launch for `frame`, then `advance` to move its ray counts into the
     /// totals.
-    fn launch_megakernel(&self, frame: &GpuFrame) -> Result<[(Stage, Launch); 2], ClError> {
+    fn launch_megakernel(&self, frame: &DeviceFrame) -> Result<[(Stage, Launch); 2], ClError> {
         let (Some(program), Some((scene, _)), Some(f)) = (
             self.program.as_ref(),
             self.scene.as_ref(),
@@ -128,10 +128,10 @@ impl Renderer {
         ) else {
             return Err(ClError::Device("no scene is loaded".into()));
         };
-        let (gpu, counters) = (&self.gpu, &self.counters);
+        let (device, counters) = (&self.device, &self.counters);
         // The small-scene test (kernels built for whole batches of triangles) takes the count
         // here, so that a scene's hidden objects need no other kernels.
-        let frame = &GpuFrame {
+        let frame = &DeviceFrame {
             triangles: if program.features.small_scene > 0 || program.features.lanes_small {
                 scene.triangles.len() as u32
             } else {
@@ -140,7 +140,7 @@ impl Renderer {
             ..*frame
         };
         let l = program.megakernel(
-            gpu,
+            device,
             frame,
             &self.camera,
             &self.env,
@@ -148,7 +148,7 @@ impl Renderer {
             &f.film,
             counters,
         )?;
-        let a = program.advance(gpu, counters, &self.stats_buffer)?;
+        let a = program.advance(device, counters, &self.stats_buffer)?;
         Ok([(Stage::Megakernel, l), (Stage::Advance, a)])
     }
 

@@ -32,7 +32,7 @@ use crate::bvh::Ray;
 pub use crate::cl::kernels::NodeForms;
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, DeviceChoice, Gpu, KernelFeatures, Program};
+use crate::cl::{Buffer, ClError, Device, DeviceChoice, KernelFeatures, Program};
 use crate::scene::{Camera, EnvMap, EnvSampling, Light, RenderFrame, Scene};
 use sah::SahBuild;
 use std::sync::Arc;
@@ -82,7 +82,7 @@ pub struct SceneStats {
 /// The path tracer on one OpenCL device.
 pub struct Renderer {
     /// The device, context and queue.
-    pub gpu: Gpu,
+    pub device: Device,
     program: Option<Program>,
     scene: Option<(SceneBuffers, HostScene)>,
     frame: Option<Frame>,
@@ -91,10 +91,10 @@ pub struct Renderer {
     settings: RenderSettings,
     /// The world camera as last given (the device's is in render space).
     world_camera: Option<Camera>,
-    camera: GpuCamera,
+    camera: DeviceCamera,
     light_count: u32,
     /// What the kernel strategy knows of the device.
-    device: DeviceFacts,
+    device_facts: DeviceFacts,
     /// The environment's overrides of the kernel strategy.
     overrides: Overrides,
     /// What the kernel strategy knows of the loaded scene (its features without the
@@ -132,18 +132,18 @@ pub struct Renderer {
 impl Renderer {
     /// Opens the device.
     pub fn new(choice: &DeviceChoice) -> Result<Self, ClError> {
-        let gpu = Gpu::open(choice)?;
-        let device = DeviceFacts::of(gpu.is_cpu());
-        let counters = Buffer::new(&gpu, COUNTER_SLOTS)?;
-        let stats_buffer = Buffer::new(&gpu, STAT_SLOTS)?;
+        let device = Device::open(choice)?;
+        let device_facts = DeviceFacts::of(device.is_cpu());
+        let counters = Buffer::new(&device, COUNTER_SLOTS)?;
+        let stats_buffer = Buffer::new(&device, STAT_SLOTS)?;
         let env = EnvBuffers {
-            info: GpuEnvironment::default(),
-            texels: Buffer::from_slice(&gpu, &[0.0; 3])?,
-            marginal: Buffer::from_slice(&gpu, &[1.0])?,
-            conditional: Buffer::from_slice(&gpu, &[1.0])?,
+            info: DeviceEnvironment::default(),
+            texels: Buffer::from_slice(&device, &[0.0; 3])?,
+            marginal: Buffer::from_slice(&device, &[1.0])?,
+            conditional: Buffer::from_slice(&device, &[1.0])?,
         };
         let mut r = Self {
-            gpu,
+            device,
             program: None,
             scene: None,
             frame: None,
@@ -151,9 +151,9 @@ impl Renderer {
             stats_buffer,
             settings: RenderSettings::default(),
             world_camera: None,
-            camera: GpuCamera::default(),
+            camera: DeviceCamera::default(),
             light_count: 0,
-            device,
+            device_facts,
             overrides: Overrides::from_env(),
             facts: SceneFacts::default(),
             lights: Vec::new(),
@@ -238,7 +238,7 @@ impl Renderer {
             },
             ..*facts
         };
-        strategy::kernel_strategy(&self.device, self.megakernel, &facts, &self.overrides)
+        strategy::kernel_strategy(&self.device_facts, self.megakernel, &facts, &self.overrides)
     }
 
     /// Builds the kernels when the loaded scene's features (with the environment's and the
@@ -256,7 +256,7 @@ impl Renderer {
         // A cold build takes seconds (the drivers cache built programs on disk: see README).
         eprintln!("penumbra: compiling kernels…");
         let t = Instant::now();
-        self.program = Some(Program::build(&self.gpu, features)?);
+        self.program = Some(Program::build(&self.device, features)?);
         Ok(t.elapsed().as_secs_f64() * 1e3)
     }
 
@@ -268,9 +268,9 @@ impl Renderer {
             Some(map) => {
                 let table = map.sampling();
                 let texels: Vec<f32> = map.texels.iter().flatten().copied().collect();
-                self.env.texels = Buffer::from_slice(&self.gpu, &texels)?;
-                self.env.marginal = Buffer::from_slice(&self.gpu, &table.marginal)?;
-                self.env.conditional = Buffer::from_slice(&self.gpu, &table.conditional)?;
+                self.env.texels = Buffer::from_slice(&self.device, &texels)?;
+                self.env.marginal = Buffer::from_slice(&self.device, &table.marginal)?;
+                self.env.conditional = Buffer::from_slice(&self.device, &table.conditional)?;
                 self.environment = Some((Arc::new(map), table));
             }
             None => self.environment = None,
@@ -391,10 +391,10 @@ impl Renderer {
         }
         self.samples = 0;
         self.stats = RenderStats::default();
-        self.counters.clear(&self.gpu)?;
-        self.stats_buffer.clear(&self.gpu)?;
+        self.counters.clear(&self.device)?;
+        self.stats_buffer.clear(&self.device)?;
         if let Some(f) = self.frame.as_mut() {
-            f.film.clear(&self.gpu)?;
+            f.film.clear(&self.device)?;
         }
         Ok(())
     }

@@ -36,15 +36,15 @@ impl Renderer {
         }
         let (nodes, wide) = device_nodes(host, add);
         if let Some(nodes) = nodes {
-            buffers.nodes = Buffer::from_slice(&self.gpu, &nodes)?;
+            buffers.nodes = Buffer::from_slice(&self.device, &nodes)?;
         }
         if let Some(wide) = wide {
-            buffers.wide_nodes = Buffer::from_slice(&self.gpu, &wide)?;
+            buffers.wide_nodes = Buffer::from_slice(&self.device, &wide)?;
         }
         buffers.forms = buffers.forms.with(add);
         if let Accel::TwoLevel(two) = &host.accel {
             let instances = host.layout.gpu_instances(two);
-            buffers.instances.write_at(&self.gpu, 0, &instances)?;
+            buffers.instances.write_at(&self.device, 0, &instances)?;
         }
         Ok(())
     }
@@ -56,12 +56,12 @@ impl Renderer {
 pub(super) fn device_accel(
     host: &mut HostScene,
     forms: NodeForms,
-) -> (Vec<GpuBvhNode>, Vec<GpuWideNode>, Vec<GpuInstance>) {
+) -> (Vec<DeviceBvhNode>, Vec<DeviceWideNode>, Vec<DeviceInstance>) {
     let (nodes, wide) = device_nodes(host, forms);
-    let nodes = nodes.unwrap_or_else(|| vec![GpuBvhNode::default()]);
-    let wide = wide.unwrap_or_else(|| vec![GpuWideNode::default()]);
+    let nodes = nodes.unwrap_or_else(|| vec![DeviceBvhNode::default()]);
+    let wide = wide.unwrap_or_else(|| vec![DeviceWideNode::default()]);
     let instances = match &host.accel {
-        Accel::Flat(_) => vec![GpuInstance::default()],
+        Accel::Flat(_) => vec![DeviceInstance::default()],
         Accel::TwoLevel(two) => {
             // The small instances' world-space copies follow the meshes' triangles.
             let first = two.blases.iter().map(|b| b.len()).sum();
@@ -78,7 +78,7 @@ pub(super) fn device_accel(
 fn device_nodes(
     host: &mut HostScene,
     forms: NodeForms,
-) -> (Option<Vec<GpuBvhNode>>, Option<Vec<GpuWideNode>>) {
+) -> (Option<Vec<DeviceBvhNode>>, Option<Vec<DeviceWideNode>>) {
     match &host.accel {
         Accel::Flat(bvh) => (
             forms.binary.then(|| bvh.nodes.clone()),

@@ -73,7 +73,7 @@ impl Renderer {
         let Some(f) = self.frame.as_ref() else {
             return Ok(false);
         };
-        f.film.read_into(&self.gpu, &mut self.readback)?;
+        f.film.read_into(&self.device, &mut self.readback)?;
         Ok(true)
     }
 }

@@ -1,8 +1,8 @@
 //! What the user controls about a render.
 
 use crate::cl::types::{
-    BACKGROUND_COUNT, BACKGROUND_CUTOUT, BACKGROUND_ENV, GpuFrame, STRATEGY_BSDF, STRATEGY_LIGHTS,
-    STRATEGY_MIS,
+    BACKGROUND_COUNT, BACKGROUND_CUTOUT, BACKGROUND_ENV, DeviceFrame, STRATEGY_BSDF,
+    STRATEGY_LIGHTS, STRATEGY_MIS,
 };
 
 /// Which estimator feeds direct light.
@@ -79,8 +79,8 @@ impl RenderSettings {
     }
 
     /// The per-wave constants, without the wave-specific fields.
-    pub fn gpu_frame(&self, light_count: u32) -> GpuFrame {
-        GpuFrame {
+    pub fn gpu_frame(&self, light_count: u32) -> DeviceFrame {
+        DeviceFrame {
             width: self.width,
             height: self.height,
             samples_in_wave: 1,

@@ -323,11 +323,11 @@ mod tests {
 
     #[test]
     fn auto_runs_the_megakernel_on_cpus_only() {
-        let gpu = DeviceFacts::default();
+        let device = DeviceFacts::default();
         assert!(runs_megakernel(&AVX, KernelChoice::Auto));
-        assert!(!runs_megakernel(&gpu, KernelChoice::Auto));
+        assert!(!runs_megakernel(&device, KernelChoice::Auto));
         assert!(!runs_megakernel(&AVX, KernelChoice::Wavefront));
-        assert!(runs_megakernel(&gpu, KernelChoice::Megakernel));
+        assert!(runs_megakernel(&device, KernelChoice::Megakernel));
     }
 
     #[test]
@@ -338,8 +338,8 @@ mod tests {
         };
         for triangles in [32, 1 << 20] {
             assert_eq!(decide(AVX, false, lambert(), triangles, o), NONE);
-            let gpu = DeviceFacts::default();
-            assert_eq!(decide(gpu, true, lambert(), triangles, o), NONE);
+            let device = DeviceFacts::default();
+            assert_eq!(decide(device, true, lambert(), triangles, o), NONE);
         }
     }
 

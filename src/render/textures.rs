@@ -11,9 +11,9 @@ use std::collections::HashMap;
 #[derive(Clone, Debug, Default)]
 pub struct TexturePack {
     /// One descriptor per texture.
-    pub textures: Vec<GpuTexture>,
+    pub textures: Vec<DeviceTexture>,
     /// One entry per `Scene::texture_refs` entry.
-    pub refs: Vec<GpuTexRef>,
+    pub refs: Vec<DeviceTexRef>,
     /// RGBA8 texels (R in the low byte) of every level of every texture.
     pub texels: Vec<u32>,
     /// The largest side kept (smaller than [`MAX_TEXTURE_SIDE`] when the budget forced it).
@@ -79,7 +79,7 @@ impl TexturePack {
         let mut textures = Vec::with_capacity(chains.len());
         let mut texels = Vec::new();
         for (chain, &(_, srgb)) in chains.iter().zip(&keys) {
-            textures.push(GpuTexture {
+            textures.push(DeviceTexture {
                 offset: texels.len() as u32,
                 width: chain[0].width,
                 height: chain[0].height,
@@ -95,7 +95,7 @@ impl TexturePack {
             .map(|r| {
                 let [a, b] = r.transform.rows();
                 let det = (a[0] * b[1] - a[1] * b[0]).abs().max(1e-12);
-                GpuTexRef {
+                DeviceTexRef {
                     m0: [a[0], a[1], a[2], f32::from_bits(r.tex_coord)],
                     m1: [b[0], b[1], b[2], 0.5 * det.log2()],
                     info: [

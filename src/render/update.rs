@@ -8,7 +8,7 @@ use super::upload::piece_copies;
 use super::{Accel, Renderer};
 use crate::bvh::WideBvh;
 use crate::cl::ClError;
-use crate::cl::types::GpuWideNode;
+use crate::cl::types::DeviceWideNode;
 use crate::scene::{Scene, is_sane};
 use std::time::Instant;
 
@@ -85,28 +85,28 @@ impl Renderer {
         two.rebuild_tlas();
         let slots = two.tlas_slots();
         let instances = host.layout.gpu_instances(two);
-        let gpu = &self.gpu;
+        let device = &self.device;
         let mut bytes = std::mem::size_of_val(instances.as_slice());
         // The TLAS in each node array the device has (`NodeForms`).
         if buffers.forms.binary {
             let nodes = two.device_tlas();
-            buffers.nodes.write_at(gpu, 0, &nodes)?;
+            buffers.nodes.write_at(device, 0, &nodes)?;
             bytes += std::mem::size_of_val(nodes.as_slice());
         }
         if buffers.forms.wide {
             let mut wide = WideBvh::collapse(&two.tlas).nodes;
-            wide.resize(slots, GpuWideNode::default());
-            buffers.wide_nodes.write_at(gpu, 0, &wide)?;
+            wide.resize(slots, DeviceWideNode::default());
+            buffers.wide_nodes.write_at(device, 0, &wide)?;
             bytes += std::mem::size_of_val(wide.as_slice());
         }
-        buffers.instances.write_at(gpu, 0, &instances)?;
+        buffers.instances.write_at(device, 0, &instances)?;
         // A moved small instance's world-space triangle copies (the TLAS's pieces).
         for &(i, _, _) in &moved {
             let base = host.layout.copy_bases[i] as usize;
             if base != u32::MAX as usize {
                 let mesh = &host.layout.small_meshes[two.instances[i].blas as usize];
                 let copies = piece_copies(two, mesh, i);
-                buffers.triangles.write_at(gpu, base, &copies)?;
+                buffers.triangles.write_at(device, base, &copies)?;
                 bytes += std::mem::size_of_val(copies.as_slice());
             }
         }

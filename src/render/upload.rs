@@ -62,18 +62,18 @@ mod tests {
             light(LightKind::Directional, glam::DVec3::ZERO, 2.0),
             light(LightKind::Point, glam::DVec3::new(0.0, 20.0, 0.0), 800.0),
         ];
-        let (gpu, cdf) = gpu_lights(&lights, &host, None);
-        assert_eq!(gpu.len(), 2);
-        eprintln!("bounds {:?} {:?}", host.bounds(), gpu);
+        let (device, cdf) = gpu_lights(&lights, &host, None);
+        assert_eq!(device.len(), 2);
+        eprintln!("bounds {:?} {:?}", host.bounds(), device);
         let sun_power = 2.0 * std::f32::consts::PI * 50.0;
         let point_power = 800.0 * 4.0 * std::f32::consts::PI;
         let expect = 0.5 * (0.5 + sun_power / (sun_power + point_power));
         assert!(
-            (gpu[0].extra[1] - expect).abs() < 1e-4,
+            (device[0].extra[1] - expect).abs() < 1e-4,
             "{:?}",
-            gpu[0].extra
+            device[0].extra
         );
-        assert!((gpu[0].extra[1] + gpu[1].extra[1] - 1.0).abs() < 1e-6);
+        assert!((device[0].extra[1] + device[1].extra[1] - 1.0).abs() < 1e-6);
         assert_eq!(*cdf.last().unwrap(), 1.0);
         // A light at the middle counts as 5 % of the diagonal away (I / 0.5 here), not as
         // infinitely bright.
@@ -81,13 +81,13 @@ mod tests {
             light(LightKind::Directional, glam::DVec3::ZERO, 1.0),
             light(LightKind::Point, glam::DVec3::ZERO, 1.0),
         ];
-        let (gpu, _) = gpu_lights(&close, &host, None);
+        let (device, _) = gpu_lights(&close, &host, None);
         let pi = std::f32::consts::PI;
         let expect = 0.5 * (2.0 / 3.0 + 4.0 * pi / (4.0 * pi + 50.0 * pi));
         assert!(
-            (gpu[1].extra[1] - expect).abs() < 1e-4,
+            (device[1].extra[1] - expect).abs() < 1e-4,
             "{:?}",
-            gpu[1].extra
+            device[1].extra
         );
     }
 

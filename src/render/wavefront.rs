@@ -7,7 +7,7 @@ use super::Renderer;
 pub use crate::cl::Stage;
 use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, Gpu, Program};
+use crate::cl::{Buffer, ClError, Device, Program};
 
 /// Kernel time per stage, in launch order ([`Stage::ALL`]); empty until a frame ran.
 #[derive(Clone, Debug, Default)]
@@ -86,10 +86,10 @@ pub(super) struct Frame {
     pub(super) height: u32,
     pub(super) slots: usize,
     pub(super) film: Buffer<[f32; 4]>,
-    pub(super) paths: Buffer<GpuPath>,
+    pub(super) paths: Buffer<DevicePath>,
     pub(super) queues: [Buffer<u32>; 2],
-    pub(super) hits: Buffer<GpuHit>,
-    pub(super) shadow_rays: Buffer<GpuShadowRay>,
+    pub(super) hits: Buffer<DeviceHit>,
+    pub(super) shadow_rays: Buffer<DeviceShadowRay>,
     /// Ray cone (width, spread angle) per slot, for texture filtering.
     pub(super) cones: Buffer<[f32; 2]>,
 }
@@ -100,11 +100,11 @@ const WAVE_PATHS_CPU: usize = 1 << 16;
 
 /// One wave's launches: the device state every stage reads, and one method per stage.
 struct Wave<'a> {
-    gpu: &'a Gpu,
+    device: &'a Device,
     program: &'a Program,
     scene: &'a SceneBuffers,
     env: &'a EnvBuffers,
-    camera: &'a GpuCamera,
+    camera: &'a DeviceCamera,
     frame: &'a Frame,
     counters: &'a Buffer<u32>,
     stats: &'a Buffer<u64>,
@@ -118,10 +118,10 @@ impl Wave<'_> {
         self.launches.push((stage, launch));
     }
 
-    fn generate(&mut self, frame: &GpuFrame) -> Result<(), ClError> {
+    fn generate(&mut self, frame: &DeviceFrame) -> Result<(), ClError> {
         let f = self.frame;
         let l = self.program.generate(
-            self.gpu,
+            self.device,
             frame,
             self.camera,
             &f.paths,
@@ -137,7 +137,7 @@ impl Wave<'_> {
     fn extend(&mut self, queue_in: usize) -> Result<(), ClError> {
         let f = self.frame;
         let l = self.program.extend(
-            self.gpu,
+            self.device,
             self.scene,
             &f.paths,
             &f.queues[queue_in],
@@ -151,13 +151,13 @@ impl Wave<'_> {
 
     fn shade(
         &mut self,
-        frame: &GpuFrame,
+        frame: &DeviceFrame,
         queue_in: usize,
         queue_out: usize,
     ) -> Result<(), ClError> {
         let f = self.frame;
         let l = self.program.shade(
-            self.gpu,
+            self.device,
             frame,
             self.env,
             self.scene,
@@ -177,7 +177,7 @@ impl Wave<'_> {
     fn connect(&mut self) -> Result<(), ClError> {
         let f = self.frame;
         let l = self.program.connect(
-            self.gpu,
+            self.device,
             self.scene,
             &f.shadow_rays,
             self.counters,
@@ -189,16 +189,18 @@ impl Wave<'_> {
     }
 
     fn advance(&mut self) -> Result<(), ClError> {
-        let l = self.program.advance(self.gpu, self.counters, self.stats)?;
+        let l = self
+            .program
+            .advance(self.device, self.counters, self.stats)?;
         self.push(Stage::Advance, l);
         Ok(())
     }
 
-    fn accumulate(&mut self, frame: &GpuFrame) -> Result<(), ClError> {
+    fn accumulate(&mut self, frame: &DeviceFrame) -> Result<(), ClError> {
         let f = self.frame;
         let l = self
             .program
-            .accumulate(self.gpu, frame, &f.paths, &f.film, self.counters)?;
+            .accumulate(self.device, frame, &f.paths, &f.film, self.counters)?;
         self.push(Stage::Accumulate, l);
         Ok(())
     }
@@ -212,7 +214,7 @@ impl Renderer {
     pub(super) fn ensure_frame(&mut self) -> Result<(), ClError> {
         let (w, h) = (self.settings.width, self.settings.height);
         let pixels = (w * h) as usize;
-        let wave = if self.gpu.info.is_gpu {
+        let wave = if self.device.info.is_gpu {
             WAVE_PATHS_GPU
         } else {
             WAVE_PATHS_CPU
@@ -226,19 +228,19 @@ impl Renderer {
             return Ok(());
         }
         self.frame = None; // free the old buffers first
-        let gpu = &self.gpu;
-        let mut film = Buffer::new(gpu, pixels)?;
-        film.clear(gpu)?;
+        let device = &self.device;
+        let mut film = Buffer::new(device, pixels)?;
+        film.clear(device)?;
         self.frame = Some(Frame {
             width: w,
             height: h,
             slots,
             film,
-            paths: Buffer::new(gpu, slots)?,
-            queues: [Buffer::new(gpu, slots)?, Buffer::new(gpu, slots)?],
-            hits: Buffer::new(gpu, slots)?,
-            shadow_rays: Buffer::new(gpu, slots)?,
-            cones: Buffer::new(gpu, slots)?,
+            paths: Buffer::new(device, slots)?,
+            queues: [Buffer::new(device, slots)?, Buffer::new(device, slots)?],
+            hits: Buffer::new(device, slots)?,
+            shadow_rays: Buffer::new(device, slots)?,
+            cones: Buffer::new(device, slots)?,
         });
         self.samples = 0;
         Ok(())
@@ -271,7 +273,7 @@ impl Renderer {
     pub fn start(&mut self, spp: u32) -> Result<(), ClError> {
         let launches = self.enqueue(spp)?;
         self.pending.extend(launches);
-        self.gpu
+        self.device
             .queue
             .flush()
             .map_err(crate::cl::call_err("submitting the frame"))
@@ -294,7 +296,7 @@ impl Renderer {
 
     /// Waits for the work [`Renderer::start`] enqueued and gathers its statistics.
     pub fn finish(&mut self) -> Result<(), ClError> {
-        self.gpu
+        self.device
             .queue
             .finish()
             .map_err(crate::cl::call_err("waiting for the frame"))?;
@@ -319,7 +321,7 @@ impl Renderer {
         let pixels = (f.width * f.height) as usize;
         let per_wave = (f.slots / pixels).max(1) as u32;
         let mut wave = Wave {
-            gpu: &self.gpu,
+            device: &self.device,
             program,
             scene,
             env: &self.env,
@@ -359,8 +361,8 @@ impl Renderer {
         for (stage, l) in &launches {
             self.stats.stage_ms.add(*stage, l.millis());
         }
-        let counters = self.counters.read(&self.gpu)?;
-        let stats = self.stats_buffer.read(&self.gpu)?;
+        let counters = self.counters.read(&self.device)?;
+        let stats = self.stats_buffer.read(&self.device)?;
         self.stats.extension_rays = stats[STAT_EXTENSION_RAYS];
         self.stats.shadow_rays = stats[STAT_SHADOW_RAYS];
         self.stats.nonfinite_samples = counters[COUNT_NONFINITE] as u64;

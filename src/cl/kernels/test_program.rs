@@ -3,7 +3,7 @@
 
 use super::{Program, kernel};
 use crate::cl::types::*;
-use crate::cl::{Buffer, ClError, EnvBuffers, Gpu, SceneBuffers, build_test_program};
+use crate::cl::{Buffer, ClError, Device, EnvBuffers, SceneBuffers, build_test_program};
 use opencl3::kernel::Kernel;
 
 /// The kernels only tests use, from their own program (`build_test_program`).
@@ -18,11 +18,11 @@ pub(super) struct TestKernels {
 
 impl Program {
     /// The test-only kernels for the same features, built the first time a test asks.
-    fn tests(&self, gpu: &Gpu) -> Result<&TestKernels, ClError> {
+    fn tests(&self, device: &Device) -> Result<&TestKernels, ClError> {
         if let Some(t) = self.tests.get() {
             return Ok(t);
         }
-        let program = build_test_program(gpu, self.features)?;
+        let program = build_test_program(device, self.features)?;
         let k = |name: &str| kernel(&program, name);
         let built = TestKernels {
             probe_layout: k("probe_layout")?,
@@ -36,29 +36,29 @@ impl Program {
     }
 
     /// `probe_layout` (test program): sizes and offsets of the shared structs as the device compiler sees them.
-    pub fn probe_layout(&self, gpu: &Gpu) -> Result<Vec<u32>, ClError> {
-        let tests = self.tests(gpu)?;
-        let out = Buffer::<u32>::new(gpu, 256)?;
-        self.run(gpu, "probe_layout", &tests.probe_layout, 1, |e| unsafe {
+    pub fn probe_layout(&self, device: &Device) -> Result<Vec<u32>, ClError> {
+        let tests = self.tests(device)?;
+        let out = Buffer::<u32>::new(device, 256)?;
+        self.run(device, "probe_layout", &tests.probe_layout, 1, |e| unsafe {
             e.set_arg(&out.mem());
         })?;
-        out.read(gpu)
+        out.read(device)
     }
 
     /// `sample_texture_test` (test program): texture lookups; query .xy = uv, .z = footprint level (see
     /// kernels/test/tests.cl), .w = texture reference (i32 bits). Zeros without `HAS_TEXTURES`.
     pub fn sample_texture_test(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         scene: &SceneBuffers,
         queries: &[[f32; 4]],
     ) -> Result<Vec<[f32; 4]>, ClError> {
-        let tests = self.tests(gpu)?;
-        let q = Buffer::from_slice(gpu, queries)?;
-        let out = Buffer::<[f32; 4]>::new(gpu, queries.len())?;
+        let tests = self.tests(device)?;
+        let q = Buffer::from_slice(device, queries)?;
+        let out = Buffer::<[f32; 4]>::new(device, queries.len())?;
         let count = queries.len() as u32;
         self.run(
-            gpu,
+            device,
             "sample_texture_test",
             &tests.sample_texture_test,
             queries.len(),
@@ -71,7 +71,7 @@ impl Program {
                     .set_arg(&out.mem());
             },
         )?;
-        out.read(gpu)
+        out.read(device)
     }
 
     /// `sample_env_test` (test program): environment samples from uniform pairs: (direction, pdf) each, and
@@ -79,17 +79,17 @@ impl Program {
     #[allow(clippy::type_complexity)]
     pub fn sample_env_test(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         env: &EnvBuffers,
         u: &[[f32; 2]],
     ) -> Result<(Vec<[f32; 4]>, Vec<f32>), ClError> {
-        let tests = self.tests(gpu)?;
-        let ub = Buffer::from_slice(gpu, u)?;
-        let out = Buffer::<[f32; 4]>::new(gpu, u.len())?;
-        let eval = Buffer::<f32>::new(gpu, u.len())?;
+        let tests = self.tests(device)?;
+        let ub = Buffer::from_slice(device, u)?;
+        let out = Buffer::<[f32; 4]>::new(device, u.len())?;
+        let eval = Buffer::<f32>::new(device, u.len())?;
         let count = u.len() as u32;
         self.run(
-            gpu,
+            device,
             "sample_env_test",
             &tests.sample_env_test,
             u.len(),
@@ -104,7 +104,7 @@ impl Program {
                     .set_arg(&eval.mem());
             },
         )?;
-        Ok((out.read(gpu)?, eval.read(gpu)?))
+        Ok((out.read(device)?, eval.read(device)?))
     }
 
     /// `spawn_test` (test program): rays spawned with the kernels' hit point and offset; case i
@@ -113,21 +113,21 @@ impl Program {
     /// triangles from `groups[i][1]` (`groups[i][3]` is unused).
     pub fn spawn_test(
         &self,
-        gpu: &Gpu,
+        device: &Device,
         verts: &[[f32; 4]],
         groups: &[[u32; 4]],
         bary: &[[f32; 2]],
         dirs: &[[f32; 4]],
     ) -> Result<Vec<u32>, ClError> {
-        let tests = self.tests(gpu)?;
-        let vb = Buffer::from_slice(gpu, verts)?;
-        let gb = Buffer::from_slice(gpu, groups)?;
-        let bb = Buffer::from_slice(gpu, bary)?;
-        let db = Buffer::from_slice(gpu, dirs)?;
-        let hits = Buffer::<u32>::new(gpu, dirs.len())?;
+        let tests = self.tests(device)?;
+        let vb = Buffer::from_slice(device, verts)?;
+        let gb = Buffer::from_slice(device, groups)?;
+        let bb = Buffer::from_slice(device, bary)?;
+        let db = Buffer::from_slice(device, dirs)?;
+        let hits = Buffer::<u32>::new(device, dirs.len())?;
         let count = dirs.len() as u32;
         self.run(
-            gpu,
+            device,
             "spawn_test",
             &tests.spawn_test,
             dirs.len(),
@@ -140,7 +140,7 @@ impl Program {
                     .set_arg(&hits.mem());
             },
         )?;
-        hits.read(gpu)
+        hits.read(device)
     }
 
     /// `bsdf_sample_test` (test program): `count` BSDF samples of `material` at (`wo`, `n`), seen from inside
@@ -148,22 +148,22 @@ impl Program {
     #[allow(clippy::too_many_arguments, clippy::type_complexity)]
     pub fn bsdf_sample_test(
         &self,
-        gpu: &Gpu,
-        material: &GpuMaterial,
+        device: &Device,
+        material: &DeviceMaterial,
         wo: [f32; 4],
         n: [f32; 4],
         inside: bool,
         count: usize,
         seed: u32,
     ) -> Result<(Vec<[f32; 4]>, Vec<[f32; 4]>), ClError> {
-        let tests = self.tests(gpu)?;
-        let material = Buffer::from_slice(gpu, &[*material])?;
-        let wi_pdf = Buffer::<[f32; 4]>::new(gpu, count)?;
-        let weight = Buffer::<[f32; 4]>::new(gpu, count)?;
+        let tests = self.tests(device)?;
+        let material = Buffer::from_slice(device, &[*material])?;
+        let wi_pdf = Buffer::<[f32; 4]>::new(device, count)?;
+        let weight = Buffer::<[f32; 4]>::new(device, count)?;
         let inside = inside as u32;
         let count32 = count as u32;
         self.run(
-            gpu,
+            device,
             "bsdf_sample_test",
             &tests.bsdf_sample_test,
             count,
@@ -178,27 +178,27 @@ impl Program {
                     .set_arg(&weight.mem());
             },
         )?;
-        Ok((wi_pdf.read(gpu)?, weight.read(gpu)?))
+        Ok((wi_pdf.read(device)?, weight.read(device)?))
     }
 
     /// `bsdf_eval_test` (test program): (f·|cos|, pdf) of `material` at (`wo`, `n`) for each direction of `wi`.
     pub fn bsdf_eval_test(
         &self,
-        gpu: &Gpu,
-        material: &GpuMaterial,
+        device: &Device,
+        material: &DeviceMaterial,
         wo: [f32; 4],
         n: [f32; 4],
         inside: bool,
         wi: &[[f32; 4]],
     ) -> Result<Vec<[f32; 4]>, ClError> {
-        let tests = self.tests(gpu)?;
-        let material = Buffer::from_slice(gpu, &[*material])?;
-        let wi_buf = Buffer::from_slice(gpu, wi)?;
-        let out = Buffer::<[f32; 4]>::new(gpu, wi.len())?;
+        let tests = self.tests(device)?;
+        let material = Buffer::from_slice(device, &[*material])?;
+        let wi_buf = Buffer::from_slice(device, wi)?;
+        let out = Buffer::<[f32; 4]>::new(device, wi.len())?;
         let inside = inside as u32;
         let count = wi.len() as u32;
         self.run(
-            gpu,
+            device,
             "bsdf_eval_test",
             &tests.bsdf_eval_test,
             wi.len(),
@@ -212,6 +212,6 @@ impl Program {
                     .set_arg(&out.mem());
             },
         )?;
-        out.read(gpu)
+        out.read(device)
     }
 }

@@ -77,14 +77,14 @@ pub struct InstanceLayout {
     pub copy_bases: Vec<u32>,
     /// Per BLAS, a small mesh's object-space device triangles (empty for the others): what a
     /// moved small instance's copies are made from once the triangles live on the device only.
-    pub small_meshes: Vec<Vec<GpuTriangle>>,
+    pub small_meshes: Vec<Vec<DeviceTriangle>>,
 }
 
 impl InstanceLayout {
     /// The world-space copies of every small instance's triangles (hidden ones too, so that
     /// showing one writes in place), to follow the meshes' `first` object-space triangles in
     /// the device triangles; keeps where each instance's copies start.
-    pub fn piece_copies(&mut self, two: &TwoLevel, first: usize) -> Vec<GpuTriangle> {
+    pub fn piece_copies(&mut self, two: &TwoLevel, first: usize) -> Vec<DeviceTriangle> {
         let mut copies = vec![];
         self.copy_bases = (0..two.instances.len())
             .map(|i| {
@@ -103,8 +103,8 @@ impl InstanceLayout {
     /// The device instances of `two` in TLAS order, one per TLAS slot (a piece of an
     /// instance: the instance's transforms and its BLAS's roots, or one triangle of a small
     /// mesh), padded to [`TwoLevel::max_pieces`] so that the buffer holds any later TLAS's.
-    pub fn gpu_instances(&self, two: &TwoLevel) -> Vec<GpuInstance> {
-        let mut out: Vec<GpuInstance> = two
+    pub fn gpu_instances(&self, two: &TwoLevel) -> Vec<DeviceInstance> {
+        let mut out: Vec<DeviceInstance> = two
             .tlas
             .tri_indices
             .iter()
@@ -124,7 +124,7 @@ impl InstanceLayout {
                 };
                 let mut world = inst.world_rows();
                 world[0][3] = f32::from_bits(self.light_bases[i as usize] as u32);
-                GpuInstance {
+                DeviceInstance {
                     row0: inst.rows[0],
                     row1: inst.rows[1],
                     row2: inst.rows[2],
@@ -139,7 +139,7 @@ impl InstanceLayout {
                 }
             })
             .collect();
-        out.resize(two.max_pieces.max(1), GpuInstance::default());
+        out.resize(two.max_pieces.max(1), DeviceInstance::default());
         out
     }
 }
@@ -148,7 +148,7 @@ impl InstanceLayout {
 /// pieces of the TLAS without entering the instance (`TwoLevel::braid`): the vertices as
 /// [`crate::bvh::Instance::device_triangle`] carries them (the host reference tests the same
 /// values), the payloads of `mesh`, the instance's mesh's object-space device triangles.
-pub fn piece_copies(two: &TwoLevel, mesh: &[GpuTriangle], i: usize) -> Vec<GpuTriangle> {
+pub fn piece_copies(two: &TwoLevel, mesh: &[DeviceTriangle], i: usize) -> Vec<DeviceTriangle> {
     let inst = &two.instances[i];
     let v = |p: Vec3, payload: f32| [p.x, p.y, p.z, payload];
     two.blases[inst.blas as usize]
@@ -156,7 +156,7 @@ pub fn piece_copies(two: &TwoLevel, mesh: &[GpuTriangle], i: usize) -> Vec<GpuTr
         .zip(mesh)
         .map(|(t, o)| {
             let w = inst.device_triangle(&t);
-            GpuTriangle {
+            DeviceTriangle {
                 v0: v(w[0], o.v0[3]),
                 v1: v(w[1], o.v1[3]),
                 v2: v(w[2], o.v2[3]),

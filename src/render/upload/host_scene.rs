@@ -41,7 +41,7 @@ pub struct HostScene {
     /// instances' world-space copies that follow the meshes' object-space triangles on the
     /// device (mesh after mesh in BLAS order, written straight into the device buffer by
     /// [`HostScene::fill_meshes`]).
-    pub triangles: Vec<GpuTriangle>,
+    pub triangles: Vec<DeviceTriangle>,
     /// Flat: each triangle's object (index in `Scene::objects`) in BVH order, for picking
     /// (4 bytes a triangle where `triangles` holds 48); empty with two levels.
     pub objects: Vec<u32>,
@@ -50,15 +50,15 @@ pub struct HostScene {
     pub vertices: Vec<[Vec3; 3]>,
     /// Corner normals, indexed as `triangles`; moved to the device by `Renderer::load_scene`
     /// (empty after; two levels: always, [`HostScene::fill_meshes`]).
-    pub shading: Vec<GpuTriShading>,
+    pub shading: Vec<DeviceTriShading>,
     /// Texture coordinates, indexed as `triangles`; empty when no material samples a texture
     /// ([`samples_textures`]), with two levels, and after `Renderer::load_scene` moved them.
-    pub uvs: Vec<GpuTriUvs>,
+    pub uvs: Vec<DeviceTriUvs>,
     /// Tangents, indexed as `triangles`; empty when no triangle is normal-mapped, with two
     /// levels, and after `Renderer::load_scene` moved them to the device.
-    pub tangents: Vec<GpuTriTangents>,
+    pub tangents: Vec<DeviceTriTangents>,
     /// Materials.
-    pub materials: Vec<GpuMaterial>,
+    pub materials: Vec<DeviceMaterial>,
     /// Emissive triangles, in light-table order.
     pub emissive: Vec<Emitter>,
     /// The map from world space to the render space the triangles are in.
@@ -166,7 +166,11 @@ impl HostScene {
     fn assemble(
         accel: Accel,
         layout: InstanceLayout,
-        (triangles, shading, tangents): (Vec<GpuTriangle>, Vec<GpuTriShading>, Vec<GpuTriTangents>),
+        (triangles, shading, tangents): (
+            Vec<DeviceTriangle>,
+            Vec<DeviceTriShading>,
+            Vec<DeviceTriTangents>,
+        ),
         materials: &[Material],
         emissive: Vec<Emitter>,
         middle: (Vec3, f32),
@@ -220,8 +224,8 @@ impl HostScene {
                     return Vec::new();
                 }
                 let n = blas.bvh.tri_indices.len();
-                let mut tris = vec![GpuTriangle::default(); n];
-                let mut shading = vec![GpuTriShading::default(); n];
+                let mut tris = vec![DeviceTriangle::default(); n];
+                let mut shading = vec![DeviceTriShading::default(); n];
                 let out = (
                     (&mut tris[..], &mut shading[..]),
                     (&mut [][..], &mut [][..]),
@@ -264,10 +268,10 @@ impl HostScene {
         meshes: &[&Mesh],
         materials: &[Material],
         (triangles, shading, uvs, tangents): (
-            &mut [GpuTriangle],
-            &mut [GpuTriShading],
-            &mut [GpuTriUvs],
-            &mut [GpuTriTangents],
+            &mut [DeviceTriangle],
+            &mut [DeviceTriShading],
+            &mut [DeviceTriUvs],
+            &mut [DeviceTriTangents],
         ),
     ) {
         let sizes: Vec<usize> = two.blases.iter().map(|b| b.bvh.tri_indices.len()).collect();
@@ -341,9 +345,9 @@ impl HostScene {
     }
 
     /// The closest hit along `ray` (render space), as the device reports it.
-    pub fn intersect(&self, ray: &Ray) -> Option<GpuHit> {
+    pub fn intersect(&self, ray: &Ray) -> Option<DeviceHit> {
         match &self.accel {
-            Accel::Flat(b) => b.intersect(ray, &self.vertices).map(|h| GpuHit {
+            Accel::Flat(b) => b.intersect(ray, &self.vertices).map(|h| DeviceHit {
                 t: h.t,
                 u: h.u,
                 v: h.v,
@@ -363,7 +367,7 @@ impl HostScene {
     }
 
     /// The object (index in `Scene::objects`) a device hit is on.
-    pub fn object_of(&self, hit: &GpuHit) -> u32 {
+    pub fn object_of(&self, hit: &DeviceHit) -> u32 {
         match &self.accel {
             Accel::Flat(_) => self.objects[hit.prim as usize],
             Accel::TwoLevel(t) => {
@@ -373,7 +377,7 @@ impl HostScene {
     }
 
     /// The world (render space) vertices of a device hit's triangle.
-    pub fn hit_triangle(&self, hit: &GpuHit) -> [Vec3; 3] {
+    pub fn hit_triangle(&self, hit: &DeviceHit) -> [Vec3; 3] {
         match &self.accel {
             Accel::Flat(_) => self.vertices[hit.prim as usize],
             Accel::TwoLevel(t) => {

@@ -16,13 +16,13 @@ pub(in crate::render) fn luminance(c: [f32; 3]) -> f32 {
 }
 
 /// The device form of a material.
-pub fn gpu_material(m: &Material) -> GpuMaterial {
+pub fn gpu_material(m: &Material) -> DeviceMaterial {
     let flags = if m.double_sided {
         MATERIAL_DOUBLE_SIDED
     } else {
         0
     } | if m.unlit { MATERIAL_UNLIT } else { 0 };
-    GpuMaterial {
+    DeviceMaterial {
         base_color: m.base_color,
         emission: [
             m.emission[0],
@@ -125,12 +125,12 @@ pub fn samples_textures(materials: &[Material]) -> bool {
 }
 
 /// The device camera for an aspect ratio (width / height).
-pub fn gpu_camera(c: &Camera, aspect: f32) -> GpuCamera {
+pub fn gpu_camera(c: &Camera, aspect: f32) -> DeviceCamera {
     let forward = c.forward.normalize().as_vec3();
     let right = c.forward.cross(c.up).normalize().as_vec3();
     let up = right.cross(forward).normalize();
     let h = (c.yfov as f32 * 0.5).tan();
-    GpuCamera {
+    DeviceCamera {
         origin: f4(c.eye.as_vec3(), 0.0),
         forward: f4(forward, 1.0),
         right: f4(right * h * aspect, 0.0),

@@ -31,8 +31,8 @@ pub(super) fn split_by<'a, T>(mut v: &'a mut [T], sizes: &[usize]) -> Vec<&'a mu
 /// texture coordinates (empty when no material samples a texture) and tangents (empty when no
 /// mesh is normal-mapped).
 pub(super) type MeshStructs<'a> = (
-    (&'a mut [GpuTriangle], &'a mut [GpuTriShading]),
-    (&'a mut [GpuTriUvs], &'a mut [GpuTriTangents]),
+    (&'a mut [DeviceTriangle], &'a mut [DeviceTriShading]),
+    (&'a mut [DeviceTriUvs], &'a mut [DeviceTriTangents]),
 );
 
 /// Whether triangle `ti` of `m` (vertices `v`) is a light: an emissive material and a
@@ -123,12 +123,12 @@ pub(super) fn object_triangles(
 /// The flat form's device structs in object order, filled a list of [`WorldTriangle`]s at a
 /// time.
 pub(super) struct FlatStructs {
-    pub(super) triangles: Vec<GpuTriangle>,
-    pub(super) shading: Vec<GpuTriShading>,
+    pub(super) triangles: Vec<DeviceTriangle>,
+    pub(super) shading: Vec<DeviceTriShading>,
     /// Filled when some material samples a texture (`keep_uvs`).
-    pub(super) uvs: Vec<GpuTriUvs>,
+    pub(super) uvs: Vec<DeviceTriUvs>,
     /// Filled when tangents may be needed (`keep_tangents`).
-    pub(super) tangents: Vec<GpuTriTangents>,
+    pub(super) tangents: Vec<DeviceTriTangents>,
     pub(super) vertices: Vec<[Vec3; 3]>,
     keep_uvs: bool,
     keep_tangents: bool,
@@ -173,25 +173,25 @@ impl FlatStructs {
 /// A triangle's vertices and corner normals on the device; `light` is its index among the
 /// emissive triangles (-1: none). A flat-shaded triangle's normals are zero (the kernels then
 /// take its geometric normal).
-fn device_triangle(t: &WorldTriangle, light: i32) -> (GpuTriangle, GpuTriShading) {
+fn device_triangle(t: &WorldTriangle, light: i32) -> (DeviceTriangle, DeviceTriShading) {
     let n = if t.smooth {
         t.n.map(|n| n.to_array())
     } else {
         [[0.0; 3]; 3]
     };
     (
-        GpuTriangle {
+        DeviceTriangle {
             v0: f4(t.v[0], f32::from_bits(t.material)),
             v1: f4(t.v[1], f32::from_bits(light as u32)),
             v2: f4(t.v[2], f32::from_bits(t.object)),
         },
-        GpuTriShading { n },
+        DeviceTriShading { n },
     )
 }
 
 /// A triangle's texture coordinates on the device.
-fn device_uvs(t: &WorldTriangle) -> GpuTriUvs {
-    GpuTriUvs {
+fn device_uvs(t: &WorldTriangle) -> DeviceTriUvs {
+    DeviceTriUvs {
         uv01: [t.uv[0].x, t.uv[0].y, t.uv[1].x, t.uv[1].y],
         uv2: [t.uv[2].x, t.uv[2].y, t.uv1[0].x, t.uv1[0].y],
         uv1_12: [t.uv1[1].x, t.uv1[1].y, t.uv1[2].x, t.uv1[2].y],
@@ -199,9 +199,9 @@ fn device_uvs(t: &WorldTriangle) -> GpuTriUvs {
 }
 
 /// A triangle's tangents on the device (zero without).
-fn device_tangents(t: &WorldTriangle) -> GpuTriTangents {
+fn device_tangents(t: &WorldTriangle) -> DeviceTriTangents {
     let c = t.tangents.unwrap_or_default().map(|v| v.to_array());
-    GpuTriTangents {
+    DeviceTriTangents {
         t0: c[0],
         t1: c[1],
         t2: c[2],
