@@ -86,7 +86,8 @@ impl<T: Pod> Buffer<T> {
         let offset = at * std::mem::size_of::<T>();
         // SAFETY: the slice fits the buffer from `at` on (checked above); the write is blocking.
         unsafe {
-            device.queue
+            device
+                .queue
                 .enqueue_write_buffer(&mut self.inner, CL_BLOCKING, offset, data, &[])
                 .map_err(call_err("uploading a buffer"))?;
         }
@@ -108,7 +109,8 @@ impl<T: Pod> Buffer<T> {
         // it covers exactly `len.max(1)` elements of a `Pod` type (any bits are a value) and
         // is gone before the unmap below.
         let result = unsafe {
-            device.queue
+            device
+                .queue
                 .enqueue_map_buffer(
                     &self.inner,
                     CL_BLOCKING,
@@ -121,7 +123,8 @@ impl<T: Pod> Buffer<T> {
                 .map_err(call_err("mapping a buffer"))?;
             let elements = std::slice::from_raw_parts_mut(ptr.cast::<T>(), self.len.max(1));
             let result = fill(elements);
-            device.queue
+            device
+                .queue
                 .enqueue_unmap_mem_object(self.inner.get(), ptr, &[])
                 .map_err(call_err("unmapping a buffer"))?
                 .wait()
@@ -148,7 +151,8 @@ impl<T: Pod> Buffer<T> {
         }
         // SAFETY: `out` has exactly the buffer's length; the read is blocking.
         unsafe {
-            device.queue
+            device
+                .queue
                 .enqueue_read_buffer(&self.inner, CL_BLOCKING, 0, out, &[])
                 .map_err(call_err("reading a buffer back"))?;
         }
@@ -160,7 +164,8 @@ impl<T: Pod> Buffer<T> {
         let bytes = self.bytes();
         // SAFETY: fills the whole allocation with a zero pattern of one element.
         unsafe {
-            device.queue
+            device
+                .queue
                 .enqueue_fill_buffer(&mut self.inner, &[T::zeroed()], 0, bytes, &[])
                 .map_err(call_err("clearing a buffer"))?;
         }
@@ -189,11 +194,17 @@ mod tests {
             .collect();
         let mut b = Buffer::from_slice(&device, &data).expect("the buffer is made");
         assert_eq!(b.read(&device).expect("it reads back"), data);
-        b.write_at(&device, 5, &[7, 8, 9]).expect("a write in place");
+        b.write_at(&device, 5, &[7, 8, 9])
+            .expect("a write in place");
         let back = b.read(&device).expect("it reads back");
         assert_eq!(&back[4..9], &[data[4], 7, 8, 9, data[8]]);
         b.clear(&device).expect("it clears");
-        assert!(b.read(&device).expect("it reads back").iter().all(|&x| x == 0));
+        assert!(
+            b.read(&device)
+                .expect("it reads back")
+                .iter()
+                .all(|&x| x == 0)
+        );
         // Buffers come and go (the destructor callback frees each one's pages).
         for _ in 0..8 {
             drop(Buffer::<u32>::new(&device, 3 * len).expect("a buffer"));
