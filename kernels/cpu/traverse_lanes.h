@@ -370,42 +370,60 @@ LANES_INLINE void lanes_prefetch(ulong base, vint first, uint size, uint bytes, 
     lanes_prefetch((ulong)(NODES), (ITEM), sizeof(GpuWideNode), sizeof(GpuWideNode),       \
                    (M) & ((ITEM) >= (vint)(0)));
 
-// Triangle TRI of each lane of mask M (tw: the triangles as words), its vertices relative to
-// the lane's origin in its permuted axes (KX, KY, KZ: 0, 1 or 2; PX, PY, PZ): declares aX ..
-// cZ. Lanes outside M read triangle 0.
+// A triangle of each lane, its vertices a, b, c relative to the lane's origin in its permuted
+// axes.
+typedef struct {
+    vfloat aX, aY, aZ, bX, bY, bZ, cX, cY, cZ;
+} LanesTriangle;
+
+// Triangle tri of each lane of mask m (tw: the triangles as words), its vertices relative to the
+// lane's origin in its permuted axes (kx, ky, kz: 0, 1 or 2; px, py, pz). Lanes outside m read
+// triangle 0.
 #ifdef LANES_GATHERS
-#define LANES_TRIANGLE(TRI, M, KX, KY, KZ, PX, PY, PZ)                          \
-    vint b_ = (TRI) * (vint)(12);                                          \
-    vfloat aX = lanes_gather((ulong)tw, b_ + (KX), M) - (PX);                     \
-    vfloat aY = lanes_gather((ulong)tw, b_ + (KY), M) - (PY);                     \
-    vfloat aZ = lanes_gather((ulong)tw, b_ + (KZ), M) - (PZ);                     \
-    vfloat bX = lanes_gather((ulong)tw, b_ + (vint)(4) + (KX), M) - (PX);        \
-    vfloat bY = lanes_gather((ulong)tw, b_ + (vint)(4) + (KY), M) - (PY);        \
-    vfloat bZ = lanes_gather((ulong)tw, b_ + (vint)(4) + (KZ), M) - (PZ);        \
-    vfloat cX = lanes_gather((ulong)tw, b_ + (vint)(8) + (KX), M) - (PX);        \
-    vfloat cY = lanes_gather((ulong)tw, b_ + (vint)(8) + (KY), M) - (PY);        \
-    vfloat cZ = lanes_gather((ulong)tw, b_ + (vint)(8) + (KZ), M) - (PZ);
+LANES_INLINE LanesTriangle lanes_triangle(global const float* tw, vint tri, vint m, vint kx,
+                                          vint ky, vint kz, vfloat px, vfloat py, vfloat pz) {
+    LanesTriangle T;
+    vint b = tri * (vint)(12);
+    T.aX = lanes_gather((ulong)tw, b + kx, m) - px;
+    T.aY = lanes_gather((ulong)tw, b + ky, m) - py;
+    T.aZ = lanes_gather((ulong)tw, b + kz, m) - pz;
+    T.bX = lanes_gather((ulong)tw, b + (vint)(4) + kx, m) - px;
+    T.bY = lanes_gather((ulong)tw, b + (vint)(4) + ky, m) - py;
+    T.bZ = lanes_gather((ulong)tw, b + (vint)(4) + kz, m) - pz;
+    T.cX = lanes_gather((ulong)tw, b + (vint)(8) + kx, m) - px;
+    T.cY = lanes_gather((ulong)tw, b + (vint)(8) + ky, m) - py;
+    T.cZ = lanes_gather((ulong)tw, b + (vint)(8) + kz, m) - pz;
+    return T;
+}
 #else
+// Word v, v + 1 or v + 2 of the rows R, as k1 or k2 (the axis is 1, or 2) says.
+LANES_INLINE vfloat lanes_axis(const vfloat* R, int v, vint k1, vint k2) {
+    return select(select(R[v], R[v + 1], k1), R[v + 2], k2);
+}
+
 // As rows: each vertex's words in the lane's permuted axes by selects.
-#define LANES_TRIANGLE(TRI, M, KX, KY, KZ, PX, PY, PZ)                          \
-    int off_[LANES];                                                         \
-    vstore_lanes(select((vint)(0), (TRI) * (vint)(12), M), 0, off_);           \
-    vfloat T[12];                                                           \
-    lanes_rows8(tw, off_, 0, T);                                             \
-    lanes_rows4(tw, off_, 8, T + 8);                                         \
-    vint kx1_ = (KX) == (vint)(1), kx2_ = (KX) == (vint)(2);              \
-    vint ky1_ = (KY) == (vint)(1), ky2_ = (KY) == (vint)(2);              \
-    vint kz1_ = (KZ) == (vint)(1), kz2_ = (KZ) == (vint)(2);              \
-    vfloat aX = LANES_AXIS(0, kx) - (PX);                                   \
-    vfloat aY = LANES_AXIS(0, ky) - (PY);                                   \
-    vfloat aZ = LANES_AXIS(0, kz) - (PZ);                                   \
-    vfloat bX = LANES_AXIS(4, kx) - (PX);                                   \
-    vfloat bY = LANES_AXIS(4, ky) - (PY);                                   \
-    vfloat bZ = LANES_AXIS(4, kz) - (PZ);                                   \
-    vfloat cX = LANES_AXIS(8, kx) - (PX);                                   \
-    vfloat cY = LANES_AXIS(8, ky) - (PY);                                   \
-    vfloat cZ = LANES_AXIS(8, kz) - (PZ);
-#define LANES_AXIS(V, K) select(select(T[V], T[V + 1], K##1_), T[V + 2], K##2_)
+LANES_INLINE LanesTriangle lanes_triangle(global const float* tw, vint tri, vint m, vint kx,
+                                          vint ky, vint kz, vfloat px, vfloat py, vfloat pz) {
+    int off[LANES];
+    vstore_lanes(select((vint)(0), tri * (vint)(12), m), 0, off);
+    vfloat R[12];
+    lanes_rows8(tw, off, 0, R);
+    lanes_rows4(tw, off, 8, R + 8);
+    vint kx1 = kx == (vint)(1), kx2 = kx == (vint)(2);
+    vint ky1 = ky == (vint)(1), ky2 = ky == (vint)(2);
+    vint kz1 = kz == (vint)(1), kz2 = kz == (vint)(2);
+    LanesTriangle T;
+    T.aX = lanes_axis(R, 0, kx1, kx2) - px;
+    T.aY = lanes_axis(R, 0, ky1, ky2) - py;
+    T.aZ = lanes_axis(R, 0, kz1, kz2) - pz;
+    T.bX = lanes_axis(R, 4, kx1, kx2) - px;
+    T.bY = lanes_axis(R, 4, ky1, ky2) - py;
+    T.bZ = lanes_axis(R, 4, kz1, kz2) - pz;
+    T.cX = lanes_axis(R, 8, kx1, kx2) - px;
+    T.cY = lanes_axis(R, 8, ky1, ky2) - py;
+    T.cZ = lanes_axis(R, 8, kz1, kz2) - pz;
+    return T;
+}
 #endif
 
 // The most (lane, triangle) pairs a leaf step tests sixteen at a time (more: one triangle of
@@ -425,6 +443,18 @@ LANES_INLINE void lanes_prefetch(ulong base, vint first, uint size, uint bytes, 
         c##A = select(c##A, c##B, s);          \
         c##B = select(c##B, tc, s);            \
     }
+
+#if LANES != 8
+// A child (entry distance d, item c) pushed onto the stacks of the lanes of mi that reached it
+// (d < inf), each lane's stack pointer *sp moved down past it (with eight lanes a node step
+// pushes its three children in one store instead).
+LANES_INLINE void lanes_push_child(float* stack, vint* sp, vint mi, vfloat d, vint c,
+                                   vfloat inf) {
+    vint p = mi & (d < inf);
+    lanes_push_pair(stack, LANES_ENTRY(*sp), lanes_kmask(p), d, as_vfloat(c));
+    *sp -= p;
+}
+#endif
 
 // Walks the lanes' rays until LANES_DONE_MIN are done or none is left walking; returns the
 // mask of those done (their `live` lanes cleared). No lane live: returns an empty mask.
@@ -580,17 +610,9 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 L->sp -= p1 + p2 + p3;
             }
 #else
-#define LANES_PUSH(J)                                                              \
-    {                                                                              \
-        vint p = mi & (d##J < inf);                                               \
-        lanes_push_pair(M->stack, LANES_ENTRY(L->sp), lanes_kmask(p), d##J,        \
-                        as_vfloat(c##J));                                         \
-        L->sp -= p;                                                                \
-    }
-            LANES_PUSH(3)
-            LANES_PUSH(2)
-            LANES_PUSH(1)
-#undef LANES_PUSH
+            lanes_push_child(M->stack, &L->sp, mi, d3, c3, inf);
+            lanes_push_child(M->stack, &L->sp, mi, d2, c2, inf);
+            lanes_push_child(M->stack, &L->sp, mi, d1, c1, inf);
 #endif
             vint enter = mi & (d0 < inf);
             arrived |= enter & (c0 < izero);
@@ -633,7 +655,9 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
                 vfloat pz = lanes_permute(L->pz, idx);
                 vfloat sx = lanes_permute(L->sx, idx), sy = lanes_permute(L->sy, idx);
                 vfloat sz = lanes_permute(L->sz, idx);
-                LANES_TRIANGLE(tri, m, kx, ky, kz, px, py, pz)
+                LanesTriangle tv = lanes_triangle(tw, tri, m, kx, ky, kz, px, py, pz);
+                vfloat aX = tv.aX, aY = tv.aY, aZ = tv.aZ, bX = tv.bX, bY = tv.bY, bZ = tv.bZ;
+                vfloat cX = tv.cX, cY = tv.cY, cZ = tv.cZ;
                 LANE_EDGES(vfloat)
                 LANE_HITS_T(vfloat, vint, m, zero, lanes_permute(L->tfar, idx))
                 by_k = lanes_any(special);
@@ -674,7 +698,10 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const GpuWideNode* nodes,
             for (int k = 0; k < kmax; ++k) {
                 vint m = ml & ((vint)(k) < cnt);
                 vint tri = first + (vint)(k);
-                LANES_TRIANGLE(tri, m, L->kx, L->ky, L->kz, L->px, L->py, L->pz)
+                LanesTriangle tv =
+                    lanes_triangle(tw, tri, m, L->kx, L->ky, L->kz, L->px, L->py, L->pz);
+                vfloat aX = tv.aX, aY = tv.aY, aZ = tv.aZ, bX = tv.bX, bY = tv.bY, bZ = tv.bZ;
+                vfloat cX = tv.cX, cY = tv.cY, cZ = tv.cZ;
                 vfloat sx = L->sx, sy = L->sy, sz = L->sz;
                 LANE_EDGES(vfloat)
                 LANE_HITS_T(vfloat, vint, m, zero, L->tfar)
