@@ -54,7 +54,7 @@ inline void mega_count(volatile global uint* counters, uint extension_rays, uint
 // triangles first, by the traversal's own watertight test. When it meets none, it would add
 // nothing and is not traced; when it meets one at t, only an any-hit ray over (0, t) is
 // traced, and an unblocked ray shades that hit as the closest-hit ray would have found it.
-// The same estimator, the same image (docs/benchmarks.md, "Twenty-first session");
+// The same estimator, the same image;
 // -DLAST_RAY_TRACED traces it as before.
 #if defined(HAS_TRIANGLE_LIGHTS) && !defined(HAS_ENV_MAP) && !defined(HAS_UNLIT) && \
     !defined(HAS_ALPHA) && !defined(TWO_LEVEL) && !defined(LAST_RAY_TRACED)

@@ -165,7 +165,7 @@ inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const Device
         packet_take_ray(&P, &R, (int)e, s[e].origin, s[e].direction, INFINITY);
     }
     packet_set_rays(&P, &R);
-    lanes_i lanes = LANE_IDS < (lanes_i)((int)n);
+    vint lanes = LANE_IDS < (vint)((int)n);
     packet_walk(&P, lanes, false, nodes, sc->tris, &sc->surf, overflow);
     ShadowQuery q[LANES];
     bool alive[LANES];
@@ -186,7 +186,7 @@ inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const Device
         if (q[e].valid) packet_take_ray(&P, &R, (int)e, q[e].origin, q[e].direction, q[e].tmax);
     }
     for (uint e = n; e < (uint)LANES; ++e) shadow[e] = 0;
-    lanes_i shadows = lanes_vload(0, shadow);
+    vint shadows = vload_lanes(0, shadow);
     if (lanes_any(shadows)) {
         packet_set_rays(&P, &R);
         W->shadow_rays += (uint)lanes_count(shadows);
@@ -388,9 +388,9 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             continue;
         }
 #ifdef LANES_SMALL
-        lanes_i done = lanes_walk_small(&M, nodes, tris, small_first, small_end, &sc.surf);
+        vint done = lanes_walk_small(&M, nodes, tris, small_first, small_end, &sc.surf);
 #else
-        lanes_i done = lanes_walk(&M, nodes, tris, &sc.surf, overflow);
+        vint done = lanes_walk(&M, nodes, tris, &sc.surf, overflow);
 #endif
         if (!lanes_any(done)) break;
         // The lanes done, in order (lowest first).

@@ -16,15 +16,16 @@
 // (other lights by sample_light itself, lane by lane): the same paths, bit for bit
 // (tests/megakernel.rs compares the images). A chunk's camera hits, LANES or fewer at once, are
 // shaded here too.
-// docs/benchmarks.md, "Twenty-fifth session", has what it measured;
-// scripts/experiments/lanes-shade.patch was its first form, shading the lanes done at each
-// return (too few to fill the vectors).
+// Batches took 11.7 % fewer instructions on the 1 M-triangle room and about 12 % less time
+// (AMD Zen 3, AVX2, 2026-12-04); shading the lanes done at each return instead (commit 29fe987)
+// was no faster: too few to fill the vectors.
 #ifndef CPU_SHADE_LANES_H
 #define CPU_SHADE_LANES_H
 
 #include "shared/types.h"
 #include "shared/rng.h"
 #include "shared/textures.h"
+#include "cpu/simd.h"
 #include "cpu/traverse_lanes.h"
 #include "shared/lights.h"
 #include "shared/path.h"
@@ -37,18 +38,6 @@
     defined(HAS_ANISOTROPY) || defined(HAS_DISPERSION) || defined(SMALL_SCENE) ||            \
     defined(HAS_IRIDESCENCE)
 #error "LANES_SHADE is for the lanes of scenes whose shading is simplest (cl::lanes_shade)"
-#endif
-
-#if LANES == 16
-typedef uint16 lanes_u;
-#define as_lanes_u as_uint16
-#define convert_lanes_f convert_float16
-#define convert_lanes_u convert_uint16
-#else
-typedef uint8 lanes_u;
-#define as_lanes_u as_uint8
-#define convert_lanes_f convert_float8
-#define convert_lanes_u convert_uint8
 #endif
 
 // A batch of vertices to shade, field by field: entry e is a path's state (a PathState's fields
@@ -118,21 +107,21 @@ LANES_INLINE bool shade_batch_get(const ShadeBatch* B, int e, PathState* s, Shad
 }
 
 typedef struct {
-    lanes_f x, y, z;
+    vfloat x, y, z;
 } LaneVec;
 
 LANES_INLINE LaneVec lv_load(const float* x, const float* y, const float* z) {
-    LaneVec v = {lanes_vload(0, x), lanes_vload(0, y), lanes_vload(0, z)};
+    LaneVec v = {vload_lanes(0, x), vload_lanes(0, y), vload_lanes(0, z)};
     return v;
 }
 
 LANES_INLINE void lv_store(LaneVec v, float* x, float* y, float* z) {
-    lanes_vstore(v.x, 0, x);
-    lanes_vstore(v.y, 0, y);
-    lanes_vstore(v.z, 0, z);
+    vstore_lanes(v.x, 0, x);
+    vstore_lanes(v.y, 0, y);
+    vstore_lanes(v.z, 0, z);
 }
 
-LANES_INLINE LaneVec lv_select(LaneVec a, LaneVec b, lanes_i m) {
+LANES_INLINE LaneVec lv_select(LaneVec a, LaneVec b, vint m) {
     LaneVec r = {select(a.x, b.x, m), select(a.y, b.y, m), select(a.z, b.z, m)};
     return r;
 }
@@ -144,66 +133,66 @@ LANES_INLINE LaneVec lv_neg(LaneVec a) {
 
 // The OpenCL library's dot of float3 (kernel-x86_64 bitcode): the products, then x + y, then
 // z added; one statement each, so that no compiler fuses a product into an addition.
-LANES_INLINE lanes_f lv_dot(LaneVec a, LaneVec b) {
-    lanes_f xx = a.x * b.x;
-    lanes_f yy = a.y * b.y;
-    lanes_f zz = a.z * b.z;
-    lanes_f xy = xx + yy;
+LANES_INLINE vfloat lv_dot(LaneVec a, LaneVec b) {
+    vfloat xx = a.x * b.x;
+    vfloat yy = a.y * b.y;
+    vfloat zz = a.z * b.z;
+    vfloat xy = xx + yy;
     return zz + xy;
 }
 
 // The library's length of float3: the root of dot(v, v), rescaled where that is below
 // FLT_MIN or infinite (then the scalar length itself, lane by lane; all-zero lanes are 0
 // either way).
-LANES_INLINE lanes_f lv_length(LaneVec v) {
-    lanes_f d = lv_dot(v, v);
-    lanes_f len = sqrt(d);
-    lanes_i zero = (v.x == 0.0f) & (v.y == 0.0f) & (v.z == 0.0f);
-    lanes_i rare = ((d < 0x1p-126f) | (d == INFINITY)) & ~zero;
+LANES_INLINE vfloat lv_length(LaneVec v) {
+    vfloat d = lv_dot(v, v);
+    vfloat len = sqrt(d);
+    vint zero = (v.x == 0.0f) & (v.y == 0.0f) & (v.z == 0.0f);
+    vint rare = ((d < 0x1p-126f) | (d == INFINITY)) & ~zero;
     if (lanes_any(rare)) {
         float x[LANES], y[LANES], z[LANES], out[LANES];
         int r[LANES];
         lv_store(v, x, y, z);
-        lanes_vstore(len, 0, out);
-        lanes_vstore(rare, 0, r);
+        vstore_lanes(len, 0, out);
+        vstore_lanes(rare, 0, r);
         for (int l = 0; l < LANES; ++l) {
             if (r[l]) out[l] = length((float3)(x[l], y[l], z[l]));
         }
-        len = lanes_vload(0, out);
+        len = vload_lanes(0, out);
     }
-    return select(len, (lanes_f)(0.0f), zero);
+    return select(len, (vfloat)(0.0f), zero);
 }
 
-LANES_INLINE lanes_f lanes_power_heuristic(lanes_f a, lanes_f b) {
-    lanes_f a2 = a * a;
-    lanes_f b2 = b * b;
-    return select((lanes_f)(0.0f), a2 / (a2 + b2), a2 + b2 > 0.0f);
+LANES_INLINE vfloat lanes_power_heuristic(vfloat a, vfloat b) {
+    vfloat a2 = a * a;
+    vfloat b2 = b * b;
+    return select((vfloat)(0.0f), a2 / (a2 + b2), a2 + b2 > 0.0f);
 }
 
 // rng_next in the lanes of m (the others' states kept; their numbers are meaningless).
-LANES_INLINE lanes_f lanes_rng_next(lanes_u* state, lanes_i m) {
-    lanes_u s = *state * 747796405u + 2891336453u;
-    lanes_u word = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+LANES_INLINE vfloat lanes_rng_next(vuint* state, vint m) {
+    vuint s = *state * 747796405u + 2891336453u;
+    vuint word = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
     word = (word >> 22u) ^ word;
     *state = select(*state, s, m);
-    return convert_lanes_f(word >> 8u) * (1.0f / 16777216.0f);
+    return convert_vfloat(word >> 8u) * (1.0f / 16777216.0f);
 }
 
 // offset_ray (traverse.h) in every lane.
 LANES_INLINE LaneVec lanes_offset_ray(LaneVec p, LaneVec err, LaneVec n) {
     LaneVec an = {fabs(n.x), fabs(n.y), fabs(n.z)};
-    lanes_f k = lv_dot(an, err);
+    vfloat k = lv_dot(an, err);
     LaneVec r;
 #define LANES_OFFSET(c)                                                                      \
     {                                                                                        \
-        lanes_f offset = k * n.c;                                                            \
-        lanes_f po = p.c + offset;                                                           \
-        lanes_i bits = as_lanes_i(po);                                                       \
-        lanes_i away = (po > 0.0f) == (offset > 0.0f);                                       \
-        lanes_i stepped = select(bits - 1, bits + 1, away);                                  \
-        stepped = select(stepped, select((lanes_i)(0x80000001), (lanes_i)(1), offset > 0.0f), \
+        vfloat offset = k * n.c;                                                            \
+        vfloat po = p.c + offset;                                                           \
+        vint bits = as_vint(po);                                                       \
+        vint away = (po > 0.0f) == (offset > 0.0f);                                       \
+        vint stepped = select(bits - 1, bits + 1, away);                                  \
+        stepped = select(stepped, select((vint)(0x80000001), (vint)(1), offset > 0.0f), \
                          po == 0.0f);                                                        \
-        r.c = select(po, as_lanes_f(stepped), offset != 0.0f);                               \
+        r.c = select(po, as_vfloat(stepped), offset != 0.0f);                               \
     }
     LANES_OFFSET(x)
     LANES_OFFSET(y)
@@ -213,39 +202,39 @@ LANES_INLINE LaneVec lanes_offset_ray(LaneVec p, LaneVec err, LaneVec n) {
 }
 
 // unit_circle (rng.h) in every lane: (cos, sin) of 2 pi u, fused where the scalar form is.
-LANES_INLINE void lanes_unit_circle(lanes_f u, lanes_f* cx, lanes_f* cy) {
-    lanes_f q = rint(4.0f * u);
-    lanes_f x = fma(q, (lanes_f)(-0.25f), u) * (2.0f * PI_F);
-    lanes_f x2 = x * x;
-    lanes_f s = fma(x * x2,
-                    fma(x2, fma(x2, fma(x2, (lanes_f)(1.0f / 362880.0f), (lanes_f)(-1.0f / 5040.0f)),
-                                (lanes_f)(1.0f / 120.0f)),
-                        (lanes_f)(-1.0f / 6.0f)),
+LANES_INLINE void lanes_unit_circle(vfloat u, vfloat* cx, vfloat* cy) {
+    vfloat q = rint(4.0f * u);
+    vfloat x = fma(q, (vfloat)(-0.25f), u) * (2.0f * PI_F);
+    vfloat x2 = x * x;
+    vfloat s = fma(x * x2,
+                    fma(x2, fma(x2, fma(x2, (vfloat)(1.0f / 362880.0f), (vfloat)(-1.0f / 5040.0f)),
+                                (vfloat)(1.0f / 120.0f)),
+                        (vfloat)(-1.0f / 6.0f)),
                     x);
-    lanes_f c = fma(x2,
-                    fma(x2, fma(x2, fma(x2, (lanes_f)(1.0f / 40320.0f), (lanes_f)(-1.0f / 720.0f)),
-                                (lanes_f)(1.0f / 24.0f)),
-                        (lanes_f)(-0.5f)),
-                    (lanes_f)(1.0f));
-    lanes_u k = convert_lanes_u(q) & 3u;
-    lanes_i odd = as_lanes_i(k & 1u) != 0, back = as_lanes_i(k & 2u) != 0;
-    lanes_f px = select(c, -s, odd), py = select(s, c, odd);
+    vfloat c = fma(x2,
+                    fma(x2, fma(x2, fma(x2, (vfloat)(1.0f / 40320.0f), (vfloat)(-1.0f / 720.0f)),
+                                (vfloat)(1.0f / 24.0f)),
+                        (vfloat)(-0.5f)),
+                    (vfloat)(1.0f));
+    vuint k = convert_vuint(q) & 3u;
+    vint odd = as_vint(k & 1u) != 0, back = as_vint(k & 2u) != 0;
+    vfloat px = select(c, -s, odd), py = select(s, c, odd);
     *cx = select(px, -px, back);
     *cy = select(py, -py, back);
 }
 
 // surface_point (traverse.h) in every lane: the point at barycentrics (u, v) and its error bound.
-LANES_INLINE LaneVec lanes_surface_point(LaneVec v0, LaneVec v1, LaneVec v2, lanes_f u, lanes_f v,
+LANES_INLINE LaneVec lanes_surface_point(LaneVec v0, LaneVec v1, LaneVec v2, vfloat u, vfloat v,
                                          LaneVec* err) {
     const float gamma7 = 7.0f * 0x1p-24f / (1.0f - 7.0f * 0x1p-24f);
     const float gamma64 = 64.0f * 0x1p-24f / (1.0f - 64.0f * 0x1p-24f);
-    lanes_f w = 1.0f - u - v;
+    vfloat w = 1.0f - u - v;
     LaneVec p = {w * v0.x + u * v1.x + v * v2.x, w * v0.y + u * v1.y + v * v2.y,
                  w * v0.z + u * v1.z + v * v2.z};
-    lanes_f ex = fmax(fmax(fabs(v0.x - p.x), fabs(v1.x - p.x)), fabs(v2.x - p.x));
-    lanes_f ey = fmax(fmax(fabs(v0.y - p.y), fabs(v1.y - p.y)), fabs(v2.y - p.y));
-    lanes_f ez = fmax(fmax(fabs(v0.z - p.z), fabs(v1.z - p.z)), fabs(v2.z - p.z));
-    lanes_f reach = fmax(fmax(ex, ey), ez);
+    vfloat ex = fmax(fmax(fabs(v0.x - p.x), fabs(v1.x - p.x)), fabs(v2.x - p.x));
+    vfloat ey = fmax(fmax(fabs(v0.y - p.y), fabs(v1.y - p.y)), fabs(v2.y - p.y));
+    vfloat ez = fmax(fmax(fabs(v0.z - p.z), fabs(v1.z - p.z)), fabs(v2.z - p.z));
+    vfloat reach = fmax(fmax(ex, ey), ez);
     err->x = gamma7 * (fabs(w * v0.x) + fabs(u * v1.x) + fabs(v * v2.x)) + gamma64 * reach;
     err->y = gamma7 * (fabs(w * v0.y) + fabs(u * v1.y) + fabs(v * v2.y)) + gamma64 * reach;
     err->z = gamma7 * (fabs(w * v0.z) + fabs(u * v1.z) + fabs(v * v2.z)) + gamma64 * reach;
@@ -254,22 +243,22 @@ LANES_INLINE LaneVec lanes_surface_point(LaneVec v0, LaneVec v1, LaneVec v2, lan
 
 // triangle_normal (traverse.h) in the lanes of m: the library's cross, scaled by a power of
 // two, normalized.
-LANES_INLINE LaneVec lanes_triangle_normal(LaneVec v0, LaneVec v1, LaneVec v2, lanes_i m) {
+LANES_INLINE LaneVec lanes_triangle_normal(LaneVec v0, LaneVec v1, LaneVec v2, vint m) {
     LaneVec a = {v1.x - v0.x, v1.y - v0.y, v1.z - v0.z};
     LaneVec b = {v2.x - v0.x, v2.y - v0.y, v2.z - v0.z};
-    lanes_f c1 = a.y * b.z, c2 = a.z * b.y;
-    lanes_f c3 = a.z * b.x, c4 = a.x * b.z;
-    lanes_f c5 = a.x * b.y, c6 = a.y * b.x;
+    vfloat c1 = a.y * b.z, c2 = a.z * b.y;
+    vfloat c3 = a.z * b.x, c4 = a.x * b.z;
+    vfloat c5 = a.x * b.y, c6 = a.y * b.x;
     LaneVec c = {c1 - c2, c3 - c4, c5 - c6};
-    lanes_f mc = fmax(fmax(fabs(c.x), fabs(c.y)), fabs(c.z));
-    lanes_u e = (as_lanes_u(mc) >> 23u) & 0xffu;
-    lanes_i normal_e = (e - 1u) < (lanes_u)(253u);
-    lanes_f scale = as_lanes_f((254u - e) << 23u);
+    vfloat mc = fmax(fmax(fabs(c.x), fabs(c.y)), fabs(c.z));
+    vuint e = (as_vuint(mc) >> 23u) & 0xffu;
+    vint normal_e = (e - 1u) < (vuint)(253u);
+    vfloat scale = as_vfloat((254u - e) << 23u);
     if (lanes_any(m & ~normal_e)) {
-        scale = select(ldexp((lanes_f)(1.0f), -ilogb(mc)), scale, normal_e);
+        scale = select(ldexp((vfloat)(1.0f), -ilogb(mc)), scale, normal_e);
     }
     LaneVec cs = {c.x * scale, c.y * scale, c.z * scale};
-    lanes_f inv = 1.0f / sqrt(cs.x * cs.x + cs.y * cs.y + cs.z * cs.z);
+    vfloat inv = 1.0f / sqrt(cs.x * cs.x + cs.y * cs.y + cs.z * cs.z);
     LaneVec n = {cs.x * inv, cs.y * inv, cs.z * inv};
     return lv_select(c, n, mc > 0.0f);
 }
@@ -277,47 +266,47 @@ LANES_INLINE LaneVec lanes_triangle_normal(LaneVec v0, LaneVec v1, LaneVec v2, l
 // A triangle's vertices (words 0-11 of each lane's DeviceTriangle at word offset off[l]) and its
 // words 3 and 7 (material, light index).
 LANES_INLINE void lanes_triangle_rows(global const DeviceTriangle* tris, const int* off, LaneVec* v0,
-                                      LaneVec* v1, LaneVec* v2, lanes_i* w3, lanes_i* w7) {
-    lanes_f T[12];
+                                      LaneVec* v1, LaneVec* v2, vint* w3, vint* w7) {
+    vfloat T[12];
     global const float* tw = (global const float*)tris;
     lanes_rows8(tw, off, 0, T);
     lanes_rows4(tw, off, 8, T + 8);
     v0->x = T[0], v0->y = T[1], v0->z = T[2];
     v1->x = T[4], v1->y = T[5], v1->z = T[6];
     v2->x = T[8], v2->y = T[9], v2->z = T[10];
-    *w3 = as_lanes_i(T[3]);
-    *w7 = as_lanes_i(T[7]);
+    *w3 = as_vint(T[3]);
+    *w7 = as_vint(T[7]);
 }
 
 // Shades entries [0, n) of the batch, as shade_vertex does (see above): emission with MIS, the
 // light sample, the BSDF sample of the next ray.
 LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, ShadeBatch* B,
                               int n) {
-    const lanes_f zero = (lanes_f)(0.0f);
+    const vfloat zero = (vfloat)(0.0f);
     const SceneSurfaces* surf = &sc->surf;
-    lanes_i m = LANE_IDS < (lanes_i)(n);
-    lanes_i valid = (lanes_i)(0), alive = (lanes_i)(0);
-    lanes_u bounce = as_lanes_u(lanes_vload(0, (const int*)B->bounce));
-    lanes_u rng = as_lanes_u(lanes_vload(0, (const int*)B->rng));
-    lanes_u flags = as_lanes_u(lanes_vload(0, (const int*)B->flags));
+    vint m = LANE_IDS < (vint)(n);
+    vint valid = (vint)(0), alive = (vint)(0);
+    vuint bounce = as_vuint(vload_lanes(0, (const int*)B->bounce));
+    vuint rng = as_vuint(vload_lanes(0, (const int*)B->rng));
+    vuint flags = as_vuint(vload_lanes(0, (const int*)B->flags));
     LaneVec thr = lv_load(B->tx, B->ty, B->tz);
     LaneVec rad = lv_load(B->rx, B->ry, B->rz);
     LaneVec wo = lv_neg(lv_load(B->dx, B->dy, B->dz));
-    lanes_f prev_pdf = lanes_vload(0, B->pdf);
-    lanes_i prev_specular = as_lanes_i(flags & PATH_SPECULAR) != 0;
-    lanes_i camera = bounce == (lanes_u)(0u);
-    lanes_i counts_emission =
-        camera | prev_specular | (lanes_i)(frame->strategy != STRATEGY_LIGHTS ? -1 : 0);
-    lanes_i mis = ~camera & ~prev_specular & (lanes_i)(frame->strategy == STRATEGY_MIS ? -1 : 0);
-    lanes_i prim = lanes_vload(0, B->prim);
-    lanes_f t = lanes_vload(0, B->t);
+    vfloat prev_pdf = vload_lanes(0, B->pdf);
+    vint prev_specular = as_vint(flags & PATH_SPECULAR) != 0;
+    vint camera = bounce == (vuint)(0u);
+    vint counts_emission =
+        camera | prev_specular | (vint)(frame->strategy != STRATEGY_LIGHTS ? -1 : 0);
+    vint mis = ~camera & ~prev_specular & (vint)(frame->strategy == STRATEGY_MIS ? -1 : 0);
+    vint prim = vload_lanes(0, B->prim);
+    vfloat t = vload_lanes(0, B->t);
 
     // Escaped: the uniform sky, reached by BSDF sampling only. An escaped camera ray is marked
     // for the film's coverage count; with the background cut out it adds nothing.
-    lanes_i escaped = m & (prim < 0);
-    lanes_i ce = escaped & counts_emission;
+    vint escaped = m & (prim < 0);
+    vint ce = escaped & counts_emission;
     if (frame->background != BACKGROUND_ENV) {
-        lanes_i marked = escaped & camera;
+        vint marked = escaped & camera;
         flags = select(flags, flags | PATH_ESCAPED, marked);
         if (frame->background == BACKGROUND_CUTOUT) ce &= ~marked;
     }
@@ -327,44 +316,44 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
     m &= ~escaped;
     if (lanes_any(m)) {
         // The hit: its triangle's rows (lanes outside m read triangle 0).
-        lanes_f hu = lanes_vload(0, B->u), hv = lanes_vload(0, B->v);
+        vfloat hu = vload_lanes(0, B->u), hv = vload_lanes(0, B->v);
         int off[LANES];
-        lanes_vstore(select((lanes_i)(0), prim * (lanes_i)(12), m), 0, off);
+        vstore_lanes(select((vint)(0), prim * (vint)(12), m), 0, off);
         LaneVec v0, v1, v2;
-        lanes_i mat, light_index;
+        vint mat, light_index;
         lanes_triangle_rows(sc->tris, off, &v0, &v1, &v2, &mat, &light_index);
-        lanes_f w0 = 1.0f - hu - hv;
+        vfloat w0 = 1.0f - hu - hv;
         LaneVec perr;
         LaneVec p = lanes_surface_point(v0, v1, v2, hu, hv, &perr);
         LaneVec ng = lanes_triangle_normal(v0, v1, v2, m);
-        lanes_i front = lv_dot(ng, wo) > 0.0f;
+        vint front = lv_dot(ng, wo) > 0.0f;
         // The material's base color and emission (lanes outside m read material 0).
         int moff[LANES];
-        lanes_vstore(select((lanes_i)(0), mat * (lanes_i)(sizeof(DeviceMaterial) / 4), m), 0, moff);
-        lanes_f MB[8];
+        vstore_lanes(select((vint)(0), mat * (vint)(sizeof(DeviceMaterial) / 4), m), 0, moff);
+        vfloat MB[8];
         lanes_rows8((global const float*)surf->materials, moff, 0, MB);
 #ifdef HAS_TRIANGLE_LIGHTS
         // Emission of a light hit by this ray, weighted against light sampling of the last
         // vertex.
         {
-            lanes_i two_sided = (as_lanes_i(MB[7]) & (lanes_i)(MATERIAL_DOUBLE_SIDED)) != 0;
-            lanes_i em = m & (light_index >= 0) & (front | two_sided) & counts_emission;
+            vint two_sided = (as_vint(MB[7]) & (vint)(MATERIAL_DOUBLE_SIDED)) != 0;
+            vint em = m & (light_index >= 0) & (front | two_sided) & counts_emission;
             if (lanes_any(em)) {
-                lanes_f weight = (lanes_f)(1.0f);
-                lanes_i w_mis = em & mis;
+                vfloat weight = (vfloat)(1.0f);
+                vint w_mis = em & mis;
                 if (lanes_any(w_mis)) {
                     // The light's selection probability and area, lane by lane (rare).
                     float sel_[LANES], area_[LANES];
                     int li_[LANES];
-                    lanes_vstore(select((lanes_i)(0), light_index, w_mis), 0, li_);
+                    vstore_lanes(select((vint)(0), light_index, w_mis), 0, li_);
                     for (int l = 0; l < LANES; ++l) {
                         global const DeviceLight* lt = &sc->lights[li_[l]];
                         sel_[l] = lt->extra.y;
                         area_[l] = lt->spot.y;
                     }
-                    lanes_f sel = lanes_vload(0, sel_), area = lanes_vload(0, area_);
-                    lanes_f cos_l = fabs(lv_dot(ng, wo));
-                    lanes_f light_pdf = select(zero, sel * t * t / (area * cos_l), cos_l > 0.0f);
+                    vfloat sel = vload_lanes(0, sel_), area = vload_lanes(0, area_);
+                    vfloat cos_l = fabs(lv_dot(ng, wo));
+                    vfloat light_pdf = select(zero, sel * t * t / (area * cos_l), cos_l > 0.0f);
                     weight = select(weight, lanes_power_heuristic(prev_pdf, light_pdf), w_mis);
                 }
                 rad.x = select(rad.x, rad.x + thr.x * MB[4] * weight, em);
@@ -374,23 +363,23 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
         }
 #endif
         // The last extension only looks for emitters.
-        m &= bounce <= (lanes_u)(frame->max_bounces);
+        m &= bounce <= (vuint)(frame->max_bounces);
         // Face the normals towards the side the ray came from; the shading normal.
         ng = lv_select(lv_neg(ng), ng, front);
         LaneVec ns = ng;
         {
             int soff[LANES];
-            lanes_vstore(select((lanes_i)(0), prim * (lanes_i)(9), m), 0, soff);
-            lanes_f N[8];
+            vstore_lanes(select((vint)(0), prim * (vint)(9), m), 0, soff);
+            vfloat N[8];
             global const float* shw = (global const float*)surf->shading;
             lanes_rows8(shw, soff, 0, N);
             float n8_[LANES];
             for (int l = 0; l < LANES; ++l) n8_[l] = shw[soff[l] + 8];
-            lanes_f n8 = lanes_vload(0, n8_);
+            vfloat n8 = vload_lanes(0, n8_);
             LaneVec sn = {w0 * N[0] + hu * N[3] + hv * N[6], w0 * N[1] + hu * N[4] + hv * N[7],
                           w0 * N[2] + hu * N[5] + hv * n8};
-            lanes_f len = lv_length(sn);
-            lanes_i has = len > 0.0f;
+            vfloat len = lv_length(sn);
+            vint has = len > 0.0f;
             LaneVec nn = {sn.x / len, sn.y / len, sn.z / len};
             nn = lv_select(nn, lv_neg(nn), lv_dot(nn, ng) < 0.0f);
             ns = lv_select(ns, nn, has);
@@ -399,17 +388,17 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
 
         // Next-event estimation: one light sample, its visibility tested by the caller.
         if (frame->strategy != STRATEGY_BSDF && frame->light_count > 0u && lanes_any(m)) {
-            lanes_f ui = lanes_rng_next(&rng, m);
-            lanes_f u1 = lanes_rng_next(&rng, m);
-            lanes_f u2 = lanes_rng_next(&rng, m);
+            vfloat ui = lanes_rng_next(&rng, m);
+            vfloat u1 = lanes_rng_next(&rng, m);
+            vfloat u2 = lanes_rng_next(&rng, m);
             float ui_[LANES], u1_[LANES], u2_[LANES], px[LANES], py[LANES], pz[LANES];
             float wx[LANES], wy[LANES], wz[LANES], dist[LANES], lx[LANES], ly[LANES], lz[LANES];
             float lpdf[LANES], gx[LANES], gy[LANES], gz[LANES];
             int on[LANES], tri_light[LANES], lprim[LANES];
             float lsel[LANES], larea[LANES];
-            lanes_vstore(ui, 0, ui_);
-            lanes_vstore(u1, 0, u1_);
-            lanes_vstore(u2, 0, u2_);
+            vstore_lanes(ui, 0, ui_);
+            vstore_lanes(u1, 0, u1_);
+            vstore_lanes(u2, 0, u2_);
             lv_store(p, px, py, pz);
             // The lights picked; emissive triangles are sampled in vectors below, other lights
             // by the scalar sample_light.
@@ -448,42 +437,42 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
             }
             // Lanes outside m: their (uninitialised) values are selected away below.
             LaneVec wi = lv_load(wx, wy, wz), lr = lv_load(lx, ly, lz);
-            lanes_f ls_pdf = lanes_vload(0, lpdf);
-            lanes_f ls_dist = lanes_vload(0, dist);
+            vfloat ls_pdf = vload_lanes(0, lpdf);
+            vfloat ls_dist = vload_lanes(0, dist);
             LaneVec target = lv_load(gx, gy, gz);
-            lanes_i on_surface = lanes_vload(0, on);
+            vint on_surface = vload_lanes(0, on);
 #ifdef HAS_TRIANGLE_LIGHTS
-            lanes_i tl = lanes_vload(0, tri_light);
+            vint tl = vload_lanes(0, tri_light);
             if (lanes_any(tl)) {
                 // sample_light's emissive triangle, lane by lane as it computes it.
                 LaneVec t0, t1, t2;
-                lanes_i lmat, unused;
+                vint lmat, unused;
                 lanes_triangle_rows(sc->tris, lprim, &t0, &t1, &t2, &lmat, &unused);
-                lanes_f su = sqrt(u1);
-                lanes_f bx = su * (1.0f - u2), by = su * u2;
+                vfloat su = sqrt(u1);
+                vfloat bx = su * (1.0f - u2), by = su * u2;
                 LaneVec q_err;
                 LaneVec q = lanes_surface_point(t0, t1, t2, bx, by, &q_err);
                 LaneVec lng = lanes_triangle_normal(t0, t1, t2, tl);
                 LaneVec d = {q.x - p.x, q.y - p.y, q.z - p.z};
-                lanes_f dist2 = lv_dot(d, d);
-                lanes_i far = tl & ~(dist2 <= 0.0f);  // else nothing (pdf 0), wi +z, target p
-                lanes_f distance = sqrt(dist2);
+                vfloat dist2 = lv_dot(d, d);
+                vint far = tl & ~(dist2 <= 0.0f);  // else nothing (pdf 0), wi +z, target p
+                vfloat distance = sqrt(dist2);
                 LaneVec lwi = {d.x / distance, d.y / distance, d.z / distance};
                 LaneVec pq = {p.x - q.x, p.y - q.y, p.z - q.z};
                 LaneVec ltarget =
                     lanes_offset_ray(q, q_err, lv_select(lv_neg(lng), lng, lv_dot(lng, pq) > 0.0f));
                 int loff[LANES];
-                lanes_vstore(select((lanes_i)(0), lmat * (lanes_i)(sizeof(DeviceMaterial) / 4), far),
+                vstore_lanes(select((vint)(0), lmat * (vint)(sizeof(DeviceMaterial) / 4), far),
                              0, loff);
-                lanes_f E[4];
+                vfloat E[4];
                 lanes_rows4((global const float*)surf->materials, loff, 4, E);
-                lanes_f cos_l = -lv_dot(lng, lwi);
-                lanes_i two_sided = (as_lanes_i(E[3]) & (lanes_i)(MATERIAL_DOUBLE_SIDED)) != 0;
-                lanes_i emits = far & (two_sided | ~(cos_l <= 0.0f));
+                vfloat cos_l = -lv_dot(lng, lwi);
+                vint two_sided = (as_vint(E[3]) & (vint)(MATERIAL_DOUBLE_SIDED)) != 0;
+                vint emits = far & (two_sided | ~(cos_l <= 0.0f));
                 cos_l = fabs(cos_l);
                 emits &= ~(cos_l <= 0.0f);
-                lanes_f lp = lanes_vload(0, lsel) * dist2 / (lanes_vload(0, larea) * cos_l);
-                LaneVec one = {(lanes_f)(0.0f), (lanes_f)(0.0f), (lanes_f)(1.0f)};
+                vfloat lp = vload_lanes(0, lsel) * dist2 / (vload_lanes(0, larea) * cos_l);
+                LaneVec one = {(vfloat)(0.0f), (vfloat)(0.0f), (vfloat)(1.0f)};
                 wi = lv_select(wi, lv_select(one, lwi, far), tl);
                 ls_dist = select(ls_dist, select(zero, distance, far), tl);
                 target = lv_select(target, lv_select(p, ltarget, far), tl);
@@ -493,19 +482,19 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                 lr = lv_select(lr, lv_select((LaneVec){zero, zero, zero}, lrad, emits), tl);
             }
 #endif
-            lanes_f side = lv_dot(wi, ng);
-            lanes_i ok = m & (side * lv_dot(wi, ns) > 0.0f) &
+            vfloat side = lv_dot(wi, ng);
+            vint ok = m & (side * lv_dot(wi, ns) > 0.0f) &
                          ((lr.x > 0.0f) | (lr.y > 0.0f) | (lr.z > 0.0f));
             if (lanes_any(ok)) {
                 // bsdf_eval, Lambertian.
-                lanes_f cos_i = lv_dot(wi, ns);
-                lanes_i lit = (lv_dot(wo, ns) > 0.0f) & (cos_i > 0.0f);
-                lanes_f bsdf_pdf = select(zero, cos_i * INV_PI_F, lit);
-                lanes_f fc = cos_i * INV_PI_F;
+                vfloat cos_i = lv_dot(wi, ns);
+                vint lit = (lv_dot(wo, ns) > 0.0f) & (cos_i > 0.0f);
+                vfloat bsdf_pdf = select(zero, cos_i * INV_PI_F, lit);
+                vfloat fc = cos_i * INV_PI_F;
                 LaneVec f = {select(zero, base.x * fc, lit), select(zero, base.y * fc, lit),
                              select(zero, base.z * fc, lit)};
-                lanes_f weight = select((lanes_f)(1.0f), lanes_power_heuristic(ls_pdf, bsdf_pdf),
-                                        (lanes_i)(frame->strategy == STRATEGY_MIS ? -1 : 0) &
+                vfloat weight = select((vfloat)(1.0f), lanes_power_heuristic(ls_pdf, bsdf_pdf),
+                                        (vint)(frame->strategy == STRATEGY_MIS ? -1 : 0) &
                                             (ls_pdf > 0.0f));
                 LaneVec c = {thr.x * f.x * lr.x * weight, thr.y * f.y * lr.y * weight,
                              thr.z * f.z * lr.z * weight};
@@ -513,15 +502,15 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                 if (lanes_any(ok)) {
                     LaneVec from = lanes_offset_ray(p, perr, lv_select(lv_neg(ng), ng, side > 0.0f));
                     LaneVec sd = wi;
-                    lanes_f tmax = ls_dist;
+                    vfloat tmax = ls_dist;
                     LaneVec seg = {target.x - from.x, target.y - from.y, target.z - from.z};
-                    lanes_f seg_len = lv_length(seg);
+                    vfloat seg_len = lv_length(seg);
                     LaneVec seg_dir = {seg.x / seg_len, seg.y / seg_len, seg.z / seg_len};
                     tmax = select(tmax, seg_len, on_surface);
                     sd = lv_select(sd, seg_dir, on_surface);
                     lv_store(from, B->qox, B->qoy, B->qoz);
                     lv_store(sd, B->qdx, B->qdy, B->qdz);
-                    lanes_vstore(tmax, 0, B->qtmax);
+                    vstore_lanes(tmax, 0, B->qtmax);
                     lv_store(c, B->qcx, B->qcy, B->qcz);
                     valid = ok;
                 }
@@ -531,45 +520,45 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
 #if !defined(HAS_TRIANGLE_LIGHTS) && !defined(HAS_ENV_MAP) && !defined(HAS_UNLIT)
         // The last extension only looks for emitters, and there are none but the sky: under a
         // black sky the path ends here, its last ray untraced.
-        if (frame_sky_black(frame)) m &= bounce != (lanes_u)(frame->max_bounces);
+        if (frame_sky_black(frame)) m &= bounce != (vuint)(frame->max_bounces);
 #endif
 
         // Sample the BSDF for the next ray (Lambertian: by its cosine); Russian roulette after
         // rr_depth bounces.
         if (lanes_any(m)) {
-            lanes_f u1 = lanes_rng_next(&rng, m);
-            lanes_f u2 = lanes_rng_next(&rng, m);
-            lanes_i ok0 = lv_dot(wo, ns) > 0.0f;
-            lanes_f r = sqrt(u1);
-            lanes_f ccx, ccy;
+            vfloat u1 = lanes_rng_next(&rng, m);
+            vfloat u2 = lanes_rng_next(&rng, m);
+            vint ok0 = lv_dot(wo, ns) > 0.0f;
+            vfloat r = sqrt(u1);
+            vfloat ccx, ccy;
             lanes_unit_circle(u2, &ccx, &ccy);
             LaneVec wl = {r * ccx, r * ccy, sqrt(fmax(0.0f, 1.0f - u1))};
-            lanes_i ok1 = ok0 & (wl.z > 0.0f);
+            vint ok1 = ok0 & (wl.z > 0.0f);
             // onb (rng.h) around ns, fused where the compiler fuses the scalar form.
-            lanes_f s = select((lanes_f)(-1.0f), (lanes_f)(1.0f), ns.z >= 0.0f);
-            lanes_f a = -1.0f / (s + ns.z);
-            lanes_f c = ns.x * ns.y * a;
-            LaneVec tt = {fma(s * ns.x * ns.x, a, (lanes_f)(1.0f)), s * c, -s * ns.x};
+            vfloat s = select((vfloat)(-1.0f), (vfloat)(1.0f), ns.z >= 0.0f);
+            vfloat a = -1.0f / (s + ns.z);
+            vfloat c = ns.x * ns.y * a;
+            LaneVec tt = {fma(s * ns.x * ns.x, a, (vfloat)(1.0f)), s * c, -s * ns.x};
             LaneVec bb = {c, fma(ns.y * ns.y, a, s), -ns.y};
             LaneVec wi = {wl.x * tt.x + wl.y * bb.x + wl.z * ns.x,
                           wl.x * tt.y + wl.y * bb.y + wl.z * ns.y,
                           wl.x * tt.z + wl.y * bb.z + wl.z * ns.z};
             wi = lv_select(ns, wi, ok1);
-            lanes_f cos_i = lv_dot(wi, ns);
-            lanes_i ok2 = ok1 & (cos_i > 0.0f);
-            lanes_f pdf = select(zero, cos_i * INV_PI_F, ok2);
+            vfloat cos_i = lv_dot(wi, ns);
+            vint ok2 = ok1 & (cos_i > 0.0f);
+            vfloat pdf = select(zero, cos_i * INV_PI_F, ok2);
             thr.x = thr.x * select(zero, base.x, ok2);
             thr.y = thr.y * select(zero, base.y, ok2);
             thr.z = thr.z * select(zero, base.z, ok2);
-            lanes_f side = lv_dot(wi, ng);
-            lanes_i go = m & (pdf > 0.0f) & (side * lv_dot(wi, ns) > 0.0f) &
+            vfloat side = lv_dot(wi, ng);
+            vint go = m & (pdf > 0.0f) & (side * lv_dot(wi, ns) > 0.0f) &
                          ((thr.x > 0.0f) | (thr.y > 0.0f) | (thr.z > 0.0f));
-            lanes_i rr = go & (bounce >= (lanes_u)(frame->rr_depth));
+            vint rr = go & (bounce >= (vuint)(frame->rr_depth));
             if (lanes_any(rr)) {
-                lanes_f q = fmin(fmax(thr.x, fmax(thr.y, thr.z)), 0.95f);
-                lanes_f x = lanes_rng_next(&rng, rr);
+                vfloat q = fmin(fmax(thr.x, fmax(thr.y, thr.z)), 0.95f);
+                vfloat x = lanes_rng_next(&rng, rr);
                 go &= ~(rr & (x >= q));
-                lanes_i keep = rr & go;
+                vint keep = rr & go;
                 thr.x = select(thr.x, thr.x / q, keep);
                 thr.y = select(thr.y, thr.y / q, keep);
                 thr.z = select(thr.z, thr.z / q, keep);
@@ -578,16 +567,16 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
             lv_store(o, B->ox, B->oy, B->oz);
             lv_store(wi, B->dx, B->dy, B->dz);
             lv_store(thr, B->tx, B->ty, B->tz);
-            lanes_vstore(pdf, 0, B->pdf);
-            flags = select(flags, (lanes_u)(0u), go);
+            vstore_lanes(pdf, 0, B->pdf);
+            flags = select(flags, (vuint)(0u), go);
             alive = go;
         }
     }
     lv_store(rad, B->rx, B->ry, B->rz);
-    lanes_vstore(as_lanes_i(rng), 0, (int*)B->rng);
-    lanes_vstore(as_lanes_i(flags), 0, (int*)B->flags);
-    lanes_vstore(alive, 0, B->alive);
-    lanes_vstore(valid, 0, B->valid);
+    vstore_lanes(as_vint(rng), 0, (int*)B->rng);
+    vstore_lanes(as_vint(flags), 0, (int*)B->flags);
+    vstore_lanes(alive, 0, B->alive);
+    vstore_lanes(valid, 0, B->valid);
 }
 #endif
 

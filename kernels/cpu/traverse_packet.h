@@ -19,6 +19,7 @@
 #include "shared/types.h"
 #include "shared/textures.h"
 #include "shared/traverse_wide.h"
+#include "cpu/simd.h"
 #include "cpu/traverse_lanes.h"
 
 #ifdef MEGA_LANES
@@ -49,24 +50,24 @@ LANES_INLINE void packet_take_ray(Packet* P, LanesRays* R, int lane, float3 o, f
 // hit yet.
 LANES_INLINE void packet_set_rays(Packet* P, const LanesRays* R) {
     LANES_LOAD_RAYS(R)
-    lanes_vstore(ox, 0, P->ox);
-    lanes_vstore(oy, 0, P->oy);
-    lanes_vstore(oz, 0, P->oz);
-    lanes_vstore(ix, 0, P->ix);
-    lanes_vstore(iy, 0, P->iy);
-    lanes_vstore(iz, 0, P->iz);
-    lanes_vstore(px, 0, P->px);
-    lanes_vstore(py, 0, P->py);
-    lanes_vstore(pz, 0, P->pz);
-    lanes_vstore(sx, 0, P->sx);
-    lanes_vstore(sy, 0, P->sy);
-    lanes_vstore(sz, 0, P->sz);
-    lanes_vstore(kz, 0, P->kz);
-    lanes_vstore(lanes_vload(0, R->tmax), 0, P->tfar);
-    lanes_vstore((lanes_f)(0.0f), 0, P->hv);
-    lanes_vstore((lanes_f)(0.0f), 0, P->hw);
-    lanes_vstore((lanes_f)(1.0f), 0, P->hdet);
-    lanes_vstore((lanes_i)(-1), 0, P->prim);
+    vstore_lanes(ox, 0, P->ox);
+    vstore_lanes(oy, 0, P->oy);
+    vstore_lanes(oz, 0, P->oz);
+    vstore_lanes(ix, 0, P->ix);
+    vstore_lanes(iy, 0, P->iy);
+    vstore_lanes(iz, 0, P->iz);
+    vstore_lanes(px, 0, P->px);
+    vstore_lanes(py, 0, P->py);
+    vstore_lanes(pz, 0, P->pz);
+    vstore_lanes(sx, 0, P->sx);
+    vstore_lanes(sy, 0, P->sy);
+    vstore_lanes(sz, 0, P->sz);
+    vstore_lanes(kz, 0, P->kz);
+    vstore_lanes(vload_lanes(0, R->tmax), 0, P->tfar);
+    vstore_lanes((vfloat)(0.0f), 0, P->hv);
+    vstore_lanes((vfloat)(0.0f), 0, P->hw);
+    vstore_lanes((vfloat)(1.0f), 0, P->hdet);
+    vstore_lanes((vint)(-1), 0, P->prim);
 }
 
 // The hit of a lane after a closest-hit walk.
@@ -76,7 +77,7 @@ LANES_INLINE DeviceHit packet_hit(const Packet* P, int lane) {
 }
 
 // The least lane of x.
-inline float packet_min(lanes_f x) {
+inline float packet_min(vfloat x) {
 #if LANES == 16
     float8 a = select(x.hi, x.lo, x.lo < x.hi);
 #else
@@ -90,26 +91,26 @@ inline float packet_min(lanes_f x) {
 // Walks the rays of the lanes `live` (from tmin 0 to each lane's tfar) for their nearest hits,
 // or with any_hit for some hit each (a lane's prim >= 0 after it: occluded), writing the hits
 // to P. A packet whose stack would overflow ends with the hits so far (counted).
-LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
+LANES_INLINE void packet_walk(Packet* P, vint live, bool any_hit,
                               global const DeviceWideNode* nodes, global const DeviceTriangle* tris,
                               const SceneSurfaces* surf, volatile global uint* overflow) {
-    const lanes_f inf = (lanes_f)(INFINITY), zero = (lanes_f)(0.0f);
-    const lanes_i izero = (lanes_i)(0);
-    lanes_f ox = lanes_vload(0, P->ox), oy = lanes_vload(0, P->oy), oz = lanes_vload(0, P->oz);
-    lanes_f ix = lanes_vload(0, P->ix), iy = lanes_vload(0, P->iy), iz = lanes_vload(0, P->iz);
-    lanes_f px = lanes_vload(0, P->px), py = lanes_vload(0, P->py), pz = lanes_vload(0, P->pz);
-    lanes_f sx = lanes_vload(0, P->sx), sy = lanes_vload(0, P->sy), sz = lanes_vload(0, P->sz);
-    lanes_i kz = lanes_vload(0, P->kz);
-    lanes_i z0 = kz == izero, z1 = kz == (lanes_i)(1);
-    lanes_f tfar = lanes_vload(0, P->tfar), hv = lanes_vload(0, P->hv), hw = lanes_vload(0, P->hw);
-    lanes_f hdet = lanes_vload(0, P->hdet);
-    lanes_i prim = lanes_vload(0, P->prim);
-    lanes_f stack_d[PACKET_STACK];
+    const vfloat inf = (vfloat)(INFINITY), zero = (vfloat)(0.0f);
+    const vint izero = (vint)(0);
+    vfloat ox = vload_lanes(0, P->ox), oy = vload_lanes(0, P->oy), oz = vload_lanes(0, P->oz);
+    vfloat ix = vload_lanes(0, P->ix), iy = vload_lanes(0, P->iy), iz = vload_lanes(0, P->iz);
+    vfloat px = vload_lanes(0, P->px), py = vload_lanes(0, P->py), pz = vload_lanes(0, P->pz);
+    vfloat sx = vload_lanes(0, P->sx), sy = vload_lanes(0, P->sy), sz = vload_lanes(0, P->sz);
+    vint kz = vload_lanes(0, P->kz);
+    vint z0 = kz == izero, z1 = kz == (vint)(1);
+    vfloat tfar = vload_lanes(0, P->tfar), hv = vload_lanes(0, P->hv), hw = vload_lanes(0, P->hw);
+    vfloat hdet = vload_lanes(0, P->hdet);
+    vint prim = vload_lanes(0, P->prim);
+    vfloat stack_d[PACKET_STACK];
     int stack_item[PACKET_STACK];
     int sp = 0;
     int item = 0;       // the root
-    lanes_i m = live;     // the lanes visiting `item`
-    lanes_i open = live;  // the lanes still looking (with any_hit: not yet blocked)
+    vint m = live;     // the lanes visiting `item`
+    vint open = live;  // the lanes still looking (with any_hit: not yet blocked)
     for (;;) {
         if (item >= 0) {
             global const DeviceWideNode* n = &nodes[item];
@@ -117,14 +118,14 @@ LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
             float4 hx = n->max_x, hy = n->max_y, hz = n->max_z;
             int4 ch = n->child;
             int4 ct = as_int4(n->count);
-            lanes_f dv[4];
+            vfloat dv[4];
             float key[4];
             int cv[4];
             // Child J (component C): the slab test in every lane of m (LANES_BOX).
 #define PACKET_CHILD(J, C)                                                                   \
     {                                                                                        \
         LANES_BOX(lx.C, ly.C, lz.C, hx.C, hy.C, hz.C, near, far)                             \
-        lanes_i reach = m & (near <= far) & (near < tfar);                                     \
+        vint reach = m & (near <= far) & (near < tfar);                                     \
         if (ch.C <= 0 && ct.C == 0) reach = izero;                                           \
         dv[J] = select(inf, near, reach);                                                    \
         key[J] = packet_min(dv[J]);                                                          \
@@ -177,9 +178,9 @@ LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
             for (int k = 0; k < count; ++k) {
                 DeviceTriangle tri = tris[first + k];
 #define PACKET_VERTEX(V, X, Y, Z)                                                     \
-    lanes_f X, Y, Z;                                                                  \
+    vfloat X, Y, Z;                                                                  \
     {                                                                                 \
-        lanes_f vx = (lanes_f)(tri.V.x), vy = (lanes_f)(tri.V.y), vz = (lanes_f)(tri.V.z); \
+        vfloat vx = (vfloat)(tri.V.x), vy = (vfloat)(tri.V.y), vz = (vfloat)(tri.V.z); \
         X = select(select(vx, vz, z1), vy, z0) - px;                                  \
         Y = select(select(vy, vx, z1), vz, z0) - py;                                  \
         Z = select(select(vz, vy, z1), vx, z0) - pz;                                  \
@@ -188,8 +189,8 @@ LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
                 PACKET_VERTEX(v1, bX, bY, bZ)
                 PACKET_VERTEX(v2, cX, cY, cZ)
 #undef PACKET_VERTEX
-                LANE_EDGES(lanes_f)
-                LANE_HITS_T(lanes_f, lanes_i, m, zero, tfar)
+                LANE_EDGES(vfloat)
+                LANE_HITS_T(vfloat, vint, m, zero, tfar)
                 LANES_KEEP_HITS(first + k, P->o, P->d, any_hit)
                 if (any_hit) {
                     // A blocked lane is done.
@@ -213,11 +214,11 @@ LANES_INLINE void packet_walk(Packet* P, lanes_i live, bool any_hit,
         }
         if (!found) break;
     }
-    lanes_vstore(tfar, 0, P->tfar);
-    lanes_vstore(hv, 0, P->hv);
-    lanes_vstore(hw, 0, P->hw);
-    lanes_vstore(hdet, 0, P->hdet);
-    lanes_vstore(prim, 0, P->prim);
+    vstore_lanes(tfar, 0, P->tfar);
+    vstore_lanes(hv, 0, P->hv);
+    vstore_lanes(hw, 0, P->hw);
+    vstore_lanes(hdet, 0, P->hdet);
+    vstore_lanes(prim, 0, P->prim);
 }
 
 #endif  // MEGA_LANES

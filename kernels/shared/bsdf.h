@@ -52,7 +52,7 @@
 // The functions shading calls at every vertex (shade_vertex in path.h, sample_light in
 // lights.h, bsdf_sample here) are inlined into their callers in the CPU megakernel with lanes
 // (MEGA_LANES), where a call's arguments and results went through memory: 5 % of the
-// 1 M-triangle scenes' time on Zen 4 (docs/benchmarks.md, "Twenty-second session"), for about
+// 1 M-triangle scenes' time on Zen 4 (2026-12-03), for about
 // 2 s more of a first, uncached kernel build. Elsewhere the compiler decides.
 #ifdef MEGA_LANES
 #define SHADE_INLINE inline __attribute__((always_inline))

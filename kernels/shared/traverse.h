@@ -27,7 +27,7 @@ inline float safe_rcp(float x) {
 // does this in one shuffle instruction; NVIDIA's compiler turns shuffle() with a mask that
 // changes inside the loop (the two-level traversal's ray changes at every instance) into more
 // work than these selects, which made two levels 3-10 % faster on an H200 and flat about 1-2 %
-// (docs/benchmarks.md, seventh session). The program defines PERMUTE_BY_SELECT for devices other than CPUs.
+// (measured 2026-12-01). The program defines PERMUTE_BY_SELECT for devices other than CPUs.
 inline float4 ray_permute(float4 v, uint4 p) {
 #ifdef PERMUTE_BY_SELECT
     bool z0 = p.z == 0u, z1 = p.z == 1u;
@@ -328,7 +328,7 @@ inline float3 stack_float3(const uint* s, uint i) {
 // What the bottom level does not need stays in memory, not in registers: the world ray in
 // the stack's first slots, the instance's slot under its walk (a hit found there names it as
 // INSTANCE_PENDING until the walk ends). With the fewer registers, more rays run at once to
-// hide the node loads (docs/benchmarks.md, eighth session).
+// hide the node loads (measured on an H200, 2026-12-01).
 inline DeviceHit traverse_two_level(global const DeviceBvhNode* nodes,
                                  global const DeviceInstance* instances,
                                  global const DeviceTriangle* object_tris,

@@ -105,8 +105,8 @@ inline int4 wide_reach(global const DeviceWideNode* n, const WideRay* w, float t
 // with any_hit the first triangle hit. Leaves whose test needs the double-precision edge
 // functions or the rounding-error bound fall back to the scalar loop. Used for leaves of three
 // or four triangles (src/bvh/wide.rs merges small subtrees into such leaves in large scenes):
-// for one or two, the scalar tests measured as fast or faster (docs/benchmarks.md, "Sixth
-// session").
+// for one or two, the scalar tests measured as fast or faster (a 32-triangle Cornell box with
+// merged leaves ran 7-10 % slower: 2-core dev machine, 2026-12-01).
 #ifndef HAS_ALPHA
 inline bool intersect_leaf4(const RayPrep* r, global const DeviceTriangle* tris,
                             const SceneSurfaces* surf, uint first, uint count, float tmin,
@@ -242,7 +242,7 @@ inline uint wide_bits(int4 mask) {
 // from a register rather than read back from the stack. The visiting order is
 // src/bvh/wide.rs's. With
 // any_hit the children are not sorted (WIDE_ANY): bunnies' shadow rays ran 20-25 % faster
-// (docs/benchmarks.md, "Seventh session"), and a shadow test's result does not depend on which
+// (2-core dev machine, 2026-12-01), and a shadow test's result does not depend on which
 // hit is found first (path.h's shadow tests walk thin walls again nearest first).
 inline bool traverse_wide_bvh(global const DeviceWideNode* nodes, uint root,
                               global const DeviceTriangle* tris, const SceneSurfaces* surf,

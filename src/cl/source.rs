@@ -72,6 +72,10 @@ const KERNELS: &[(&str, &str)] = &[
         include_str!("../../kernels/gpu/stages.cl"),
     ),
     (
+        "kernels/cpu/simd.h",
+        include_str!("../../kernels/cpu/simd.h"),
+    ),
+    (
         "kernels/cpu/traverse_lanes.h",
         include_str!("../../kernels/cpu/traverse_lanes.h"),
     ),
