@@ -10,7 +10,7 @@ set -uo pipefail
 : "${A:?old binary}" "${B:?new binary}" "${OUT:?output folder}"
 S=${SCENES:-.device/scenes}
 DEVICE=${DEVICE:-gpu}
-RUNS=${RUNS:-3}
+REPEAT=${REPEAT:-3}
 mkdir -p "$OUT"
 LOG=$OUT/log.txt
 TMP=$(mktemp -d)
@@ -24,7 +24,9 @@ command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version -
 log "== images (same_images.sh on $DEVICE)"
 for side in A B; do
     bin=${!side}
+    # The lanes are a CPU path: on a GPU each kernel once.
     PENUMBRA=$bin PENUMBRA_SCENES=$S DEVICE=$DEVICE SIZE=${SIZE:-192x128} \
+        RUNS=${IMAGE_RUNS:-wavefront:- megakernel:-} \
         scripts/same_images.sh "$TMP/$side" >>"$LOG" 2>&1
 done
 scripts/same_images.sh --compare "$TMP/A" "$TMP/B" 2>&1 | tee -a "$LOG" >&2
@@ -32,7 +34,7 @@ scripts/same_images.sh --compare "$TMP/A" "$TMP/B" 2>&1 | tee -a "$LOG" >&2
 log "== benchmarks"
 "$B" bench generate --from "$S/StanfordBunny/bunny.glb" --triangles 1000000 \
     -o "$TMP/bunnies.glb" >>"$LOG" 2>&1
-for i in $(seq "$RUNS"); do
+for i in $(seq "$REPEAT"); do
     for side in A B; do
         bin=${!side}
         for scene in "$TMP/bunnies.glb" "$S/DreamApartment/dream-apartment.glb"; do

@@ -7,7 +7,8 @@
 #   scripts/same_images.sh --compare /tmp/before /tmp/after
 #
 # Environment: PENUMBRA (binary, default target/release/penumbra), PENUMBRA_SCENES (default
-# ../shared/scenes), DEVICE (default cpu), SIZE (default 96x64), SPP (default 2).
+# ../shared/scenes), DEVICE (default cpu), SIZE (default 96x64), SPP (default 2), RUNS (default
+# "wavefront:- megakernel:- megakernel:0 megakernel:1": KERNEL:PENUMBRA_LANES, - for unset).
 # The CPU's lanes are also forced on (PENUMBRA_LANES=1) and off (=0) for the megakernel, so the
 # scalar, the lanes and the wavefront paths are each covered.
 set -uo pipefail
@@ -37,7 +38,7 @@ mapfile -t scenes < <(find "$S" \( -name '*.glb' -o -name '*.gltf' \) | sort)
 scenes=(assets/cornell-box.glb "${scenes[@]}")
 for scene in "${scenes[@]}"; do
     name=$(basename "${scene%.*}")
-    for run in wavefront:- megakernel:- megakernel:0 megakernel:1; do
+    for run in ${RUNS:-wavefront:- megakernel:- megakernel:0 megakernel:1}; do
         kernel=${run%:*} lanes=${run#*:}
         tag=$name.$kernel
         env=()
