@@ -26,8 +26,8 @@
 
 #ifdef MEGA_LANES
 #define LANES_STACK (WIDE_STACK_SIZE + 1)
-// A lane's stack is LANES_STACK entries and three more, which a push of three entries in one
-// 32-byte store (LANES_PUSH3) may write past its top.
+// A lane's stack is LANES_STACK entries and three more, which the eight-lane push of a node's
+// children in one 32-byte store (lanes_walk) may write past its top.
 #define LANES_STACK_STRIDE (LANES_STACK + 3)
 // The word offset of each lane's stack entry sp (a lane's entries side by side).
 #define LANES_ENTRY(sp) ((LANE_IDS * (vint)(LANES_STACK_STRIDE) + (sp)) * (vint)(2))
