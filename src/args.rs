@@ -24,8 +24,8 @@ pub const MAX_BOUNCES: u32 = 256;
 /// The OpenCL device.
 #[derive(Args, Debug, Clone, Default)]
 pub struct DeviceArgs {
-    /// OpenCL device: gpu, cpu or an index from `penumbra devices` (default: first GPU, else
-    /// first CPU; also PENUMBRA_DEVICE).
+    /// OpenCL device: gpu, cpu or an index from `penumbra devices`, also read from
+    /// PENUMBRA_DEVICE (default: the first GPU, else the first CPU).
     #[arg(long)]
     pub device: Option<String>,
 }
@@ -40,10 +40,10 @@ impl DeviceArgs {
 /// The image size.
 #[derive(Args, Debug, Clone, Default)]
 pub struct SizeArgs {
-    /// Image width in pixels.
+    /// Image width in pixels (default: 640 for render, 960 for the viewer).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub width: Option<u32>,
-    /// Image height in pixels.
+    /// Image height in pixels (default: 480 for render, 600 for the viewer).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub height: Option<u32>,
 }
@@ -65,13 +65,15 @@ impl SizeArgs {
 /// Which camera, or where the camera is.
 #[derive(Args, Debug, Clone, Default)]
 pub struct CameraArgs {
-    /// Camera of the glTF file to use (index; the automatic camera when the file has none).
+    /// Camera of the glTF file to use, by index (default: the file's first camera, else an
+    /// automatic one).
     #[arg(long, allow_negative_numbers = true)]
     pub camera: Option<usize>,
-    /// Camera position X,Y,Z (replaces the file's camera; use with --look-at).
+    /// Camera position X,Y,Z in scene units, with --look-at (default: the chosen camera's).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "look_at")]
     pub eye: Option<[f64; 3]>,
-    /// Point the camera looks at, X,Y,Z (use with --eye).
+    /// Point the camera looks at, X,Y,Z in scene units, with --eye (default: the chosen
+    /// camera's).
     #[arg(long, value_parser = parse_vec3, allow_negative_numbers = true, requires = "eye")]
     pub look_at: Option<[f64; 3]>,
     /// Vertical field of view in degrees (default: the camera's).
@@ -137,14 +139,14 @@ pub struct LensArgs {
 /// Samples per pixel, bounces and the random sequence.
 #[derive(Args, Debug, Clone)]
 pub struct SamplingArgs {
-    /// Samples per pixel.
+    /// Samples per pixel (default: 64 for render, endless in the viewer).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
-    /// Bounces after the first hit (0 = direct light only).
+    /// Bounces after the first hit, a count (0 = direct light only).
     #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().bounces,
           value_parser = clap::value_parser!(u32).range(0..=MAX_BOUNCES as i64))]
     pub bounces: u32,
-    /// Seed of the random sequence.
+    /// Seed of the random sequence, an integer.
     #[arg(long, allow_negative_numbers = true, default_value_t = RenderSettings::default().seed)]
     pub seed: u32,
 }
@@ -152,11 +154,11 @@ pub struct SamplingArgs {
 /// How large the lights are, which sets how soft their shadows are.
 #[derive(Args, Debug, Clone, Default)]
 pub struct ShadowArgs {
-    /// Radius of point and spot lights in scene units (soft shadows); default 2% of the
-    /// scene's diagonal. Directional lights get an angular radius of 2·R/diagonal radians.
+    /// Radius of point and spot lights in scene units (soft shadows); directional lights get
+    /// an angular radius of 2·R/diagonal radians (default: 2% of the scene's diagonal).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_non_negative)]
     pub light_radius: Option<f32>,
-    /// Hard shadows: every light radius 0.
+    /// Hard shadows: every light radius 0 (default: off, soft shadows).
     #[arg(long, conflicts_with = "light_radius")]
     pub hard_shadows: bool,
 }
@@ -176,20 +178,20 @@ impl ShadowArgs {
 /// The light from outside the scene.
 #[derive(Args, Debug, Clone)]
 pub struct EnvArgs {
-    /// Uniform sky radiance as R,G,B (or one value for gray); default black.
+    /// Uniform sky radiance as linear R,G,B (or one value for gray) (default: black).
     #[arg(long, value_parser = parse_color)]
     pub sky: Option<[f32; 3]>,
     /// Environment light: `studio` or `outdoor` (bundled), `none`, an equirectangular .hdr or
     /// .exr image (importance-sampled), or a uniform color R,G,B / gray value (like --sky).
-    /// Default: `studio` when the scene's own lights do not light the view (docs/viewer.md).
-    /// Any environment replaces the default light rig.
+    /// Any environment replaces the default light rig (default: studio when the scene's own
+    /// lights do not light the view, else none; docs/first-image.md).
     #[arg(
         long,
         value_name = "studio|outdoor|none|FILE|COLOR",
         conflicts_with = "sky"
     )]
     pub env: Option<String>,
-    /// Radiance scale of the --env image.
+    /// Radiance scale of the --env image, a factor.
     #[arg(
         long,
         default_value_t = RenderSettings::default().env_intensity,
@@ -263,7 +265,7 @@ fn within_max_exposure(s: &str, unit: &str) -> Result<f32, String> {
 /// How bright the image is shown and written.
 #[derive(Args, Debug, Clone, Default)]
 pub struct ExposureArgs {
-    /// Exposure in stops (default: automatic, metered on the image as it converges).
+    /// Exposure in stops (default: automatic, metered on the subject as the image converges).
     #[arg(
         long,
         allow_negative_numbers = true,
@@ -271,7 +273,8 @@ pub struct ExposureArgs {
         value_parser = parse_exposure
     )]
     pub exposure: Option<f32>,
-    /// Physical exposure: a camera at this EV100 (about 15 for a scene lit by a sun in lux).
+    /// Physical exposure: a camera at this EV100, in EV (about 15 for a scene lit by a sun in
+    /// lux) (default: automatic, as for --exposure).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_ev100)]
     pub ev100: Option<f32>,
 }
@@ -328,8 +331,8 @@ pub struct CommonArgs {
     /// or auto (the megakernel on CPU devices, the wavefront elsewhere).
     #[arg(long, default_value = "auto", value_parser = parse_kernel)]
     pub kernel: KernelChoice,
-    /// The `KHR_materials_variants` variant to show (by name); without it, the default
-    /// materials.
+    /// The `KHR_materials_variants` variant to show, by name (default: the file's default
+    /// materials).
     #[arg(long, value_name = "NAME")]
     pub variant: Option<String>,
     /// Acceleration structure: flat (one BVH over every triangle), two-level (a BLAS per
@@ -491,8 +494,8 @@ impl CommonArgs {
         }
         if env_arg == first_image::EnvArg::Auto {
             if let Some(preset) = first.environment {
-                eprintln!(
-                    "penumbra: {}: its own lights do not light the view; using the {} environment",
+                log::warn!(
+                    "{}: its own lights do not light the view; using the {} environment",
                     scene.source,
                     preset.name()
                 );
@@ -504,8 +507,8 @@ impl CommonArgs {
             scene.lights.extend(first.lights.iter().cloned());
         }
         if scene.default_rig {
-            eprintln!(
-                "penumbra: {} has no lights; using the default light rig",
+            log::warn!(
+                "{} has no lights; using the default light rig",
                 scene.source
             );
         }
@@ -537,6 +540,9 @@ pub struct Prepared {
 
 /// Loads the scene at `path` (or the bundled one) and logs its warnings; the loading time in ms.
 fn load(path: Option<&Path>) -> Result<(Scene, f64)> {
+    if let Some(p) = path {
+        crate::cli::scene_file::check(p)?;
+    }
     let t = std::time::Instant::now();
     let scene = load_or_bundled(path)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -572,8 +578,8 @@ pub fn prepare(
 ) -> Result<Prepared> {
     let (mut scene, load_ms) = load(path)?;
     if scene.default_rig && !environment {
-        eprintln!(
-            "penumbra: {} has no lights; using the default light rig",
+        log::warn!(
+            "{} has no lights; using the default light rig",
             scene.source
         );
     }
@@ -590,7 +596,7 @@ pub struct StrategyArgs {
     /// Direct-light strategy.
     #[arg(long, value_enum, default_value_t = StrategyArg::Mis)]
     pub strategy: StrategyArg,
-    /// Disable Russian roulette.
+    /// Disable Russian roulette (default: off, paths end by Russian roulette).
     #[arg(long)]
     pub no_russian_roulette: bool,
 }

@@ -4,11 +4,7 @@
 use clap::Parser;
 
 fn main() {
-    env_logger::Builder::from_env(
-        env_logger::Env::default().default_filter_or("warn,egui_wgpu=error,winit=error"),
-    )
-    .format_timestamp(None)
-    .init();
+    penumbra::cli::messages::init_logging();
     let cli = match penumbra::cli::Cli::try_parse() {
         Ok(cli) => cli,
         // --help and --version print as clap makes them, with exit code 0.

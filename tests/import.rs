@@ -238,7 +238,7 @@ fn bad_files_fail_with_one_clear_line() {
          KHR_materials_pbrSpecularGlossiness",
     );
 
-    assert_clean_failure(&d.join("does-not-exist.glb"), "cannot read");
+    assert_clean_failure(&d.join("does-not-exist.glb"), "does not exist");
     let junk = d.join("junk.gltf");
     std::fs::write(&junk, b"{ not json").unwrap();
     assert_clean_failure(&junk, "not a valid glTF");

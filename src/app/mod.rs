@@ -656,7 +656,7 @@ impl App {
             Ok(new) => new,
             Err(e) => {
                 let message = e.to_string();
-                eprintln!("penumbra: device error: {message}");
+                log::error!("the device failed: {message}");
                 self.device_error = Some(message);
                 false
             }

@@ -135,8 +135,8 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         prepared.lights.clear();
     }
     if !prepared.lights.is_empty() && configs.iter().any(|c| c.strategy == Strategy::Bsdf) {
-        eprintln!(
-            "penumbra: {source} has {} punctual light(s), which BSDF sampling never reaches: \
+        log::warn!(
+            "{source} has {} punctual light(s), which BSDF sampling never reaches: \
              the bsdf curves will flatten (bias); --no-punctual leaves them out",
             prepared.lights.len()
         );

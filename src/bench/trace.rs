@@ -407,7 +407,7 @@ pub fn run(args: &TraceArgs) -> Result<()> {
     // Diffuse first-bounce rays from the primary hits.
     let points = rays::surface_points(&primary, &primary_hits, &|h| host.hit_triangle(h));
     if points.is_empty() {
-        eprintln!("penumbra: {source}: no primary ray hit anything; only primary rays timed");
+        log::warn!("{source}: no primary ray hit anything; only primary rays timed");
     } else {
         let diffuse = rays::diffuse_rays(&points, primary.len(), args.seed);
         let (hits, times) = tracer.closest(&diffuse)?;

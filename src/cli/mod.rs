@@ -2,7 +2,9 @@
 
 mod devices;
 pub mod first_image;
+pub mod messages;
 mod render;
+pub mod scene_file;
 
 use crate::args::{CommonArgs, EnvChoice, StrategyArgs};
 use crate::bench;
@@ -44,13 +46,14 @@ pub struct ViewArgs {
     /// Shared options.
     #[command(flatten)]
     pub common: CommonArgs,
-    /// Exit after this many frames (for tests).
+    /// Exit after this many frames, for tests (default: run until the window closes).
     #[arg(long)]
     pub frames: Option<u64>,
-    /// Save the final frame to this PNG path on exit (for tests); an EXR beside it.
+    /// Save the final frame to this PNG path on exit, an EXR beside it, for tests (default:
+    /// none; F12 saves screenshots in screenshots/).
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
-    /// Start with the overlay hidden: the image fills the window (Tab shows the overlay).
+    /// Start with the overlay hidden: the image fills the window; Tab shows it (default: off).
     #[arg(long)]
     pub no_overlay: bool,
 }
@@ -105,7 +108,11 @@ pub fn run(cli: Cli) -> Result<()> {
 /// configuration.
 fn view(args: ViewArgs) -> Result<()> {
     use crate::app::{DEFAULT_SIZE, ViewerConfig};
-    // Without a display nothing else is worth loading.
+    // The scene file is the user's first concern: a missing one is reported as missing even
+    // without a display. Without a display nothing else is worth loading.
+    if let Some(scene) = &args.scene {
+        scene_file::check(scene)?;
+    }
     crate::app::preflight(args.screenshot.as_deref())?;
     let common = &args.common;
     let settings = common.settings(DEFAULT_SIZE)?;
@@ -151,6 +158,33 @@ mod tests {
     fn the_command_line_definition_is_consistent() {
         use clap::CommandFactory;
         Cli::command().debug_assert();
+    }
+
+    /// The help states the defaults the code uses: the sizes and spp of `render` and the
+    /// viewer.
+    #[test]
+    fn the_help_states_the_defaults_in_use() {
+        use clap::CommandFactory;
+        let command = Cli::command();
+        let render = command.find_subcommand("render").expect("render");
+        let help = |name: &str| {
+            let arg = render.get_arguments().find(|a| a.get_id() == name);
+            arg.and_then(|a| a.get_help()).map(|h| h.to_string())
+        };
+        let (view_size, render_size) = (crate::app::DEFAULT_SIZE, render::DEFAULT_SIZE);
+        let width = format!(
+            "default: {} for render, {} for the viewer",
+            render_size.0, view_size.0
+        );
+        let height = format!(
+            "default: {} for render, {} for the viewer",
+            render_size.1, view_size.1
+        );
+        let spp = format!("default: {} for render", render::DEFAULT_SPP);
+        for (name, expect) in [("width", width), ("height", height), ("spp", spp)] {
+            let help = help(name).unwrap_or_default();
+            assert!(help.contains(&expect), "--{name}: {help}");
+        }
     }
 
     #[test]

@@ -14,15 +14,19 @@ use std::time::Instant;
 /// Samples per pixel when `--spp` is not given.
 pub const DEFAULT_SPP: u32 = 64;
 
+/// Image width and height when `--width`, `--height` are not given.
+pub const DEFAULT_SIZE: (u32, u32) = (640, 480);
+
 /// Renders and writes the image; prints the summary line on stdout.
 pub fn run(args: &RenderArgs) -> Result<()> {
+    let started = Instant::now();
     let format = Format::of(&args.output)?;
     if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
         && !dir.is_dir()
     {
         anyhow::bail!("{}: the output folder does not exist", dir.display());
     }
-    let mut settings = args.common.settings((640, 480))?;
+    let mut settings = args.common.settings(DEFAULT_SIZE)?;
     args.strategy.apply(&mut settings);
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
     let mut prepared = args.common.prepare(Some(&args.scene))?;
@@ -196,8 +200,26 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     ] {
         summary[key] = value;
     }
+    eprintln!(
+        "penumbra: wrote {}: {w}×{h} pixels, {spp} spp, rendered in {} ({} in all)",
+        args.output.display(),
+        duration(seconds),
+        duration(started.elapsed().as_secs_f64())
+    );
     println!("{summary}");
     Ok(())
+}
+
+/// Seconds for a person: "0.42 s", "12.3 s", "3 min 07 s".
+fn duration(seconds: f64) -> String {
+    match seconds {
+        s if s < 10.0 => format!("{s:.2} s"),
+        s if s < 60.0 => format!("{s:.1} s"),
+        s => {
+            let whole = s.round() as u64;
+            format!("{} min {:02} s", whole / 60, whole % 60)
+        }
+    }
 }
 
 /// The seconds a call of `render` aims at: the progress moves about this often.
@@ -259,6 +281,13 @@ impl ProgressLines {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn durations_read_as_people_write_them() {
+        assert_eq!(duration(0.4234), "0.42 s");
+        assert_eq!(duration(12.34), "12.3 s");
+        assert_eq!(duration(187.4), "3 min 07 s");
+    }
 
     #[test]
     fn calls_are_sized_to_the_time_a_sample_takes() {
