@@ -1535,3 +1535,33 @@ fn quad_glb() -> Vec<u8> {
     g.node(json!({"mesh": m}));
     g.glb()
 }
+
+#[test]
+fn a_buffer_too_large_for_memory_names_its_size() {
+    // A sparse 100 GiB buffer file under a 4 GB address-space limit: it can be neither mapped
+    // nor read, and the one line says how large it is.
+    let dir = tempfile::tempdir().unwrap();
+    let g = base();
+    let size = 100u64 << 30;
+    let bin = std::fs::File::create(dir.path().join("big.bin")).unwrap();
+    std::io::Write::write_all(&mut &bin, &g.bin).unwrap();
+    bin.set_len(size).unwrap();
+    let mut doc = base_doc_with_buffer("big.bin");
+    doc["buffers"][0]["byteLength"] = json!(size);
+    let scene = write(dir.path(), "big", &doc);
+    let exe = env!("CARGO_BIN_EXE_penumbra");
+    let out = dir.path().join("o.png");
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(r#"ulimit -v 4000000 && exec "$0" render "$1" -o "$2" --spp 1"#)
+        .args([exe, scene.to_str().unwrap(), out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("buffers[0].uri") && err.contains(&format!("{size} bytes (100.0 GiB)")),
+        "{err}"
+    );
+}

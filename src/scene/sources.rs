@@ -46,7 +46,16 @@ impl Bytes {
             return Ok(Bytes::Mapped(map, 0..len));
         }
         drop(file);
-        Ok(Bytes::Owned(std::fs::read(path)?))
+        // A file that cannot be mapped is read: say how large it is when that fails too.
+        std::fs::read(path).map(Bytes::Owned).map_err(|e| {
+            std::io::Error::new(
+                e.kind(),
+                format!(
+                    "cannot hold its {size} bytes ({:.1} GiB) in memory: {e}",
+                    size as f64 / (1u64 << 30) as f64
+                ),
+            )
+        })
     }
 
     /// The bytes of `range` (within these) alone; owned ones are moved down in place.
