@@ -9,10 +9,11 @@ use crate::cli::first_image;
 use crate::render::background::Background;
 use crate::render::exposure::ExposureMode;
 use crate::render::{BvhChoice, KernelChoice, RenderSettings, Renderer, Strategy};
-use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled};
+use crate::scene::limits::MAX_INTENSITY;
+use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled_with};
 use anyhow::{Result, bail};
 use clap::Args;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 pub use crate::cli::first_image::EnvChoice;
 
@@ -188,7 +189,8 @@ pub struct EnvArgs {
     #[arg(
         long,
         value_name = "studio|outdoor|none|FILE|COLOR",
-        conflicts_with = "sky"
+        conflicts_with = "sky",
+        value_parser = parse_env
     )]
     pub env: Option<String>,
     /// Radiance scale of the --env image, a factor.
@@ -196,7 +198,7 @@ pub struct EnvArgs {
         long,
         default_value_t = RenderSettings::default().env_intensity,
         allow_negative_numbers = true,
-        value_parser = parse_non_negative
+        value_parser = parse_intensity
     )]
     pub env_intensity: f32,
     /// Rotation of the --env image about the up (+Y) axis in degrees, counter-clockwise seen
@@ -340,6 +342,21 @@ pub struct CommonArgs {
     /// or more that instancing shrinks eightfold, and for any of 16 M or more).
     #[arg(long, default_value = "auto")]
     pub bvh: BvhChoice,
+    /// A folder whose files the scene may also read: by default a buffer or image URI must
+    /// lead to a file inside the scene file's folder (docs/robustness.md)
+    /// (default: the scene file's folder).
+    #[arg(long, value_name = "DIR", value_parser = parse_folder)]
+    pub asset_root: Option<PathBuf>,
+}
+
+/// An existing folder.
+fn parse_folder(s: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(s);
+    if path.is_dir() {
+        Ok(path)
+    } else {
+        Err(format!("'{s}' is not an existing folder"))
+    }
 }
 
 fn parse_background(s: &str) -> Result<Background, String> {
@@ -448,7 +465,7 @@ impl CommonArgs {
     /// [`CommonArgs::prepare`] for an image of this width over height (the viewer's image is
     /// the window less the overlay's panel).
     pub fn prepare_for(&self, path: Option<&Path>, aspect: f64) -> Result<Prepared> {
-        let (mut scene, load_ms) = load(path)?;
+        let (mut scene, load_ms) = load(path, self.asset_root.as_deref())?;
         if let Some(name) = &self.variant {
             let v = scene.variant_named(name).map_err(anyhow::Error::msg)?;
             scene.select_variant(Some(v));
@@ -538,13 +555,14 @@ pub struct Prepared {
     pub first_view: Option<first_image::FirstImage>,
 }
 
-/// Loads the scene at `path` (or the bundled one) and logs its warnings; the loading time in ms.
-fn load(path: Option<&Path>) -> Result<(Scene, f64)> {
+/// Loads the scene at `path` (or the bundled one), its files read from its folder or
+/// `asset_root`, and logs its warnings; the loading time in ms.
+fn load(path: Option<&Path>, asset_root: Option<&Path>) -> Result<(Scene, f64)> {
     if let Some(p) = path {
         crate::cli::scene_file::check(p)?;
     }
     let t = std::time::Instant::now();
-    let scene = load_or_bundled(path)?;
+    let scene = load_or_bundled_with(path, asset_root)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     for w in &scene.warnings {
         log::warn!("{}: {w}", scene.source);
@@ -576,7 +594,7 @@ pub fn prepare(
     shadows: &ShadowArgs,
     environment: bool,
 ) -> Result<Prepared> {
-    let (mut scene, load_ms) = load(path)?;
+    let (mut scene, load_ms) = load(path, None)?;
     if scene.default_rig && !environment {
         log::warn!(
             "{} has no lights; using the default light rig",
@@ -660,7 +678,30 @@ fn parse_color(s: &str) -> Result<[f32; 3], String> {
             "'{s}': color values must be finite and not negative"
         ));
     }
+    if c.iter().any(|v| *v > MAX_INTENSITY) {
+        return Err(format!(
+            "'{s}': color values must be at most {MAX_INTENSITY:e}"
+        ));
+    }
     Ok(c)
+}
+
+/// An `--env` value: a list of numbers must be a valid color (checked here, a usage error);
+/// anything else is a name or a file, checked when it is loaded.
+fn parse_env(s: &str) -> Result<String, String> {
+    if s.split(',').all(|p| p.trim().parse::<f32>().is_ok()) {
+        parse_color(s)?;
+    }
+    Ok(s.to_string())
+}
+
+/// A radiance scale: finite, ≥ 0 and at most [`MAX_INTENSITY`], so that a scaled environment
+/// texel (itself at most that) stays far from f32's overflow.
+fn parse_intensity(s: &str) -> Result<f32, String> {
+    match parse_non_negative(s)? {
+        v if v <= MAX_INTENSITY => Ok(v),
+        _ => Err(format!("'{s}' is out of range (0..={MAX_INTENSITY:e})")),
+    }
 }
 
 /// A finite number (NaN and ±inf are refused).

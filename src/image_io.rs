@@ -1,7 +1,9 @@
 //! Writing and reading linear images: EXR is linear radiance (RGB float). Tone-mapped PNGs are
-//! written by `render::tonemap`.
+//! written by `render::tonemap`. Every image is encoded in memory and written by
+//! [`write_file`], whose every write is checked (a full disk is an error, never a success).
 
 use anyhow::{Context, Result, bail};
+use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
 /// Image formats penumbra writes, chosen by extension.
@@ -29,18 +31,138 @@ impl Format {
     }
 }
 
+/// The output file of a command, opened (and so checked) before the work that fills it: its
+/// extension is a known format, it is not a folder, its folder exists and it can be written.
+/// An existing file keeps its bytes until [`OutputFile::write`]; a file this opening created is
+/// removed again when it is dropped unwritten (the work failed).
+pub struct OutputFile {
+    path: PathBuf,
+    file: Option<std::fs::File>,
+    created: bool,
+    /// The format its extension names.
+    pub format: Format,
+}
+
+impl OutputFile {
+    /// Opens `path` for writing without changing it; one line saying why not.
+    pub fn open(path: &Path) -> Result<Self> {
+        let shown = path.display();
+        if path.is_dir() {
+            bail!("{shown}: the output is a folder");
+        }
+        let format = Format::of(path)?;
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
+            && !dir.is_dir()
+        {
+            bail!("{}: the output folder does not exist", dir.display());
+        }
+        let existed = path.exists();
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .create(!existed)
+            .open(path)
+            .map_err(|e| anyhow::anyhow!("{shown}: cannot write: {}", os_message(&e)))?;
+        Ok(OutputFile {
+            path: path.to_path_buf(),
+            file: Some(file),
+            created: !existed,
+            format,
+        })
+    }
+
+    /// Replaces the file's bytes with `bytes`, every write checked.
+    pub fn write(mut self, bytes: &[u8]) -> Result<()> {
+        let mut file = self.file.take().expect("written once");
+        let result = replace_contents(&mut file, bytes);
+        if result.is_err() && self.created {
+            let _ = std::fs::remove_file(&self.path);
+        }
+        result.map_err(|e| {
+            anyhow::anyhow!("{}: cannot write: {}", self.path.display(), os_message(&e))
+        })
+    }
+}
+
+impl Drop for OutputFile {
+    fn drop(&mut self) {
+        if self.file.is_some() && self.created {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
+}
+
+/// The OS's message for `e` without the `(os error N)` suffix Rust appends.
+fn os_message(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    match text.rfind(" (os error ") {
+        Some(at) => text[..at].to_string(),
+        None => text,
+    }
+}
+
+/// Writes `bytes` from the start of `file`, cutting what was there, and (for a regular file)
+/// waits until they are on disk: an error of any step is returned, so that a full disk or
+/// device (`/dev/full`) is never reported as a success.
+fn replace_contents(file: &mut std::fs::File, bytes: &[u8]) -> std::io::Result<()> {
+    let regular = file.metadata()?.is_file();
+    if regular {
+        file.set_len(0)?;
+        file.rewind()?;
+    }
+    file.write_all(bytes)?;
+    file.flush()?;
+    if regular {
+        file.sync_all()?;
+    }
+    Ok(())
+}
+
+/// Writes `bytes` to `path` (created or replaced), every write checked.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    let mut file = std::fs::File::create(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot write: {}", path.display(), os_message(&e)))?;
+    replace_contents(&mut file, bytes)
+        .map_err(|e| anyhow::anyhow!("{}: cannot write: {}", path.display(), os_message(&e)))
+}
+
 /// Writes linear RGB as a float EXR.
 pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<()> {
+    write_file(path, &encode_exr(width, height, rgb, None)?)
+}
+
+/// Linear RGB (premultiplied by `alpha` when given, an A channel then) encoded as a float EXR.
+pub fn encode_exr(
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    alpha: Option<&[f32]>,
+) -> Result<Vec<u8>> {
     use exr::prelude::*;
     let w = width as usize;
-    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-        let p = rgb[y * w + x];
-        (p[0], p[1], p[2])
-    });
-    Image::from_encoded_channels((w, height as usize), EXR_ENCODING, channels)
-        .write()
-        .to_file(path)
-        .with_context(|| format!("{}: cannot write EXR", path.display()))
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    let size = (w, height as usize);
+    match alpha {
+        None => {
+            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                let p = rgb[y * w + x];
+                (p[0], p[1], p[2])
+            });
+            Image::from_encoded_channels(size, EXR_ENCODING, channels)
+                .write()
+                .to_buffered(&mut bytes)
+        }
+        Some(alpha) => {
+            let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
+                let p = rgb[y * w + x];
+                (p[0], p[1], p[2], alpha[y * w + x])
+            });
+            Image::from_encoded_channels(size, EXR_ENCODING, channels)
+                .write()
+                .to_buffered(&mut bytes)
+        }
+    }
+    .context("cannot encode EXR")?;
+    Ok(bytes.into_inner())
 }
 
 /// The exr crate's default encoding (RLE, 64-pixel tiles) with the tiles in increasing order:
@@ -60,16 +182,7 @@ pub fn write_exr_rgba(
     rgb: &[[f32; 3]],
     alpha: &[f32],
 ) -> Result<()> {
-    use exr::prelude::*;
-    let w = width as usize;
-    let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
-        let p = rgb[y * w + x];
-        (p[0], p[1], p[2], alpha[y * w + x])
-    });
-    Image::from_encoded_channels((w, height as usize), EXR_ENCODING, channels)
-        .write()
-        .to_file(path)
-        .with_context(|| format!("{}: cannot write EXR", path.display()))
+    write_file(path, &encode_exr(width, height, rgb, Some(alpha))?)
 }
 
 /// The size of each layer of an EXR file and its chunk count, from the header alone (no pixel

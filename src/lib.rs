@@ -12,5 +12,6 @@ pub mod cli;
 pub mod cpu_time;
 pub mod date;
 pub mod image_io;
+pub mod message;
 pub mod render;
 pub mod scene;

@@ -2,6 +2,7 @@
 #![deny(unsafe_code)]
 
 use clap::Parser;
+use penumbra::message::print;
 
 fn main() {
     penumbra::cli::messages::init_logging();
@@ -10,14 +11,14 @@ fn main() {
         // --help and --version print as clap makes them, with exit code 0.
         Err(e) if !e.use_stderr() => e.exit(),
         Err(e) => {
-            eprintln!("penumbra: error: {}", penumbra::cli::usage_error(&e));
+            print("error", &penumbra::cli::usage_error(&e));
             std::process::exit(2);
         }
     };
     if let Err(e) = penumbra::cli::run(cli) {
         // One line: the error and its causes, outermost first.
         let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
-        eprintln!("penumbra: error: {}", chain.join(": "));
+        print("error", &chain.join(": "));
         std::process::exit(1);
     }
 }

@@ -263,9 +263,19 @@ fn buffers_are_read_only_from_regular_files_and_never_past_their_length() {
         "{e}"
     );
 
+    // A link to a device outside the folder is refused for where it leads; a device inside
+    // the allowed folders (a pipe here) for what it is, before anything is read.
     std::os::unix::fs::symlink("/dev/zero", d.join("zero.bin")).unwrap();
     doc["buffers"][0]["uri"] = json!("zero.bin");
     let e = run(&doc, "dev-zero").unwrap_err();
+    assert!(e.contains("buffers[0].uri") && e.contains("outside"), "{e}");
+    let made = std::process::Command::new("mkfifo")
+        .arg(d.join("pipe.bin"))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    doc["buffers"][0]["uri"] = json!("pipe.bin");
+    let e = run(&doc, "pipe").unwrap_err();
     assert!(
         e.contains("buffers[0].uri") && e.contains("not a regular file"),
         "{e}"
@@ -435,11 +445,7 @@ fn out_of_spec_cameras_lights_and_materials_are_skipped_or_clamped() {
     m["emissiveFactor"] = json!([1e39, 0.5, -3.0]);
     m["extensions"] = json!({"KHR_materials_ior": {"ior": 0.5}});
     let s = assert_warns(&doc, "factors", "materials[0]");
-    let w = s
-        .warnings
-        .iter()
-        .find(|w| w.contains("materials[0]"))
-        .unwrap();
+    let w = material_warning(&s);
     assert!(w.contains("metallicFactor") && w.contains("ior 0.5"), "{w}");
     assert_eq!(
         s.warnings
@@ -454,6 +460,14 @@ fn out_of_spec_cameras_lights_and_materials_are_skipped_or_clamped() {
     assert_eq!(mat.base_color, [1.0, 0.0, 0.5, 1.0]);
     assert_eq!(mat.emission, [1.0, 0.5, 0.0]);
     assert_eq!(mat.ior, 1.5);
+}
+
+/// The warning about `materials[0]`.
+fn material_warning(s: &Scene) -> &str {
+    s.warnings
+        .iter()
+        .find(|w| w.contains("materials[0]"))
+        .expect("a warning about materials[0]")
 }
 
 /// Runs `penumbra render` and returns (exit code, stderr).
@@ -963,4 +977,591 @@ fn the_binary_renders_hostile_textures_and_values_without_non_finite_samples() {
             file.display()
         );
     }
+}
+
+/// The base document with its buffer in the file `uri` (relative to the glTF file).
+fn base_doc_with_buffer(uri: &str) -> Value {
+    base().json(Some(uri.to_string()))
+}
+
+#[test]
+fn files_outside_the_scene_folder_are_refused_unless_an_asset_root_allows_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let (scene_dir, outside) = (dir.path().join("scene"), dir.path().join("outside"));
+    std::fs::create_dir_all(scene_dir.join("sub")).unwrap();
+    std::fs::create_dir_all(&outside).unwrap();
+    std::fs::write(outside.join("data.bin"), &base().bin).unwrap();
+    std::fs::write(scene_dir.join("inside.bin"), &base().bin).unwrap();
+    std::os::unix::fs::symlink(outside.join("data.bin"), scene_dir.join("link.bin")).unwrap();
+    std::os::unix::fs::symlink(&outside, scene_dir.join("sub/out")).unwrap();
+    let load_uri = |uri: &str, name: &str, root: Option<&Path>| {
+        let path = write(&scene_dir, name, &base_doc_with_buffer(uri));
+        penumbra::scene::load_with(&path, root).map_err(|e| e.to_string())
+    };
+    // Every way out: `..`, percent-encoded `..` and slashes, `..` through a subfolder, a
+    // symbolic link to a file outside and one to a folder outside.
+    for (i, uri) in [
+        "../outside/data.bin",
+        "%2E%2E/outside/data.bin",
+        "..%2Foutside%2Fdata.bin",
+        "sub/../../outside/data.bin",
+        "link.bin",
+        "sub/out/data.bin",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let name = format!("out-{i}");
+        let e = load_uri(uri, &name, None).expect_err(uri);
+        assert!(
+            e.contains("buffers[0].uri")
+                && e.contains(&format!("'{uri}'"))
+                && e.contains("outside"),
+            "{uri}: {e}"
+        );
+        assert!(!e.contains('\n'), "{e}");
+        // The asset root above both folders lets the same file be read.
+        let s = load_uri(uri, &name, Some(dir.path())).unwrap_or_else(|e| panic!("{uri}: {e}"));
+        assert_eq!(s.triangle_count(), 2, "{uri}");
+    }
+    // Inside the folder, `..` that stays inside is fine; data: URIs need no folder.
+    assert!(load_uri("sub/../inside.bin", "inside", None).is_ok());
+    assert!(try_load(&base_doc(), "data-uri").is_ok());
+    // An asset root that does not hold the file allows nothing more.
+    let e = load_uri(
+        "../outside/data.bin",
+        "other-root",
+        Some(&scene_dir.join("sub")),
+    )
+    .unwrap_err();
+    assert!(e.contains("outside"), "{e}");
+
+    // An image outside: refused (not read), one warning naming the URI, the texture left out.
+    let mut png = Vec::new();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([9, 9, 9, 255]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    std::fs::write(outside.join("tex.png"), &png).unwrap();
+    let mut doc = base_doc();
+    doc["images"][0] = json!({"uri": "../outside/tex.png"});
+    let path = write(&scene_dir, "image-out", &doc);
+    let s = load(&path).unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.contains("images[0]")
+            && w.contains("'../outside/tex.png'")
+            && w.contains("outside the scene")),
+        "{:?}",
+        s.warnings
+    );
+    assert!(s.materials[0].textures.base_color.is_none());
+    let s = penumbra::scene::load_with(&path, Some(dir.path())).unwrap();
+    assert!(
+        s.materials[0].textures.base_color.is_some(),
+        "{:?}",
+        s.warnings
+    );
+
+    // Through the binary: exit 1 with one line, and --asset-root lets it render.
+    let path = write(
+        &scene_dir,
+        "cli",
+        &base_doc_with_buffer("../outside/data.bin"),
+    );
+    let (code, err) = render(&[path.to_str().unwrap(), "--spp", "1"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("'../outside/data.bin'") && err.contains("--asset-root"),
+        "{err}"
+    );
+    let root = dir.path().to_str().unwrap();
+    let (code, err) = render(&[path.to_str().unwrap(), "--spp", "1", "--asset-root", root]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = render(&[path.to_str().unwrap(), "--asset-root", "/no/such/folder"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("--asset-root"), "{err}");
+}
+
+/// Runs `penumbra render SCENE -o OUT` at 8×8 with `extra` options.
+fn render_output(scene: &str, out: &str, extra: &[&str]) -> std::process::Output {
+    let mut all = vec!["render", scene, "-o", out, "--width", "8", "--height", "8"];
+    all.extend_from_slice(extra);
+    penumbra(&all)
+}
+
+/// [`render_output`]: (exit code, stderr).
+fn render_to(scene: &str, out: &str, extra: &[&str]) -> (Option<i32>, String) {
+    let o = render_output(scene, out, extra);
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn bundled() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets/cornell-box.glb")
+        .to_str()
+        .unwrap()
+        .to_string()
+}
+
+#[test]
+fn output_paths_are_checked_before_rendering_and_every_write_is_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let missing_scene = d.join("no-such-scene.glb");
+    let missing_scene = missing_scene.to_str().unwrap();
+    std::fs::create_dir(d.join("folder.png")).unwrap();
+    let folder = d.join("folder.png");
+    let no_folder = d.join("no/such/out.png");
+    // The output is refused before the scene is even read: the error names the output, not
+    // the missing scene.
+    for (out, expect) in [
+        (folder.to_str().unwrap(), "is a folder"),
+        (no_folder.to_str().unwrap(), "output folder does not exist"),
+        (
+            "/proc/penumbra-test.exr",
+            "/proc/penumbra-test.exr: cannot write",
+        ),
+        ("out.jpg", "must end in .exr or .png"),
+    ] {
+        let (code, err) = render_to(missing_scene, out, &[]);
+        assert_eq!(code, Some(1), "{out}: {err}");
+        assert_eq!(err.lines().count(), 1, "{out}: one line: {err}");
+        assert!(err.contains(expect), "{out}: {err}");
+        assert!(
+            !err.contains("no-such-scene"),
+            "{out}: checked before the scene: {err}"
+        );
+        // The OS's message once, without Rust's "(os error N)".
+        assert!(!err.contains("os error"), "{out}: {err}");
+    }
+
+    // A full device: the render runs, the write fails, exit 1 with one line (PNG and EXR).
+    for out in ["/dev/full"] {
+        for (ext_flag, what) in [("png", "PNG"), ("exr", "EXR")] {
+            // /dev/full has no extension: reach it through a link named for the format.
+            let link = d.join(format!("full.{ext_flag}"));
+            let _ = std::fs::remove_file(&link);
+            std::os::unix::fs::symlink(out, &link).unwrap();
+            let (code, err) = render_to(&bundled(), link.to_str().unwrap(), &["--spp", "1"]);
+            assert_eq!(code, Some(1), "{what}: {err}");
+            let errors: Vec<&str> = err.lines().filter(|l| l.contains("error")).collect();
+            assert_eq!(errors.len(), 1, "{what}: {err}");
+            assert!(
+                errors[0].contains("cannot write") && errors[0].contains("No space left"),
+                "{what}: {err}"
+            );
+        }
+    }
+
+    // A render that fails leaves no file it created, and an existing file as it was.
+    let fresh = d.join("fresh.png");
+    let (code, _) = render_to(missing_scene, fresh.to_str().unwrap(), &[]);
+    assert_eq!(code, Some(1));
+    assert!(
+        !fresh.exists(),
+        "the output created for the check is removed"
+    );
+    let old = d.join("old.png");
+    std::fs::write(&old, b"old bytes").unwrap();
+    let (code, _) = render_to(missing_scene, old.to_str().unwrap(), &[]);
+    assert_eq!(code, Some(1));
+    assert_eq!(std::fs::read(&old).unwrap(), b"old bytes");
+    // A successful render replaces it with a PNG that decodes.
+    let (code, err) = render_to(&bundled(), old.to_str().unwrap(), &["--spp", "1"]);
+    assert_eq!(code, Some(0), "{err}");
+    let png = image::open(&old).unwrap();
+    assert_eq!((png.width(), png.height()), (8, 8));
+}
+
+/// A Radiance HDR file of `width × height` texels, each the RGBE bytes `rgbe` (flat: widths
+/// under 8 are never run-length encoded).
+fn hdr_file(path: &Path, width: u32, height: u32, rgbe: [u8; 4]) {
+    let mut bytes =
+        format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n").into_bytes();
+    for _ in 0..width * height {
+        bytes.extend_from_slice(&rgbe);
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+#[test]
+fn infinite_or_huge_radiance_is_clamped_at_load_with_one_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let limit = penumbra::scene::limits::MAX_INTENSITY;
+    // The largest exponent: every channel 255/256 × 2^127 ≈ 1.7e38.
+    let hdr = dir.path().join("max-exponent.hdr");
+    hdr_file(&hdr, 4, 2, [255, 255, 255, 255]);
+    let (map, warning) = EnvMap::load_checked(&hdr).unwrap();
+    let w = warning.expect("one warning");
+    assert!(
+        w.contains("max-exponent.hdr") && w.contains("24 values above"),
+        "{w}"
+    );
+    assert!(
+        map.texels.iter().flatten().all(|&v| v == limit),
+        "clamped to the limit"
+    );
+
+    // inf, NaN and negative texels in an EXR: 0, said once.
+    let exr = dir.path().join("bad.exr");
+    let bad = [
+        [f32::INFINITY, 1.0, 1.0],
+        [f32::NAN, -5.0, 2.0],
+        [1.0, 1.0, 1.0],
+        [3e38, 0.5, 0.5],
+    ];
+    penumbra::image_io::write_exr(&exr, 2, 2, &bad).unwrap();
+    let (map, warning) = EnvMap::load_checked(&exr).unwrap();
+    let w = warning.expect("one warning");
+    assert!(
+        w.contains("2 values non-finite")
+            && w.contains("1 values negative")
+            && w.contains("1 values above"),
+        "{w}"
+    );
+    assert_eq!(map.texels[0], [0.0, 1.0, 1.0]);
+    assert_eq!(map.texels[1], [0.0, 0.0, 2.0]);
+    assert_eq!(map.texels[3], [limit, 0.5, 0.5]);
+    // A clean map has no warning.
+    let clean = dir.path().join("clean.hdr");
+    hdr_file(&clean, 4, 2, [128, 128, 128, 129]);
+    assert!(EnvMap::load_checked(&clean).unwrap().1.is_none());
+
+    // Colors and scales past the limit are usage errors (exit 2).
+    let scene = bundled();
+    for args in [
+        vec!["--env-intensity", "3e38"],
+        vec!["--sky", "3e38"],
+        vec!["--env", "3e38,0,0"],
+        vec!["--background", "env", "--sky", "1,1e13,1"],
+    ] {
+        let out = dir.path().join("x.exr");
+        let (code, err) = render_to(&scene, out.to_str().unwrap(), &args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(args[args.len() - 2]), "{args:?}: {err}");
+    }
+
+    // Through the binary: the clamped map at the largest scale renders finite, with one
+    // warning line, and the summary counts non-finite samples and pixels (none here).
+    let out = dir.path().join("lit.exr");
+    let intensity = format!("{limit:e}");
+    let o = render_output(
+        &scene,
+        out.to_str().unwrap(),
+        &[
+            "--spp",
+            "2",
+            "--env",
+            hdr.to_str().unwrap(),
+            "--env-intensity",
+            &intensity,
+        ],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let warnings: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("radiance clamped"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(warnings[0].starts_with("penumbra: warning: "), "{err}");
+    let summary: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(summary["nonfinite_samples"].is_u64(), "{summary}");
+    assert_eq!(summary["nonfinite_pixels"], json!(0), "{summary}");
+    let (_, _, px) = penumbra::image_io::read_exr(&out).unwrap();
+    assert!(px.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(
+        px.iter().flatten().any(|v| *v > 1e6),
+        "the bright sky shows"
+    );
+}
+
+#[test]
+fn control_characters_in_files_and_paths_never_make_a_second_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let forged = "x.bin\npenumbra: error: forged\u{1b}[2J";
+    // A URI (an error), an extension name (a warning) and a command-line path (an error).
+    let mut doc = base_doc();
+    doc["buffers"][0]["uri"] = json!(forged);
+    let bad_uri = write(dir.path(), "uri", &doc);
+    let mut doc = base_doc();
+    doc["extensionsUsed"] = json!([format!("EXT_x\npenumbra: error: forged\u{1b}[31m")]);
+    let bad_ext = write(dir.path(), "ext", &doc);
+    let odd = dir.path().join("odd\nname\u{1b}[0m.gltf");
+    let out = dir.path().join("o.exr");
+    for (scene, code) in [(&bad_uri, Some(1)), (&bad_ext, Some(0)), (&odd, Some(1))] {
+        let (got, err) = render_to(
+            scene.to_str().unwrap(),
+            out.to_str().unwrap(),
+            &["--spp", "1"],
+        );
+        assert_eq!(got, code, "{err}");
+        assert!(!err.contains('\u{1b}'), "no raw escape: {err:?}");
+        assert!(
+            err.lines().all(|l| l.starts_with("penumbra: ")),
+            "every line is one message: {err:?}"
+        );
+        assert!(
+            !err.lines()
+                .any(|l| l.starts_with("penumbra: error: forged")),
+            "{err:?}"
+        );
+        assert!(
+            err.contains("\\n") && err.contains("\\u{1b}"),
+            "escaped: {err:?}"
+        );
+    }
+}
+
+#[test]
+fn a_deep_node_chain_fails_before_the_import_walks_it() {
+    // 100,000 nested nodes: refused by the linear check (before the rest transforms, which
+    // walk each chain to its root) with the node named where the limit is passed.
+    let mut doc = base_doc();
+    let nodes = doc["nodes"].as_array_mut().unwrap();
+    let first = nodes.len();
+    let depth = 100_000;
+    for level in 0..depth {
+        let mut node = json!({"translation": [0.0, 0.0, 0.0]});
+        if level + 1 < depth {
+            node["children"] = json!([first + level + 1]);
+        }
+        nodes.push(node);
+    }
+    doc["scenes"][0]["nodes"] = json!([first]);
+    let e = try_load(&doc, "deep").unwrap_err();
+    let limit = penumbra::scene::limits::MAX_NODE_DEPTH;
+    assert!(
+        e.contains(&format!(
+            "nodes[{}]: nested more than {limit} deep",
+            first + limit + 1
+        )),
+        "{e}"
+    );
+    // At the limit it loads.
+    let mut doc = base_doc();
+    let nodes = doc["nodes"].as_array_mut().unwrap();
+    let first = nodes.len();
+    for level in 0..=limit {
+        nodes.push(json!({"children": [first + level + 1]}));
+    }
+    nodes.push(json!({"mesh": 0}));
+    doc["scenes"][0]["nodes"] = json!([first]);
+    let s = try_load(&doc, "at-limit");
+    assert!(s.is_err(), "one past: the walk's own check");
+    let nodes = doc["nodes"].as_array_mut().unwrap();
+    nodes[first + limit]["children"] = json!([]);
+    nodes[first + limit]["mesh"] = json!(0);
+    let s = try_load(&doc, "at-limit").unwrap();
+    assert_eq!(s.triangle_count(), 2, "the mesh at the end of the chain");
+
+    // Parents that form a cycle no scene reaches.
+    let mut doc = base_doc();
+    let nodes = doc["nodes"].as_array_mut().unwrap();
+    let first = nodes.len();
+    nodes.push(json!({"children": [first + 1]}));
+    nodes.push(json!({"children": [first]}));
+    let e = try_load(&doc, "cycle-apart").unwrap_err();
+    assert!(e.contains("a cycle"), "{e}");
+}
+
+#[test]
+fn values_the_specification_forbids_are_one_warning_each() {
+    type Change = Box<dyn Fn(&mut Value)>;
+    let cases: Vec<(&str, Change, &str)> = vec![
+        (
+            "version",
+            Box::new(|d| d["asset"]["version"] = json!("3.0")),
+            "asset.version",
+        ),
+        (
+            "min",
+            Box::new(|d| d["asset"]["minVersion"] = json!("2.1")),
+            "asset.minVersion",
+        ),
+        (
+            "no-prims",
+            Box::new(|d| {
+                d["meshes"]
+                    .as_array_mut()
+                    .unwrap()
+                    .push(json!({"primitives": []}))
+            }),
+            "meshes[1]: no primitives",
+        ),
+        (
+            "znear",
+            Box::new(|d| d["cameras"][0]["perspective"]["znear"] = json!(0.0)),
+            "znear",
+        ),
+        (
+            "zfar",
+            Box::new(|d| d["cameras"][0]["perspective"]["zfar"] = json!(0.01)),
+            "zfar",
+        ),
+        (
+            "aspect",
+            Box::new(|d| d["cameras"][0]["perspective"]["aspectRatio"] = json!(-1.0)),
+            "aspectRatio",
+        ),
+        (
+            "range",
+            Box::new(|d| d["extensions"]["KHR_lights_punctual"]["lights"][0]["range"] = json!(0.0)),
+            "lights[0].range",
+        ),
+        (
+            "matrix-trs",
+            Box::new(|d| {
+                d["nodes"][0]["matrix"] = json!([
+                    1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0
+                ]);
+                d["nodes"][0]["scale"] = json!([2.0, 2.0, 2.0]);
+            }),
+            "nodes[0]: has both matrix and",
+        ),
+        (
+            "projective",
+            Box::new(|d| {
+                d["nodes"][0]["matrix"] = json!([
+                    1.0, 0.0, 0.0, 0.5, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0
+                ]);
+            }),
+            "nodes[0].matrix: its last row",
+        ),
+        (
+            "transform",
+            Box::new(|d| {
+                d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] =
+                    json!({"KHR_texture_transform": {"scale": [1e39, 1.0]}});
+            }),
+            "KHR_texture_transform",
+        ),
+        (
+            "channel-node",
+            channel(99, "translation"),
+            "animations[0].channels[0].target.node",
+        ),
+        (
+            // Accessor 0 is VEC3 positions: a rotation needs VEC4.
+            "channel-type",
+            channel(0, "rotation"),
+            "animations[0].channels[0]: its sampler's output",
+        ),
+    ];
+    for (name, change, expect) in cases {
+        let mut doc = base_doc();
+        change(&mut doc);
+        let s = assert_warns(&doc, name, expect);
+        let matching = s.warnings.iter().filter(|w| w.contains(expect)).count();
+        assert_eq!(matching, 1, "{name}: one warning: {:?}", s.warnings);
+    }
+
+    // The material's warning lists every extension factor brought into range.
+    let mut doc = base_doc();
+    doc["materials"][0]["extensions"] = json!({
+        "KHR_materials_clearcoat": {"clearcoatFactor": 3.0},
+        "KHR_materials_sheen": {"sheenColorFactor": [2.0, 0.0, 0.0]},
+        "KHR_materials_iridescence": {"iridescenceFactor": -1.0},
+        "KHR_materials_dispersion": {"dispersion": -1.0},
+        "KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 9.0},
+        "KHR_materials_anisotropy": {"anisotropyStrength": 2.0, "anisotropyRotation": 1e39}
+    });
+    let s = assert_warns(&doc, "factors", "materials[0]");
+    let w = material_warning(&s);
+    for key in [
+        "clearcoatFactor 3",
+        "sheenColorFactor 2",
+        "iridescenceFactor -1",
+        "dispersion -1",
+        "diffuseTransmissionFactor 9",
+        "anisotropyStrength 2",
+    ] {
+        assert!(w.contains(key), "{key}: {w}");
+    }
+    let about = |w: &&String| w.contains("materials[0]");
+    assert_eq!(s.warnings.iter().filter(about).count(), 1, "one warning");
+    let m = &s.materials[0];
+    assert_eq!(
+        (m.clearcoat, m.anisotropy, m.diffuse_transmission),
+        (1.0, 1.0, 1.0)
+    );
+    assert_eq!(m.iridescence, 0.0);
+    // A rotation of 1e39 turns the frame by some angle; it never becomes infinite.
+    assert!(
+        m.anisotropy_rotation.is_finite(),
+        "{}",
+        m.anisotropy_rotation
+    );
+    assert!((0.0..=std::f32::consts::TAU).contains(&m.anisotropy_rotation));
+
+    // A GLB whose header length is shorter than the file.
+    let dir = tempfile::tempdir().unwrap();
+    let mut glb = quad_glb();
+    let real = glb.len();
+    glb.extend_from_slice(&[0u8; 64]);
+    let path = dir.path().join("long.glb");
+    std::fs::write(&path, &glb).unwrap();
+    let s = load(&path).unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.contains(&format!(
+            "header's length {real} is shorter than the file ({} bytes)",
+            real + 64
+        ))),
+        "{:?}",
+        s.warnings
+    );
+}
+
+/// A change adding an animation whose one channel targets `node`'s `path`, with accessor 0 as
+/// its sampler's input and output.
+fn channel(node: usize, path: &'static str) -> Box<dyn Fn(&mut Value)> {
+    Box::new(move |d| {
+        d["animations"] = json!([{
+            "channels": [{"sampler": 0, "target": {"node": node, "path": path}}],
+            "samplers": [{"input": 0, "output": 0}]
+        }]);
+    })
+}
+
+/// A GLB of one quad.
+fn quad_glb() -> Vec<u8> {
+    let mut g = common::Gltf::default();
+    g.lambert([0.5; 3], [0.0; 3], 1.0, false);
+    let m = g.mesh(vec![quad()]);
+    g.node(json!({"mesh": m}));
+    g.glb()
+}
+
+#[test]
+fn a_buffer_too_large_for_memory_names_its_size() {
+    // A sparse 100 GiB buffer file under a 4 GB address-space limit: it can be neither mapped
+    // nor read, and the one line says how large it is.
+    let dir = tempfile::tempdir().unwrap();
+    let g = base();
+    let size = 100u64 << 30;
+    let bin = std::fs::File::create(dir.path().join("big.bin")).unwrap();
+    std::io::Write::write_all(&mut &bin, &g.bin).unwrap();
+    bin.set_len(size).unwrap();
+    let mut doc = base_doc_with_buffer("big.bin");
+    doc["buffers"][0]["byteLength"] = json!(size);
+    let scene = write(dir.path(), "big", &doc);
+    let exe = env!("CARGO_BIN_EXE_penumbra");
+    let out = dir.path().join("o.png");
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(r#"ulimit -v 4000000 && exec "$0" render "$1" -o "$2" --spp 1"#)
+        .args([exe, scene.to_str().unwrap(), out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("buffers[0].uri") && err.contains(&format!("{size} bytes (100.0 GiB)")),
+        "{err}"
+    );
 }

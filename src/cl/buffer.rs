@@ -17,11 +17,40 @@ pub struct Buffer<T: Pod> {
     len: usize,
 }
 
+/// Checks one allocation against the device's `CL_DEVICE_MAX_MEM_ALLOC_SIZE` (`max_alloc`)
+/// and `CL_DEVICE_GLOBAL_MEM_SIZE` (`global`) before it is asked for: a driver may fail a
+/// larger one with an assertion (PoCL, a 16384² film) rather than an error code.
+fn fits_one_buffer(bytes: u64, max_alloc: Option<u64>, global: Option<u64>) -> Result<(), String> {
+    let gb = |b: u64| b as f64 / 1e9;
+    for (limit, what) in [(max_alloc, "in one buffer"), (global, "in all")] {
+        if let Some(limit) = limit
+            && bytes > limit
+        {
+            return Err(format!(
+                "a device buffer of {bytes} bytes ({:.2} GB) is more than the device allows \
+                 {what} ({limit} bytes, {:.2} GB)",
+                gb(bytes),
+                gb(limit)
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl<T: Pod> Buffer<T> {
     /// An uninitialised buffer of `len` elements. On a CPU device a buffer of a huge page or
     /// more lives in host memory advised for huge pages (see `HostPages`).
     pub fn new(device: &Device, len: usize) -> Result<Self, ClError> {
-        let bytes = len.max(1) * std::mem::size_of::<T>();
+        let bytes = len
+            .max(1)
+            .checked_mul(std::mem::size_of::<T>())
+            .ok_or_else(|| ClError::Device(format!("a buffer of {len} elements overflows")))?;
+        fits_one_buffer(
+            bytes as u64,
+            device.device.max_mem_alloc_size().ok(),
+            device.device.global_mem_size().ok(),
+        )
+        .map_err(ClError::Device)?;
         let host = if bytes >= HUGE_PAGE && device.is_cpu() {
             HostPages::new(bytes)
         } else {
@@ -182,6 +211,20 @@ impl<T: Pod> Buffer<T> {
 mod tests {
     use super::*;
     use crate::cl::DeviceChoice;
+
+    #[test]
+    fn a_buffer_past_the_device_limits_is_refused_naming_both_sizes() {
+        assert!(fits_one_buffer(1 << 30, Some(1 << 30), Some(1 << 34)).is_ok());
+        assert!(fits_one_buffer(1 << 30, None, None).is_ok());
+        let e = fits_one_buffer((1 << 30) + 1, Some(1 << 30), Some(1 << 34)).unwrap_err();
+        assert!(
+            e.contains("1073741825 bytes") && e.contains("1073741824 bytes"),
+            "{e}"
+        );
+        assert!(e.contains("in one buffer"), "{e}");
+        let e = fits_one_buffer(1 << 35, None, Some(1 << 34)).unwrap_err();
+        assert!(e.contains("in all"), "{e}");
+    }
 
     #[test]
     fn a_cpu_devices_large_buffer_keeps_what_is_written() {

@@ -14,7 +14,10 @@ const DEFAULT_FILTER: &str = "warn,egui_wgpu=error,winit=error";
 pub fn init_logging() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(DEFAULT_FILTER))
         .format(|buf, record| {
-            let line = log_line(record.level(), record.target(), &record.args().to_string());
+            // Control characters escaped: a file's text cannot forge a second line.
+            let text = record.args().to_string();
+            let message = crate::message::one_line(&text);
+            let line = log_line(record.level(), record.target(), &message);
             writeln!(buf, "{line}")
         })
         .init();

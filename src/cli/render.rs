@@ -2,10 +2,10 @@
 
 use super::RenderArgs;
 use crate::args::EnvChoice;
-use crate::image_io::{Format, write_exr, write_exr_rgba};
+use crate::image_io::{Format, OutputFile, encode_exr};
 use crate::render::background::{self, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
-use crate::render::tonemap::{ToneMapper, to_rgba8, write_rgba_png};
+use crate::render::tonemap::{ToneMapper, encode_rgba_png, to_rgba8};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -20,12 +20,9 @@ pub const DEFAULT_SIZE: (u32, u32) = (640, 480);
 /// Renders and writes the image; prints the summary line on stdout.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
-    let format = Format::of(&args.output)?;
-    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
-        && !dir.is_dir()
-    {
-        anyhow::bail!("{}: the output folder does not exist", dir.display());
-    }
+    // The output is checked (and opened) before the scene is read: a path that cannot be
+    // written fails now, not after the render.
+    let output = OutputFile::open(&args.output)?;
     let mut settings = args.common.settings(DEFAULT_SIZE)?;
     args.strategy.apply(&mut settings);
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
@@ -97,6 +94,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // tone-mapped.
     let (mut image, mut coverage) = (Vec::new(), Vec::new());
     renderer.image_into(&mut image, Some(&mut coverage))?;
+    let nonfinite_pixels = zero_nonfinite(&mut image);
+    if nonfinite_pixels > 0 {
+        log::warn!(
+            "{}: {nonfinite_pixels} pixels summed to a non-finite value and are written as 0",
+            args.scene.display()
+        );
+    }
     let background = args.common.background;
     let straight = background
         .cutout()
@@ -106,17 +110,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let metering = exposure::meter_subject(shown, Some(&coverage));
     let exposure = mode.stops(metering.as_ref());
     let (w, h) = (settings.width, settings.height);
-    match format {
-        Format::Exr if background.cutout() => {
-            write_exr_rgba(&args.output, w, h, &image, &coverage)?
-        }
-        Format::Exr => write_exr(&args.output, w, h, &image)?,
+    let bytes = match output.format {
+        Format::Exr => encode_exr(w, h, &image, background.cutout().then_some(&coverage[..]))?,
         Format::Png => {
             let mut rgba = to_rgba8(shown, exposure, ToneMapper::default());
             background::apply(&mut rgba, &coverage, background);
-            write_rgba_png(&args.output, w, h, &rgba)?;
+            encode_rgba_png(w, h, &rgba)?
         }
-    }
+    };
+    output.write(&bytes)?;
     let stats = renderer.stats();
     if stats.stack_overflows > 0 {
         anyhow::bail!(
@@ -197,6 +199,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ("meshes", serde_json::json!(scene_stats.meshes)),
         ("instances", serde_json::json!(scene_stats.instances)),
         ("device_bytes", serde_json::json!(scene_stats.device_bytes)),
+        ("nonfinite_pixels", serde_json::json!(nonfinite_pixels)),
     ] {
         summary[key] = value;
     }
@@ -220,6 +223,20 @@ fn duration(seconds: f64) -> String {
             format!("{} min {:02} s", whole / 60, whole % 60)
         }
     }
+}
+
+/// Sets pixels with a non-finite or negative channel to 0 and counts them: the kernels drop
+/// non-finite samples, but a film's sum of finite samples can still overflow f32, and no
+/// such value may reach the file.
+fn zero_nonfinite(image: &mut [[f32; 3]]) -> u64 {
+    let mut count = 0;
+    for p in image.iter_mut() {
+        if p.iter().any(|v| !v.is_finite() || *v < 0.0) {
+            *p = [0.0; 3];
+            count += 1;
+        }
+    }
+    count
 }
 
 /// The seconds a call of `render` aims at: the progress moves about this often.

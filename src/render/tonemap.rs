@@ -101,10 +101,19 @@ pub fn write_png(
     write_rgba_png(path, width, height, &rgba)
 }
 
-/// Writes RGBA8 pixels (already tone-mapped) as PNG.
+/// Writes RGBA8 pixels (already tone-mapped) as PNG, every write checked.
 pub fn write_rgba_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
-    image::save_buffer(path, rgba, width, height, image::ColorType::Rgba8)
-        .with_context(|| format!("{}: cannot write PNG", path.display()))
+    crate::image_io::write_file(path, &encode_rgba_png(width, height, rgba)?)
+}
+
+/// RGBA8 pixels (already tone-mapped) encoded as PNG.
+pub fn encode_rgba_png(width: u32, height: u32, rgba: &[u8]) -> Result<Vec<u8>> {
+    use image::ImageEncoder;
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(rgba, width, height, image::ExtendedColorType::Rgba8)
+        .context("cannot encode PNG")?;
+    Ok(bytes)
 }
 
 #[cfg(test)]

@@ -307,6 +307,43 @@ pub fn decode_draco(
     }))
 }
 
+/// A warning when the primitive's accessors declare counts other than its decoded Draco data
+/// holds (the specification requires them equal); the decoded data is used.
+pub fn draco_count_mismatch(
+    root: &gltf::json::Root,
+    primitive: &gltf::json::mesh::Primitive,
+    draco: &DracoPrimitive,
+    path: &str,
+) -> Option<String> {
+    let count = |a: usize| root.accessors.get(a).map(|a| a.count.0);
+    let points = draco.attributes.values().next().map_or(0, Vec::len) as u64;
+    let mut problems = Vec::new();
+    if let Some(declared) = primitive.indices.as_ref().and_then(|i| count(i.value()))
+        && declared != draco.indices.len() as u64
+    {
+        problems.push(format!(
+            "indices declare {declared}, the Draco data has {}",
+            draco.indices.len()
+        ));
+    }
+    for (semantic, accessor) in &primitive.attributes {
+        if let (Some(name), Some(declared)) = (semantic_name(semantic), count(accessor.value()))
+            && draco.attributes.contains_key(&name)
+            && declared != points
+        {
+            problems.push(format!(
+                "{name} declares {declared}, the Draco data has {points}"
+            ));
+        }
+    }
+    (!problems.is_empty()).then(|| {
+        format!(
+            "{path}: accessor counts disagree with the decoded mesh ({}); the decoded mesh is used",
+            problems.join(", ")
+        )
+    })
+}
+
 /// The glTF name of an attribute semantic (`POSITION`, `TEXCOORD_0` …).
 fn semantic_name(
     s: &gltf::json::validation::Checked<gltf::json::mesh::Semantic>,
@@ -338,6 +375,48 @@ fn draco_value(t: DataType, b: &[u8], normalized: bool) -> f32 {
 mod tests {
     use super::*;
     use serde_json::json;
+
+    /// Accessor counts are compared with the decoded Draco data: a disagreement is one
+    /// warning naming each accessor, agreement none.
+    #[test]
+    fn draco_accessor_counts_that_disagree_are_one_warning() {
+        let root: gltf::json::Root = serde_json::from_value(json!({
+            "asset": {"version": "2.0"},
+            "accessors": [
+                {"componentType": 5126, "count": 4, "type": "VEC3"},
+                {"componentType": 5125, "count": 6, "type": "SCALAR"},
+                {"componentType": 5126, "count": 3, "type": "VEC2"}
+            ],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 2}, "indices": 1}]}]
+        }))
+        .unwrap();
+        let primitive = &root.meshes[0].primitives[0];
+        let decoded = |points: usize, corners: usize| DracoPrimitive {
+            indices: vec![0; corners],
+            attributes: ["POSITION", "TEXCOORD_0"]
+                .into_iter()
+                .map(|s| (s.to_string(), vec![[0.0; 4]; points]))
+                .collect(),
+        };
+        let w = draco_count_mismatch(&root, primitive, &decoded(4, 3), "p").unwrap();
+        assert!(
+            w.starts_with("p: ")
+                && w.contains("indices declare 6, the Draco data has 3")
+                && w.contains("TEXCOORD_0 declares 3, the Draco data has 4")
+                && !w.contains("POSITION"),
+            "{w}"
+        );
+        let root: gltf::json::Root = {
+            let mut v = serde_json::to_value(&root).unwrap();
+            v["accessors"][2]["count"] = json!(4);
+            serde_json::from_value(v).unwrap()
+        };
+        let primitive = &root.meshes[0].primitives[0];
+        assert_eq!(
+            draco_count_mismatch(&root, primitive, &decoded(4, 6), "p"),
+            None
+        );
+    }
 
     #[test]
     fn meshopt_attributes_and_octahedral_filter_round_trip() {

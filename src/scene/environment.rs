@@ -30,6 +30,38 @@ fn check_env_size(width: u64, height: u64) -> Result<(), String> {
     Ok(())
 }
 
+/// Makes every texel finite and within 0..=[`limits::MAX_INTENSITY`] (non-finite values become
+/// 0, negative ones 0, larger ones the limit), so that a scaled texel, its luminance sums and
+/// the film's sums of samples stay finite in f32; says what changed, if anything.
+fn clamp_radiance(texels: &mut [[f32; 3]]) -> Option<String> {
+    let (mut nonfinite, mut negative, mut huge) = (0u64, 0u64, 0u64);
+    for v in texels.iter_mut().flatten() {
+        if !v.is_finite() {
+            nonfinite += 1;
+            *v = 0.0;
+        } else if *v < 0.0 {
+            negative += 1;
+            *v = 0.0;
+        } else if *v > limits::MAX_INTENSITY {
+            huge += 1;
+            *v = limits::MAX_INTENSITY;
+        }
+    }
+    let parts: Vec<String> = [
+        (nonfinite, "non-finite (set to 0)".to_string()),
+        (negative, "negative (set to 0)".to_string()),
+        (
+            huge,
+            format!("above {:e} (clamped to it)", limits::MAX_INTENSITY),
+        ),
+    ]
+    .into_iter()
+    .filter(|(n, _)| *n > 0)
+    .map(|(n, what)| format!("{n} values {what}"))
+    .collect();
+    (!parts.is_empty()).then(|| format!("radiance clamped: {}", parts.join(", ")))
+}
+
 /// An environment image in linear radiance.
 #[derive(Clone)]
 pub struct EnvMap {
@@ -68,9 +100,19 @@ fn luminance(c: [f32; 3]) -> f32 {
 }
 
 impl EnvMap {
-    /// Loads a `.hdr` (Radiance RGBE) or `.exr` image. Non-finite and negative values become 0;
-    /// images wider than [`MAX_ENV_WIDTH`] are halved until they fit.
+    /// Loads a `.hdr` (Radiance RGBE) or `.exr` image. Non-finite and negative values become 0
+    /// and values above [`limits::MAX_INTENSITY`] that limit, with one warning; images wider
+    /// than [`MAX_ENV_WIDTH`] are halved until they fit.
     pub fn load(path: &Path) -> Result<Self, String> {
+        let (map, warning) = Self::load_checked(path)?;
+        if let Some(w) = warning {
+            log::warn!("{w}");
+        }
+        Ok(map)
+    }
+
+    /// [`EnvMap::load`] returning its warning (texels changed) instead of logging it.
+    pub fn load_checked(path: &Path) -> Result<(Self, Option<String>), String> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -119,19 +161,18 @@ impl EnvMap {
         if width == 0 || height == 0 {
             return Err(format!("{}: the image is empty", path.display()));
         }
+        let mut texels = texels;
+        let warning = clamp_radiance(&mut texels).map(|c| format!("{}: {c}", path.display()));
         let mut map = Self {
             name: path.display().to_string(),
             width,
             height,
-            texels: texels
-                .into_iter()
-                .map(|p: [f32; 3]| p.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 }))
-                .collect(),
+            texels,
         };
         while map.width > MAX_ENV_WIDTH {
             map = map.halved();
         }
-        Ok(map)
+        Ok((map, warning))
     }
 
     /// A map of one radiance everywhere (`height` rows so that sin θ shapes the sampling).

@@ -4,7 +4,7 @@
 
 use super::accessor::BufferData;
 use super::compression;
-use super::pose::{node_matrix, node_pose, rest_worlds};
+use super::pose::{check_nesting, node_matrix, node_pose, rest_worlds};
 use super::variants;
 use super::{
     Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError, default_light_rig, limits,
@@ -28,6 +28,12 @@ pub const AUTO_YFOV: f64 = 0.8;
 
 /// Loads a glTF or GLB file. Every problem with the file is a one-line [`SceneError`].
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    load_with(path, None)
+}
+
+/// [`load`] reading the files its URIs name from inside the file's folder or, when given,
+/// inside `asset_root` (`--asset-root`).
+pub fn load_with(path: &Path, asset_root: Option<&Path>) -> Result<Scene, SceneError> {
     let fail = |message: String| SceneError::Invalid {
         path: path.to_path_buf(),
         message,
@@ -38,12 +44,20 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     }
     let bytes =
         sources::Bytes::of_file(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
-    load_owned(bytes, path.parent(), &path.display().to_string()).map_err(fail)
+    let folders =
+        sources::Folders::new(path.parent().unwrap_or(Path::new("")), asset_root).map_err(&fail)?;
+    load_owned(bytes, Some(&folders), &path.display().to_string()).map_err(fail)
 }
 
-/// Loads glTF or GLB bytes; external files are resolved against `base`.
+/// Loads glTF or GLB bytes; external files are resolved against `base` and read only from
+/// inside it.
 pub fn load_from_bytes(bytes: &[u8], base: Option<&Path>, source: &str) -> Result<Scene, String> {
-    load_owned(sources::Bytes::Owned(bytes.to_vec()), base, source)
+    let folders = base.map(|b| sources::Folders::new(b, None)).transpose()?;
+    load_owned(
+        sources::Bytes::Owned(bytes.to_vec()),
+        folders.as_ref(),
+        source,
+    )
 }
 
 /// [`load_owned`] of bytes with no external files (for tests of [`sources::Bytes`]).
@@ -56,7 +70,11 @@ fn load_bytes(bytes: sources::Bytes) -> Result<Scene, String> {
 /// binary chunk is read in place and every buffer is freed before the scene's bounds are
 /// computed, so that the file and the imported meshes are held together only while the
 /// meshes are read.
-fn load_owned(bytes: sources::Bytes, base: Option<&Path>, source: &str) -> Result<Scene, String> {
+fn load_owned(
+    bytes: sources::Bytes,
+    base: Option<&sources::Folders>,
+    source: &str,
+) -> Result<Scene, String> {
     let _memory = crate::cl::kernels::OpeningMemory::begin();
     let mut warnings = Vec::new();
     let parsed = validate::parse(bytes, &mut warnings)?;
@@ -68,6 +86,7 @@ fn load_owned(bytes: sources::Bytes, base: Option<&Path>, source: &str) -> Resul
         decoded_views: HashMap::new(),
     };
     buffer_data.decoded_views = compression::decode_meshopt_views(root, &buffer_data.buffers)?;
+    check_nesting(&document)?;
     let rest = rest_worlds(&document, &parsed.precise_nodes);
 
     let mut table = TextureTable {

@@ -35,6 +35,11 @@ pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 /// [`MAX_IMAGE_PIXELS`] plus its conversion).
 pub const MAX_IMAGE_DECODE_BYTES: u64 = 1 << 30;
 
+/// The most pixels all texture images of a scene may decode to together (2²⁹: 2 GiB as the
+/// RGBA8 the scene keeps, e.g. 32 images of 4096²); images past it are left out with a
+/// warning each. Which ones, when several are decoded at once, may differ between runs.
+pub const MAX_DECODED_PIXELS: u64 = 1 << 29;
+
 /// The largest side of an environment image (.hdr or .exr), checked from its header.
 pub const MAX_ENV_SIDE: u32 = 16384;
 

@@ -12,6 +12,7 @@ mod env_presets;
 mod environment;
 pub mod framing;
 mod gltf_import;
+mod lenient;
 mod lights;
 pub mod limits;
 mod pose;
@@ -24,7 +25,7 @@ mod variants;
 pub use bounds::{ABSURD_COORDINATE, RenderFrame, is_sane, robust_bounds, robust_bounds_of};
 pub use env_presets::EnvPreset;
 pub use environment::{EnvMap, EnvSampling, MAX_ENV_WIDTH};
-pub use gltf_import::{AUTO_YFOV, load, load_from_bytes};
+pub use gltf_import::{AUTO_YFOV, load, load_from_bytes, load_with};
 pub use lights::{LightPreset, Shadows, default_light_radius, default_light_rig, preset_lights};
 pub use textures::{
     Image, MAX_TEXTURE_SIDE, MaterialTextures, MipLevel, TexTransform, TextureRef, Wrap,
@@ -42,8 +43,16 @@ pub const BUNDLED_SCENE: &[u8] = include_bytes!("../../assets/cornell-box.glb");
 
 /// Loads `path`, or the bundled Cornell box when there is none.
 pub fn load_or_bundled(path: Option<&Path>) -> Result<Scene, SceneError> {
+    load_or_bundled_with(path, None)
+}
+
+/// [`load_or_bundled`] with the files a scene's URIs name read also from inside `asset_root`.
+pub fn load_or_bundled_with(
+    path: Option<&Path>,
+    asset_root: Option<&Path>,
+) -> Result<Scene, SceneError> {
     match path {
-        Some(p) => load(p),
+        Some(p) => load_with(p, asset_root),
         None => load_from_bytes(BUNDLED_SCENE, None, "bundled Cornell box").map_err(|message| {
             SceneError::Invalid {
                 path: PathBuf::from("assets/cornell-box.glb"),

@@ -3,6 +3,7 @@
 //! bind matrix) blended per vertex.
 
 use super::accessor::{self, Attributes, BufferData};
+use super::limits;
 use super::validate::PreciseNode;
 use glam::{DMat4, DQuat, DVec3, Vec3, Vec4};
 
@@ -20,14 +21,7 @@ pub struct Pose {
 /// (a node no scene reaches is placed by its own transform). Used for skin joints.
 pub fn rest_worlds(document: &gltf::Document, precise: &[PreciseNode]) -> Vec<DMat4> {
     let count = document.nodes().len();
-    let mut parent: Vec<Option<usize>> = vec![None; count];
-    for node in document.nodes() {
-        for child in node.children() {
-            if child.index() != node.index() && parent[child.index()].is_none() {
-                parent[child.index()] = Some(node.index());
-            }
-        }
-    }
+    let parent = parents(document);
     let local: Vec<DMat4> = document
         .nodes()
         .map(|n| node_matrix(&n, precise.get(n.index())).unwrap_or(DMat4::IDENTITY))
@@ -48,6 +42,61 @@ pub fn rest_worlds(document: &gltf::Document, precise: &[PreciseNode]) -> Vec<DM
             world
         })
         .collect()
+}
+
+/// Each node's first parent (the first node listing it as a child, itself excluded).
+fn parents(document: &gltf::Document) -> Vec<Option<usize>> {
+    let mut parent: Vec<Option<usize>> = vec![None; document.nodes().len()];
+    for node in document.nodes() {
+        for child in node.children() {
+            if child.index() != node.index() && parent[child.index()].is_none() {
+                parent[child.index()] = Some(node.index());
+            }
+        }
+    }
+    parent
+}
+
+/// Checks, in time linear in the number of nodes, that no chain of first parents is deeper
+/// than [`limits::MAX_NODE_DEPTH`] or closes a cycle. [`rest_worlds`] walks each node's chain
+/// to its root, so once this passes it takes at most `MAX_NODE_DEPTH` products a node instead
+/// of one a level of a chain 100,000 deep (quadratic: a minute before the walk's own check).
+pub fn check_nesting(document: &gltf::Document) -> Result<(), String> {
+    const UNKNOWN: usize = usize::MAX;
+    const ON_CHAIN: usize = usize::MAX - 1;
+    let parent = parents(document);
+    let mut depth = vec![UNKNOWN; parent.len()];
+    let mut chain = Vec::new();
+    for start in 0..parent.len() {
+        // Climb until a node of known depth or a root, then number the chain downwards: each
+        // node is climbed through once over all starts.
+        chain.clear();
+        let mut at = start;
+        let above = loop {
+            match depth[at] {
+                ON_CHAIN => return Err(format!("nodes[{at}]: its parents form a cycle")),
+                UNKNOWN => {}
+                known => break Some(known),
+            }
+            depth[at] = ON_CHAIN;
+            chain.push(at);
+            match parent[at] {
+                Some(p) => at = p,
+                None => break None,
+            }
+        };
+        let top = above.map_or(0, |d| d + 1);
+        for (d, &node) in (top..).zip(chain.iter().rev()) {
+            if d > limits::MAX_NODE_DEPTH {
+                return Err(format!(
+                    "nodes[{node}]: nested more than {} deep",
+                    limits::MAX_NODE_DEPTH
+                ));
+            }
+            depth[node] = d;
+        }
+    }
+    Ok(())
 }
 
 /// The pose of `node`'s mesh: its morph weights and, with a skin, its joint matrices.

@@ -1,7 +1,7 @@
 //! The bytes a glTF file refers to: its buffers (the GLB chunk, `data:` URIs, files beside it)
-//! and its encoded images. URIs are resolved relative to the glTF file; only regular files are
-//! read, never more bytes than a buffer declares; images are checked against the size limits
-//! from their header before they are decoded.
+//! and its encoded images. URIs are resolved relative to the glTF file; only regular files
+//! inside the allowed folders ([`Folders`]) are read, never more bytes than a buffer declares;
+//! images are checked against the size limits from their header before they are decoded.
 
 use super::limits;
 use std::io::Read;
@@ -46,7 +46,16 @@ impl Bytes {
             return Ok(Bytes::Mapped(map, 0..len));
         }
         drop(file);
-        Ok(Bytes::Owned(std::fs::read(path)?))
+        // A file that cannot be mapped is read: say how large it is when that fails too.
+        std::fs::read(path).map(Bytes::Owned).map_err(|e| {
+            std::io::Error::new(
+                e.kind(),
+                format!(
+                    "cannot hold its {size} bytes ({:.1} GiB) in memory: {e}",
+                    size as f64 / (1u64 << 30) as f64
+                ),
+            )
+        })
     }
 
     /// The bytes of `range` (within these) alone; owned ones are moved down in place.
@@ -70,10 +79,57 @@ impl Bytes {
     }
 }
 
+/// Where a glTF file's URIs may lead: they are relative to `base`, and a file is read only when
+/// its real path (percent-decoding, `..` and symbolic links resolved) lies inside one of
+/// `allowed`, so that `../../etc/passwd` or a link out of the folder is refused.
+pub struct Folders {
+    base: PathBuf,
+    allowed: Vec<PathBuf>,
+}
+
+impl Folders {
+    /// URIs relative to `base` (the glTF file's folder; empty means the current folder), files
+    /// inside `base` or, when given, inside `asset_root`.
+    pub fn new(base: &Path, asset_root: Option<&Path>) -> Result<Self, String> {
+        let base = if base.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            base
+        };
+        let real = |dir: &Path| {
+            dir.canonicalize()
+                .map_err(|e| format!("{}: cannot resolve the folder: {e}", dir.display()))
+        };
+        let mut allowed = vec![real(base)?];
+        if let Some(root) = asset_root {
+            allowed.push(real(root)?);
+        }
+        Ok(Folders {
+            base: base.to_path_buf(),
+            allowed,
+        })
+    }
+
+    /// The real path of `relative` (from the base), or why it may not be read.
+    fn file(&self, uri: &str, relative: &Path) -> Result<PathBuf, String> {
+        let real = self
+            .base
+            .join(relative)
+            .canonicalize()
+            .map_err(|e| format!("'{uri}': {e}"))?;
+        if !self.allowed.iter().any(|dir| real.starts_with(dir)) {
+            return Err(format!(
+                "'{uri}' resolves outside the scene's folder (--asset-root DIR allows a wider one)"
+            ));
+        }
+        Ok(real)
+    }
+}
+
 /// Loads every buffer of `document`: exactly `byteLength` bytes each.
 pub fn load_buffers(
     document: &gltf::Document,
-    base: Option<&Path>,
+    base: Option<&Folders>,
     blob: Option<Bytes>,
 ) -> Result<Vec<Bytes>, String> {
     let mut blob = blob;
@@ -115,13 +171,13 @@ pub fn load_buffers(
 enum Resolved {
     /// The decoded bytes of a `data:` URI.
     Data(Vec<u8>),
-    /// A file relative to the glTF file.
+    /// The real path of a file inside the allowed folders.
     File(PathBuf),
 }
 
 /// Resolves a glTF URI: a base64 `data:` URI, or a relative path (percent-encoded) from
-/// `base`. Other schemes and absolute paths are refused.
-fn resolve(uri: &str, base: Option<&Path>) -> Result<Resolved, String> {
+/// `base` that stays inside its allowed folders. Other schemes and absolute paths are refused.
+fn resolve(uri: &str, base: Option<&Folders>) -> Result<Resolved, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let Some((_, payload)) = rest.split_once(";base64,") else {
             return Err("only base64 data: URIs are supported".into());
@@ -150,7 +206,7 @@ fn resolve(uri: &str, base: Option<&Path>) -> Result<Resolved, String> {
             "'{uri}' names a file, but the glTF was not loaded from a folder"
         ));
     };
-    Ok(Resolved::File(base.join(relative)))
+    base.file(uri, relative).map(Resolved::File)
 }
 
 /// An external buffer file of at least `want` bytes: mapped from [`MAP_FROM`] bytes on (as a
@@ -196,12 +252,47 @@ fn read_regular(path: &Path, want: Option<usize>) -> Result<Vec<u8>, String> {
     Ok(data)
 }
 
+/// The pixels all images of one scene may decode to together
+/// ([`limits::MAX_DECODED_PIXELS`]): each image takes its share from its header before it is
+/// decoded, so that many images each under the per-image limit cannot exhaust memory together.
+pub struct DecodeBudget(std::sync::atomic::AtomicU64);
+
+impl Default for DecodeBudget {
+    fn default() -> Self {
+        DecodeBudget(std::sync::atomic::AtomicU64::new(
+            limits::MAX_DECODED_PIXELS,
+        ))
+    }
+}
+
+impl DecodeBudget {
+    /// Takes `width × height` pixels, or says that the budget is spent.
+    fn take(&self, width: u32, height: u32) -> Result<(), String> {
+        use std::sync::atomic::Ordering;
+        let pixels = width as u64 * height as u64;
+        self.0
+            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |left| {
+                left.checked_sub(pixels)
+            })
+            .map(|_| ())
+            .map_err(|_| {
+                format!(
+                    "its {width}×{height} pixels would take the scene's images past {} pixels \
+                     in all",
+                    limits::MAX_DECODED_PIXELS
+                )
+            })
+    }
+}
+
 /// Reads and decodes image `image` of the document (`images[i]`) with its size checked from
-/// the header first; `base` resolves relative URIs.
+/// the header first, against the per-image limits and what is left of `budget`; `base`
+/// resolves relative URIs.
 pub fn decode_image(
     image: &gltf::Image,
-    base: Option<&Path>,
+    base: Option<&Folders>,
     buffers: &[Bytes],
+    budget: &DecodeBudget,
 ) -> Result<gltf::image::Data, String> {
     let bytes: std::borrow::Cow<[u8]> = match image.source() {
         gltf::image::Source::View { view, .. } => {
@@ -225,21 +316,25 @@ pub fn decode_image(
                 .into(),
         },
     };
-    decode_bounded(&bytes)
+    decode_bounded(&bytes, budget)
 }
 
 /// Decodes an encoded PNG, JPEG, WebP or KTX2 (Basis Universal) image after checking its
-/// header's size against the limits.
-pub fn decode_bounded(bytes: &[u8]) -> Result<gltf::image::Data, String> {
+/// header's size against the limits and taking its pixels from `budget`.
+fn decode_bounded(bytes: &[u8], budget: &DecodeBudget) -> Result<gltf::image::Data, String> {
     use gltf::image::Format as F;
     use image::DynamicImage as D;
     if super::basisu::is_ktx2(bytes) {
-        return super::basisu::decode(bytes);
+        // The KTX2 decoder checks its header against the per-image limits itself.
+        let data = super::basisu::decode(bytes)?;
+        budget.take(data.width, data.height)?;
+        return Ok(data);
     }
     let format = image::guess_format(bytes).map_err(|e| e.to_string())?;
     let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
     let (width, height) = reader().into_dimensions().map_err(|e| e.to_string())?;
     limits::check_image_size(width, height)?;
+    budget.take(width, height)?;
     let mut bounded = reader();
     let mut caps = image::Limits::default();
     caps.max_image_width = Some(limits::MAX_IMAGE_SIDE);
@@ -271,6 +366,34 @@ pub fn decode_bounded(bytes: &[u8]) -> Result<gltf::image::Data, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Images take their pixels from one budget before they are decoded: past it, an image
+    /// is refused from its header, whatever the per-image limits allow.
+    #[test]
+    fn images_together_stay_within_the_decode_budget() {
+        let mut png = Vec::new();
+        image::RgbaImage::new(64, 32)
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let budget = DecodeBudget(std::sync::atomic::AtomicU64::new(3 * 64 * 32));
+        for _ in 0..3 {
+            let data = decode_bounded(&png, &budget).unwrap();
+            assert_eq!((data.width, data.height), (64, 32));
+        }
+        let e = decode_bounded(&png, &budget).unwrap_err();
+        assert!(e.contains("64×32") && e.contains("in all"), "{e}");
+        // A refused image takes nothing: a smaller one still fits.
+        let budget = DecodeBudget(std::sync::atomic::AtomicU64::new(64 * 32 - 1));
+        assert!(decode_bounded(&png, &budget).is_err());
+        assert_eq!(
+            budget.0.load(std::sync::atomic::Ordering::Relaxed),
+            64 * 32 - 1
+        );
+        assert_eq!(
+            DecodeBudget::default().0.into_inner(),
+            limits::MAX_DECODED_PIXELS
+        );
+    }
 
     /// A mapped file gives the bytes a read gives, and its ranges those of the read bytes.
     #[test]

@@ -81,6 +81,13 @@ fn precise_nodes(json: &[u8]) -> Vec<PreciseNode> {
 /// optional extensions) are appended to `warnings`. A GLB file's `BIN` chunk keeps the
 /// allocation of `bytes` (moved down to its start, not copied): a file of meshes is held once.
 pub fn parse(bytes: Bytes, warnings: &mut Vec<String>) -> Result<Parsed, String> {
+    // A GLB header's length word (bytes 8..12) against the file's length.
+    let glb_lengths = bytes.starts_with(b"glTF").then(|| {
+        let header = bytes
+            .get(8..12)
+            .map_or(0, |w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]));
+        (header as u64, bytes.len() as u64)
+    });
     let (json_bytes, blob) = if bytes.starts_with(b"glTF") {
         let glb =
             gltf::Glb::from_slice(&bytes).map_err(|e| format!("not a valid GLB file: {e}"))?;
@@ -105,6 +112,7 @@ pub fn parse(bytes: Bytes, warnings: &mut Vec<String>) -> Result<Parsed, String>
         };
         return Err(format!("{first}{more}"));
     }
+    super::lenient::warn_invalid(&root, glb_lengths, warnings);
     let precise_nodes = precise_nodes(&json_bytes);
     Ok(Parsed {
         document: gltf::Document::from_json_without_validation(root),

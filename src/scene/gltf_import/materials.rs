@@ -122,7 +122,7 @@ pub(super) fn import_material(
         unlit: m.unlit(),
         ..Material::default()
     };
-    read_extensions(&m, document, table, &mut material, warnings);
+    read_extensions(&m, document, table, &mut material, &mut fix, warnings);
     if !fix.0.is_empty() {
         warnings.push(format!(
             "materials[{}]: {}",
@@ -181,6 +181,7 @@ pub(super) fn read_extensions(
     document: &gltf::Document,
     table: &mut TextureTable,
     material: &mut Material,
+    fix: &mut Fixes,
     warnings: &mut Vec<String>,
 ) {
     let what = format!("material {}", m.index().unwrap_or(0));
@@ -188,6 +189,7 @@ pub(super) fn read_extensions(
         document,
         table,
         what: &what,
+        fix,
         warnings,
     };
     if let Some(x) = m.extension_value("KHR_materials_clearcoat") {
@@ -207,7 +209,7 @@ pub(super) fn read_extensions(
     }
     if let Some(x) = m.extension_value("KHR_materials_dispersion") {
         // 20 / Abbe number; any value >= 0 is valid (above 1 exaggerates).
-        material.dispersion = Reader::non_negative(x, "dispersion", 0.0);
+        material.dispersion = reader.non_negative(x, "dispersion", 0.0);
     }
 }
 
@@ -215,16 +217,17 @@ struct Reader<'a> {
     document: &'a gltf::Document,
     table: &'a mut TextureTable,
     what: &'a str,
+    fix: &'a mut Fixes,
     warnings: &'a mut Vec<String>,
 }
 
 impl Reader<'_> {
-    /// A number of the extension object, clamped to [0, 1]; `default` when absent or not a
-    /// number.
-    fn unit(x: &Value, key: &str, default: f32) -> f32 {
-        x.get(key)
-            .and_then(Value::as_f64)
-            .map_or(default, |v| (v as f32).clamp(0.0, 1.0))
+    /// A number of the extension object, clamped to [0, 1] (noted in the material's
+    /// warning); `default` when absent or not a number.
+    fn unit(&mut self, x: &Value, key: &str, default: f32) -> f32 {
+        x.get(key).and_then(Value::as_f64).map_or(default, |v| {
+            self.fix.range(key, v as f32, 0.0, 1.0, default)
+        })
     }
 
     /// A textureInfo (or normalTextureInfo) object: the texture with its texCoord and
@@ -250,8 +253,8 @@ impl Reader<'_> {
     }
 
     fn clearcoat(&mut self, x: &Value, material: &mut Material) {
-        material.clearcoat = Self::unit(x, "clearcoatFactor", 0.0);
-        material.clearcoat_roughness = Self::unit(x, "clearcoatRoughnessFactor", 0.0);
+        material.clearcoat = self.unit(x, "clearcoatFactor", 0.0);
+        material.clearcoat_roughness = self.unit(x, "clearcoatRoughnessFactor", 0.0);
         material.clearcoat_normal_scale = x
             .get("clearcoatNormalTexture")
             .and_then(|n| n.get("scale"))
@@ -263,58 +266,69 @@ impl Reader<'_> {
         t.clearcoat_normal = self.texture(x, "clearcoatNormalTexture", false);
     }
 
-    /// An RGB factor of the extension object, each channel clamped to [0, 1]; `default` where
-    /// absent or not a number.
-    fn color(x: &Value, key: &str, default: f32) -> [f32; 3] {
+    /// An RGB factor of the extension object, each channel clamped to [0, 1] (noted in the
+    /// material's warning); `default` where absent or not a number.
+    fn color(&mut self, x: &Value, key: &str, default: f32) -> [f32; 3] {
         let color = x.get(key).and_then(Value::as_array);
         std::array::from_fn(|i| {
             color
                 .and_then(|c| c.get(i))
                 .and_then(Value::as_f64)
-                .map_or(default, |v| (v as f32).clamp(0.0, 1.0))
+                .map_or(default, |v| {
+                    self.fix.range(key, v as f32, 0.0, 1.0, default)
+                })
         })
     }
 
     fn sheen(&mut self, x: &Value, material: &mut Material) {
-        material.sheen_color = Self::color(x, "sheenColorFactor", 0.0);
-        material.sheen_roughness = Self::unit(x, "sheenRoughnessFactor", 0.0);
+        material.sheen_color = self.color(x, "sheenColorFactor", 0.0);
+        material.sheen_roughness = self.unit(x, "sheenRoughnessFactor", 0.0);
         let t: &mut MaterialTextures = &mut material.textures;
         t.sheen_color = self.texture(x, "sheenColorTexture", true);
         t.sheen_roughness = self.texture(x, "sheenRoughnessTexture", false);
     }
 
     fn anisotropy(&mut self, x: &Value, material: &mut Material) {
-        material.anisotropy = Self::unit(x, "anisotropyStrength", 0.0);
+        material.anisotropy = self.unit(x, "anisotropyStrength", 0.0);
+        // Any angle is valid: reduced to [0, 2π) in f64, so that one past f32's range (1e39)
+        // still turns the frame instead of becoming infinite there.
         material.anisotropy_rotation = x
             .get("anisotropyRotation")
             .and_then(Value::as_f64)
             .filter(|r| r.is_finite())
-            .map_or(0.0, |r| r as f32);
+            .map_or(0.0, |r| r.rem_euclid(std::f64::consts::TAU) as f32);
         material.textures.anisotropy = self.texture(x, "anisotropyTexture", false);
     }
 
-    /// A non-negative finite number of the extension object; `default` otherwise.
-    fn non_negative(x: &Value, key: &str, default: f32) -> f32 {
-        x.get(key)
-            .and_then(Value::as_f64)
-            .filter(|v| v.is_finite() && *v >= 0.0)
-            .map_or(default, |v| v as f32)
+    /// A non-negative finite number of the extension object; `default` when absent, and
+    /// (noted in the material's warning) when negative or not finite in f32.
+    fn non_negative(&mut self, x: &Value, key: &str, default: f32) -> f32 {
+        let Some(v) = x.get(key).and_then(Value::as_f64) else {
+            return default;
+        };
+        if (v as f32).is_finite() && v >= 0.0 {
+            return v as f32;
+        }
+        self.fix.0.push(format!(
+            "{key} {v} is negative or not finite, {default} is used"
+        ));
+        default
     }
 
     fn diffuse_transmission(&mut self, x: &Value, material: &mut Material) {
-        material.diffuse_transmission = Self::unit(x, "diffuseTransmissionFactor", 0.0);
-        material.diffuse_transmission_color = Self::color(x, "diffuseTransmissionColorFactor", 1.0);
+        material.diffuse_transmission = self.unit(x, "diffuseTransmissionFactor", 0.0);
+        material.diffuse_transmission_color = self.color(x, "diffuseTransmissionColorFactor", 1.0);
         let t: &mut MaterialTextures = &mut material.textures;
         t.diffuse_transmission = self.texture(x, "diffuseTransmissionTexture", false);
         t.diffuse_transmission_color = self.texture(x, "diffuseTransmissionColorTexture", true);
     }
 
     fn iridescence(&mut self, x: &Value, material: &mut Material) {
-        material.iridescence = Self::unit(x, "iridescenceFactor", 0.0);
-        material.iridescence_ior = Self::non_negative(x, "iridescenceIor", 1.3).max(1.0);
+        material.iridescence = self.unit(x, "iridescenceFactor", 0.0);
+        material.iridescence_ior = self.non_negative(x, "iridescenceIor", 1.3).max(1.0);
         material.iridescence_thickness = [
-            Self::non_negative(x, "iridescenceThicknessMinimum", 100.0),
-            Self::non_negative(x, "iridescenceThicknessMaximum", 400.0),
+            self.non_negative(x, "iridescenceThicknessMinimum", 100.0),
+            self.non_negative(x, "iridescenceThicknessMaximum", 400.0),
         ];
         let t: &mut MaterialTextures = &mut material.textures;
         t.iridescence = self.texture(x, "iridescenceTexture", false);

@@ -112,6 +112,12 @@ pub(super) fn import_mesh(
             continue;
         }
         let json = &root.meshes[mesh.index()].primitives[prim.index()];
+        let draco = compression::decode_draco(root, data, json, &what)?;
+        if let Some(d) = &draco
+            && let Some(w) = compression::draco_count_mismatch(root, json, d, &what)
+        {
+            warnings.push(w);
+        }
         let attributes = Attributes {
             root,
             data,
@@ -123,7 +129,7 @@ pub(super) fn import_mesh(
                     Checked::Invalid => None,
                 })
                 .collect(),
-            draco: compression::decode_draco(root, data, json, &what)?,
+            draco,
             path: what.clone(),
         };
         let mut positions: Vec<Vec3> = attributes

@@ -5,7 +5,6 @@ use super::super::textures::{Image, MaterialTextures, TexTransform, TextureRef, 
 use super::super::{sources, validate};
 use rayon::prelude::*;
 use std::collections::HashMap;
-use std::path::Path;
 use std::sync::Arc;
 
 /// Texture references collected while importing materials, and the images they need.
@@ -75,15 +74,42 @@ impl TextureTable {
         let mut t = TexTransform::default();
         let mut tex_coord = tex_coord;
         if let Some(x) = transform {
-            let pair = |key: &str, default: [f32; 2]| {
-                x.get(key)
-                    .and_then(|v| v.as_array())
+            // A value given but not finite in f32 (1e39 arrives here as null) leaves out the
+            // whole transform, with a warning.
+            let mut finite = true;
+            let mut pair = |key: &str, default: [f32; 2]| {
+                let Some(v) = x.get(key) else {
+                    return default;
+                };
+                match v
+                    .as_array()
                     .and_then(|a| Some([a.first()?.as_f64()? as f32, a.get(1)?.as_f64()? as f32]))
-                    .unwrap_or(default)
+                {
+                    Some(p) if p.iter().all(|c| c.is_finite()) => p,
+                    _ => {
+                        finite = false;
+                        default
+                    }
+                }
             };
             t.offset = pair("offset", [0.0; 2]);
             t.scale = pair("scale", [1.0; 2]);
-            t.rotation = x.get("rotation").and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
+            // Any angle is valid: reduced to [0, 2π) in f64 before it becomes f32.
+            match x
+                .get("rotation")
+                .map(|v| v.as_f64().filter(|r| r.is_finite()))
+            {
+                None => {}
+                Some(Some(r)) => t.rotation = r.rem_euclid(std::f64::consts::TAU) as f32,
+                Some(None) => finite = false,
+            }
+            if !finite {
+                warnings.push(format!(
+                    "{what}: KHR_texture_transform has a value that is not finite in f32; no \
+                     transform is used"
+                ));
+                t = TexTransform::default();
+            }
             if let Some(set) = x.get("texCoord").and_then(|v| v.as_u64()) {
                 tex_coord = set as u32;
             }
@@ -172,12 +198,13 @@ impl TextureTable {
 /// warning and its texture slots fall back to the factors.
 pub(super) fn decode_images(
     document: &gltf::Document,
-    base: Option<&Path>,
+    base: Option<&sources::Folders>,
     buffers: &[sources::Bytes],
     table: &mut TextureTable,
     warnings: &mut Vec<String>,
 ) -> Vec<Arc<Image>> {
     let all: Vec<gltf::Image> = document.images().collect();
+    let budget = sources::DecodeBudget::default();
     let decoded: Vec<Result<Image, String>> = table
         .order
         .par_iter()
@@ -191,7 +218,7 @@ pub(super) fn decode_images(
                     .name()
                     .map_or_else(|| i.to_string(), |n| format!("{i} ({n})")),
             };
-            let data = sources::decode_image(image, base, buffers).map_err(|e| {
+            let data = sources::decode_image(image, base, buffers, &budget).map_err(|e| {
                 let detail = name.strip_prefix(&i.to_string()).unwrap_or_default();
                 format!("images[{i}]{detail}: cannot decode: {e}")
             })?;
