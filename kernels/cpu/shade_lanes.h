@@ -15,7 +15,13 @@
 // here), draws the same random numbers, and samples an emissive triangle as sample_light does
 // (other lights by sample_light itself, lane by lane): the same paths, bit for bit
 // (tests/megakernel.rs compares the images). A chunk's camera hits, LANES or fewer at once, are
-// shaded here too.
+// shaded here too. The vertex's weights (power heuristic, an emitter's light pdf, the light
+// sample's MIS weight, Russian roulette's probability) are path.h's, one definition for both
+// widths (DEFINE_VERTEX_WEIGHTS); the rest is still written here a second time in vectors: the
+// hit's point, error bound and normals (traverse.h's surface_point, triangle_normal,
+// offset_ray), the shading normal, the Lambertian BSDF's evaluation and cosine sample (bsdf.h's
+// LAMBERT_ONLY forms, rng.h's unit_circle and onb) and an emissive triangle's sample
+// (lights.h), each followed operation for operation; a change to them is made in both places.
 // Batches took 11.7 % fewer instructions on the 1 M-triangle room and about 12 % less time
 // (AMD Zen 3, AVX2, 2026-12-04); shading the lanes done at each return instead (commit 29fe987)
 // was no faster: too few to fill the vectors.
@@ -163,11 +169,9 @@ LANES_INLINE vfloat lv_length(LaneVec v) {
     return select(len, (vfloat)(0.0f), zero);
 }
 
-LANES_INLINE vfloat lanes_power_heuristic(vfloat a, vfloat b) {
-    vfloat a2 = a * a;
-    vfloat b2 = b * b;
-    return select((vfloat)(0.0f), a2 / (a2 + b2), a2 + b2 > 0.0f);
-}
+// path.h's vertex weights in every lane: lanes_power_heuristic, lanes_emitter_pdf,
+// lanes_light_sample_weight, lanes_survival.
+DEFINE_VERTEX_WEIGHTS(lanes, vfloat, vint)
 
 // rng_next in the lanes of m (the others' states kept; their numbers are meaningless).
 LANES_INLINE vfloat lanes_rng_next(vuint* state, vint m) {
@@ -178,26 +182,24 @@ LANES_INLINE vfloat lanes_rng_next(vuint* state, vint m) {
     return convert_vfloat(word >> 8u) * (1.0f / 16777216.0f);
 }
 
+// offset_ray (traverse.h) in every lane, one axis: the point's coordinate p moved by the
+// offset k along the normal's coordinate n, then one float further away.
+LANES_INLINE vfloat lanes_offset_axis(vfloat p, vfloat k, vfloat n) {
+    vfloat offset = k * n;
+    vfloat po = p + offset;
+    vint bits = as_vint(po);
+    vint away = (po > 0.0f) == (offset > 0.0f);
+    vint stepped = select(bits - 1, bits + 1, away);
+    stepped = select(stepped, select((vint)(0x80000001), (vint)(1), offset > 0.0f), po == 0.0f);
+    return select(po, as_vfloat(stepped), offset != 0.0f);
+}
+
 // offset_ray (traverse.h) in every lane.
 LANES_INLINE LaneVec lanes_offset_ray(LaneVec p, LaneVec err, LaneVec n) {
     LaneVec an = {fabs(n.x), fabs(n.y), fabs(n.z)};
     vfloat k = lv_dot(an, err);
-    LaneVec r;
-#define LANES_OFFSET(c)                                                                      \
-    {                                                                                        \
-        vfloat offset = k * n.c;                                                            \
-        vfloat po = p.c + offset;                                                           \
-        vint bits = as_vint(po);                                                       \
-        vint away = (po > 0.0f) == (offset > 0.0f);                                       \
-        vint stepped = select(bits - 1, bits + 1, away);                                  \
-        stepped = select(stepped, select((vint)(0x80000001), (vint)(1), offset > 0.0f), \
-                         po == 0.0f);                                                        \
-        r.c = select(po, as_vfloat(stepped), offset != 0.0f);                               \
-    }
-    LANES_OFFSET(x)
-    LANES_OFFSET(y)
-    LANES_OFFSET(z)
-#undef LANES_OFFSET
+    LaneVec r = {lanes_offset_axis(p.x, k, n.x), lanes_offset_axis(p.y, k, n.y),
+                 lanes_offset_axis(p.z, k, n.z)};
     return r;
 }
 
@@ -353,7 +355,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                     }
                     vfloat sel = vload_lanes(0, sel_), area = vload_lanes(0, area_);
                     vfloat cos_l = fabs(lv_dot(ng, wo));
-                    vfloat light_pdf = select(zero, sel * t * t / (area * cos_l), cos_l > 0.0f);
+                    vfloat light_pdf = lanes_emitter_pdf(sel, area, t, cos_l);
                     weight = select(weight, lanes_power_heuristic(prev_pdf, light_pdf), w_mis);
                 }
                 rad.x = select(rad.x, rad.x + thr.x * MB[4] * weight, em);
@@ -493,9 +495,8 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                 vfloat fc = cos_i * INV_PI_F;
                 LaneVec f = {select(zero, base.x * fc, lit), select(zero, base.y * fc, lit),
                              select(zero, base.z * fc, lit)};
-                vfloat weight = select((vfloat)(1.0f), lanes_power_heuristic(ls_pdf, bsdf_pdf),
-                                        (vint)(frame->strategy == STRATEGY_MIS ? -1 : 0) &
-                                            (ls_pdf > 0.0f));
+                vfloat weight = lanes_light_sample_weight(
+                    ls_pdf, bsdf_pdf, (vint)(frame->strategy == STRATEGY_MIS ? -1 : 0));
                 LaneVec c = {thr.x * f.x * lr.x * weight, thr.y * f.y * lr.y * weight,
                              thr.z * f.z * lr.z * weight};
                 ok &= (c.x > 0.0f) | (c.y > 0.0f) | (c.z > 0.0f);
@@ -555,7 +556,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                          ((thr.x > 0.0f) | (thr.y > 0.0f) | (thr.z > 0.0f));
             vint rr = go & (bounce >= (vuint)(frame->rr_depth));
             if (lanes_any(rr)) {
-                vfloat q = fmin(fmax(thr.x, fmax(thr.y, thr.z)), 0.95f);
+                vfloat q = lanes_survival(thr.x, thr.y, thr.z);
                 vfloat x = lanes_rng_next(&rng, rr);
                 go &= ~(rr & (x >= q));
                 vint keep = rr & go;

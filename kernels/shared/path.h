@@ -5,6 +5,8 @@
 //     the light sample later in `connect`;
 //   - the megakernels (cpu/megakernel.cl, cpu/megakernel_lanes.cl) keep it in registers and
 //     trace the light sample at once.
+// The vertex's weights (MIS, Russian roulette) are written once for every lane width
+// (DEFINE_VERTEX_WEIGHTS): the CPU lanes' batched shading (cpu/shade_lanes.h) uses them on vectors.
 #ifndef SHARED_PATH_H
 #define SHARED_PATH_H
 
@@ -23,11 +25,42 @@ inline bool frame_sky_black(const DeviceFrame* frame) {
     return frame->sky.x <= 0.0f && frame->sky.y <= 0.0f && frame->sky.z <= 0.0f;
 }
 
-inline float power_heuristic(float a, float b) {
-    float a2 = a * a;
-    float b2 = b * b;
-    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
-}
+// The weights a path vertex computes, written once for every lane width: shade_vertex uses them
+// on scalars, the CPU lanes' batched shading (cpu/shade_lanes.h) on vectors, so that
+// the estimator's multiple importance sampling and Russian roulette change in one place.
+// DEFINE_VERTEX_WEIGHTS(f, F, I) defines, for floats F with masks I (a comparison's type; scalar
+// comparisons give 1, vector ones -1, and select() takes either):
+//   f##_power_heuristic(a, b)   the power heuristic's weight of a sample of pdf a against b;
+//   f##_emitter_pdf(sel, area, t, cos_l)  light sampling's solid-angle pdf of an emissive
+//                               triangle's point at distance t (the light's selection
+//                               probability sel, area `area`, cosine cos_l at the light; 0 where
+//                               cos_l is not positive);
+//   f##_light_sample_weight(light_pdf, bsdf_pdf, mis)  a light sample's MIS weight against the
+//                               BSDF sample (1 where mis is clear or the light's pdf is 0: a
+//                               delta light);
+//   f##_survival(x, y, z)       Russian roulette's probability of going on for a throughput of
+//                               (x, y, z).
+// Each is one expression per operation in the order shade_vertex has always computed it, with
+// no product next to a sum, so that no compiler fuses the scalar form and not the vector one.
+#define DEFINE_VERTEX_WEIGHTS(f, F, I)                                                             \
+    SHADE_INLINE F f##_power_heuristic(F a, F b) {                                                 \
+        F a2 = a * a;                                                                              \
+        F b2 = b * b;                                                                              \
+        return select((F)(0.0f), a2 / (a2 + b2), a2 + b2 > 0.0f);                                  \
+    }                                                                                              \
+    SHADE_INLINE F f##_emitter_pdf(F sel, F area, F t, F cos_l) {                                  \
+        return select((F)(0.0f), sel * t * t / (area * cos_l), cos_l > 0.0f);                      \
+    }                                                                                              \
+    SHADE_INLINE F f##_light_sample_weight(F light_pdf, F bsdf_pdf,                                \
+                                                                    I mis) {                       \
+        return select((F)(1.0f), f##_power_heuristic(light_pdf, bsdf_pdf),                         \
+                      mis & (light_pdf > 0.0f));                                                   \
+    }                                                                                              \
+    SHADE_INLINE F f##_survival(F x, F y, F z) {                                                   \
+        return fmin(fmax(x, fmax(y, z)), 0.95f);                                                   \
+    }
+
+DEFINE_VERTEX_WEIGHTS(vertex, float, int)
 
 // A path between two vertices.
 typedef struct {
@@ -135,7 +168,7 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         float3 le = env_radiance(&sc->env, -wo, &env_pdf);
         if (bounce == 0u) le = env_background(&sc->env, -wo);  // seen directly: filtered
         float weight = 1.0f;
-        if (mis) weight = power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
+        if (mis) weight = vertex_power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
         if (light_sampled_only) weight = 0.0f;
         if (counts_emission) radiance += throughput * le * weight;
 #else
@@ -186,8 +219,8 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         if (mis) {
             global const DeviceLight* l = &sc->lights[light_index];
             float cos_l = fabs(dot(ng, wo));
-            float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
-            weight = power_heuristic(prev_pdf, light_pdf);
+            float light_pdf = vertex_emitter_pdf(l->extra.y, l->spot.y, hit.t, cos_l);
+            weight = vertex_power_heuristic(prev_pdf, light_pdf);
         }
         if (light_sampled_only) weight = 0.0f;
 #ifdef HAS_TEXTURES
@@ -305,9 +338,8 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
             (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
             float bsdf_pdf;
             float3 f = bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
-            float weight = (frame->strategy == STRATEGY_MIS && ls.pdf > 0.0f)
-                               ? power_heuristic(ls.pdf, bsdf_pdf)
-                               : 1.0f;
+            float weight =
+                vertex_light_sample_weight(ls.pdf, bsdf_pdf, frame->strategy == STRATEGY_MIS);
             float3 contribution = throughput * f * ls.radiance * weight;
             if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
                 float3 from = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
@@ -353,7 +385,7 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
     bool alive = pdf > 0.0f && side * dot(wi, ns) > 0.0f &&
                  (throughput.x > 0.0f || throughput.y > 0.0f || throughput.z > 0.0f);
     if (alive && bounce >= frame->rr_depth) {
-        float q = fmin(fmax(throughput.x, fmax(throughput.y, throughput.z)), 0.95f);
+        float q = vertex_survival(throughput.x, throughput.y, throughput.z);
         if (rng_next(&rng) >= q) {
             alive = false;
         } else {
