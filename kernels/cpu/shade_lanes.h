@@ -15,13 +15,14 @@
 // here), draws the same random numbers, and samples an emissive triangle as sample_light does
 // (other lights by sample_light itself, lane by lane): the same paths, bit for bit
 // (tests/megakernel.rs compares the images). A chunk's camera hits, LANES or fewer at once, are
-// shaded here too. The vertex's weights (power heuristic, an emitter's light pdf, the light
-// sample's MIS weight, Russian roulette's probability) are path.h's, one definition for both
-// widths (DEFINE_VERTEX_WEIGHTS); the rest is still written here a second time in vectors: the
-// hit's point, error bound and normals (traverse.h's surface_point, triangle_normal,
-// offset_ray), the shading normal, the Lambertian BSDF's evaluation and cosine sample (bsdf.h's
+// shaded here too. What does not depend on the material is path.h's, one definition for both
+// widths (DEFINE_VERTEX_MATHS: the MIS weights, Russian roulette's probability, the shading
+// normal, the light sample's test, contribution and shadow segment, whether the path goes on).
+// The rest is still written here a second time, in vectors, operation for operation: the hit's
+// point, error bound and normal and the offset rays (traverse.h's surface_point,
+// triangle_normal, offset_ray), the Lambertian BSDF's evaluation and cosine sample (bsdf.h's
 // LAMBERT_ONLY forms, rng.h's unit_circle and onb) and an emissive triangle's sample
-// (lights.h), each followed operation for operation; a change to them is made in both places.
+// (lights.h); a change to those is made in both places.
 // Batches took 11.7 % fewer instructions on the 1 M-triangle room and about 12 % less time
 // (AMD Zen 3, AVX2, 2026-12-04); shading the lanes done at each return instead (commit 29fe987)
 // was no faster: too few to fill the vectors.
@@ -137,6 +138,31 @@ LANES_INLINE LaneVec lv_neg(LaneVec a) {
     return r;
 }
 
+LANES_INLINE LaneVec lv_sub(LaneVec a, LaneVec b) {
+    LaneVec r = {a.x - b.x, a.y - b.y, a.z - b.z};
+    return r;
+}
+
+LANES_INLINE LaneVec lv_mul(LaneVec a, LaneVec b) {
+    LaneVec r = {a.x * b.x, a.y * b.y, a.z * b.z};
+    return r;
+}
+
+LANES_INLINE LaneVec lv_scale(LaneVec a, vfloat s) {
+    LaneVec r = {a.x * s, a.y * s, a.z * s};
+    return r;
+}
+
+LANES_INLINE LaneVec lv_div(LaneVec a, vfloat s) {
+    LaneVec r = {a.x / s, a.y / s, a.z / s};
+    return r;
+}
+
+// The lanes where some component is positive.
+LANES_INLINE vint lv_positive(LaneVec a) {
+    return (a.x > 0.0f) | (a.y > 0.0f) | (a.z > 0.0f);
+}
+
 // The OpenCL library's dot of float3 (kernel-x86_64 bitcode): the products, then x + y, then
 // z added; one statement each, so that no compiler fuses a product into an addition.
 LANES_INLINE vfloat lv_dot(LaneVec a, LaneVec b) {
@@ -169,9 +195,11 @@ LANES_INLINE vfloat lv_length(LaneVec v) {
     return select(len, (vfloat)(0.0f), zero);
 }
 
-// path.h's vertex weights in every lane: lanes_power_heuristic, lanes_emitter_pdf,
-// lanes_light_sample_weight, lanes_survival.
-DEFINE_VERTEX_WEIGHTS(lanes, vfloat, vint)
+// path.h's vertex maths in every lane: lanes_power_heuristic, lanes_emitter_pdf,
+// lanes_light_sample_weight, lanes_survival, lanes_shading_normal, lanes_side_normal,
+// lanes_light_sample_faces, lanes_light_contribution, lanes_shadow_segment, lanes_goes_on.
+DEFINE_VERTEX_MATHS(lanes, vfloat, vint, LaneVec, lv)
+
 
 // rng_next in the lanes of m (the others' states kept; their numbers are meaningless).
 LANES_INLINE vfloat lanes_rng_next(vuint* state, vint m) {
@@ -380,11 +408,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
             vfloat n8 = vload_lanes(0, n8_);
             LaneVec sn = {w0 * N[0] + hu * N[3] + hv * N[6], w0 * N[1] + hu * N[4] + hv * N[7],
                           w0 * N[2] + hu * N[5] + hv * n8};
-            vfloat len = lv_length(sn);
-            vint has = len > 0.0f;
-            LaneVec nn = {sn.x / len, sn.y / len, sn.z / len};
-            nn = lv_select(nn, lv_neg(nn), lv_dot(nn, ng) < 0.0f);
-            ns = lv_select(ns, nn, has);
+            ns = lanes_shading_normal(sn, ng);
         }
         LaneVec base = {MB[0], MB[1], MB[2]};
 
@@ -485,8 +509,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
             }
 #endif
             vfloat side = lv_dot(wi, ng);
-            vint ok = m & (side * lv_dot(wi, ns) > 0.0f) &
-                         ((lr.x > 0.0f) | (lr.y > 0.0f) | (lr.z > 0.0f));
+            vint ok = m & lanes_light_sample_faces(side, wi, ns, lr);
             if (lanes_any(ok)) {
                 // bsdf_eval, Lambertian.
                 vfloat cos_i = lv_dot(wi, ns);
@@ -497,18 +520,12 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                              select(zero, base.z * fc, lit)};
                 vfloat weight = lanes_light_sample_weight(
                     ls_pdf, bsdf_pdf, (vint)(frame->strategy == STRATEGY_MIS ? -1 : 0));
-                LaneVec c = {thr.x * f.x * lr.x * weight, thr.y * f.y * lr.y * weight,
-                             thr.z * f.z * lr.z * weight};
-                ok &= (c.x > 0.0f) | (c.y > 0.0f) | (c.z > 0.0f);
+                LaneVec c = lanes_light_contribution(thr, f, lr, weight);
+                ok &= lv_positive(c);
                 if (lanes_any(ok)) {
-                    LaneVec from = lanes_offset_ray(p, perr, lv_select(lv_neg(ng), ng, side > 0.0f));
-                    LaneVec sd = wi;
-                    vfloat tmax = ls_dist;
-                    LaneVec seg = {target.x - from.x, target.y - from.y, target.z - from.z};
-                    vfloat seg_len = lv_length(seg);
-                    LaneVec seg_dir = {seg.x / seg_len, seg.y / seg_len, seg.z / seg_len};
-                    tmax = select(tmax, seg_len, on_surface);
-                    sd = lv_select(sd, seg_dir, on_surface);
+                    LaneVec from = lanes_offset_ray(p, perr, lanes_side_normal(ng, side));
+                    LaneVec sd;
+                    vfloat tmax = lanes_shadow_segment(from, wi, ls_dist, target, on_surface, &sd);
                     lv_store(from, B->qox, B->qoy, B->qoz);
                     lv_store(sd, B->qdx, B->qdy, B->qdz);
                     vstore_lanes(tmax, 0, B->qtmax);
@@ -552,8 +569,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
             thr.y = thr.y * select(zero, base.y, ok2);
             thr.z = thr.z * select(zero, base.z, ok2);
             vfloat side = lv_dot(wi, ng);
-            vint go = m & (pdf > 0.0f) & (side * lv_dot(wi, ns) > 0.0f) &
-                         ((thr.x > 0.0f) | (thr.y > 0.0f) | (thr.z > 0.0f));
+            vint go = m & lanes_goes_on(pdf, side, wi, ns, thr);
             vint rr = go & (bounce >= (vuint)(frame->rr_depth));
             if (lanes_any(rr)) {
                 vfloat q = lanes_survival(thr.x, thr.y, thr.z);
@@ -564,7 +580,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                 thr.y = select(thr.y, thr.y / q, keep);
                 thr.z = select(thr.z, thr.z / q, keep);
             }
-            LaneVec o = lanes_offset_ray(p, perr, lv_select(lv_neg(ng), ng, side > 0.0f));
+            LaneVec o = lanes_offset_ray(p, perr, lanes_side_normal(ng, side));
             lv_store(o, B->ox, B->oy, B->oz);
             lv_store(wi, B->dx, B->dy, B->dz);
             lv_store(thr, B->tx, B->ty, B->tz);
