@@ -16,6 +16,42 @@
 #include "cpu/megakernel.h"
 
 #ifndef MEGA_LANES
+// What the kernel traces rays through: the 4-wide BVH, or with SMALL_SCENE the work group's
+// copy of a small scene.
+typedef struct {
+#ifdef SMALL_SCENE
+    local const SmallScene* small;
+#else
+    global const DeviceWideNode* nodes;
+#endif
+    global const DeviceTriangle* tris;
+    global const DeviceInstance* instances;
+    global const DeviceTriangle* object_tris;
+    const SceneSurfaces* surf;
+    volatile global uint* overflow;
+} MegaTracer;
+
+// The nearest hit of the ray from o along d in (0, tmax), or with any_hit some hit.
+inline DeviceHit mega_trace(const MegaTracer* T, float3 o, float3 d, float tmax, bool any_hit) {
+#ifdef SMALL_SCENE
+    return trace_small(T->small, T->tris, T->surf, o, d, 0.0f, tmax, any_hit);
+#else
+    return trace_scene_wide(T->nodes, T->tris, T->instances, T->object_tris, T->surf, o, d, 0.0f,
+                            tmax, any_hit, T->overflow);
+#endif
+}
+
+// What of a light sample's contribution reaches the path (path.h's shadow test).
+inline float3 mega_shadow(const MegaTracer* T, const ShadowQuery* q) {
+#ifdef SMALL_SCENE
+    return shadow_pass_small(T->small, T->tris, T->instances, T->object_tris, T->surf, q,
+                             T->overflow);
+#else
+    return shadow_pass_wide(T->nodes, T->tris, T->instances, T->object_tris, T->surf, q,
+                            T->overflow);
+#endif
+}
+
 kernel void megakernel(MEGAKERNEL_PARAMS) {
 #ifdef SMALL_SCENE
     local SmallScene small;
@@ -25,7 +61,9 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels) return;
-    MEGA_SHADE_SCENE(sc);
+    ShadeScene sc = mega_shade_scene(environment, tris, instances, shading, uvs, tangents,
+                                     materials, tex_refs, textures, texels, env_texels,
+                                     env_marginal, env_conditional, lights, light_cdf);
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
     // The samples are added to the film's sum one by one, so that the image does not depend
     // on how many samples each launch took (a float sum depends on its order).
@@ -37,16 +75,10 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     uint counted = 0;  // samples whose camera ray hit (the film's .w with the background cut out)
 #ifdef SMALL_SCENE
     sc.surf.small = &small;
-#define MEGA_TRACE_TO(o, d, tmax, any_hit) \
-    trace_small(&small, tris, &sc.surf, o, d, 0.0f, tmax, any_hit)
-#define MEGA_SHADOW(q) shadow_pass_small(&small, tris, instances, object_tris, &sc.surf, q, overflow)
+    const MegaTracer T = {&small, tris, instances, object_tris, &sc.surf, overflow};
 #else
-#define MEGA_TRACE_TO(o, d, tmax, any_hit)                                                 \
-    trace_scene_wide(nodes, tris, instances, object_tris, &sc.surf, o, d, 0.0f, tmax, any_hit, \
-                     overflow)
-#define MEGA_SHADOW(q) shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, q, overflow)
+    const MegaTracer T = {nodes, tris, instances, object_tris, &sc.surf, overflow};
 #endif
-#define MEGA_TRACE(o, d, any_hit) MEGA_TRACE_TO(o, d, INFINITY, any_hit)
 #ifdef LAST_RAY_EMITTERS
     bool last_by_emitters = mega_last_ray_by_emitters(&frame);
 #endif
@@ -60,18 +92,18 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
                 hit = mega_nearest_emitter(&frame, &sc, s.origin, s.direction);
                 if (hit.prim == NO_HIT) break;
                 ++extension_rays;
-                if (MEGA_TRACE_TO(s.origin, s.direction, hit.t, true).prim != NO_HIT) break;
+                if (mega_trace(&T, s.origin, s.direction, hit.t, true).prim != NO_HIT) break;
             } else
 #endif
             {
-                hit = MEGA_TRACE(s.origin, s.direction, false);
+                hit = mega_trace(&T, s.origin, s.direction, INFINITY, false);
                 ++extension_rays;
             }
             ShadowQuery q;
             bool alive = shade_vertex(&frame, bounce, &sc, hit, &s, &q);
             if (q.valid) {
                 ++shadow_rays;
-                s.radiance += MEGA_SHADOW(&q);
+                s.radiance += mega_shadow(&T, &q);
             }
             if (!alive) break;
         }

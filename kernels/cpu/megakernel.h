@@ -22,12 +22,27 @@
         volatile global uint *counters
 
 // What shading reads of the scene, from the kernel's parameters.
-#define MEGA_SHADE_SCENE(sc)                                                                \
-    ShadeScene sc = {tris,                                                                  \
-                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances}, \
-                     {environment, env_texels, env_marginal, env_conditional},              \
-                     lights,                                                                \
-                     light_cdf}
+inline ShadeScene mega_shade_scene(DeviceEnvironment environment,
+                                   global const DeviceTriangle* tris,
+                                   global const DeviceInstance* instances,
+                                   global const DeviceTriShading* shading,
+                                   global const DeviceTriUvs* uvs,
+                                   global const DeviceTriTangents* tangents,
+                                   global const DeviceMaterial* materials,
+                                   global const DeviceTexRef* tex_refs,
+                                   global const DeviceTexture* textures, global const uint* texels,
+                                   global const float* env_texels,
+                                   global const float* env_marginal,
+                                   global const float* env_conditional,
+                                   global const DeviceLight* lights,
+                                   global const float* light_cdf) {
+    ShadeScene sc = {tris,
+                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances},
+                     {environment, env_texels, env_marginal, env_conditional},
+                     lights,
+                     light_cdf};
+    return sc;
+}
 
 // A finished sample: its radiance added to the pixel's sum (a non-finite one dropped and
 // counted), and counted in the film's .w when its camera ray hit.

@@ -221,6 +221,86 @@ inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const Device
     return true;
 }
 
+// The paths in flight, MEGA_SLOTS of them: each in a lane (its ray walking), ready (its next
+// ray, or its light sample's segment, waiting for a lane: the queue `ready`), free (the stack
+// `free_slot`), or with LANES_SHADE in the batch (its vertex waiting to be shaded with others).
+typedef struct {
+    PathState s[MEGA_SLOTS];
+    uint bounce[MEGA_SLOTS], chunk[MEGA_SLOTS], entry[MEGA_SLOTS];
+    // A path whose next ray is its vertex's light sample: the sample, and whether the path goes
+    // on after it.
+    ShadowQuery sample[MEGA_SLOTS];
+    bool in_shadow[MEGA_SLOTS], goes_on[MEGA_SLOTS];
+#ifdef LAST_RAY_EMITTERS
+    // A path whose next ray is its last ray's segment to the emitter it meets: that hit.
+    bool to_emitter[MEGA_SLOTS];
+    DeviceHit emitter[MEGA_SLOTS];
+    bool last_by_emitters;
+#endif
+    int ready[MEGA_SLOTS], free_slot[MEGA_SLOTS];
+    uint ready_head, ready_count, free_count;
+#ifdef LANES_SHADE
+    ShadeBatch B;
+    int batch_slot[LANES];
+    int batch_n;  // vertices in the batch
+#endif
+} MegaSlots;
+
+// Path k's next ray is ready.
+inline void slot_ready(MegaSlots* S, int k) {
+    S->ready[(S->ready_head + S->ready_count++) % MEGA_SLOTS] = k;
+}
+
+// Path k's next ray (alive), or its end (the last ray first tested against the emitters).
+inline void slot_next(MegaSlots* S, MegaWork* W, const DeviceFrame* frame, const ShadeScene* sc,
+                      global float4* film, int k, bool alive) {
+#ifdef LAST_RAY_EMITTERS
+    if (alive && S->last_by_emitters && S->bounce[k] == frame->max_bounces + 1u) {
+        DeviceHit e = mega_nearest_emitter(frame, sc, S->s[k].origin, S->s[k].direction);
+        if (e.prim != NO_HIT) {
+            S->to_emitter[k] = true;
+            S->emitter[k] = e;
+        } else {
+            alive = false;  // it meets no emitter: it would add nothing
+        }
+    }
+#endif
+    if (alive) {
+        slot_ready(S, k);
+    } else {
+        mega_path_done(W, frame, film, S->chunk[k], S->entry[k], &S->s[k]);
+        S->free_slot[S->free_count++] = k;
+    }
+}
+
+// Path k's vertex shaded (alive: whether the path goes on): its light sample, else its next
+// ray, is ready.
+inline void slot_shaded(MegaSlots* S, MegaWork* W, const DeviceFrame* frame,
+                        const ShadeScene* sc, global float4* film, int k, bool alive) {
+    alive = alive && ++S->bounce[k] <= frame->max_bounces + 1u;
+    if (S->sample[k].valid) {
+        ++W->shadow_rays;
+        S->in_shadow[k] = true;
+        S->goes_on[k] = alive;
+        slot_ready(S, k);
+    } else {
+        slot_next(S, W, frame, sc, film, k, alive);
+    }
+}
+
+#ifdef LANES_SHADE
+// The batch's vertices shaded together (shade_lanes.h), each path then as slot_shaded says.
+inline void slots_shade_batch(MegaSlots* S, MegaWork* W, const DeviceFrame* frame,
+                              const ShadeScene* sc, global float4* film) {
+    lanes_shade(frame, sc, &S->B, S->batch_n);
+    for (int e = 0; e < S->batch_n; ++e) {
+        int k = S->batch_slot[e];
+        slot_shaded(S, W, frame, sc, film, k, shade_batch_get(&S->B, e, &S->s[k], &S->sample[k]));
+    }
+    S->batch_n = 0;
+}
+#endif
+
 // The lanes' loop: MEGA_SLOTS paths in flight, each in a lane (its ray walking), ready (its
 // next ray, or its light sample's segment, waiting for a lane), free, or with LANES_SHADE in
 // the batch (its vertex waiting to be shaded with others; shade_lanes.h). A path traces one
@@ -242,7 +322,9 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         W.chunk[i].remaining = 0u;
         W.chunk[i].more = false;
     }
-    MEGA_SHADE_SCENE(sc);
+    ShadeScene sc = mega_shade_scene(environment, tris, instances, shading, uvs, tangents,
+                                     materials, tex_refs, textures, texels, env_texels,
+                                     env_marginal, env_conditional, lights, light_cdf);
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
     LaneMemory M;
     lanes_init(&M);
@@ -252,88 +334,24 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #endif
     LanesRays R;  // rays given to lanes, set in their fields together
     lanes_rays_init(&R);
-    PathState s[MEGA_SLOTS];
-    uint bounce[MEGA_SLOTS], chunk[MEGA_SLOTS], entry[MEGA_SLOTS];
-    // A path whose next ray is its vertex's light sample: the sample, and whether the path goes
-    // on after it.
-    ShadowQuery sample[MEGA_SLOTS];
-    bool in_shadow[MEGA_SLOTS], goes_on[MEGA_SLOTS];
+    MegaSlots S;
 #ifdef LAST_RAY_EMITTERS
-    // A path whose next ray is its last ray's segment to the emitter it meets: that hit.
-    bool to_emitter[MEGA_SLOTS];
-    DeviceHit emitter[MEGA_SLOTS];
-    bool last_by_emitters = mega_last_ray_by_emitters(&frame);
+    S.last_by_emitters = mega_last_ray_by_emitters(&frame);
 #endif
     int lane_slot[LANES];  // the path of each lane's ray, -1: idle
     uint idle_lanes = (1u << LANES) - 1u;  // bit l: lane l idle
-    int ready[MEGA_SLOTS], free_slot[MEGA_SLOTS];
-    uint ready_head = 0u, ready_count = 0u, free_count = MEGA_SLOTS;
+    S.ready_head = S.ready_count = 0u;
+    S.free_count = MEGA_SLOTS;
+#ifdef LANES_SHADE
+    S.batch_n = 0;
+#endif
     for (int k = 0; k < MEGA_SLOTS; ++k) {
-        free_slot[k] = MEGA_SLOTS - 1 - k;
+        S.free_slot[k] = MEGA_SLOTS - 1 - k;
 #ifdef LAST_RAY_EMITTERS
-        to_emitter[k] = false;
+        S.to_emitter[k] = false;
 #endif
     }
     for (int l = 0; l < LANES; ++l) lane_slot[l] = -1;
-#ifdef LANES_SHADE
-    ShadeBatch B;
-    int batch_slot[LANES];
-#endif
-    int batch_n = 0;  // vertices in the batch
-#define SLOT_READY(k) ready[(ready_head + ready_count++) % MEGA_SLOTS] = (k);
-    // A path's next ray, or its end (the last ray first tested against the emitters).
-#define SLOT_NEXT(k, alive_)                                                                \
-    {                                                                                        \
-        bool a_ = (alive_);                                                                  \
-        SLOT_NEXT_LAST_RAY(k, a_)                                                            \
-        if (a_) {                                                                            \
-            SLOT_READY(k)                                                                    \
-        } else {                                                                             \
-            mega_path_done(&W, &frame, film, chunk[k], entry[k], &s[k]);                     \
-            free_slot[free_count++] = (k);                                                   \
-        }                                                                                    \
-    }
-#ifdef LAST_RAY_EMITTERS
-#define SLOT_NEXT_LAST_RAY(k, a_)                                                            \
-    if (a_ && last_by_emitters && bounce[k] == frame.max_bounces + 1u) {                     \
-        DeviceHit e_ = mega_nearest_emitter(&frame, &sc, s[k].origin, s[k].direction);         \
-        if (e_.prim != NO_HIT) {                                                             \
-            to_emitter[k] = true;                                                            \
-            emitter[k] = e_;                                                                 \
-        } else {                                                                             \
-            a_ = false; /* it meets no emitter: it would add nothing */                      \
-        }                                                                                    \
-    }
-#else
-#define SLOT_NEXT_LAST_RAY(k, a_)
-#endif
-    // Path k's vertex shaded (alive_: whether the path goes on): its light sample, else its
-    // next ray, is ready.
-#define SLOT_SHADED(k, alive_)                                                               \
-    {                                                                                        \
-        bool al_ = (alive_) && ++bounce[k] <= frame.max_bounces + 1u;                        \
-        if (sample[k].valid) {                                                               \
-            ++W.shadow_rays;                                                                 \
-            in_shadow[k] = true;                                                             \
-            goes_on[k] = al_;                                                                \
-            SLOT_READY(k)                                                                    \
-        } else {                                                                             \
-            SLOT_NEXT(k, al_)                                                                \
-        }                                                                                    \
-    }
-#ifdef LANES_SHADE
-#define SHADE_BATCH                                                                          \
-    {                                                                                        \
-        lanes_shade(&frame, &sc, &B, batch_n);                                               \
-        for (int e = 0; e < batch_n; ++e) {                                                  \
-            int k = batch_slot[e];                                                           \
-            SLOT_SHADED(k, shade_batch_get(&B, e, &s[k], &sample[k]))                        \
-        }                                                                                    \
-        batch_n = 0;                                                                         \
-    }
-#else
-#define SHADE_BATCH
-#endif
     for (;;) {
         // Idle lanes take ready rays, then new paths (starting chunks while the queue is
         // empty); lanes left idle with vertices waiting have the batch shaded at once.
@@ -341,23 +359,23 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         for (uint bits = idle_lanes; bits != 0u; bits &= bits - 1u) {
             int l = (int)__builtin_ctz(bits);
             int k = -1;
-            if (ready_count > 0u) {
-                k = ready[ready_head];
-                ready_head = (ready_head + 1u) % MEGA_SLOTS;
-                --ready_count;
-            } else if (free_count > 0u) {
+            if (S.ready_count > 0u) {
+                k = S.ready[S.ready_head];
+                S.ready_head = (S.ready_head + 1u) % MEGA_SLOTS;
+                --S.ready_count;
+            } else if (S.free_count > 0u) {
                 while (W.queue_head == W.queue_end &&
                        mega_chunk_start(&W, &frame, &camera, &sc, nodes, instances, object_tris,
                                         film, overflow)) {
                 }
                 if (W.queue_head < W.queue_end) {
                     uint q = W.queue_head++;
-                    k = free_slot[--free_count];
-                    s[k] = W.queued[q];
-                    chunk[k] = W.queued_chunk[q];
-                    entry[k] = W.queued_entry[q];
-                    bounce[k] = 1u;
-                    in_shadow[k] = false;
+                    k = S.free_slot[--S.free_count];
+                    S.s[k] = W.queued[q];
+                    S.chunk[k] = W.queued_chunk[q];
+                    S.entry[k] = W.queued_entry[q];
+                    S.bounce[k] = 1u;
+                    S.in_shadow[k] = false;
                 }
             }
             if (k < 0) {
@@ -367,26 +385,28 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             lane_slot[l] = k;
             idle_lanes &= ~(1u << l);
 #ifdef LAST_RAY_EMITTERS
-            if (to_emitter[k]) {
-                lanes_take_ray(&M, &R, l, s[k].origin, s[k].direction, emitter[k].t, true);
+            if (S.to_emitter[k]) {
+                lanes_take_ray(&M, &R, l, S.s[k].origin, S.s[k].direction, S.emitter[k].t, true);
                 continue;
             }
 #endif
-            if (in_shadow[k]) {
-                lanes_take_ray(&M, &R, l, sample[k].origin, sample[k].direction, sample[k].tmax,
-                               true);
+            if (S.in_shadow[k]) {
+                lanes_take_ray(&M, &R, l, S.sample[k].origin, S.sample[k].direction,
+                               S.sample[k].tmax, true);
             } else {
-                lanes_take_ray(&M, &R, l, s[k].origin, s[k].direction, INFINITY, false);
+                lanes_take_ray(&M, &R, l, S.s[k].origin, S.s[k].direction, INFINITY, false);
             }
         }
         if (R.taken != 0u) {
             lanes_set_rays(&M, &R);
             R.taken = 0u;
         }
-        if (idle && batch_n > 0) {
-            SHADE_BATCH
+#ifdef LANES_SHADE
+        if (idle && S.batch_n > 0) {
+            slots_shade_batch(&S, &W, &frame, &sc, film);
             continue;
         }
+#endif
 #ifdef LANES_SMALL
         vint done = lanes_walk_small(&M, nodes, tris, small_first, small_end, &sc.surf);
 #else
@@ -400,50 +420,47 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             lane_slot[l] = -1;
             idle_lanes |= 1u << l;
 #ifdef LAST_RAY_EMITTERS
-            if (to_emitter[k]) {
+            if (S.to_emitter[k]) {
                 // The last ray's segment to its emitter walked: unblocked, the emitter is its
                 // closest hit. The path ends.
-                to_emitter[k] = false;
+                S.to_emitter[k] = false;
                 ++W.extension_rays;
                 if (M.prim[l] < 0) {
-                    shade_vertex(&frame, bounce[k], &sc, emitter[k], &s[k], &sample[k]);
+                    shade_vertex(&frame, S.bounce[k], &sc, S.emitter[k], &S.s[k], &S.sample[k]);
                 }
-                SLOT_NEXT(k, false)
+                slot_next(&S, &W, &frame, &sc, film, k, false);
                 continue;
             }
 #endif
-            if (in_shadow[k]) {
+            if (S.in_shadow[k]) {
                 // The vertex's light sample walked: its light is added (unless blocked, perhaps
                 // only by thin walls, which the scalar test passes) before the path goes on.
-                in_shadow[k] = false;
+                S.in_shadow[k] = false;
                 if (M.prim[l] < 0) {
-                    s[k].radiance += sample[k].contribution;
+                    S.s[k].radiance += S.sample[k].contribution;
                 } else {
 #ifdef HAS_THIN_WALLS
-                    s[k].radiance += shadow_pass_wide(nodes, tris, instances, object_tris,
-                                                      &sc.surf, &sample[k], overflow);
+                    S.s[k].radiance += shadow_pass_wide(nodes, tris, instances, object_tris,
+                                                        &sc.surf, &S.sample[k], overflow);
 #endif
                 }
-                SLOT_NEXT(k, goes_on[k])
+                slot_next(&S, &W, &frame, &sc, film, k, S.goes_on[k]);
                 continue;
             }
             // The vertex the extension ray found: shaded at once, or with LANES_SHADE once the
             // batch is full.
             ++W.extension_rays;
 #ifdef LANES_SHADE
-            shade_batch_put(&B, batch_n, &s[k], bounce[k], lanes_hit(&M, l));
-            batch_slot[batch_n++] = k;
-            if (batch_n == LANES) SHADE_BATCH
+            shade_batch_put(&S.B, S.batch_n, &S.s[k], S.bounce[k], lanes_hit(&M, l));
+            S.batch_slot[S.batch_n++] = k;
+            if (S.batch_n == LANES) slots_shade_batch(&S, &W, &frame, &sc, film);
 #else
-            SLOT_SHADED(k, shade_vertex(&frame, bounce[k], &sc, lanes_hit(&M, l), &s[k], &sample[k]))
+            slot_shaded(&S, &W, &frame, &sc, film, k,
+                        shade_vertex(&frame, S.bounce[k], &sc, lanes_hit(&M, l), &S.s[k],
+                                     &S.sample[k]));
 #endif
         }
     }
-#undef SHADE_BATCH
-#undef SLOT_SHADED
-#undef SLOT_NEXT_LAST_RAY
-#undef SLOT_NEXT
-#undef SLOT_READY
     mega_count(counters, W.extension_rays, W.shadow_rays, W.nonfinite);
 }
 #endif  // MEGA_LANES

@@ -15,7 +15,14 @@
 // here), draws the same random numbers, and samples an emissive triangle as sample_light does
 // (other lights by sample_light itself, lane by lane): the same paths, bit for bit
 // (tests/megakernel.rs compares the images). A chunk's camera hits, LANES or fewer at once, are
-// shaded here too.
+// shaded here too. What does not depend on the material is path.h's, one definition for both
+// widths (DEFINE_VERTEX_MATHS: the MIS weights, Russian roulette's probability, the shading
+// normal, the light sample's test, contribution and shadow segment, whether the path goes on).
+// The rest is still written here a second time, in vectors, operation for operation: the hit's
+// point, error bound and normal and the offset rays (traverse.h's surface_point,
+// triangle_normal, offset_ray), the Lambertian BSDF's evaluation and cosine sample (bsdf.h's
+// LAMBERT_ONLY forms, rng.h's unit_circle and onb) and an emissive triangle's sample
+// (lights.h); a change to those is made in both places.
 // Batches took 11.7 % fewer instructions on the 1 M-triangle room and about 12 % less time
 // (AMD Zen 3, AVX2, 2026-12-04); shading the lanes done at each return instead (commit 29fe987)
 // was no faster: too few to fill the vectors.
@@ -131,6 +138,31 @@ LANES_INLINE LaneVec lv_neg(LaneVec a) {
     return r;
 }
 
+LANES_INLINE LaneVec lv_sub(LaneVec a, LaneVec b) {
+    LaneVec r = {a.x - b.x, a.y - b.y, a.z - b.z};
+    return r;
+}
+
+LANES_INLINE LaneVec lv_mul(LaneVec a, LaneVec b) {
+    LaneVec r = {a.x * b.x, a.y * b.y, a.z * b.z};
+    return r;
+}
+
+LANES_INLINE LaneVec lv_scale(LaneVec a, vfloat s) {
+    LaneVec r = {a.x * s, a.y * s, a.z * s};
+    return r;
+}
+
+LANES_INLINE LaneVec lv_div(LaneVec a, vfloat s) {
+    LaneVec r = {a.x / s, a.y / s, a.z / s};
+    return r;
+}
+
+// The lanes where some component is positive.
+LANES_INLINE vint lv_positive(LaneVec a) {
+    return (a.x > 0.0f) | (a.y > 0.0f) | (a.z > 0.0f);
+}
+
 // The OpenCL library's dot of float3 (kernel-x86_64 bitcode): the products, then x + y, then
 // z added; one statement each, so that no compiler fuses a product into an addition.
 LANES_INLINE vfloat lv_dot(LaneVec a, LaneVec b) {
@@ -163,11 +195,11 @@ LANES_INLINE vfloat lv_length(LaneVec v) {
     return select(len, (vfloat)(0.0f), zero);
 }
 
-LANES_INLINE vfloat lanes_power_heuristic(vfloat a, vfloat b) {
-    vfloat a2 = a * a;
-    vfloat b2 = b * b;
-    return select((vfloat)(0.0f), a2 / (a2 + b2), a2 + b2 > 0.0f);
-}
+// path.h's vertex maths in every lane: lanes_power_heuristic, lanes_emitter_pdf,
+// lanes_light_sample_weight, lanes_survival, lanes_shading_normal, lanes_side_normal,
+// lanes_light_sample_faces, lanes_light_contribution, lanes_shadow_segment, lanes_goes_on.
+DEFINE_VERTEX_MATHS(lanes, vfloat, vint, LaneVec, lv)
+
 
 // rng_next in the lanes of m (the others' states kept; their numbers are meaningless).
 LANES_INLINE vfloat lanes_rng_next(vuint* state, vint m) {
@@ -178,26 +210,24 @@ LANES_INLINE vfloat lanes_rng_next(vuint* state, vint m) {
     return convert_vfloat(word >> 8u) * (1.0f / 16777216.0f);
 }
 
+// offset_ray (traverse.h) in every lane, one axis: the point's coordinate p moved by the
+// offset k along the normal's coordinate n, then one float further away.
+LANES_INLINE vfloat lanes_offset_axis(vfloat p, vfloat k, vfloat n) {
+    vfloat offset = k * n;
+    vfloat po = p + offset;
+    vint bits = as_vint(po);
+    vint away = (po > 0.0f) == (offset > 0.0f);
+    vint stepped = select(bits - 1, bits + 1, away);
+    stepped = select(stepped, select((vint)(0x80000001), (vint)(1), offset > 0.0f), po == 0.0f);
+    return select(po, as_vfloat(stepped), offset != 0.0f);
+}
+
 // offset_ray (traverse.h) in every lane.
 LANES_INLINE LaneVec lanes_offset_ray(LaneVec p, LaneVec err, LaneVec n) {
     LaneVec an = {fabs(n.x), fabs(n.y), fabs(n.z)};
     vfloat k = lv_dot(an, err);
-    LaneVec r;
-#define LANES_OFFSET(c)                                                                      \
-    {                                                                                        \
-        vfloat offset = k * n.c;                                                            \
-        vfloat po = p.c + offset;                                                           \
-        vint bits = as_vint(po);                                                       \
-        vint away = (po > 0.0f) == (offset > 0.0f);                                       \
-        vint stepped = select(bits - 1, bits + 1, away);                                  \
-        stepped = select(stepped, select((vint)(0x80000001), (vint)(1), offset > 0.0f), \
-                         po == 0.0f);                                                        \
-        r.c = select(po, as_vfloat(stepped), offset != 0.0f);                               \
-    }
-    LANES_OFFSET(x)
-    LANES_OFFSET(y)
-    LANES_OFFSET(z)
-#undef LANES_OFFSET
+    LaneVec r = {lanes_offset_axis(p.x, k, n.x), lanes_offset_axis(p.y, k, n.y),
+                 lanes_offset_axis(p.z, k, n.z)};
     return r;
 }
 
@@ -353,7 +383,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                     }
                     vfloat sel = vload_lanes(0, sel_), area = vload_lanes(0, area_);
                     vfloat cos_l = fabs(lv_dot(ng, wo));
-                    vfloat light_pdf = select(zero, sel * t * t / (area * cos_l), cos_l > 0.0f);
+                    vfloat light_pdf = lanes_emitter_pdf(sel, area, t, cos_l);
                     weight = select(weight, lanes_power_heuristic(prev_pdf, light_pdf), w_mis);
                 }
                 rad.x = select(rad.x, rad.x + thr.x * MB[4] * weight, em);
@@ -378,11 +408,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
             vfloat n8 = vload_lanes(0, n8_);
             LaneVec sn = {w0 * N[0] + hu * N[3] + hv * N[6], w0 * N[1] + hu * N[4] + hv * N[7],
                           w0 * N[2] + hu * N[5] + hv * n8};
-            vfloat len = lv_length(sn);
-            vint has = len > 0.0f;
-            LaneVec nn = {sn.x / len, sn.y / len, sn.z / len};
-            nn = lv_select(nn, lv_neg(nn), lv_dot(nn, ng) < 0.0f);
-            ns = lv_select(ns, nn, has);
+            ns = lanes_shading_normal(sn, ng);
         }
         LaneVec base = {MB[0], MB[1], MB[2]};
 
@@ -483,8 +509,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
             }
 #endif
             vfloat side = lv_dot(wi, ng);
-            vint ok = m & (side * lv_dot(wi, ns) > 0.0f) &
-                         ((lr.x > 0.0f) | (lr.y > 0.0f) | (lr.z > 0.0f));
+            vint ok = m & lanes_light_sample_faces(side, wi, ns, lr);
             if (lanes_any(ok)) {
                 // bsdf_eval, Lambertian.
                 vfloat cos_i = lv_dot(wi, ns);
@@ -493,21 +518,14 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                 vfloat fc = cos_i * INV_PI_F;
                 LaneVec f = {select(zero, base.x * fc, lit), select(zero, base.y * fc, lit),
                              select(zero, base.z * fc, lit)};
-                vfloat weight = select((vfloat)(1.0f), lanes_power_heuristic(ls_pdf, bsdf_pdf),
-                                        (vint)(frame->strategy == STRATEGY_MIS ? -1 : 0) &
-                                            (ls_pdf > 0.0f));
-                LaneVec c = {thr.x * f.x * lr.x * weight, thr.y * f.y * lr.y * weight,
-                             thr.z * f.z * lr.z * weight};
-                ok &= (c.x > 0.0f) | (c.y > 0.0f) | (c.z > 0.0f);
+                vfloat weight = lanes_light_sample_weight(
+                    ls_pdf, bsdf_pdf, (vint)(frame->strategy == STRATEGY_MIS ? -1 : 0));
+                LaneVec c = lanes_light_contribution(thr, f, lr, weight);
+                ok &= lv_positive(c);
                 if (lanes_any(ok)) {
-                    LaneVec from = lanes_offset_ray(p, perr, lv_select(lv_neg(ng), ng, side > 0.0f));
-                    LaneVec sd = wi;
-                    vfloat tmax = ls_dist;
-                    LaneVec seg = {target.x - from.x, target.y - from.y, target.z - from.z};
-                    vfloat seg_len = lv_length(seg);
-                    LaneVec seg_dir = {seg.x / seg_len, seg.y / seg_len, seg.z / seg_len};
-                    tmax = select(tmax, seg_len, on_surface);
-                    sd = lv_select(sd, seg_dir, on_surface);
+                    LaneVec from = lanes_offset_ray(p, perr, lanes_side_normal(ng, side));
+                    LaneVec sd;
+                    vfloat tmax = lanes_shadow_segment(from, wi, ls_dist, target, on_surface, &sd);
                     lv_store(from, B->qox, B->qoy, B->qoz);
                     lv_store(sd, B->qdx, B->qdy, B->qdz);
                     vstore_lanes(tmax, 0, B->qtmax);
@@ -551,11 +569,10 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
             thr.y = thr.y * select(zero, base.y, ok2);
             thr.z = thr.z * select(zero, base.z, ok2);
             vfloat side = lv_dot(wi, ng);
-            vint go = m & (pdf > 0.0f) & (side * lv_dot(wi, ns) > 0.0f) &
-                         ((thr.x > 0.0f) | (thr.y > 0.0f) | (thr.z > 0.0f));
+            vint go = m & lanes_goes_on(pdf, side, wi, ns, thr);
             vint rr = go & (bounce >= (vuint)(frame->rr_depth));
             if (lanes_any(rr)) {
-                vfloat q = fmin(fmax(thr.x, fmax(thr.y, thr.z)), 0.95f);
+                vfloat q = lanes_survival(thr.x, thr.y, thr.z);
                 vfloat x = lanes_rng_next(&rng, rr);
                 go &= ~(rr & (x >= q));
                 vint keep = rr & go;
@@ -563,7 +580,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
                 thr.y = select(thr.y, thr.y / q, keep);
                 thr.z = select(thr.z, thr.z / q, keep);
             }
-            LaneVec o = lanes_offset_ray(p, perr, lv_select(lv_neg(ng), ng, side > 0.0f));
+            LaneVec o = lanes_offset_ray(p, perr, lanes_side_normal(ng, side));
             lv_store(o, B->ox, B->oy, B->oz);
             lv_store(wi, B->dx, B->dy, B->dz);
             lv_store(thr, B->tx, B->ty, B->tz);

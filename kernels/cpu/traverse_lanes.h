@@ -29,8 +29,15 @@
 // A lane's stack is LANES_STACK entries and three more, which the eight-lane push of a node's
 // children in one 32-byte store (lanes_walk) may write past its top.
 #define LANES_STACK_STRIDE (LANES_STACK + 3)
+
 // The word offset of each lane's stack entry sp (a lane's entries side by side).
-#define LANES_ENTRY(sp) ((LANE_IDS * (vint)(LANES_STACK_STRIDE) + (sp)) * (vint)(2))
+LANES_INLINE vint lanes_entry(vint sp) {
+    return (LANE_IDS * (vint)(LANES_STACK_STRIDE) + sp) * (vint)(2);
+}
+
+// intersect_triangle's arithmetic in every lane (traverse_wide.h): LanesTriangle, LanesEdges,
+// LanesVerdict, lanes_edges and lanes_verdict.
+DEFINE_LANE_TRIANGLE_TEST(Lanes, lanes, vfloat, vint)
 
 // The lanes' rays and walks, one field a lane (offsets are in 4-byte words: a DeviceWideNode is 32,
 // min_x, min_y, min_z, max_x, max_y, max_z, child, count, 4 each; a DeviceTriangle 12):
@@ -75,21 +82,17 @@ typedef struct {
 #undef LANES_ARRAY_I
         };
     };
-    // The stacks: entry k of lane l at word 2 (l LANES_STACK_STRIDE + k) (LANES_ENTRY), its entry
+    // The stacks: entry k of lane l at word 2 (l LANES_STACK_STRIDE + k) (lanes_entry), its entry
     // distance, then its item in lanes_pack form (as float bits).
     float stack[2 * LANES_STACK_STRIDE * LANES];
     float3 o[LANES], d[LANES];  // the rays, for the scalar test's rare cases
 } LaneMemory;
 
 LANES_INLINE void lanes_init(LaneMemory* M) {
-    for (int l = 0; l < LANES; ++l) {
-#define LANES_ZERO(f) M->f[l] = 0;
-        LANES_FLOAT_FIELDS(LANES_ZERO)
-        LANES_INT_FIELDS(LANES_ZERO)
-#undef LANES_ZERO
-        M->hdet[l] = 1.0f;
-        M->prim[l] = -1;
-    }
+    const Lanes zero = {0};
+    M->V = zero;
+    M->V.hdet = (vfloat)(1.0f);
+    M->V.prim = (vint)(-1);
 }
 
 // Rays given to lanes, lane by lane (scalar stores, which lanes_set_rays and packet_set_rays
@@ -126,59 +129,72 @@ LANES_INLINE void lanes_rays_put(LanesRays* R, int lane, float3 o, float3 d, flo
     R->taken |= 1u << lane;
 }
 
-// A component of each lane's vector (X, Y, Z) picked by the lane's axis K (0, 1, 2).
-#define LANES_PICK(X, Y, Z, K) select(select(X, Y, (K) == (vint)(1)), Z, (K) == (vint)(2))
+// A component of each lane's vector (x, y, z) picked by the lane's axis k (0, 1, 2).
+LANES_INLINE vfloat lanes_pick(vfloat x, vfloat y, vfloat z, vint k) {
+    return select(select(x, y, k == (vint)(1)), z, k == (vint)(2));
+}
 
-// traverse_wide.h's slab test of one box (its planes LX .. HZ, scalars) in every lane, from the
-// lanes' origins ox, oy, oz and reciprocal directions ix, iy, iz: declares NEAR (the entry
-// distance, at least 0) and FAR. With lo <= hi the near plane's distance is the lesser of the
-// two, bit for bit (rounding is monotonic), so no plane is picked by the direction's sign.
-#define LANES_BOX(LX, LY, LZ, HX, HY, HZ, NEAR, FAR)                                         \
-    vfloat NEAR, FAR;                                                                      \
-    {                                                                                       \
-        vfloat x0_ = ((vfloat)(LX) - ox) * ix, x1_ = ((vfloat)(HX) - ox) * ix;           \
-        vfloat y0_ = ((vfloat)(LY) - oy) * iy, y1_ = ((vfloat)(HY) - oy) * iy;           \
-        vfloat z0_ = ((vfloat)(LZ) - oz) * iz, z1_ = ((vfloat)(HZ) - oz) * iz;           \
-        NEAR = WIDE_MAX(WIDE_MAX(WIDE_MIN(x0_, x1_), WIDE_MIN(y0_, y1_)),                   \
-                        WIDE_MAX(WIDE_MIN(z0_, z1_), (vfloat)(0.0f)));                     \
-        FAR = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0_, x1_), WIDE_MAX(y0_, y1_)), WIDE_MAX(z0_, z1_)) * \
-              1.00000024f;                                                                  \
-    }
+// A ray's origin and safe reciprocal direction in every lane, as the slab test reads them.
+typedef struct {
+    vfloat ox, oy, oz, ix, iy, iz;
+} LanesSlabRay;
 
-// prepare_ray lane by lane on R's rays, by selects (no branch on the dominant axis; one division
-// an axis for all the lanes): declares ix iy iz (the safe reciprocal direction), kx ky kz (the
-// permutation: z the dominant axis), px py pz (the origin in the permuted axes) and sx sy sz
-// (the shear), prepare_ray's values bit for bit.
-#define LANES_PREPARE_RAYS(OX, OY, OZ, DX, DY, DZ)                                            \
-    vfloat ix, iy, iz, px, py, pz, sx, sy, sz;                                               \
-    vint kx, ky, kz;                                                                       \
-    {                                                                                         \
-        const vfloat tiny_ = (vfloat)(1e-20f), one_ = (vfloat)(1.0f);                      \
-        vfloat ax_ = fabs(DX), ay_ = fabs(DY), az_ = fabs(DZ);                               \
-        ix = one_ / select(copysign(tiny_, DX), DX, ax_ > tiny_);                             \
-        iy = one_ / select(copysign(tiny_, DY), DY, ay_ > tiny_);                             \
-        iz = one_ / select(copysign(tiny_, DZ), DZ, az_ > tiny_);                             \
-        const vint two_ = (vint)(2);                                                    \
-        kz = select(select(two_, (vint)(1), ay_ > az_), select(two_, (vint)(0), ax_ > az_), \
-                    ax_ > ay_);                                                               \
-        kx = select(select((vint)(1), two_, kz == (vint)(1)), (vint)(0), kz == two_);  \
-        ky = select(select(two_, (vint)(0), kz == (vint)(1)), (vint)(1), kz == two_);  \
-        vfloat rz_ = LANES_PICK(ix, iy, iz, kz);                                             \
-        sx = LANES_PICK(DX, DY, DZ, kx) * rz_;                                                \
-        sy = LANES_PICK(DX, DY, DZ, ky) * rz_;                                                \
-        sz = rz_;                                                                             \
-        px = LANES_PICK(OX, OY, OZ, kx);                                                      \
-        py = LANES_PICK(OX, OY, OZ, ky);                                                      \
-        pz = LANES_PICK(OX, OY, OZ, kz);                                                      \
-    }
+// traverse_wide.h's slab test of one box (its planes lx .. hz) in every lane of r: the entry
+// distance (at least 0), and the exit distance in *far. With lo <= hi the near plane's distance
+// is the lesser of the two, bit for bit (rounding is monotonic), so no plane is picked by the
+// direction's sign.
+LANES_INLINE vfloat lanes_box(const LanesSlabRay* r, float lx, float ly, float lz, float hx,
+                              float hy, float hz, vfloat* far) {
+    vfloat x0 = ((vfloat)(lx) - r->ox) * r->ix, x1 = ((vfloat)(hx) - r->ox) * r->ix;
+    vfloat y0 = ((vfloat)(ly) - r->oy) * r->iy, y1 = ((vfloat)(hy) - r->oy) * r->iy;
+    vfloat z0 = ((vfloat)(lz) - r->oz) * r->iz, z1 = ((vfloat)(hz) - r->oz) * r->iz;
+    *far = WIDE_MIN(WIDE_MIN(WIDE_MAX(x0, x1), WIDE_MAX(y0, y1)), WIDE_MAX(z0, z1)) * 1.00000024f;
+    return WIDE_MAX(WIDE_MAX(WIDE_MIN(x0, x1), WIDE_MIN(y0, y1)),
+                    WIDE_MAX(WIDE_MIN(z0, z1), (vfloat)(0.0f)));
+}
 
-// R's rays as vectors: declares ox oy oz (origins), dx dy dz (directions), then
-// LANES_PREPARE_RAYS's values.
-#define LANES_LOAD_RAYS(R)                                                                    \
-    vfloat ox = vload_lanes(0, (R)->ox), oy = vload_lanes(0, (R)->oy);                       \
-    vfloat oz = vload_lanes(0, (R)->oz), dx = vload_lanes(0, (R)->dx);                       \
-    vfloat dy = vload_lanes(0, (R)->dy), dz = vload_lanes(0, (R)->dz);                       \
-    LANES_PREPARE_RAYS(ox, oy, oz, dx, dy, dz)
+// prepare_ray's values in every lane: the safe reciprocal direction (ix, iy, iz), the
+// permutation (kx, ky, kz: z the dominant axis), the origin in the permuted axes (px, py, pz)
+// and the shear (sx, sy, sz).
+typedef struct {
+    vfloat ix, iy, iz, px, py, pz, sx, sy, sz;
+    vint kx, ky, kz;
+} LanesPrepared;
+
+// prepare_ray lane by lane on the rays from (ox, oy, oz) along (dx, dy, dz), by selects (no
+// branch on the dominant axis; one division an axis for all the lanes): prepare_ray's values
+// bit for bit.
+LANES_INLINE LanesPrepared lanes_prepare_rays(vfloat ox, vfloat oy, vfloat oz, vfloat dx,
+                                              vfloat dy, vfloat dz) {
+    const vfloat tiny = (vfloat)(1e-20f), one = (vfloat)(1.0f);
+    const vint two = (vint)(2);
+    LanesPrepared r;
+    vfloat ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
+    r.ix = one / select(copysign(tiny, dx), dx, ax > tiny);
+    r.iy = one / select(copysign(tiny, dy), dy, ay > tiny);
+    r.iz = one / select(copysign(tiny, dz), dz, az > tiny);
+    r.kz = select(select(two, (vint)(1), ay > az), select(two, (vint)(0), ax > az), ax > ay);
+    r.kx = select(select((vint)(1), two, r.kz == (vint)(1)), (vint)(0), r.kz == two);
+    r.ky = select(select(two, (vint)(0), r.kz == (vint)(1)), (vint)(1), r.kz == two);
+    vfloat rz = lanes_pick(r.ix, r.iy, r.iz, r.kz);
+    r.sx = lanes_pick(dx, dy, dz, r.kx) * rz;
+    r.sy = lanes_pick(dx, dy, dz, r.ky) * rz;
+    r.sz = rz;
+    r.px = lanes_pick(ox, oy, oz, r.kx);
+    r.py = lanes_pick(ox, oy, oz, r.ky);
+    r.pz = lanes_pick(ox, oy, oz, r.kz);
+    return r;
+}
+
+// R's rays as vectors: their origins in *ox, *oy, *oz, and lanes_prepare_rays's values.
+LANES_INLINE LanesPrepared lanes_load_rays(const LanesRays* R, vfloat* ox, vfloat* oy,
+                                           vfloat* oz) {
+    *ox = vload_lanes(0, R->ox);
+    *oy = vload_lanes(0, R->oy);
+    *oz = vload_lanes(0, R->oz);
+    return lanes_prepare_rays(*ox, *oy, *oz, vload_lanes(0, R->dx), vload_lanes(0, R->dy),
+                              vload_lanes(0, R->dz));
+}
 
 // Lane `lane` will take the ray from o along d, to tmax (any_hit: a shadow ray, done at its
 // first hit: any one, a hit says the segment is blocked); lanes_set_rays gives it the ray.
@@ -196,22 +212,23 @@ LANES_INLINE void lanes_set_rays(LaneMemory* M, const LanesRays* R) {
     Lanes* L = &M->V;
     const vint m =
         ((vint)((int)R->taken) >> LANE_IDS & (vint)(1)) != (vint)(0);
-    LANES_LOAD_RAYS(R)
+    vfloat ox, oy, oz;
+    LanesPrepared r = lanes_load_rays(R, &ox, &oy, &oz);
     L->ox = select(L->ox, ox, m);
     L->oy = select(L->oy, oy, m);
     L->oz = select(L->oz, oz, m);
-    L->ix = select(L->ix, ix, m);
-    L->iy = select(L->iy, iy, m);
-    L->iz = select(L->iz, iz, m);
-    L->px = select(L->px, px, m);
-    L->py = select(L->py, py, m);
-    L->pz = select(L->pz, pz, m);
-    L->sx = select(L->sx, sx, m);
-    L->sy = select(L->sy, sy, m);
-    L->sz = select(L->sz, sz, m);
-    L->kx = select(L->kx, kx, m);
-    L->ky = select(L->ky, ky, m);
-    L->kz = select(L->kz, kz, m);
+    L->ix = select(L->ix, r.ix, m);
+    L->iy = select(L->iy, r.iy, m);
+    L->iz = select(L->iz, r.iz, m);
+    L->px = select(L->px, r.px, m);
+    L->py = select(L->py, r.py, m);
+    L->pz = select(L->pz, r.pz, m);
+    L->sx = select(L->sx, r.sx, m);
+    L->sy = select(L->sy, r.sy, m);
+    L->sz = select(L->sz, r.sz, m);
+    L->kx = select(L->kx, r.kx, m);
+    L->ky = select(L->ky, r.ky, m);
+    L->kz = select(L->kz, r.kz, m);
     L->tfar = select(L->tfar, vload_lanes(0, R->tmax), m);
     // No hit: hv, hw and hdet are read only with a hit, which sets them.
     L->prim = select(L->prim, (vint)(-1), m);
@@ -277,23 +294,23 @@ LANES_INLINE void lanes_rare_cases(vint special, vint tri, const float3* o, cons
     *prim = vload_lanes(0, prim_);
 }
 
-// After LANE_HITS_T (t, v, w, det, ok, special): triangle I's hits kept in the lanes of ok,
-// nearer than their hits so far (tfar, hv, hw, hdet, prim), the scalar test deciding the
-// lanes of special (whose rays are O[l], D[l]).
-#define LANES_KEEP_HITS(I, O, D, ANY_HIT)                                                    \
-    {                                                                                        \
-        const vint i_ = (vint)(I);                                                     \
-        ok &= ~special;                                                                      \
-        tfar = select(tfar, t, ok);                                                          \
-        hv = select(hv, v, ok);                                                              \
-        hw = select(hw, w, ok);                                                              \
-        hdet = select(hdet, det, ok);                                                        \
-        prim = select(prim, i_, ok);                                                         \
-        if (lanes_any(special)) {                                                            \
-            lanes_rare_cases(special, i_, O, D, tris, surf, ANY_HIT, &tfar, &hv, &hw, &hdet, \
-                             &prim);                                                         \
-        }                                                                                    \
+// Triangle tri's verdict h (with its edge functions e) kept in the lanes of h.ok that it does
+// not send to the scalar test, nearer than their hits so far (*t, *v, *w, *det, *prim); the
+// scalar test decides the lanes of h.special (whose rays are o[l], d[l]).
+LANES_INLINE void lanes_keep_hits(LanesVerdict h, LanesEdges e, vint tri, const float3* o,
+                                  const float3* d, global const DeviceTriangle* tris,
+                                  const SceneSurfaces* surf, bool any_hit, vfloat* t, vfloat* v,
+                                  vfloat* w, vfloat* det, vint* prim) {
+    vint ok = h.ok & ~h.special;
+    *t = select(*t, h.t, ok);
+    *v = select(*v, e.v, ok);
+    *w = select(*w, e.w, ok);
+    *det = select(*det, h.det, ok);
+    *prim = select(*prim, tri, ok);
+    if (lanes_any(h.special)) {
+        lanes_rare_cases(h.special, tri, o, d, tris, surf, any_hit, t, v, w, det, prim);
     }
+}
 
 // Lanes at a leaf are tested together once at least this many are (the others wait at it).
 // Six of sixteen and three of eight measured fastest; two or four of eight were no faster on
@@ -363,18 +380,13 @@ LANES_INLINE void lanes_prefetch(ulong base, vint first, uint size, uint bytes, 
 #define LANES_PREFETCH_TRIS 4
 #endif
 
-// The node of NODES each lane of M goes to next (ITEM, if a node): its two cache lines are
+// The node of `nodes` each lane of m goes to next (item, if a node): its two cache lines are
 // fetched as the lane takes it, a node step's leaves and pops before the step loads it, so the
 // sixteen lanes' misses overlap that work (4-8 % of the 1 M-triangle scenes' time on Zen 4).
-#define LANES_PREFETCH_NODE(NODES, ITEM, M)                                                 \
-    lanes_prefetch((ulong)(NODES), (ITEM), sizeof(DeviceWideNode), sizeof(DeviceWideNode),       \
-                   (M) & ((ITEM) >= (vint)(0)));
-
-// A triangle of each lane, its vertices a, b, c relative to the lane's origin in its permuted
-// axes.
-typedef struct {
-    vfloat aX, aY, aZ, bX, bY, bZ, cX, cY, cZ;
-} LanesTriangle;
+LANES_INLINE void lanes_prefetch_node(global const DeviceWideNode* nodes, vint item, vint m) {
+    lanes_prefetch((ulong)nodes, item, sizeof(DeviceWideNode), sizeof(DeviceWideNode),
+                   m & (item >= (vint)(0)));
+}
 
 // Triangle tri of each lane of mask m (tw: the triangles as words), its vertices relative to the
 // lane's origin in its permuted axes (kx, ky, kz: 0, 1 or 2; px, py, pz). Lanes outside m read
@@ -432,29 +444,120 @@ LANES_INLINE LanesTriangle lanes_triangle(global const float* tw, vint tri, vint
 #define LANES_PAIRS_MAX 64
 #endif
 
-// Compare-exchange of two (distance, item) pairs in every lane, nearest first.
-#define LANES_ORDER(A, B)                      \
-    {                                          \
-        vint s = d##B < d##A;                 \
-        vfloat td = d##A;                     \
-        d##A = select(d##A, d##B, s);          \
-        d##B = select(d##B, td, s);            \
-        vint tc = c##A;                       \
-        c##A = select(c##A, c##B, s);          \
-        c##B = select(c##B, tc, s);            \
-    }
+// A child's slab test, one axis: the distances along the lanes' rays (origin o, reciprocal
+// direction inv) of its near and far planes pn, pf, which become its entry and exit distances
+// (first: the first axis), or are folded into them (*d, *f) as traverse_wide.h's slab test does.
+LANES_INLINE void lanes_slab(vfloat pn, vfloat pf, vfloat o, vfloat inv, bool first, vfloat* d,
+                             vfloat* f) {
+    vfloat n = (pn - o) * inv, x = (pf - o) * inv;
+    *d = first ? n : select(*d, n, n > *d);
+    *f = first ? x : select(*f, x, x < *f);
+}
 
-#if LANES != 8
-// A child (entry distance d, item c) pushed onto the stacks of the lanes of mi that reached it
-// (d < inf), each lane's stack pointer *sp moved down past it (with eight lanes a node step
-// pushes its three children in one store instead).
-LANES_INLINE void lanes_push_child(float* stack, vint* sp, vint mi, vfloat d, vint c,
-                                   vfloat inf) {
-    vint p = mi & (d < inf);
-    lanes_push_pair(stack, LANES_ENTRY(*sp), lanes_kmask(p), d, as_vfloat(c));
-    *sp -= p;
+// A child after its slab test (entry and exit distances d, f; child and count words cw, kw) in
+// the lanes of mi: its entry distance (at least 0) where it is reached before the lane's hit
+// tfar, else infinity; its item in lanes_pack form in *c.
+LANES_INLINE vfloat lanes_child(vfloat d, vfloat f, vint cw, vint kw, vint mi, vfloat tfar,
+                                vint* c) {
+    const vfloat zero = (vfloat)(0.0f);
+    const vint izero = (vint)(0);
+    vfloat nr = select(d, zero, zero > d), fr = f * 1.00000024f;
+    vint reach = mi & ((cw > izero) | (kw != izero)) & (nr <= fr) & (nr < tfar);
+    *c = lanes_pack(cw, kw);
+    return select((vfloat)(INFINITY), nr, reach);
+}
+
+#ifdef LANES_GATHERS
+// Children j and j + 1 of each lane's node (at word offset base, lanes of mi, km its bits) by
+// gathers: a row's words of two children are side by side, so one 8-byte gather element brings
+// both (half the gathered elements). The near planes' word offsets are n*, the far ones' f*.
+LANES_INLINE void lanes_children_gathered(const Lanes* L, global const float* nw, vint base,
+                                          vint mi, vmask km, vint nx, vint ny, vint nz,
+                                          vint fx, vint fy, vint fz, int j, vfloat* d,
+                                          vint* c) {
+    vint at = base + (vint)(j);
+    vfloat n0, n1, f0, f1, d0, d1, e0, e1;
+    lanes_gather_pair((ulong)nw, at + nx, km, &n0, &n1);
+    lanes_gather_pair((ulong)nw, at + fx, km, &f0, &f1);
+    lanes_slab(n0, f0, L->ox, L->ix, true, &d0, &e0);
+    lanes_slab(n1, f1, L->ox, L->ix, true, &d1, &e1);
+    lanes_gather_pair((ulong)nw, at + ny, km, &n0, &n1);
+    lanes_gather_pair((ulong)nw, at + fy, km, &f0, &f1);
+    lanes_slab(n0, f0, L->oy, L->iy, false, &d0, &e0);
+    lanes_slab(n1, f1, L->oy, L->iy, false, &d1, &e1);
+    lanes_gather_pair((ulong)nw, at + nz, km, &n0, &n1);
+    lanes_gather_pair((ulong)nw, at + fz, km, &f0, &f1);
+    lanes_slab(n0, f0, L->oz, L->iz, false, &d0, &e0);
+    lanes_slab(n1, f1, L->oz, L->iz, false, &d1, &e1);
+    vfloat cw0, cw1, kw0, kw1;
+    lanes_gather_pair((ulong)nw, at + (vint)(24), km, &cw0, &cw1);
+    lanes_gather_pair((ulong)nw, at + (vint)(28), km, &kw0, &kw1);
+    d[j] = lanes_child(d0, e0, as_vint(cw0), as_vint(kw0), mi, L->tfar, &c[j]);
+    d[j + 1] = lanes_child(d1, e1, as_vint(cw1), as_vint(kw1), mi, L->tfar, &c[j + 1]);
+}
+#else
+// One axis of the four children's slab tests, the lanes' nodes as rows (each lane's at word
+// offset off[l]): the planes at words wlo (minima) and whi (maxima), for the lanes' origin o
+// and reciprocal direction inv (first: the first axis).
+LANES_INLINE void lanes_node_axis(global const float* nw, const int* off, int wlo, int whi,
+                                  vfloat o, vfloat inv, bool first, vfloat* d, vfloat* f) {
+    vfloat lo[4], hi[4];
+    vint pos = inv >= (vfloat)(0.0f);
+    lanes_rows4(nw, off, wlo, lo);
+    lanes_rows4(nw, off, whi, hi);
+#pragma unroll
+    for (int j = 0; j < 4; ++j) {
+        lanes_slab(select(hi[j], lo[j], pos), select(lo[j], hi[j], pos), o, inv, first, &d[j],
+                   &f[j]);
+    }
 }
 #endif
+
+// Compare-exchange of children a and b's (distance, item) pairs in every lane, nearest first.
+LANES_INLINE void lanes_order(vfloat* d, vint* c, int a, int b) {
+    vint s = d[b] < d[a];
+    vfloat td = d[a];
+    d[a] = select(d[a], d[b], s);
+    d[b] = select(d[b], td, s);
+    vint tc = c[a];
+    c[a] = select(c[a], c[b], s);
+    c[b] = select(c[b], tc, s);
+}
+
+// A node's sorted children 1, 2, 3 (entry distances d, items c) pushed, farthest first, onto the
+// stacks of the lanes of mi that reached them (d < infinity), each lane's stack pointer *sp
+// moved down past them.
+LANES_INLINE void lanes_push_children(float* stack, vint* sp, vint mi, const vfloat* d,
+                                      const vint* c) {
+    const vfloat inf = (vfloat)(INFINITY);
+#if LANES == 8
+    // Eight lanes: a lane's pushed entries are one 32-byte store at its stack pointer. The
+    // reached children are a prefix of 1, 2, 3 (sorted; the others at infinity), so the
+    // entries, farthest first, are selects: the top is child 1, below it 2, 3.
+    vint p1 = mi & (d[1] < inf), p2 = mi & (d[2] < inf), p3 = mi & (d[3] < inf);
+    vfloat e[8];
+    e[0] = select(select(d[1], d[2], p2), d[3], p3);
+    e[1] = as_vfloat(select(select(c[1], c[2], p2), c[3], p3));
+    e[2] = select(d[1], d[2], p3);
+    e[3] = as_vfloat(select(c[1], c[2], p3));
+    e[4] = d[1];
+    e[5] = as_vfloat(c[1]);
+    e[6] = e[7] = (vfloat)(0.0f);
+    vfloat rows[8];
+    lanes_transpose8(e, rows);
+    int at[LANES];
+    vstore_lanes(lanes_entry(*sp), 0, at);
+#pragma unroll
+    for (int l = 0; l < LANES; ++l) vstore8(rows[l], 0, stack + at[l]);
+    *sp -= p1 + p2 + p3;
+#else
+    for (int j = 3; j >= 1; --j) {
+        vint p = mi & (d[j] < inf);
+        lanes_push_pair(stack, lanes_entry(*sp), lanes_kmask(p), d[j], as_vfloat(c[j]));
+        *sp -= p;
+    }
+#endif
+}
 
 // Walks the lanes' rays until LANES_DONE_MIN are done or none is left walking; returns the
 // mask of those done (their `live` lanes cleared). No lane live: returns an empty mask.
@@ -472,111 +575,39 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const DeviceWideNode* nodes,
         vint mi = L->has & (L->cur >= izero);
         if (lanes_any(mi)) {
             vint base = L->cur * (vint)(32);
-// Child J's slab test in every lane of mi from its near and far planes (NX .. FZ) and its
-// child and count words (C, K): declares d##J, the entry distance of a reached child (else
-// infinity), and sets c##J to its item in lanes_pack form.
-#define LANES_CHILD(J, NX, NY, NZ, FX, FY, FZ, C, K)                                         \
-    vfloat d##J;                                                                         \
-    {                                                                                     \
-        vfloat x0 = (NX - L->ox) * L->ix, y0 = (NY - L->oy) * L->iy;                     \
-        vfloat nr = select(x0, y0, y0 > x0);                                             \
-        vfloat z0 = (NZ - L->oz) * L->iz;                                                \
-        nr = select(nr, z0, z0 > nr);                                                     \
-        nr = select(nr, zero, zero > nr);                                                 \
-        vfloat x1 = (FX - L->ox) * L->ix, y1 = (FY - L->oy) * L->iy;                     \
-        vfloat fr = select(x1, y1, y1 < x1);                                             \
-        vfloat z1 = (FZ - L->oz) * L->iz;                                                \
-        fr = select(fr, z1, z1 < fr) * 1.00000024f;                                       \
-        vint cw = (C), kw = (K);                                                         \
-        vint reach = mi & ((cw > izero) | (kw != izero)) & (nr <= fr) & (nr < L->tfar);  \
-        d##J = select(inf, nr, reach);                                                    \
-        c##J = lanes_pack(cw, kw);                                                        \
-    }
-            vint c0, c1, c2, c3;
+            vfloat d[4];
+            vint c[4];
 #ifdef LANES_GATHERS
-            // Children J and J + 1 at once: a row's words of two children are side by side, so
-            // one 8-byte gather element brings both (half the gathered elements).
-            ushort km = lanes_kmask(mi);
+            vmask km = lanes_kmask(mi);
             vint nx = select((vint)(12), izero, L->ix >= zero);
             vint ny = select((vint)(16), (vint)(4), L->iy >= zero);
             vint nz = select((vint)(20), (vint)(8), L->iz >= zero);
             vint fx = (vint)(12) - nx, fy = (vint)(20) - ny, fz = (vint)(28) - nz;
-#define LANES_CHILDREN(J, K)                                                                \
-    vfloat nx##J, nx##K, ny##J, ny##K, nz##J, nz##K, fx##J, fx##K, fy##J, fy##K, fz##J,    \
-        fz##K, cw##J, cw##K, kw##J, kw##K;                                                  \
-    lanes_gather_pair((ulong)nw, base + (vint)(J) + nx, km, &nx##J, &nx##K);                       \
-    lanes_gather_pair((ulong)nw, base + (vint)(J) + ny, km, &ny##J, &ny##K);                       \
-    lanes_gather_pair((ulong)nw, base + (vint)(J) + nz, km, &nz##J, &nz##K);                       \
-    lanes_gather_pair((ulong)nw, base + (vint)(J) + fx, km, &fx##J, &fx##K);                       \
-    lanes_gather_pair((ulong)nw, base + (vint)(J) + fy, km, &fy##J, &fy##K);                       \
-    lanes_gather_pair((ulong)nw, base + (vint)(J) + fz, km, &fz##J, &fz##K);                       \
-    lanes_gather_pair((ulong)nw, base + (vint)(J + 24), km, &cw##J, &cw##K);                       \
-    lanes_gather_pair((ulong)nw, base + (vint)(J + 28), km, &kw##J, &kw##K);                       \
-    LANES_CHILD(J, nx##J, ny##J, nz##J, fx##J, fy##J, fz##J, as_vint(cw##J), as_vint(kw##J)) \
-    LANES_CHILD(K, nx##K, ny##K, nz##K, fx##K, fy##K, fz##K, as_vint(cw##K), as_vint(kw##K))
-            LANES_CHILDREN(0, 1)
-            LANES_CHILDREN(2, 3)
+            lanes_children_gathered(L, nw, base, mi, km, nx, ny, nz, fx, fy, fz, 0, d, c);
+            lanes_children_gathered(L, nw, base, mi, km, nx, ny, nz, fx, fy, fz, 2, d, c);
 #else
-            // The nodes as rows, one axis at a time (each child's near and far distances
-            // folded in as in LANES_CHILD, x, y, z in turn), so that only one axis's planes and
-            // the running distances are live: the 32 words of a node at once were more vectors
-            // than registers.
-            int off_[LANES];
-            vstore_lanes(select(izero, base, mi), 0, off_);
-            vfloat d0, d1, d2, d3, f0, f1, f2, f3;
-            {
-                vfloat lo[4], hi[4];
-                vint pos = L->ix >= zero;
-                lanes_rows4(nw, off_, 0, lo);
-                lanes_rows4(nw, off_, 12, hi);
-#define LANES_SLAB_X(J)                                                \
-    d##J = (select(hi[J], lo[J], pos) - L->ox) * L->ix;              \
-    f##J = (select(lo[J], hi[J], pos) - L->ox) * L->ix;
-                LANES_SLAB_X(0) LANES_SLAB_X(1) LANES_SLAB_X(2) LANES_SLAB_X(3)
-#undef LANES_SLAB_X
-            }
-#define LANES_SLAB(J, O, I)                                                              \
-    {                                                                                  \
-        vfloat n_ = (select(hi[J], lo[J], pos) - L->O) * L->I;                        \
-        vfloat f_ = (select(lo[J], hi[J], pos) - L->O) * L->I;                        \
-        d##J = select(d##J, n_, n_ > d##J);                                            \
-        f##J = select(f##J, f_, f_ < f##J);                                            \
-    }
-// The axis of origin O and reciprocal I, its planes at words WLO (minima) and WHI (maxima).
-#define LANES_SLABS(WLO, WHI, O, I)                                                   \
-    {                                                                               \
-        vfloat lo[4], hi[4];                                                       \
-        vint pos = L->I >= zero;                                                 \
-        lanes_rows4(nw, off_, WLO, lo);                                             \
-        lanes_rows4(nw, off_, WHI, hi);                                             \
-        LANES_SLAB(0, O, I) LANES_SLAB(1, O, I) LANES_SLAB(2, O, I) LANES_SLAB(3, O, I) \
-    }
-            LANES_SLABS(4, 16, oy, iy)
-            LANES_SLABS(8, 20, oz, iz)
-#undef LANES_SLABS
-#undef LANES_SLAB
+            // The nodes as rows, one axis at a time, so that only one axis's planes and the
+            // running distances are live: the 32 words of a node at once were more vectors than
+            // registers.
+            int off[LANES];
+            vstore_lanes(select(izero, base, mi), 0, off);
+            vfloat f[4];
+            lanes_node_axis(nw, off, 0, 12, L->ox, L->ix, true, d, f);
+            lanes_node_axis(nw, off, 4, 16, L->oy, L->iy, false, d, f);
+            lanes_node_axis(nw, off, 8, 20, L->oz, L->iz, false, d, f);
             vfloat W[8];
-            lanes_rows8(nw, off_, 24, W);
-#define LANES_CHILDREN(J)                                                                   \
-    {                                                                                       \
-        vfloat nr = select(d##J, zero, zero > d##J), fr = f##J * 1.00000024f;              \
-        vint cw = as_vint(W[J]), kw = as_vint(W[4 + J]);                           \
-        vint reach = mi & ((cw > izero) | (kw != izero)) & (nr <= fr) & (nr < L->tfar);  \
-        d##J = select(inf, nr, reach);                                                    \
-        c##J = lanes_pack(cw, kw);                                                        \
-    }
-            LANES_CHILDREN(0)
-            LANES_CHILDREN(1)
-            LANES_CHILDREN(2)
-            LANES_CHILDREN(3)
+            lanes_rows8(nw, off, 24, W);
+#pragma unroll
+            for (int j = 0; j < 4; ++j) {
+                d[j] = lanes_child(d[j], f[j], as_vint(W[j]), as_vint(W[4 + j]), mi, L->tfar,
+                                   &c[j]);
+            }
 #endif
-#undef LANES_CHILDREN
-#undef LANES_CHILD
-            LANES_ORDER(0, 1)
-            LANES_ORDER(2, 3)
-            LANES_ORDER(0, 2)
-            LANES_ORDER(1, 3)
-            LANES_ORDER(1, 2)
+            lanes_order(d, c, 0, 1);
+            lanes_order(d, c, 2, 3);
+            lanes_order(d, c, 0, 2);
+            lanes_order(d, c, 1, 3);
+            lanes_order(d, c, 1, 2);
             // A lane about to overflow its stack ends its walk with the hit so far (as
             // traverse_wide_bvh does; the overflow is counted).
             vint full = mi & (L->sp > (vint)(LANES_STACK - 4));
@@ -587,37 +618,11 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const DeviceWideNode* nodes,
                 L->has &= ~full;
             }
             // The reached children but the nearest pushed, farthest first; the nearest entered.
-#if LANES == 8
-            // Eight lanes: a lane's pushed entries are one 32-byte store at its stack pointer.
-            // The reached children are a prefix of 1, 2, 3 (sorted; the others at infinity),
-            // so the entries, farthest first, are selects: the top is child 1, below it 2, 3.
-            {
-                vint p1 = mi & (d1 < inf), p2 = mi & (d2 < inf), p3 = mi & (d3 < inf);
-                vfloat e[8];
-                e[0] = select(select(d1, d2, p2), d3, p3);
-                e[1] = as_vfloat(select(select(c1, c2, p2), c3, p3));
-                e[2] = select(d1, d2, p3);
-                e[3] = as_vfloat(select(c1, c2, p3));
-                e[4] = d1;
-                e[5] = as_vfloat(c1);
-                e[6] = e[7] = zero;
-                vfloat rows[8];
-                lanes_transpose8(e, rows);
-                int at_[LANES];
-                vstore_lanes(LANES_ENTRY(L->sp), 0, at_);
-#pragma unroll
-                for (int l = 0; l < LANES; ++l) vstore8(rows[l], 0, M->stack + at_[l]);
-                L->sp -= p1 + p2 + p3;
-            }
-#else
-            lanes_push_child(M->stack, &L->sp, mi, d3, c3, inf);
-            lanes_push_child(M->stack, &L->sp, mi, d2, c2, inf);
-            lanes_push_child(M->stack, &L->sp, mi, d1, c1, inf);
-#endif
-            vint enter = mi & (d0 < inf);
-            arrived |= enter & (c0 < izero);
-            L->cur = select(L->cur, c0, enter);
-            LANES_PREFETCH_NODE(nodes, c0, enter)
+            lanes_push_children(M->stack, &L->sp, mi, d, c);
+            vint enter = mi & (d[0] < inf);
+            arrived |= enter & (c[0] < izero);
+            L->cur = select(L->cur, c[0], enter);
+            lanes_prefetch_node(nodes, c[0], enter);
             L->has &= ~(mi & ~enter);
         }
         // Leaves, once enough lanes are at one (or no lane is at a node).
@@ -656,16 +661,14 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const DeviceWideNode* nodes,
                 vfloat sx = lanes_permute(L->sx, idx), sy = lanes_permute(L->sy, idx);
                 vfloat sz = lanes_permute(L->sz, idx);
                 LanesTriangle tv = lanes_triangle(tw, tri, m, kx, ky, kz, px, py, pz);
-                vfloat aX = tv.aX, aY = tv.aY, aZ = tv.aZ, bX = tv.bX, bY = tv.bY, bZ = tv.bZ;
-                vfloat cX = tv.cX, cY = tv.cY, cZ = tv.cZ;
-                LANE_EDGES(vfloat)
-                LANE_HITS_T(vfloat, vint, m, zero, lanes_permute(L->tfar, idx))
-                by_k = lanes_any(special);
-                vstore_lanes(t, 0, rt + p0);
-                vstore_lanes(v, 0, rv + p0);
-                vstore_lanes(w, 0, rw + p0);
-                vstore_lanes(det, 0, rdet + p0);
-                hits[p0 / LANES] = lanes_kmask(ok);
+                LanesEdges e = lanes_edges(&tv, sx, sy);
+                LanesVerdict h = lanes_verdict(&tv, e, sz, m, zero, lanes_permute(L->tfar, idx));
+                by_k = lanes_any(h.special);
+                vstore_lanes(h.t, 0, rt + p0);
+                vstore_lanes(e.v, 0, rv + p0);
+                vstore_lanes(e.w, 0, rw + p0);
+                vstore_lanes(h.det, 0, rdet + p0);
+                hits[p0 / LANES] = lanes_kmask(h.ok);
                 found |= hits[p0 / LANES];
             }
             // No pair hit: the lanes' hits stand as they are. Else each hit, in pair order,
@@ -700,21 +703,10 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const DeviceWideNode* nodes,
                 vint tri = first + (vint)(k);
                 LanesTriangle tv =
                     lanes_triangle(tw, tri, m, L->kx, L->ky, L->kz, L->px, L->py, L->pz);
-                vfloat aX = tv.aX, aY = tv.aY, aZ = tv.aZ, bX = tv.bX, bY = tv.bY, bZ = tv.bZ;
-                vfloat cX = tv.cX, cY = tv.cY, cZ = tv.cZ;
-                vfloat sx = L->sx, sy = L->sy, sz = L->sz;
-                LANE_EDGES(vfloat)
-                LANE_HITS_T(vfloat, vint, m, zero, L->tfar)
-                ok &= ~special;
-                L->tfar = select(L->tfar, t, ok);
-                L->hv = select(L->hv, v, ok);
-                L->hw = select(L->hw, w, ok);
-                L->hdet = select(L->hdet, det, ok);
-                L->prim = select(L->prim, tri, ok);
-                if (lanes_any(special)) {
-                    lanes_rare_cases(special, tri, M->o, M->d, tris, surf, false, &L->tfar,
-                                     &L->hv, &L->hw, &L->hdet, &L->prim);
-                }
+                LanesEdges e = lanes_edges(&tv, L->sx, L->sy);
+                LanesVerdict h = lanes_verdict(&tv, e, L->sz, m, zero, L->tfar);
+                lanes_keep_hits(h, e, tri, M->o, M->d, tris, surf, false, &L->tfar, &L->hv,
+                                &L->hw, &L->hdet, &L->prim);
             }
             // A shadow ray that hit something is done: its stack emptied.
             L->sp = select(L->sp, izero, ml & L->any & (L->prim >= izero));
@@ -730,7 +722,7 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const DeviceWideNode* nodes,
             done |= pm & ~m;
             if (!lanes_any(m)) break;
             L->sp += m;
-            vint at = LANES_ENTRY(L->sp);
+            vint at = lanes_entry(L->sp);
             vfloat d, itemf;
             lanes_pop_pair(M->stack, at, lanes_kmask(m), &d, &itemf);
             vint keep = m & (d < L->tfar);
@@ -738,7 +730,7 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const DeviceWideNode* nodes,
             L->cur = select(L->cur, item, keep);
             L->has |= keep;
             arrived |= keep & (item < izero);
-            LANES_PREFETCH_NODE(nodes, item, keep)
+            lanes_prefetch_node(nodes, item, keep);
         }
         // A leaf waits for other lanes to reach theirs: its triangles are fetched meanwhile.
         lanes_prefetch((ulong)tris, L->cur & (vint)(LANES_FIRST_MASK), sizeof(DeviceTriangle),
@@ -771,26 +763,27 @@ LANES_INLINE vint lanes_walk(LaneMemory* M, global const DeviceWideNode* nodes,
 // slot), found once a work item by a walk of the small tree. A range covers its subtree's
 // leaves (were they not contiguous, it would cover triangles of other children too, which are
 // then tested twice, with the same verdicts).
+LANES_INLINE void lanes_small_child(global const DeviceWideNode* nodes, int n, int i,
+                                    uint* first, uint* end, int* stack, int* sp) {
+    // Child i of node n: a leaf widens the range, an interior node is walked later.
+    int c = ((global const int*)&nodes[n].child)[i];
+    uint k = ((global const uint*)&nodes[n].count)[i];
+    if (k != 0u) {
+        *first = min(*first, (uint)~c);
+        *end = max(*end, (uint)~c + k);
+    } else if (c > 0) {
+        stack[(*sp)++] = c;
+    }
+}
+
 LANES_INLINE void lanes_small_ranges(global const DeviceWideNode* nodes, uint count, uint* first,
                                      uint* end) {
-    // Child i of node n: a leaf widens the range, an interior node is walked later.
-#define LANES_SMALL_CHILD(n, i)                                                        \
-    {                                                                                  \
-        int c_ = ((global const int*)&nodes[n].child)[i];                              \
-        uint k_ = ((global const uint*)&nodes[n].count)[i];                            \
-        if (k_ != 0u) {                                                                \
-            first[j] = min(first[j], (uint)~c_);                                       \
-            end[j] = max(end[j], (uint)~c_ + k_);                                      \
-        } else if (c_ > 0) {                                                           \
-            stack[sp++] = c_;                                                          \
-        }                                                                              \
-    }
     for (int j = 0; j < 4; ++j) {
         first[j] = count;
         end[j] = 0u;
         int stack[LANES_STACK];
         int sp = 0;
-        LANES_SMALL_CHILD(0, j)
+        lanes_small_child(nodes, 0, j, &first[j], &end[j], stack, &sp);
         while (sp > 0) {
             if (sp + 4 > LANES_STACK) {
                 // Deeper than a tree of so few triangles can be: all of them.
@@ -799,16 +792,22 @@ LANES_INLINE void lanes_small_ranges(global const DeviceWideNode* nodes, uint co
                 break;
             }
             int n = stack[--sp];
-            for (int i = 0; i < 4; ++i) LANES_SMALL_CHILD(n, i)
+            for (int i = 0; i < 4; ++i) {
+                lanes_small_child(nodes, n, i, &first[j], &end[j], stack, &sp);
+            }
         }
         end[j] = min(end[j], count);
     }
-#undef LANES_SMALL_CHILD
+}
+
+// Vertex v's axis k (each lane's permutation), relative to the lane's origin p on that axis.
+LANES_INLINE vfloat lanes_small_axis(float4 v, vint k, vfloat p) {
+    return lanes_pick((vfloat)(v.x), (vfloat)(v.y), (vfloat)(v.z), k) - p;
 }
 
 // Every live lane's ray against the triangles of the root's children it reaches (ranges:
 // lanes_small_ranges's), each child's in order; the nearest hit is kept, the first of equally
-// near ones (the verdicts are the leaf steps': LANE_EDGES, LANE_HITS_T, the scalar test's rare
+// near ones (the verdicts are the leaf steps': lanes_edges, lanes_verdict, the scalar test's rare
 // cases). Returns the lanes done: all that were live.
 LANES_INLINE vint lanes_walk_small(LaneMemory* M, global const DeviceWideNode* nodes,
                                       global const DeviceTriangle* tris, const uint* first,
@@ -819,30 +818,30 @@ LANES_INLINE vint lanes_walk_small(LaneMemory* M, global const DeviceWideNode* n
     const vfloat zero = (vfloat)(0.0f);
     global const float4* tv = (global const float4*)tris;
     const vint kx = L->kx, ky = L->ky, kz = L->kz;
-    const vfloat ox = L->ox, oy = L->oy, oz = L->oz, ix = L->ix, iy = L->iy, iz = L->iz;
+    const LanesSlabRay ray = {L->ox, L->oy, L->oz, L->ix, L->iy, L->iz};
     const vfloat px = L->px, py = L->py, pz = L->pz, sx = L->sx, sy = L->sy, sz = L->sz;
     vfloat tfar = L->tfar, hv = L->hv, hw = L->hw, hdet = L->hdet;
     vint prim = L->prim;
     global const float* r = (global const float*)nodes;  // the root: min_x .. max_z, 4 words each
     for (int j = 0; j < 4; ++j) {
         if (first[j] >= end[j]) continue;
-        LANES_BOX(r[j], r[4 + j], r[8 + j], r[12 + j], r[16 + j], r[20 + j], near, far)
+        vfloat far;
+        vfloat near = lanes_box(&ray, r[j], r[4 + j], r[8 + j], r[12 + j], r[16 + j], r[20 + j],
+                                &far);
         const vint m = live & (near <= far) & (near < tfar);
         if (!lanes_any(m)) continue;
         for (uint i = first[j]; i < end[j]; ++i) {
             float4 a = tv[3u * i], b = tv[3u * i + 1u], c = tv[3u * i + 2u];
-            // Vertex V's axis K (the lane's permutation), relative to the lane's origin.
-#define LANES_SMALL_AXIS(V, K, P) \
-    (LANES_PICK((vfloat)(V.x), (vfloat)(V.y), (vfloat)(V.z), K) - (P))
-            vfloat aX = LANES_SMALL_AXIS(a, kx, px), aY = LANES_SMALL_AXIS(a, ky, py);
-            vfloat aZ = LANES_SMALL_AXIS(a, kz, pz), bX = LANES_SMALL_AXIS(b, kx, px);
-            vfloat bY = LANES_SMALL_AXIS(b, ky, py), bZ = LANES_SMALL_AXIS(b, kz, pz);
-            vfloat cX = LANES_SMALL_AXIS(c, kx, px), cY = LANES_SMALL_AXIS(c, ky, py);
-            vfloat cZ = LANES_SMALL_AXIS(c, kz, pz);
-#undef LANES_SMALL_AXIS
-            LANE_EDGES(vfloat)
-            LANE_HITS_T(vfloat, vint, m, zero, tfar)
-            LANES_KEEP_HITS((int)i, M->o, M->d, false)
+            LanesTriangle tri = {
+                lanes_small_axis(a, kx, px), lanes_small_axis(a, ky, py),
+                lanes_small_axis(a, kz, pz), lanes_small_axis(b, kx, px),
+                lanes_small_axis(b, ky, py), lanes_small_axis(b, kz, pz),
+                lanes_small_axis(c, kx, px), lanes_small_axis(c, ky, py),
+                lanes_small_axis(c, kz, pz)};
+            LanesEdges e = lanes_edges(&tri, sx, sy);
+            LanesVerdict h = lanes_verdict(&tri, e, sz, m, zero, tfar);
+            lanes_keep_hits(h, e, (vint)((int)i), M->o, M->d, tris, surf, false, &tfar, &hv, &hw,
+                            &hdet, &prim);
         }
     }
     L->tfar = tfar;

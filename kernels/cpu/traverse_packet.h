@@ -49,20 +49,21 @@ LANES_INLINE void packet_take_ray(Packet* P, LanesRays* R, int lane, float3 o, f
 // The packet's lanes take R's rays (all of them: the walk's mask says which it walks), with no
 // hit yet.
 LANES_INLINE void packet_set_rays(Packet* P, const LanesRays* R) {
-    LANES_LOAD_RAYS(R)
+    vfloat ox, oy, oz;
+    LanesPrepared r = lanes_load_rays(R, &ox, &oy, &oz);
     vstore_lanes(ox, 0, P->ox);
     vstore_lanes(oy, 0, P->oy);
     vstore_lanes(oz, 0, P->oz);
-    vstore_lanes(ix, 0, P->ix);
-    vstore_lanes(iy, 0, P->iy);
-    vstore_lanes(iz, 0, P->iz);
-    vstore_lanes(px, 0, P->px);
-    vstore_lanes(py, 0, P->py);
-    vstore_lanes(pz, 0, P->pz);
-    vstore_lanes(sx, 0, P->sx);
-    vstore_lanes(sy, 0, P->sy);
-    vstore_lanes(sz, 0, P->sz);
-    vstore_lanes(kz, 0, P->kz);
+    vstore_lanes(r.ix, 0, P->ix);
+    vstore_lanes(r.iy, 0, P->iy);
+    vstore_lanes(r.iz, 0, P->iz);
+    vstore_lanes(r.px, 0, P->px);
+    vstore_lanes(r.py, 0, P->py);
+    vstore_lanes(r.pz, 0, P->pz);
+    vstore_lanes(r.sx, 0, P->sx);
+    vstore_lanes(r.sy, 0, P->sy);
+    vstore_lanes(r.sz, 0, P->sz);
+    vstore_lanes(r.kz, 0, P->kz);
     vstore_lanes(vload_lanes(0, R->tmax), 0, P->tfar);
     vstore_lanes((vfloat)(0.0f), 0, P->hv);
     vstore_lanes((vfloat)(0.0f), 0, P->hw);
@@ -88,6 +89,46 @@ inline float packet_min(vfloat x) {
     return c.x < c.y ? c.x : c.y;
 }
 
+// Child j of node n in the lanes of m: its entry distance in each lane that reaches it before
+// its hit tfar, else infinity (lanes_box's slab test).
+LANES_INLINE vfloat packet_child(const LanesSlabRay* ray, global const DeviceWideNode* n, int j,
+                                 vint m, vfloat tfar) {
+    global const float* w = (global const float*)n;  // min_x .. max_z, 4 words each
+    vfloat far;
+    vfloat near = lanes_box(ray, w[j], w[4 + j], w[8 + j], w[12 + j], w[16 + j], w[20 + j], &far);
+    vint reach = m & (near <= far) & (near < tfar);
+    return select((vfloat)(INFINITY), near, reach);
+}
+
+// Swaps the children in slots *a and *b where b's key is less (nearest first).
+LANES_INLINE void packet_order(const float* key, uint* a, uint* b) {
+    if (key[*b] < key[*a]) {
+        uint t = *a;
+        *a = *b;
+        *b = t;
+    }
+}
+
+// A triangle's vertices relative to each lane's origin (px, py, pz) in its permuted axes, the
+// permutation named by the dominant axis (z0: x is, z1: y is; else z).
+LANES_INLINE LanesTriangle packet_triangle(DeviceTriangle tri, vint z0, vint z1, vfloat px,
+                                           vfloat py, vfloat pz) {
+    LanesTriangle T;
+    vfloat vx = (vfloat)(tri.v0.x), vy = (vfloat)(tri.v0.y), vz = (vfloat)(tri.v0.z);
+    T.aX = select(select(vx, vz, z1), vy, z0) - px;
+    T.aY = select(select(vy, vx, z1), vz, z0) - py;
+    T.aZ = select(select(vz, vy, z1), vx, z0) - pz;
+    vx = (vfloat)(tri.v1.x), vy = (vfloat)(tri.v1.y), vz = (vfloat)(tri.v1.z);
+    T.bX = select(select(vx, vz, z1), vy, z0) - px;
+    T.bY = select(select(vy, vx, z1), vz, z0) - py;
+    T.bZ = select(select(vz, vy, z1), vx, z0) - pz;
+    vx = (vfloat)(tri.v2.x), vy = (vfloat)(tri.v2.y), vz = (vfloat)(tri.v2.z);
+    T.cX = select(select(vx, vz, z1), vy, z0) - px;
+    T.cY = select(select(vy, vx, z1), vz, z0) - py;
+    T.cZ = select(select(vz, vy, z1), vx, z0) - pz;
+    return T;
+}
+
 // Walks the rays of the lanes `live` (from tmin 0 to each lane's tfar) for their nearest hits,
 // or with any_hit for some hit each (a lane's prim >= 0 after it: occluded), writing the hits
 // to P. A packet whose stack would overflow ends with the hits so far (counted).
@@ -96,8 +137,8 @@ LANES_INLINE void packet_walk(Packet* P, vint live, bool any_hit,
                               const SceneSurfaces* surf, volatile global uint* overflow) {
     const vfloat inf = (vfloat)(INFINITY), zero = (vfloat)(0.0f);
     const vint izero = (vint)(0);
-    vfloat ox = vload_lanes(0, P->ox), oy = vload_lanes(0, P->oy), oz = vload_lanes(0, P->oz);
-    vfloat ix = vload_lanes(0, P->ix), iy = vload_lanes(0, P->iy), iz = vload_lanes(0, P->iz);
+    const LanesSlabRay ray = {vload_lanes(0, P->ox), vload_lanes(0, P->oy), vload_lanes(0, P->oz),
+                              vload_lanes(0, P->ix), vload_lanes(0, P->iy), vload_lanes(0, P->iz)};
     vfloat px = vload_lanes(0, P->px), py = vload_lanes(0, P->py), pz = vload_lanes(0, P->pz);
     vfloat sx = vload_lanes(0, P->sx), sy = vload_lanes(0, P->sy), sz = vload_lanes(0, P->sz);
     vint kz = vload_lanes(0, P->kz);
@@ -114,61 +155,44 @@ LANES_INLINE void packet_walk(Packet* P, vint live, bool any_hit,
     for (;;) {
         if (item >= 0) {
             global const DeviceWideNode* n = &nodes[item];
-            float4 lx = n->min_x, ly = n->min_y, lz = n->min_z;
-            float4 hx = n->max_x, hy = n->max_y, hz = n->max_z;
-            int4 ch = n->child;
-            int4 ct = as_int4(n->count);
+            global const int* ch = (global const int*)&n->child;
+            global const int* ct = (global const int*)&n->count;
             vfloat dv[4];
             float key[4];
             int cv[4];
-            // Child J (component C): the slab test in every lane of m (LANES_BOX).
-#define PACKET_CHILD(J, C)                                                                   \
-    {                                                                                        \
-        LANES_BOX(lx.C, ly.C, lz.C, hx.C, hy.C, hz.C, near, far)                             \
-        vint reach = m & (near <= far) & (near < tfar);                                     \
-        if (ch.C <= 0 && ct.C == 0) reach = izero;                                           \
-        dv[J] = select(inf, near, reach);                                                    \
-        key[J] = packet_min(dv[J]);                                                          \
-        cv[J] = ct.C != 0 ? (int)(0x80000000u | ((uint)ct.C << 27) | (uint)~ch.C) : ch.C;   \
-    }
-            PACKET_CHILD(0, x)
-            PACKET_CHILD(1, y)
-            PACKET_CHILD(2, z)
-            PACKET_CHILD(3, w)
-#undef PACKET_CHILD
+            // Each child's slab test in every lane of m (an empty slot in none), its item in
+            // lanes_pack form.
+#pragma unroll
+            for (int j = 0; j < 4; ++j) {
+                vint mj = ch[j] <= 0 && ct[j] == 0 ? izero : m;
+                dv[j] = packet_child(&ray, n, j, mj, tfar);
+                key[j] = packet_min(dv[j]);
+                cv[j] = ct[j] != 0 ? (int)(0x80000000u | ((uint)ct[j] << 27) | (uint)~ch[j])
+                                   : ch[j];
+            }
             // Nearest first (by the nearest lane's entry; with any_hit in slot order): the
             // others pushed farthest first, the nearest entered.
-            uint s0 = 0u, s1 = 1u, s2 = 2u, s3 = 3u;
+            uint s[4] = {0u, 1u, 2u, 3u};
             if (!any_hit) {
-#define PACKET_ORDER(A, B)                        \
-    if (key[s##B] < key[s##A]) {                  \
-        uint t_ = s##A;                           \
-        s##A = s##B;                              \
-        s##B = t_;                                \
-    }
-                PACKET_ORDER(0, 1)
-                PACKET_ORDER(2, 3)
-                PACKET_ORDER(0, 2)
-                PACKET_ORDER(1, 3)
-                PACKET_ORDER(1, 2)
-#undef PACKET_ORDER
+                packet_order(key, &s[0], &s[1]);
+                packet_order(key, &s[2], &s[3]);
+                packet_order(key, &s[0], &s[2]);
+                packet_order(key, &s[1], &s[3]);
+                packet_order(key, &s[1], &s[2]);
             }
             if (sp + 3 > PACKET_STACK) {
                 atomic_inc(overflow);
                 break;
             }
-#define PACKET_PUSH(S)                          \
-    if (key[S] < INFINITY) {                    \
-        stack_d[sp] = dv[S];                    \
-        stack_item[sp++] = cv[S];               \
-    }
-            PACKET_PUSH(s3)
-            PACKET_PUSH(s2)
-            PACKET_PUSH(s1)
-#undef PACKET_PUSH
-            if (key[s0] < INFINITY) {
-                item = cv[s0];
-                m = dv[s0] < inf;
+            for (int i = 3; i >= 1; --i) {
+                if (key[s[i]] < INFINITY) {
+                    stack_d[sp] = dv[s[i]];
+                    stack_item[sp++] = cv[s[i]];
+                }
+            }
+            if (key[s[0]] < INFINITY) {
+                item = cv[s[0]];
+                m = dv[s[0]] < inf;
                 continue;
             }
         } else {
@@ -176,22 +200,11 @@ LANES_INLINE void packet_walk(Packet* P, vint live, bool any_hit,
             int first = item & LANES_FIRST_MASK;
             int count = (item >> 27) & 15;
             for (int k = 0; k < count; ++k) {
-                DeviceTriangle tri = tris[first + k];
-#define PACKET_VERTEX(V, X, Y, Z)                                                     \
-    vfloat X, Y, Z;                                                                  \
-    {                                                                                 \
-        vfloat vx = (vfloat)(tri.V.x), vy = (vfloat)(tri.V.y), vz = (vfloat)(tri.V.z); \
-        X = select(select(vx, vz, z1), vy, z0) - px;                                  \
-        Y = select(select(vy, vx, z1), vz, z0) - py;                                  \
-        Z = select(select(vz, vy, z1), vx, z0) - pz;                                  \
-    }
-                PACKET_VERTEX(v0, aX, aY, aZ)
-                PACKET_VERTEX(v1, bX, bY, bZ)
-                PACKET_VERTEX(v2, cX, cY, cZ)
-#undef PACKET_VERTEX
-                LANE_EDGES(vfloat)
-                LANE_HITS_T(vfloat, vint, m, zero, tfar)
-                LANES_KEEP_HITS(first + k, P->o, P->d, any_hit)
+                LanesTriangle tv = packet_triangle(tris[first + k], z0, z1, px, py, pz);
+                LanesEdges e = lanes_edges(&tv, sx, sy);
+                LanesVerdict h = lanes_verdict(&tv, e, sz, m, zero, tfar);
+                lanes_keep_hits(h, e, (vint)(first + k), P->o, P->d, tris, surf, any_hit, &tfar,
+                                &hv, &hw, &hdet, &prim);
                 if (any_hit) {
                     // A blocked lane is done.
                     open &= prim < izero;

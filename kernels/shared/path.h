@@ -5,6 +5,8 @@
 //     the light sample later in `connect`;
 //   - the megakernels (cpu/megakernel.cl, cpu/megakernel_lanes.cl) keep it in registers and
 //     trace the light sample at once.
+// The vertex's maths that does not depend on the material is written once for every lane width
+// (DEFINE_VERTEX_MATHS): the CPU lanes' batched shading (cpu/shade_lanes.h) uses it on vectors.
 #ifndef SHARED_PATH_H
 #define SHARED_PATH_H
 
@@ -23,11 +25,90 @@ inline bool frame_sky_black(const DeviceFrame* frame) {
     return frame->sky.x <= 0.0f && frame->sky.y <= 0.0f && frame->sky.z <= 0.0f;
 }
 
-inline float power_heuristic(float a, float b) {
-    float a2 = a * a;
-    float b2 = b * b;
-    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
-}
+// The maths of a path vertex that does not depend on the material, written once for every lane
+// width: shade_vertex uses it on scalars, the CPU lanes' batched shading (cpu/shade_lanes.h) on
+// vectors, so that the estimator's multiple importance sampling, Russian roulette and the
+// vertex's normals and rays change in one place. DEFINE_VERTEX_MATHS(f, F, I, V, v) defines, for
+// floats F with masks I (a comparison's type; scalar comparisons give 1, vector ones -1, and
+// select() takes either) and 3-vectors V whose operations are named v##_sub, v##_mul, v##_scale,
+// v##_div, v##_neg, v##_select, v##_dot, v##_length and v##_positive (f3_* below on float3;
+// the lanes' lv_*):
+//   f##_power_heuristic(a, b)   the power heuristic's weight of a sample of pdf a against b;
+//   f##_emitter_pdf(sel, area, t, cos_l)  light sampling's solid-angle pdf of an emissive
+//                               triangle's point at distance t (the light's selection
+//                               probability sel, area `area`, cosine cos_l at the light; 0 where
+//                               cos_l is not positive);
+//   f##_light_sample_weight(light_pdf, bsdf_pdf, mis)  a light sample's MIS weight against the
+//                               BSDF sample (1 where mis is clear or the light's pdf is 0: a
+//                               delta light);
+//   f##_survival(x, y, z)       Russian roulette's probability of going on for a throughput of
+//                               (x, y, z);
+//   f##_shading_normal(n, ng)   the interpolated normal n made unit and turned to ng's side, or
+//                               ng where n has length 0 (a flat-shaded triangle);
+//   f##_side_normal(ng, side)   ng, or -ng where side (a direction's cosine with ng) is not
+//                               positive: the side a ray leaves on;
+//   f##_light_sample_faces(side, wi, ns, radiance)  whether a light sample in direction wi
+//                               (cosine side with ng) is on the side the shading normal ns says
+//                               and brings light;
+//   f##_light_contribution(throughput, bsdf, radiance, weight)  what the sample adds when clear;
+//   f##_shadow_segment(from, wi, distance, target, on_surface, *dir)  the shadow ray's length and
+//                               direction: to the light's point where it is on a surface (as
+//                               traced from `from`), else along wi to `distance`;
+//   f##_goes_on(pdf, side, wi, ns, throughput)  whether a BSDF sample continues the path.
+// Each is one expression per operation in the order shade_vertex has always computed it, with
+// no product next to a sum, so that no compiler fuses the scalar form and not the vector one.
+#define DEFINE_VERTEX_MATHS(f, F, I, V, v)                                                         \
+    SHADE_INLINE F f##_power_heuristic(F a, F b) {                                                 \
+        F a2 = a * a;                                                                              \
+        F b2 = b * b;                                                                              \
+        return select((F)(0.0f), a2 / (a2 + b2), a2 + b2 > 0.0f);                                  \
+    }                                                                                              \
+    SHADE_INLINE F f##_emitter_pdf(F sel, F area, F t, F cos_l) {                                  \
+        return select((F)(0.0f), sel * t * t / (area * cos_l), cos_l > 0.0f);                      \
+    }                                                                                              \
+    SHADE_INLINE F f##_light_sample_weight(F light_pdf, F bsdf_pdf, I mis) {                       \
+        return select((F)(1.0f), f##_power_heuristic(light_pdf, bsdf_pdf),                         \
+                      mis & (light_pdf > 0.0f));                                                   \
+    }                                                                                              \
+    SHADE_INLINE F f##_survival(F x, F y, F z) { return fmin(fmax(x, fmax(y, z)), 0.95f); }        \
+    SHADE_INLINE V f##_shading_normal(V n, V ng) {                                                 \
+        F len = v##_length(n);                                                                     \
+        V nn = v##_div(n, len);                                                                    \
+        nn = v##_select(nn, v##_neg(nn), v##_dot(nn, ng) < 0.0f);                                  \
+        return v##_select(ng, nn, len > 0.0f);                                                     \
+    }                                                                                              \
+    SHADE_INLINE V f##_side_normal(V ng, F side) {                                                 \
+        return v##_select(v##_neg(ng), ng, side > 0.0f);                                           \
+    }                                                                                              \
+    SHADE_INLINE I f##_light_sample_faces(F side, V wi, V ns, V radiance) {                        \
+        return (side * v##_dot(wi, ns) > 0.0f) & v##_positive(radiance);                           \
+    }                                                                                              \
+    SHADE_INLINE V f##_light_contribution(V throughput, V bsdf, V radiance, F weight) {               \
+        return v##_scale(v##_mul(v##_mul(throughput, bsdf), radiance), weight);                       \
+    }                                                                                              \
+    SHADE_INLINE F f##_shadow_segment(V from, V wi, F distance, V target, I on_surface,            \
+                                      V* dir) {                                                    \
+        V seg = v##_sub(target, from);                                                             \
+        F len = v##_length(seg);                                                                   \
+        *dir = v##_select(wi, v##_div(seg, len), on_surface);                                      \
+        return select(distance, len, on_surface);                                                  \
+    }                                                                                              \
+    SHADE_INLINE I f##_goes_on(F pdf, F side, V wi, V ns, V throughput) {                          \
+        return (pdf > 0.0f) & (side * v##_dot(wi, ns) > 0.0f) & v##_positive(throughput);          \
+    }
+
+// DEFINE_VERTEX_MATHS's vector operations on float3.
+inline float3 f3_sub(float3 a, float3 b) { return a - b; }
+inline float3 f3_mul(float3 a, float3 b) { return a * b; }
+inline float3 f3_scale(float3 a, float s) { return a * s; }
+inline float3 f3_div(float3 a, float s) { return a / s; }
+inline float3 f3_neg(float3 a) { return -a; }
+inline float3 f3_select(float3 a, float3 b, int m) { return m ? b : a; }
+inline float f3_dot(float3 a, float3 b) { return dot(a, b); }
+inline float f3_length(float3 a) { return length(a); }
+inline int f3_positive(float3 a) { return a.x > 0.0f || a.y > 0.0f || a.z > 0.0f; }
+
+DEFINE_VERTEX_MATHS(vertex, float, int, float3, f3)
 
 // A path between two vertices.
 typedef struct {
@@ -135,7 +216,7 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         float3 le = env_radiance(&sc->env, -wo, &env_pdf);
         if (bounce == 0u) le = env_background(&sc->env, -wo);  // seen directly: filtered
         float weight = 1.0f;
-        if (mis) weight = power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
+        if (mis) weight = vertex_power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
         if (light_sampled_only) weight = 0.0f;
         if (counts_emission) radiance += throughput * le * weight;
 #else
@@ -186,8 +267,8 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         if (mis) {
             global const DeviceLight* l = &sc->lights[light_index];
             float cos_l = fabs(dot(ng, wo));
-            float light_pdf = cos_l > 0.0f ? l->extra.y * hit.t * hit.t / (l->spot.y * cos_l) : 0.0f;
-            weight = power_heuristic(prev_pdf, light_pdf);
+            float light_pdf = vertex_emitter_pdf(l->extra.y, l->spot.y, hit.t, cos_l);
+            weight = vertex_power_heuristic(prev_pdf, light_pdf);
         }
         if (light_sampled_only) weight = 0.0f;
 #ifdef HAS_TEXTURES
@@ -229,11 +310,7 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
 #ifdef TWO_LEVEL
         n = instance_normal(&inst, n);
 #endif
-        float len = length(n);
-        if (len > 0.0f) {
-            ns = n / len;
-            if (dot(ns, ng) < 0.0f) ns = -ns;
-        }
+        ns = vertex_shading_normal(n, ng);
     }
 #ifdef HAS_CLEARCOAT
     // The coat has its own normal texture; without one it takes the interpolated normal.
@@ -301,24 +378,18 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         // block shadow rays (no caustics through next-event estimation), except smooth thin
         // walls, which `shadow_pass` passes with their tint and without the MIS weight.
         float side = dot(ls.wi, ng);
-        if (side * dot(ls.wi, ns) > 0.0f &&
-            (ls.radiance.x > 0.0f || ls.radiance.y > 0.0f || ls.radiance.z > 0.0f)) {
+        if (vertex_light_sample_faces(side, ls.wi, ns, ls.radiance)) {
             float bsdf_pdf;
             float3 f = bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
-            float weight = (frame->strategy == STRATEGY_MIS && ls.pdf > 0.0f)
-                               ? power_heuristic(ls.pdf, bsdf_pdf)
-                               : 1.0f;
-            float3 contribution = throughput * f * ls.radiance * weight;
-            if (contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f) {
-                float3 from = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
-                float3 dir = ls.wi;
+            float weight =
+                vertex_light_sample_weight(ls.pdf, bsdf_pdf, frame->strategy == STRATEGY_MIS);
+            float3 contribution = vertex_light_contribution(throughput, f, ls.radiance, weight);
+            if (f3_positive(contribution)) {
+                float3 from = offset_ray(p, p_err, vertex_side_normal(ng, side));
                 // Virtual lights (spheres, discs, the sky) are not geometry: trace to them.
-                float tmax = ls.distance;
-                if (ls.on_surface) {
-                    float3 seg = ls.target - from;
-                    tmax = length(seg);
-                    dir = seg / tmax;
-                }
+                float3 dir;
+                float tmax = vertex_shadow_segment(from, ls.wi, ls.distance, ls.target,
+                                                   ls.on_surface, &dir);
                 shadow->origin = from;
                 shadow->direction = dir;
                 shadow->tmax = tmax;
@@ -350,10 +421,9 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
     float3 weight = bsdf_sample(&m, ns, wo, (float3)(u1, u2, u3), &wi, &pdf, &specular);
     throughput *= weight;
     float side = dot(wi, ng);
-    bool alive = pdf > 0.0f && side * dot(wi, ns) > 0.0f &&
-                 (throughput.x > 0.0f || throughput.y > 0.0f || throughput.z > 0.0f);
+    bool alive = vertex_goes_on(pdf, side, wi, ns, throughput);
     if (alive && bounce >= frame->rr_depth) {
-        float q = fmin(fmax(throughput.x, fmax(throughput.y, throughput.z)), 0.95f);
+        float q = vertex_survival(throughput.x, throughput.y, throughput.z);
         if (rng_next(&rng) >= q) {
             alive = false;
         } else {
@@ -376,7 +446,7 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
 #ifdef HAS_DISPERSION
         flags |= s->flags & (0xffffffffu << PATH_WAVELENGTH_SHIFT);  // the path's wavelength
 #endif
-        s->origin = offset_ray(p, p_err, side > 0.0f ? ng : -ng);
+        s->origin = offset_ray(p, p_err, vertex_side_normal(ng, side));
         s->prev_pdf = pdf;
         s->direction = wi;
         s->flags = flags;

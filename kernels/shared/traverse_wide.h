@@ -67,37 +67,68 @@ inline int4 wide_reach(global const DeviceWideNode* n, const WideRay* w, float t
 }
 #undef WIDE_PLANE
 
-// intersect_triangle's sheared vertices and edge functions in lanes of TYPE (a triangle a
-// lane), from the vertices relative to the ray's origin in its permuted axes (aX .. cZ) and the
-// shear (sx, sy): declares ax, ay, bx, by, cx, cy and the edge functions u, v, w.
-#define LANE_EDGES(TYPE)                \
-    TYPE ax = aX - sx * aZ;             \
-    TYPE ay = aY - sy * aZ;             \
-    TYPE bx = bX - sx * bZ;             \
-    TYPE by = bY - sy * bZ;             \
-    TYPE cx = cX - sx * cZ;             \
-    TYPE cy = cY - sy * cZ;             \
-    TYPE u = cx * by - cy * bx;         \
-    TYPE v = ax * cy - ay * cx;         \
-    TYPE w = bx * ay - by * ax;
-
-// After LANE_EDGES in lanes of TF (float16 in trace_small; traverse_lanes.h's width there), with
-// masks of TI: intersect_triangle's verdict lane by lane for the lanes of MASK, a hit in (TMIN,
-// TMAX): declares the mask ok, the edge functions' sum det, the distance t and the mask special
-// of the lanes that need the scalar test (an edge function of zero, or a hit close enough for its
-// rounding-error bound). Needs sz, the shear's z, and zero, a TF of zeros.
-#define LANE_HITS_T(TF, TI, MASK, TMIN, TMAX)                                 \
-    TI ok = (MASK) & ~(((u < zero) | (v < zero) | (w < zero)) &               \
-                       ((u > zero) | (v > zero) | (w > zero)));               \
-    TF det = u + v + w;                                                       \
-    ok &= det != zero;                                                        \
-    TF az = sz * aZ, bz = sz * bZ, cz = sz * cZ;                              \
-    TF t = (u * az + v * bz + w * cz) / det;                                  \
-    ok &= (t > (TMIN)) & (t < (TMAX));                                        \
-    TF far_z = select(fabs(az), fabs(bz), fabs(bz) > fabs(az));               \
-    far_z = select(far_z, fabs(cz), fabs(cz) > far_z);                        \
-    TI special = (MASK) & ((u == zero) | (v == zero) | (w == zero) |          \
-                           (ok & (t < 0.00390625f * far_z)));
+// intersect_triangle's arithmetic in lanes (a triangle a lane), one definition for every width:
+// DEFINE_LANE_TRIANGLE_TEST(T, f, TF, TI) defines, for lanes of floats TF with masks of TI,
+//   T##Triangle  the vertices a, b, c relative to the ray's origin in its permuted axes;
+//   T##Edges     the edge functions u, v, w;
+//   T##Verdict   the verdict: the edge functions' sum det, the distance t, the mask ok of the
+//                lanes with a hit and the mask special of those that need the scalar test (an
+//                edge function of zero, or a hit close enough for its rounding-error bound);
+//   f##_edges(tri, sx, sy)  the edge functions of the sheared vertices (shear sx, sy);
+//   f##_verdict(tri, e, sz, mask, tmin, tmax)  the verdict for the lanes of mask, a hit in
+//                (tmin, tmax), from the edge functions e and the shear's z.
+// (intersect_leaf4 uses it on four triangles, trace_small on sixteen, the CPU lanes at their
+// width.)
+// Each lane computes what intersect_triangle computes, operation for operation. With the CPU's
+// lanes (MEGA_LANES) they are always inlined, as the walks' own code.
+#ifdef MEGA_LANES
+#define LANE_TEST_INLINE inline __attribute__((always_inline))
+#else
+#define LANE_TEST_INLINE inline
+#endif
+#define DEFINE_LANE_TRIANGLE_TEST(T, f, TF, TI)                                                    \
+    typedef struct {                                                                               \
+        TF aX, aY, aZ, bX, bY, bZ, cX, cY, cZ;                                                     \
+    } T##Triangle;                                                                                 \
+    typedef struct {                                                                               \
+        TF u, v, w;                                                                                \
+    } T##Edges;                                                                                    \
+    typedef struct {                                                                               \
+        TF det, t;                                                                                 \
+        TI ok, special;                                                                            \
+    } T##Verdict;                                                                                  \
+    LANE_TEST_INLINE T##Edges f##_edges(const T##Triangle* r, TF sx,                               \
+                                                             TF sy) {                              \
+        TF ax = r->aX - sx * r->aZ;                                                                \
+        TF ay = r->aY - sy * r->aZ;                                                                \
+        TF bx = r->bX - sx * r->bZ;                                                                \
+        TF by = r->bY - sy * r->bZ;                                                                \
+        TF cx = r->cX - sx * r->cZ;                                                                \
+        TF cy = r->cY - sy * r->cZ;                                                                \
+        T##Edges e;                                                                                \
+        e.u = cx * by - cy * bx;                                                                   \
+        e.v = ax * cy - ay * cx;                                                                   \
+        e.w = bx * ay - by * ax;                                                                   \
+        return e;                                                                                  \
+    }                                                                                              \
+    LANE_TEST_INLINE T##Verdict f##_verdict(const T##Triangle* r, T##Edges e,                      \
+                                                           TF sz, TI mask, TF tmin, TF tmax) {     \
+        const TF zero = (TF)(0.0f);                                                                \
+        T##Verdict h;                                                                              \
+        h.ok = mask & ~(((e.u < zero) | (e.v < zero) | (e.w < zero)) &                             \
+                        ((e.u > zero) | (e.v > zero) | (e.w > zero)));                             \
+        h.det = e.u + e.v + e.w;                                                                   \
+        h.ok &= h.det != zero;                                                                     \
+        TF az = sz * r->aZ, bz = sz * r->bZ, cz = sz * r->cZ;                                      \
+        h.t = (e.u * az + e.v * bz + e.w * cz) / h.det;                                            \
+        h.ok &= (h.t > tmin) & (h.t < tmax);                                                       \
+        TF far_z = select(fabs(az), fabs(bz), fabs(bz) > fabs(az));                                \
+        far_z = select(far_z, fabs(cz), fabs(cz) > far_z);                                         \
+        h.special = mask & ((e.u == zero) | (e.v == zero) | (e.w == zero) |                        \
+                            (h.ok & (h.t < 0.00390625f * far_z)));                                 \
+        return h;                                                                                  \
+    }
+DEFINE_LANE_TRIANGLE_TEST(Lane4, lane4, float4, int4)
 
 // intersect_leaf for a leaf of at most four triangles, the four tested at once in float4 lanes
 // with intersect_triangle's arithmetic lane by lane, so that the same hit is kept: the first
@@ -108,6 +139,19 @@ inline int4 wide_reach(global const DeviceWideNode* n, const WideRay* w, float t
 // for one or two, the scalar tests measured as fast or faster (a 32-triangle Cornell box with
 // merged leaves ran 7-10 % slower: 2-core dev machine, 2026-12-01).
 #ifndef HAS_ALPHA
+// A vertex of four triangles (p0 .. p3) relative to the ray's origin o4 in its permuted axes
+// (perm), one triangle a lane: its axes in *X, *Y, *Z.
+inline void leaf4_vertex(float4 p0, float4 p1, float4 p2, float4 p3, float4 o4, uint4 perm,
+                         float4* X, float4* Y, float4* Z) {
+    p0 = shuffle(p0 - o4, perm);
+    p1 = shuffle(p1 - o4, perm);
+    p2 = shuffle(p2 - o4, perm);
+    p3 = shuffle(p3 - o4, perm);
+    *X = (float4)(p0.x, p1.x, p2.x, p3.x);
+    *Y = (float4)(p0.y, p1.y, p2.y, p3.y);
+    *Z = (float4)(p0.z, p1.z, p2.z, p3.z);
+}
+
 inline bool intersect_leaf4(const RayPrep* r, global const DeviceTriangle* tris,
                             const SceneSurfaces* surf, uint first, uint count, float tmin,
                             float3 o, float3 d, bool any_hit, DeviceHit* hit) {
@@ -115,35 +159,21 @@ inline bool intersect_leaf4(const RayPrep* r, global const DeviceTriangle* tris,
     DeviceTriangle t0 = tris[first], t1 = tris[min(first + 1u, last)];
     DeviceTriangle t2 = tris[min(first + 2u, last)], t3 = tris[min(first + 3u, last)];
     float4 o4 = (float4)(r->origin, 0.0f);
-#define LEAF4_VERTEX(V, X, Y, Z)                                                     \
-    float4 X, Y, Z;                                                                \
-    {                                                                              \
-        float4 p0 = shuffle(t0.V - o4, r->perm), p1 = shuffle(t1.V - o4, r->perm); \
-        float4 p2 = shuffle(t2.V - o4, r->perm), p3 = shuffle(t3.V - o4, r->perm); \
-        X = (float4)(p0.x, p1.x, p2.x, p3.x);                                      \
-        Y = (float4)(p0.y, p1.y, p2.y, p3.y);                                      \
-        Z = (float4)(p0.z, p1.z, p2.z, p3.z);                                      \
-    }
-    LEAF4_VERTEX(v0, aX, aY, aZ)
-    LEAF4_VERTEX(v1, bX, bY, bZ)
-    LEAF4_VERTEX(v2, cX, cY, cZ)
-#undef LEAF4_VERTEX
+    Lane4Triangle tri4;
+    leaf4_vertex(t0.v0, t1.v0, t2.v0, t3.v0, o4, r->perm, &tri4.aX, &tri4.aY, &tri4.aZ);
+    leaf4_vertex(t0.v1, t1.v1, t2.v1, t3.v1, o4, r->perm, &tri4.bX, &tri4.bY, &tri4.bZ);
+    leaf4_vertex(t0.v2, t1.v2, t2.v2, t3.v2, o4, r->perm, &tri4.cX, &tri4.cY, &tri4.cZ);
     float4 sx = (float4)(r->shear.x), sy = (float4)(r->shear.y), sz = (float4)(r->shear.z);
-    LANE_EDGES(float4)
+    Lane4Edges e = lane4_edges(&tri4, sx, sy);
     int4 lane = (int4)(0, 1, 2, 3) < (int4)((int)count);
-    float4 zero = (float4)(0.0f);
-    int4 ok = lane & ~(((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero)));
-    float4 det = u + v + w;
-    ok &= det != zero;
-    float4 az = sz * aZ, bz = sz * bZ, cz = sz * cZ;
-    float4 t = (u * az + v * bz + w * cz) / det;
-    ok &= (t > (float4)(tmin)) & (t < (float4)(hit->t));
-    float4 near_bound = 0.00390625f * fmax(fmax(fabs(az), fabs(bz)), fabs(cz));
+    Lane4Verdict h = lane4_verdict(&tri4, e, sz, lane, (float4)(tmin), (float4)(hit->t));
     // Rare cases for the scalar test: an edge function of zero (double precision there) or a
     // hit close enough for the error bound.
-    if (any(lane & ((u == zero) | (v == zero) | (w == zero) | (ok & (t < near_bound))))) {
+    if (any(h.special)) {
         return intersect_leaf(r, tris, surf, first, count, tmin, o, d, any_hit, hit);
     }
+    int4 ok = h.ok;
+    float4 t = h.t, v = e.v, w = e.w, det = h.det;
     if (!any(ok)) return false;
     float4 tt = select((float4)(INFINITY), t, ok);
     uint k;
@@ -469,6 +499,7 @@ inline DeviceHit trace_scene_wide(global const DeviceWideNode* nodes, global con
 // are held by vertex and axis, so that a ray's axis permutation picks rows instead of shuffling
 // each vertex.
 #define SMALL_BATCHES ((SMALL_SCENE + SMALL_LANES - 1) / SMALL_LANES)
+DEFINE_LANE_TRIANGLE_TEST(Lane16, lane16, float16, int16)
 typedef struct SmallScene {
     float c[9][SMALL_BATCHES * SMALL_LANES];  // [vertex * 3 + axis][triangle]
     float4 normal[SMALL_SCENE];               // triangle_normal's
@@ -529,24 +560,26 @@ inline DeviceHit trace_small(local const SmallScene* s, global const DeviceTrian
     uint count = s->count;
 #pragma unroll
     for (uint at = 0u; at < SMALL_BATCHES * SMALL_LANES; at += SMALL_LANES) {
-        float16 aX = vload16(0, &s->c[kx][at]) - (float16)(op.x);
-        float16 aY = vload16(0, &s->c[ky][at]) - (float16)(op.y);
-        float16 aZ = vload16(0, &s->c[kz][at]) - (float16)(op.z);
-        float16 bX = vload16(0, &s->c[3u + kx][at]) - (float16)(op.x);
-        float16 bY = vload16(0, &s->c[3u + ky][at]) - (float16)(op.y);
-        float16 bZ = vload16(0, &s->c[3u + kz][at]) - (float16)(op.z);
-        float16 cX = vload16(0, &s->c[6u + kx][at]) - (float16)(op.x);
-        float16 cY = vload16(0, &s->c[6u + ky][at]) - (float16)(op.y);
-        float16 cZ = vload16(0, &s->c[6u + kz][at]) - (float16)(op.z);
-        LANE_EDGES(float16)
+        Lane16Triangle tri;
+        tri.aX = vload16(0, &s->c[kx][at]) - (float16)(op.x);
+        tri.aY = vload16(0, &s->c[ky][at]) - (float16)(op.y);
+        tri.aZ = vload16(0, &s->c[kz][at]) - (float16)(op.z);
+        tri.bX = vload16(0, &s->c[3u + kx][at]) - (float16)(op.x);
+        tri.bY = vload16(0, &s->c[3u + ky][at]) - (float16)(op.y);
+        tri.bZ = vload16(0, &s->c[3u + kz][at]) - (float16)(op.z);
+        tri.cX = vload16(0, &s->c[6u + kx][at]) - (float16)(op.x);
+        tri.cY = vload16(0, &s->c[6u + ky][at]) - (float16)(op.y);
+        tri.cZ = vload16(0, &s->c[6u + kz][at]) - (float16)(op.z);
+        Lane16Edges e = lane16_edges(&tri, sx, sy);
         int16 index = lanes + (int16)((int)at);
         int16 lane = index < (int16)((int)count);
-        LANE_HITS_T(float16, int16, lane, (float16)(tmin), best_t)
-        any_special |= special;
-        best_t = select(best_t, t, ok);
-        best_v = select(best_v, v, ok);
-        best_w = select(best_w, w, ok);
-        best_det = select(best_det, det, ok);
+        Lane16Verdict h = lane16_verdict(&tri, e, sz, lane, (float16)(tmin), best_t);
+        int16 ok = h.ok;
+        any_special |= h.special;
+        best_t = select(best_t, h.t, ok);
+        best_v = select(best_v, e.v, ok);
+        best_w = select(best_w, e.w, ok);
+        best_det = select(best_det, h.det, ok);
         best_index = select(best_index, index, ok);
     }
     if (small_min(any_special) < 0) {
