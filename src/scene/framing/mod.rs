@@ -170,9 +170,10 @@ pub fn lit_side(probe: &Probe, lights: &[Light]) -> DVec3 {
 pub const FLAT_RATIO: f64 = 0.2;
 
 /// The direction (subject to eye) that faces a standing, mostly flat subject ([`FLAT_RATIO`],
-/// its thin side horizontal): along its thin axis, from the side its lights are on; else, for
-/// a board across z, from glTF's front, +Z (Khronos's test boards face it; ClearCoatTest's
-/// tiles are wound to face −Z, its samples +Z); else from the only side where an 8 × 8 grid of
+/// its thin side horizontal): along its thin axis, from the side its punctual lights are on; else, for
+/// a board across z, from glTF's front, +Z (Khronos's test boards face it; which side shows
+/// more front faces does not tell: ClearCoatTest shows more from behind); else from the only
+/// side where an 8 × 8 grid of
 /// rays finds surfaces that show (front faces, or double-sided ones: a single-sided board
 /// shows nothing from behind), else from +X.
 pub fn flat_facing(probe: &Probe, lights: &[Light]) -> Option<DVec3> {
@@ -203,8 +204,11 @@ pub fn flat_facing(probe: &Probe, lights: &[Light]) -> Option<DVec3> {
         n
     };
     let (plus, minus) = (fronts(1.0), fronts(-1.0));
+    // The punctual lights alone (the first entries): the board's own glowing parts
+    // (ClearCoatTest's labels) are no side to face.
     let lit: f64 = light_directions(probe, lights, centre)
         .iter()
+        .take(lights.len())
         .map(|(l, w)| w * l.dot(axis))
         .sum();
     let sign = if lit != 0.0 {
