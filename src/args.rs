@@ -8,6 +8,7 @@ use crate::cl::DeviceChoice;
 use crate::cli::first_image;
 use crate::render::background::Background;
 use crate::render::exposure::ExposureMode;
+use crate::render::tonemap::ToneMapper;
 use crate::render::{BvhChoice, KernelChoice, RenderSettings, Renderer, Strategy};
 use crate::scene::limits::MAX_INTENSITY;
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows, load_or_bundled_with};
@@ -279,6 +280,9 @@ pub struct ExposureArgs {
     /// lux) (default: automatic, as for --exposure).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_ev100)]
     pub ev100: Option<f32>,
+    /// Tone curve: neutral (Khronos PBR Neutral, keeps base colours), aces or linear.
+    #[arg(long, default_value = "neutral", value_parser = ToneMapper::from_arg)]
+    pub tonemap: ToneMapper,
 }
 
 impl ExposureArgs {
@@ -451,6 +455,18 @@ impl CommonArgs {
         self.exposure.mode()
     }
 
+    /// How the exposure of `prepared` is chosen: `--exposure`, `--ev100`, else by incident
+    /// metering where the first view measured the light at the subject, else metered on the
+    /// image.
+    pub fn exposure_for(&self, prepared: &Prepared) -> ExposureMode {
+        match (self.exposure_mode(), prepared.white_radiance) {
+            (ExposureMode::Auto, Some(w)) => {
+                ExposureMode::Incident(crate::render::exposure::incident_stops(w))
+            }
+            (mode, _) => mode,
+        }
+    }
+
     /// Loads the scene (or the bundled one), applies camera and light options and decides the
     /// first image: the automatic camera gives way to the first view, and the rule "the
     /// scene's lights light the view" decides the environment (`cli/first_image.rs`).
@@ -509,13 +525,43 @@ impl CommonArgs {
         if environment.is_some() {
             scene.drop_default_rig();
         }
+        // The radiance of a white diffuse surface at the subject under the environment, as it
+        // will be used: an incident meter's reading at the subject points, each facing as the
+        // surface there faces (their `framing::METER_PERCENTILE`).
+        let env_radiance = match &environment {
+            Some(EnvChoice::Map(m)) => {
+                let coarse = m.coarse(64, 32);
+                let mut e: Vec<f64> = first
+                    .view
+                    .subject_normals
+                    .iter()
+                    .map(|&n| coarse.irradiance(n, self.env.env_rotation))
+                    .collect();
+                e.sort_by(f64::total_cmp);
+                crate::scene::framing::meter_percentile(&e) / std::f64::consts::PI
+            }
+            Some(EnvChoice::Color(c)) => crate::render::exposure::luminance(*c) as f64,
+            None => 0.0,
+        } * self.env.env_intensity as f64;
+        let env_scale = match env_arg {
+            first_image::EnvArg::Auto => first.env_scale(env_radiance),
+            _ => 1.0,
+        };
+        let white_radiance = first.white_radiance(env_radiance * env_scale);
         if env_arg == first_image::EnvArg::Auto {
-            if let Some(preset) = first.environment {
-                log::warn!(
+            match first.environment {
+                Some(preset) if first.fill => log::warn!(
+                    "{}: its metal and glass would reflect a black world; adding the {} \
+                     environment as a fill",
+                    scene.source,
+                    preset.name()
+                ),
+                Some(preset) => log::warn!(
                     "{}: its own lights do not light the view; using the {} environment",
                     scene.source,
                     preset.name()
-                );
+                ),
+                None => {}
             }
             if !first.lights.is_empty() {
                 // The rig is placed for a view from outside; a room's lamps replace it.
@@ -532,6 +578,8 @@ impl CommonArgs {
         let mut prepared = finish(scene, camera, &self.shadows, load_ms);
         prepared.environment = environment;
         prepared.first_view = Some(first);
+        prepared.env_scale = env_scale as f32;
+        prepared.white_radiance = white_radiance;
         Ok(prepared)
     }
 }
@@ -553,6 +601,11 @@ pub struct Prepared {
     pub environment: Option<EnvChoice>,
     /// What the first-view analysis found ([`CommonArgs::prepare`] only).
     pub first_view: Option<first_image::FirstImage>,
+    /// The factor on `--env-intensity` for an environment added as a fill (1 otherwise).
+    pub env_scale: f32,
+    /// The radiance of a white diffuse surface at the subject, where the first view measured
+    /// it: what incident metering exposes ([`CommonArgs::exposure_for`]).
+    pub white_radiance: Option<f64>,
 }
 
 /// Loads the scene at `path` (or the bundled one), its files read from its folder or
@@ -583,6 +636,8 @@ fn finish(scene: Scene, camera: Camera, shadows: &ShadowArgs, load_ms: f64) -> P
         shadows,
         environment: None,
         first_view: None,
+        env_scale: 1.0,
+        white_radiance: None,
     }
 }
 

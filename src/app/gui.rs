@@ -319,14 +319,19 @@ impl Gui {
                     let mut auto = v.auto_exposure.is_some();
                     if ui.checkbox(&mut auto, "auto").changed() {
                         v.auto_exposure = auto.then(AutoExposure::default);
+                        v.incident_exposure = false;
                     }
                     let s = ui.add(egui::Slider::new(&mut v.exposure, -24.0..=24.0).text("stops"));
                     if s.changed() {
                         v.auto_exposure = None;
+                        v.incident_exposure = false;
                     }
                 })
                 .response
-                .on_hover_text("exposure: automatic (metered on the image) or in stops");
+                .on_hover_text(
+                    "exposure: automatic (metered on the image) or in stops (set at first from \
+                     the light at the subject)",
+                );
                 ui.horizontal_wrapped(|ui| {
                     ui.label("tone mapper");
                     for t in ToneMapper::ALL {

@@ -6,6 +6,7 @@ use super::camera::CameraController;
 use super::frame_loop::Changes;
 use super::gui::{EnvSource, Model};
 use super::{App, pick};
+use crate::render::exposure::AutoExposure;
 use crate::scene::{Scene, SceneError};
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, TryRecvError};
@@ -85,7 +86,11 @@ impl App {
                     scene.drop_default_rig();
                 }
                 self.autofocus = self.model.view.aperture > 0.0;
-                if let Some(auto) = self.model.view.auto_exposure.as_mut() {
+                let view = &mut self.model.view;
+                if std::mem::take(&mut view.incident_exposure) {
+                    view.auto_exposure = Some(AutoExposure::default());
+                }
+                if let Some(auto) = view.auto_exposure.as_mut() {
                     auto.reset();
                 }
                 for w in &scene.warnings {

@@ -99,8 +99,10 @@ pub struct ViewerConfig {
     /// An environment (map or color) lights the scene: files opened later without lights get
     /// no default rig.
     pub env_lights: bool,
-    /// How the exposure is chosen: metered on the film, or fixed.
+    /// How the exposure is chosen: metered on the film, or fixed (incident metering fixes it).
     pub exposure: ExposureMode,
+    /// The tone curve (`--tonemap`).
+    pub tone_mapper: ToneMapper,
     /// What escaped camera rays show (`--background`).
     pub background: Background,
     /// Focus the lens on what the image centre sees once the scene is on the device (a lens
@@ -173,6 +175,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
     );
     let mut view = view;
     view.background = config.background;
+    view.tone_mapper = config.tone_mapper;
     let camera = CameraController::new(config.camera, &bounds);
     let path_text = config
         .path

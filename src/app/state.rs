@@ -94,6 +94,9 @@ pub struct ViewState {
     pub exposure: f32,
     /// Automatic exposure (metered on the film) while set; the slider turns it off.
     pub auto_exposure: Option<AutoExposure>,
+    /// Whether `exposure` is the first view's incident metering, untouched: a scene opened
+    /// later, which the first view did not measure, is metered on the image instead.
+    pub incident_exposure: bool,
     /// Tone curve.
     pub tone_mapper: ToneMapper,
     /// What escaped camera rays show.
@@ -129,6 +132,7 @@ impl ViewState {
             shadows,
             exposure: exposure.stops(None),
             auto_exposure: (exposure == ExposureMode::Auto).then(AutoExposure::default),
+            incident_exposure: matches!(exposure, ExposureMode::Incident(_)),
             tone_mapper: ToneMapper::default(),
             background: if base.cutout {
                 Background::Transparent

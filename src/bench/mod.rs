@@ -1,8 +1,10 @@
 //! `penumbra bench`: ray throughput of the traversal kernels (`trace`), where a frame's time
 //! goes (`frame`), error against run time (`converge`), and a generator of large test scenes
-//! (`generate`), and the host BVH build and update (`bvh`). What each measures, and the figures,
+//! (`generate`), the host BVH build and update (`bvh`), and how faithfully the first image shows
+//! base colours (`albedo`). What each measures, and the figures,
 //! are in `docs/benchmarks.md`.
 
+mod albedo;
 mod bvh;
 mod converge;
 mod curve;
@@ -14,6 +16,7 @@ mod stats;
 pub mod stress;
 mod trace;
 
+pub use albedo::AlbedoArgs;
 pub use bvh::BvhArgs;
 pub use converge::ConvergeArgs;
 pub use frame::FrameArgs;
@@ -48,6 +51,9 @@ pub enum BenchCommand {
     /// against the original, leaks from closed meshes, spawned-ray reintersection, grazing
     /// shadow rays and acne; a Markdown table.
     Stress(Box<StressArgs>),
+    /// The mean displayed colour of materials of known base colour under a white environment
+    /// against that base colour, per tone curve and exposure rule; a Markdown table.
+    Albedo(Box<AlbedoArgs>),
 }
 
 /// Runs a benchmark.
@@ -59,6 +65,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Generate(a) => generate::run(&a),
         BenchCommand::Bvh(a) => bvh::run(&a),
         BenchCommand::Stress(a) => stress::run(&a),
+        BenchCommand::Albedo(a) => albedo::run(&a),
     }
 }
 

@@ -115,9 +115,11 @@ fn view(args: ViewArgs) -> Result<()> {
     }
     crate::app::preflight(args.screenshot.as_deref())?;
     let common = &args.common;
-    let settings = common.settings(DEFAULT_SIZE)?;
+    let mut settings = common.settings(DEFAULT_SIZE)?;
     let aspect = crate::app::image_aspect((settings.width, settings.height), !args.no_overlay);
     let mut prepared = common.prepare_for(args.scene.as_deref(), aspect)?;
+    settings.env_intensity *= prepared.env_scale;
+    let exposure = common.exposure_for(&prepared);
     let environment = prepared.environment.take();
     let device = common.device_choice()?;
     // With a lens but no focus distance, focus on what the image centre sees once loaded.
@@ -139,7 +141,8 @@ fn view(args: ViewArgs) -> Result<()> {
             Some(EnvChoice::Map(map)) => Some(map),
             _ => None,
         },
-        exposure: common.exposure_mode(),
+        exposure,
+        tone_mapper: common.exposure.tonemap,
         background: common.background,
         autofocus,
         frames: args.frames,

@@ -5,7 +5,7 @@ use crate::args::EnvChoice;
 use crate::image_io::{Format, OutputFile, encode_exr};
 use crate::render::background::{self, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
-use crate::render::tonemap::{ToneMapper, encode_rgba_png, to_rgba8};
+use crate::render::tonemap::{encode_rgba_png, to_rgba8};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -27,6 +27,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     args.strategy.apply(&mut settings);
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
     let mut prepared = args.common.prepare(Some(&args.scene))?;
+    settings.env_intensity *= prepared.env_scale;
     let environment = prepared.environment.take();
     let mut renderer = args.common.open_renderer(&settings)?;
     if let Some(EnvChoice::Map(map)) = environment {
@@ -106,14 +107,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .cutout()
         .then(|| unpremultiply(&image, &coverage));
     let shown = straight.as_deref().unwrap_or(&image);
-    let mode = args.common.exposure_mode();
+    let mode = args.common.exposure_for(&prepared);
     let metering = exposure::meter_subject(shown, Some(&coverage));
     let exposure = mode.stops(metering.as_ref());
     let (w, h) = (settings.width, settings.height);
     let bytes = match output.format {
         Format::Exr => encode_exr(w, h, &image, background.cutout().then_some(&coverage[..]))?,
         Format::Png => {
-            let mut rgba = to_rgba8(shown, exposure, ToneMapper::default());
+            let mut rgba = to_rgba8(shown, exposure, args.common.exposure.tonemap);
             background::apply(&mut rgba, &coverage, background);
             encode_rgba_png(w, h, &rgba)?
         }
@@ -136,6 +137,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "lit_fraction": f.view.lit_fraction,
             "coverage": f.view.coverage,
             "sky_fraction": f.view.sky_fraction,
+            "key_irradiance": f.view.key_irradiance,
+            "shiny_share": f.view.shiny_share,
+            "shiny_sky": f.view.shiny_sky,
+            "environment_fill": f.fill,
         })
     });
     let mut summary = serde_json::json!({
@@ -172,7 +177,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         "environment": renderer.environment().map(|m| m.name.clone()),
         "background": background.name(),
         "exposure": exposure,
-        "auto_exposure": mode == ExposureMode::Auto,
+        "auto_exposure": matches!(mode, ExposureMode::Auto | ExposureMode::Incident(_)),
+        "metering": match mode {
+            ExposureMode::Auto => "image",
+            ExposureMode::Incident(_) => "incident",
+            _ => "fixed",
+        },
+        "tonemap": args.common.exposure.tonemap.arg_name(),
         "camera": {
             "eye": prepared.camera.eye.to_array(),
             "forward": prepared.camera.forward.to_array(),

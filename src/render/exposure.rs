@@ -15,6 +15,11 @@
 //! value: the noise of a converging film moves the key by a fraction of a stop, which would
 //! otherwise make the image pump as samples accumulate.
 //!
+//! **Incident metering.** What the first view of a scene (not an interior) uses: the light
+//! falling on the subject, measured by the first-view probe as the radiance W of a white
+//! diffuse surface there, is exposed so that W shows at [`WHITE`] ([`incident_stops`]). Every
+//! material then shows its own albedo: a navy sofa stays navy, a white board white.
+//!
 //! **Physical mode.** A camera at EV100 maps radiance L to L / (1.2 · 2^EV100) (the saturation-
 //! based calibration with K = 12.5, q = 0.65). A white diffuse surface under a 100 000 lux sun
 //! has L ≈ 100 000/π ≈ 32 000, which EV100 15 maps to about 0.8.
@@ -26,6 +31,10 @@ pub const HIGHLIGHT_TRIM: f32 = 0.03;
 /// The 90th percentile of luminance may map at most to this (ACES: 0.9), so that a bright
 /// subject in front of a dark background is not blown out.
 pub const BRIGHT_LIMIT: f32 = 3.0;
+/// The display value (before the tone curve) of a white diffuse surface under incident
+/// metering: the Khronos Sample Viewer's calibration (exposure 1 under a white environment of
+/// radiance 1), where PBR Neutral shows base colours as they are.
+pub const WHITE: f32 = 1.0;
 /// Changes of the metered exposure smaller than this (stops) are ignored once settled.
 pub const DEAD_BAND: f32 = 0.3;
 /// The most pixels metered (a regular subset of larger images).
@@ -109,6 +118,11 @@ pub fn auto_stops(m: &Metering) -> f32 {
     key_stops.min(bright_stops)
 }
 
+/// The exposure in stops that shows a white diffuse surface of radiance `white` at [`WHITE`].
+pub fn incident_stops(white: f64) -> f32 {
+    (WHITE as f64 / white).log2() as f32
+}
+
 /// The exposure in stops of a camera at `ev100`: 2^stops = 1 / (1.2 · 2^EV100).
 pub fn ev100_stops(ev100: f32) -> f32 {
     -(1.2f32.log2() + ev100)
@@ -126,6 +140,8 @@ pub enum ExposureMode {
     Auto,
     /// Fixed, in stops.
     Manual(f32),
+    /// Fixed, in stops, by incident metering of the first view ([`incident_stops`]).
+    Incident(f32),
     /// A physical camera at this EV100.
     Ev100(f32),
 }
@@ -136,7 +152,7 @@ impl ExposureMode {
     pub fn stops(self, m: Option<&Metering>) -> f32 {
         match self {
             ExposureMode::Auto => m.map_or(0.0, auto_stops),
-            ExposureMode::Manual(s) => s,
+            ExposureMode::Manual(s) | ExposureMode::Incident(s) => s,
             ExposureMode::Ev100(ev) => ev100_stops(ev),
         }
     }

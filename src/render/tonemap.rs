@@ -4,13 +4,16 @@
 use anyhow::{Context, Result};
 use std::path::Path;
 
-/// Tone curves.
+/// Tone curves. Khronos PBR Neutral is the default: under a white light that shows a white
+/// diffuse surface at 1, it shows base colours as they are (to within its 0.04 offset, which
+/// takes off the dielectric's reflection) up to 0.76 and keeps their hue above; ACES darkens
+/// and saturates them (measured in docs/first-image.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ToneMapper {
     /// ACES filmic (Narkowicz's fit).
-    #[default]
     Aces,
-    /// Khronos PBR Neutral.
+    /// Khronos PBR Neutral (Khronos, 2024).
+    #[default]
     PbrNeutral,
     /// Clamp only.
     Linear,
@@ -18,7 +21,7 @@ pub enum ToneMapper {
 
 impl ToneMapper {
     /// Every tone mapper, for menus.
-    pub const ALL: [ToneMapper; 3] = [ToneMapper::Aces, ToneMapper::PbrNeutral, ToneMapper::Linear];
+    pub const ALL: [ToneMapper; 3] = [ToneMapper::PbrNeutral, ToneMapper::Aces, ToneMapper::Linear];
 
     /// Name shown to users.
     pub fn name(self) -> &'static str {
@@ -27,6 +30,26 @@ impl ToneMapper {
             ToneMapper::PbrNeutral => "Khronos PBR Neutral",
             ToneMapper::Linear => "linear",
         }
+    }
+
+    /// The name `--tonemap` takes.
+    pub fn arg_name(self) -> &'static str {
+        match self {
+            ToneMapper::Aces => "aces",
+            ToneMapper::PbrNeutral => "neutral",
+            ToneMapper::Linear => "linear",
+        }
+    }
+
+    /// The tone mapper `--tonemap NAME` names, or a one-line error listing the names.
+    pub fn from_arg(name: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|t| t.arg_name() == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|t| t.arg_name()).collect();
+                format!("unknown tone mapper {name:?} (one of {})", names.join(", "))
+            })
     }
 
     /// Maps one linear RGB value (already exposed) to [0, 1].
@@ -42,7 +65,10 @@ impl ToneMapper {
     }
 }
 
-/// Khronos PBR Neutral tone mapper (reference implementation from the Khronos repository).
+/// Khronos PBR Neutral tone mapper: the reference formula (KhronosGroup/ToneMapping,
+/// `PBR_Neutral/pbrNeutral.glsl`, 2024): an offset that removes a dielectric's 0.04 reflection
+/// near black, linear up to 0.76, then the peak compressed towards 1 and desaturated towards
+/// white by a share of what was compressed.
 fn pbr_neutral(c: [f32; 3]) -> [f32; 3] {
     const START: f32 = 0.8 - 0.04;
     const DESATURATION: f32 = 0.15;
@@ -132,6 +158,34 @@ mod tests {
                 last = y;
             }
         }
+    }
+
+    /// PBR Neutral against values of the reference formula worked by hand: linear below the
+    /// knee (less the 0.04 offset, or x − 6.25x² near black), compressed and desaturated
+    /// above it, names round-trip.
+    #[test]
+    fn pbr_neutral_follows_the_reference() {
+        let n = |c| ToneMapper::PbrNeutral.apply(c);
+        // min 0.1 ≥ 0.08: offset 0.04, peak 0.46 < 0.76: linear.
+        let a = n([0.5, 0.3, 0.1]);
+        for (x, y) in a.iter().zip([0.46, 0.26, 0.06]) {
+            assert!((x - y).abs() < 1e-6, "{a:?}");
+        }
+        // Near black: offset x − 6.25x² with x = 0.02.
+        let b = n([0.02, 0.2, 0.3]);
+        let off = 0.02 - 6.25 * 0.02 * 0.02;
+        assert!((b[1] - (0.2 - off)).abs() < 1e-6, "{b:?}");
+        // White at 1: peak 0.96 → 1 − 0.24²/(0.96 + 0.24 − 0.76) = 0.8691, grey stays grey.
+        let w = n([1.0; 3]);
+        assert!((w[0] - 0.869_09).abs() < 1e-4 && w[0] == w[2], "{w:?}");
+        for t in ToneMapper::ALL {
+            assert_eq!(ToneMapper::from_arg(t.arg_name()), Ok(t));
+        }
+        assert!(
+            ToneMapper::from_arg("filmic")
+                .unwrap_err()
+                .contains("neutral")
+        );
     }
 
     #[test]

@@ -207,6 +207,22 @@ impl RenderFrame {
         }
     }
 
+    /// A render-space camera in world space (inverse of [`RenderFrame::camera`]).
+    pub fn world_camera(&self, c: &Camera) -> Camera {
+        Camera {
+            eye: c.eye / self.scale + self.origin,
+            ..c.clone()
+        }
+    }
+
+    /// Render-space bounds in world space.
+    pub fn world_bounds(&self, b: &Bounds) -> Bounds {
+        Bounds {
+            min: b.min / self.scale + self.origin,
+            max: b.max / self.scale + self.origin,
+        }
+    }
+
     /// Lights in render space: positions and radii move and scale; point and spot intensities
     /// scale by scale², so the irradiance I / d² they give stays the same (directional
     /// irradiance and angular radii do not change).

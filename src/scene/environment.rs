@@ -286,6 +286,68 @@ impl EnvMap {
         )
     }
 
+    /// The map box-filtered to at most `width` × `height` texels (whole blocks of texels
+    /// averaged): enough for irradiance, which is smooth.
+    pub fn coarse(&self, width: u32, height: u32) -> EnvMap {
+        let (bx, by) = (
+            self.width.div_ceil(width.max(1)) as usize,
+            self.height.div_ceil(height.max(1)) as usize,
+        );
+        let (w, h) = (self.width as usize, self.height as usize);
+        let (cw, ch) = (w.div_ceil(bx), h.div_ceil(by));
+        let mut texels = vec![[0.0f32; 3]; cw * ch];
+        for (i, t) in texels.iter_mut().enumerate() {
+            let (cx, cy) = (i % cw, i / cw);
+            let mut n = 0.0;
+            for y in cy * by..((cy + 1) * by).min(h) {
+                for x in cx * bx..((cx + 1) * bx).min(w) {
+                    let p = self.texels[y * w + x];
+                    for c in 0..3 {
+                        t[c] += p[c];
+                    }
+                    n += 1.0;
+                }
+            }
+            *t = t.map(|v| v / n);
+        }
+        EnvMap {
+            name: self.name.clone(),
+            width: cw as u32,
+            height: ch as u32,
+            texels,
+        }
+    }
+
+    /// The luminance of the irradiance on a surface facing `normal` (unit, world space) from
+    /// the map turned by `rotation_degrees` about +Y (as `--env-rotation` turns it): what an
+    /// incident light meter there reads, its dome towards `normal`. A uniform map of radiance
+    /// L gives πL.
+    pub fn irradiance(&self, normal: glam::DVec3, rotation_degrees: f32) -> f64 {
+        let (s, c) = (rotation_degrees as f64).to_radians().sin_cos();
+        // Into the map's frame: undo the rotation about +Y (as kernels/shared/env.h does).
+        let n = glam::DVec3::new(
+            c * normal.x - s * normal.z,
+            normal.y,
+            s * normal.x + c * normal.z,
+        );
+        let (w, h) = (self.width as usize, self.height as usize);
+        let texel_solid =
+            (2.0 * std::f64::consts::PI / w as f64) * (std::f64::consts::PI / h as f64);
+        let mut e = 0.0;
+        for y in 0..h {
+            let v = (y as f32 + 0.5) / h as f32;
+            let sin = (std::f64::consts::PI * v as f64).sin();
+            for x in 0..w {
+                let d = Self::direction((x as f32 + 0.5) / w as f32, v).as_dvec3();
+                let cos = d.dot(n);
+                if cos > 0.0 {
+                    e += luminance(self.texels[y * w + x]) as f64 * cos * sin * texel_solid;
+                }
+            }
+        }
+        e
+    }
+
     /// The texel a direction (in the map's frame) falls into.
     pub fn texel_of(&self, d: Vec3) -> (u32, u32) {
         let (u, v) = Self::uv_of(d);
@@ -322,6 +384,48 @@ mod tests {
         assert!((EnvMap::direction(0.5, 0.5) - Vec3::NEG_Z).length() < 1e-6);
         assert!((EnvMap::direction(0.75, 0.5) - Vec3::X).length() < 1e-6);
         assert!((EnvMap::direction(0.2, 0.0) - Vec3::Y).length() < 1e-6);
+    }
+
+    /// A uniform map gives πL on a surface facing any way; a map bright in its upper half
+    /// alone gives a surface facing up (the sky) all of it and one facing down none, and
+    /// turning the map moves the bright half where the meter faces.
+    #[test]
+    fn irradiance_is_that_of_the_dome_the_meter_faces() {
+        use glam::DVec3;
+        let uniform = EnvMap::uniform([2.0; 3], 64, 32);
+        for n in [
+            DVec3::Y,
+            DVec3::NEG_Z,
+            DVec3::new(1.0, 1.0, 0.0).normalize(),
+        ] {
+            let e = uniform.irradiance(n, 30.0);
+            assert!((e / (2.0 * PI as f64) - 1.0).abs() < 2e-3, "{n}: {e}");
+        }
+        let mut sky = EnvMap::uniform([0.0; 3], 64, 32);
+        for t in &mut sky.texels[..64 * 16] {
+            *t = [1.0; 3];
+        }
+        assert!((sky.irradiance(DVec3::Y, 0.0) / PI as f64 - 1.0).abs() < 2e-3);
+        assert!(sky.irradiance(DVec3::NEG_Y, 0.0) < 1e-9);
+        // A map bright towards its u = 0.75 column (+x in its frame) alone.
+        let mut side = EnvMap::uniform([0.0; 3], 64, 32);
+        for (i, t) in side.texels.iter_mut().enumerate() {
+            if (40..56).contains(&(i % 64)) {
+                *t = [1.0; 3];
+            }
+        }
+        let (east, west) = (
+            side.irradiance(DVec3::X, 0.0),
+            side.irradiance(DVec3::NEG_X, 0.0),
+        );
+        assert!(east > 0.1 && west < 1e-9, "{east} {west}");
+        // Turned by 180° about +y, the bright side is at −x.
+        let turned = side.irradiance(DVec3::NEG_X, 180.0);
+        assert!((turned / east - 1.0).abs() < 1e-3, "{turned} {east}");
+        // The coarse map (blocks of 4 × 4 texels) gives the same light.
+        let coarse = side.coarse(16, 8);
+        assert_eq!((coarse.width, coarse.height), (16, 8));
+        assert!((coarse.irradiance(DVec3::X, 0.0) / east - 1.0).abs() < 0.02);
     }
 
     #[test]

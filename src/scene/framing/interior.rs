@@ -32,12 +32,43 @@ pub enum Shell {
     Object,
 }
 
-/// Classifies the model by [`SHELL_RAYS`] rays from `point`. A surface seen from inside a room
-/// faces the point; the shell of a closed object seen from within faces away, so only hits on
-/// front faces count. At least [`INTERIOR_HIT_FRACTION`] of the rays must hit front faces; when
-/// the rays that escape leave mostly sideways through one side (their mean direction is long and
-/// near horizontal), the model is an open box instead.
-pub fn classify_shell(probe: &Probe, point: DVec3) -> Shell {
+/// Points besides the middle that must be enclosed too (at least this many of the four at a
+/// quarter of the bounds' width and depth from the middle): a room encloses every point of
+/// it; a hollow object or a group with a gap between its parts encloses its middle alone.
+pub const ENCLOSED_POINTS: usize = 3;
+
+/// Classifies the model seen from the middle of its bounds ([`classify_shell`]), and keeps an
+/// interior or an open box only when at least [`ENCLOSED_POINTS`] of the four points a quarter
+/// of the width and depth away from the middle are enclosed by front faces as well (more than
+/// [`INTERIOR_HIT_FRACTION`] of their rays, a quarter less for an open box, which loses more
+/// through its opening seen from near it).
+pub fn classify_model(probe: &Probe) -> Shell {
+    let b = probe.bounds;
+    let centre = b.center();
+    let shell = classify_shell(probe, centre);
+    let need = match shell {
+        Shell::Object => return shell,
+        Shell::Interior => INTERIOR_HIT_FRACTION,
+        Shell::OpenSide(_) => 0.75 * INTERIOR_HIT_FRACTION,
+    };
+    let e = b.max - b.min;
+    let enclosed = [(-1.0, 0.0), (1.0, 0.0), (0.0, -1.0), (0.0, 1.0)]
+        .into_iter()
+        .filter(|(x, z)| {
+            let p = centre + DVec3::new(0.25 * x * e.x, 0.0, 0.25 * z * e.z);
+            front_fraction(probe, p).0 >= need
+        })
+        .count();
+    if enclosed >= ENCLOSED_POINTS {
+        shell
+    } else {
+        Shell::Object
+    }
+}
+
+/// The share of [`SHELL_RAYS`] rays from `point` that hit front faces (surfaces that face the
+/// point), the rays that escape and the sum of their directions.
+fn front_fraction(probe: &Probe, point: DVec3) -> (f64, usize, DVec3) {
     let (mut front, mut misses) = (0usize, 0usize);
     let mut escape = DVec3::ZERO;
     for d in sphere_directions(SHELL_RAYS) {
@@ -50,7 +81,17 @@ pub fn classify_shell(probe: &Probe, point: DVec3) -> Shell {
             }
         }
     }
-    if (front as f64) < INTERIOR_HIT_FRACTION * SHELL_RAYS as f64 {
+    (front as f64 / SHELL_RAYS as f64, misses, escape)
+}
+
+/// Classifies the model by [`SHELL_RAYS`] rays from `point`. A surface seen from inside a room
+/// faces the point; the shell of a closed object seen from within faces away, so only hits on
+/// front faces count. At least [`INTERIOR_HIT_FRACTION`] of the rays must hit front faces; when
+/// the rays that escape leave mostly sideways through one side (their mean direction is long and
+/// near horizontal), the model is an open box instead.
+pub fn classify_shell(probe: &Probe, point: DVec3) -> Shell {
+    let (front, misses, escape) = front_fraction(probe, point);
+    if front < INTERIOR_HIT_FRACTION {
         return Shell::Object;
     }
     let mean = escape / misses.max(1) as f64;
@@ -75,6 +116,7 @@ pub(super) fn interior_camera(probe: &Probe) -> Option<Camera> {
     let b = probe.bounds;
     let size = b.max - b.min;
     let far = probe.scale();
+    let metre = probe.frame.scale;
     // Standing points: where a vertical ray finds a floor (the top of the bounds stands in for
     // a missing ceiling: models of flats are often open above).
     let mut spots = Vec::new();
@@ -100,10 +142,11 @@ pub(super) fn interior_camera(probe: &Probe) -> Option<Camera> {
             continue;
         }
         // Metres, centimetres or millimetres, whichever makes a room height of it; else 60%.
+        // (The probe's render frame is `metre` render units a world unit.)
         let eye_height = [1.0, 100.0, 1000.0]
             .into_iter()
-            .find(|unit| (2.0..=5.0).contains(&(height / unit)))
-            .map_or(0.6 * height, |unit| EYE_HEIGHT * unit);
+            .find(|unit| (2.0..=5.0).contains(&(height / (unit * metre))))
+            .map_or(0.6 * height, |unit| EYE_HEIGHT * unit * metre);
         let eye = DVec3::new(x, bottom + eye_height, z);
         let distances: Vec<f64> = (0..AZIMUTHS)
             .map(|a| {
@@ -131,7 +174,7 @@ pub(super) fn interior_camera(probe: &Probe) -> Option<Camera> {
         .unwrap_or(0);
     let forward = horizontal(look as f64 / n as f64 * std::f64::consts::TAU);
     let behind = distances[(look + n / 2) % n];
-    let eye = eye - forward * (0.6 * behind).min(behind - 0.3).max(0.0);
+    let eye = eye - forward * (0.6 * behind).min(behind - 0.3 * metre).max(0.0);
     // Look slightly down, at the floor's far half.
     let target = eye + forward * 10.0 - DVec3::Y * 1.2;
     Some(Camera::look_at(AUTO_CAMERA, eye, target, INTERIOR_YFOV))

@@ -37,6 +37,12 @@ pub const SKY_RAYS: usize = 16;
 /// The share of those rays that must leave the scene for an environment to light the view: a
 /// room with a window lets out a few percent; cracks in a closed model far fewer.
 pub const MIN_SKY_FRACTION: f64 = 0.002;
+/// The share of the hemisphere rays from the metal and glass the camera sees that may leave
+/// the scene while its own lights still surround them: above it, what they reflect or show
+/// through is mostly the world, black without an environment.
+pub const MAX_SHINY_SKY: f64 = 0.25;
+/// The share of the subject points that must be metal or glass for [`MAX_SHINY_SKY`] to matter.
+pub const MIN_SHINY_SHARE: f64 = 0.05;
 
 /// What [`light_test`] finds from a camera (the [`FirstView`] fields of the same names).
 pub(super) struct LightTest {
@@ -46,6 +52,21 @@ pub(super) struct LightTest {
     pub(super) subject_radiance: f64,
     pub(super) emitter_radiance: f64,
     pub(super) sky_fraction: f64,
+    pub(super) key_irradiance: f64,
+    pub(super) shiny_share: f64,
+    pub(super) shiny_sky: f64,
+    pub(super) subject_normals: Vec<DVec3>,
+}
+
+/// The percentile of the light at the subject points that incident metering shows a white
+/// surface under at [`WHITE`](crate::render::exposure::WHITE): the brighter lit quarter of
+/// the subject may go above it (into the tone curve's shoulder), little of it clips.
+pub const METER_PERCENTILE: f64 = 0.75;
+
+/// The [`METER_PERCENTILE`] value of `values` (sorted ascending), 0 when there are none.
+pub fn meter_percentile(values: &[f64]) -> f64 {
+    let at = ((values.len() as f64 * METER_PERCENTILE) as usize).min(values.len().max(1) - 1);
+    values.get(at).copied().unwrap_or(0.0)
 }
 
 /// The most powerful emissive triangles: (centroid, unit normal, radiance × area), at most
@@ -87,7 +108,7 @@ pub(super) fn emitters(probe: &Probe) -> Vec<(DVec3, DVec3, f64)> {
 }
 
 /// A primary ray through the pixel at fractions (fx, fy) of the image (0,0 = top left).
-fn camera_ray(camera: &Camera, aspect: f64, fx: f64, fy: f64) -> DVec3 {
+pub fn camera_ray(camera: &Camera, aspect: f64, fx: f64, fy: f64) -> DVec3 {
     let right = camera.forward.cross(camera.up).normalize();
     let h = (camera.yfov * 0.5).tan();
     (camera.forward + right * ((2.0 * fx - 1.0) * h * aspect) + camera.up * ((1.0 - 2.0 * fy) * h))
@@ -159,43 +180,67 @@ pub(super) fn light_test(
     let emitters = emitters(probe);
     let far = probe.scale() * 100.0 + (camera.eye - probe.bounds.center()).length() * 4.0;
     let sky: Vec<DVec3> = sphere_directions(SKY_RAYS).collect();
-    // (direct irradiance and escaping hemisphere rays at a subject point, emitter radiance)
-    type Sample = (Option<(f64, usize)>, Option<f64>);
+    // Hemisphere rays from `point` (normal `n`) that leave the scene.
+    let escaping = |point: DVec3, n: DVec3| {
+        let origin = point + n * (1e-4 * probe.scale());
+        sky.iter()
+            .filter(|&&s| {
+                let s = if s.dot(n) < 0.0 { -s } else { s };
+                probe.hit(origin, s, far).is_none()
+            })
+            .count()
+    };
+    // The normal of `prim` facing against `d`.
+    let facing = |prim: usize, d: DVec3| {
+        let n = probe.normal(prim);
+        if n.dot(d) > 0.0 { -n } else { n }
+    };
+    // (direct irradiance, escaping hemisphere rays and normal at a subject point, emitter
+    // radiance, escaping hemisphere rays at the metal or glass the camera sees first)
+    type Sample = (Option<(f64, usize, DVec3)>, Option<f64>, Option<usize>);
     let samples: Vec<Sample> = (0..PROBE_COLUMNS * PROBE_ROWS)
         .into_par_iter()
         .map(|i| {
             let fx = ((i % PROBE_COLUMNS) as f64 + 0.5) / PROBE_COLUMNS as f64;
             let fy = ((i / PROBE_COLUMNS) as f64 + 0.5) / PROBE_ROWS as f64;
             let d = camera_ray(camera, aspect, fx, fy);
+            // Glass in front of the subject is what the camera sees there.
+            let shiny = probe.hit_all_at(camera.eye, d, far).and_then(|(t, prim)| {
+                probe
+                    .shiny(prim)
+                    .then(|| escaping(camera.eye + d * t, facing(prim, d)))
+            });
             let Some((t, prim)) = probe.hit(camera.eye, d, far) else {
-                return (None, None);
+                return (None, None, shiny);
             };
             if probe.emission(prim) > 0.0 {
-                return (None, Some(probe.emission(prim) as f64));
+                return (None, Some(probe.emission(prim) as f64), shiny);
             }
-            let mut n = probe.normal(prim);
-            if n.dot(d) > 0.0 {
-                n = -n;
-            }
+            let n = facing(prim, d);
             let point = camera.eye + d * t;
-            let origin = point + n * (1e-4 * probe.scale());
-            let escaping = sky
-                .iter()
-                .filter(|&&s| {
-                    let s = if s.dot(n) < 0.0 { -s } else { s };
-                    probe.hit(origin, s, far).is_none()
-                })
-                .count();
             (
-                Some((irradiance(probe, lights, &emitters, point, n), escaping)),
+                Some((
+                    irradiance(probe, lights, &emitters, point, n),
+                    escaping(point, n),
+                    n,
+                )),
                 None,
+                shiny,
             )
         })
         .collect();
-    let escaping: usize = samples.iter().filter_map(|s| s.0).map(|(_, k)| k).sum();
-    let mut subject: Vec<f64> = samples.iter().filter_map(|s| s.0).map(|(e, _)| e).collect();
+    let escaping: usize = samples.iter().filter_map(|s| s.0).map(|(_, k, _)| k).sum();
+    let mut subject: Vec<f64> = samples
+        .iter()
+        .filter_map(|s| s.0)
+        .map(|(e, ..)| e)
+        .collect();
+    let subject_normals: Vec<DVec3> = samples.iter().filter_map(|s| s.0).map(|s| s.2).collect();
     let mut seen: Vec<f64> = samples.iter().filter_map(|s| s.1).collect();
     let coverage = (subject.len() + seen.len()) as f64 / samples.len() as f64;
+    let shiny: Vec<usize> = samples.iter().filter_map(|s| s.2).collect();
+    let shiny_share = shiny.len() as f64 / subject.len().max(1) as f64;
+    let shiny_sky = shiny.iter().sum::<usize>() as f64 / (shiny.len().max(1) * SKY_RAYS) as f64;
     if subject.is_empty() {
         return LightTest {
             lit: false,
@@ -204,6 +249,10 @@ pub(super) fn light_test(
             subject_radiance: 0.0,
             emitter_radiance: 0.0,
             sky_fraction: 0.0,
+            key_irradiance: 0.0,
+            shiny_share,
+            shiny_sky,
+            subject_normals,
         };
     }
     let sky_fraction = escaping as f64 / (subject.len() * SKY_RAYS) as f64;
@@ -211,6 +260,8 @@ pub(super) fn light_test(
     subject.sort_by(f64::total_cmp);
     seen.sort_by(f64::total_cmp);
     let subject_radiance = subject[subject.len() / 2] / std::f64::consts::PI;
+    let lit_points = &subject[subject.partition_point(|&e| e <= 0.0)..];
+    let key_irradiance = meter_percentile(lit_points);
     let emitter_radiance = if seen.is_empty() {
         0.0
     } else {
@@ -226,5 +277,9 @@ pub(super) fn light_test(
         subject_radiance,
         emitter_radiance,
         sky_fraction,
+        key_irradiance,
+        shiny_share,
+        shiny_sky,
+        subject_normals,
     }
 }

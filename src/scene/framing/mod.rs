@@ -22,12 +22,13 @@ mod tests;
 mod world_tris;
 
 pub use interior::{
-    EYE_HEIGHT, INTERIOR_HIT_FRACTION, INTERIOR_YFOV, OPEN_SIDE_FRACTION, SHELL_RAYS, Shell,
-    classify_shell,
+    ENCLOSED_POINTS, EYE_HEIGHT, INTERIOR_HIT_FRACTION, INTERIOR_YFOV, OPEN_SIDE_FRACTION,
+    SHELL_RAYS, Shell, classify_model, classify_shell,
 };
 pub use light_test::{
-    MAX_EMITTERS, MAX_STOPS_BELOW_EMITTERS, MIN_LIT_FRACTION, MIN_SKY_FRACTION, PROBE_COLUMNS,
-    PROBE_ROWS, SKY_RAYS,
+    MAX_EMITTERS, MAX_SHINY_SKY, MAX_STOPS_BELOW_EMITTERS, METER_PERCENTILE, MIN_LIT_FRACTION,
+    MIN_SHINY_SHARE, MIN_SKY_FRACTION, PROBE_COLUMNS, PROBE_ROWS, SKY_RAYS, camera_ray,
+    meter_percentile,
 };
 pub use probe::Probe;
 pub use subject_bounds::{FIT_POINTS, SAMPLE_FROM, robust_bounds};
@@ -63,6 +64,17 @@ pub struct FirstView {
     /// The share of rays from the subject points over their hemispheres that leave the scene:
     /// 0 in a closed room, which an environment cannot light.
     pub sky_fraction: f64,
+    /// The [`METER_PERCENTILE`] of the direct irradiance from the scene's lights at the
+    /// subject points they light (0 when they light none): what an incident light meter at
+    /// the subject reads.
+    pub key_irradiance: f64,
+    /// The share of the subject points that are metal or glass (glass in front included).
+    pub shiny_share: f64,
+    /// The share of the hemisphere rays from those points that leave the scene.
+    pub shiny_sky: f64,
+    /// The unit normals (towards the camera) at the subject points: where an environment's
+    /// light is metered.
+    pub subject_normals: Vec<DVec3>,
 }
 
 impl FirstView {
@@ -70,6 +82,13 @@ impl FirstView {
     /// geometry, or at least [`MIN_SKY_FRACTION`] of the subject's hemisphere rays leave.
     pub fn environment_reaches(&self) -> bool {
         self.coverage < 1.0 || self.sky_fraction >= MIN_SKY_FRACTION
+    }
+
+    /// Whether the metal and glass in view would reflect a black world: at least
+    /// [`MIN_SHINY_SHARE`] of the subject is metal or glass and more than [`MAX_SHINY_SKY`] of
+    /// their hemisphere leaves the scene (the scene's own lights and walls do not surround them).
+    pub fn shine_needs_environment(&self) -> bool {
+        self.shiny_share >= MIN_SHINY_SHARE && self.shiny_sky > MAX_SHINY_SKY
     }
 }
 
@@ -146,6 +165,62 @@ pub fn lit_side(probe: &Probe, lights: &[Light]) -> DVec3 {
     best.1
 }
 
+/// A subject is mostly flat (a board, a wall of samples) when its bounds' thinnest side is at
+/// most this share of the next: it is then seen facing it.
+pub const FLAT_RATIO: f64 = 0.2;
+
+/// The direction (subject to eye) that faces a standing, mostly flat subject ([`FLAT_RATIO`],
+/// its thin side horizontal): along its thin axis, from the side its punctual lights are on; else, for
+/// a board across z, from glTF's front, +Z (Khronos's test boards face it; which side shows
+/// more front faces does not tell: ClearCoatTest shows more from behind); else from the only
+/// side where an 8 × 8 grid of
+/// rays finds surfaces that show (front faces, or double-sided ones: a single-sided board
+/// shows nothing from behind), else from +X.
+pub fn flat_facing(probe: &Probe, lights: &[Light]) -> Option<DVec3> {
+    let b = probe.bounds;
+    let e = (b.max - b.min).max(DVec3::ZERO);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &k| e[i].total_cmp(&e[k]));
+    let (thin, u, v) = (order[0], order[1], order[2]);
+    if e[thin] > FLAT_RATIO * e[u] || e[u] <= 0.0 || thin == 1 {
+        return None;
+    }
+    let axis = DVec3::AXES[thin];
+    let centre = b.center();
+    // Surfaces that show to rays along −s over the board, from side `s`.
+    let fronts = |s: f64| {
+        let mut n = 0usize;
+        for i in 0..8 {
+            for k in 0..8 {
+                let mut p = centre + axis * (s * e.length());
+                p[u] = b.min[u] + (i as f64 + 0.5) / 8.0 * e[u];
+                p[v] = b.min[v] + (k as f64 + 0.5) / 8.0 * e[v];
+                let d = -axis * s;
+                if probe.hit_all(p, d).is_some_and(|prim| probe.shows(prim, d)) {
+                    n += 1;
+                }
+            }
+        }
+        n
+    };
+    let (plus, minus) = (fronts(1.0), fronts(-1.0));
+    // The punctual lights alone (the first entries): the board's own glowing parts
+    // (ClearCoatTest's labels) are no side to face.
+    let lit: f64 = light_directions(probe, lights, centre)
+        .iter()
+        .take(lights.len())
+        .map(|(l, w)| w * l.dot(axis))
+        .sum();
+    let sign = if lit != 0.0 {
+        lit.signum()
+    } else if thin == 2 || plus > 0 || minus == 0 {
+        1.0
+    } else {
+        -1.0
+    };
+    Some(axis * sign)
+}
+
 /// A camera looking at the middle of `bounds` from direction `dir` (unit, subject to eye), at
 /// the distance where all `points` fit 90% of the frame of `aspect` (width/height). With the
 /// eight corners of the bounds as points the whole box fits; with the subject's vertices its
@@ -204,13 +279,33 @@ pub fn first_view(
     let _memory = crate::cl::kernels::OpeningMemory::begin();
     let probe = Probe::new(scene);
     let t = std::time::Instant::now();
-    let view = first_view_with(&probe, lights, camera, aspect);
+    let view = first_view_in_frame(&probe, lights, camera, aspect);
     log::debug!("probe: rays in {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
     probe.keep_blases(scene);
     view
 }
 
-/// [`first_view`] with a probe already built.
+/// [`first_view_with`] for world-space `lights` and `camera`, traced in the probe's render
+/// frame: the view it returns is in world space.
+pub fn first_view_in_frame(
+    probe: &Probe,
+    lights: &[Light],
+    camera: Option<&Camera>,
+    aspect: f64,
+) -> FirstView {
+    let frame = probe.frame;
+    let lights = frame.lights(lights);
+    let camera = camera.map(|c| frame.camera(c));
+    let view = first_view_with(probe, &lights, camera.as_ref(), aspect);
+    FirstView {
+        camera: frame.world_camera(&view.camera),
+        bounds: frame.world_bounds(&view.bounds),
+        ..view
+    }
+}
+
+/// [`first_view`] with a probe already built, in the probe's render frame (lights, camera and
+/// the view returned).
 pub fn first_view_with(
     probe: &Probe,
     lights: &[Light],
@@ -223,16 +318,17 @@ pub fn first_view_with(
         None if !probe.any_opaque => (Camera::framing(&bounds, super::AUTO_YFOV), false),
         None => {
             let outside = |dir: DVec3| fit(&bounds, &probe.points, dir, super::AUTO_YFOV, aspect);
-            match classify_shell(probe, bounds.center()) {
+            let object = || flat_facing(probe, lights).unwrap_or_else(|| lit_side(probe, lights));
+            match classify_model(probe) {
                 Shell::Interior => match interior_camera(probe) {
                     Some(c) => (c, true),
-                    None => (outside(lit_side(probe, lights)), false),
+                    None => (outside(object()), false),
                 },
                 Shell::OpenSide(d) => {
                     // Straight into the opening, a little from above.
                     (outside((d + DVec3::Y * 0.15).normalize()), false)
                 }
-                Shell::Object => (outside(lit_side(probe, lights)), false),
+                Shell::Object => (outside(object()), false),
             }
         }
     };
@@ -243,6 +339,10 @@ pub fn first_view_with(
         subject_radiance,
         emitter_radiance,
         sky_fraction,
+        key_irradiance,
+        shiny_share,
+        shiny_sky,
+        subject_normals,
     } = light_test(probe, lights, &camera, aspect);
     FirstView {
         camera,
@@ -254,6 +354,10 @@ pub fn first_view_with(
         subject_radiance,
         emitter_radiance,
         sky_fraction,
+        key_irradiance,
+        shiny_share,
+        shiny_sky,
+        subject_normals,
     }
 }
 

@@ -5,8 +5,14 @@
 //! builds them once and no tree over every placed triangle is built. Their leaf triangles are
 //! tested in world space, so the hits (and the first view) are those of one tree over the
 //! world triangles ([`Probe::flat`]).
+//!
+//! The probe works in the scene's render frame ([`RenderFrame::around`] its robust bounds, the
+//! frame the renderer uses): the scene's middle at the origin and its size between 1/2 and 1,
+//! so its f32 triangles and rays, and every decision they make, are the same wherever the
+//! scene sits and whatever its units (at 10⁵ from the origin, f32 world coordinates moved the
+//! shadow rays' start off the surface: the Cornell box's lit fraction fell from 0.83 to 0.61).
 
-use super::super::{Bounds, Mesh, Scene};
+use super::super::{Bounds, Mesh, RenderFrame, Scene};
 use super::subject_bounds::{fit_points, regular_sample, robust_bounds_windowed};
 use super::{WorldTris, luminance};
 use crate::bvh::{Blas, Bvh, Ray, TwoLevel, intersect_triangle};
@@ -25,12 +31,18 @@ pub struct Probe {
     pub(super) emission: Vec<f32>,
     /// Whether light passes each material (glass and blended surfaces).
     pub(super) see_through: Vec<bool>,
+    /// Whether each material is metal or glass (what reflects or shows its surroundings).
+    pub(super) shiny: Vec<bool>,
+    /// Whether each material is double-sided (its back faces show).
+    pub(super) double_sided: Vec<bool>,
     /// Whether some triangle is opaque.
     pub(super) any_opaque: bool,
     /// Up to [`super::FIT_POINTS`] vertices inside the robust bounds, for fitting the view.
     pub(super) points: Vec<Vec3>,
-    /// Robust bounds of the visible geometry.
+    /// Robust bounds of the visible geometry, in the render frame.
     pub bounds: Bounds,
+    /// The render frame the probe works in: world points map to it by [`RenderFrame::point`].
+    pub frame: RenderFrame,
 }
 
 /// The trees of a [`Probe`].
@@ -63,7 +75,8 @@ impl Probe {
     /// telling an interior.
     pub fn new(scene: &Scene) -> Self {
         let t = std::time::Instant::now();
-        let tris = WorldTris::new(scene.world_objects(&super::super::RenderFrame::default()));
+        let frame = RenderFrame::around(&scene.bounds());
+        let tris = WorldTris::new(scene.world_objects(&frame));
         log::debug!(
             "probe: world vertices in {:.0} ms",
             t.elapsed().as_secs_f64() * 1e3
@@ -72,7 +85,7 @@ impl Probe {
         let cpu = crate::cpu_time::process_cpu_seconds().unwrap_or(0.0);
         if tris.objects.iter().any(|o| o.kept.is_some()) {
             // Triangles were dropped: the meshes' triangles are not the world's.
-            return Self::with_flat(scene, tris);
+            return Self::with_flat(scene, tris, frame);
         }
         let objects: Vec<&super::super::Object> = scene
             .objects
@@ -86,10 +99,12 @@ impl Probe {
             .par_iter()
             .map(crate::bvh::quick_blas_shared)
             .collect();
+        let frame_from_world =
+            DMat4::from_scale(DVec3::splat(frame.scale)) * DMat4::from_translation(-frame.origin);
         let instances: Vec<(u32, DMat4)> = objects
             .iter()
             .zip(&mesh_of)
-            .map(|(o, &m)| (m, o.world_from_object))
+            .map(|(o, &m)| (m, frame_from_world * o.world_from_object))
             .collect();
         let hidden = vec![false; instances.len()];
         let two = TwoLevel::with_hidden(blases, &instances, hidden, 0);
@@ -98,19 +113,17 @@ impl Probe {
             t.elapsed().as_secs_f64() * 1e3,
             crate::cpu_time::process_cpu_seconds().unwrap_or(0.0) - cpu
         );
-        Self::with_tracer(scene, Tracer::TwoLevel { two, meshes }, tris)
+        Self::with_tracer(scene, Tracer::TwoLevel { two, meshes }, tris, frame)
     }
 
     /// The probe over one quick tree of the world triangles (`Tracer::Flat`): how the first
     /// view was found before the two levels, and what it falls back to.
     pub fn flat(scene: &Scene) -> Self {
-        Self::with_flat(
-            scene,
-            WorldTris::new(scene.world_objects(&super::super::RenderFrame::default())),
-        )
+        let frame = RenderFrame::around(&scene.bounds());
+        Self::with_flat(scene, WorldTris::new(scene.world_objects(&frame)), frame)
     }
 
-    fn with_flat(scene: &Scene, world: WorldTris) -> Self {
+    fn with_flat(scene: &Scene, world: WorldTris, frame: RenderFrame) -> Self {
         let (tris, materials) = world.to_vecs();
         let see_through = see_through_materials(scene);
         let passes = |m: u32| see_through.get(m as usize).copied().unwrap_or(false);
@@ -135,10 +148,10 @@ impl Probe {
             (bvh, verts, kept)
         });
         drop((tris, materials));
-        Self::with_tracer(scene, Tracer::Flat { all, opaque }, world)
+        Self::with_tracer(scene, Tracer::Flat { all, opaque }, world, frame)
     }
 
-    fn with_tracer(scene: &Scene, tracer: Tracer, tris: WorldTris) -> Self {
+    fn with_tracer(scene: &Scene, tracer: Tracer, tris: WorldTris, frame: RenderFrame) -> Self {
         let t = std::time::Instant::now();
         let cpu = crate::cpu_time::process_cpu_seconds().unwrap_or(0.0);
         let sample = regular_sample(&tris);
@@ -165,11 +178,18 @@ impl Probe {
                 .iter()
                 .map(|m| luminance(m.emission))
                 .collect(),
+            shiny: scene
+                .materials
+                .iter()
+                .map(|m| m.metallic >= 0.5 || m.transmission > 0.0)
+                .collect(),
+            double_sided: scene.materials.iter().map(|m| m.double_sided).collect(),
             see_through,
             any_opaque,
             tris,
             points,
             bounds,
+            frame,
         }
     }
 
@@ -230,25 +250,57 @@ impl Probe {
         }
     }
 
-    /// The closest triangle along a ray, glass included.
-    pub(super) fn hit_all(&self, origin: DVec3, dir: DVec3) -> Option<usize> {
-        let ray = Ray {
-            origin: origin.as_vec3(),
-            direction: dir.as_vec3(),
-            tmin: 0.0,
-            tmax: f32::INFINITY,
-        };
-        self.trace(&ray, false, false).map(|h| h.1)
+    /// Whether triangle `i` shows to a ray along `d`: it faces the ray, or is double-sided.
+    pub(super) fn shows(&self, i: usize, d: DVec3) -> bool {
+        self.normal(i).dot(d) < 0.0
+            || self
+                .double_sided
+                .get(self.tris.material(i) as usize)
+                .copied()
+                .unwrap_or(false)
     }
 
-    pub(super) fn hit(&self, origin: DVec3, dir: DVec3, tmax: f64) -> Option<(f64, usize)> {
+    /// Whether triangle `i` is metal or glass.
+    pub(super) fn shiny(&self, i: usize) -> bool {
+        self.shiny
+            .get(self.tris.material(i) as usize)
+            .copied()
+            .unwrap_or(false)
+    }
+
+    /// The closest triangle along a ray within `tmax`, see-through ones included unless
+    /// `opaque`: (distance, index).
+    fn closest(&self, origin: DVec3, dir: DVec3, tmax: f64, opaque: bool) -> Option<(f64, usize)> {
         let ray = Ray {
             origin: origin.as_vec3(),
             direction: dir.as_vec3(),
             tmin: 0.0,
             tmax: tmax as f32,
         };
-        self.trace(&ray, false, true).map(|h| (h.0 as f64, h.1))
+        self.trace(&ray, false, opaque).map(|h| (h.0 as f64, h.1))
+    }
+
+    /// The closest triangle along a ray within `tmax`, glass included: (distance, index).
+    pub(super) fn hit_all_at(&self, origin: DVec3, dir: DVec3, tmax: f64) -> Option<(f64, usize)> {
+        self.closest(origin, dir, tmax, false)
+    }
+
+    /// The material seen along a world-space ray (glass included), if any: how the first
+    /// view's camera rays find what a pixel shows.
+    pub fn material_seen(&self, origin: DVec3, dir: DVec3) -> Option<u32> {
+        let origin = self.frame.point(origin).as_dvec3();
+        self.hit_all_at(origin, dir, f64::INFINITY)
+            .map(|h| self.tris.material(h.1))
+    }
+
+    /// The closest triangle along a ray, glass included.
+    pub(super) fn hit_all(&self, origin: DVec3, dir: DVec3) -> Option<usize> {
+        self.closest(origin, dir, f64::INFINITY, false).map(|h| h.1)
+    }
+
+    /// The closest opaque triangle along a ray within `tmax`: (distance, index).
+    pub(super) fn hit(&self, origin: DVec3, dir: DVec3, tmax: f64) -> Option<(f64, usize)> {
+        self.closest(origin, dir, tmax, true)
     }
 
     pub(super) fn visible(&self, from: DVec3, to: DVec3) -> bool {

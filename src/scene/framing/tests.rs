@@ -398,8 +398,9 @@ fn the_two_level_probe_finds_what_one_tree_over_the_world_finds() {
                 (k % 5) as f64 * 0.3 - 0.6,
                 (k % 3) as f64 - 1.0,
             ) * 0.5;
+        // The probes work in the render frame.
         let ray = Ray {
-            origin: o.as_vec3(),
+            origin: two.frame.point(o),
             direction: d.as_vec3(),
             tmin: 0.0,
             tmax: f32::INFINITY,
@@ -417,8 +418,8 @@ fn the_two_level_probe_finds_what_one_tree_over_the_world_finds() {
     assert!(hits > 3000, "{hits}");
     let lamp = point(DVec3::new(3.0, 2.2, 2.0), 5.0);
     for lights in [vec![], vec![lamp]] {
-        let a = first_view_with(&two, &lights, None, 1.6);
-        let b = first_view_with(&flat, &lights, None, 1.6);
+        let a = first_view_in_frame(&two, &lights, None, 1.6);
+        let b = first_view_in_frame(&flat, &lights, None, 1.6);
         assert_eq!(format!("{a:?}"), format!("{b:?}"));
     }
     assert!(first_view_with(&two, &[], None, 1.6).interior);
@@ -478,4 +479,238 @@ fn an_added_light_shows_in_view_near_the_camera() {
     // Irradiance about 1 at the subject.
     let d2 = (l.position - DVec3::ZERO).length_squared();
     assert!((l.intensity as f64 / d2 - 1.0).abs() < 1e-3);
+}
+
+/// A box open towards +z (the inside of a 2-unit cube without its front, faces inward) with a
+/// short and a tall block on its floor and a lamp under its ceiling: a Cornell box. A viewer
+/// shows it from the open side, looking in, lit by its lamp.
+fn cornell() -> (Scene, Light) {
+    let mut walls = cuboid(Vec3::splat(-1.0), Vec3::splat(1.0), true);
+    walls.drain(2..4); // the +z quad (the second) is the opening
+    let mut blocks = cuboid(
+        Vec3::new(-0.6, -1.0, -0.1),
+        Vec3::new(-0.1, -0.4, 0.4),
+        false,
+    );
+    blocks.extend(cuboid(
+        Vec3::new(0.1, -1.0, -0.7),
+        Vec3::new(0.6, 0.2, -0.2),
+        false,
+    ));
+    let scene = scene_of(&[(walls, Material::default()), (blocks, Material::default())]);
+    (scene, point(DVec3::new(0.0, 0.9, 0.0), 4.0))
+}
+
+/// The same scene moved by 10⁵ and 10⁷ and scaled by 10⁻³ and 10³ (its lamp's intensity by
+/// scale², so its light is the same) gets the same first view as at the origin: the camera in
+/// the same place relative to the scene, the same interior and light decisions and the same
+/// key irradiance (which sets the exposure). At 10⁵ the world-space probe judged the shared
+/// Cornell box unlit (lit fraction 0.61 against 0.83).
+#[test]
+fn a_moved_or_scaled_scene_gets_the_same_first_view() {
+    let (scene, lamp) = cornell();
+    let at_origin = first_view(&scene, std::slice::from_ref(&lamp), None, 4.0 / 3.0);
+    assert!(at_origin.lit && !at_origin.interior, "{at_origin:?}");
+    assert!(at_origin.camera.eye.z > 1.0, "{at_origin:?}");
+    let relative = |v: &FirstView, scale: f64, offset: DVec3| (v.camera.eye - offset) / scale;
+    for (scale, offset) in [
+        (1.0, DVec3::splat(1e5)),
+        (1.0, DVec3::new(1e7, -1e7, 1e7)),
+        (1e-3, DVec3::ZERO),
+        (1e3, DVec3::ZERO),
+        (1e3, DVec3::splat(1e7)),
+    ] {
+        let m = DMat4::from_translation(offset) * DMat4::from_scale(DVec3::splat(scale));
+        let mut moved = scene.clone();
+        for o in &mut moved.objects {
+            o.world_from_object = m * o.world_from_object;
+        }
+        let lamp = Light {
+            position: m.transform_point3(lamp.position),
+            intensity: (lamp.intensity as f64 * scale * scale) as f32,
+            ..lamp.clone()
+        };
+        let v = first_view(&moved, &[lamp], None, 4.0 / 3.0);
+        let case = format!("scale {scale}, offset {offset}: {v:?}");
+        assert_eq!(
+            (v.lit, v.interior),
+            (at_origin.lit, at_origin.interior),
+            "{case}"
+        );
+        let eye = relative(&v, scale, offset);
+        assert!(
+            (eye - at_origin.camera.eye).length() < 1e-3,
+            "{case}: eye {eye}"
+        );
+        assert!(
+            v.camera.forward.dot(at_origin.camera.forward) > 1.0 - 1e-6,
+            "{case}"
+        );
+        assert!(
+            (v.lit_fraction - at_origin.lit_fraction).abs() < 0.02,
+            "{case}"
+        );
+        assert!(
+            (v.key_irradiance / at_origin.key_irradiance - 1.0).abs() < 0.02,
+            "{case}"
+        );
+        assert!((v.coverage - at_origin.coverage).abs() < 0.02, "{case}");
+    }
+}
+
+/// A hollow block (a cavity in its middle, like a shoe's) and two blocks with the middle of
+/// their bounds in the gap between them are objects, framed from outside (the old test, from
+/// the middle alone, took both for rooms); a room is still seen from inside.
+#[test]
+fn a_hollow_object_or_a_gap_is_not_an_interior() {
+    let mut hollow = cuboid(Vec3::splat(-1.0), Vec3::splat(1.0), false);
+    hollow.extend(cuboid(Vec3::splat(-0.4), Vec3::splat(0.4), true));
+    let mut pair = cuboid(
+        Vec3::new(-2.0, -1.0, -1.0),
+        Vec3::new(-0.05, 1.0, 1.0),
+        false,
+    );
+    pair.extend(cuboid(
+        Vec3::new(0.05, -1.0, -1.0),
+        Vec3::new(2.0, 1.0, 1.0),
+        false,
+    ));
+    for (name, tris) in [("hollow", hollow), ("pair", pair)] {
+        let scene = scene_of(&[(tris, Material::default())]);
+        let probe = Probe::new(&scene);
+        // From the middle alone both look like rooms.
+        assert_eq!(
+            classify_shell(&probe, probe.bounds.center()),
+            Shell::Interior,
+            "{name}"
+        );
+        assert_eq!(classify_model(&probe), Shell::Object, "{name}");
+        let view = first_view(&scene, &[], None, 1.5);
+        let b = view.bounds;
+        let e = view.camera.eye;
+        let inside = (0..3).all(|i| e[i] > b.min[i] && e[i] < b.max[i]);
+        assert!(!view.interior && !inside, "{name}: {view:?}");
+    }
+    let room = cuboid(Vec3::ZERO, Vec3::new(6.0, 2.7, 4.0), true);
+    let probe = Probe::new(&scene_of(&[(room, Material::default())]));
+    assert_eq!(classify_model(&probe), Shell::Interior);
+}
+
+/// A board (2 × 1.5, 0.04 thick) whose face looks along +x is seen facing it, straight on,
+/// from +x (its face, not its back: the back is single-sided and faces away); a closed board
+/// standing across z is seen from glTF's front, +z. A board lying on the ground is not seen
+/// straight down (a plan) but from above and aside as before. (The lit-side search, from 14°
+/// or 29° above, saw boards 22–45° off axis.)
+#[test]
+fn a_flat_subject_is_seen_facing_it() {
+    let face = |lo: Vec3, hi: Vec3, drop: std::ops::Range<usize>| {
+        let mut t = cuboid(lo, hi, false);
+        t.drain(drop);
+        t
+    };
+    // Standing, facing +x: the −x quad (the third) left out, so its back shows nothing.
+    let standing = face(Vec3::new(0.0, 0.0, -1.0), Vec3::new(0.04, 1.5, 1.0), 4..6);
+    let view = first_view(
+        &scene_of(&[(standing, Material::default())]),
+        &[],
+        None,
+        1.5,
+    );
+    assert!(view.camera.forward.dot(DVec3::NEG_X) > 0.999, "{view:?}");
+    let closed = cuboid(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 1.5, 0.04), false);
+    let view = first_view(&scene_of(&[(closed, Material::default())]), &[], None, 1.5);
+    assert!(view.camera.forward.dot(DVec3::NEG_Z) > 0.999, "{view:?}");
+    // Lying, facing up: the −y quad (the fifth) left out.
+    let lying = face(
+        Vec3::new(-1.0, 0.0, -0.75),
+        Vec3::new(1.0, 0.04, 0.75),
+        8..10,
+    );
+    let probe = Probe::new(&scene_of(&[(lying, Material::default())]));
+    assert!(flat_facing(&probe, &[]).is_none());
+    // A cube is not flat: seen from above and aside as before.
+    let probe = Probe::new(&scene_of(&[(subject(), Material::default())]));
+    assert!(flat_facing(&probe, &[]).is_none());
+}
+
+/// A metal cube on a white floor under a lamp: the lamp lights the view, but most of what the
+/// cube mirrors is the world, black without an environment, so the view asks for one (as a
+/// fill: a viewer shows the cube mirroring the studio and the floor lit by the lamp). The same
+/// cube and lamp inside a closed room mirror the lit walls: the room keeps its own light. A
+/// white cube instead of the metal one asks for nothing.
+#[test]
+fn metal_its_lights_do_not_surround_asks_for_the_environment() {
+    let metal = Material {
+        metallic: 1.0,
+        roughness: 0.1,
+        ..Material::default()
+    };
+    let floor = cuboid(
+        Vec3::new(-3.0, -0.6, -3.0),
+        Vec3::new(3.0, -0.5, 3.0),
+        false,
+    );
+    let lamp = point(DVec3::new(1.0, 3.0, 2.0), 20.0);
+    let open = [
+        (subject(), metal.clone()),
+        (floor.clone(), Material::default()),
+    ];
+    let view = first_view(&scene_of(&open), std::slice::from_ref(&lamp), None, 1.5);
+    assert!(view.lit && view.environment_reaches(), "{view:?}");
+    assert!(
+        view.shiny_share > 0.3 && view.shine_needs_environment(),
+        "{view:?}"
+    );
+    assert!(view.key_irradiance > 0.0, "{view:?}");
+
+    let white = [
+        (subject(), Material::default()),
+        (floor.clone(), Material::default()),
+    ];
+    let view = first_view(&scene_of(&white), std::slice::from_ref(&lamp), None, 1.5);
+    assert!(view.lit && view.shiny_share == 0.0 && !view.shine_needs_environment());
+
+    let room = cuboid(Vec3::splat(-4.0), Vec3::splat(4.0), true);
+    let camera = Camera::look_at("inside", DVec3::new(0.0, 1.0, 3.5), DVec3::ZERO, 0.9);
+    let closed = [
+        (subject(), metal),
+        (floor, Material::default()),
+        (room, Material::default()),
+    ];
+    let view = first_view(&scene_of(&closed), &[lamp], Some(&camera), 1.5);
+    assert!(view.lit && view.shiny_share >= MIN_SHINY_SHARE, "{view:?}");
+    assert!(
+        !view.environment_reaches() && !view.shine_needs_environment(),
+        "{view:?}"
+    );
+}
+
+/// The bundled Cornell box, and the shared one when PENUMBRA_SCENES is set, moved 10⁵ away
+/// keep the first view they get at the origin: lit by their own lamp (the shared one was
+/// judged unlit there, lit fraction 0.61 against 0.83, and got the studio environment), the
+/// camera in the same place relative to the box.
+#[test]
+fn a_cornell_box_moved_far_away_is_still_lit_by_its_lamp() {
+    let mut paths = vec![None];
+    match std::env::var_os("PENUMBRA_SCENES") {
+        Some(dir) => paths.push(Some(
+            std::path::PathBuf::from(dir).join("CornellBox/CornellBox.glb"),
+        )),
+        None => eprintln!("PENUMBRA_SCENES is not set: the bundled Cornell box alone"),
+    }
+    for path in paths {
+        let scene = crate::scene::load_or_bundled(path.as_deref()).unwrap();
+        let offset = DVec3::splat(1e5);
+        let moved = crate::bench::stress::moved(&scene, 1.0, offset);
+        let a = first_view(&scene, &scene.lights, None, 4.0 / 3.0);
+        let b = first_view(&moved, &moved.lights, None, 4.0 / 3.0);
+        let case = format!("{path:?}: {a:?} against {b:?}");
+        assert!(a.lit && b.lit, "{case}");
+        assert!((a.lit_fraction - b.lit_fraction).abs() < 0.01, "{case}");
+        let size = a.bounds.diagonal();
+        assert!(
+            (b.camera.eye - offset - a.camera.eye).length() < 1e-6 * size,
+            "{case}"
+        );
+    }
 }
