@@ -40,11 +40,15 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #define MEGA_TRACE_TO(o, d, tmax, any_hit) \
     trace_small(&small, tris, &sc.surf, o, d, 0.0f, tmax, any_hit)
 #define MEGA_SHADOW(q) shadow_pass_small(&small, tris, instances, object_tris, &sc.surf, q, overflow)
+#define MEGA_CAMERA_HIT(o, d, hit) \
+    camera_hit_small(&small, tris, instances, object_tris, &sc.surf, o, d, hit, overflow)
 #else
 #define MEGA_TRACE_TO(o, d, tmax, any_hit)                                                 \
     trace_scene_wide(nodes, tris, instances, object_tris, &sc.surf, o, d, 0.0f, tmax, any_hit, \
                      overflow)
 #define MEGA_SHADOW(q) shadow_pass_wide(nodes, tris, instances, object_tris, &sc.surf, q, overflow)
+#define MEGA_CAMERA_HIT(o, d, hit) \
+    camera_hit_wide(nodes, tris, instances, object_tris, &sc.surf, o, d, hit, overflow)
 #endif
 #define MEGA_TRACE(o, d, any_hit) MEGA_TRACE_TO(o, d, INFINITY, any_hit)
 #ifdef LAST_RAY_EMITTERS
@@ -65,6 +69,9 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #endif
             {
                 hit = MEGA_TRACE(s.origin, s.direction, false);
+#ifdef HAS_SINGLE_SIDED
+                if (bounce == 0u) hit = MEGA_CAMERA_HIT(s.origin, s.direction, hit);
+#endif
                 ++extension_rays;
             }
             ShadowQuery q;
