@@ -180,7 +180,7 @@ inline float3 bend_for_reflection(float3 ng, float3 w, float3 n, float lift) {
 // a mirror, raised by the lobe's width (alpha = roughness²) so that most of a glossy lobe stays
 // above too, at most 0.1 (so that a rough surface's normal map keeps its shape; seen head-on a
 // normal then leans at most 42°). A white metal of roughness 0.1 seen head-on through a normal
-// 70° off kept 0.73 of a furnace's light at 0.01 and keeps 0.9 with this.
+// 70° off kept 0.73 of a furnace's light at 0.01 and keeps 0.92 with this (tests/textures.rs).
 inline float reflection_lift(float roughness) {
     return fmin(0.01f + 2.0f * roughness * roughness, 0.1f);
 }
