@@ -2723,7 +2723,8 @@ fn bent_angle(w: V, x: V, theta: f64, roughness: f64) -> f64 {
 
 /// A steep normal map (the mapped normal 70° from the geometric one): its normals are bent for
 /// both directions where the BSDF is evaluated, so f(wo, wi) = f(wi, wo) still holds, with the
-/// bent normal the lesser bend of the two (checked here by an independent bisection).
+/// bent normal the lesser bend of the two (checked here by an independent bisection); rough
+/// lobes (the rough metal, the plastic) are not bent.
 #[test]
 fn reflection_with_a_steep_normal_map_is_reciprocal() {
     let d = BsdfKernels::new();
@@ -2732,11 +2733,19 @@ fn reflection_with_a_steep_normal_map_is_reciprocal() {
     let n = [theta_n.sin(), 0.0, theta_n.cos()];
     let mut plastic = Mat::dielectric([0.8, 0.4, 0.2], 0.5);
     plastic.specular_color = [1.0, 0.7, 1.2];
+    let glossy_plastic = Mat {
+        roughness: 0.3,
+        ..plastic
+    };
     let materials = [
         ("glossy metal", Mat::metal([0.9; 3], 0.2)),
         ("rough metal", Mat::metal([0.9, 0.5, 0.2], 0.7)),
         ("plastic", plastic),
-        ("rough coat over plastic", plastic.coated(0.8, 0.4)),
+        // Base and coat bent alike (both lifted by the cap, 0.1): f·cos divides by one normal.
+        (
+            "glossy plastic under a coat",
+            glossy_plastic.coated(0.8, 0.4),
+        ),
     ];
     let dirs: Vec<V> = [5.0f64, 30.0, 55.0, 80.0]
         .iter()
@@ -2753,8 +2762,13 @@ fn reflection_with_a_steep_normal_map_is_reciprocal() {
             for &wi in &dirs {
                 // Both directions are below the mapped normal's horizon for some pairs: f is
                 // 0 either way there.
+                // The base is bent where it is glossy: roughness below 0.5 (BEND_ROUGHNESS_MAX).
                 let r = m.roughness as f64;
-                let theta = bent_angle(wo, x, theta_n, r).min(bent_angle(wi, x, theta_n, r));
+                let theta = if r < 0.5 {
+                    bent_angle(wo, x, theta_n, r).min(bent_angle(wi, x, theta_n, r))
+                } else {
+                    theta_n
+                };
                 bent += (theta < theta_n - 1e-3) as usize;
                 let nb = add(scale(x, theta.sin()), [0.0, 0.0, theta.cos()]);
                 let f = d.bent(m, wo, n, &[f4(wi)])[0];
@@ -2771,7 +2785,7 @@ fn reflection_with_a_steep_normal_map_is_reciprocal() {
             }
         }
     }
-    assert!(bent > 100, "the bend acts on many pairs ({bent})");
+    assert!(bent > 60, "the bend acts on many pairs ({bent})");
 }
 
 /// The render's mean over the image, 24 × 24 pixels, 256 samples, 3 bounces, black sky.

@@ -185,11 +185,22 @@ inline float reflection_lift(float roughness) {
     return fmin(0.01f + 2.0f * roughness * roughness, 0.1f);
 }
 
-// m's normals at a normal-mapped vertex, *ns and the coat's, bent for direction w.
+// The roughness below which a lobe's normal is bent: a rougher lobe spreads below the surface
+// whatever its normal, and its normal map's shape matters more than a mirror direction.
+#define BEND_ROUGHNESS_MAX 0.5f
+
+// m's normals at a normal-mapped vertex, *ns and the coat's, bent for direction w where their
+// lobe is glossy: a base with a specular layer or metal of roughness below BEND_ROUGHNESS_MAX,
+// a coat below it. A Lambertian base is never bent: it has no reflection to keep above the
+// surface, and bending it for wi would light it from below its mapped normal's horizon.
 inline void bend_normals(SurfaceMaterial* m, float3 ng, float3 w, float3* ns) {
-    *ns = bend_for_reflection(ng, w, *ns, reflection_lift(m->roughness));
+    bool glossy = m->metallic > 0.0f || m->specular_factor > 0.0f;
+    if (glossy && m->roughness < BEND_ROUGHNESS_MAX) {
+        *ns = bend_for_reflection(ng, w, *ns, reflection_lift(m->roughness));
+    }
 #ifdef HAS_CLEARCOAT
-    if (dot(m->coat_normal, m->coat_normal) > 0.0f) {
+    if (dot(m->coat_normal, m->coat_normal) > 0.0f && m->clearcoat > 0.0f &&
+        m->coat_roughness < BEND_ROUGHNESS_MAX) {
         m->coat_normal =
             bend_for_reflection(ng, w, m->coat_normal, reflection_lift(m->coat_roughness));
     }
