@@ -12,13 +12,13 @@
         global const NODE* nodes, global const DeviceTriangle* tris,                                \
         global const DeviceInstance* instances, global const DeviceTriangle* object_tris,              \
         global const DeviceTriShading* shading, global const DeviceTriUvs* uvs,                        \
-        global const DeviceTriTangents* tangents,                                                   \
+        global const DeviceTriTangents* tangents, global const DeviceTriColors* colors,             \
         global const DeviceMaterial* materials, global const DeviceTexRef* tex_refs,                   \
         global const DeviceTexture* textures, global const uint* texels, global const DeviceRay* rays, \
         uint count, global DeviceHit* hits, volatile global uint* counters) {                       \
         uint i = get_global_id(0);                                                               \
         if (i >= count) return;                                                                  \
-        SceneSurfaces surf = {shading,  uvs,    tangents, materials,                             \
+        SceneSurfaces surf = {shading,  uvs,    tangents, colors,  materials,                    \
                               tex_refs, textures, texels, instances};                            \
         DeviceRay r = rays[i];                                                                      \
         hits[i] = TRAVERSE(nodes, tris, instances, object_tris, &surf, r.origin.xyz,             \
@@ -29,13 +29,13 @@
         global const NODE* nodes, global const DeviceTriangle* tris,                                \
         global const DeviceInstance* instances, global const DeviceTriangle* object_tris,              \
         global const DeviceTriShading* shading, global const DeviceTriUvs* uvs,                        \
-        global const DeviceTriTangents* tangents,                                                   \
+        global const DeviceTriTangents* tangents, global const DeviceTriColors* colors,             \
         global const DeviceMaterial* materials, global const DeviceTexRef* tex_refs,                   \
         global const DeviceTexture* textures, global const uint* texels, global const DeviceRay* rays, \
         uint count, global uint* occluded, volatile global uint* counters) {                     \
         uint i = get_global_id(0);                                                               \
         if (i >= count) return;                                                                  \
-        SceneSurfaces surf = {shading,  uvs,    tangents, materials,                             \
+        SceneSurfaces surf = {shading,  uvs,    tangents, colors,  materials,                    \
                               tex_refs, textures, texels, instances};                            \
         DeviceRay r = rays[i];                                                                      \
         DeviceHit h = TRAVERSE(nodes, tris, instances, object_tris, &surf, r.origin.xyz,            \

@@ -339,3 +339,84 @@ fn bad_environment_arguments_fail_with_one_line() {
         assert!(!err.contains("panicked"), "{err}");
     }
 }
+
+/// A smooth thin-walled glass pane over the upper half of the view, the environment a ramp
+/// across u (8 texels wide) that is dark behind the camera (where the pane reflects). A pinhole
+/// camera looking along −Z sees the same u all down a column, so a viewer sees the pane's half
+/// as the ramp beside it, dimmed by the pane's transmittance: as smooth through the glass as
+/// through the air (before, the map was read texel by texel past a pane: blocks).
+#[test]
+fn the_environment_through_a_thin_pane_is_as_smooth_as_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let env = write_env(dir.path(), "ramp", 8, 4, |u, _| {
+        [if (0.25..0.75).contains(&u) {
+            4.0 * u - 1.0
+        } else {
+            0.0
+        }; 3]
+    });
+    let mut g = Gltf::default();
+    g.use_ext("KHR_materials_transmission");
+    g.materials.push(json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0,
+                                 "roughnessFactor": 0.0},
+        "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}}
+    }));
+    let mesh = g.mesh(vec![Prim::triangles(
+        vec![
+            [-5.0, 0.0, -2.0],
+            [5.0, 0.0, -2.0],
+            [5.0, 5.0, -2.0],
+            [-5.0, 5.0, -2.0],
+        ],
+        vec![0, 1, 2, 0, 2, 3],
+        0,
+    )]);
+    g.node(json!({"mesh": mesh}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.01}}));
+    g.node(json!({"camera": 0}));
+    let scene = g.write_glb(dir.path(), "pane");
+    for kernel in ["wavefront", "megakernel"] {
+        let out = dir.path().join(format!("pane-{kernel}.exr"));
+        let (_, px) = render_exr(
+            &scene,
+            &out,
+            &[
+                "--kernel",
+                kernel,
+                "--width",
+                "32",
+                "--height",
+                "16",
+                "--spp",
+                "256",
+                "--bounces",
+                "1",
+                "--env",
+                env.to_str().unwrap(),
+            ],
+        );
+        // Per column, the pane (row 3) over the air (row 12): one transmittance everywhere.
+        let ratios: Vec<f64> = (0..32)
+            .filter(|&x| px[12 * 32 + x][1] > 0.3)
+            .map(|x| px[3 * 32 + x][1] as f64 / px[12 * 32 + x][1] as f64)
+            .collect();
+        assert!(
+            ratios.len() >= 16,
+            "{kernel}: enough lit columns ({})",
+            ratios.len()
+        );
+        let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+        assert!(
+            (0.85..0.97).contains(&mean),
+            "{kernel}: transmittance {mean}"
+        );
+        for r in &ratios {
+            assert!(
+                (r / mean - 1.0).abs() < 0.08,
+                "{kernel}: column ratios {ratios:?}"
+            );
+        }
+    }
+}

@@ -579,6 +579,69 @@ fn normal_maps_tilt_towards_u_and_up_the_image() {
     }
 }
 
+/// A white metal quad facing the camera (head-on) whose uniform normal map leans 70° towards
+/// +u, of roughness `roughness`, under a uniform sky of radiance 1 (`--env 1`).
+fn steep_normal_mapped_mirror(dir: &Path, roughness: f32) -> PathBuf {
+    let mut g = Gltf::default();
+    let mut t = TextureSet::default();
+    // (sin 70°, 0, cos 70°) encoded as (n + 1) / 2.
+    let image = t.embedded(&mut g, &png(2, 2, &[[248, 128, 171, 255]; 4]));
+    let tex = t.texture(image, REPEAT);
+    g.materials.push(json!({
+        "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 1.0,
+                                 "roughnessFactor": roughness},
+        "normalTexture": {"index": tex}
+    }));
+    t.finish(&mut g);
+    let mesh = quad(&mut g, 0, false, false);
+    g.node(json!({"mesh": mesh}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.4, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.0, 0.0, 3.0]}));
+    g.write_glb(dir, &format!("steep-mirror-{roughness}"))
+}
+
+/// A white furnace: a white metal (Fresnel 1 at every angle) under a uniform sky of radiance 1
+/// reflects radiance 1 wherever its reflections escape to the sky. Seen head-on, a normal 70°
+/// off the geometric one mirrors the view 50° below the surface: without the bent shading
+/// normal every such path ended there, black (the rims of shiny normal-mapped surfaces). With
+/// it the mirror reflects just above the surface, radiance exactly 1; a glossy lobe about that
+/// grazing direction still loses what falls below the surface.
+#[test]
+fn a_white_metal_with_a_steep_normal_map_stays_white_in_a_furnace() {
+    let dir = tempfile::tempdir().unwrap();
+    for (roughness, least) in [(0.0, 0.998), (0.1, 0.9)] {
+        let scene = steep_normal_mapped_mirror(dir.path(), roughness);
+        for kernel in ["wavefront", "megakernel"] {
+            let out = dir.path().join(format!("steep-{roughness}-{kernel}.exr"));
+            let (summary, px) = render_exr(
+                &scene,
+                &out,
+                &[
+                    "--kernel",
+                    kernel,
+                    "--width",
+                    "16",
+                    "--height",
+                    "16",
+                    "--spp",
+                    "64",
+                    "--bounces",
+                    "4",
+                    "--env",
+                    "1",
+                ],
+            );
+            assert_eq!(summary["nonfinite_samples"], 0);
+            let m = mean(&px, 1);
+            assert!(
+                m > least && m < 1.002,
+                "roughness {roughness}, {kernel}: mean radiance {m}, expected in ({least}, 1]"
+            );
+        }
+    }
+}
+
 /// A white floor (y = 0) under a red quad (y = 1, |x|, |z| < 1) with `occluder` as the red
 /// material's extra JSON, lit straight from above; the camera looks down from y = 5 and sees
 /// x, z in ±1.5 on the floor.
@@ -1005,7 +1068,7 @@ fn iridescence_factors_and_textures_are_read() {
 }
 
 /// `KHR_materials_dispersion` is read (20 / Abbe number, no upper bound; a negative one is
-/// the default 0) and packed in the anisotropy lane's `.w`; nothing warns. It makes a
+/// the default 0) and packed in the anisotropy lane's `.w`; only the negative one warns. It makes a
 /// material dispersive only on a transmitting volume.
 #[test]
 fn dispersion_is_read() {
@@ -1037,7 +1100,13 @@ fn dispersion_is_read() {
     g.node(json!({"mesh": mesh}));
     let dir = tempfile::tempdir().unwrap();
     let s = penumbra::scene::load(&g.write_glb(dir.path(), "dispersion")).unwrap();
-    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    // The negative dispersion is out of the specification's range: one warning, for it alone.
+    assert_eq!(
+        s.warnings,
+        [format!(
+            "materials[{negative}]: dispersion -1 is negative or not finite, 0 is used"
+        )]
+    );
     let d: Vec<f32> = [prism, rutile, default, negative, thin]
         .iter()
         .map(|&m| s.materials[m].dispersion)
@@ -1056,7 +1125,7 @@ fn dispersion_is_read() {
 }
 
 /// `KHR_materials_diffuse_transmission` is read: factor and color with their textures (the
-/// color texture is sRGB, the factor texture's alpha is data); nothing warns.
+/// color texture is sRGB, the factor texture's alpha is data); only the out-of-range colour warns.
 #[test]
 fn diffuse_transmission_factors_and_textures_are_read() {
     let mut g = Gltf::default();
@@ -1080,7 +1149,13 @@ fn diffuse_transmission_factors_and_textures_are_read() {
     g.node(json!({"mesh": mesh}));
     let dir = tempfile::tempdir().unwrap();
     let s = penumbra::scene::load(&g.write_glb(dir.path(), "leaf")).unwrap();
-    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    // The colour's 2 is out of the specification's range: one warning, for it alone.
+    assert_eq!(
+        s.warnings,
+        [format!(
+            "materials[{m}]: diffuseTransmissionColorFactor 2 is out of range, 1 is used"
+        )]
+    );
     let mat = &s.materials[m];
     assert_eq!(mat.diffuse_transmission, 0.35);
     assert_eq!(

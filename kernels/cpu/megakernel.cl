@@ -41,6 +41,19 @@ inline DeviceHit mega_trace(const MegaTracer* T, float3 o, float3 d, float tmax,
 #endif
 }
 
+#ifdef HAS_SINGLE_SIDED
+// What a camera ray sees, given its closest hit: the backs of single-sided surfaces passed.
+inline DeviceHit mega_camera_hit(const MegaTracer* T, float3 o, float3 d, DeviceHit hit) {
+#ifdef SMALL_SCENE
+    return camera_hit_small(T->small, T->tris, T->instances, T->object_tris, T->surf, o, d, hit,
+                            T->overflow);
+#else
+    return camera_hit_wide(T->nodes, T->tris, T->instances, T->object_tris, T->surf, o, d, hit,
+                           T->overflow);
+#endif
+}
+#endif
+
 // What of a light sample's contribution reaches the path (path.h's shadow test).
 inline float3 mega_shadow(const MegaTracer* T, const ShadowQuery* q) {
 #ifdef SMALL_SCENE
@@ -61,7 +74,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels) return;
-    ShadeScene sc = mega_shade_scene(environment, tris, instances, shading, uvs, tangents,
+    ShadeScene sc = mega_shade_scene(environment, tris, instances, shading, uvs, tangents, colors,
                                      materials, tex_refs, textures, texels, env_texels,
                                      env_marginal, env_conditional, lights, light_cdf);
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
@@ -97,6 +110,9 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #endif
             {
                 hit = mega_trace(&T, s.origin, s.direction, INFINITY, false);
+#ifdef HAS_SINGLE_SIDED
+                if (bounce == 0u) hit = mega_camera_hit(&T, s.origin, s.direction, hit);
+#endif
                 ++extension_rays;
             }
             ShadowQuery q;

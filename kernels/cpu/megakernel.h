@@ -14,7 +14,8 @@
         global const DeviceWideNode *nodes, global const DeviceTriangle *tris,                    \
         global const DeviceInstance *instances, global const DeviceTriangle *object_tris,         \
         global const DeviceTriShading *shading, global const DeviceTriUvs *uvs,                   \
-        global const DeviceTriTangents *tangents, global const DeviceMaterial *materials,         \
+        global const DeviceTriTangents *tangents, global const DeviceTriColors *colors,           \
+        global const DeviceMaterial *materials,                                                   \
         global const DeviceTexRef *tex_refs, global const DeviceTexture *textures,                \
         global const uint *texels, global const float *env_texels,                          \
         global const float *env_marginal, global const float *env_conditional,              \
@@ -28,6 +29,7 @@ inline ShadeScene mega_shade_scene(DeviceEnvironment environment,
                                    global const DeviceTriShading* shading,
                                    global const DeviceTriUvs* uvs,
                                    global const DeviceTriTangents* tangents,
+                                   global const DeviceTriColors* colors,
                                    global const DeviceMaterial* materials,
                                    global const DeviceTexRef* tex_refs,
                                    global const DeviceTexture* textures, global const uint* texels,
@@ -37,7 +39,7 @@ inline ShadeScene mega_shade_scene(DeviceEnvironment environment,
                                    global const DeviceLight* lights,
                                    global const float* light_cdf) {
     ShadeScene sc = {tris,
-                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances},
+                     {shading, uvs, tangents, colors, materials, tex_refs, textures, texels, instances},
                      {environment, env_texels, env_marginal, env_conditional},
                      lights,
                      light_cdf};

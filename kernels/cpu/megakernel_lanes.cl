@@ -167,20 +167,28 @@ inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const Device
     packet_set_rays(&P, &R);
     vint lanes = LANE_IDS < (vint)((int)n);
     packet_walk(&P, lanes, false, nodes, sc->tris, &sc->surf, overflow);
+    DeviceHit hit[LANES];
+    for (uint e = 0u; e < n; ++e) {
+        hit[e] = packet_hit(&P, (int)e);
+#ifdef HAS_SINGLE_SIDED
+        hit[e] = camera_hit_wide(nodes, sc->tris, instances, object_tris, &sc->surf, s[e].origin,
+                                 s[e].direction, hit[e], overflow);
+#endif
+    }
     ShadowQuery q[LANES];
     bool alive[LANES];
     int shadow[LANES];
 #ifdef LANES_SHADE
     // The camera hits shaded together (shade_lanes.h).
     ShadeBatch B;
-    for (uint e = 0u; e < n; ++e) shade_batch_put(&B, (int)e, &s[e], 0u, packet_hit(&P, (int)e));
+    for (uint e = 0u; e < n; ++e) shade_batch_put(&B, (int)e, &s[e], 0u, hit[e]);
     lanes_shade(frame, sc, &B, (int)n);
 #endif
     for (uint e = 0u; e < n; ++e) {
 #ifdef LANES_SHADE
         alive[e] = shade_batch_get(&B, (int)e, &s[e], &q[e]);
 #else
-        alive[e] = shade_vertex(frame, 0u, sc, packet_hit(&P, (int)e), &s[e], &q[e]);
+        alive[e] = shade_vertex(frame, 0u, sc, hit[e], &s[e], &q[e]);
 #endif
         shadow[e] = q[e].valid ? -1 : 0;
         if (q[e].valid) packet_take_ray(&P, &R, (int)e, q[e].origin, q[e].direction, q[e].tmax);
@@ -322,7 +330,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         W.chunk[i].remaining = 0u;
         W.chunk[i].more = false;
     }
-    ShadeScene sc = mega_shade_scene(environment, tris, instances, shading, uvs, tangents,
+    ShadeScene sc = mega_shade_scene(environment, tris, instances, shading, uvs, tangents, colors,
                                      materials, tex_refs, textures, texels, env_texels,
                                      env_marginal, env_conditional, lights, light_cdf);
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];

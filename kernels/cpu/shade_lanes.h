@@ -43,7 +43,7 @@
     defined(HAS_UNLIT) || defined(HAS_THIN_WALLS) || defined(HAS_TRANSMISSION) ||           \
     defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_DIFFUSE_TRANSMISSION) ||     \
     defined(HAS_ANISOTROPY) || defined(HAS_DISPERSION) || defined(SMALL_SCENE) ||            \
-    defined(HAS_IRIDESCENCE)
+    defined(HAS_IRIDESCENCE) || defined(HAS_VERTEX_COLORS)
 #error "LANES_SHADE is for the lanes of scenes whose shading is simplest (cl::lanes_shade)"
 #endif
 

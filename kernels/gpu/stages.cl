@@ -33,23 +33,33 @@ kernel void generate(DeviceFrame frame, DeviceCamera camera, global DevicePath* 
 kernel void extend(global const DeviceBvhNode* nodes, global const DeviceTriangle* tris,
                    global const DeviceInstance* instances, global const DeviceTriangle* object_tris,
                    global const DeviceTriShading* shading, global const DeviceTriUvs* uvs,
-                   global const DeviceTriTangents* tangents,
+                   global const DeviceTriTangents* tangents, global const DeviceTriColors* colors,
                    global const DeviceMaterial* materials, global const DeviceTexRef* tex_refs,
                    global const DeviceTexture* textures, global const uint* texels,
                    global const DevicePath* paths, global const uint* queue,
                    volatile global uint* counters, global DeviceHit* hits) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_IN]) return;
-    SceneSurfaces surf = {shading,  uvs,      tangents, materials,
-                          tex_refs, textures, texels,   instances};
+    SceneSurfaces surf = {shading,  uvs,      tangents, colors,
+                          materials, tex_refs, textures, texels, instances};
     global const DevicePath* p = &paths[queue[i]];
-    hits[i] = trace_scene(nodes, tris, instances, object_tris, &surf, p->origin.xyz,
-                          p->direction.xyz, 0.0f, INFINITY, false, &counters[COUNT_OVERFLOW]);
+    DeviceHit hit = trace_scene(nodes, tris, instances, object_tris, &surf, p->origin.xyz,
+                                p->direction.xyz, 0.0f, INFINITY, false, &counters[COUNT_OVERFLOW]);
+#ifdef HAS_SINGLE_SIDED
+    // A camera ray (no BSDF sample made it, and it passed no surface: no flags) culls the
+    // backs of single-sided surfaces.
+    if (p->origin.w == 0.0f && as_uint(p->direction.w) == 0u) {
+        hit = camera_hit(nodes, tris, instances, object_tris, &surf, p->origin.xyz,
+                         p->direction.xyz, hit, &counters[COUNT_OVERFLOW]);
+    }
+#endif
+    hits[i] = hit;
 }
 
 kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const DeviceTriangle* tris,
                   global const DeviceInstance* instances, global const DeviceTriShading* shading,
                   global const DeviceTriUvs* uvs, global const DeviceTriTangents* tangents,
+                  global const DeviceTriColors* colors,
                   global const DeviceMaterial* materials, global const DeviceTexRef* tex_refs,
                   global const DeviceTexture* textures, global const uint* texels,
                   global const float* env_texels, global const float* env_marginal,
@@ -63,7 +73,7 @@ kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const
     uint slot = queue_in[i];
     DevicePath path = paths[slot];
     ShadeScene sc = {tris,
-                     {shading, uvs, tangents, materials, tex_refs, textures, texels, instances},
+                     {shading, uvs, tangents, colors, materials, tex_refs, textures, texels, instances},
                      {environment, env_texels, env_marginal, env_conditional},
                      lights,
                      light_cdf};
@@ -105,15 +115,15 @@ kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const
 kernel void connect(global const DeviceBvhNode* nodes, global const DeviceTriangle* tris,
                     global const DeviceInstance* instances, global const DeviceTriangle* object_tris,
                     global const DeviceTriShading* shading, global const DeviceTriUvs* uvs,
-                    global const DeviceTriTangents* tangents,
+                    global const DeviceTriTangents* tangents, global const DeviceTriColors* colors,
                     global const DeviceMaterial* materials, global const DeviceTexRef* tex_refs,
                     global const DeviceTexture* textures, global const uint* texels,
                     global const DeviceShadowRay* shadow_rays, volatile global uint* counters,
                     global DevicePath* paths) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_SHADOW]) return;
-    SceneSurfaces surf = {shading,  uvs,      tangents, materials,
-                          tex_refs, textures, texels,   instances};
+    SceneSurfaces surf = {shading,  uvs,      tangents, colors,
+                          materials, tex_refs, textures, texels, instances};
     DeviceShadowRay r = shadow_rays[i];
     ShadowQuery q;
     q.origin = r.origin.xyz;

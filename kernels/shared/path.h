@@ -214,7 +214,9 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         // Escaped into the environment map, weighted against its sampling at the last vertex.
         float env_pdf;
         float3 le = env_radiance(&sc->env, -wo, &env_pdf);
-        if (bounce == 0u) le = env_background(&sc->env, -wo);  // seen directly: filtered
+        // Seen directly, by a camera ray or its continuation straight through thin walls (no BSDF
+        // sample made it: prev_pdf 0), the map is filtered: as smooth through a pane as beside it.
+        if (prev_pdf == 0.0f) le = env_background(&sc->env, -wo);
         float weight = 1.0f;
         if (mis) weight = vertex_power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
         if (light_sampled_only) weight = 0.0f;
@@ -289,6 +291,9 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
 #ifdef HAS_TEXTURES
         if (mat->textures.x >= 0) color *= texture_sample(surf, mat->textures.x, &tc).xyz;
 #endif
+#ifdef HAS_VERTEX_COLORS
+        color *= vertex_color(surf, hit.prim, hit.u, hit.v).xyz;
+#endif
         s->radiance = radiance + throughput * color;
         return false;
     }
@@ -323,19 +328,32 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
 #endif
 #endif
 #ifdef HAS_NORMAL_MAPS
-    if (mat->textures.z >= 0) {
+    // A normal-mapped vertex's normals are bent to keep wo's reflection above the surface
+    // (`bend_normals`, once the material's roughness is known), and bent for wi too where the
+    // BSDF is evaluated (`bent_for`).
+    bool mapped = mat->textures.z >= 0;
+    if (mapped) {
         ns = normal_map(surf, mat->textures.z, mat->alpha.w, &tc, hit_tangents(surf, hit), hit.u,
                         hit.v, ns, ng, front);
     }
+#ifdef HAS_CLEARCOAT
+    mapped = mapped || mat->textures3.z >= 0;
+#endif
 #endif
     SurfaceMaterial m = surface_material(mat);
 #ifdef HAS_CLEARCOAT
     m.coat_normal = coat_normal;
 #endif
+#ifdef HAS_VERTEX_COLORS
+    m.base_color *= vertex_color(surf, hit.prim, hit.u, hit.v).xyz;
+#endif
 #ifdef HAS_TEXTURES
     apply_textures(&m, mat, surf, &tc);
     float alpha_r = m.roughness * m.roughness;
     s->cone = (float2)(cone_width, cone.y + alpha_r);
+#endif
+#ifdef HAS_NORMAL_MAPS
+    if (mapped) bend_normals(&m, ng, wo, &ns);
 #endif
 #ifdef HAS_ANISOTROPY
     if (m.anisotropy > 0.0f) {
@@ -380,7 +398,12 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         float side = dot(ls.wi, ng);
         if (vertex_light_sample_faces(side, ls.wi, ns, ls.radiance)) {
             float bsdf_pdf;
+#ifdef HAS_NORMAL_MAPS
+            float3 f = mapped ? bsdf_eval_bent(&m, ng, ns, wo, ls.wi, &bsdf_pdf)
+                              : bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
+#else
             float3 f = bsdf_eval(&m, ns, wo, ls.wi, &bsdf_pdf);
+#endif
             float weight =
                 vertex_light_sample_weight(ls.pdf, bsdf_pdf, frame->strategy == STRATEGY_MIS);
             float3 contribution = vertex_light_contribution(throughput, f, ls.radiance, weight);
@@ -419,6 +442,19 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
     float u2 = rng_next(&rng);
     float u3 = m.transmission > 0.0f ? rng_next(&rng) : 0.0f;
     float3 weight = bsdf_sample(&m, ns, wo, (float3)(u1, u2, u3), &wi, &pdf, &specular);
+#ifdef HAS_NORMAL_MAPS
+    // As the light sample: the value with the normals bent for wi too, over the sampling's pdf
+    // (a delta lobe's reflection about the bent normal is wo's mirror image, which bends
+    // nothing).
+    if (mapped && !specular && pdf > 0.0f) {
+        SurfaceMaterial mi;
+        float3 ni;
+        if (bent_for(&m, ng, ns, wi, &mi, &ni)) {
+            float unused;
+            weight = bsdf_eval(&mi, ni, wo, wi, &unused) / pdf;
+        }
+    }
+#endif
     throughput *= weight;
     float side = dot(wi, ng);
     bool alive = vertex_goes_on(pdf, side, wi, ns, throughput);
@@ -470,6 +506,9 @@ inline bool thin_wall_tint(global const DeviceTriangle* tris, const SceneSurface
     TexCoords tc = texcoords_at(surf->uvs[hit.prim], hit.u, hit.v);
     apply_textures(&m, mat, surf, &tc);
 #endif
+#ifdef HAS_VERTEX_COLORS
+    m.base_color *= vertex_color(surf, hit.prim, hit.u, hit.v).xyz;
+#endif
     if (!bsdf_passes_straight(&m)) return false;
     float3 ng = triangle_normal(tri.v0.xyz, tri.v1.xyz, tri.v2.xyz);
 #ifdef TWO_LEVEL
@@ -516,6 +555,49 @@ DEFINE_SHADOW_TEST(shadow_pass, global const DeviceBvhNode*, trace_scene)
 DEFINE_SHADOW_TEST(shadow_pass_wide, global const DeviceWideNode*, trace_scene_wide)
 #ifdef SMALL_SCENE
 DEFINE_SHADOW_TEST(shadow_pass_small, local const SmallScene*, trace_small_scene)
+#endif
+
+#ifdef HAS_SINGLE_SIDED
+// The most culled back faces a camera ray passes; beyond them it shades the next one found.
+#define MAX_CULLED 16u
+
+// Whether a camera ray along d meets `hit` on the back of a single-sided surface, which the
+// glTF spec culls (doubleSided false): the camera does not see it. Its geometric normal is
+// shade_vertex's (with two levels, the object-space normal carried to world space).
+inline bool camera_culls(global const DeviceTriangle* tris, const SceneSurfaces* surf, DeviceHit hit,
+                         float3 d) {
+    DeviceTriangle tri = tris[hit.prim];
+    global const DeviceMaterial* mat = &surf->materials[as_uint(tri.v0.w)];
+    if ((as_uint(mat->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u) return false;
+    float3 ng = flat_normal(surf, hit.prim, tri);
+#ifdef TWO_LEVEL
+    DeviceInstance inst = surf->instances[hit.instance];
+    ng = instance_normal(&inst, ng);
+#endif
+    return dot(ng, d) > 0.0f;
+}
+
+// The hit a camera ray (o, d) sees, given the closest one, `hit`: the backs of single-sided
+// surfaces are passed as if absent, each further hit found beyond the last (as shadow rays
+// pass thin walls). Only camera rays cull: see docs/gltf-conformance.md for why the paths'
+// other rays meet both sides. The wavefront's `extend` and the megakernels use it this way.
+#define DEFINE_CAMERA_HIT(NAME, NODES, TRACE)                                                  \
+    inline DeviceHit NAME(NODES nodes, global const DeviceTriangle* tris,                         \
+                          global const DeviceInstance* instances,                                 \
+                          global const DeviceTriangle* object_tris, const SceneSurfaces* surf,    \
+                          float3 o, float3 d, DeviceHit hit, volatile global uint* overflow) {    \
+        for (uint k = 0u; k < MAX_CULLED && hit.prim != NO_HIT && camera_culls(tris, surf, hit, d); \
+             ++k) {                                                                           \
+            hit = TRACE(nodes, tris, instances, object_tris, surf, o, d, hit.t, INFINITY, false,  \
+                        overflow);                                                            \
+        }                                                                                     \
+        return hit;                                                                           \
+    }
+DEFINE_CAMERA_HIT(camera_hit, global const DeviceBvhNode*, trace_scene)
+DEFINE_CAMERA_HIT(camera_hit_wide, global const DeviceWideNode*, trace_scene_wide)
+#ifdef SMALL_SCENE
+DEFINE_CAMERA_HIT(camera_hit_small, local const SmallScene*, trace_small_scene)
+#endif
 #endif
 
 #endif  // SHARED_PATH_H

@@ -14,6 +14,7 @@ typedef struct {
     global const DeviceTriShading* shading;
     global const DeviceTriUvs* uvs;  // a placeholder without HAS_TEXTURES
     global const DeviceTriTangents* tangents;
+    global const DeviceTriColors* colors;  // a placeholder without HAS_VERTEX_COLORS
     global const DeviceMaterial* materials;
     global const DeviceTexRef* refs;
     global const DeviceTexture* textures;
@@ -195,6 +196,15 @@ inline void texcoords_footprint(TexCoords* tc, DeviceTriUvs sh, float3 e1, float
     tc->lod1 = base + 0.5f * log2(uv_area1 / world);
 }
 
+#ifdef HAS_VERTEX_COLORS
+// COLOR_0 of triangle `prim` at barycentrics (u, v) (u: weight of vertex 1): what the glTF spec
+// multiplies into the base color and its alpha.
+inline float4 vertex_color(const SceneSurfaces* s, uint prim, float u, float v) {
+    DeviceTriColors c = s->colors[prim];
+    return (1.0f - u - v) * c.c0 + u * c.c1 + v * c.c2;
+}
+#endif
+
 #ifdef HAS_ALPHA
 // Whether a ray passes through triangle `prim` at barycentrics (u, v): MASK below the cutoff
 // always; BLEND with probability 1 - alpha, decided by a hash of the ray and the triangle so
@@ -210,6 +220,9 @@ inline bool alpha_passes(const SceneSurfaces* s, uint prim, uint material, float
         TexCoords tc = texcoords_at(s->uvs[prim], u, v);
         alpha *= texture_sample(s, m->textures.x, &tc).w;
     }
+#endif
+#ifdef HAS_VERTEX_COLORS
+    alpha *= vertex_color(s, prim, u, v).w;
 #endif
     if (mode == ALPHA_MASK) return alpha < m->alpha.x;
     uint h = hash_u32(prim ^ hash_u32(as_uint(o.x) ^ hash_u32(as_uint(o.y) ^

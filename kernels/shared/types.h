@@ -72,6 +72,14 @@ typedef struct {
     float4 t2;
 } DeviceTriTangents;
 
+// COLOR_0 at a triangle's corners (linear RGBA); on the device only with HAS_VERTEX_COLORS,
+// else a one-element placeholder that is never read.
+typedef struct {
+    float4 c0;
+    float4 c1;
+    float4 c2;
+} DeviceTriColors;
+
 typedef struct {
     uint offset;  // first texel of level 0; levels follow, level l is max(1, w >> l) x max(1, h >> l)
     uint width;   // of level 0

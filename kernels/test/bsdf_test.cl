@@ -4,6 +4,7 @@
 #include "shared/types.h"
 #include "shared/rng.h"
 #include "shared/bsdf.h"
+#include "shared/surface.h"
 
 inline SurfaceMaterial bsdf_test_material(global const DeviceMaterial* material, uint inside) {
     SurfaceMaterial m = surface_material(material);
@@ -48,5 +49,25 @@ kernel void bsdf_eval_test(global const DeviceMaterial* material, float4 wo, flo
     SurfaceMaterial m = bsdf_test_material(material, inside);
     float pdf;
     float3 f = bsdf_eval(&m, n.xyz, wo.xyz, wi[i].xyz, &pdf);
+    value_pdf[i] = (float4)(f, pdf);
+}
+
+// As bsdf_eval_test at a normal-mapped vertex whose geometric normal is +Z and whose mapped
+// normal is n: the normals bent for wo, then the value for wi with them bent for wi too
+// (surface.h, bsdf_eval_bent), as shade_vertex evaluates it.
+kernel void bsdf_eval_bent_test(global const DeviceMaterial* material, float4 wo, float4 n,
+                                uint inside, uint count, global const float4* wi,
+                                global float4* value_pdf) {
+    uint i = get_global_id(0);
+    if (i >= count) return;
+    SurfaceMaterial m = bsdf_test_material(material, inside);
+    float3 ng = (float3)(0.0f, 0.0f, 1.0f);
+    float3 ns = n.xyz;
+#ifdef HAS_CLEARCOAT
+    m.coat_normal = n.xyz;
+#endif
+    bend_normals(&m, ng, wo.xyz, &ns);
+    float pdf;
+    float3 f = bsdf_eval_bent(&m, ng, ns, wo.xyz, wi[i].xyz, &pdf);
     value_pdf[i] = (float4)(f, pdf);
 }

@@ -31,6 +31,9 @@ kernel void probe_layout(global uint* out) {
     PROBE_SIZE(DeviceTriTangents);
     PROBE_FIELD(DeviceTriTangents, t0); PROBE_FIELD(DeviceTriTangents, t1);
     PROBE_FIELD(DeviceTriTangents, t2);
+    PROBE_SIZE(DeviceTriColors);
+    PROBE_FIELD(DeviceTriColors, c0); PROBE_FIELD(DeviceTriColors, c1);
+    PROBE_FIELD(DeviceTriColors, c2);
     PROBE_SIZE(DeviceTexture);
     PROBE_FIELD(DeviceTexture, offset); PROBE_FIELD(DeviceTexture, width);
     PROBE_FIELD(DeviceTexture, height); PROBE_FIELD(DeviceTexture, flags);

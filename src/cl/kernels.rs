@@ -485,17 +485,18 @@ unsafe fn set_geometry(e: &mut ExecuteKernel, nodes: opencl3::types::cl_mem, sce
     }
 }
 
-/// Sets the seven surface arguments every traversing kernel takes after the triangles, in the
+/// Sets the eight surface arguments every traversing kernel takes after the triangles, in the
 /// order of `SceneSurfaces` (kernels/shared/textures.h).
 ///
 /// # Safety
-/// Only for kernels whose next seven parameters are exactly those.
+/// Only for kernels whose next eight parameters are exactly those.
 unsafe fn set_surfaces(e: &mut ExecuteKernel, scene: &SceneBuffers) {
-    // SAFETY: the caller's kernel declares these seven buffers next, in this order.
+    // SAFETY: the caller's kernel declares these eight buffers next, in this order.
     unsafe {
         e.set_arg(&scene.shading.mem())
             .set_arg(&scene.uvs.mem())
             .set_arg(&scene.tangents.mem())
+            .set_arg(&scene.colors.mem())
             .set_arg(&scene.materials.mem())
             .set_arg(&scene.tex_refs.mem())
             .set_arg(&scene.textures.mem())

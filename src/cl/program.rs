@@ -12,6 +12,12 @@ pub struct KernelFeatures {
     pub textures: bool,
     /// Some material has a normal map (`HAS_NORMAL_MAPS`; implies textures).
     pub normal_maps: bool,
+    /// Some mesh has vertex colours (`HAS_VERTEX_COLORS`: `COLOR_0` multiplies the base color
+    /// and its alpha).
+    pub vertex_colors: bool,
+    /// Some material is single-sided (`HAS_SINGLE_SIDED`: camera rays pass the backs of its
+    /// surfaces, as glTF culls them).
+    pub single_sided: bool,
     /// Some material is alpha-masked or blended (`HAS_ALPHA`: alpha tests in traversal).
     pub alpha: bool,
     /// Some material transmits light (`HAS_TRANSMISSION`).
@@ -76,6 +82,8 @@ impl KernelFeatures {
             (self.textures, "HAS_TEXTURES"),
             (self.normal_maps, "HAS_NORMAL_MAPS"),
             (self.alpha, "HAS_ALPHA"),
+            (self.vertex_colors, "HAS_VERTEX_COLORS"),
+            (self.single_sided, "HAS_SINGLE_SIDED"),
             (self.transmission, "HAS_TRANSMISSION"),
             (self.env_map, "HAS_ENV_MAP"),
             (self.thin_walls, "HAS_THIN_WALLS"),

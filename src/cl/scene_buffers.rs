@@ -90,6 +90,8 @@ pub struct SceneBuffers {
     pub uvs: Buffer<DeviceTriUvs>,
     /// Tangents in BVH order (one placeholder element without normal maps).
     pub tangents: Buffer<DeviceTriTangents>,
+    /// Vertex colours in BVH order (one placeholder element when no mesh has them).
+    pub colors: Buffer<DeviceTriColors>,
     /// Texture references (materials index them).
     pub tex_refs: Buffer<DeviceTexRef>,
     /// Texture descriptors.
@@ -115,6 +117,7 @@ impl SceneBuffers {
             + self.shading.bytes()
             + self.uvs.bytes()
             + self.tangents.bytes()
+            + self.colors.bytes()
             + self.tex_refs.bytes()
             + self.textures.bytes()
             + self.texels.bytes()

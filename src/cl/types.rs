@@ -291,6 +291,20 @@ pub struct DeviceTriTangents {
 }
 const _: () = assert!(size_of::<DeviceTriTangents>() == 48);
 
+/// `COLOR_0` at a triangle's corners, linear RGBA, in BVH order (48 bytes); uploaded only
+/// when some mesh has vertex colours (`HAS_VERTEX_COLORS`), white where a mesh has none.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct DeviceTriColors {
+    /// Colour at vertex 0 (RGBA).
+    pub c0: [f32; 4],
+    /// Colour at vertex 1.
+    pub c1: [f32; 4],
+    /// Colour at vertex 2.
+    pub c2: [f32; 4],
+}
+const _: () = assert!(size_of::<DeviceTriColors>() == 48);
+
 /// One texture in the packed texel buffer (16 bytes). Its mip levels follow each other from
 /// `offset`, level `l` being `max(1, width >> l)` × `max(1, height >> l)` RGBA8 texels.
 #[repr(C)]
@@ -547,6 +561,7 @@ pub fn layouts() -> Vec<StructLayout> {
         layout!(DeviceTriShading, n),
         layout!(DeviceTriUvs, uv01, uv2, uv1_12),
         layout!(DeviceTriTangents, t0, t1, t2),
+        layout!(DeviceTriColors, c0, c1, c2),
         layout!(DeviceTexture, offset, width, height, flags),
         layout!(DeviceTexRef, m0, m1, info),
         layout!(

@@ -41,6 +41,11 @@ impl Planned<'_> {
             Accel::Flat(_) => (0, false),
         }
     }
+
+    /// Whether some triangle has vertex colours: flat, the host scene's; two levels, a mesh's.
+    fn colored(&self) -> bool {
+        !self.host.colors.is_empty() || self.meshes.iter().any(|m| !m.colors.is_empty())
+    }
 }
 
 /// The per-triangle buffers of a scene on the device.
@@ -49,6 +54,7 @@ struct TriangleBuffers {
     shading: Buffer<DeviceTriShading>,
     uvs: Buffer<DeviceTriUvs>,
     tangents: Buffer<DeviceTriTangents>,
+    colors: Buffer<DeviceTriColors>,
 }
 
 /// The per-triangle buffers of a scene replaced, to be written again in place.
@@ -57,6 +63,7 @@ type OldTriangleBuffers = (
     Option<Buffer<DeviceTriShading>>,
     Option<Buffer<DeviceTriUvs>>,
     Option<Buffer<DeviceTriTangents>>,
+    Option<Buffer<DeviceTriColors>>,
 );
 
 impl Renderer {
@@ -211,6 +218,7 @@ impl Renderer {
     ) -> Result<SceneBuffers, ClError> {
         let forms = self.node_forms();
         let (mesh_triangles, mesh_tangents) = planned.mesh_triangles();
+        let mesh_colors = !planned.meshes.is_empty() && planned.colored();
         let host = &mut planned.host;
         let (nodes, wide_nodes, instances) = device_accel(host, forms);
         log::debug!(
@@ -228,6 +236,8 @@ impl Renderer {
         let shading = std::mem::take(&mut host.shading);
         let uvs = std::mem::take(&mut host.uvs);
         let tangents = std::mem::take(&mut host.tangents);
+        let colors = std::mem::take(&mut host.colors);
+        let color_count = if mesh_colors { mesh_triangles } else { 0 } + colors.len();
         let tangent_count = if mesh_tangents { mesh_triangles } else { 0 } + tangents.len();
         // Texture coordinates only when some material samples a texture (a superset of the
         // kernels' `HAS_TEXTURES`, which alone reads them); else a placeholder.
@@ -238,6 +248,7 @@ impl Renderer {
             mesh_triangles + shading.len(),
             tangent_count.max(1),
             uv_count.max(1),
+            color_count.max(1),
         );
         // Two levels trace the meshes' object-space triangles in `triangles`: the separate
         // object-triangle buffer is a placeholder either way.
@@ -263,6 +274,7 @@ impl Renderer {
                 "tangents",
                 lengths.2 * std::mem::size_of::<DeviceTriTangents>(),
             ),
+            ("colors", lengths.4 * std::mem::size_of::<DeviceTriColors>()),
             ("texels", bytes(pack.texels.len(), 4)),
         ];
         log::debug!(
@@ -291,6 +303,7 @@ impl Renderer {
                     Some(b.shading),
                     Some(b.uvs),
                     Some(b.tangents),
+                    Some(b.colors),
                 ),
             ),
             None => Default::default(),
@@ -301,12 +314,15 @@ impl Renderer {
         let wide_buffer = put(device, old_wide, &wide_nodes)?;
         drop(wide_nodes);
         let per_triangle = match &host.accel {
-            Accel::Flat(_) => flat_buffers(device, old, (triangles, shading, uvs, tangents))?,
+            Accel::Flat(_) => {
+                flat_buffers(device, old, (triangles, shading, uvs, tangents, colors))?
+            }
             Accel::TwoLevel(two) => {
-                let (o_tri, o_sh, o_uv, o_tan) = old;
+                let (o_tri, o_sh, o_uv, o_tan, o_col) = old;
                 let mut shading_buffer = sized(device, o_sh, lengths.1)?;
                 let mut uvs_buffer = sized(device, o_uv, lengths.3)?;
                 let mut tangents_buffer = sized(device, o_tan, lengths.2)?;
+                let mut colors_buffer = sized(device, o_col, lengths.4)?;
                 let mut triangles_buffer = sized(device, o_tri, lengths.0)?;
                 let n = mesh_triangles;
                 let meshes = &planned.meshes;
@@ -314,26 +330,34 @@ impl Renderer {
                     shading_buffer.fill_mapped(device, |sh| {
                         uvs_buffer.fill_mapped(device, |uv| {
                             tangents_buffer.fill_mapped(device, |tan| {
-                                let tan_out = &mut tan[..if mesh_tangents { n } else { 0 }];
-                                let uv_out = &mut uv[..if mesh_uvs { n } else { 0 }];
-                                let out = (&mut tris[..n], &mut sh[..n], uv_out, tan_out);
-                                HostScene::fill_meshes(two, meshes, materials, out);
-                                tris[n..].copy_from_slice(&triangles);
-                                if !mesh_tangents {
-                                    tan.fill(DeviceTriTangents::default());
-                                }
-                                if !mesh_uvs {
-                                    uv.fill(DeviceTriUvs::default());
-                                }
+                                colors_buffer.fill_mapped(device, |col| {
+                                    let tan_out = &mut tan[..if mesh_tangents { n } else { 0 }];
+                                    let uv_out = &mut uv[..if mesh_uvs { n } else { 0 }];
+                                    let col_out = &mut col[..if mesh_colors { n } else { 0 }];
+                                    let out =
+                                        (&mut tris[..n], &mut sh[..n], uv_out, tan_out, col_out);
+                                    HostScene::fill_meshes(two, meshes, materials, out);
+                                    tris[n..].copy_from_slice(&triangles);
+                                    if !mesh_tangents {
+                                        tan.fill(DeviceTriTangents::default());
+                                    }
+                                    if !mesh_uvs {
+                                        uv.fill(DeviceTriUvs::default());
+                                    }
+                                    if !mesh_colors {
+                                        col.fill(DeviceTriColors::default());
+                                    }
+                                })
                             })
                         })
                     })
-                })????;
+                })?????;
                 TriangleBuffers {
                     triangles: triangles_buffer,
                     shading: shading_buffer,
                     uvs: uvs_buffer,
                     tangents: tangents_buffer,
+                    colors: colors_buffer,
                 }
             }
         };
@@ -348,6 +372,7 @@ impl Renderer {
             shading: per_triangle.shading,
             uvs: per_triangle.uvs,
             tangents: per_triangle.tangents,
+            colors: per_triangle.colors,
             tex_refs: Buffer::from_slice(device, &pack.refs)?,
             textures: Buffer::from_slice(device, &pack.textures)?,
             texels: Buffer::from_slice(device, &pack.texels)?,
@@ -360,18 +385,23 @@ impl Renderer {
     }
 }
 
+/// A flat scene's per-triangle host arrays: triangles, shading, texture coordinates, tangents
+/// and colours.
+type FlatArrays = (
+    Vec<DeviceTriangle>,
+    Vec<DeviceTriShading>,
+    Vec<DeviceTriUvs>,
+    Vec<DeviceTriTangents>,
+    Vec<DeviceTriColors>,
+);
+
 /// A flat scene's per-triangle buffers from its host arrays (triangles, shading, texture
-/// coordinates, tangents; the last two a placeholder of one when empty), each array freed as
+/// coordinates, tangents, colours; the last three a placeholder of one when empty), each array freed as
 /// soon as its buffer is made; `old`'s buffers written again where the length is the same.
 fn flat_buffers(
     device: &Device,
-    (o_tri, o_sh, o_uv, o_tan): OldTriangleBuffers,
-    (triangles, shading, mut uvs, mut tangents): (
-        Vec<DeviceTriangle>,
-        Vec<DeviceTriShading>,
-        Vec<DeviceTriUvs>,
-        Vec<DeviceTriTangents>,
-    ),
+    (o_tri, o_sh, o_uv, o_tan, o_col): OldTriangleBuffers,
+    (triangles, shading, mut uvs, mut tangents, mut colors): FlatArrays,
 ) -> Result<TriangleBuffers, ClError> {
     let shading_buffer = put(device, o_sh, &shading)?;
     drop(shading);
@@ -385,12 +415,18 @@ fn flat_buffers(
     }
     let tangents_buffer = put(device, o_tan, &tangents)?;
     drop(tangents);
+    if colors.is_empty() {
+        colors.push(DeviceTriColors::default());
+    }
+    let colors_buffer = put(device, o_col, &colors)?;
+    drop(colors);
     let triangles_buffer = put(device, o_tri, &triangles)?;
     Ok(TriangleBuffers {
         triangles: triangles_buffer,
         shading: shading_buffer,
         uvs: uvs_buffer,
         tangents: tangents_buffer,
+        colors: colors_buffer,
     })
 }
 
@@ -403,6 +439,8 @@ fn scene_facts(scene: &Scene, planned: &Planned) -> SceneFacts {
     let features = KernelFeatures {
         two_level: matches!(host.accel, Accel::TwoLevel(_)),
         triangle_pieces: matches!(&host.accel, Accel::TwoLevel(t) if t.has_small_meshes()),
+        // The kernels read vertex colours exactly when the upload made them.
+        vertex_colors: planned.colored(),
         ..scene_features(
             scene,
             !host.emissive.is_empty(),
@@ -442,6 +480,12 @@ pub(super) fn scene_features(
         textures: used(&|m| m.textures.any()),
         normal_maps: used(&|m| m.textures.normal_mapped()) && tangents,
         alpha: used(&|m| m.alpha != AlphaMode::Opaque),
+        single_sided: used(&|m| !m.double_sided),
+        // Predicted from the visible meshes; `scene_facts` takes the upload's own answer.
+        vertex_colors: scene
+            .objects
+            .iter()
+            .any(|o| o.visible && !o.mesh.colors.is_empty()),
         transmission: used(&|m| m.transmission > 0.0),
         env_map: false,
         two_level: false,

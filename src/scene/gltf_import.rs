@@ -15,6 +15,7 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
+mod colors;
 mod materials;
 mod meshes;
 mod texture_table;

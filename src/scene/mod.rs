@@ -94,6 +94,9 @@ pub struct Mesh {
     /// `TANGENT` or generated (MikkTSpace) for normal-mapped primitives; empty when no
     /// primitive of the mesh is normal-mapped. Zero where unknown.
     pub tangents: Vec<[Vec4; 3]>,
+    /// `COLOR_0` per vertex (linear RGBA; alpha 1 where the file gave RGB); empty when no
+    /// primitive of the mesh has it, white for the vertices of those without.
+    pub colors: Vec<Vec4>,
     /// The triangles whose material a `KHR_materials_variants` variant changes.
     pub variants: Vec<VariantRange>,
 }
@@ -420,6 +423,8 @@ pub struct WorldTriangle {
     pub uv1: [Vec2; 3],
     /// World-space tangents per vertex (w = bitangent sign), when the mesh has them.
     pub tangents: Option<[Vec4; 3]>,
+    /// `COLOR_0` per vertex (linear RGBA), when the mesh has it.
+    pub colors: Option<[Vec4; 3]>,
     /// Material index.
     pub material: u32,
     /// Object index.
@@ -882,6 +887,7 @@ impl<'a> Placed<'a> {
         } else {
             idx.map(|i| o.mesh.uvs1[i as usize])
         };
+        let colors = (!o.mesh.colors.is_empty()).then(|| idx.map(|i| o.mesh.colors[i as usize]));
         let flip = self.flip;
         let tangents = o.mesh.tangents.get(ti).map(|t| {
             let corners = if flip { [t[0], t[2], t[1]] } else { *t };
@@ -901,6 +907,7 @@ impl<'a> Placed<'a> {
             uv,
             uv1,
             tangents,
+            colors,
             material: o.mesh.materials[ti],
             object: self.object,
         }

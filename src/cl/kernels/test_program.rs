@@ -13,6 +13,7 @@ pub(super) struct TestKernels {
     sample_env_test: Kernel,
     bsdf_sample_test: Kernel,
     bsdf_eval_test: Kernel,
+    bsdf_eval_bent_test: Kernel,
     spawn_test: Kernel,
 }
 
@@ -30,6 +31,7 @@ impl Program {
             sample_env_test: k("sample_env_test")?,
             bsdf_sample_test: k("bsdf_sample_test")?,
             bsdf_eval_test: k("bsdf_eval_test")?,
+            bsdf_eval_bent_test: k("bsdf_eval_bent_test")?,
             spawn_test: k("spawn_test")?,
         };
         Ok(self.tests.get_or_init(|| built))
@@ -192,26 +194,50 @@ impl Program {
         wi: &[[f32; 4]],
     ) -> Result<Vec<[f32; 4]>, ClError> {
         let tests = self.tests(device)?;
+        let kernel = ("bsdf_eval_test", &tests.bsdf_eval_test);
+        self.eval_test(device, kernel, material, (wo, n), inside, wi)
+    }
+
+    /// `bsdf_eval_bent_test` (test program): as [`Program::bsdf_eval_test`] at a normal-mapped
+    /// vertex of geometric normal +Z and mapped normal `n`, its normals bent for `wo` and each
+    /// `wi` as the shade kernel bends them (kernels/shared/surface.h, `bsdf_eval_bent`).
+    pub fn bsdf_eval_bent_test(
+        &self,
+        device: &Device,
+        material: &DeviceMaterial,
+        wo: [f32; 4],
+        n: [f32; 4],
+        wi: &[[f32; 4]],
+    ) -> Result<Vec<[f32; 4]>, ClError> {
+        let tests = self.tests(device)?;
+        let kernel = ("bsdf_eval_bent_test", &tests.bsdf_eval_bent_test);
+        self.eval_test(device, kernel, material, (wo, n), false, wi)
+    }
+
+    /// Runs one of the BSDF evaluation test kernels, which share their parameters.
+    fn eval_test(
+        &self,
+        device: &Device,
+        (name, kernel): (&'static str, &Kernel),
+        material: &DeviceMaterial,
+        (wo, n): ([f32; 4], [f32; 4]),
+        inside: bool,
+        wi: &[[f32; 4]],
+    ) -> Result<Vec<[f32; 4]>, ClError> {
         let material = Buffer::from_slice(device, &[*material])?;
         let wi_buf = Buffer::from_slice(device, wi)?;
         let out = Buffer::<[f32; 4]>::new(device, wi.len())?;
         let inside = inside as u32;
         let count = wi.len() as u32;
-        self.run(
-            device,
-            "bsdf_eval_test",
-            &tests.bsdf_eval_test,
-            wi.len(),
-            |e| unsafe {
-                e.set_arg(&material.mem())
-                    .set_arg(&wo)
-                    .set_arg(&n)
-                    .set_arg(&inside)
-                    .set_arg(&count)
-                    .set_arg(&wi_buf.mem())
-                    .set_arg(&out.mem());
-            },
-        )?;
+        self.run(device, name, kernel, wi.len(), |e| unsafe {
+            e.set_arg(&material.mem())
+                .set_arg(&wo)
+                .set_arg(&n)
+                .set_arg(&inside)
+                .set_arg(&count)
+                .set_arg(&wi_buf.mem())
+                .set_arg(&out.mem());
+        })?;
         out.read(device)
     }
 }

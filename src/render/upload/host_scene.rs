@@ -13,6 +13,16 @@ use crate::scene::{Material, Mesh, RenderFrame, Scene, WorldTriangle, robust_bou
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
+/// The device arrays [`HostScene::fill_meshes`] writes every mesh's structs into: triangles,
+/// shading, texture coordinates, tangents and colours (the last three may be empty).
+pub type MeshArrays<'a> = (
+    &'a mut [DeviceTriangle],
+    &'a mut [DeviceTriShading],
+    &'a mut [DeviceTriUvs],
+    &'a mut [DeviceTriTangents],
+    &'a mut [DeviceTriColors],
+);
+
 /// An emissive triangle of the light table.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Emitter {
@@ -57,6 +67,9 @@ pub struct HostScene {
     /// Tangents, indexed as `triangles`; empty when no triangle is normal-mapped, with two
     /// levels, and after `Renderer::load_scene` moved them to the device.
     pub tangents: Vec<DeviceTriTangents>,
+    /// Vertex colours, indexed as `triangles`; empty when no mesh has them, with two levels,
+    /// and after `Renderer::load_scene` moved them to the device.
+    pub colors: Vec<DeviceTriColors>,
     /// Materials.
     pub materials: Vec<DeviceMaterial>,
     /// Emissive triangles, in light-table order.
@@ -74,7 +87,9 @@ impl HostScene {
     /// data are never held together.
     pub fn flat(world: Vec<WorldTriangle>, materials: &[Material]) -> Self {
         let normal_mapped = world.iter().any(|t| t.tangents.is_some());
-        let mut structs = FlatStructs::new(world.len(), normal_mapped, samples_textures(materials));
+        let colored = world.iter().any(|t| t.colors.is_some());
+        let textured = samples_textures(materials);
+        let mut structs = FlatStructs::new(world.len(), normal_mapped, textured, colored);
         structs.add(world);
         let middle = middle_of(1, &|_| {
             structs.vertices.iter().map(|v| v.map(Vec3::as_dvec3))
@@ -90,7 +105,8 @@ impl HostScene {
         // Tangents are kept when some kept triangle has them (as `flat` decides).
         let maybe_mapped = visible().any(|o| !o.mesh.tangents.is_empty());
         let textured = samples_textures(materials);
-        let mut structs = FlatStructs::new(scene.triangle_count(), maybe_mapped, textured);
+        let colored = visible().any(|o| !o.mesh.colors.is_empty());
+        let mut structs = FlatStructs::new(scene.triangle_count(), maybe_mapped, textured, colored);
         let dropped = scene.flatten_each(space, |world| structs.add(world));
         if !structs.mapped {
             structs.tangents = Vec::new();
@@ -107,6 +123,7 @@ impl HostScene {
             shading,
             uvs,
             tangents,
+            colors,
             vertices,
             ..
         } = structs;
@@ -127,6 +144,11 @@ impl HostScene {
             gather(tangents, &bvh.tri_indices)
         } else {
             tangents
+        };
+        let colors = if colors.is_empty() {
+            colors
+        } else {
+            gather(colors, &bvh.tri_indices)
         };
         let mut emissive = Vec::new();
         for (order, (tri, v)) in triangles.iter_mut().zip(&vertices).enumerate() {
@@ -151,6 +173,7 @@ impl HostScene {
             vertices,
             objects,
             uvs,
+            colors,
             ..Self::assemble(
                 Accel::Flat(bvh),
                 InstanceLayout::default(),
@@ -184,6 +207,7 @@ impl HostScene {
             shading,
             uvs: vec![],
             tangents,
+            colors: vec![],
             materials: materials.iter().map(gpu_material).collect(),
             emissive,
             space: RenderFrame::default(),
@@ -229,6 +253,7 @@ impl HostScene {
                 let out = (
                     (&mut tris[..], &mut shading[..]),
                     (&mut [][..], &mut [][..]),
+                    &mut [][..],
                 );
                 object_triangles(m, &blas.bvh.tri_indices, materials, out);
                 tris
@@ -259,20 +284,15 @@ impl HostScene {
     }
 
     /// Two levels: writes every mesh's device structs, once, in object space and BLAS order
-    /// (`meshes[b]` is BLAS b's mesh) to the front of `triangles` and `shading` (and of `uvs`
-    /// and `tangents` when not empty), each mesh its own range, in parallel. The renderer writes
+    /// (`meshes[b]` is BLAS b's mesh) to the front of `triangles` and `shading` (and of `uvs`,
+    /// `tangents` and `colors` when not empty), each mesh its own range, in parallel. The renderer writes
     /// them straight into the device buffers ([`crate::cl::Buffer::fill_mapped`]): on a CPU
     /// device no host copy of these arrays (144 bytes a triangle) is made beside them.
     pub fn fill_meshes(
         two: &TwoLevel,
         meshes: &[&Mesh],
         materials: &[Material],
-        (triangles, shading, uvs, tangents): (
-            &mut [DeviceTriangle],
-            &mut [DeviceTriShading],
-            &mut [DeviceTriUvs],
-            &mut [DeviceTriTangents],
-        ),
+        (triangles, shading, uvs, tangents, colors): MeshArrays,
     ) {
         let sizes: Vec<usize> = two.blases.iter().map(|b| b.bvh.tri_indices.len()).collect();
         let sizes_if = |full: bool| {
@@ -283,6 +303,7 @@ impl HostScene {
             }
         };
         let (uv_sizes, tangent_sizes) = (sizes_if(!uvs.is_empty()), sizes_if(!tangents.is_empty()));
+        let color_sizes = sizes_if(!colors.is_empty());
         let parts = split_by(triangles, &sizes)
             .into_iter()
             .zip(split_by(shading, &sizes))
@@ -290,7 +311,9 @@ impl HostScene {
                 split_by(uvs, &uv_sizes)
                     .into_iter()
                     .zip(split_by(tangents, &tangent_sizes)),
-            );
+            )
+            .zip(split_by(colors, &color_sizes))
+            .map(|((a, b), c)| (a, b, c));
         meshes
             .par_iter()
             .zip(&two.blases)

@@ -1,11 +1,11 @@
 //! Mesh triangles into the device's structs: vertices (with material, light and object in
-//! their .w lanes), corner normals, texture coordinates and tangents; flat (world space, a list
+//! their .w lanes), corner normals, texture coordinates, tangents and vertex colours; flat (world space, a list
 //! of placed triangles at a time) or per mesh (object space, in its BLAS's order).
 
 use super::structs::f4;
 use crate::cl::types::*;
 use crate::scene::{Material, Mesh, WorldTriangle};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 /// The area of the triangle with vertices `v`.
@@ -28,11 +28,12 @@ pub(super) fn split_by<'a, T>(mut v: &'a mut [T], sizes: &[usize]) -> Vec<&'a mu
 }
 
 /// One mesh's device structs for [`object_triangles`] to fill: triangles, corner normals,
-/// texture coordinates (empty when no material samples a texture) and tangents (empty when no
-/// mesh is normal-mapped).
+/// texture coordinates (empty when no material samples a texture), tangents (empty when no
+/// mesh is normal-mapped) and vertex colours (empty when no mesh has them).
 pub(super) type MeshStructs<'a> = (
     (&'a mut [DeviceTriangle], &'a mut [DeviceTriShading]),
     (&'a mut [DeviceTriUvs], &'a mut [DeviceTriTangents]),
+    &'a mut [DeviceTriColors],
 );
 
 /// Whether triangle `ti` of `m` (vertices `v`) is a light: an emissive material and a
@@ -67,14 +68,16 @@ pub(super) fn emissive_triangles(
 }
 
 /// Writes the device structs of one mesh's triangles in object space, in the order `order`,
-/// to `out` (texture coordinates and tangents unless their slices are empty); an emissive triangle's `v1.w` counts the
+/// to `out` (texture coordinates, tangents and colours unless their slices are empty); an
+/// emissive triangle's `v1.w` counts the
 /// mesh's emissive triangles ([`emissive_triangles`]).
 pub(super) fn object_triangles(
     m: &Mesh,
     order: &[u32],
     materials: &[Material],
-    ((tris, shading), (uvs, tangents)): MeshStructs,
+    ((tris, shading), (uvs, tangents), colors): MeshStructs,
 ) {
+    let colored = !colors.is_empty();
     let normal_mapped = !tangents.is_empty();
     let textured = !uvs.is_empty();
     let mut emitters = 0;
@@ -105,6 +108,7 @@ pub(super) fn object_triangles(
             uv: idx.map(|i| corner(&m.uvs, i)),
             uv1: idx.map(|i| corner(&m.uvs1, i)),
             tangents: m.tangents.get(ti as usize).copied(),
+            colors: (!m.colors.is_empty()).then(|| idx.map(|i| m.colors[i as usize])),
             material,
             object: 0,
         };
@@ -116,6 +120,9 @@ pub(super) fn object_triangles(
         }
         if normal_mapped {
             tangents[k] = device_tangents(&t);
+        }
+        if colored {
+            colors[k] = device_colors(&t);
         }
     }
 }
@@ -129,24 +136,34 @@ pub(super) struct FlatStructs {
     pub(super) uvs: Vec<DeviceTriUvs>,
     /// Filled when tangents may be needed (`keep_tangents`).
     pub(super) tangents: Vec<DeviceTriTangents>,
+    /// Filled when some mesh has vertex colours (`keep_colors`).
+    pub(super) colors: Vec<DeviceTriColors>,
     pub(super) vertices: Vec<[Vec3; 3]>,
     keep_uvs: bool,
     keep_tangents: bool,
+    keep_colors: bool,
     /// Whether some triangle added had tangents.
     pub(super) mapped: bool,
 }
 
 impl FlatStructs {
-    pub(super) fn new(capacity: usize, keep_tangents: bool, keep_uvs: bool) -> Self {
+    pub(super) fn new(
+        capacity: usize,
+        keep_tangents: bool,
+        keep_uvs: bool,
+        keep_colors: bool,
+    ) -> Self {
         let if_kept = |keep: bool| if keep { capacity } else { 0 };
         Self {
             triangles: Vec::with_capacity(capacity),
             shading: Vec::with_capacity(capacity),
             uvs: Vec::with_capacity(if_kept(keep_uvs)),
             tangents: Vec::with_capacity(if_kept(keep_tangents)),
+            colors: Vec::with_capacity(if_kept(keep_colors)),
             vertices: Vec::with_capacity(capacity),
             keep_uvs,
             keep_tangents,
+            keep_colors,
             mapped: false,
         }
     }
@@ -165,6 +182,9 @@ impl FlatStructs {
         if self.keep_tangents {
             self.tangents
                 .par_extend(world.par_iter().map(device_tangents));
+        }
+        if self.keep_colors {
+            self.colors.par_extend(world.par_iter().map(device_colors));
         }
         self.vertices.par_extend(world.par_iter().map(|t| t.v));
     }
@@ -195,6 +215,16 @@ fn device_uvs(t: &WorldTriangle) -> DeviceTriUvs {
         uv01: [t.uv[0].x, t.uv[0].y, t.uv[1].x, t.uv[1].y],
         uv2: [t.uv[2].x, t.uv[2].y, t.uv1[0].x, t.uv1[0].y],
         uv1_12: [t.uv1[1].x, t.uv1[1].y, t.uv1[2].x, t.uv1[2].y],
+    }
+}
+
+/// A triangle's vertex colours on the device (white without).
+fn device_colors(t: &WorldTriangle) -> DeviceTriColors {
+    let c = t.colors.unwrap_or([Vec4::ONE; 3]).map(|v| v.to_array());
+    DeviceTriColors {
+        c0: c[0],
+        c1: c[1],
+        c2: c[2],
     }
 }
 

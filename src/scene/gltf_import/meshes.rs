@@ -7,6 +7,7 @@ use super::super::compression;
 use super::super::pose::{Pose, apply_morph_targets, apply_skin, node_pose};
 use super::super::variants::{self, VariantRange};
 use super::super::{Mesh, limits, tangents};
+use super::colors::{pad_colors, read_colors};
 use glam::{DMat4, Vec2, Vec3, Vec4};
 use gltf::json::validation::Checked;
 use gltf::mesh::Mode;
@@ -170,6 +171,7 @@ pub(super) fn import_mesh(
                 ));
             }
         }
+        let colors = read_colors(&attributes, positions.len())?;
         let material = prim
             .material()
             .index()
@@ -274,6 +276,7 @@ pub(super) fn import_mesh(
         pad_attribute(&mut out.normals, base as usize, normals, vertices);
         pad_attribute(&mut out.uvs, base as usize, uvs, vertices);
         pad_attribute(&mut out.uvs1, base as usize, uvs1, vertices);
+        pad_colors(&mut out.colors, base as usize, colors, vertices);
         append(&mut out.positions, positions);
         if base == 0 {
             append(&mut out.indices, triangles);
