@@ -458,6 +458,11 @@ fn frames_and_screenshot_save_the_final_frame_and_hard_shadows_are_sharper() {
         "--frames",
         "2",
         "--no-overlay",
+        // A fixed exposure and tone curve: the edge is measured, not the automatic exposure.
+        "--exposure",
+        "1.2",
+        "--tonemap",
+        "aces",
     ];
     let mut shots = Vec::new();
     for (name, extra) in [("soft", None), ("hard", Some("--hard-shadows"))] {
@@ -513,6 +518,11 @@ fn keys_and_mouse_drive_the_window() {
         "--spp",
         "48",
         "--no-overlay",
+        // As above: the edge is measured under a fixed exposure and tone curve.
+        "--exposure",
+        "1.2",
+        "--tonemap",
+        "aces",
         "--screenshot",
         last.to_str().unwrap(),
     ];
