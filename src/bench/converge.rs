@@ -147,10 +147,18 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
 
     let mut renderer = args.common.open_renderer(&settings)?;
+    // The environment map lights the scene as it does in `render` (the references come from
+    // `render`).
+    if let Some(crate::args::EnvChoice::Map(map)) = prepared.environment.take() {
+        renderer.set_environment(Some(map))?;
+    }
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| source.clone())?;
-    if renderer.host_scene().is_some_and(|h| h.emissive.is_empty()) && prepared.lights.is_empty() {
+    if renderer.host_scene().is_some_and(|h| h.emissive.is_empty())
+        && prepared.lights.is_empty()
+        && renderer.environment().is_none()
+    {
         bail!("{source}: no light is left (no emissive triangles and --no-punctual)");
     }
     renderer.set_camera(&prepared.camera)?;
