@@ -29,15 +29,22 @@ fn render(
 }
 
 /// Per 8×8 block and channel, over `SEEDS` renders: the mean of the block means and the
-/// variance of that mean.
-fn block_stats(scene: &Path, dir: &Path, kernel: &str, extra: &[&str]) -> (Vec<f64>, Vec<f64>) {
+/// variance of that mean; and the mean samples per pixel the renders took.
+fn block_stats(
+    scene: &Path,
+    dir: &Path,
+    kernel: &str,
+    extra: &[&str],
+) -> (Vec<f64>, Vec<f64>, f64) {
     let n = (SIZE / BLOCK) * (SIZE / BLOCK) * 3;
     let (mut sum, mut sum2) = (vec![0.0f64; n], vec![0.0f64; n]);
+    let mut spp = 0.0;
     for seed in 0..SEEDS {
         let seed = (100 + seed).to_string();
         let mut args = vec!["--seed", &seed];
         args.extend_from_slice(extra);
-        let (_, px) = render(scene, &dir.join(format!("{kernel}.exr")), kernel, &args);
+        let (summary, px) = render(scene, &dir.join(format!("{kernel}.exr")), kernel, &args);
+        spp += summary["mean_spp"].as_f64().unwrap() / f64::from(SEEDS);
         for b in 0..n {
             let (c, blk) = (b % 3, b / 3);
             let (bx, by) = (blk % (SIZE / BLOCK), blk / (SIZE / BLOCK));
@@ -59,7 +66,7 @@ fn block_stats(scene: &Path, dir: &Path, kernel: &str, extra: &[&str]) -> (Vec<f
         .zip(&mean)
         .map(|(s2, m)| ((s2 / k - m * m) * k / (k - 1.0)).max(0.0) / k)
         .collect();
-    (mean, var)
+    (mean, var, spp)
 }
 
 #[test]
@@ -68,10 +75,17 @@ fn adaptive_renders_average_to_the_uniform_image() {
     let scene = white_sphere_under_panel(&dir, 16, 32);
     for kernel in KERNELS {
         let base = ["--spp", "64", "--sky", "0.3"];
-        let (uniform, uniform_var) = block_stats(&scene, &dir, kernel, &base);
-        // A loose threshold: many pixels stop at the minimum (32), the others go on to 64.
-        let adaptive_args = [&base[..], &["--noise-threshold", "0.3"]].concat();
-        let (adaptive, adaptive_var) = block_stats(&scene, &dir, kernel, &adaptive_args);
+        let (uniform, uniform_var, uniform_spp) = block_stats(&scene, &dir, kernel, &base);
+        // About half the pixels stop, at the minimum (32) or at the check at 48; the others
+        // go on to 64.
+        let adaptive_args = [&base[..], &["--noise-threshold", "0.1"]].concat();
+        let (adaptive, adaptive_var, adaptive_spp) =
+            block_stats(&scene, &dir, kernel, &adaptive_args);
+        assert_eq!(uniform_spp, 64.0);
+        assert!(
+            (32.0..60.0).contains(&adaptive_spp),
+            "{kernel}: adaptive renders took {adaptive_spp} spp"
+        );
         for b in 0..uniform.len() {
             let sigma = (uniform_var[b] + adaptive_var[b]).sqrt();
             let diff = (adaptive[b] - uniform[b]).abs();
@@ -156,5 +170,36 @@ fn bad_stopping_rules_fail_in_one_line() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(err.trim().lines().count(), 1, "{flag} {value}: {err}");
         assert!(err.contains(flag), "{flag} {value}: {err}");
+    }
+}
+
+#[test]
+fn cutting_the_background_out_leaves_the_object_as_it_was() {
+    let dir = output_dir("adaptive-cutout");
+    let scene = white_sphere_under_panel(&dir, 16, 32);
+    for kernel in KERNELS {
+        let args = ["--spp", "128", "--sky", "0.3", "--noise-threshold", "0.3"];
+        let (_, shown) = render(
+            &scene,
+            &dir.join(format!("{kernel}-env.exr")),
+            kernel,
+            &args,
+        );
+        let cut = [&args[..], &["--background", "transparent"]].concat();
+        let (summary, cutout) =
+            render(&scene, &dir.join(format!("{kernel}-cut.exr")), kernel, &cut);
+        assert!(summary["converged_share"].as_f64().unwrap() > 0.0);
+        // The sky corner: no hit, nothing; the image centre lies on the sphere, far from its
+        // edge, so its neighbourhood converges alike either way: it took the same samples and
+        // shows the same mean.
+        assert_eq!(cutout[0], [0.0; 3], "{kernel}");
+        let centre = SIZE / 2 * SIZE + SIZE / 2;
+        for c in 0..3 {
+            let (a, b) = (cutout[centre][c], shown[centre][c]);
+            assert!(
+                b > 0.0 && (a - b).abs() <= 1e-5 * b,
+                "{kernel}: centre {a} vs {b}"
+            );
+        }
     }
 }
