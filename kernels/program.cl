@@ -22,6 +22,8 @@
 #include "shared/env.h"
 #include "shared/lights.h"
 #include "shared/path.h"
+// Adaptive sampling: the half buffer, the error estimate and the convergence check.
+#include "shared/adaptive.h"
 // The CPU lanes' batched shading (LANES_SHADE only).
 #include "cpu/shade_lanes.h"
 // The wavefront stages (GPUs; CPUs with --kernel wavefront).

@@ -776,7 +776,7 @@ fn parse_non_negative(s: &str) -> Result<f32, String> {
 }
 
 /// A finite number > 0.
-fn parse_positive(s: &str) -> Result<f32, String> {
+pub(crate) fn parse_positive(s: &str) -> Result<f32, String> {
     match parse_finite(s)? {
         v if v > 0.0 => Ok(v),
         _ => Err(format!("'{s}' must be a finite number > 0")),

@@ -4,7 +4,8 @@
 // the path state in registers: no queues, no path buffers, one launch per pass. Each vertex is
 // shaded by path.h's shade_vertex, as the wavefront's `shade` does, and its light sample is
 // traced at once (the wavefront's `connect`), so both compute the same estimator from the
-// same random numbers. The samples of a pixel are added to its film sum in order, one by one.
+// same random numbers. The samples of a pixel are added to its film sum in order, one by one;
+// with adaptive sampling a converged pixel takes none.
 //
 // Rays are traced through the 4-wide BVH (traverse_wide.h), whose box tests use the CPU's
 // vector lanes, or with SMALL_SCENE tested against every triangle of a small scene.
@@ -73,7 +74,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #endif
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
-    if (pixel >= pixels) return;
+    if (pixel >= pixels || pixel_converged(&frame, state, pixel)) return;
     ShadeScene sc = mega_shade_scene(environment, tris, instances, shading, uvs, tangents, colors,
                                      materials, tex_refs, textures, texels, env_texels,
                                      env_marginal, env_conditional, lights, light_cdf);
@@ -86,6 +87,8 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     uint shadow_rays = 0;
     uint nonfinite = 0;
     uint counted = 0;  // samples whose camera ray hit (the film's .w with the background cut out)
+    float3 even = (float3)(0.0f);  // adaptive sampling's half buffer (shared/adaptive.h)
+    uint evens = 0;
 #ifdef SMALL_SCENE
     sc.surf.small = &small;
     const MegaTracer T = {&small, tris, instances, object_tris, &sc.surf, overflow};
@@ -124,9 +127,11 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             if (!alive) break;
         }
         mega_add_sample(&s, &sum, &counted, &nonfinite);
+        if (frame.adaptive != 0u) half_add(s.radiance, frame.first_sample + j, &even, &evens);
     }
     if (frame.background == BACKGROUND_ENV) counted = frame.samples_in_wave;
     film[pixel] = (float4)(sum, pixel_film.w + (float)counted);
+    if (frame.adaptive != 0u) half_store(halves, state, pixel, even, evens, frame.samples_in_wave);
     mega_count(counters, extension_rays, shadow_rays, nonfinite);
 }
 #endif  // !MEGA_LANES

@@ -1,12 +1,13 @@
 // What the CPU megakernels share (megakernel.cl one path at a time, megakernel_lanes.cl with
 // MEGA_LANES): the kernel's parameters, the scene shading reads from them, a finished sample's
-// sum and the work item's ray counts, and the last ray traced only toward the emitters.
+// sum and the work item's ray counts (and adaptive sampling's film, shared/adaptive.h), and the last ray traced only toward the emitters.
 #ifndef CPU_MEGAKERNEL_H
 #define CPU_MEGAKERNEL_H
 
 #include "shared/types.h"
 #include "shared/traverse.h"
 #include "shared/path.h"
+#include "shared/adaptive.h"
 
 // The kernel's parameters, in both megakernels.
 #define MEGAKERNEL_PARAMS                                                                   \
@@ -20,7 +21,7 @@
         global const uint *texels, global const float *env_texels,                          \
         global const float *env_marginal, global const float *env_conditional,              \
         global const DeviceLight *lights, global const float *light_cdf, global float4 *film, \
-        volatile global uint *counters
+        volatile global uint *counters, global float4 *halves, global uint *state
 
 // What shading reads of the scene, from the kernel's parameters.
 inline ShadeScene mega_shade_scene(DeviceEnvironment environment,

@@ -46,6 +46,7 @@ typedef struct {
     uint pixel[LANES];    // entry e's pixel (a pixel's entries follow each other, in sample order)
     float3 result[LANES];  // entry e's radiance, once its path is done
     uint escaped;          // bit e: entry e's camera ray escaped (PATH_ESCAPED)
+    uint even;             // bit e: entry e's sample index is even (adaptive.h's half buffer)
     uint count;            // entries
     uint remaining;        // paths not yet done: 0 when the record is not in flight
     uint next_sample;      // one pixel a chunk: the pixel's next sample to start
@@ -61,6 +62,8 @@ typedef struct {
     uint tile_x, tile_y, tile_w, tile_h;
     uint next_pixel;  // of the tile, in 4×4 blocks
     uint extension_rays, shadow_rays, nonfinite;
+    global float4* halves;  // adaptive sampling's film (shared/adaptive.h)
+    global uint* state;
 } MegaWork;
 
 // The tile's pixel `i` in the order of 4×4 blocks (16 of them, row by row), or -1 outside the
@@ -81,8 +84,12 @@ inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global float4
         float4 f = film[p];
         float3 sum = f.xyz;
         uint counted = 0u, samples = 0u;
+        float3 even = (float3)(0.0f);
+        uint evens = 0u;
         for (; e < c->count && c->pixel[e] == p; ++e, ++samples) {
             counted += ((c->escaped >> e) & 1u) == 0u;
+            // The index's parity from the chunk's bit: 0 for even, 1 for odd.
+            half_add(c->result[e], ((c->even >> e) & 1u) ^ 1u, &even, &evens);
             if (all(isfinite(c->result[e]))) {
                 sum += c->result[e];
             } else {
@@ -91,6 +98,7 @@ inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global float4
         }
         uint n = frame->background == BACKGROUND_ENV ? samples : counted;
         film[p] = (float4)(sum, f.w + (float)n);
+        if (frame->adaptive != 0u) half_store(W->halves, W->state, p, even, evens, samples);
     }
 }
 
@@ -140,7 +148,7 @@ inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const Device
         c->count = 0u;
         for (uint k = 0u; k < pixels && W->next_pixel < LANES_TILE * LANES_TILE;) {
             int p = mega_tile_pixel(W, frame, W->next_pixel++);
-            if (p < 0) continue;
+            if (p < 0 || pixel_converged(frame, W->state, (uint)p)) continue;
             for (uint j = 0u; j < min(spp, (uint)LANES); ++j) {
                 c->pixel[c->count] = (uint)p;
                 sample0[c->count++] = j;
@@ -153,6 +161,10 @@ inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const Device
     c->next_sample += spp >= (uint)LANES ? c->count : spp;
     c->more = c->next_sample < spp;
     c->escaped = 0u;
+    c->even = 0u;
+    for (uint e = 0u; e < c->count; ++e) {
+        c->even |= (uint)(((frame->first_sample + sample0[e]) & 1u) == 0u) << e;
+    }
     c->remaining = c->count;
     uint n = c->count;
     W->extension_rays += n;
@@ -326,6 +338,8 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     W.next_pixel = 0u;
     W.queue_head = W.queue_end = 0u;
     W.extension_rays = W.shadow_rays = W.nonfinite = 0u;
+    W.halves = halves;
+    W.state = state;
     for (int i = 0; i < MEGA_CHUNKS; ++i) {
         W.chunk[i].remaining = 0u;
         W.chunk[i].more = false;

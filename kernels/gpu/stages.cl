@@ -1,19 +1,31 @@
 // The wavefront stages of the path tracer, in the order the host launches them:
 //   generate -> [extend -> shade -> connect -> advance] x (bounces + 2) -> accumulate
 // Paths live in `paths` by slot (pixel + sample_in_wave * pixels); queues hold the slots of the
-// live paths, compacted by atomic counters, so later bounces only touch live paths.
+// live paths, compacted by atomic counters, so later bounces only touch live paths. With
+// adaptive sampling (adaptive.h) `generate` queues only the active pixels' slots and an
+// `advance` follows it; `converge` and `converge_dilate` check the film between waves.
 
 #include "shared/types.h"
 #include "shared/textures.h"
 #include "shared/traverse.h"
 #include "shared/path.h"
+#include "shared/adaptive.h"
 
+// Camera rays for the wave's slots. With adaptive sampling only the active pixels' slots are
+// queued, in COUNT_OUT (0 here: every `advance` leaves it so), which the `advance` launched next
+// makes the first bounce's input.
 kernel void generate(DeviceFrame frame, DeviceCamera camera, global DevicePath* paths, global uint* queue,
-                     global uint* counters, global float2* cones) {
+                     global uint* counters, global float2* cones, global const uint* state) {
     uint slot = get_global_id(0);
     uint pixels = frame.width * frame.height;
     uint total = pixels * frame.samples_in_wave;
-    if (slot == 0) {
+    if (frame.adaptive != 0u) {
+        if (slot == 0) {
+            counters[COUNT_IN] = 0;
+            counters[COUNT_SHADOW] = 0;
+        }
+        if (slot >= total || pixel_converged(&frame, state, slot % pixels)) return;
+    } else if (slot == 0) {
         counters[COUNT_IN] = total;
         counters[COUNT_OUT] = 0;
         counters[COUNT_SHADOW] = 0;
@@ -26,8 +38,12 @@ kernel void generate(DeviceFrame frame, DeviceCamera camera, global DevicePath* 
     p.throughput = (float4)(s.throughput, as_float(slot));
     p.radiance = (float4)(s.radiance, as_float(s.rng));
     paths[slot] = p;
-    queue[slot] = slot;
     cones[slot] = s.cone;
+    if (frame.adaptive != 0u) {
+        queue[atomic_inc(&counters[COUNT_OUT])] = slot;
+    } else {
+        queue[slot] = slot;
+    }
 }
 
 kernel void extend(global const DeviceBvhNode* nodes, global const DeviceTriangle* tris,
@@ -149,11 +165,13 @@ kernel void advance(global uint* counters, global ulong* stats) {
 // Adds every finished sample of the wave to the film (.xyz radiance sum, .w sample count; with
 // coverage counted, .w counts the samples whose camera ray hit), in a fixed order per pixel
 // so the result does not depend on the queues' order. Non-finite samples are counted and dropped.
+// With adaptive sampling converged pixels are skipped and the others' half buffers and sample
+// counts updated (adaptive.h).
 kernel void accumulate(DeviceFrame frame, global const DevicePath* paths, global float4* film,
-                       volatile global uint* counters) {
+                       volatile global uint* counters, global float4* halves, global uint* state) {
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
-    if (pixel >= pixels) return;
+    if (pixel >= pixels || pixel_converged(&frame, state, pixel)) return;
     // Added to the film's sum one by one, so that the image does not depend on how many
     // samples each wave took (a float sum depends on its order).
     float4 pixel_film = film[pixel];
@@ -174,4 +192,12 @@ kernel void accumulate(DeviceFrame frame, global const DevicePath* paths, global
         }
     }
     film[pixel] = (float4)(sum, pixel_film.w + (float)counted);
+    if (frame.adaptive != 0u) {
+        float3 even = (float3)(0.0f);
+        uint evens = 0u;
+        for (uint j = 0; j < frame.samples_in_wave; ++j) {
+            half_add(paths[pixel + j * pixels].radiance.xyz, frame.first_sample + j, &even, &evens);
+        }
+        half_store(halves, state, pixel, even, evens, frame.samples_in_wave);
+    }
 }

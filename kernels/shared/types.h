@@ -1,7 +1,7 @@
 // Structs shared with the host. Each mirrors one in src/cl/types.rs field for field; the layout
 // probe test checks sizes and offsets. No bare float3: payloads ride in .w of a float4.
 // The constants named in comments here (TEXTURE_*, WRAP_*, TEXREF_*, MATERIAL_*, ALPHA_*,
-// LIGHT_*, STRATEGY_*, PATH_*, COUNT_*, STAT_*) are defined once in src/cl/types.rs, from which
+// LIGHT_*, STRATEGY_*, PATH_*, COUNT_*, STAT_*, PIXEL_*) are defined once in src/cl/types.rs, from which
 // the host generates generated/constants.h (src/cl/source.rs).
 #ifndef SHARED_TYPES_H
 #define SHARED_TYPES_H
@@ -151,6 +151,8 @@ typedef struct {
     uint bounce;
     uint background;  // BACKGROUND_*: what an escaped camera ray adds
     uint triangles;   // the scene's, for SMALL_SCENE (traverse_wide.h); 0 elsewhere
+    uint adaptive;    // 1: adaptive sampling (adaptive.h); 0: its buffers untouched
+    uint pad[3];
 } DeviceFrame;
 
 typedef struct {

@@ -65,7 +65,7 @@ kernel void probe_layout(global uint* out) {
     PROBE_FIELD(DeviceFrame, rr_depth); PROBE_FIELD(DeviceFrame, strategy);
     PROBE_FIELD(DeviceFrame, sky); PROBE_FIELD(DeviceFrame, light_count);
     PROBE_FIELD(DeviceFrame, bounce); PROBE_FIELD(DeviceFrame, background);
-    PROBE_FIELD(DeviceFrame, triangles);
+    PROBE_FIELD(DeviceFrame, triangles); PROBE_FIELD(DeviceFrame, adaptive);
     PROBE_SIZE(DevicePath);
     PROBE_FIELD(DevicePath, origin); PROBE_FIELD(DevicePath, direction);
     PROBE_FIELD(DevicePath, throughput); PROBE_FIELD(DevicePath, radiance);

@@ -103,6 +103,8 @@ pub struct Progress {
     pub plan: Option<Plan>,
     /// The last batch's wall time in milliseconds.
     pub batch_ms: f64,
+    /// With adaptive sampling, the share of pixels the last convergence check stopped.
+    pub converged_share: Option<f64>,
 }
 
 struct Batch {
@@ -244,6 +246,10 @@ impl FrameLoop {
         p.stats = self.renderer.stats().clone();
         p.plan = Some(batch.plan);
         p.batch_ms = ms;
+        p.converged_share = self
+            .renderer
+            .active_pixels()
+            .map(|active| 1.0 - f64::from(active) / pixel_count(size).max(1) as f64);
         if p.seconds > 0.0 {
             p.samples_per_second = pixel_count(size) as f64 * spp as f64 / p.seconds;
             p.rays_per_second = (p.stats.extension_rays + p.stats.shadow_rays) as f64 / p.seconds;

@@ -207,8 +207,12 @@ impl Gui {
             .view
             .spp_target
             .map_or_else(|| "∞".to_string(), |t| t.to_string());
+        let converged = info
+            .progress
+            .converged_share
+            .map_or_else(String::new, |c| format!(" · {:.0} % converged", c * 100.0));
         ui.label(format!(
-            "{} / {target} spp · {:.2} MS/s · {:.0} fps",
+            "{} / {target} spp{converged} · {:.2} MS/s · {:.0} fps",
             info.progress.spp,
             info.progress.samples_per_second * 1e-6,
             info.fps
@@ -229,6 +233,26 @@ impl Gui {
                 {
                     actions.changes.settings = true;
                 }
+                ui.horizontal_wrapped(|ui| {
+                    // Adaptive sampling: converged pixels stop (docs/adaptive-sampling.md).
+                    let mut adaptive = v.noise_threshold.is_some();
+                    if ui.checkbox(&mut adaptive, "adaptive").changed() {
+                        v.noise_threshold = adaptive.then_some(0.01);
+                        actions.changes.settings = true;
+                    }
+                    if let Some(t) = v.noise_threshold.as_mut()
+                        && ui
+                            .add(
+                                egui::DragValue::new(t)
+                                    .range(0.001..=1.0)
+                                    .speed(0.001)
+                                    .prefix("noise threshold "),
+                            )
+                            .changed()
+                    {
+                        actions.changes.settings = true;
+                    }
+                });
                 ui.horizontal_wrapped(|ui| {
                     let mut endless = v.spp_target.is_none();
                     if ui.checkbox(&mut endless, "endless").changed() {

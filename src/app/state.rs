@@ -73,6 +73,8 @@ pub struct RigLight {
 pub struct ViewState {
     /// Bounces after the first hit.
     pub bounces: u32,
+    /// Adaptive sampling's noise threshold (`render --noise-threshold`); `None`: off.
+    pub noise_threshold: Option<f32>,
     /// Seed of the random sequence.
     pub seed: u32,
     /// Uniform sky radiance.
@@ -122,6 +124,7 @@ impl ViewState {
     ) -> Self {
         let mut s = Self {
             bounces: base.bounces,
+            noise_threshold: base.noise_threshold,
             seed: base.seed,
             sky: base.sky,
             env_intensity: base.env_intensity,
@@ -175,6 +178,7 @@ impl ViewState {
             width: size.0.max(1),
             height: size.1.max(1),
             bounces: self.bounces,
+            noise_threshold: self.noise_threshold,
             seed: self.seed,
             sky: self.sky,
             env_intensity: self.env_intensity.max(0.0),

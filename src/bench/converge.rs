@@ -46,6 +46,10 @@ pub struct ConvergeArgs {
     /// punctual light).
     #[arg(long)]
     pub no_punctual: bool,
+    /// Also run each configuration with adaptive sampling at this noise threshold
+    /// (`render --noise-threshold`), as a curve of its own named "CONFIG+adaptive".
+    #[arg(long, value_parser = crate::args::parse_positive)]
+    pub adaptive: Option<f32>,
     /// Write the steps as CSV here.
     #[arg(long)]
     pub csv: Option<PathBuf>,
@@ -143,10 +147,18 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
 
     let mut renderer = args.common.open_renderer(&settings)?;
+    // The environment map lights the scene as it does in `render` (the references come from
+    // `render`).
+    if let Some(crate::args::EnvChoice::Map(map)) = prepared.environment.take() {
+        renderer.set_environment(Some(map))?;
+    }
     let scene_stats = renderer
         .load_scene(&prepared.scene, &prepared.lights)
         .with_context(|| source.clone())?;
-    if renderer.host_scene().is_some_and(|h| h.emissive.is_empty()) && prepared.lights.is_empty() {
+    if renderer.host_scene().is_some_and(|h| h.emissive.is_empty())
+        && prepared.lights.is_empty()
+        && renderer.environment().is_none()
+    {
         bail!("{source}: no light is left (no emissive triangles and --no-punctual)");
     }
     renderer.set_camera(&prepared.camera)?;
@@ -155,16 +167,31 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
 
     let base_seed = settings.seed;
     let mut curves = Vec::new();
-    for (ci, config) in configs.iter().enumerate() {
+    // Each configuration uniform, then adaptive when asked (the same seed: the same samples
+    // until pixels converge).
+    let thresholds = [None, args.adaptive];
+    let runs = configs.iter().enumerate().flat_map(|(ci, config)| {
+        thresholds
+            .iter()
+            .filter(|t| t.is_none() || args.adaptive.is_some())
+            .map(move |t| (ci, config, *t))
+    });
+    for (ci, config, threshold) in runs {
         settings.strategy = config.strategy;
         settings.russian_roulette = config.russian_roulette.then_some(3);
         settings.seed = base_seed.wrapping_add(ci as u32 + 1);
+        settings.noise_threshold = threshold;
         renderer.set_settings(&settings)?;
+        let name = match threshold {
+            Some(_) => format!("{}+adaptive", config.name()),
+            None => config.name(),
+        };
         let mut steps = Vec::new();
         let mut seconds = 0.0;
         let mut spp = 0;
         let mut next = 1;
-        while spp < max_spp && seconds <= args.max_seconds {
+        // An adaptive render ends where no pixel is left active.
+        while spp < max_spp && seconds <= args.max_seconds && renderer.active_pixels() != Some(0) {
             let start = Instant::now();
             renderer.render(next - spp)?;
             seconds += start.elapsed().as_secs_f64();
@@ -183,14 +210,9 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             bail!("{source}: traversal stack overflow: the images are wrong");
         }
         if !args.json {
-            eprintln!(
-                "penumbra: {}: {} spp in {:.2} s",
-                config.name(),
-                spp,
-                seconds
-            );
+            eprintln!("penumbra: {name}: {spp} spp in {seconds:.2} s");
         }
-        curves.push(Curve::fit(config.name(), steps, args.fit_from));
+        curves.push(Curve::fit(name, steps, args.fit_from));
     }
 
     let date = today();
@@ -224,6 +246,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             "bounces": settings.bounces,
             "max_spp": max_spp,
             "max_seconds": args.max_seconds,
+            "noise_threshold": args.adaptive,
             "fit_from": args.fit_from,
             "punctual_lights": prepared.lights.len(),
             "light_radius": if prepared.lights.is_empty() { 0.0 } else { prepared.shadows.point_radius() },

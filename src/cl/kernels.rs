@@ -48,6 +48,8 @@ pub struct Program {
     trace_closest_wide: Kernel,
     trace_any_wide: Kernel,
     megakernel: Kernel,
+    converge: Kernel,
+    converge_dilate: Kernel,
     /// Work-group size of the megakernel (see `megakernel_local_size`).
     mega_local_size: usize,
     /// The test-only kernels, built on first use (never in production).
@@ -84,6 +86,8 @@ impl Program {
             trace_closest_wide: kernel(&program, "trace_closest_wide")?,
             trace_any_wide: kernel(&program, "trace_any_wide")?,
             megakernel: k(Stage::Megakernel)?,
+            converge: k(Stage::Converge)?,
+            converge_dilate: kernel(&program, "converge_dilate")?,
             mega_local_size: megakernel_local_size(features.lanes).min(max_group),
             tests: OnceLock::new(),
             local_size: 64.min(max_group),
@@ -133,6 +137,7 @@ impl Program {
         queue: &Buffer<u32>,
         counters: &Buffer<u32>,
         cones: &Buffer<[f32; 2]>,
+        state: &Buffer<u32>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(
@@ -146,7 +151,8 @@ impl Program {
                     .set_arg(&paths.mem())
                     .set_arg(&queue.mem())
                     .set_arg(&counters.mem())
-                    .set_arg(&cones.mem());
+                    .set_arg(&cones.mem())
+                    .set_arg(&state.mem());
             },
         )
     }
@@ -266,13 +272,14 @@ impl Program {
         )
     }
 
-    /// `accumulate`: adds the wave's finished samples to the film.
+    /// `accumulate`: adds the wave's finished samples to the film (and with adaptive sampling
+    /// to the half buffer and sample counts).
     pub fn accumulate(
         &self,
         device: &Device,
         frame: &DeviceFrame,
         paths: &Buffer<DevicePath>,
-        film: &Buffer<[f32; 4]>,
+        film: &AdaptiveFilm,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
@@ -284,10 +291,41 @@ impl Program {
             |e| unsafe {
                 e.set_arg(frame)
                     .set_arg(&paths.mem())
-                    .set_arg(&film.mem())
-                    .set_arg(&counters.mem());
+                    .set_arg(&film.sum.mem())
+                    .set_arg(&counters.mem())
+                    .set_arg(&film.half.mem())
+                    .set_arg(&film.state.mem());
             },
         )
+    }
+
+    /// The convergence check of adaptive sampling: `converge` (each pixel's error against
+    /// `threshold`), then `converge_dilate` (converged where the 3×3 neighbourhood is under it;
+    /// the active pixels counted in `COUNT_ACTIVE`).
+    pub fn converge(
+        &self,
+        device: &Device,
+        frame: &DeviceFrame,
+        film: &AdaptiveFilm,
+        threshold: f32,
+        counters: &Buffer<u32>,
+    ) -> Result<[Launch; 2], ClError> {
+        let pixels = (frame.width * frame.height) as usize;
+        let stage = Stage::Converge.name();
+        let mark = self.run(device, stage, &self.converge, pixels, |e| unsafe {
+            e.set_arg(frame)
+                .set_arg(&film.sum.mem())
+                .set_arg(&film.half.mem())
+                .set_arg(&film.state.mem())
+                .set_arg(&threshold)
+                .set_arg(&counters.mem());
+        })?;
+        let dilate = self.run(device, stage, &self.converge_dilate, pixels, |e| unsafe {
+            e.set_arg(frame)
+                .set_arg(&film.state.mem())
+                .set_arg(&counters.mem());
+        })?;
+        Ok([mark, dilate])
     }
 
     /// `trace_closest`: closest hits of arbitrary rays (tests and `bench trace`).
@@ -425,7 +463,7 @@ impl Program {
         camera: &DeviceCamera,
         env: &EnvBuffers,
         scene: &SceneBuffers,
-        film: &Buffer<[f32; 4]>,
+        film: &AdaptiveFilm,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
         let pixels = (frame.width * frame.height) as usize;
@@ -452,11 +490,25 @@ impl Program {
                     .set_arg(&env.conditional.mem())
                     .set_arg(&scene.lights.mem())
                     .set_arg(&scene.light_cdf.mem())
-                    .set_arg(&film.mem())
-                    .set_arg(&counters.mem());
+                    .set_arg(&film.sum.mem())
+                    .set_arg(&counters.mem())
+                    .set_arg(&film.half.mem())
+                    .set_arg(&film.state.mem());
             },
         )
     }
+}
+
+/// The film as the kernels that add samples take it: the sums and counts, and adaptive
+/// sampling's half buffer and pixel states (kernels/shared/adaptive.h; untouched unless
+/// `DeviceFrame::adaptive`).
+pub struct AdaptiveFilm {
+    /// Per pixel: the sum of its samples, `.w` their count (or the hits among them).
+    pub sum: Buffer<[f32; 4]>,
+    /// Per pixel: the sum of its even-numbered samples, `.w` their count.
+    pub half: Buffer<[f32; 4]>,
+    /// Per pixel: the samples it took and its convergence bits (`PIXEL_*`).
+    pub state: Buffer<u32>,
 }
 
 /// The megakernel's work-group size: 64, or 1 with `lanes`. On PoCL's CPU device a work-group

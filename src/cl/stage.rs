@@ -20,11 +20,14 @@ pub enum Stage {
     /// Whole paths per work item, all bounces in one kernel (CPU devices; no other stage
     /// but `advance` runs then).
     Megakernel,
+    /// Adaptive sampling's convergence check between waves (`converge`, then
+    /// `converge_dilate`).
+    Converge,
 }
 
 impl Stage {
     /// Every stage, in launch order.
-    pub const ALL: [Stage; 7] = [
+    pub const ALL: [Stage; 8] = [
         Stage::Generate,
         Stage::Extend,
         Stage::Shade,
@@ -32,6 +35,7 @@ impl Stage {
         Stage::Advance,
         Stage::Accumulate,
         Stage::Megakernel,
+        Stage::Converge,
     ];
 
     /// The kernel's (and the stage's) name.
@@ -44,6 +48,7 @@ impl Stage {
             Stage::Advance => "advance",
             Stage::Accumulate => "accumulate",
             Stage::Megakernel => "megakernel",
+            Stage::Converge => "converge",
         }
     }
 }

@@ -143,8 +143,17 @@ kernel_constants! {
     COUNT_NONFINITE: usize = 3;
     /// Traversal stack overflows.
     COUNT_OVERFLOW: usize = 4;
+    /// Pixels left active by the last convergence check (adaptive sampling).
+    COUNT_ACTIVE: usize = 5;
     /// Length of the counters buffer.
     COUNTER_SLOTS: usize = 8;
+
+    /// Bits of an adaptive pixel's state (kernels/shared/adaptive.h): the samples it took.
+    PIXEL_SAMPLES: u32 = 0x3fff_ffff;
+    /// Its error was under the threshold at the last check.
+    PIXEL_UNDER: u32 = 0x4000_0000;
+    /// It and its eight neighbours were under the threshold: it takes no samples.
+    PIXEL_CONVERGED: u32 = 0x8000_0000;
 
     /// The side of the square of pixels a work item of the megakernel with lanes
     /// (`MEGA_LANES`) renders: its sixteen lanes take them one after the other, so that a lane
@@ -439,7 +448,7 @@ pub struct DeviceCamera {
 }
 const _: () = assert!(size_of::<DeviceCamera>() == 64);
 
-/// Per-frame constants of the path tracer (64 bytes).
+/// Per-frame constants of the path tracer (80 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct DeviceFrame {
@@ -471,8 +480,13 @@ pub struct DeviceFrame {
     /// built for up to `SMALL_SCENE_MAX` of them so that hiding or showing an object in such a
     /// scene does not build the kernels again; 0 elsewhere.
     pub triangles: u32,
+    /// 1: adaptive sampling (kernels/shared/adaptive.h): converged pixels are skipped and the
+    /// half buffer and sample counts kept; 0: neither is read or written.
+    pub adaptive: u32,
+    /// Pads the struct to the device's 16-byte alignment.
+    pub pad: [u32; 3],
 }
-const _: () = assert!(size_of::<DeviceFrame>() == 64);
+const _: () = assert!(size_of::<DeviceFrame>() == 80);
 
 /// The state of one path between stages (64 bytes).
 #[repr(C)]
@@ -608,7 +622,8 @@ pub fn layouts() -> Vec<StructLayout> {
             light_count,
             bounce,
             background,
-            triangles
+            triangles,
+            adaptive
         ),
         layout!(DevicePath, origin, direction, throughput, radiance),
         layout!(DeviceHit, t, u, v, prim, instance),

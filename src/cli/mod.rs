@@ -72,6 +72,14 @@ pub struct RenderArgs {
     /// Direct-light strategy and Russian roulette.
     #[command(flatten)]
     pub strategy: StrategyArgs,
+    /// Adaptive sampling: a pixel stops taking samples once its relative error is under this
+    /// (0.01 is clean, 0.1 rough); --spp is then the most a pixel takes (default: off).
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::args::parse_positive)]
+    pub noise_threshold: Option<f32>,
+    /// Stop after this many seconds of rendering, wall clock; --spp is then the most a pixel
+    /// takes (default: none).
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::args::parse_seconds)]
+    pub time_limit: Option<f64>,
 }
 
 /// One line for a command-line usage error (`penumbra: error: …`, exit code 2): clap's first

@@ -25,6 +25,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let output = OutputFile::open(&args.output)?;
     let mut settings = args.common.settings(DEFAULT_SIZE)?;
     args.strategy.apply(&mut settings);
+    settings.noise_threshold = args.noise_threshold;
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
     let mut prepared = args.common.prepare(Some(&args.scene))?;
     settings.env_intensity *= prepared.env_scale;
@@ -73,7 +74,27 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // The fewest samples a call first, then calls sized by the time a sample took.
     let mut chunk = MIN_SAMPLES_PER_CALL;
     while done < spp {
-        let n = chunk.min(spp - done);
+        // The last check left no pixel active: more samples would add nothing.
+        if renderer.active_pixels() == Some(0) {
+            break;
+        }
+        if args
+            .time_limit
+            .is_some_and(|limit| start.elapsed().as_secs_f64() >= limit)
+        {
+            break;
+        }
+        let mut n = chunk.min(spp - done);
+        if let Some(limit) = args.time_limit {
+            // The call sized to end near the limit, at a sample's time measured so far.
+            let left = limit - start.elapsed().as_secs_f64();
+            let per_sample = start.elapsed().as_secs_f64() / f64::from(done.max(1));
+            if done > 0 && per_sample > 0.0 {
+                n = n.min(((left / per_sample).ceil() as u32).max(1));
+            } else {
+                n = n.min(1);
+            }
+        }
         let call = Instant::now();
         renderer.render(n)?;
         chunk = samples_per_call(call.elapsed().as_secs_f64() / f64::from(n));
@@ -120,6 +141,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     };
     output.write(&bytes)?;
+    let adaptive = renderer.adaptive_stats()?;
     let stats = renderer.stats();
     if stats.stack_overflows > 0 {
         anyhow::bail!(
@@ -128,7 +150,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             stats.stack_overflows
         );
     }
-    let samples = settings.width as f64 * settings.height as f64 * spp as f64;
+    // The samples every pixel took, or with adaptive sampling those the pixels took.
+    let samples = match &adaptive {
+        Some(a) => a.samples as f64,
+        None => settings.width as f64 * settings.height as f64 * f64::from(done),
+    };
+    let mean_spp = samples / (settings.width as f64 * settings.height as f64);
     let rays = (stats.extension_rays + stats.shadow_rays) as f64;
     let first_view = prepared.first_view.as_ref().map(|f| {
         serde_json::json!({
@@ -211,11 +238,28 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ("instances", serde_json::json!(scene_stats.instances)),
         ("device_bytes", serde_json::json!(scene_stats.device_bytes)),
         ("nonfinite_pixels", serde_json::json!(nonfinite_pixels)),
+        ("samples", serde_json::json!(samples as u64)),
+        ("mean_spp", serde_json::json!(mean_spp)),
+        ("noise_threshold", serde_json::json!(args.noise_threshold)),
+        ("time_limit", serde_json::json!(args.time_limit)),
+        (
+            "converged_share",
+            serde_json::json!(adaptive.as_ref().map(|a| a.converged_share)),
+        ),
+        (
+            "mean_error",
+            serde_json::json!(adaptive.as_ref().map(|a| a.mean_error)),
+        ),
     ] {
         summary[key] = value;
     }
+    let taken = if adaptive.is_some() || done < spp {
+        format!("{mean_spp:.1} of at most {spp} spp")
+    } else {
+        format!("{spp} spp")
+    };
     eprintln!(
-        "penumbra: wrote {}: {w}×{h} pixels, {spp} spp, rendered in {} ({} in all)",
+        "penumbra: wrote {}: {w}×{h} pixels, {taken}, rendered in {} ({} in all)",
         args.output.display(),
         duration(seconds),
         duration(started.elapsed().as_secs_f64())

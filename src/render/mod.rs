@@ -1,6 +1,7 @@
 //! The renderer: owns the OpenCL device, the scene on it and the film, and runs the wavefront
 //! stages. It knows nothing of windows; the viewer and the command line drive it alike.
 
+mod adaptive;
 pub mod background;
 pub mod camera;
 pub mod exposure;
@@ -19,6 +20,7 @@ mod update;
 mod upload;
 mod wavefront;
 
+pub use adaptive::{AdaptiveStats, min_samples};
 pub use instancing::BvhChoice;
 pub use lights::gpu_lights;
 pub use megakernel::KernelChoice;
@@ -127,6 +129,12 @@ pub struct Renderer {
     extra_forms: NodeForms,
     /// The film as last read back (sums and counts), kept for the next read.
     readback: Vec<[f32; 4]>,
+    /// Adaptive sampling's pixel states as last read back (`PIXEL_*` bits).
+    state_readback: Vec<u32>,
+    /// Whether a convergence check ran since the last reset.
+    adaptive_checked: bool,
+    /// Pixels the last convergence check left active (`None` before the first).
+    active_pixels: Option<u32>,
 }
 
 impl Renderer {
@@ -170,6 +178,9 @@ impl Renderer {
             sah_waiting: None,
             extra_forms: NodeForms::NONE,
             readback: Vec::new(),
+            state_readback: Vec::new(),
+            adaptive_checked: false,
+            active_pixels: None,
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -393,8 +404,15 @@ impl Renderer {
         self.stats = RenderStats::default();
         self.counters.clear(&self.device)?;
         self.stats_buffer.clear(&self.device)?;
+        self.adaptive_checked = false;
+        self.active_pixels = None;
         if let Some(f) = self.frame.as_mut() {
-            f.film.clear(&self.device)?;
+            f.film.sum.clear(&self.device)?;
+            // Adaptive sampling's buffers are only read with it on (kernels/shared/adaptive.h).
+            if self.settings.noise_threshold.is_some() {
+                f.film.half.clear(&self.device)?;
+                f.film.state.clear(&self.device)?;
+            }
         }
         Ok(())
     }

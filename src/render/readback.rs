@@ -2,6 +2,7 @@
 
 use super::Renderer;
 use crate::cl::ClError;
+use crate::cl::types::PIXEL_SAMPLES;
 
 impl Renderer {
     /// The film as linear RGB (the mean of the samples), row by row from the top.
@@ -22,17 +23,26 @@ impl Renderer {
         let read = self.read_film()?;
         let n = (self.settings.width * self.settings.height) as usize;
         let counted = self.settings.cutout || self.settings.count_coverage;
+        // With adaptive sampling each pixel took its own number of samples.
+        let adaptive = counted && self.read_states()?;
         let samples = self.samples.max(1) as f32;
+        let states = &self.state_readback;
+        let taken = |i: usize| {
+            if adaptive {
+                ((states[i] & PIXEL_SAMPLES) as f32).max(1.0)
+            } else {
+                samples
+            }
+        };
         image.clear();
         if !read {
             image.resize(n, [0.0; 3]);
         } else if counted {
             // `.w` counts the samples whose camera ray hit: the mean is over all samples.
-            image.extend(
-                self.readback
-                    .iter()
-                    .map(|p| [p[0] / samples, p[1] / samples, p[2] / samples]),
-            );
+            image.extend(self.readback.iter().enumerate().map(|(i, p)| {
+                let s = taken(i);
+                [p[0] / s, p[1] / s, p[2] / s]
+            }));
         } else {
             image.extend(self.readback.iter().map(|p| {
                 let n = p[3].max(1.0);
@@ -45,7 +55,8 @@ impl Renderer {
                 coverage.extend(
                     self.readback
                         .iter()
-                        .map(|p| (p[3] / samples).clamp(0.0, 1.0)),
+                        .enumerate()
+                        .map(|(i, p)| (p[3] / taken(i)).clamp(0.0, 1.0)),
                 );
             } else {
                 coverage.resize(n, 1.0);
@@ -73,7 +84,7 @@ impl Renderer {
         let Some(f) = self.frame.as_ref() else {
             return Ok(false);
         };
-        f.film.read_into(&self.device, &mut self.readback)?;
+        f.film.sum.read_into(&self.device, &mut self.readback)?;
         Ok(true)
     }
 }

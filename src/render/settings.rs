@@ -50,6 +50,9 @@ pub struct RenderSettings {
     /// The film keeps each pixel's coverage with the background shown too (for metering the
     /// subject); the image is the same.
     pub count_coverage: bool,
+    /// Adaptive sampling: pixels whose relative error is under this stop taking samples
+    /// (docs/adaptive-sampling.md); `None`: every pixel takes every sample.
+    pub noise_threshold: Option<f32>,
 }
 
 impl Default for RenderSettings {
@@ -68,6 +71,7 @@ impl Default for RenderSettings {
             focus_distance: 1.0,
             cutout: false,
             count_coverage: false,
+            noise_threshold: None,
         }
     }
 }
@@ -102,6 +106,8 @@ impl RenderSettings {
                 (false, false) => BACKGROUND_ENV,
             },
             triangles: 0,
+            adaptive: u32::from(self.noise_threshold.is_some()),
+            pad: [0; 3],
         }
     }
 }

@@ -5,7 +5,7 @@
 
 use super::Renderer;
 pub use crate::cl::Stage;
-use crate::cl::kernels::{EnvBuffers, Launch, SceneBuffers};
+use crate::cl::kernels::{AdaptiveFilm, EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, Device, Program};
 
@@ -85,7 +85,7 @@ pub(super) struct Frame {
     pub(super) width: u32,
     pub(super) height: u32,
     pub(super) slots: usize,
-    pub(super) film: Buffer<[f32; 4]>,
+    pub(super) film: AdaptiveFilm,
     pub(super) paths: Buffer<DevicePath>,
     pub(super) queues: [Buffer<u32>; 2],
     pub(super) hits: Buffer<DeviceHit>,
@@ -128,9 +128,14 @@ impl Wave<'_> {
             &f.queues[0],
             self.counters,
             &f.cones,
+            &f.film.state,
             self.slots,
         )?;
         self.push(Stage::Generate, l);
+        if frame.adaptive != 0 {
+            // `generate` queued the active pixels' slots in COUNT_OUT: the first bounce's input.
+            self.advance()?;
+        }
         Ok(())
     }
 
@@ -229,8 +234,14 @@ impl Renderer {
         }
         self.frame = None; // free the old buffers first
         let device = &self.device;
-        let mut film = Buffer::new(device, pixels)?;
-        film.clear(device)?;
+        let mut film = AdaptiveFilm {
+            sum: Buffer::new(device, pixels)?,
+            half: Buffer::new(device, pixels)?,
+            state: Buffer::new(device, pixels)?,
+        };
+        film.sum.clear(device)?;
+        film.half.clear(device)?;
+        film.state.clear(device)?;
         self.frame = Some(Frame {
             width: w,
             height: h,
@@ -304,12 +315,27 @@ impl Renderer {
         self.collect(launches)
     }
 
+    /// Enqueues `spp` more samples without waiting, with adaptive sampling's convergence
+    /// checks between them.
+    fn enqueue(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
+        match self.settings.noise_threshold {
+            Some(threshold) => self.enqueue_adaptive(spp, threshold),
+            None => self.enqueue_samples(spp),
+        }
+    }
+
+    /// Enqueues `spp` more samples by the kernels in use.
+    pub(super) fn enqueue_samples(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
+        if self.megakernel {
+            self.enqueue_megakernel(spp)
+        } else {
+            self.enqueue_wavefront(spp)
+        }
+    }
+
     /// Enqueues the stages for `spp` more samples without waiting: per wave, `generate`, then
     /// `extend`, `shade`, `connect` and `advance` for each bounce, then `accumulate`.
-    fn enqueue(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
-        if self.megakernel {
-            return self.enqueue_megakernel(spp);
-        }
+    fn enqueue_wavefront(&mut self, spp: u32) -> Result<Vec<(Stage, Launch)>, ClError> {
         self.ensure_frame()?;
         let (Some(program), Some((scene, _)), Some(f)) = (
             self.program.as_ref(),
@@ -367,6 +393,9 @@ impl Renderer {
         self.stats.shadow_rays = stats[STAT_SHADOW_RAYS];
         self.stats.nonfinite_samples = counters[COUNT_NONFINITE] as u64;
         self.stats.stack_overflows = counters[COUNT_OVERFLOW] as u64;
+        if self.adaptive_checked {
+            self.active_pixels = Some(counters[COUNT_ACTIVE]);
+        }
         Ok(())
     }
 }
