@@ -348,7 +348,8 @@ LANES_INLINE vint lanes_pack(vint c, vint k) {
 
 // lanes_prefetch's loads of one element, at a.
 LANES_INLINE void lanes_prefetch_element(ulong a, uint size, uint bytes) {
-#pragma unroll
+    // No unroll pragma: `bytes` is a constant only after inlining, and the compiler unrolls
+    // these few iterations itself then (the pragma made PoCL warn where it could not).
     for (uint o = 0u; o < bytes; o += 64u) __builtin_prefetch((const void*)(a + o));
     if (size % 64u != 0u || bytes % 64u != 0u) __builtin_prefetch((const void*)(a + bytes - 1u));
 }

@@ -169,13 +169,13 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     let mut curves = Vec::new();
     // Each configuration uniform, then adaptive when asked (the same seed: the same samples
     // until pixels converge).
-    let thresholds = [None, args.adaptive];
-    let runs = configs.iter().enumerate().flat_map(|(ci, config)| {
-        thresholds
-            .iter()
-            .filter(|t| t.is_none() || args.adaptive.is_some())
-            .map(move |t| (ci, config, *t))
-    });
+    let thresholds: Vec<Option<f32>> = std::iter::once(None)
+        .chain(args.adaptive.map(Some))
+        .collect();
+    let runs = configs
+        .iter()
+        .enumerate()
+        .flat_map(|(ci, config)| thresholds.iter().map(move |t| (ci, config, *t)));
     for (ci, config, threshold) in runs {
         settings.strategy = config.strategy;
         settings.russian_roulette = config.russian_roulette.then_some(3);
