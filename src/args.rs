@@ -512,6 +512,13 @@ impl CommonArgs {
             scene.source,
             t.elapsed().as_secs_f64() * 1e3
         );
+        if let Some(cost) = first.view.unprobed_cost {
+            log::warn!(
+                "{}: each ray would test about {cost:.0} triangles (many lie in one place); \
+                 the first view frames its bounds without probing them",
+                scene.source
+            );
+        }
         if let Some(c) = &first.camera {
             camera = c.clone();
             if let Some(fov) = self.camera.fov {

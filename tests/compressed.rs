@@ -254,3 +254,85 @@ fn basisu_textures_render_like_their_originals() {
         failures.join("\n")
     );
 }
+
+/// The JSON and binary chunks of a GLB.
+fn glb_chunks(bytes: &[u8]) -> (serde_json::Value, Vec<u8>) {
+    let len = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    let json_len = len(12);
+    let json = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let bin_at = 20 + json_len;
+    (json, bytes[bin_at + 8..bin_at + 8 + len(bin_at)].to_vec())
+}
+
+/// A GLB of `json` and `bin`, both padded to 4 bytes.
+fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+    let mut j = serde_json::to_vec(json).unwrap();
+    j.resize(j.len().div_ceil(4) * 4, b' ');
+    let mut b = bin.to_vec();
+    b.resize(b.len().div_ceil(4) * 4, 0);
+    let total = 12 + 8 + j.len() + 8 + b.len();
+    let mut out = Vec::new();
+    for word in [0x4654_6C67, 2, total as u32, j.len() as u32, 0x4E4F_534A] {
+        out.extend_from_slice(&u32::to_le_bytes(word));
+    }
+    out.extend_from_slice(&j);
+    out.extend_from_slice(&u32::to_le_bytes(b.len() as u32));
+    out.extend_from_slice(&u32::to_le_bytes(0x004E_4942));
+    out.extend_from_slice(&b);
+    out
+}
+
+#[test]
+fn a_draco_file_whose_accessor_counts_disagree_is_one_warning() {
+    let Some(bin) = tools() else {
+        return skip("the glTF tools are not installed (scripts/install_gltf_tools.sh)");
+    };
+    let work = tempfile::tempdir().unwrap();
+    let box_glb = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/cornell-box.glb");
+    let draco = work.path().join("box.draco.glb");
+    let status = Command::new(bin.join("gltf-transform"))
+        .arg("draco")
+        .arg(&box_glb)
+        .arg(&draco)
+        .stdout(std::process::Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success(), "gltf-transform draco failed");
+    // Every Draco primitive's POSITION accessor claims one vertex more than its mesh decodes.
+    let (mut json, data) = glb_chunks(&std::fs::read(&draco).unwrap());
+    let mut changed = 0;
+    for mesh in json["meshes"].clone().as_array().unwrap() {
+        for p in mesh["primitives"].as_array().unwrap() {
+            if p["extensions"]["KHR_draco_mesh_compression"].is_object() {
+                let a = p["attributes"]["POSITION"].as_u64().unwrap() as usize;
+                let count = json["accessors"][a]["count"].as_u64().unwrap();
+                json["accessors"][a]["count"] = serde_json::json!(count + 1);
+                changed += 1;
+            }
+        }
+    }
+    assert!(changed > 0, "gltf-transform wrote no Draco primitive");
+    let bad = work.path().join("bad.glb");
+    std::fs::write(&bad, glb(&json, &data)).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .args([
+            "render", "--width", "32", "--height", "24", "--spp", "1", "-o",
+        ])
+        .arg(work.path().join("bad.png"))
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("disagree with the decoded mesh"))
+        .collect();
+    assert_eq!(warnings.len(), changed, "{stderr}");
+    assert!(
+        warnings
+            .iter()
+            .all(|l| l.starts_with("penumbra: warning: ")),
+        "{stderr}"
+    );
+}

@@ -1441,6 +1441,17 @@ fn values_the_specification_forbids_are_one_warning_each() {
             "KHR_texture_transform",
         ),
         (
+            // The base mesh has no morph targets: one weight is one too many.
+            "weight-count",
+            Box::new(|d| d["meshes"][0]["weights"] = json!([0.5])),
+            "meshes[0].weights: 1 weights for 0 morph targets",
+        ),
+        (
+            "node-weight-count",
+            Box::new(|d| d["nodes"][0]["weights"] = json!([0.5, 0.25])),
+            "weights: 2 weights for 0 morph targets",
+        ),
+        (
             "channel-node",
             channel(99, "translation"),
             "animations[0].channels[0].target.node",

@@ -233,6 +233,49 @@ impl TwoLevel {
         two
     }
 
+    /// The expected triangle tests and node steps of a ray that enters the TLAS's root box:
+    /// the TLAS's SAH cost with each leaf costing its piece, a whole BLAS its own SAH cost (also
+    /// taken for a piece entered below a BLAS's root, which costs at most that) and a small
+    /// mesh's triangle 1. Instances that overlap add up: 256 coincident copies of a mesh cost
+    /// 256 of its trees, which is what a ray through them pays.
+    pub fn ray_cost(&self) -> f64 {
+        if self.tlas.nodes.is_empty() {
+            return 0.0;
+        }
+        let area = |b: Aabb| {
+            if b.min.cmple(b.max).all() {
+                b.area() as f64
+            } else {
+                0.0
+            }
+        };
+        let root_area = area(self.tlas.child(0, 0).0.union(self.tlas.child(0, 1).0))
+            .max(f32::MIN_POSITIVE as f64);
+        let mut cost = 0.0;
+        for node in 0..self.tlas.nodes.len() as u32 {
+            for side in 0..2 {
+                let (b, child) = self.tlas.child(node, side);
+                let weight = match child {
+                    Child::Node(_) => 1.0,
+                    Child::Leaf { first, count } => (first..first + count)
+                        .map(|slot| {
+                            let piece = self.pieces[slot as usize];
+                            if piece & PIECE_TRIANGLE != 0 {
+                                1.0
+                            } else {
+                                let instance = self.tlas.tri_indices[slot as usize] as usize;
+                                let blas = self.instances[instance].blas as usize;
+                                self.blases[blas].bvh.sah_cost as f64
+                            }
+                        })
+                        .sum(),
+                };
+                cost += area(b) * weight;
+            }
+        }
+        cost / root_area
+    }
+
     /// Triangles over all instances.
     pub fn triangle_count(&self) -> usize {
         self.instances

@@ -31,7 +31,7 @@ pub fn warn_invalid(
             ));
         }
         if let Some(w) = &mesh.weights {
-            weights(&format!("meshes[{m}].weights"), w, &mut warn);
+            weights(&format!("meshes[{m}].weights"), w, targets(mesh), &mut warn);
         }
     }
     for (c, camera) in root.cameras.iter().enumerate() {
@@ -56,7 +56,13 @@ pub fn warn_invalid(
     for (n, node) in root.nodes.iter().enumerate() {
         node_transform(n, node, &mut warn);
         if let Some(w) = &node.weights {
-            weights(&format!("nodes[{n}].weights"), w, &mut warn);
+            let mesh = node.mesh.and_then(|m| root.meshes.get(m.value()));
+            weights(
+                &format!("nodes[{n}].weights"),
+                w,
+                mesh.and_then(targets),
+                &mut warn,
+            );
         }
     }
     for (a, animation) in root.animations.iter().enumerate() {
@@ -90,10 +96,26 @@ fn asset(asset: &json::Asset, warn: &mut impl FnMut(String)) {
     }
 }
 
-/// Morph target weights must be finite numbers.
-fn weights(at: &str, weights: &[f32], warn: &mut impl FnMut(String)) {
+/// The number of morph targets of `mesh`'s first primitive (the spec requires every
+/// primitive to have as many), `None` for a mesh of no primitives.
+fn targets(mesh: &json::Mesh) -> Option<usize> {
+    let first = mesh.primitives.first()?;
+    Some(first.targets.as_ref().map_or(0, Vec::len))
+}
+
+/// Morph target weights must be finite numbers, one for each of the mesh's morph targets.
+fn weights(at: &str, weights: &[f32], targets: Option<usize>, warn: &mut impl FnMut(String)) {
     if let Some(bad) = weights.iter().find(|w| !w.is_finite()) {
         warn(format!("{at}: {bad} is not a finite weight; 0 is used"));
+    }
+    if let Some(n) = targets
+        && weights.len() != n
+    {
+        warn(format!(
+            "{at}: {} weights for {n} morph targets (the counts must match); a missing weight \
+             is 0, an extra one is unused",
+            weights.len()
+        ));
     }
 }
 

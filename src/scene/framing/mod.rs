@@ -75,6 +75,9 @@ pub struct FirstView {
     /// The unit normals (towards the camera) at the subject points: where an environment's
     /// light is metered.
     pub subject_normals: Vec<DVec3>,
+    /// Set when the probe's rays were not traced because each would have taken about this
+    /// many triangle tests ([`PROBE_MAX_RAY_COST`]): the view is the bounds' alone.
+    pub unprobed_cost: Option<f64>,
 }
 
 impl FirstView {
@@ -313,6 +316,10 @@ pub fn first_view_with(
     aspect: f64,
 ) -> FirstView {
     let bounds = probe.bounds;
+    let cost = probe.ray_cost();
+    if cost > PROBE_MAX_RAY_COST {
+        return unprobed(probe, camera, aspect, cost);
+    }
     let (camera, interior) = match camera {
         Some(c) => (c.clone(), false),
         None if !probe.any_opaque => (Camera::framing(&bounds, super::AUTO_YFOV), false),
@@ -358,6 +365,44 @@ pub fn first_view_with(
         shiny_share,
         shiny_sky,
         subject_normals,
+        unprobed_cost: None,
+    }
+}
+
+/// The most triangle tests and node steps one probe ray may be expected to take
+/// ([`Probe::ray_cost`]). The probe traces some 40,000 rays at a few nanoseconds a test, so
+/// this bounds it to about two seconds; a healthy tree costs tens, while 10⁶ triangles in one
+/// place cost 10⁶ (the probe took 110 s on them).
+pub const PROBE_MAX_RAY_COST: f64 = 16384.0;
+
+/// The first view without tracing the probe's rays, for a scene whose trees would make them
+/// too slow (each about `cost` tests): `camera`, else the robust bounds fitted from the front
+/// and a little above; taken as unlit by its own lights, open to the environment, and metered
+/// on the image (`unprobed_cost` says so to the caller).
+fn unprobed(probe: &Probe, camera: Option<&Camera>, aspect: f64, cost: f64) -> FirstView {
+    let dir = DVec3::new(0.35, 0.3, 1.0).normalize();
+    let camera = camera.cloned().unwrap_or_else(|| {
+        if probe.any_opaque {
+            fit(&probe.bounds, &probe.points, dir, super::AUTO_YFOV, aspect)
+        } else {
+            Camera::framing(&probe.bounds, super::AUTO_YFOV)
+        }
+    });
+    FirstView {
+        camera,
+        bounds: probe.bounds,
+        interior: false,
+        lit: false,
+        coverage: 0.0,
+        lit_fraction: 0.0,
+        subject_radiance: 0.0,
+        emitter_radiance: 0.0,
+        sky_fraction: 1.0,
+        key_irradiance: 0.0,
+        shiny_share: 0.0,
+        shiny_sky: 0.0,
+        subject_normals: Vec::new(),
+        unprobed_cost: Some(cost),
     }
 }
 

@@ -193,6 +193,15 @@ impl Probe {
         }
     }
 
+    /// The expected triangle tests and node steps of one probe ray (the trees' SAH cost):
+    /// tens in a healthy scene, the triangle count where every triangle lies in one place.
+    pub fn ray_cost(&self) -> f64 {
+        match &self.tracer {
+            Tracer::TwoLevel { two, .. } => two.ray_cost(),
+            Tracer::Flat { all, .. } => all.0.sah_cost as f64,
+        }
+    }
+
     /// Leaves the quick BLASes in `scene` for the renderer's first load
     /// ([`Scene::keep_quick_blases`]).
     pub fn keep_blases(self, scene: &Scene) {

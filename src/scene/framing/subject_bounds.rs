@@ -199,10 +199,17 @@ pub(super) fn robust_bounds_windowed(tris: &WorldTris, bulk: &WorldTris) -> Boun
     let centroid = |t: &[Vec3; 3]| (t[0] + t[1] + t[2]) / 3.0;
     let mut lo = Vec3::ZERO;
     let mut hi = Vec3::ZERO;
+    // Clipped on the axes where the window has a width; where every centroid in it sits at
+    // one coordinate (coincident triangles, or a floor's height), the triangles keep their
+    // own extent, which a window of no width would clip to a point.
+    let (mut clip_lo, mut clip_hi) = (Vec3::NEG_INFINITY, Vec3::INFINITY);
     for (axis, [a, b]) in centroid_percentiles(bulk).into_iter().enumerate() {
         let margin = 0.5 * (b - a);
         lo[axis] = a - margin;
         hi[axis] = b + margin;
+        if margin > 0.0 {
+            (clip_lo[axis], clip_hi[axis]) = (lo[axis], hi[axis]);
+        }
     }
     let bounds = tris
         .chunks(1 << 16)
@@ -212,7 +219,7 @@ pub(super) fn robust_bounds_windowed(tris: &WorldTris, bulk: &WorldTris) -> Boun
                 let c = centroid(&t);
                 if c.cmpge(lo).all() && c.cmple(hi).all() {
                     for v in t {
-                        bounds.grow(v.clamp(lo, hi).as_dvec3());
+                        bounds.grow(v.clamp(clip_lo, clip_hi).as_dvec3());
                     }
                 }
             });

@@ -714,3 +714,75 @@ fn a_cornell_box_moved_far_away_is_still_lit_by_its_lamp() {
         );
     }
 }
+
+/// `n` copies of one triangle in the z = 0 plane, as one mesh placed `copies` times.
+fn coincident(n: usize, copies: usize) -> Scene {
+    let mesh = Arc::new(Mesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices: vec![[0, 1, 2]; n],
+        materials: vec![0; n],
+        ..Default::default()
+    });
+    let mut scene = Scene::default();
+    for i in 0..copies {
+        scene.objects.push(Object {
+            name: format!("copy {i}"),
+            world_from_object: DMat4::IDENTITY,
+            visible: true,
+            mesh: mesh.clone(),
+        });
+    }
+    scene.materials.push(Material::default());
+    scene
+}
+
+/// Whether `camera` is finite and sees the point `p` near the middle of its frame.
+fn looks_at(camera: &Camera, p: DVec3) -> bool {
+    let finite = camera.eye.is_finite() && camera.forward.is_finite();
+    let to = (p - camera.eye).normalize();
+    finite && to.dot(camera.forward) > 0.95
+}
+
+#[test]
+fn coincident_triangles_are_framed_by_their_own_extent() {
+    // Every centroid in one place once gave a window of no width, bounds of a point and a
+    // camera of NaN direction.
+    let view = first_view(&coincident(1000, 1), &[], None, 1.5);
+    let b = view.bounds;
+    assert!(
+        b.max.x - b.min.x > 0.99 && b.max.y - b.min.y > 0.99,
+        "{b:?}"
+    );
+    assert!(
+        looks_at(&view.camera, DVec3::new(0.5, 0.5, 0.0)),
+        "{:?}",
+        view.camera
+    );
+    assert_eq!(view.unprobed_cost, None);
+    assert!(view.coverage > 0.0);
+}
+
+#[test]
+fn triangles_too_entangled_for_the_probe_are_framed_without_it() {
+    // 10⁵ copies of one triangle: each probe ray would test all of them (some 40,000 rays of
+    // 10⁵ tests); the same through 64 coincident instances of 2,048.
+    for (n, copies) in [(100_000, 1), (2048, 64)] {
+        let scene = coincident(n, copies);
+        let view = first_view(&scene, &[], None, 1.5);
+        let cost = view.unprobed_cost.expect("the probe was skipped");
+        let triangles = (n * copies) as f64;
+        assert!(
+            cost > 0.5 * triangles && cost < 2.0 * triangles,
+            "{n}×{copies}: {cost}"
+        );
+        assert!(
+            looks_at(&view.camera, DVec3::new(0.5, 0.5, 0.0)),
+            "{:?}",
+            view.camera
+        );
+        assert!(!view.lit && view.environment_reaches());
+    }
+    // Well below the bound, the probe runs.
+    let view = first_view(&coincident(1000, 4), &[], None, 1.5);
+    assert_eq!(view.unprobed_cost, None);
+}
