@@ -6,6 +6,7 @@ use penumbra::message::print;
 
 fn main() {
     penumbra::cli::messages::init_logging();
+    quiet_on_closed_stdout();
     let cli = match penumbra::cli::Cli::try_parse() {
         Ok(cli) => cli,
         // --help and --version print as clap makes them, with exit code 0.
@@ -21,4 +22,24 @@ fn main() {
         print("error", &chain.join(": "));
         std::process::exit(1);
     }
+}
+
+/// A reader of the summary that goes away early (`penumbra bench … | head -1`, a pipeline
+/// killed by a timeout) makes `println!` panic on the broken pipe. Ends the process as a Unix
+/// tool killed by SIGPIPE ends, quietly with status 141, instead of a panic and a backtrace;
+/// every other panic is reported as before.
+fn quiet_on_closed_stdout() {
+    let report = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let text = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if text.starts_with("failed printing to stdout") && text.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        report(info);
+    }));
 }

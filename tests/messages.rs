@@ -219,3 +219,28 @@ fn warnings_and_the_closing_line_share_one_form() {
         "{err}"
     );
 }
+
+#[test]
+fn a_reader_that_goes_away_ends_the_output_quietly() {
+    // `penumbra devices | head -0`: the pipe is closed before the list is printed.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .arg("devices")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = stderr(&out);
+    assert!(
+        !err.contains("panicked") && !err.contains("backtrace"),
+        "{err}"
+    );
+    // 141 as a Unix tool killed by SIGPIPE; 0 only if the list was written into the pipe's
+    // buffer before it closed.
+    assert!(
+        matches!(out.status.code(), Some(141 | 0)),
+        "{:?}: {err}",
+        out.status
+    );
+}
