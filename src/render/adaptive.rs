@@ -137,6 +137,19 @@ impl Renderer {
         }))
     }
 
+    /// The samples each pixel took, row by row from the top; `None` without adaptive sampling.
+    pub fn pixel_samples(&mut self) -> Result<Option<Vec<u32>>, ClError> {
+        if !self.read_states()? {
+            return Ok(None);
+        }
+        Ok(Some(
+            self.state_readback
+                .iter()
+                .map(|s| s & PIXEL_SAMPLES)
+                .collect(),
+        ))
+    }
+
     /// Each pixel's relative error, row by row from the top; `None` without adaptive
     /// sampling. Also leaves the film and the states in their readback buffers.
     pub fn pixel_errors(&mut self) -> Result<Option<Vec<f32>>, ClError> {

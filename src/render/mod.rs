@@ -24,6 +24,7 @@ pub use adaptive::{AdaptiveStats, min_samples};
 pub use instancing::BvhChoice;
 pub use lights::gpu_lights;
 pub use megakernel::KernelChoice;
+pub use readback::Aovs;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
 pub use update::InstanceUpdate;
@@ -245,6 +246,7 @@ impl Renderer {
         let facts = SceneFacts {
             features: KernelFeatures {
                 env_map: self.environment.is_some(),
+                aovs: self.settings.aovs,
                 ..facts.features
             },
             ..*facts
@@ -367,7 +369,11 @@ impl Renderer {
         let aspect_changed = settings.aspect() != self.settings.aspect();
         let env_changed = settings.env_intensity != self.settings.env_intensity
             || settings.env_rotation != self.settings.env_rotation;
+        let aovs_changed = settings.aovs != self.settings.aovs;
         self.settings = settings.clone();
+        if aovs_changed && self.scene.is_some() {
+            self.ensure_program()?;
+        }
         self.apply_lens();
         if env_changed && self.environment.is_some() {
             self.upload_lights()?;
@@ -412,6 +418,9 @@ impl Renderer {
             if self.settings.noise_threshold.is_some() {
                 f.film.half.clear(&self.device)?;
                 f.film.state.clear(&self.device)?;
+            }
+            if self.settings.aovs {
+                f.film.aovs.clear(&self.device)?;
             }
         }
         Ok(())

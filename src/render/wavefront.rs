@@ -5,7 +5,7 @@
 
 use super::Renderer;
 pub use crate::cl::Stage;
-use crate::cl::kernels::{AdaptiveFilm, EnvBuffers, Launch, SceneBuffers};
+use crate::cl::kernels::{AdaptiveFilm, AovBuffers, EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, Device, Program};
 
@@ -92,6 +92,9 @@ pub(super) struct Frame {
     pub(super) shadow_rays: Buffer<DeviceShadowRay>,
     /// Ray cone (width, spread angle) per slot, for texture filtering.
     pub(super) cones: Buffer<[f32; 2]>,
+    /// With guide buffers, each slot's record as two float4s (kernels/shared/aovs.h); else one
+    /// placeholder element.
+    pub(super) aov_paths: Buffer<[f32; 4]>,
 }
 
 /// Paths in flight per wave on a GPU, and on other devices.
@@ -129,6 +132,7 @@ impl Wave<'_> {
             self.counters,
             &f.cones,
             &f.film.state,
+            &f.aov_paths,
             self.slots,
         )?;
         self.push(Stage::Generate, l);
@@ -173,6 +177,7 @@ impl Wave<'_> {
             &f.shadow_rays,
             self.counters,
             &f.cones,
+            &f.aov_paths,
             self.slots,
         )?;
         self.push(Stage::Shade, l);
@@ -203,9 +208,14 @@ impl Wave<'_> {
 
     fn accumulate(&mut self, frame: &DeviceFrame) -> Result<(), ClError> {
         let f = self.frame;
-        let l = self
-            .program
-            .accumulate(self.device, frame, &f.paths, &f.film, self.counters)?;
+        let l = self.program.accumulate(
+            self.device,
+            frame,
+            &f.paths,
+            &f.aov_paths,
+            &f.film,
+            self.counters,
+        )?;
         self.push(Stage::Accumulate, l);
         Ok(())
     }
@@ -225,11 +235,10 @@ impl Renderer {
             WAVE_PATHS_CPU
         };
         let slots = pixels * (wave / pixels).max(1);
-        if self
-            .frame
-            .as_ref()
-            .is_some_and(|f| f.width == w && f.height == h && f.slots == slots)
-        {
+        let aovs = self.settings.aovs;
+        if self.frame.as_ref().is_some_and(|f| {
+            f.width == w && f.height == h && f.slots == slots && (f.aov_paths.len() > 1) == aovs
+        }) {
             return Ok(());
         }
         self.frame = None; // free the old buffers first
@@ -238,6 +247,7 @@ impl Renderer {
             sum: Buffer::new(device, pixels)?,
             half: Buffer::new(device, pixels)?,
             state: Buffer::new(device, pixels)?,
+            aovs: AovBuffers::new(device, if aovs { pixels } else { 1 })?,
         };
         film.sum.clear(device)?;
         film.half.clear(device)?;
@@ -252,6 +262,7 @@ impl Renderer {
             hits: Buffer::new(device, slots)?,
             shadow_rays: Buffer::new(device, slots)?,
             cones: Buffer::new(device, slots)?,
+            aov_paths: Buffer::new(device, if aovs { 2 * slots } else { 1 })?,
         });
         self.samples = 0;
         Ok(())
