@@ -136,6 +136,8 @@ pub struct Renderer {
     adaptive_checked: bool,
     /// Pixels the last convergence check left active (`None` before the first).
     active_pixels: Option<u32>,
+    /// A check was enqueued whose count `active_pixels` does not hold yet.
+    active_stale: bool,
 }
 
 impl Renderer {
@@ -182,6 +184,7 @@ impl Renderer {
             state_readback: Vec::new(),
             adaptive_checked: false,
             active_pixels: None,
+            active_stale: false,
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -412,6 +415,7 @@ impl Renderer {
         self.stats_buffer.clear(&self.device)?;
         self.adaptive_checked = false;
         self.active_pixels = None;
+        self.active_stale = false;
         if let Some(f) = self.frame.as_mut() {
             f.film.sum.clear(&self.device)?;
             // Adaptive sampling's buffers are only read with it on (kernels/shared/adaptive.h).

@@ -113,6 +113,9 @@ struct Wave<'a> {
     stats: &'a Buffer<u64>,
     /// Path slots in this wave.
     slots: usize,
+    /// The most paths a bounce's queue holds: the active pixels' slots (all of them without
+    /// adaptive sampling). `extend`, `shade` and `connect` are launched over this many.
+    live: usize,
     launches: Vec<(Stage, Launch)>,
 }
 
@@ -152,7 +155,7 @@ impl Wave<'_> {
             &f.queues[queue_in],
             self.counters,
             &f.hits,
-            self.slots,
+            self.live,
         )?;
         self.push(Stage::Extend, l);
         Ok(())
@@ -178,7 +181,7 @@ impl Wave<'_> {
             self.counters,
             &f.cones,
             &f.aov_paths,
-            self.slots,
+            self.live,
         )?;
         self.push(Stage::Shade, l);
         Ok(())
@@ -192,7 +195,7 @@ impl Wave<'_> {
             &f.shadow_rays,
             self.counters,
             &f.paths,
-            self.slots,
+            self.live,
         )?;
         self.push(Stage::Connect, l);
         Ok(())
@@ -357,6 +360,13 @@ impl Renderer {
         };
         let pixels = (f.width * f.height) as usize;
         let per_wave = (f.slots / pixels).max(1) as u32;
+        // With adaptive sampling `generate` queues only the active pixels' paths, as many as
+        // the last convergence check counted (read back before any later wave: see
+        // `enqueue_adaptive`); the bounces' launches are sized to them.
+        let active = match (self.settings.noise_threshold, self.active_pixels) {
+            (Some(_), Some(active)) => (active as usize).min(pixels),
+            _ => pixels,
+        };
         let mut wave = Wave {
             device: &self.device,
             program,
@@ -367,12 +377,14 @@ impl Renderer {
             counters: &self.counters,
             stats: &self.stats_buffer,
             slots: 0,
+            live: 0,
             launches: Vec::new(),
         };
         let mut done = 0;
         while done < spp {
             let n = per_wave.min(spp - done);
             wave.slots = pixels * n as usize;
+            wave.live = active * n as usize;
             let mut frame = self.settings.gpu_frame(self.light_count);
             frame.samples_in_wave = n;
             frame.first_sample = self.samples + done;
@@ -406,6 +418,7 @@ impl Renderer {
         self.stats.stack_overflows = counters[COUNT_OVERFLOW] as u64;
         if self.adaptive_checked {
             self.active_pixels = Some(counters[COUNT_ACTIVE]);
+            self.active_stale = false;
         }
         Ok(())
     }
