@@ -21,6 +21,8 @@
 #include "shared/surface.h"
 #include "shared/env.h"
 #include "shared/lights.h"
+// Guide buffers for a denoiser (with AOVS): each path's albedo, normal and depth record.
+#include "shared/aovs.h"
 #include "shared/path.h"
 // Adaptive sampling: the half buffer, the error estimate and the convergence check.
 #include "shared/adaptive.h"

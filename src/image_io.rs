@@ -165,6 +165,73 @@ pub fn encode_exr(
     Ok(bytes.into_inner())
 }
 
+/// Float channels by name, each one value per pixel, row by row from the top.
+pub type Channels = Vec<(String, Vec<f32>)>;
+
+/// Linear RGB (premultiplied by `alpha` when given) as `R`, `G`, `B` (and `A`) with more named
+/// float channels beside them in the same part (`albedo.R`, `depth.Z`: the dotted names by which
+/// Blender, Nuke and OIDN's tools group channels into layers), each one value per pixel, row by
+/// row from the top.
+pub fn encode_exr_channels(
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    alpha: Option<&[f32]>,
+    extra: &Channels,
+) -> Result<Vec<u8>> {
+    use exr::prelude::*;
+    let channel = |name: &str, values: Vec<f32>| AnyChannel::new(name, FlatSamples::F32(values));
+    let plane = |c: usize| rgb.iter().map(|p| p[c]).collect::<Vec<f32>>();
+    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    list.push(channel("R", plane(0)));
+    list.push(channel("G", plane(1)));
+    list.push(channel("B", plane(2)));
+    if let Some(alpha) = alpha {
+        list.push(channel("A", alpha.to_vec()));
+    }
+    for (name, values) in extra {
+        anyhow::ensure!(
+            values.len() == rgb.len(),
+            "channel {name} has the wrong size"
+        );
+        list.push(channel(name, values.clone()));
+    }
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::default(),
+        EXR_ENCODING,
+        AnyChannels::sort(list),
+    );
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut bytes)
+        .context("cannot encode EXR")?;
+    Ok(bytes.into_inner())
+}
+
+/// Every float channel of an EXR file's first part by name, one value per pixel row by row
+/// from the top, with the image's width and height.
+pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, Channels)> {
+    use exr::prelude::*;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .with_context(|| format!("{}: cannot read EXR", path.display()))?;
+    let layer = image.layer_data;
+    let channels = layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect()))
+        .collect();
+    Ok((layer.size.0 as u32, layer.size.1 as u32, channels))
+}
+
 /// The exr crate's default encoding (RLE, 64-pixel tiles) with the tiles in increasing order:
 /// its default order is "unspecified", and its parallel compression then writes the tiles in
 /// whatever order the threads finish them, so one image gave files that differed from run to

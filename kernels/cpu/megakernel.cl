@@ -5,7 +5,8 @@
 // shaded by path.h's shade_vertex, as the wavefront's `shade` does, and its light sample is
 // traced at once (the wavefront's `connect`), so both compute the same estimator from the
 // same random numbers. The samples of a pixel are added to its film sum in order, one by one;
-// with adaptive sampling a converged pixel takes none.
+// with adaptive sampling a converged pixel takes none. With AOVS each path's guide record
+// (shared/aovs.h) is added to the pixel's AOV sums in the same order.
 //
 // Rays are traced through the 4-wide BVH (traverse_wide.h), whose box tests use the CPU's
 // vector lanes, or with SMALL_SCENE tested against every triangle of a small scene.
@@ -89,6 +90,10 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     uint counted = 0;  // samples whose camera ray hit (the film's .w with the background cut out)
     float3 even = (float3)(0.0f);  // adaptive sampling's half buffer (shared/adaptive.h)
     uint evens = 0;
+#ifdef AOVS
+    float3 aov_albedo_sum = (float3)(0.0f), aov_normal_sum = (float3)(0.0f);
+    float2 aov_depth_sum = (float2)(0.0f);
+#endif
 #ifdef SMALL_SCENE
     sc.surf.small = &small;
     const MegaTracer T = {&small, tris, instances, object_tris, &sc.surf, overflow};
@@ -128,10 +133,17 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
         }
         mega_add_sample(&s, &sum, &counted, &nonfinite);
         if (frame.adaptive != 0u) half_add(s.radiance, frame.first_sample + j, &even, &evens);
+#ifdef AOVS
+        aov_add(&s.aov, &aov_albedo_sum, &aov_normal_sum, &aov_depth_sum);
+#endif
     }
     if (frame.background == BACKGROUND_ENV) counted = frame.samples_in_wave;
     film[pixel] = (float4)(sum, pixel_film.w + (float)counted);
     if (frame.adaptive != 0u) half_store(halves, state, pixel, even, evens, frame.samples_in_wave);
+#ifdef AOVS
+    aov_store(aov_albedo, aov_normal, aov_depth, pixel, aov_albedo_sum, aov_normal_sum,
+              aov_depth_sum, frame.samples_in_wave);
+#endif
     mega_count(counters, extension_rays, shadow_rays, nonfinite);
 }
 #endif  // !MEGA_LANES

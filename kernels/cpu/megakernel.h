@@ -8,6 +8,7 @@
 #include "shared/traverse.h"
 #include "shared/path.h"
 #include "shared/adaptive.h"
+#include "shared/aovs.h"
 
 // The kernel's parameters, in both megakernels.
 #define MEGAKERNEL_PARAMS                                                                   \
@@ -21,7 +22,8 @@
         global const uint *texels, global const float *env_texels,                          \
         global const float *env_marginal, global const float *env_conditional,              \
         global const DeviceLight *lights, global const float *light_cdf, global float4 *film, \
-        volatile global uint *counters, global float4 *halves, global uint *state
+        volatile global uint *counters, global float4 *halves, global uint *state,           \
+        global float4 *aov_albedo, global float4 *aov_normal, global float2 *aov_depth
 
 // What shading reads of the scene, from the kernel's parameters.
 inline ShadeScene mega_shade_scene(DeviceEnvironment environment,

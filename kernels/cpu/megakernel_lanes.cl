@@ -14,6 +14,11 @@
 #include "cpu/megakernel.h"
 
 #ifdef MEGA_LANES
+#ifdef AOVS
+// The lanes record no guide buffers: with AOVs the host builds the one-path-at-a-time
+// megakernel (src/render/strategy.rs).
+#error "MEGA_LANES with AOVS"
+#endif
 // With MEGA_LANES a work item renders a square of LANES_TILE² pixels in two shapes of walk:
 //   - a chunk of a pixel's samples (sixteen at a time) or, below sixteen samples, of a 4×4
 //     block's, starts together: their camera rays walk the tree as one packet

@@ -10,12 +10,14 @@
 #include "shared/traverse.h"
 #include "shared/path.h"
 #include "shared/adaptive.h"
+#include "shared/aovs.h"
 
 // Camera rays for the wave's slots. With adaptive sampling only the active pixels' slots are
 // queued, in COUNT_OUT (0 here: every `advance` leaves it so), which the `advance` launched next
-// makes the first bounce's input.
+// makes the first bounce's input. With AOVS each slot's guide record starts in `aov_paths`.
 kernel void generate(DeviceFrame frame, DeviceCamera camera, global DevicePath* paths, global uint* queue,
-                     global uint* counters, global float2* cones, global const uint* state) {
+                     global uint* counters, global float2* cones, global const uint* state,
+                     global float4* aov_paths) {
     uint slot = get_global_id(0);
     uint pixels = frame.width * frame.height;
     uint total = pixels * frame.samples_in_wave;
@@ -39,6 +41,9 @@ kernel void generate(DeviceFrame frame, DeviceCamera camera, global DevicePath* 
     p.radiance = (float4)(s.radiance, as_float(s.rng));
     paths[slot] = p;
     cones[slot] = s.cone;
+#ifdef AOVS
+    aov_save(aov_paths, slot, &s.aov);
+#endif
     if (frame.adaptive != 0u) {
         queue[atomic_inc(&counters[COUNT_OUT])] = slot;
     } else {
@@ -83,7 +88,8 @@ kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const
                   global const DeviceLight* lights, global const float* light_cdf,
                   global DevicePath* paths, global const uint* queue_in, global const DeviceHit* hits,
                   global uint* queue_out, global DeviceShadowRay* shadow_rays,
-                  volatile global uint* counters, global float2* cones) {
+                  volatile global uint* counters, global float2* cones,
+                  global float4* aov_paths) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_IN]) return;
     uint slot = queue_in[i];
@@ -104,6 +110,9 @@ kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const
 #ifdef HAS_TEXTURES
     s.cone = cones[slot];
 #endif
+#ifdef AOVS
+    s.aov = aov_load(aov_paths, slot);
+#endif
     ShadowQuery q;
     bool alive = shade_vertex(&frame, frame.bounce, &sc, hits[i], &s, &q);
     if (q.valid) {
@@ -115,6 +124,9 @@ kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const
     }
 #ifdef HAS_TEXTURES
     cones[slot] = s.cone;
+#endif
+#ifdef AOVS
+    aov_save(aov_paths, slot, &s.aov);
 #endif
     path.radiance = (float4)(s.radiance, as_float(s.rng));
     if (alive) {
@@ -166,9 +178,11 @@ kernel void advance(global uint* counters, global ulong* stats) {
 // coverage counted, .w counts the samples whose camera ray hit), in a fixed order per pixel
 // so the result does not depend on the queues' order. Non-finite samples are counted and dropped.
 // With adaptive sampling converged pixels are skipped and the others' half buffers and sample
-// counts updated (adaptive.h).
+// counts updated (adaptive.h). With AOVS the slots' guide records go into the AOV sums (aovs.h).
 kernel void accumulate(DeviceFrame frame, global const DevicePath* paths, global float4* film,
-                       volatile global uint* counters, global float4* halves, global uint* state) {
+                       volatile global uint* counters, global float4* halves, global uint* state,
+                       global const float4* aov_paths, global float4* aov_albedo,
+                       global float4* aov_normal, global float2* aov_depth) {
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels || pixel_converged(&frame, state, pixel)) return;
@@ -200,4 +214,14 @@ kernel void accumulate(DeviceFrame frame, global const DevicePath* paths, global
         }
         half_store(halves, state, pixel, even, evens, frame.samples_in_wave);
     }
+#ifdef AOVS
+    float3 albedo = (float3)(0.0f), normal = (float3)(0.0f);
+    float2 depth = (float2)(0.0f);
+    for (uint j = 0; j < frame.samples_in_wave; ++j) {
+        PathAov a = aov_load(aov_paths, pixel + j * pixels);
+        aov_add(&a, &albedo, &normal, &depth);
+    }
+    aov_store(aov_albedo, aov_normal, aov_depth, pixel, albedo, normal, depth,
+              frame.samples_in_wave);
+#endif
 }

@@ -19,6 +19,7 @@
 #include "shared/surface.h"
 #include "shared/env.h"
 #include "shared/lights.h"
+#include "shared/aovs.h"
 
 // Whether the uniform sky is black: an escaped ray then adds nothing.
 inline bool frame_sky_black(const DeviceFrame* frame) {
@@ -121,6 +122,9 @@ typedef struct {
                         // from PATH_WAVELENGTH_SHIFT up (HAS_DISPERSION)
     uint rng;
     float2 cone;        // ray cone (width, spread angle) for texture filtering
+#ifdef AOVS
+    PathAov aov;        // the guide buffers' record (aovs.h)
+#endif
 } PathState;
 
 // A light sample to test for visibility: `contribution` is added to the path's radiance when
@@ -176,6 +180,9 @@ inline PathState camera_path(const DeviceFrame* frame, const DeviceCamera* camer
     s.rng = rng;
     // The ray cone for texture filtering: no width at the eye, one pixel's angle of spread.
     s.cone = (float2)(0.0f, 2.0f * length(camera->up.xyz) / (float)frame->height);
+#ifdef AOVS
+    s.aov = aov_start();
+#endif
     return s;
 }
 
@@ -208,7 +215,12 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         // counts the samples whose camera ray hit); with the background cut out it adds nothing.
         if (bounce == 0u && frame->background != BACKGROUND_ENV) {
             s->flags |= PATH_ESCAPED;
-            if (frame->background == BACKGROUND_CUTOUT) return false;
+            if (frame->background == BACKGROUND_CUTOUT) {
+#ifdef AOVS
+                aov_escape(&s->aov, (float3)(0.0f));
+#endif
+                return false;
+            }
         }
 #ifdef HAS_ENV_MAP
         // Escaped into the environment map, weighted against its sampling at the last vertex.
@@ -217,6 +229,9 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         // Seen directly, by a camera ray or its continuation straight through thin walls (no BSDF
         // sample made it: prev_pdf 0), the map is filtered: as smooth through a pane as beside it.
         if (prev_pdf == 0.0f) le = env_background(&sc->env, -wo);
+#ifdef AOVS
+        aov_escape(&s->aov, le);
+#endif
         float weight = 1.0f;
         if (mis) weight = vertex_power_heuristic(prev_pdf, sc->env.info.scale.z * env_pdf);
         if (light_sampled_only) weight = 0.0f;
@@ -224,11 +239,17 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
 #else
         // Escaped: the uniform sky, reached by BSDF sampling only.
         if (counts_emission) radiance += throughput * frame->sky.xyz;
+#ifdef AOVS
+        aov_escape(&s->aov, frame->sky.xyz);
+#endif
 #endif
         s->radiance = radiance;
         return false;
     }
 
+#ifdef AOVS
+    if (bounce == 0u) s->aov.depth = hit.t;  // the camera ray is unit: t is the distance
+#endif
     DeviceTriangle tri = sc->tris[hit.prim];
 #ifdef TWO_LEVEL
     // The mesh's object-space triangle, carried to world space by the hit's instance.
@@ -295,6 +316,9 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
         color *= vertex_color(surf, hit.prim, hit.u, hit.v).xyz;
 #endif
         s->radiance = radiance + throughput * color;
+#ifdef AOVS
+        aov_plain(&s->aov, color, front ? ng : -ng);
+#endif
         return false;
     }
 #endif
@@ -359,6 +383,9 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
     if (m.anisotropy > 0.0f) {
         m.aniso_dir = anisotropy_direction(surf, hit.prim, hit.u, hit.v, ns, front, m.aniso_rotation);
     }
+#endif
+#ifdef AOVS
+    aov_surface(&s->aov, &m, ns);
 #endif
 
 #ifdef HAS_DISPERSION

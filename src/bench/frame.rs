@@ -27,12 +27,16 @@ pub struct FrameArgs {
     /// Print one JSON object on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Record the guide buffers for a denoiser too, as `render --aovs` does (default: off).
+    #[arg(long)]
+    pub aovs: bool,
 }
 
 /// Runs the benchmark.
 pub fn run(args: &FrameArgs) -> Result<()> {
     let mut settings = args.common.settings((1920, 1080))?;
     args.strategy.apply(&mut settings);
+    settings.aovs = args.aovs;
     let spp = args.common.sampling.spp.unwrap_or(16);
     let prepared = args.common.prepare(args.scene.as_deref())?;
     let source = prepared.scene.source.clone();

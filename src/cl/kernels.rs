@@ -138,6 +138,7 @@ impl Program {
         counters: &Buffer<u32>,
         cones: &Buffer<[f32; 2]>,
         state: &Buffer<u32>,
+        aov_paths: &Buffer<[f32; 4]>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(
@@ -152,7 +153,8 @@ impl Program {
                     .set_arg(&queue.mem())
                     .set_arg(&counters.mem())
                     .set_arg(&cones.mem())
-                    .set_arg(&state.mem());
+                    .set_arg(&state.mem())
+                    .set_arg(&aov_paths.mem());
             },
         )
     }
@@ -200,6 +202,7 @@ impl Program {
         shadow_rays: &Buffer<DeviceShadowRay>,
         counters: &Buffer<u32>,
         cones: &Buffer<[f32; 2]>,
+        aov_paths: &Buffer<[f32; 4]>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(
@@ -224,7 +227,8 @@ impl Program {
                     .set_arg(&queue_out.mem())
                     .set_arg(&shadow_rays.mem())
                     .set_arg(&counters.mem())
-                    .set_arg(&cones.mem());
+                    .set_arg(&cones.mem())
+                    .set_arg(&aov_paths.mem());
             },
         )
     }
@@ -273,12 +277,14 @@ impl Program {
     }
 
     /// `accumulate`: adds the wave's finished samples to the film (and with adaptive sampling
-    /// to the half buffer and sample counts).
+    /// to the half buffer and sample counts; with `AOVS` the slots' guide records in
+    /// `aov_paths` to the AOV sums).
     pub fn accumulate(
         &self,
         device: &Device,
         frame: &DeviceFrame,
         paths: &Buffer<DevicePath>,
+        aov_paths: &Buffer<[f32; 4]>,
         film: &AdaptiveFilm,
         counters: &Buffer<u32>,
     ) -> Result<Launch, ClError> {
@@ -294,7 +300,9 @@ impl Program {
                     .set_arg(&film.sum.mem())
                     .set_arg(&counters.mem())
                     .set_arg(&film.half.mem())
-                    .set_arg(&film.state.mem());
+                    .set_arg(&film.state.mem())
+                    .set_arg(&aov_paths.mem());
+                set_aovs(e, &film.aovs);
             },
         )
     }
@@ -494,6 +502,7 @@ impl Program {
                     .set_arg(&counters.mem())
                     .set_arg(&film.half.mem())
                     .set_arg(&film.state.mem());
+                set_aovs(e, &film.aovs);
             },
         )
     }
@@ -509,6 +518,56 @@ pub struct AdaptiveFilm {
     pub half: Buffer<[f32; 4]>,
     /// Per pixel: the samples it took and its convergence bits (`PIXEL_*`).
     pub state: Buffer<u32>,
+    /// The guide buffers (written with `AOVS` only).
+    pub aovs: AovBuffers,
+}
+
+/// The guide buffers for a denoiser, per pixel, row by row from the top: sums over the
+/// pixel's samples (kernels/shared/aovs.h, docs/aovs.md). Built without `AOVS`, the kernels
+/// never touch them and each is a one-element placeholder.
+pub struct AovBuffers {
+    /// `.xyz` the sum of the samples' albedos (each in [0, 1]), `.w` the samples added: the
+    /// pixel's sample count, by which `.xyz` and the normals' sum are divided.
+    pub albedo: Buffer<[f32; 4]>,
+    /// `.xyz` the sum of the samples' world-space shading normals (unit, or 0 where a sample
+    /// recorded none), `.w` 0.
+    pub normal: Buffer<[f32; 4]>,
+    /// `.x` the sum of the camera distances of the samples' first hits (render space), `.y`
+    /// the samples whose camera ray hit.
+    pub depth: Buffer<[f32; 2]>,
+}
+
+impl AovBuffers {
+    /// Buffers for `pixels` pixels, cleared.
+    pub fn new(device: &Device, pixels: usize) -> Result<Self, ClError> {
+        let mut b = Self {
+            albedo: Buffer::new(device, pixels)?,
+            normal: Buffer::new(device, pixels)?,
+            depth: Buffer::new(device, pixels)?,
+        };
+        b.clear(device)?;
+        Ok(b)
+    }
+
+    /// Zeroes the sums.
+    pub fn clear(&mut self, device: &Device) -> Result<(), ClError> {
+        self.albedo.clear(device)?;
+        self.normal.clear(device)?;
+        self.depth.clear(device)
+    }
+}
+
+/// Sets the three AOV sums, the last arguments of the kernels that add samples.
+///
+/// # Safety
+/// Only for kernels whose next three parameters are exactly those.
+unsafe fn set_aovs(e: &mut ExecuteKernel, aovs: &AovBuffers) {
+    // SAFETY: the caller's kernel declares these three buffers next, in this order.
+    unsafe {
+        e.set_arg(&aovs.albedo.mem())
+            .set_arg(&aovs.normal.mem())
+            .set_arg(&aovs.depth.mem());
+    }
 }
 
 /// The megakernel's work-group size: 64, or 1 with `lanes`. On PoCL's CPU device a work-group

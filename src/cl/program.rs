@@ -71,6 +71,9 @@ pub struct KernelFeatures {
     /// The lanes load their nodes and triangles by gathers (`LANES_GATHERS`,
     /// kernels/cpu/traverse_lanes.h) rather than as rows transposed by shuffles.
     pub lanes_gathers: bool,
+    /// Each path records guide buffers for a denoiser (`AOVS`, kernels/shared/aovs.h): the
+    /// renderer's choice ([`crate::render::RenderSettings::aovs`]), not the scene's.
+    pub aovs: bool,
 }
 
 impl KernelFeatures {
@@ -101,6 +104,7 @@ impl KernelFeatures {
             (self.lanes, "MEGA_LANES"),
             (self.lanes_shade, "LANES_SHADE"),
             (self.lanes_small, "LANES_SMALL"),
+            (self.aovs, "AOVS"),
         ] {
             if on {
                 d.push_str(" -D");

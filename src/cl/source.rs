@@ -64,6 +64,10 @@ const KERNELS: &[(&str, &str)] = &[
         include_str!("../../kernels/shared/lights.h"),
     ),
     (
+        "kernels/shared/aovs.h",
+        include_str!("../../kernels/shared/aovs.h"),
+    ),
+    (
         "kernels/shared/path.h",
         include_str!("../../kernels/shared/path.h"),
     ),

@@ -80,6 +80,11 @@ pub struct RenderArgs {
     /// takes (default: none).
     #[arg(long, allow_negative_numbers = true, value_parser = crate::args::parse_seconds)]
     pub time_limit: Option<f64>,
+    /// Also write guide buffers for a denoiser as layers of the EXR output: albedo.R/G/B,
+    /// normal.X/Y/Z, depth.Z, and with --noise-threshold samples.Y and error.Y; needs an .exr
+    /// output (default: off).
+    #[arg(long)]
+    pub aovs: bool,
 }
 
 /// One line for a command-line usage error (`penumbra: error: …`, exit code 2): clap's first

@@ -2,7 +2,7 @@
 
 use super::RenderArgs;
 use crate::args::EnvChoice;
-use crate::image_io::{Format, OutputFile, encode_exr};
+use crate::image_io::{Format, OutputFile, encode_exr, encode_exr_channels};
 use crate::render::background::{self, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
 use crate::render::tonemap::{encode_rgba_png, to_rgba8};
@@ -23,9 +23,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // The output is checked (and opened) before the scene is read: a path that cannot be
     // written fails now, not after the render.
     let output = OutputFile::open(&args.output)?;
+    if args.aovs && output.format != Format::Exr {
+        anyhow::bail!(
+            "{}: --aovs writes the guide buffers as EXR layers: the output must end in .exr",
+            args.output.display()
+        );
+    }
     let mut settings = args.common.settings(DEFAULT_SIZE)?;
     args.strategy.apply(&mut settings);
     settings.noise_threshold = args.noise_threshold;
+    settings.aovs = args.aovs;
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
     let mut prepared = args.common.prepare(Some(&args.scene))?;
     settings.env_intensity *= prepared.env_scale;
@@ -132,8 +139,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let metering = exposure::meter_subject(shown, Some(&coverage));
     let exposure = mode.stops(metering.as_ref());
     let (w, h) = (settings.width, settings.height);
+    let alpha = background.cutout().then_some(&coverage[..]);
     let bytes = match output.format {
-        Format::Exr => encode_exr(w, h, &image, background.cutout().then_some(&coverage[..]))?,
+        Format::Exr if args.aovs => {
+            encode_exr_channels(w, h, &image, alpha, &aov_channels(&mut renderer)?)?
+        }
+        Format::Exr => encode_exr(w, h, &image, alpha)?,
         Format::Png => {
             let mut rgba = to_rgba8(shown, exposure, args.common.exposure.tonemap);
             background::apply(&mut rgba, &coverage, background);
@@ -242,6 +253,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ("mean_spp", serde_json::json!(mean_spp)),
         ("noise_threshold", serde_json::json!(args.noise_threshold)),
         ("time_limit", serde_json::json!(args.time_limit)),
+        ("aovs", serde_json::json!(args.aovs)),
         (
             "converged_share",
             serde_json::json!(adaptive.as_ref().map(|a| a.converged_share)),
@@ -269,6 +281,36 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 }
 
 /// Seconds for a person: "0.42 s", "12.3 s", "3 min 07 s".
+/// The guide buffers as named EXR channels (docs/aovs.md), with adaptive sampling's samples
+/// per pixel and error estimate.
+fn aov_channels(renderer: &mut crate::render::Renderer) -> Result<crate::image_io::Channels> {
+    let mut channels = Vec::new();
+    if let Some(aovs) = renderer.aovs()? {
+        for (layer, names, values) in [
+            ("albedo", ["R", "G", "B"], &aovs.albedo),
+            ("normal", ["X", "Y", "Z"], &aovs.normal),
+        ] {
+            for (c, name) in names.iter().enumerate() {
+                channels.push((
+                    format!("{layer}.{name}"),
+                    values.iter().map(|v| v[c]).collect(),
+                ));
+            }
+        }
+        channels.push(("depth.Z".to_string(), aovs.depth));
+    }
+    if let Some(errors) = renderer.pixel_errors()? {
+        channels.push(("error.Y".to_string(), errors));
+    }
+    if let Some(samples) = renderer.pixel_samples()? {
+        channels.push((
+            "samples.Y".to_string(),
+            samples.iter().map(|&s| s as f32).collect(),
+        ));
+    }
+    Ok(channels)
+}
+
 fn duration(seconds: f64) -> String {
     match seconds {
         s if s < 10.0 => format!("{s:.2} s"),

@@ -6,7 +6,7 @@
 
 use super::Renderer;
 use crate::cl::kernels::Launch;
-use crate::cl::types::{PIXEL_CONVERGED, PIXEL_SAMPLES};
+use crate::cl::types::{COUNT_ACTIVE, PIXEL_CONVERGED, PIXEL_SAMPLES};
 use crate::cl::{ClError, Stage};
 
 /// Samples between two convergence checks (Cycles' step).
@@ -62,6 +62,13 @@ impl Renderer {
         let mut launches = Vec::new();
         let mut left = spp;
         while left > 0 {
+            if self.active_stale && !self.megakernel {
+                // The wavefront sizes its launches to the active pixels: the count of a check
+                // still in flight is waited for (a read after it on the in-order queue).
+                let counters = self.counters.read(&self.device)?;
+                self.active_pixels = Some(counters[COUNT_ACTIVE]);
+                self.active_stale = false;
+            }
             let n = left.min(CHECK_STEP - self.samples % CHECK_STEP);
             launches.extend(self.enqueue_samples(n)?);
             left -= n;
@@ -81,6 +88,7 @@ impl Renderer {
         let [mark, dilate] =
             program.converge(&self.device, &frame, &f.film, threshold, &self.counters)?;
         self.adaptive_checked = true;
+        self.active_stale = true;
         Ok(vec![(Stage::Converge, mark), (Stage::Converge, dilate)])
     }
 
@@ -135,6 +143,19 @@ impl Renderer {
             converged_share: converged as f64 / pixels,
             mean_error: finite.iter().sum::<f64>() / finite.len().max(1) as f64,
         }))
+    }
+
+    /// The samples each pixel took, row by row from the top; `None` without adaptive sampling.
+    pub fn pixel_samples(&mut self) -> Result<Option<Vec<u32>>, ClError> {
+        if !self.read_states()? {
+            return Ok(None);
+        }
+        Ok(Some(
+            self.state_readback
+                .iter()
+                .map(|s| s & PIXEL_SAMPLES)
+                .collect(),
+        ))
     }
 
     /// Each pixel's relative error, row by row from the top; `None` without adaptive

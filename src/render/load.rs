@@ -505,6 +505,7 @@ pub(super) fn scene_features(
         lanes_shade: false,
         lanes_small: false,
         lanes_gathers: false,
+        aovs: false,
     }
 }
 

@@ -24,6 +24,7 @@ pub use adaptive::{AdaptiveStats, min_samples};
 pub use instancing::BvhChoice;
 pub use lights::gpu_lights;
 pub use megakernel::KernelChoice;
+pub use readback::Aovs;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
 pub use update::InstanceUpdate;
@@ -135,6 +136,8 @@ pub struct Renderer {
     adaptive_checked: bool,
     /// Pixels the last convergence check left active (`None` before the first).
     active_pixels: Option<u32>,
+    /// A check was enqueued whose count `active_pixels` does not hold yet.
+    active_stale: bool,
 }
 
 impl Renderer {
@@ -181,6 +184,7 @@ impl Renderer {
             state_readback: Vec::new(),
             adaptive_checked: false,
             active_pixels: None,
+            active_stale: false,
         };
         r.set_kernel(KernelChoice::Auto)?;
         Ok(r)
@@ -245,6 +249,7 @@ impl Renderer {
         let facts = SceneFacts {
             features: KernelFeatures {
                 env_map: self.environment.is_some(),
+                aovs: self.settings.aovs,
                 ..facts.features
             },
             ..*facts
@@ -367,7 +372,11 @@ impl Renderer {
         let aspect_changed = settings.aspect() != self.settings.aspect();
         let env_changed = settings.env_intensity != self.settings.env_intensity
             || settings.env_rotation != self.settings.env_rotation;
+        let aovs_changed = settings.aovs != self.settings.aovs;
         self.settings = settings.clone();
+        if aovs_changed && self.scene.is_some() {
+            self.ensure_program()?;
+        }
         self.apply_lens();
         if env_changed && self.environment.is_some() {
             self.upload_lights()?;
@@ -406,12 +415,16 @@ impl Renderer {
         self.stats_buffer.clear(&self.device)?;
         self.adaptive_checked = false;
         self.active_pixels = None;
+        self.active_stale = false;
         if let Some(f) = self.frame.as_mut() {
             f.film.sum.clear(&self.device)?;
             // Adaptive sampling's buffers are only read with it on (kernels/shared/adaptive.h).
             if self.settings.noise_threshold.is_some() {
                 f.film.half.clear(&self.device)?;
                 f.film.state.clear(&self.device)?;
+            }
+            if self.settings.aovs {
+                f.film.aovs.clear(&self.device)?;
             }
         }
         Ok(())

@@ -1,8 +1,25 @@
-//! Reading the film back: the image as linear RGB and each pixel's coverage.
+//! Reading the film back: the image as linear RGB, each pixel's coverage and the guide
+//! buffers.
 
 use super::Renderer;
 use crate::cl::ClError;
+use crate::cl::kernels::AovBuffers;
 use crate::cl::types::PIXEL_SAMPLES;
+
+/// The guide buffers for a denoiser, averaged over each pixel's samples, row by row from the
+/// top (docs/aovs.md).
+#[derive(Clone, Debug, Default)]
+pub struct Aovs {
+    /// Albedo of the first surface that is not near-specular (tinted by those before it; an
+    /// escaped sample's environment colour clamped to 1), each channel in [0, 1].
+    pub albedo: Vec<[f32; 3]>,
+    /// World-space shading normal of that surface (0 for escaped samples), not renormalised:
+    /// shorter than 1 where the pixel's samples disagree.
+    pub normal: Vec<[f32; 3]>,
+    /// Distance from the camera along the ray to the first hit, in scene units, over the
+    /// samples that hit; `f32::INFINITY` where none did.
+    pub depth: Vec<f32>,
+}
 
 impl Renderer {
     /// The film as linear RGB (the mean of the samples), row by row from the top.
@@ -73,6 +90,48 @@ impl Renderer {
         let (mut image, mut coverage) = (Vec::new(), Vec::new());
         self.image_into(&mut image, Some(&mut coverage))?;
         Ok(coverage)
+    }
+
+    /// The guide buffers averaged ([`Aovs`]); `None` unless
+    /// [`RenderSettings::aovs`](super::RenderSettings::aovs) is on and samples were taken.
+    pub fn aovs(&mut self) -> Result<Option<Aovs>, ClError> {
+        if !self.pending.is_empty() {
+            self.finish()?;
+        }
+        let Some(b) = self.aov_buffers() else {
+            return Ok(None);
+        };
+        let (albedo, normal, depth) = (
+            b.albedo.read(&self.device)?,
+            b.normal.read(&self.device)?,
+            b.depth.read(&self.device)?,
+        );
+        let scale = self.space().scale as f32;
+        let mean = |s: [f32; 4], n: f32| [s[0] / n, s[1] / n, s[2] / n];
+        Ok(Some(Aovs {
+            albedo: albedo.iter().map(|a| mean(*a, a[3].max(1.0))).collect(),
+            normal: (normal.iter().zip(&albedo))
+                .map(|(s, a)| mean(*s, a[3].max(1.0)))
+                .collect(),
+            depth: depth
+                .iter()
+                .map(|d| {
+                    if d[1] > 0.0 {
+                        d[0] / d[1] / scale
+                    } else {
+                        f32::INFINITY
+                    }
+                })
+                .collect(),
+        }))
+    }
+
+    /// The guide buffers' sums on the device, for a denoiser that reads them there (layout:
+    /// [`AovBuffers`]); `None` unless [`RenderSettings::aovs`](super::RenderSettings::aovs)
+    /// is on and the film exists. Wait for the samples first ([`Renderer::finish`]).
+    pub fn aov_buffers(&self) -> Option<&AovBuffers> {
+        let f = self.frame.as_ref()?;
+        (self.settings.aovs && f.aov_paths.len() > 1).then_some(&f.film.aovs)
     }
 
     /// Finishes the pending launches and reads the film into [`Renderer::readback`]; false

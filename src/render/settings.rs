@@ -53,6 +53,9 @@ pub struct RenderSettings {
     /// Adaptive sampling: pixels whose relative error is under this stop taking samples
     /// (docs/adaptive-sampling.md); `None`: every pixel takes every sample.
     pub noise_threshold: Option<f32>,
+    /// Guide buffers for a denoiser: the film also sums each sample's albedo, normal and depth
+    /// (docs/aovs.md; `Renderer::aovs`). Off, the kernels are built without them.
+    pub aovs: bool,
 }
 
 impl Default for RenderSettings {
@@ -72,6 +75,7 @@ impl Default for RenderSettings {
             cutout: false,
             count_coverage: false,
             noise_threshold: None,
+            aovs: false,
         }
     }
 }

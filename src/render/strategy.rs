@@ -11,7 +11,7 @@
 //! | megakernel on a GPU | | one ray at a time over the tree |
 //! | CPU megakernel | two levels, or alpha | one ray at a time over the tree |
 //! | CPU megakernel | flat, no alpha, 1 to [`SMALL_SCENE_MAX`] triangles, no lanes | `SMALL_SCENE`: every ray tests every triangle (count rounded up to 16) |
-//! | CPU megakernel | flat, no alpha, under 2^27 triangles, leaves of at most 15 | lanes (`MEGA_LANES`) when `PENUMBRA_LANES=1`; never when `=0`; else with AVX-512 or AVX2 from [`LANES_MIN_TRIANGLES`] on, and below where the lanes test a small scene whole or shade in batches |
+//! | CPU megakernel | flat, no alpha, under 2^27 triangles, leaves of at most 15 | lanes (`MEGA_LANES`), never with guide buffers (`AOVS`, which the lanes do not record); else when `PENUMBRA_LANES=1`; never when `=0`; else with AVX-512 or AVX2 from [`LANES_MIN_TRIANGLES`] on, and below where the lanes test a small scene whole or shade in batches |
 //! | lanes | small (as `SMALL_SCENE`), `PENUMBRA_LANES_SMALL` not `0` | `LANES_SMALL`: the lanes test the triangles whole |
 //! | lanes | every material Lambertian, none of the features `shades_simply` excludes, `PENUMBRA_LANES_SHADE` not `0` | `LANES_SHADE`: vertices shaded in batches |
 //! | lanes | | nodes and triangles loaded as rows on AMD CPUs, else `LANES_GATHERS`; `PENUMBRA_LANES_LOAD=rows\|gathers` chooses |
@@ -222,7 +222,9 @@ pub fn kernel_strategy(
     // `SMALL_SCENE` one ray at a time, with the same hits.
     let small_in_lanes = small && overrides.lanes_small;
     let batched = overrides.lanes_shade && shades_simply(&f);
-    let lanes = scene.triangles < LANES_MAX_TRIANGLES
+    // The lanes record no guide buffers: with them, paths go one at a time.
+    let lanes = !f.aovs
+        && scene.triangles < LANES_MAX_TRIANGLES
         && scene.largest_leaf <= LANES_MAX_LEAF
         && overrides.lanes.unwrap_or(
             device.vectors && (scene.triangles >= LANES_MIN_TRIANGLES || small_in_lanes || batched),
@@ -406,6 +408,25 @@ mod tests {
             largest_leaf: LANES_MAX_LEAF + 1,
         };
         assert!(!kernel_strategy(&AVX, true, &scene, &o).lanes);
+    }
+
+    #[test]
+    fn guide_buffers_take_paths_one_at_a_time_even_where_lanes_are_forced() {
+        let o = Overrides {
+            lanes: Some(true),
+            ..Overrides::default()
+        };
+        let aovs = KernelFeatures {
+            aovs: true,
+            ..lambert()
+        };
+        assert_eq!(decide(AVX, true, aovs, 1 << 20, o), NONE);
+        // A small scene is still tested whole, one ray at a time.
+        assert_eq!(decide(AVX, true, aovs, 32, o).0, 32);
+        assert!(
+            decide(AVX, true, lambert(), 1 << 20, o).1,
+            "lanes without AOVs"
+        );
     }
 
     #[test]

@@ -5,7 +5,7 @@
 
 use super::Renderer;
 pub use crate::cl::Stage;
-use crate::cl::kernels::{AdaptiveFilm, EnvBuffers, Launch, SceneBuffers};
+use crate::cl::kernels::{AdaptiveFilm, AovBuffers, EnvBuffers, Launch, SceneBuffers};
 use crate::cl::types::*;
 use crate::cl::{Buffer, ClError, Device, Program};
 
@@ -92,6 +92,9 @@ pub(super) struct Frame {
     pub(super) shadow_rays: Buffer<DeviceShadowRay>,
     /// Ray cone (width, spread angle) per slot, for texture filtering.
     pub(super) cones: Buffer<[f32; 2]>,
+    /// With guide buffers, each slot's record as two float4s (kernels/shared/aovs.h); else one
+    /// placeholder element.
+    pub(super) aov_paths: Buffer<[f32; 4]>,
 }
 
 /// Paths in flight per wave on a GPU, and on other devices.
@@ -110,6 +113,9 @@ struct Wave<'a> {
     stats: &'a Buffer<u64>,
     /// Path slots in this wave.
     slots: usize,
+    /// The most paths a bounce's queue holds: the active pixels' slots (all of them without
+    /// adaptive sampling). `extend`, `shade` and `connect` are launched over this many.
+    live: usize,
     launches: Vec<(Stage, Launch)>,
 }
 
@@ -129,6 +135,7 @@ impl Wave<'_> {
             self.counters,
             &f.cones,
             &f.film.state,
+            &f.aov_paths,
             self.slots,
         )?;
         self.push(Stage::Generate, l);
@@ -148,7 +155,7 @@ impl Wave<'_> {
             &f.queues[queue_in],
             self.counters,
             &f.hits,
-            self.slots,
+            self.live,
         )?;
         self.push(Stage::Extend, l);
         Ok(())
@@ -173,7 +180,8 @@ impl Wave<'_> {
             &f.shadow_rays,
             self.counters,
             &f.cones,
-            self.slots,
+            &f.aov_paths,
+            self.live,
         )?;
         self.push(Stage::Shade, l);
         Ok(())
@@ -187,7 +195,7 @@ impl Wave<'_> {
             &f.shadow_rays,
             self.counters,
             &f.paths,
-            self.slots,
+            self.live,
         )?;
         self.push(Stage::Connect, l);
         Ok(())
@@ -203,9 +211,14 @@ impl Wave<'_> {
 
     fn accumulate(&mut self, frame: &DeviceFrame) -> Result<(), ClError> {
         let f = self.frame;
-        let l = self
-            .program
-            .accumulate(self.device, frame, &f.paths, &f.film, self.counters)?;
+        let l = self.program.accumulate(
+            self.device,
+            frame,
+            &f.paths,
+            &f.aov_paths,
+            &f.film,
+            self.counters,
+        )?;
         self.push(Stage::Accumulate, l);
         Ok(())
     }
@@ -225,11 +238,10 @@ impl Renderer {
             WAVE_PATHS_CPU
         };
         let slots = pixels * (wave / pixels).max(1);
-        if self
-            .frame
-            .as_ref()
-            .is_some_and(|f| f.width == w && f.height == h && f.slots == slots)
-        {
+        let aovs = self.settings.aovs;
+        if self.frame.as_ref().is_some_and(|f| {
+            f.width == w && f.height == h && f.slots == slots && (f.aov_paths.len() > 1) == aovs
+        }) {
             return Ok(());
         }
         self.frame = None; // free the old buffers first
@@ -238,6 +250,7 @@ impl Renderer {
             sum: Buffer::new(device, pixels)?,
             half: Buffer::new(device, pixels)?,
             state: Buffer::new(device, pixels)?,
+            aovs: AovBuffers::new(device, if aovs { pixels } else { 1 })?,
         };
         film.sum.clear(device)?;
         film.half.clear(device)?;
@@ -252,6 +265,7 @@ impl Renderer {
             hits: Buffer::new(device, slots)?,
             shadow_rays: Buffer::new(device, slots)?,
             cones: Buffer::new(device, slots)?,
+            aov_paths: Buffer::new(device, if aovs { 2 * slots } else { 1 })?,
         });
         self.samples = 0;
         Ok(())
@@ -346,6 +360,13 @@ impl Renderer {
         };
         let pixels = (f.width * f.height) as usize;
         let per_wave = (f.slots / pixels).max(1) as u32;
+        // With adaptive sampling `generate` queues only the active pixels' paths, as many as
+        // the last convergence check counted (read back before any later wave: see
+        // `enqueue_adaptive`); the bounces' launches are sized to them.
+        let active = match (self.settings.noise_threshold, self.active_pixels) {
+            (Some(_), Some(active)) => (active as usize).min(pixels),
+            _ => pixels,
+        };
         let mut wave = Wave {
             device: &self.device,
             program,
@@ -356,12 +377,14 @@ impl Renderer {
             counters: &self.counters,
             stats: &self.stats_buffer,
             slots: 0,
+            live: 0,
             launches: Vec::new(),
         };
         let mut done = 0;
         while done < spp {
             let n = per_wave.min(spp - done);
             wave.slots = pixels * n as usize;
+            wave.live = active * n as usize;
             let mut frame = self.settings.gpu_frame(self.light_count);
             frame.samples_in_wave = n;
             frame.first_sample = self.samples + done;
@@ -395,6 +418,7 @@ impl Renderer {
         self.stats.stack_overflows = counters[COUNT_OVERFLOW] as u64;
         if self.adaptive_checked {
             self.active_pixels = Some(counters[COUNT_ACTIVE]);
+            self.active_stale = false;
         }
         Ok(())
     }
