@@ -5,6 +5,7 @@
 //! host memory. docs/denoiser.md describes the design.
 
 pub mod network;
+pub mod oidn;
 pub mod prepare;
 pub mod tza;
 
