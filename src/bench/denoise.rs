@@ -44,8 +44,16 @@ pub fn synthetic(width: usize, height: usize) -> [Vec<[f32; 3]>; 3] {
             let h = ((y * width + x) as u32).wrapping_mul(2_654_435_761) >> 8;
             let noise = (h & 0xffff) as f32 / 65536.0;
             let inside = (u - 0.5).powi(2) + (v - 0.5).powi(2) < 0.08;
-            let albedo = if inside { [0.8, 0.3, 0.2] } else { [0.6, 0.6, 0.6] };
-            let light = if v < 0.05 && (u - 0.5).abs() < 0.1 { 20.0 } else { 1.0 - 0.7 * v };
+            let albedo = if inside {
+                [0.8, 0.3, 0.2]
+            } else {
+                [0.6, 0.6, 0.6]
+            };
+            let light = if v < 0.05 && (u - 0.5).abs() < 0.1 {
+                20.0
+            } else {
+                1.0 - 0.7 * v
+            };
             let l = light * 4.0 * noise * noise;
             c.push(albedo.map(|k| k * l));
             a.push(albedo);
@@ -63,9 +71,14 @@ pub fn run(args: &DenoiseArgs) -> Result<()> {
         bail!("--width, --height and --runs must be at least 1");
     }
     if !["cpu", "cuda", "none"].contains(&args.oidn_device.as_str()) {
-        bail!("--oidn-device '{}' is not cpu, cuda or none", args.oidn_device);
+        bail!(
+            "--oidn-device '{}' is not cpu, cuda or none",
+            args.oidn_device
+        );
     }
-    let device = Device::open(&DeviceChoice::from_arg_or_env(args.device.as_deref()).map_err(anyhow::Error::msg)?)?;
+    let device = Device::open(
+        &DeviceChoice::from_arg_or_env(args.device.as_deref()).map_err(anyhow::Error::msg)?,
+    )?;
     let (w, h) = (args.width, args.height);
     let images = synthetic(w, h);
     let mut denoiser = Denoiser::new(&device, quality)?;
@@ -80,7 +93,10 @@ pub fn run(args: &DenoiseArgs) -> Result<()> {
         report = Some(r);
     }
     let report = report.expect("at least one run");
-    let best = times.iter().cloned().fold((f64::MAX, f64::MAX), |a, b| if b.0 < a.0 { b } else { a });
+    let best = times
+        .iter()
+        .cloned()
+        .fold((f64::MAX, f64::MAX), |a, b| if b.0 < a.0 { b } else { a });
     let gflops = denoiser.flops(w, h) / (best.1 * 1e-3) / 1e9;
     println!(
         "penumbra {} network, {w}x{h}, {} tile(s) of {}x{}: {:.1} ms (convolutions {:.1} ms, {gflops:.0} GFLOP/s), best of {}",
@@ -95,7 +111,14 @@ pub fn run(args: &DenoiseArgs) -> Result<()> {
     let mut oidn_ms = None;
     if args.oidn_device != "none" {
         if oidn::available() {
-            let (_, t) = oidn::denoise(w, h, quality, &args.oidn_device, [&images[0], &images[1], &images[2]], args.runs)?;
+            let (_, t) = oidn::denoise(
+                w,
+                h,
+                quality,
+                &args.oidn_device,
+                [&images[0], &images[1], &images[2]],
+                args.runs,
+            )?;
             let ms = t.iter().cloned().fold(f64::MAX, f64::min);
             println!(
                 "Open Image Denoise 2.5.1 ({} device): {ms:.1} ms, best of {}; penumbra / OIDN = {:.2}",

@@ -144,9 +144,10 @@ struct Tensors {
 }
 
 /// Floats a slot's tensor takes at `width` x `height` (the level's size) with `channels`: the
-/// bordered planes and the rows a partial block of four rows reads past the last plane.
+/// bordered planes and what a block's reads may take past the last one (rows of a partial
+/// block of four, a vector of 16 past a row's end).
 pub fn tensor_len(width: usize, height: usize, channels: usize) -> usize {
-    (width + 2) * (height + 2) * channels + (width + 2) * 6
+    (width + 2) * (height + 2) * channels + (width + 2) * 6 + 32
 }
 
 /// Blocks `oihw` weights as the convolution kernel reads them: `[o / ocb][i][tap][o % ocb]`,

@@ -7,10 +7,6 @@ use super::{Launch, kernel};
 use crate::cl::{Buffer, ClError, Device, build_denoise_program, call_err};
 use opencl3::kernel::{ExecuteKernel, Kernel};
 
-/// Work items along x in a convolution's work-group: neighbouring columns, so that their loads
-/// are one vector (PoCL vectorises work items across lanes) or one coalesced transaction.
-const CONV_GROUP_X: usize = 64;
-
 /// A 2D kernel's work-group (the preparation kernels).
 const GROUP_2D: [usize; 2] = [16, 4];
 
@@ -77,12 +73,17 @@ pub struct TileWindow {
 /// The denoiser's built kernels.
 pub struct DenoiseKernels {
     conv: Kernel,
+    conv_up: Kernel,
     conv_pool: Kernel,
     exposure_bins: Kernel,
     input: Kernel,
     output: Kernel,
     /// Output channels a convolution's work item computes (`DN_OCB`).
     pub ocb: usize,
+    /// Neighbouring columns a convolution's work item computes (`DN_VEC`).
+    vec: usize,
+    /// A convolution's work-group along x.
+    group_x: usize,
 }
 
 fn round_up(n: usize, m: usize) -> usize {
@@ -114,47 +115,59 @@ fn launch(
 }
 
 impl DenoiseKernels {
-    /// Builds the denoiser's program for the device: 8 output channels a work item on GPUs,
-    /// 4 on CPUs (whose compilers keep each of the 4 x 4 accumulators in a vector register of
-    /// lanes, 16 of AVX-512's 32).
+    /// Builds the denoiser's program for the device. On a CPU a work item computes 16 columns
+    /// (one AVX-512 vector) of 4 rows and 4 output channels, 16 accumulator registers of 32,
+    /// and a work-group is 4 of them (PoCL runs a group as one task); on a GPU 2 columns of 4
+    /// rows and 8 channels, in groups of 64 along the row (coalesced loads).
     pub fn build(device: &Device) -> Result<Self, ClError> {
-        let ocb = if device.is_cpu() { 4 } else { 8 };
-        let program = build_denoise_program(device, &format!(" -DDN_OCB={ocb}"))?;
+        let (ocb, vec, group_x) = if device.is_cpu() {
+            (4, 16, 4)
+        } else {
+            (8, 2, 64)
+        };
+        let program = build_denoise_program(device, &format!(" -DDN_OCB={ocb} -DDN_VEC={vec}"))?;
         Ok(Self {
             conv: kernel(&program, "conv3x3")?,
+            conv_up: kernel(&program, "conv3x3_up")?,
             conv_pool: kernel(&program, "conv3x3_pool")?,
             exposure_bins: kernel(&program, "denoise_exposure_bins")?,
             input: kernel(&program, "denoise_input")?,
             output: kernel(&program, "denoise_output")?,
             ocb,
+            vec,
+            group_x,
         })
     }
 
-    /// `conv3x3` or `conv3x3_pool`.
+    /// `conv3x3`, `conv3x3_up` or `conv3x3_pool`.
     pub fn conv(&self, device: &Device, a: &ConvArgs) -> Result<Launch, ClError> {
         assert_eq!(a.out_channels % self.ocb, 0, "output channels not blocked");
         let (src1, c1) = a.src1.unwrap_or((a.src0, 0));
-        let (kernel, stage, global) = if a.pool {
-            let g = [a.width / 2, a.height / 2, a.out_channels / self.ocb];
-            (&self.conv_pool, "conv3x3_pool", g)
-        } else {
-            let g = [a.width, a.height.div_ceil(4), a.out_channels / self.ocb];
-            (&self.conv, "conv3x3", g)
+        assert!(!(a.pool && a.up0), "no kernel pools an upsampled input");
+        let blocks = a.out_channels / self.ocb;
+        let columns = a.width.div_ceil(self.vec);
+        let rows = [columns, a.height.div_ceil(4), blocks];
+        let (kernel, stage, global) = match (a.pool, a.up0) {
+            (true, _) => {
+                let g = [columns, a.height / 2, blocks];
+                (&self.conv_pool, "conv3x3_pool", g)
+            }
+            (false, true) => (&self.conv_up, "conv3x3_up", rows),
+            (false, false) => (&self.conv, "conv3x3", rows),
         };
-        let ints = [a.c0 as i32, a.up0 as i32, c1 as i32];
+        let ints = [a.c0 as i32, c1 as i32];
         let dims = [a.width as i32, a.height as i32];
         launch(
             device,
             stage,
             kernel,
             &global,
-            &[CONV_GROUP_X, 1, 1],
+            &[self.group_x, 1, 1],
             |e| unsafe {
                 e.set_arg(&a.src0.mem())
                     .set_arg(&ints[0])
-                    .set_arg(&ints[1])
                     .set_arg(&src1.mem())
-                    .set_arg(&ints[2])
+                    .set_arg(&ints[1])
                     .set_arg(&a.weights.mem())
                     .set_arg(&a.bias.mem())
                     .set_arg(&a.dst.mem())
