@@ -11,6 +11,7 @@ pub mod cl;
 pub mod cli;
 pub mod cpu_time;
 pub mod date;
+pub mod denoise;
 pub mod image_io;
 pub mod message;
 pub mod render;

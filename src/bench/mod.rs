@@ -8,6 +8,7 @@ mod albedo;
 mod bvh;
 mod converge;
 mod curve;
+mod denoise;
 mod frame;
 pub mod generate;
 mod plot;
@@ -19,6 +20,7 @@ mod trace;
 pub use albedo::AlbedoArgs;
 pub use bvh::BvhArgs;
 pub use converge::ConvergeArgs;
+pub use denoise::DenoiseArgs;
 pub use frame::FrameArgs;
 pub use generate::GenerateArgs;
 pub use stress::StressArgs;
@@ -54,6 +56,9 @@ pub enum BenchCommand {
     /// The mean displayed colour of materials of known base colour under a white environment
     /// against that base colour, per tone curve and exposure rule; a Markdown table.
     Albedo(Box<AlbedoArgs>),
+    /// The denoiser's network time on the device, beside Intel's Open Image Denoise on the
+    /// same input where pyoidn is installed.
+    Denoise(Box<DenoiseArgs>),
 }
 
 /// Runs a benchmark.
@@ -66,6 +71,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Bvh(a) => bvh::run(&a),
         BenchCommand::Stress(a) => stress::run(&a),
         BenchCommand::Albedo(a) => albedo::run(&a),
+        BenchCommand::Denoise(a) => denoise::run(&a),
     }
 }
 

@@ -4,6 +4,7 @@
 //! returns the profiling event; the test-only kernels' wrappers are in `test_program`.
 #![allow(unsafe_code)]
 
+mod denoise;
 mod test_program;
 
 use super::types::*;
@@ -13,6 +14,8 @@ use opencl3::event::Event;
 use opencl3::kernel::{ExecuteKernel, Kernel};
 use std::sync::OnceLock;
 use test_program::TestKernels;
+
+pub use denoise::{ConvArgs, DenoiseKernels, FilmInput, TileWindow};
 
 // Also named from here by the renderer, the scene loader and the benchmarks.
 pub use super::host_memory::{OpeningMemory, map_file};

@@ -139,10 +139,33 @@ pub fn build_test_program(
     build_source(device, &super::source::test_program_source()?, features)
 }
 
+/// Builds the denoiser's program (kernels/denoise/) with its `-D` options.
+pub fn build_denoise_program(
+    device: &Device,
+    defines: &str,
+) -> Result<opencl3::program::Program, ClError> {
+    build_with(
+        device,
+        &super::source::denoise_program_source()?,
+        KernelFeatures::default(),
+        defines,
+    )
+}
+
 pub(crate) fn build_source(
     device: &Device,
     source: &str,
     features: KernelFeatures,
+) -> Result<opencl3::program::Program, ClError> {
+    build_with(device, source, features, "")
+}
+
+/// Builds `source` with the features' defines and `defines` after them.
+fn build_with(
+    device: &Device,
+    source: &str,
+    features: KernelFeatures,
+    defines: &str,
 ) -> Result<opencl3::program::Program, ClError> {
     let mut options = String::new();
     // Correctly rounded division keeps the device's triangle tests identical to the host's.
@@ -167,6 +190,7 @@ pub(crate) fn build_source(
         options.push_str(" -DPERMUTE_BY_SELECT");
     }
     options.push_str(&features.defines());
+    options.push_str(defines);
     if let Some(cap) = register_cap(device, features) {
         options.push_str(&format!(" -cl-nv-maxrregcount={cap}"));
     }

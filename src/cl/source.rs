@@ -17,6 +17,9 @@ const PROGRAM_ROOT: &str = "program.cl";
 /// The test program's root: the production program and the kernels only tests use.
 const TEST_PROGRAM_ROOT: &str = "test/program.cl";
 
+/// The denoiser's program root (its own program, built apart from the path tracer's).
+const DENOISE_PROGRAM_ROOT: &str = "denoise/program.cl";
+
 /// Every kernel file, by its path in the repository.
 const KERNELS: &[(&str, &str)] = &[
     (
@@ -109,6 +112,26 @@ const KERNELS: &[(&str, &str)] = &[
     ),
     ("kernels/tools.cl", include_str!("../../kernels/tools.cl")),
     (
+        "kernels/denoise/program.cl",
+        include_str!("../../kernels/denoise/program.cl"),
+    ),
+    (
+        "kernels/denoise/tensor.h",
+        include_str!("../../kernels/denoise/tensor.h"),
+    ),
+    (
+        "kernels/denoise/transfer.h",
+        include_str!("../../kernels/denoise/transfer.h"),
+    ),
+    (
+        "kernels/denoise/conv.cl",
+        include_str!("../../kernels/denoise/conv.cl"),
+    ),
+    (
+        "kernels/denoise/prepare.cl",
+        include_str!("../../kernels/denoise/prepare.cl"),
+    ),
+    (
         "kernels/test/program.cl",
         include_str!("../../kernels/test/program.cl"),
     ),
@@ -130,6 +153,11 @@ const DEFINES_NAME: &str = "generated/constants.h";
 /// path (e.g. `PENUMBRA_KERNEL_DIR=.` for `kernels/shared/path.h`) replaces the built-in text.
 pub fn program_source() -> Result<String, ClError> {
     expand_with_env(PROGRAM_ROOT)
+}
+
+/// The denoiser's program source, its includes expanded (`PENUMBRA_KERNEL_DIR` applies).
+pub fn denoise_program_source() -> Result<String, ClError> {
+    expand_with_env(DENOISE_PROGRAM_ROOT)
 }
 
 /// [`program_source`] followed by the test-only kernels.

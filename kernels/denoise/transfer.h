@@ -1,0 +1,37 @@
+// Open Image Denoise's perceptually uniform (PU) transfer function for HDR colour: a fit of the
+// PU curve (Aydin et al. 2008) normalised so that 65504 (the largest half) maps to 1. Its host
+// twin, used by the tests, is src/denoise/prepare.rs.
+#ifndef DENOISE_TRANSFER_H
+#define DENOISE_TRANSFER_H
+
+#define PU_A 1.41283765e+03f
+#define PU_B 1.64593172e+00f
+#define PU_C 4.31384981e-01f
+#define PU_D (-2.94139609e-03f)
+#define PU_E 1.92653254e-01f
+#define PU_F 6.26026094e-03f
+#define PU_G 9.98620152e-01f
+#define PU_Y0 1.57945760e-06f
+#define PU_Y1 3.22087631e-02f
+#define PU_X0 2.23151711e-03f
+#define PU_X1 3.70974749e-01f
+
+// The curve before normalisation; the kernels scale it by 1 / pu_forward(65504), which the
+// host computes once (`prepare::PU_NORM`).
+inline float pu_forward(float y) {
+    if (y <= PU_Y0)
+        return PU_A * y;
+    if (y <= PU_Y1)
+        return PU_B * pow(y, PU_C) + PU_D;
+    return PU_E * log(y + PU_F) + PU_G;
+}
+
+inline float pu_inverse(float x) {
+    if (x <= PU_X0)
+        return x / PU_A;
+    if (x <= PU_X1)
+        return pow((x - PU_D) / PU_B, 1.0f / PU_C);
+    return exp((x - PU_G) / PU_E) - PU_F;
+}
+
+#endif

@@ -1,0 +1,297 @@
+//! Typed wrappers over the denoiser's kernels (kernels/denoise/): the U-Net's convolutions and
+//! the input and output preparation. Each launches under its kernel's name and returns the
+//! profiling event.
+#![allow(unsafe_code)]
+
+use super::{Launch, kernel};
+use crate::cl::{Buffer, ClError, Device, build_denoise_program, call_err};
+use opencl3::kernel::{ExecuteKernel, Kernel};
+
+/// A 2D kernel's work-group (the preparation kernels).
+const GROUP_2D: [usize; 2] = [16, 4];
+
+/// A film-like buffer the denoiser reads: RGBA f32 per pixel, row-major, and how a pixel's
+/// value is made of it.
+#[derive(Clone, Copy)]
+pub struct FilmInput<'a> {
+    /// The pixels (`.w` is a sample count where `by_count`, else ignored).
+    pub buffer: &'a Buffer<[f32; 4]>,
+    /// The factor on `.xyz` when not `by_count` (e.g. 1 / samples for a sum, 1 for a mean).
+    pub scale: f32,
+    /// The value is `.xyz / .w` (a sum over its per-pixel sample count; 0 where `.w` is 0).
+    pub by_count: bool,
+}
+
+/// One convolution's operands: `dst = relu(conv3x3(concat(upsample?(src0), src1)) + bias)`,
+/// max-pooled 2x2 when `pool`. Tensors are laid out as kernels/denoise/tensor.h says.
+pub struct ConvArgs<'a> {
+    /// The first input and its channels.
+    pub src0: &'a Buffer<f32>,
+    /// Channels of `src0`.
+    pub c0: usize,
+    /// `src0` is at half the resolution and read upsampled (nearest).
+    pub up0: bool,
+    /// The skip connection concatenated after `src0`, and its channels (0: none).
+    pub src1: Option<(&'a Buffer<f32>, usize)>,
+    /// Weights blocked as `[out / ocb][in][tap][ocb]`.
+    pub weights: &'a Buffer<f32>,
+    /// Biases, padded to the output channels.
+    pub bias: &'a Buffer<f32>,
+    /// The output tensor.
+    pub dst: &'a Buffer<f32>,
+    /// Output channels (a multiple of [`DenoiseKernels::ocb`]).
+    pub out_channels: usize,
+    /// The convolution's resolution (the output's before pooling).
+    pub width: usize,
+    /// See `width`.
+    pub height: usize,
+    /// Max-pool the output 2x2.
+    pub pool: bool,
+}
+
+/// Where one tile of the image goes in the network's input, and back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TileWindow {
+    /// The tile buffer's size (multiples of 16).
+    pub tile_w: usize,
+    /// See `tile_w`.
+    pub tile_h: usize,
+    /// The first image pixel of the region copied.
+    pub image_x: usize,
+    /// See `image_x`.
+    pub image_y: usize,
+    /// Where that pixel lies in the tile.
+    pub tile_x: usize,
+    /// See `tile_x`.
+    pub tile_y: usize,
+    /// The region's size.
+    pub w: usize,
+    /// See `w`.
+    pub h: usize,
+}
+
+/// The denoiser's built kernels.
+pub struct DenoiseKernels {
+    conv: Kernel,
+    conv_up: Kernel,
+    conv_pool: Kernel,
+    exposure_bins: Kernel,
+    input: Kernel,
+    output: Kernel,
+    /// Output channels a convolution's work item computes (`DN_OCB`).
+    pub ocb: usize,
+    /// Neighbouring columns a convolution's work item computes (`DN_VEC`).
+    vec: usize,
+    /// A convolution's work-group along x.
+    group_x: usize,
+}
+
+fn round_up(n: usize, m: usize) -> usize {
+    n.max(1).div_ceil(m) * m
+}
+
+fn launch(
+    device: &Device,
+    stage: &'static str,
+    kernel: &Kernel,
+    global: &[usize],
+    local: &[usize],
+    set: impl FnOnce(&mut ExecuteKernel),
+) -> Result<Launch, ClError> {
+    let mut exec = ExecuteKernel::new(kernel);
+    set(&mut exec);
+    let global: Vec<usize> = global
+        .iter()
+        .zip(local)
+        .map(|(&g, &l)| round_up(g, l))
+        .collect();
+    exec.set_global_work_sizes(&global)
+        .set_local_work_sizes(local);
+    // SAFETY: every wrapper sets exactly its kernel's arguments, in order, with the types the
+    // kernel declares; the buffers outlive the launch because the queue is in order and every
+    // reader of the results waits on it.
+    let event = unsafe { exec.enqueue_nd_range(&device.queue) }.map_err(call_err(stage))?;
+    Ok(Launch { stage, event })
+}
+
+impl DenoiseKernels {
+    /// Builds the denoiser's program for the device. On a CPU a work item computes 16 columns
+    /// (one AVX-512 vector) of 4 rows and 4 output channels, 16 accumulator registers of 32,
+    /// and a work-group is 4 of them (PoCL runs a group as one task); on a GPU 2 columns of 4
+    /// rows and 8 channels, in groups of 64 along the row (coalesced loads).
+    pub fn build(device: &Device) -> Result<Self, ClError> {
+        let (ocb, vec, group_x) = if device.is_cpu() {
+            (4, 16, 4)
+        } else {
+            (8, 2, 64)
+        };
+        let program = build_denoise_program(device, &format!(" -DDN_OCB={ocb} -DDN_VEC={vec}"))?;
+        Ok(Self {
+            conv: kernel(&program, "conv3x3")?,
+            conv_up: kernel(&program, "conv3x3_up")?,
+            conv_pool: kernel(&program, "conv3x3_pool")?,
+            exposure_bins: kernel(&program, "denoise_exposure_bins")?,
+            input: kernel(&program, "denoise_input")?,
+            output: kernel(&program, "denoise_output")?,
+            ocb,
+            vec,
+            group_x,
+        })
+    }
+
+    /// `conv3x3`, `conv3x3_up` or `conv3x3_pool`.
+    pub fn conv(&self, device: &Device, a: &ConvArgs) -> Result<Launch, ClError> {
+        assert_eq!(a.out_channels % self.ocb, 0, "output channels not blocked");
+        let (src1, c1) = a.src1.unwrap_or((a.src0, 0));
+        assert!(!(a.pool && a.up0), "no kernel pools an upsampled input");
+        let blocks = a.out_channels / self.ocb;
+        let columns = a.width.div_ceil(self.vec);
+        let rows = [columns, a.height.div_ceil(4), blocks];
+        let (kernel, stage, global) = match (a.pool, a.up0) {
+            (true, _) => {
+                let g = [columns, a.height / 2, blocks];
+                (&self.conv_pool, "conv3x3_pool", g)
+            }
+            (false, true) => (&self.conv_up, "conv3x3_up", rows),
+            (false, false) => (&self.conv, "conv3x3", rows),
+        };
+        let ints = [a.c0 as i32, c1 as i32];
+        let dims = [a.width as i32, a.height as i32];
+        launch(
+            device,
+            stage,
+            kernel,
+            &global,
+            &[self.group_x, 1, 1],
+            |e| unsafe {
+                e.set_arg(&a.src0.mem())
+                    .set_arg(&ints[0])
+                    .set_arg(&src1.mem())
+                    .set_arg(&ints[1])
+                    .set_arg(&a.weights.mem())
+                    .set_arg(&a.bias.mem())
+                    .set_arg(&a.dst.mem())
+                    .set_arg(&dims[0])
+                    .set_arg(&dims[1]);
+            },
+        )
+    }
+
+    /// `denoise_exposure_bins`: the mean luminance of `bins` = (across, down) blocks of the
+    /// `width` x `height` colour.
+    pub fn exposure_bins(
+        &self,
+        device: &Device,
+        color: FilmInput,
+        width: usize,
+        height: usize,
+        bins: (usize, usize),
+        out: &Buffer<f32>,
+    ) -> Result<Launch, ClError> {
+        let by_count = color.by_count as i32;
+        let ints = [width as i32, height as i32, bins.0 as i32, bins.1 as i32];
+        launch(
+            device,
+            "denoise_exposure_bins",
+            &self.exposure_bins,
+            &[bins.0 * bins.1],
+            &[64],
+            |e| unsafe {
+                e.set_arg(&color.buffer.mem())
+                    .set_arg(&color.scale)
+                    .set_arg(&by_count);
+                for i in &ints {
+                    e.set_arg(i);
+                }
+                e.set_arg(&out.mem());
+            },
+        )
+    }
+
+    /// `denoise_input`: the network's input tensor for one tile of the `width`-wide image.
+    #[allow(clippy::too_many_arguments)]
+    pub fn input(
+        &self,
+        device: &Device,
+        inputs: [FilmInput; 3],
+        width: usize,
+        tile: TileWindow,
+        exposure: f32,
+        pu_norm: f32,
+        dst: &Buffer<f32>,
+    ) -> Result<Launch, ClError> {
+        let flags = inputs.map(|i| i.by_count as i32);
+        let ints = [
+            width,
+            tile.image_x,
+            tile.image_y,
+            tile.tile_x,
+            tile.tile_y,
+            tile.w,
+            tile.h,
+            tile.tile_w,
+            tile.tile_h,
+        ]
+        .map(|v| v as i32);
+        launch(
+            device,
+            "denoise_input",
+            &self.input,
+            &[tile.tile_w, tile.tile_h],
+            &GROUP_2D,
+            |e| unsafe {
+                for (input, flag) in inputs.iter().zip(&flags) {
+                    e.set_arg(&input.buffer.mem())
+                        .set_arg(&input.scale)
+                        .set_arg(flag);
+                }
+                for i in &ints {
+                    e.set_arg(i);
+                }
+                e.set_arg(&exposure).set_arg(&pu_norm).set_arg(&dst.mem());
+            },
+        )
+    }
+
+    /// `denoise_output`: one tile's denoised pixels into the `width`-wide output image.
+    #[allow(clippy::too_many_arguments)]
+    pub fn output(
+        &self,
+        device: &Device,
+        src: &Buffer<f32>,
+        tile: TileWindow,
+        width: usize,
+        pu_max: f32,
+        output_scale: f32,
+        out: &Buffer<[f32; 4]>,
+    ) -> Result<Launch, ClError> {
+        let ints = [
+            tile.tile_w,
+            tile.tile_h,
+            tile.tile_x,
+            tile.tile_y,
+            tile.image_x,
+            tile.image_y,
+            tile.w,
+            tile.h,
+            width,
+        ]
+        .map(|v| v as i32);
+        launch(
+            device,
+            "denoise_output",
+            &self.output,
+            &[tile.w, tile.h],
+            &GROUP_2D,
+            |e| unsafe {
+                e.set_arg(&src.mem());
+                for i in &ints {
+                    e.set_arg(i);
+                }
+                e.set_arg(&pu_max)
+                    .set_arg(&output_scale)
+                    .set_arg(&out.mem());
+            },
+        )
+    }
+}

