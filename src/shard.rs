@@ -160,20 +160,7 @@ impl Shard {
         use exr::prelude::*;
         let shown = path.display();
         let layer = crate::image_io::read_exr_layer(path)?;
-        let info = match layer.attributes.other.get(&Text::from(ATTRIBUTE)) {
-            Some(AttributeValue::Text(t)) => serde_json::from_str::<ShardInfo>(&t.to_string())
-                .map_err(|e| anyhow::anyhow!("{shown}: the shard header is damaged: {e}"))?,
-            _ => {
-                bail!("{shown}: not a shard (no {ATTRIBUTE} header: render it with --sample-start)")
-            }
-        };
-        if info.samples == 0 || info.sample_start.checked_add(info.samples).is_none() {
-            bail!(
-                "{shown}: the shard header's range ({} samples from {}) is empty or past the sequence",
-                info.samples,
-                info.sample_start
-            );
-        }
+        let info = info_of(path, &layer.attributes)?;
         let channel = |name: &str| {
             layer
                 .channel_data
@@ -201,20 +188,58 @@ impl Shard {
             film,
         })
     }
+
+    /// Reads only a shard EXR's header (no pixel): a shard with an empty film.
+    pub fn read_header(path: &Path) -> Result<Shard> {
+        let meta = exr::meta::MetaData::read_from_file(path, false)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read EXR: {e}", path.display()))?;
+        let Some(header) = meta.headers.first() else {
+            bail!("{}: an EXR without layers", path.display());
+        };
+        Ok(Shard {
+            width: header.layer_size.width() as u32,
+            height: header.layer_size.height() as u32,
+            info: info_of(path, &header.own_attributes)?,
+            film: Vec::new(),
+        })
+    }
 }
 
-/// Shards added up, in the order of their sample ranges. Refused, with one line naming the
-/// files: shards of another size, scene or settings (another identity), PNG settings or
-/// background; overlapping ranges; a gap between ranges (a missing shard). `names[i]` names
-/// `shards[i]` in messages.
-pub fn merge(mut shards: Vec<(String, Shard)>) -> Result<Shard> {
+/// The [`ShardInfo`] of a layer's attributes; one line naming `path` and the problem otherwise.
+fn info_of(path: &Path, attributes: &exr::meta::header::LayerAttributes) -> Result<ShardInfo> {
+    use exr::prelude::*;
+    let shown = path.display();
+    let info = match attributes.other.get(&Text::from(ATTRIBUTE)) {
+        Some(AttributeValue::Text(t)) => serde_json::from_str::<ShardInfo>(&t.to_string())
+            .map_err(|e| anyhow::anyhow!("{shown}: the shard header is damaged: {e}"))?,
+        _ => bail!("{shown}: not a shard (no {ATTRIBUTE} header: render it with --sample-start)"),
+    };
+    if info.samples == 0 || info.sample_start.checked_add(info.samples).is_none() {
+        bail!(
+            "{shown}: the shard header's range ({} samples from {}) is empty or past the sequence",
+            info.samples,
+            info.sample_start
+        );
+    }
+    Ok(info)
+}
+
+/// The header of the merge of shards whose headers are `shards` (films not needed), after
+/// sorting them by their ranges. Refused, with one line naming the files: shards of another
+/// size, scene or settings (another identity), PNG settings or background; overlapping
+/// ranges; a gap between ranges (a missing shard). The first element of each pair names the
+/// shard in messages.
+pub fn check<N: std::fmt::Display>(shards: &mut [(N, Shard)]) -> Result<Shard> {
     shards.sort_by_key(|(_, s)| s.info.sample_start);
-    let mut shards = shards.into_iter();
-    let Some((first_name, mut sum)) = shards.next() else {
+    let Some(((first_name, first), rest)) = shards.split_first() else {
         bail!("no shard to merge");
     };
-    let mut last_name = first_name.clone();
-    for (name, s) in shards {
+    let mut sum = Shard {
+        film: Vec::new(),
+        ..first.clone()
+    };
+    let mut last_name = first_name;
+    for (name, s) in rest {
         let (a, b) = (&sum.info, &s.info);
         if (s.width, s.height) != (sum.width, sum.height) {
             bail!(
@@ -258,9 +283,6 @@ pub fn merge(mut shards: Vec<(String, Shard)>) -> Result<Shard> {
                 b.sample_start - 1
             );
         }
-        for (p, q) in sum.film.iter_mut().zip(&s.film) {
-            *p = film::add(*p, *q);
-        }
         sum.info.samples += b.samples;
         for (x, y) in [
             (&mut sum.info.kernel, &b.kernel),
@@ -273,6 +295,20 @@ pub fn merge(mut shards: Vec<(String, Shard)>) -> Result<Shard> {
         last_name = name;
     }
     Ok(sum)
+}
+
+impl Shard {
+    /// Adds `film` (another shard's, of the same size) to this shard's film; an empty film
+    /// (from [`check`]) takes it as it is.
+    pub fn add_film(&mut self, film: Vec<FilmPixel>) {
+        if self.film.is_empty() {
+            self.film = film;
+        } else {
+            for (p, q) in self.film.iter_mut().zip(&film) {
+                *p = film::add(*p, *q);
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -316,8 +352,12 @@ mod tests {
     #[test]
     fn merging_adds_the_sums_in_any_file_order() {
         let named = |s: Shard| (format!("{}.exr", s.info.sample_start), s);
-        let m = merge(vec![named(shard(8, 4, 3)), named(shard(0, 8, 5))]).unwrap();
+        let mut shards = vec![named(shard(8, 4, 3)), named(shard(0, 8, 5))];
+        let mut m = check(&mut shards).unwrap();
         assert_eq!((m.info.sample_start, m.info.samples), (0, 12));
+        for (_, s) in shards {
+            m.add_film(s.film);
+        }
         assert_eq!(m.film[0], [8 << 33, 8, 0, 12]);
     }
 
@@ -325,9 +365,8 @@ mod tests {
     fn merging_refuses_overlaps_gaps_and_other_settings() {
         let named = |s: Shard| (format!("{}.exr", s.info.sample_start), s);
         let err = |v: Vec<Shard>| {
-            merge(v.into_iter().map(named).collect())
-                .unwrap_err()
-                .to_string()
+            let mut named: Vec<_> = v.into_iter().map(named).collect();
+            check(&mut named).unwrap_err().to_string()
         };
         assert!(err(vec![shard(0, 8, 1), shard(4, 8, 1)]).contains("overlap"));
         assert!(err(vec![shard(0, 8, 1), shard(12, 8, 1)]).contains("samples 8…11 are missing"));

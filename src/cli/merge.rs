@@ -9,7 +9,17 @@ use crate::render::exposure::ExposureMode;
 use crate::render::tonemap::ToneMapper;
 use crate::shard::{self, Shard};
 use anyhow::{Result, anyhow};
+use std::path::Path;
 use std::time::Instant;
+
+/// A shard's path, shown in messages.
+struct Named<'a>(&'a Path);
+
+impl std::fmt::Display for Named<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.display().fmt(f)
+    }
+}
 
 /// Reads the shards, refuses any that do not belong together (one line), and writes the sum:
 /// an EXR is itself a shard of all the samples; a PNG is exposed and tone-mapped as the
@@ -17,13 +27,22 @@ use std::time::Instant;
 pub fn run(args: &MergeArgs) -> Result<()> {
     let started = Instant::now();
     let output = OutputFile::open(&args.output)?;
-    let shards = args
+    // The headers first: shards that do not belong together are refused before any pixel is
+    // read; then one film at a time, so that a merge holds two films, not one per shard.
+    let mut shards = args
         .shards
         .iter()
-        .map(|path| Ok((path.display().to_string(), Shard::read(path)?)))
+        .map(|path| Ok((Named(path), Shard::read_header(path)?)))
         .collect::<Result<Vec<_>>>()?;
     let count = shards.len();
-    let merged = shard::merge(shards)?;
+    let mut merged = shard::check(&mut shards)?;
+    for (name, header) in &shards {
+        let s = Shard::read(name.0)?;
+        if s.info != header.info {
+            anyhow::bail!("{name}: changed while it was merged");
+        }
+        merged.add_film(s.film);
+    }
     let (w, h) = (merged.width, merged.height);
     let bytes = match output.format {
         Format::Exr => merged.encode()?,
