@@ -363,9 +363,9 @@ fn duration(seconds: f64) -> String {
     }
 }
 
-/// Sets pixels with a non-finite or negative channel to 0 and counts them: the kernels drop
-/// non-finite samples, but a film's sum of finite samples can still overflow f32, and no
-/// such value may reach the file.
+/// Sets pixels with a non-finite or negative channel to 0 and counts them: no such value may
+/// reach the file. The kernels drop non-finite samples and the film's fixed-point sums
+/// saturate (kernels/shared/film.h), so a mean is finite unless the film's readback changes.
 fn zero_nonfinite(image: &mut [[f32; 3]]) -> u64 {
     let mut count = 0;
     for p in image.iter_mut() {
