@@ -25,6 +25,7 @@
 #include "shared/aovs.h"
 #include "shared/path.h"
 // Adaptive sampling: the half buffer, the error estimate and the convergence check.
+#include "shared/film.h"
 #include "shared/adaptive.h"
 // The CPU lanes' batched shading (LANES_SHADE only).
 #include "cpu/shade_lanes.h"

@@ -236,7 +236,7 @@ pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, Channels)> {
 /// its default order is "unspecified", and its parallel compression then writes the tiles in
 /// whatever order the threads finish them, so one image gave files that differed from run to
 /// run. In order, the same pixels always make the same bytes.
-const EXR_ENCODING: exr::image::Encoding = exr::image::Encoding {
+pub(crate) const EXR_ENCODING: exr::image::Encoding = exr::image::Encoding {
     line_order: exr::meta::attribute::LineOrder::Increasing,
     ..exr::image::Encoding::FAST_LOSSLESS
 };
@@ -289,6 +289,22 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
     let size = image.layer_data.size;
     let (_, pixels) = image.layer_data.channel_data.pixels;
     Ok((size.width() as u32, size.height() as u32, pixels))
+}
+
+/// An EXR file's first layer with every channel (of any sample type) and every attribute.
+pub fn read_exr_layer(
+    path: &Path,
+) -> Result<exr::image::Layer<exr::image::AnyChannels<exr::image::FlatSamples>>> {
+    use exr::prelude::*;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot read EXR: {e}", path.display()))?;
+    Ok(image.layer_data)
 }
 
 /// A path in `dir` named `{stem}-{timestamp}.{ext}` that does not exist yet; a counter is

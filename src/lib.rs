@@ -16,3 +16,4 @@ pub mod image_io;
 pub mod message;
 pub mod render;
 pub mod scene;
+pub mod shard;

@@ -80,10 +80,8 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
                                      materials, tex_refs, textures, texels, env_texels,
                                      env_marginal, env_conditional, lights, light_cdf);
     volatile global uint* overflow = &counters[COUNT_OVERFLOW];
-    // The samples are added to the film's sum one by one, so that the image does not depend
-    // on how many samples each launch took (a float sum depends on its order).
-    float4 pixel_film = film[pixel];
-    float3 sum = pixel_film.xyz;
+    ulong4 pixel_film = film[pixel];
+    ulong3 sum = pixel_film.xyz;
     uint extension_rays = 0;
     uint shadow_rays = 0;
     uint nonfinite = 0;
@@ -138,7 +136,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
 #endif
     }
     if (frame.background == BACKGROUND_ENV) counted = frame.samples_in_wave;
-    film[pixel] = (float4)(sum, pixel_film.w + (float)counted);
+    film[pixel] = (ulong4)(sum, pixel_film.w + counted);
     if (frame.adaptive != 0u) half_store(halves, state, pixel, even, evens, frame.samples_in_wave);
 #ifdef AOVS
     aov_store(aov_albedo, aov_normal, aov_depth, pixel, aov_albedo_sum, aov_normal_sum,

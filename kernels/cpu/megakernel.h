@@ -21,7 +21,7 @@
         global const DeviceTexRef *tex_refs, global const DeviceTexture *textures,                \
         global const uint *texels, global const float *env_texels,                          \
         global const float *env_marginal, global const float *env_conditional,              \
-        global const DeviceLight *lights, global const float *light_cdf, global float4 *film, \
+        global const DeviceLight *lights, global const float *light_cdf, global ulong4 *film, \
         volatile global uint *counters, global float4 *halves, global uint *state,           \
         global float4 *aov_albedo, global float4 *aov_normal, global float2 *aov_depth
 
@@ -51,10 +51,10 @@ inline ShadeScene mega_shade_scene(DeviceEnvironment environment,
 
 // A finished sample: its radiance added to the pixel's sum (a non-finite one dropped and
 // counted), and counted in the film's .w when its camera ray hit.
-inline void mega_add_sample(const PathState* s, float3* sum, uint* counted, uint* nonfinite) {
+inline void mega_add_sample(const PathState* s, ulong3* sum, uint* counted, uint* nonfinite) {
     *counted += (s->flags & PATH_ESCAPED) == 0u;
     if (all(isfinite(s->radiance))) {
-        *sum += s->radiance;
+        film_add(sum, s->radiance);
     } else {
         ++*nonfinite;
     }

@@ -81,13 +81,13 @@ inline int mega_tile_pixel(const MegaWork* W, const DeviceFrame* frame, uint i) 
 }
 
 // A record's chunk done: its results added to the film, pixel by pixel in sample order.
-inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global float4* film,
+inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global ulong4* film,
                             MegaChunk* c) {
     uint e = 0u;
     while (e < c->count) {
         uint p = c->pixel[e];
-        float4 f = film[p];
-        float3 sum = f.xyz;
+        ulong4 f = film[p];
+        ulong3 sum = f.xyz;
         uint counted = 0u, samples = 0u;
         float3 even = (float3)(0.0f);
         uint evens = 0u;
@@ -96,19 +96,19 @@ inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global float4
             // The index's parity from the chunk's bit: 0 for even, 1 for odd.
             half_add(c->result[e], ((c->even >> e) & 1u) ^ 1u, &even, &evens);
             if (all(isfinite(c->result[e]))) {
-                sum += c->result[e];
+                film_add(&sum, c->result[e]);
             } else {
                 ++W->nonfinite;
             }
         }
         uint n = frame->background == BACKGROUND_ENV ? samples : counted;
-        film[p] = (float4)(sum, f.w + (float)n);
+        film[p] = (ulong4)(sum, f.w + n);
         if (frame->adaptive != 0u) half_store(W->halves, W->state, p, even, evens, samples);
     }
 }
 
 // A path done: its radiance into its chunk's record.
-inline void mega_path_done(MegaWork* W, const DeviceFrame* frame, global float4* film, uint chunk,
+inline void mega_path_done(MegaWork* W, const DeviceFrame* frame, global ulong4* film, uint chunk,
                            uint entry, const PathState* s) {
     MegaChunk* c = &W->chunk[chunk];
     c->result[entry] = s->radiance;
@@ -122,7 +122,7 @@ inline void mega_path_done(MegaWork* W, const DeviceFrame* frame, global float4*
 inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const DeviceCamera* camera,
                              const ShadeScene* sc, global const DeviceWideNode* nodes,
                              global const DeviceInstance* instances,
-                             global const DeviceTriangle* object_tris, global float4* film,
+                             global const DeviceTriangle* object_tris, global ulong4* film,
                              volatile global uint* overflow) {
     uint spp = frame->samples_in_wave;
     // A pixel with samples left whose last chunk is done; else a free record for new pixels.
@@ -278,7 +278,7 @@ inline void slot_ready(MegaSlots* S, int k) {
 
 // Path k's next ray (alive), or its end (the last ray first tested against the emitters).
 inline void slot_next(MegaSlots* S, MegaWork* W, const DeviceFrame* frame, const ShadeScene* sc,
-                      global float4* film, int k, bool alive) {
+                      global ulong4* film, int k, bool alive) {
 #ifdef LAST_RAY_EMITTERS
     if (alive && S->last_by_emitters && S->bounce[k] == frame->max_bounces + 1u) {
         DeviceHit e = mega_nearest_emitter(frame, sc, S->s[k].origin, S->s[k].direction);
@@ -301,7 +301,7 @@ inline void slot_next(MegaSlots* S, MegaWork* W, const DeviceFrame* frame, const
 // Path k's vertex shaded (alive: whether the path goes on): its light sample, else its next
 // ray, is ready.
 inline void slot_shaded(MegaSlots* S, MegaWork* W, const DeviceFrame* frame,
-                        const ShadeScene* sc, global float4* film, int k, bool alive) {
+                        const ShadeScene* sc, global ulong4* film, int k, bool alive) {
     alive = alive && ++S->bounce[k] <= frame->max_bounces + 1u;
     if (S->sample[k].valid) {
         ++W->shadow_rays;
@@ -316,7 +316,7 @@ inline void slot_shaded(MegaSlots* S, MegaWork* W, const DeviceFrame* frame,
 #ifdef LANES_SHADE
 // The batch's vertices shaded together (shade_lanes.h), each path then as slot_shaded says.
 inline void slots_shade_batch(MegaSlots* S, MegaWork* W, const DeviceFrame* frame,
-                              const ShadeScene* sc, global float4* film) {
+                              const ShadeScene* sc, global ulong4* film) {
     lanes_shade(frame, sc, &S->B, S->batch_n);
     for (int e = 0; e < S->batch_n; ++e) {
         int k = S->batch_slot[e];

@@ -179,21 +179,19 @@ kernel void advance(global uint* counters, global ulong* stats) {
 // so the result does not depend on the queues' order. Non-finite samples are counted and dropped.
 // With adaptive sampling converged pixels are skipped and the others' half buffers and sample
 // counts updated (adaptive.h). With AOVS the slots' guide records go into the AOV sums (aovs.h).
-kernel void accumulate(DeviceFrame frame, global const DevicePath* paths, global float4* film,
+kernel void accumulate(DeviceFrame frame, global const DevicePath* paths, global ulong4* film,
                        volatile global uint* counters, global float4* halves, global uint* state,
                        global const float4* aov_paths, global float4* aov_albedo,
                        global float4* aov_normal, global float2* aov_depth) {
     uint pixel = get_global_id(0);
     uint pixels = frame.width * frame.height;
     if (pixel >= pixels || pixel_converged(&frame, state, pixel)) return;
-    // Added to the film's sum one by one, so that the image does not depend on how many
-    // samples each wave took (a float sum depends on its order).
-    float4 pixel_film = film[pixel];
-    float3 sum = pixel_film.xyz;
+    ulong4 pixel_film = film[pixel];
+    ulong3 sum = pixel_film.xyz;
     for (uint j = 0; j < frame.samples_in_wave; ++j) {
         float3 r = paths[pixel + j * pixels].radiance.xyz;
         if (all(isfinite(r))) {
-            sum += r;
+            film_add(&sum, r);
         } else {
             atomic_inc(&counters[COUNT_NONFINITE]);
         }
@@ -205,7 +203,7 @@ kernel void accumulate(DeviceFrame frame, global const DevicePath* paths, global
             counted += (as_uint(paths[pixel + j * pixels].direction.w) & PATH_ESCAPED) == 0u;
         }
     }
-    film[pixel] = (float4)(sum, pixel_film.w + (float)counted);
+    film[pixel] = (ulong4)(sum, pixel_film.w + counted);
     if (frame.adaptive != 0u) {
         float3 even = (float3)(0.0f);
         uint evens = 0u;

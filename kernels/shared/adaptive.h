@@ -11,6 +11,7 @@
 #define SHARED_ADAPTIVE_H
 
 #include "shared/types.h"
+#include "shared/film.h"
 
 // Whether the pixel takes no samples in this launch.
 inline bool pixel_converged(const DeviceFrame* frame, global const uint* state, uint pixel) {
@@ -48,13 +49,13 @@ inline float pixel_error(float4 film, float4 h, uint state) {
 
 // The convergence check, first pass: PIXEL_UNDER set where the pixel's error is under
 // `threshold`. Pixel 0 zeroes COUNT_ACTIVE for `converge_dilate`.
-kernel void converge(DeviceFrame frame, global const float4* film, global const float4* halves,
+kernel void converge(DeviceFrame frame, global const ulong4* film, global const float4* halves,
                      global uint* state, float threshold, volatile global uint* counters) {
     uint pixel = get_global_id(0);
     if (pixel == 0u) counters[COUNT_ACTIVE] = 0u;
     if (pixel >= frame.width * frame.height) return;
     uint s = state[pixel];
-    bool under = pixel_error(film[pixel], halves[pixel], s) < threshold;
+    bool under = pixel_error(film_float(film[pixel]), halves[pixel], s) < threshold;
     state[pixel] = under ? s | PIXEL_UNDER : s & ~PIXEL_UNDER;
 }
 

@@ -515,8 +515,9 @@ impl Program {
 /// sampling's half buffer and pixel states (kernels/shared/adaptive.h; untouched unless
 /// `DeviceFrame::adaptive`).
 pub struct AdaptiveFilm {
-    /// Per pixel: the sum of its samples, `.w` their count (or the hits among them).
-    pub sum: Buffer<[f32; 4]>,
+    /// Per pixel: the sum of its samples in fixed point, `.w` their count (or the hits among
+    /// them): kernels/shared/film.h.
+    pub sum: Buffer<[u64; 4]>,
     /// Per pixel: the sum of its even-numbered samples, `.w` their count.
     pub half: Buffer<[f32; 4]>,
     /// Per pixel: the samples it took and its convergence bits (`PIXEL_*`).

@@ -75,6 +75,10 @@ const KERNELS: &[(&str, &str)] = &[
         include_str!("../../kernels/shared/path.h"),
     ),
     (
+        "kernels/shared/film.h",
+        include_str!("../../kernels/shared/film.h"),
+    ),
+    (
         "kernels/shared/adaptive.h",
         include_str!("../../kernels/shared/adaptive.h"),
     ),

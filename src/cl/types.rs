@@ -148,6 +148,10 @@ kernel_constants! {
     /// Length of the counters buffer.
     COUNTER_SLOTS: usize = 8;
 
+    /// The film's fixed point (kernels/shared/film.h): a sum's integer is its radiance times
+    /// 2^FILM_FRACTION_BITS.
+    FILM_FRACTION_BITS: u32 = 24;
+
     /// Bits of an adaptive pixel's state (kernels/shared/adaptive.h): the samples it took.
     PIXEL_SAMPLES: u32 = 0x3fff_ffff;
     /// Its error was under the threshold at the last check.

@@ -1,7 +1,8 @@
-//! The command line: `view` (default), `render`, `devices`, `bench`.
+//! The command line: `view` (default), `render`, `merge`, `devices`, `bench`.
 
 mod devices;
 pub mod first_image;
+mod merge;
 pub mod messages;
 mod render;
 pub mod scene_file;
@@ -31,6 +32,9 @@ pub enum Command {
     View(ViewArgs),
     /// Render a scene headless to an image; prints a JSON summary on stdout.
     Render(RenderArgs),
+    /// Add up shards (`render --sample-start … -o SHARD.exr`) into one image, bit for bit the
+    /// render of all their samples.
+    Merge(MergeArgs),
     /// List OpenCL platforms and devices with the index --device takes.
     Devices,
     /// Benchmarks: ray throughput and error against time.
@@ -85,6 +89,26 @@ pub struct RenderArgs {
     /// output (default: off).
     #[arg(long)]
     pub aovs: bool,
+    /// Render samples K … K+spp−1 of the random sequence: a shard, whose .exr holds the exact
+    /// sums `penumbra merge` adds up (docs/farm.md) (default: 0, a plain image).
+    #[arg(
+        long,
+        value_name = "K",
+        conflicts_with_all = ["noise_threshold", "time_limit"]
+    )]
+    pub sample_start: Option<u32>,
+}
+
+/// Options of `merge`.
+#[derive(Args, Debug, Clone)]
+pub struct MergeArgs {
+    /// Shard EXRs of `render --sample-start`, in any order.
+    #[arg(required = true, value_name = "SHARD")]
+    pub shards: Vec<PathBuf>,
+    /// Output image: .exr (itself a shard of all the samples) or .png (tone-mapped as render
+    /// writes it). Overwritten if present.
+    #[arg(short, long)]
+    pub output: PathBuf,
 }
 
 /// One line for a command-line usage error (`penumbra: error: …`, exit code 2): clap's first
@@ -112,6 +136,7 @@ pub fn run(cli: Cli) -> Result<()> {
         None => view(cli.view),
         Some(Command::View(v)) => view(v),
         Some(Command::Render(r)) => render::run(&r),
+        Some(Command::Merge(m)) => merge::run(&m),
         Some(Command::Devices) => devices::run(),
         Some(Command::Bench(b)) => bench::run(b),
     }

@@ -3,9 +3,10 @@
 use super::RenderArgs;
 use crate::args::EnvChoice;
 use crate::image_io::{Format, OutputFile, encode_exr, encode_exr_channels};
-use crate::render::background::{self, unpremultiply};
+use crate::render::background::{self, Background, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
-use crate::render::tonemap::{encode_rgba_png, to_rgba8};
+use crate::render::tonemap::{ToneMapper, encode_rgba_png, to_rgba8};
+use crate::shard::{Shard, ShardInfo};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -34,6 +35,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     settings.noise_threshold = args.noise_threshold;
     settings.aovs = args.aovs;
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
+    if let Some(k) = args.sample_start
+        && k.checked_add(spp).is_none()
+    {
+        anyhow::bail!(
+            "--sample-start {k} with --spp {spp} runs past the sequence's last sample (4294967295)"
+        );
+    }
     let mut prepared = args.common.prepare(Some(&args.scene))?;
     settings.env_intensity *= prepared.env_scale;
     let environment = prepared.environment.take();
@@ -65,6 +73,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         renderer.set_lens(settings.lens_radius, focus)?;
     }
 
+    renderer.set_next_sample(args.sample_start.unwrap_or(0));
     let bar = ProgressBar::new(spp as u64).with_style(
         ProgressStyle::with_template(
             "{spinner} {bar:40} {pos}/{len} spp {elapsed_precise} eta {eta}",
@@ -131,25 +140,38 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let background = args.common.background;
-    let straight = background
-        .cutout()
-        .then(|| unpremultiply(&image, &coverage));
-    let shown = straight.as_deref().unwrap_or(&image);
     let mode = args.common.exposure_for(&prepared);
-    let metering = exposure::meter_subject(shown, Some(&coverage));
-    let exposure = mode.stops(metering.as_ref());
+    let exposure = exposure_stops(&image, &coverage, background, mode);
     let (w, h) = (settings.width, settings.height);
+    let tonemap = args.common.exposure.tonemap;
     let alpha = background.cutout().then_some(&coverage[..]);
-    let bytes = match output.format {
-        Format::Exr if args.aovs => {
+    let bytes = match (output.format, args.sample_start) {
+        (Format::Exr, None) if args.aovs => {
             encode_exr_channels(w, h, &image, alpha, &aov_channels(&mut renderer)?)?
         }
-        Format::Exr => encode_exr(w, h, &image, alpha)?,
-        Format::Png => {
-            let mut rgba = to_rgba8(shown, exposure, args.common.exposure.tonemap);
-            background::apply(&mut rgba, &coverage, background);
-            encode_rgba_png(w, h, &rgba)?
+        (Format::Exr, None) => encode_exr(w, h, &image, alpha)?,
+        (Format::Exr, Some(sample_start)) => {
+            let info = ShardInfo {
+                sample_start,
+                samples: done,
+                identity: shard_identity(args, &prepared, &renderer)?,
+                counted: settings.cutout || settings.count_coverage,
+                background: background.name(),
+                exposure: (mode != ExposureMode::Auto).then(|| mode.stops(None)),
+                tonemap: tonemap.arg_name().into(),
+                scene: args.scene.display().to_string(),
+                kernel: format!("{:?}", renderer.kernel()).to_lowercase(),
+                device: renderer.device.description(),
+            };
+            Shard {
+                width: w,
+                height: h,
+                info,
+                film: renderer.film()?,
+            }
+            .encode()?
         }
+        (Format::Png, _) => encode_png(w, h, &image, &coverage, background, exposure, tonemap)?,
     };
     output.write(&bytes)?;
     let adaptive = renderer.adaptive_stats()?;
@@ -280,6 +302,65 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The exposure in stops `mode` gives `image`: metered on the subject (without the
+/// background), on the straight colour when the background is cut out.
+pub(super) fn exposure_stops(
+    image: &[[f32; 3]],
+    coverage: &[f32],
+    background: Background,
+    mode: ExposureMode,
+) -> f32 {
+    let straight = background.cutout().then(|| unpremultiply(image, coverage));
+    let shown = straight.as_deref().unwrap_or(image);
+    mode.stops(exposure::meter_subject(shown, Some(coverage)).as_ref())
+}
+
+/// The PNG `render` writes: `image` exposed by `exposure` stops, tone-mapped, the background
+/// drawn where `coverage` is short of 1 when it is cut out.
+pub(super) fn encode_png(
+    w: u32,
+    h: u32,
+    image: &[[f32; 3]],
+    coverage: &[f32],
+    background: Background,
+    exposure: f32,
+    tonemap: ToneMapper,
+) -> Result<Vec<u8>> {
+    let straight = background.cutout().then(|| unpremultiply(image, coverage));
+    let shown = straight.as_deref().unwrap_or(image);
+    let mut rgba = to_rgba8(shown, exposure, tonemap);
+    background::apply(&mut rgba, coverage, background);
+    encode_rgba_png(w, h, &rgba)
+}
+
+/// The identity of a shard ([`crate::shard::identity`]): the scene file's bytes and every
+/// setting that changes the linear image — size, bounces, seed, strategy, Russian roulette,
+/// sky and environment, lens and focus, background cut out or not (`RenderSettings`), the
+/// camera, the lights (with their radius), the environment and the variant. Not in it: the
+/// device, the kernels and the BVH, which change the image only in rounding (a merge of
+/// shards from different ones is still the estimate of all their samples); files the scene
+/// refers to (a .gltf's buffers and images) and an environment file are named, not read.
+fn shard_identity(
+    args: &RenderArgs,
+    prepared: &crate::args::Prepared,
+    renderer: &crate::render::Renderer,
+) -> Result<String> {
+    let scene = std::fs::read(&args.scene)
+        .with_context(|| format!("{}: cannot read", args.scene.display()))?;
+    let texts = [
+        format!("{:?}", renderer.settings()),
+        format!("{:?}", prepared.camera),
+        format!("{:?}", prepared.lights),
+        format!("{:?}", renderer.environment().map(|m| &m.name)),
+        format!("{:?}", args.common.env),
+        format!("{:?}", prepared.scene.variant),
+        args.common.background.name(),
+    ];
+    let mut parts: Vec<&[u8]> = vec![&scene];
+    parts.extend(texts.iter().map(|t| t.as_bytes()));
+    Ok(crate::shard::identity(&parts))
+}
+
 /// Seconds for a person: "0.42 s", "12.3 s", "3 min 07 s".
 /// The guide buffers as named EXR channels (docs/aovs.md), with adaptive sampling's samples
 /// per pixel and error estimate.
@@ -322,9 +403,9 @@ fn duration(seconds: f64) -> String {
     }
 }
 
-/// Sets pixels with a non-finite or negative channel to 0 and counts them: the kernels drop
-/// non-finite samples, but a film's sum of finite samples can still overflow f32, and no
-/// such value may reach the file.
+/// Sets pixels with a non-finite or negative channel to 0 and counts them: no such value may
+/// reach the file. The kernels drop non-finite samples and the film's fixed-point sums
+/// saturate (kernels/shared/film.h), so a mean is finite unless the film's readback changes.
 fn zero_nonfinite(image: &mut [[f32; 3]]) -> u64 {
     let mut count = 0;
     for p in image.iter_mut() {

@@ -4,7 +4,7 @@
 //! with their neighbours, take no more samples. The host reads how many stay active, and on
 //! demand the per-pixel error and sample counts.
 
-use super::Renderer;
+use super::{Renderer, film};
 use crate::cl::kernels::Launch;
 use crate::cl::types::{COUNT_ACTIVE, PIXEL_CONVERGED, PIXEL_SAMPLES};
 use crate::cl::{ClError, Stage};
@@ -174,7 +174,7 @@ impl Renderer {
                 .iter()
                 .zip(&half)
                 .zip(&self.state_readback)
-                .map(|((film, half), state)| pixel_error(*film, *half, *state))
+                .map(|((film, half), state)| pixel_error(film::as_float(*film), *half, *state))
                 .collect(),
         ))
     }

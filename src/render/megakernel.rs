@@ -165,11 +165,12 @@ impl Renderer {
             let n = (per_launch as u32).min(spp - done);
             let mut frame = self.settings.gpu_frame(self.light_count);
             frame.samples_in_wave = n;
-            frame.first_sample = self.samples + done;
+            frame.first_sample = self.next_sample + done;
             launches.extend(self.launch_megakernel(&frame)?);
             done += n;
         }
         self.samples += spp;
+        self.next_sample += spp;
         Ok(launches)
     }
 }

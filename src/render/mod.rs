@@ -5,6 +5,7 @@ mod adaptive;
 pub mod background;
 pub mod camera;
 pub mod exposure;
+pub mod film;
 pub mod instancing;
 mod lights;
 mod load;
@@ -128,8 +129,11 @@ pub struct Renderer {
     /// Node arrays uploaded beyond those the kernels in use traverse (see
     /// [`Renderer::set_node_forms`]).
     extra_forms: NodeForms,
+    /// The index in the random sequence of the next sample `render` takes: 0 after a reset,
+    /// advanced by every sample rendered ([`Renderer::set_next_sample`]).
+    next_sample: u32,
     /// The film as last read back (sums and counts), kept for the next read.
-    readback: Vec<[f32; 4]>,
+    readback: Vec<film::FilmPixel>,
     /// Adaptive sampling's pixel states as last read back (`PIXEL_*` bits).
     state_readback: Vec<u32>,
     /// Whether a convergence check ran since the last reset.
@@ -180,6 +184,7 @@ impl Renderer {
             sah: None,
             sah_waiting: None,
             extra_forms: NodeForms::NONE,
+            next_sample: 0,
             readback: Vec::new(),
             state_readback: Vec::new(),
             adaptive_checked: false,
@@ -410,6 +415,7 @@ impl Renderer {
             self.finish()?;
         }
         self.samples = 0;
+        self.next_sample = 0;
         self.stats = RenderStats::default();
         self.counters.clear(&self.device)?;
         self.stats_buffer.clear(&self.device)?;
@@ -433,6 +439,13 @@ impl Renderer {
     /// Samples per pixel in the film.
     pub fn samples(&self) -> u32 {
         self.samples
+    }
+
+    /// The next samples rendered are those of index `index`, `index + 1`, … of the random
+    /// sequence (a shard's range, or a device's batch): the film's integer sums make the image
+    /// the same whatever order the samples come in (kernels/shared/film.h).
+    pub fn set_next_sample(&mut self, index: u32) {
+        self.next_sample = index;
     }
 
     /// Work counters and stage times since the last reset.

@@ -1,7 +1,7 @@
-//! Reading the film back: the image as linear RGB, each pixel's coverage and the guide
-//! buffers.
+//! Reading the film back: the image as linear RGB, each pixel's coverage, the raw sums and
+//! the guide buffers.
 
-use super::Renderer;
+use super::{Renderer, film};
 use crate::cl::ClError;
 use crate::cl::kernels::AovBuffers;
 use crate::cl::types::PIXEL_SAMPLES;
@@ -39,46 +39,28 @@ impl Renderer {
     ) -> Result<(), ClError> {
         let read = self.read_film()?;
         let n = (self.settings.width * self.settings.height) as usize;
+        if !read {
+            image.clear();
+            image.resize(n, [0.0; 3]);
+            if let Some(coverage) = coverage {
+                coverage.clear();
+                coverage.resize(n, 1.0);
+            }
+            return Ok(());
+        }
         let counted = self.settings.cutout || self.settings.count_coverage;
         // With adaptive sampling each pixel took its own number of samples.
         let adaptive = counted && self.read_states()?;
-        let samples = self.samples.max(1) as f32;
+        let samples = f64::from(self.samples);
         let states = &self.state_readback;
         let taken = |i: usize| {
             if adaptive {
-                ((states[i] & PIXEL_SAMPLES) as f32).max(1.0)
+                f64::from(states[i] & PIXEL_SAMPLES)
             } else {
                 samples
             }
         };
-        image.clear();
-        if !read {
-            image.resize(n, [0.0; 3]);
-        } else if counted {
-            // `.w` counts the samples whose camera ray hit: the mean is over all samples.
-            image.extend(self.readback.iter().enumerate().map(|(i, p)| {
-                let s = taken(i);
-                [p[0] / s, p[1] / s, p[2] / s]
-            }));
-        } else {
-            image.extend(self.readback.iter().map(|p| {
-                let n = p[3].max(1.0);
-                [p[0] / n, p[1] / n, p[2] / n]
-            }));
-        }
-        if let Some(coverage) = coverage {
-            coverage.clear();
-            if read && counted {
-                coverage.extend(
-                    self.readback
-                        .iter()
-                        .enumerate()
-                        .map(|(i, p)| (p[3] / taken(i)).clamp(0.0, 1.0)),
-                );
-            } else {
-                coverage.resize(n, 1.0);
-            }
-        }
+        film::image_into(&self.readback, counted, taken, image, coverage);
         Ok(())
     }
 
@@ -132,6 +114,15 @@ impl Renderer {
     pub fn aov_buffers(&self) -> Option<&AovBuffers> {
         let f = self.frame.as_ref()?;
         (self.settings.aovs && f.aov_paths.len() > 1).then_some(&f.film.aovs)
+    }
+
+    /// The film's raw pixels: each pixel's fixed-point sums and count, exact (a shard's data).
+    pub fn film(&mut self) -> Result<Vec<film::FilmPixel>, ClError> {
+        let n = (self.settings.width * self.settings.height) as usize;
+        if !self.read_film()? {
+            return Ok(vec![[0; 4]; n]);
+        }
+        Ok(self.readback.clone())
     }
 
     /// Finishes the pending launches and reads the film into [`Renderer::readback`]; false

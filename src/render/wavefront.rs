@@ -387,7 +387,7 @@ impl Renderer {
             wave.live = active * n as usize;
             let mut frame = self.settings.gpu_frame(self.light_count);
             frame.samples_in_wave = n;
-            frame.first_sample = self.samples + done;
+            frame.first_sample = self.next_sample + done;
             wave.generate(&frame)?;
             for bounce in 0..=self.settings.bounces + 1 {
                 frame.bounce = bounce;
@@ -402,6 +402,7 @@ impl Renderer {
             done += n;
         }
         self.samples += spp;
+        self.next_sample += spp;
         Ok(wave.launches)
     }
 
