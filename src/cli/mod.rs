@@ -1,5 +1,6 @@
 //! The command line: `view` (default), `render`, `devices`, `bench`.
 
+pub mod animate;
 mod devices;
 pub mod first_image;
 pub mod messages;
@@ -80,6 +81,9 @@ pub struct RenderArgs {
     /// takes (default: none).
     #[arg(long, allow_negative_numbers = true, value_parser = crate::args::parse_seconds)]
     pub time_limit: Option<f64>,
+    /// Animation: the instant or the frames rendered.
+    #[command(flatten)]
+    pub animation: animate::AnimationArgs,
 }
 
 /// One line for a command-line usage error (`penumbra: error: …`, exit code 2): clap's first

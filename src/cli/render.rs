@@ -1,11 +1,14 @@
-//! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary.
+//! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary; with
+//! `--frames`, a sequence of the scene's animation, one image and one summary line a frame.
 
 use super::RenderArgs;
-use crate::args::EnvChoice;
+use super::animate::{self, Frame};
+use crate::args::{EnvChoice, Prepared};
 use crate::image_io::{Format, OutputFile, encode_exr};
 use crate::render::background::{self, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
 use crate::render::tonemap::{encode_rgba_png, to_rgba8};
+use crate::render::{RenderSettings, Renderer, SceneStats};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -20,14 +23,19 @@ pub const DEFAULT_SIZE: (u32, u32) = (640, 480);
 /// Renders and writes the image; prints the summary line on stdout.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
+    let frames = args.animation.frames(&args.output)?;
     // The output is checked (and opened) before the scene is read: a path that cannot be
-    // written fails now, not after the render.
-    let output = OutputFile::open(&args.output)?;
+    // written fails now, not after the render (a sequence's first frame's).
+    let mut output = Some(OutputFile::open(&frames[0].output)?);
     let mut settings = args.common.settings(DEFAULT_SIZE)?;
     args.strategy.apply(&mut settings);
     settings.noise_threshold = args.noise_threshold;
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
     let mut prepared = args.common.prepare(Some(&args.scene))?;
+    let clip = args.animation.clip(&prepared)?;
+    if let Some(c) = clip {
+        animate::pose(&mut prepared, c, frames[0].time.unwrap_or(0.0));
+    }
     settings.env_intensity *= prepared.env_scale;
     let environment = prepared.environment.take();
     let mut renderer = args.common.open_renderer(&settings)?;
@@ -58,6 +66,75 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         renderer.set_lens(settings.lens_radius, focus)?;
     }
 
+    let setup = Setup {
+        settings,
+        spp,
+        scene_stats,
+        started,
+    };
+    for (k, frame) in frames.iter().enumerate() {
+        // Each later frame: the scene posed anew and brought up to date on the renderer (the
+        // film restarts, the seed stays).
+        let mut update_ms = None;
+        if k > 0
+            && let Some(c) = clip
+        {
+            let t = Instant::now();
+            let applied = animate::pose(&mut prepared, c, frame.time.unwrap_or(0.0));
+            renderer.update_scene(&prepared.scene, &prepared.lights, applied.deformed > 0)?;
+            renderer.set_camera(&prepared.camera)?;
+            update_ms = Some(t.elapsed().as_secs_f64() * 1e3);
+        }
+        let output = match output.take() {
+            Some(first) => first,
+            None => OutputFile::open(&frame.output)?,
+        };
+        let animation = serde_json::json!({
+            "clips": animate::clips_json(&prepared),
+            "clip": clip.map(|c| prepared.scene.animation.clips[c].name.clone()),
+            "time": clip.map(|_| frame.time.unwrap_or(0.0)),
+            "frame": frame.number,
+            "scene_update_ms": update_ms,
+        });
+        render_frame(
+            args,
+            &setup,
+            &mut renderer,
+            &prepared,
+            frame,
+            output,
+            animation,
+        )?;
+    }
+    Ok(())
+}
+
+/// What every frame of a render shares.
+struct Setup {
+    settings: RenderSettings,
+    spp: u32,
+    scene_stats: SceneStats,
+    started: Instant,
+}
+
+/// Renders the loaded scene, writes `frame`'s image to `output` and prints its summary line
+/// with the fields of `animation` added.
+fn render_frame(
+    args: &RenderArgs,
+    setup: &Setup,
+    renderer: &mut Renderer,
+    prepared: &Prepared,
+    frame: &Frame,
+    output: OutputFile,
+    animation: serde_json::Value,
+) -> Result<()> {
+    let Setup {
+        settings,
+        spp,
+        scene_stats,
+        started,
+    } = setup;
+    let spp = *spp;
     let bar = ProgressBar::new(spp as u64).with_style(
         ProgressStyle::with_template(
             "{spinner} {bar:40} {pos}/{len} spp {elapsed_precise} eta {eta}",
@@ -128,7 +205,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .cutout()
         .then(|| unpremultiply(&image, &coverage));
     let shown = straight.as_deref().unwrap_or(&image);
-    let mode = args.common.exposure_for(&prepared);
+    let mode = args.common.exposure_for(prepared);
     let metering = exposure::meter_subject(shown, Some(&coverage));
     let exposure = mode.stops(metering.as_ref());
     let (w, h) = (settings.width, settings.height);
@@ -172,7 +249,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     });
     let mut summary = serde_json::json!({
         "scene": args.scene.display().to_string(),
-        "output": args.output.display().to_string(),
+        "output": frame.output.display().to_string(),
         "device": renderer.device.description(),
         "kernel": renderer.kernel(),
         "width": settings.width,
@@ -253,6 +330,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     ] {
         summary[key] = value;
     }
+    if let serde_json::Value::Object(fields) = animation {
+        for (key, value) in fields {
+            summary[key] = value;
+        }
+    }
     let taken = if adaptive.is_some() || done < spp {
         format!("{mean_spp:.1} of at most {spp} spp")
     } else {
@@ -260,7 +342,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     eprintln!(
         "penumbra: wrote {}: {w}×{h} pixels, {taken}, rendered in {} ({} in all)",
-        args.output.display(),
+        frame.output.display(),
         duration(seconds),
         duration(started.elapsed().as_secs_f64())
     );

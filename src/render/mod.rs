@@ -26,7 +26,7 @@ pub use lights::gpu_lights;
 pub use megakernel::KernelChoice;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
-pub use update::InstanceUpdate;
+pub use update::{InstanceUpdate, SceneUpdate};
 pub use upload::{Accel, HostScene, gpu_camera, gpu_material, samples_textures};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
