@@ -1,10 +1,12 @@
 //! `penumbra bench`: ray throughput of the traversal kernels (`trace`), where a frame's time
 //! goes (`frame`), error against run time (`converge`), and a generator of large test scenes
 //! (`generate`), the host BVH build and update (`bvh`), and how faithfully the first image shows
-//! base colours (`albedo`). What each measures, and the figures,
+//! base colours (`albedo`), and the per-frame update of an animated scene (`animation`). What
+//! each measures, and the figures,
 //! are in `docs/benchmarks.md`.
 
 mod albedo;
+mod animation;
 mod bvh;
 mod converge;
 mod curve;
@@ -17,6 +19,7 @@ pub mod stress;
 mod trace;
 
 pub use albedo::AlbedoArgs;
+pub use animation::AnimationBenchArgs;
 pub use bvh::BvhArgs;
 pub use converge::ConvergeArgs;
 pub use frame::FrameArgs;
@@ -54,6 +57,9 @@ pub enum BenchCommand {
     /// The mean displayed colour of materials of known base colour under a white environment
     /// against that base colour, per tone curve and exposure rule; a Markdown table.
     Albedo(Box<AlbedoArgs>),
+    /// Host time of an animated scene's per-frame update: evaluating the clip, deforming
+    /// skinned and morphed meshes, refitting their BVHs and rebuilding the top level.
+    Animation(Box<AnimationBenchArgs>),
 }
 
 /// Runs a benchmark.
@@ -66,6 +72,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Bvh(a) => bvh::run(&a),
         BenchCommand::Stress(a) => stress::run(&a),
         BenchCommand::Albedo(a) => albedo::run(&a),
+        BenchCommand::Animation(a) => animation::run(&a),
     }
 }
 

@@ -124,6 +124,9 @@ pub struct Renderer {
     /// The meshes whose SAH BLASes start building once the quick scene's first samples are
     /// in (see [`Renderer::swap_in_sah`]).
     sah_waiting: Option<Vec<Arc<crate::scene::Mesh>>>,
+    /// An animated scene's packed textures with a fingerprint of what they were packed from
+    /// (see `Renderer::texture_pack`).
+    texture_cache: Option<(u64, Arc<TexturePack>)>,
     /// Node arrays uploaded beyond those the kernels in use traverse (see
     /// [`Renderer::set_node_forms`]).
     extra_forms: NodeForms,
@@ -176,6 +179,7 @@ impl Renderer {
             quick_first: None,
             sah: None,
             sah_waiting: None,
+            texture_cache: None,
             extra_forms: NodeForms::NONE,
             readback: Vec::new(),
             state_readback: Vec::new(),

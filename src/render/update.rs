@@ -36,7 +36,9 @@ pub enum SceneUpdate {
 impl Renderer {
     /// Brings the device up to date with `scene` (the loaded scene after an animation pose)
     /// and `lights`: moved instances in place where only transforms changed and the scene is
-    /// on two levels, else the scene loaded again in a render space around its new bounds
+    /// on two levels, else the scene loaded again in a render space around its new bounds (as
+    /// a fresh load of this pose would be, so a sequence's frame is its single render), the old
+    /// buffers written in place where their sizes agree and the textures packed once
     /// (kernels are kept when the scene's features stay the same). Resets the film.
     pub fn update_scene(
         &mut self,
@@ -48,7 +50,9 @@ impl Renderer {
             self.set_lights(lights)?;
             return Ok(SceneUpdate::Moved);
         }
-        self.load_scene(scene, lights)?;
+        let space = crate::scene::RenderFrame::around(&scene.bounds());
+        let old = self.scene.take().map(|(buffers, _)| buffers);
+        self.load_with(scene, lights, space, super::instancing::Blases::Sah, old)?;
         Ok(SceneUpdate::Reloaded)
     }
 
