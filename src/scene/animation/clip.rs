@@ -80,7 +80,7 @@ pub fn read_clips(
                     read_channel(root, data, animation, channel)
                         .map_err(|why| {
                             warnings.push(format!(
-                                "animations[{a}].channels[{c}]: {why}; the channel is skipped"
+                                "animations[{a}].channels[{c}]{why}; the channel is skipped"
                             ))
                         })
                         .ok()
@@ -102,7 +102,8 @@ pub fn read_clips(
         .collect()
 }
 
-/// One channel read and checked, or why it cannot be used.
+/// One channel read and checked, or why it cannot be used: the rest of a message that starts
+/// with the channel's path (": …", or ".target.node: …" for what lies under it).
 fn read_channel(
     root: &gltf::json::Root,
     data: &BufferData,
@@ -113,29 +114,29 @@ fn read_channel(
     let sampler = animation
         .samplers
         .get(s)
-        .ok_or_else(|| format!("sampler {s} does not exist"))?;
+        .ok_or_else(|| format!(": sampler {s} does not exist"))?;
     let node = channel.target.node.value();
     let json_node = root
         .nodes
         .get(node)
-        .ok_or_else(|| format!("node {node} does not exist"))?;
+        .ok_or_else(|| format!(".target.node: node {node} does not exist"))?;
     let target = match channel.target.path {
         Checked::Valid(Property::Translation) => Target::Translation,
         Checked::Valid(Property::Rotation) => Target::Rotation,
         Checked::Valid(Property::Scale) => Target::Scale,
         Checked::Valid(Property::MorphTargetWeights) => Target::Weights,
-        Checked::Invalid => return Err("its target path is not one glTF defines".into()),
+        Checked::Invalid => return Err(".target.path: not a path glTF defines".into()),
     };
     if target != Target::Weights && json_node.matrix.is_some() {
         return Err(format!(
-            "nodes[{node}] is placed by a matrix, which animations may not target"
+            ": nodes[{node}] is placed by a matrix, which animations may not target"
         ));
     }
     let interp = match sampler.interpolation {
         Checked::Valid(Interpolation::Step) => Interp::Step,
         Checked::Valid(Interpolation::Linear) => Interp::Linear,
         Checked::Valid(Interpolation::CubicSpline) => Interp::CubicSpline,
-        Checked::Invalid => return Err(format!("samplers[{s}].interpolation is unknown")),
+        Checked::Invalid => return Err(format!(": samplers[{s}].interpolation is unknown")),
     };
     let width = match target {
         Target::Translation | Target::Scale => 3,
@@ -149,43 +150,54 @@ fn read_channel(
                 .map_or(0, Vec::len);
             if targets == 0 {
                 return Err(format!(
-                    "nodes[{node}] has no mesh with morph targets for its weights"
+                    ": nodes[{node}] has no mesh with morph targets for its weights"
                 ));
             }
             targets
         }
     };
-    let floats = |index: usize, what: &str| -> Result<Vec<f32>, String> {
-        if index >= root.accessors.len() {
-            return Err(format!(
-                "samplers[{s}].{what}: accessor {index} does not exist"
-            ));
+    use gltf::json::accessor::Type;
+    // The accessor `index` of `what`, checked to be of the type `wanted`.
+    let typed = |index: usize, what: &str, wanted: Type| -> Result<usize, String> {
+        let a = root
+            .accessors
+            .get(index)
+            .ok_or_else(|| format!(": samplers[{s}].{what}: accessor {index} does not exist"))?;
+        match a.type_ {
+            Checked::Valid(t) if t == wanted => Ok(index),
+            Checked::Valid(t) if what == "output" => Err(format!(
+                ": its sampler's output is {t:?}, the path needs {wanted:?}"
+            )),
+            _ => Err(format!(
+                ": samplers[{s}].{what}: accessor {index} is not {wanted:?}"
+            )),
         }
-        accessor::read_floats::<1>(root, data, index)
-            .map(|v| v.into_iter().map(|[x]| x).collect())
-            .map_err(|e| format!("samplers[{s}].{what}: {e}"))
     };
-    let times = floats(sampler.input.value(), "input")?;
+    let wanted = match target {
+        Target::Translation | Target::Scale => Type::Vec3,
+        Target::Rotation => Type::Vec4,
+        Target::Weights => Type::Scalar,
+    };
+    let output = typed(sampler.output.value(), "output", wanted)?;
+    let input = typed(sampler.input.value(), "input", Type::Scalar)?;
+    let at = |what: &'static str| move |e: String| format!(": samplers[{s}].{what}: {e}");
+    let times = read_flat::<1>(root, data, input).map_err(at("input"))?;
     // Outputs are read flat: a VEC3 or VEC4 accessor as its components in order.
-    let output = sampler.output.value();
-    let values = match root.accessors.get(output).map(|a| a.type_) {
-        Some(Checked::Valid(gltf::json::accessor::Type::Vec3)) => {
-            read_flat::<3>(root, data, output).map_err(|e| format!("samplers[{s}].output: {e}"))?
-        }
-        Some(Checked::Valid(gltf::json::accessor::Type::Vec4)) => {
-            read_flat::<4>(root, data, output).map_err(|e| format!("samplers[{s}].output: {e}"))?
-        }
-        _ => floats(output, "output")?,
-    };
+    let values = match wanted {
+        Type::Vec3 => read_flat::<3>(root, data, output),
+        Type::Vec4 => read_flat::<4>(root, data, output),
+        _ => read_flat::<1>(root, data, output),
+    }
+    .map_err(at("output"))?;
     if times.is_empty() {
-        return Err(format!("samplers[{s}].input has no keys"));
+        return Err(format!(": samplers[{s}].input has no keys"));
     }
     if let Some(k) = times.iter().position(|t| !t.is_finite()) {
-        return Err(format!("samplers[{s}].input: key {k} is not finite"));
+        return Err(format!(": samplers[{s}].input: key {k} is not finite"));
     }
     if let Some(k) = times.windows(2).position(|w| w[1] <= w[0]) {
         return Err(format!(
-            "samplers[{s}].input: key {} ({}) does not come after key {k} ({})",
+            ": samplers[{s}].input: key {} ({}) does not come after key {k} ({})",
             k + 1,
             times[k + 1],
             times[k]
@@ -194,13 +206,13 @@ fn read_channel(
     let per_key = width * if interp == Interp::CubicSpline { 3 } else { 1 };
     if values.len() != times.len() * per_key {
         return Err(format!(
-            "samplers[{s}].output holds {} values for {} keys of {per_key}",
+            ": samplers[{s}].output holds {} values for {} keys of {per_key}",
             values.len(),
             times.len()
         ));
     }
     if let Some(k) = values.iter().position(|v| !v.is_finite()) {
-        return Err(format!("samplers[{s}].output: value {k} is not finite"));
+        return Err(format!(": samplers[{s}].output: value {k} is not finite"));
     }
     Ok(Channel {
         node,
