@@ -1,7 +1,8 @@
 //! A fuzz harness on stable Rust: mutates small glTF scenes, with knowledge of their structure
 //! (the JSON tree: deleted and replaced values, dangling indices, huge counts, bad enums,
 //! non-finite numbers, duplicated children) and byte by byte (the GLB container, the JSON text
-//! and the binary chunk), and runs the loader in-process under `catch_unwind`.
+//! and the binary chunk), and runs the loader in-process under `catch_unwind` (posing every
+//! animation clip of what loads).
 //!
 //! A failure is a panic, a load slower than [`SLOW`], or a loaded scene that breaks what the
 //! renderer relies on (finite geometry, factors in range, indices in range, non-negative
@@ -471,6 +472,17 @@ fn uri_folder() -> tempfile::TempDir {
     dir
 }
 
+/// Poses `scene` at a few instants of each of its clips (before, inside and far past the
+/// keys): mutated animation data must not make a pose panic.
+fn pose_every_clip(mut scene: Scene) {
+    let animation = scene.animation.clone();
+    for clip in 0..animation.clips.len() {
+        for t in [-1.0, 0.37, 1e9] {
+            animation.apply(&mut scene, Some(clip), t);
+        }
+    }
+}
+
 /// What the renderer relies on in a loaded scene.
 fn check(s: &Scene) -> Result<(), String> {
     let fin = |v: f32| v.is_finite();
@@ -583,7 +595,7 @@ fn run_one(bytes: &[u8], base: &Path) -> Result<(), String> {
     let start = Instant::now();
     IN_LOADER.store(true, std::sync::atomic::Ordering::Relaxed);
     let result = catch_unwind(AssertUnwindSafe(|| {
-        load_from_bytes(bytes, Some(base), "fuzz input")
+        load_from_bytes(bytes, Some(base), "fuzz input").inspect(|s| pose_every_clip(s.clone()))
     }));
     IN_LOADER.store(false, std::sync::atomic::Ordering::Relaxed);
     let elapsed = start.elapsed();

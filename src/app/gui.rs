@@ -26,6 +26,8 @@ pub struct Model {
     pub camera: CameraController,
     /// The picked object.
     pub selected: Option<usize>,
+    /// The animation timeline (idle for a scene without clips).
+    pub timeline: super::timeline::Timeline,
 }
 
 impl Model {
@@ -33,6 +35,7 @@ impl Model {
     pub fn new(scene: Scene, view: ViewState, camera: CameraController) -> Self {
         Self {
             loaded_transforms: scene.objects.iter().map(|o| o.world_from_object).collect(),
+            timeline: super::timeline::Timeline::for_scene(&scene),
             scene,
             view,
             camera,
@@ -184,6 +187,7 @@ impl Gui {
                     .show(ui, |ui| {
                         // Statistics first: visible without scrolling in a 600 px window.
                         stats_section(ui, m, info);
+                        m.timeline.section(ui, &m.scene);
                         self.render_section(ui, m, &mut actions);
                         self.camera_section(ui, m, &mut actions);
                         self.lights_section(ui, m, &mut actions);
@@ -675,6 +679,16 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
                     plan.spp,
                     p.batch_ms,
                     super::frame_loop::FRAME_BUDGET_MS
+                ));
+            }
+            if !m.scene.animation.clips.is_empty()
+                && let Some(s) = info.scene_stats
+            {
+                // A pose's host time, then the device update it caused (the last BVH build or
+                // instance update, and the upload).
+                ui.label(format!(
+                    "scene update: pose {:.2} ms · BVH {:.1} ms · upload {:.1} ms",
+                    m.timeline.pose_ms, s.bvh_build_ms, s.upload_ms
                 ));
             }
             if p.stats.nonfinite_samples > 0 {

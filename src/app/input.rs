@@ -140,6 +140,7 @@ impl App {
             KeyCode::Minus | KeyCode::NumpadSubtract => self.model.camera.scale_speed(-1.0),
             KeyCode::KeyQ if ctrl => self.quit = true,
             KeyCode::Tab | KeyCode::F1 => self.overlay = !self.overlay,
+            KeyCode::Space => self.model.timeline.toggle(),
             KeyCode::F12 => self.screenshot(),
             _ => {}
         }

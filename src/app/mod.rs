@@ -14,6 +14,7 @@ mod loading;
 mod pick;
 mod screenshot;
 mod state;
+mod timeline;
 
 use crate::cl::DeviceChoice;
 use crate::render::background::{Background, unpremultiply};
@@ -66,6 +67,7 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("H", "hard / soft shadows"),
     ("F12", "screenshot (PNG + EXR in screenshots/)"),
     ("Tab, F1", "hide / show the overlay"),
+    ("Space", "play / pause the animation"),
     ("Ctrl + Q", "quit (like closing the window)"),
     ("drop a file", "open a .gltf / .glb scene"),
 ];
@@ -385,6 +387,7 @@ impl ApplicationHandler for App {
             || self.input.look
             || self.input.pan
             || self.moving(now)
+            || self.model.timeline.playing
             || self.loader.is_some();
         let interval = if active {
             ACTIVE_INTERVAL
@@ -536,6 +539,14 @@ impl App {
         };
         let screenshot = actions.screenshot;
         self.apply(actions, now);
+        // A playing clip (or a scrubbed time) poses the scene: the image restarts at each new
+        // time and accumulates while it stands.
+        if self.model.timeline.update(&mut self.model.scene, now) {
+            self.frame_loop.invalidate(Changes {
+                scene: true,
+                ..Changes::default()
+            });
+        }
 
         // Collect a finished batch and start the next one before showing this image. A step (or
         // an environment change) that builds kernels blocks for seconds with a cold cache: show

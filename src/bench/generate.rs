@@ -1,7 +1,9 @@
 //! `penumbra bench generate --triangles N -o FILE.glb`: a large scene for traversal and render
 //! benchmarks: copies of one mesh (a subdivided sphere, or the geometry of `--from FILE`) in a
 //! grid on the floor of a closed room lit by an emissive ceiling panel, with a camera inside
-//! the room. Copies are glTF nodes sharing one mesh, so the file stays small.
+//! the room. Copies are glTF nodes sharing one mesh, so the file stays small. With `--skinned`
+//! every copy is a skinned mesh that bends at half height in a looping two-second clip
+//! ("bend"), for the animation benchmark.
 
 use crate::scene::{Mesh, load};
 use anyhow::{Context, Result, bail};
@@ -25,6 +27,10 @@ pub struct GenerateArgs {
     /// no mesh is shared: a scene of unique meshes, for memory and opening time.
     #[arg(long)]
     pub unique: bool,
+    /// Skin every copy to two joints (the base and one at half height) and animate the upper
+    /// joint in a looping clip: a scene whose every triangle moves each frame.
+    #[arg(long, conflicts_with = "unique")]
+    pub skinned: bool,
     /// Output .glb file (overwritten).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -206,9 +212,12 @@ impl GlbWriter {
         while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
-        self.views.push(json!({
-            "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len(), "target": target,
-        }));
+        let mut view =
+            json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
+        if target != 0 {
+            view["target"] = json!(target);
+        }
+        self.views.push(view);
         self.bin.extend_from_slice(bytes);
         self.views.len() - 1
     }
@@ -225,6 +234,21 @@ impl GlbWriter {
                 .fold(Vec3::splat(f32::NEG_INFINITY), |a, &p| a.max(p));
             a["min"] = json!([lo.x, lo.y, lo.z]);
             a["max"] = json!([hi.x, hi.y, hi.z]);
+        }
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+
+    /// A float accessor of `count` elements of `kind` (SCALAR, VEC4, MAT4) from `values`.
+    fn floats(&mut self, values: &[f32], count: usize, kind: &str) -> usize {
+        let view = self.view(bytemuck::cast_slice(values), 0);
+        let mut a =
+            json!({"bufferView": view, "componentType": 5126, "count": count, "type": kind});
+        if kind == "SCALAR" {
+            let lo = values.iter().copied().fold(f32::INFINITY, f32::min);
+            let hi = values.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            a["min"] = json!([lo]);
+            a["max"] = json!([hi]);
         }
         self.accessors.push(a);
         self.accessors.len() - 1
@@ -274,6 +298,29 @@ pub fn glb(gltf: &Value, bin: &[u8]) -> Vec<u8> {
     out.extend_from_slice(b"BIN\0");
     out.extend_from_slice(&bin);
     out
+}
+
+/// Skin attributes of `mesh` (written as `json`): joint 0 (the base) below a third of the unit
+/// height, joint 1 (the upper one) above two thirds, blended smoothly between.
+fn add_skin_attributes(w: &mut GlbWriter, json: &mut Value, mesh: &Mesh, unit_from_object: DMat4) {
+    let joints: Vec<u8> = (0..mesh.positions.len())
+        .flat_map(|_| [0, 1, 0, 0])
+        .collect();
+    let weights: Vec<f32> = mesh
+        .positions
+        .iter()
+        .flat_map(|p| {
+            let h = unit_from_object.transform_point3(p.as_dvec3()).y as f32;
+            let x = ((h - 1.0 / 3.0) * 3.0).clamp(0.0, 1.0);
+            let upper = x * x * (3.0 - 2.0 * x);
+            [1.0 - upper, upper, 0.0, 0.0]
+        })
+        .collect();
+    let view = w.view(&joints, 34962);
+    w.accessors.push(json!({"bufferView": view, "componentType": 5121, "count": mesh.positions.len(), "type": "VEC4"}));
+    let attributes = &mut json["primitives"][0]["attributes"];
+    attributes["JOINTS_0"] = json!(w.accessors.len() - 1);
+    attributes["WEIGHTS_0"] = json!(w.floats(&weights, mesh.positions.len(), "VEC4"));
 }
 
 fn lambertian(name: &str, gray: f32) -> Value {
@@ -352,7 +399,17 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     let mut nodes = Vec::new();
     for (i, p) in parts.iter().enumerate() {
         meshes.push(w.mesh(&format!("part{i}"), &p.mesh, 0));
+        if args.skinned {
+            add_skin_attributes(
+                &mut w,
+                &mut meshes[i],
+                &p.mesh,
+                normalize * p.world_from_object,
+            );
+        }
     }
+    let mut skins = Vec::new();
+    let mut channels = Vec::new();
     for c in 0..copies {
         if args.unique && c > 0 {
             for (i, p) in parts.iter().enumerate() {
@@ -369,8 +426,26 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         // Turn each copy a little so the grid is not perfectly regular.
         let turn = DMat4::from_rotation_y(c as f64 * 2.399_963);
         for (i, p) in parts.iter().enumerate() {
-            let m = DMat4::from_translation(at) * turn * normalize * p.world_from_object;
-            nodes.push(json!({"name": format!("copy{c}.{i}"), "mesh": first_mesh + i, "matrix": matrix(m)}));
+            let unit_from_object = normalize * p.world_from_object;
+            if !args.skinned {
+                let m = DMat4::from_translation(at) * turn * unit_from_object;
+                nodes.push(json!({"name": format!("copy{c}.{i}"), "mesh": first_mesh + i, "matrix": matrix(m)}));
+                continue;
+            }
+            // The base joint places the copy; the upper one, half a unit above it, bends.
+            let base = nodes.len();
+            nodes.push(json!({"name": format!("copy{c}.{i} base"), "matrix": matrix(DMat4::from_translation(at) * turn), "children": [base + 1]}));
+            nodes.push(
+                json!({"name": format!("copy{c}.{i} upper"), "translation": [0.0, 0.5, 0.0]}),
+            );
+            let upper_bind = DMat4::from_translation(DVec3::new(0.0, -0.5, 0.0)) * unit_from_object;
+            let binds: Vec<f32> = [unit_from_object, upper_bind]
+                .iter()
+                .flat_map(|m| m.as_mat4().to_cols_array())
+                .collect();
+            skins.push(json!({"joints": [base, base + 1], "inverseBindMatrices": w.floats(&binds, 2, "MAT4")}));
+            nodes.push(json!({"name": format!("copy{c}.{i}"), "mesh": first_mesh + i, "skin": skins.len() - 1}));
+            channels.push(json!({"sampler": 0, "target": {"node": base + 1, "path": "rotation"}}));
         }
     }
     meshes.push(w.mesh("room", &room(room_lo, room_hi), 1));
@@ -400,7 +475,32 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         "translation": [eye.x, eye.y, eye.z], "rotation": [q.x, q.y, q.z, q.w],
     }));
 
+    let animations = if args.skinned {
+        // 0 → +25° → −25° → 0 about z over two seconds, one sampler for every copy.
+        let keys = [0.0f32, 0.5, 1.5, 2.0];
+        let angles = [0.0f32, 25.0, -25.0, 0.0];
+        let rotations: Vec<f32> = angles
+            .iter()
+            .flat_map(|a| glam::Quat::from_rotation_z(a.to_radians()).to_array())
+            .collect();
+        let input = w.floats(&keys, keys.len(), "SCALAR");
+        let output = w.floats(&rotations, keys.len(), "VEC4");
+        json!([{"name": "bend", "channels": channels,
+                "samplers": [{"input": input, "output": output, "interpolation": "LINEAR"}]}])
+    } else {
+        json!([])
+    };
     let triangles = copies * per_copy + 14;
+    // Every node but the skins' upper joints (their base's children) is a root.
+    let children: std::collections::HashSet<u64> = nodes
+        .iter()
+        .filter_map(|n| n["children"].as_array())
+        .flatten()
+        .filter_map(Value::as_u64)
+        .collect();
+    let roots: Vec<usize> = (0..nodes.len())
+        .filter(|&i| !children.contains(&(i as u64)))
+        .collect();
     while !w.bin.len().is_multiple_of(4) {
         w.bin.push(0);
     }
@@ -408,7 +508,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         "asset": {"version": "2.0", "generator": "penumbra bench generate"},
         "extensionsUsed": ["KHR_materials_specular", "KHR_materials_emissive_strength"],
         "scene": 0,
-        "scenes": [{"name": "generated", "nodes": (0..nodes.len()).collect::<Vec<_>>()}],
+        "scenes": [{"name": "generated", "nodes": roots}],
         "nodes": nodes,
         "meshes": meshes,
         "materials": [
@@ -427,6 +527,8 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         "cameras": [{"name": "camera", "type": "perspective", "perspective": {
             "yfov": 55f64.to_radians(), "aspectRatio": 16.0 / 9.0, "znear": 0.01,
         }}],
+        "skins": skins,
+        "animations": animations,
         "accessors": w.accessors,
         "bufferViews": w.views,
         "buffers": [{"byteLength": w.bin.len()}],

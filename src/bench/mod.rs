@@ -1,10 +1,12 @@
 //! `penumbra bench`: ray throughput of the traversal kernels (`trace`), where a frame's time
 //! goes (`frame`), error against run time (`converge`), and a generator of large test scenes
 //! (`generate`), the host BVH build and update (`bvh`), and how faithfully the first image shows
-//! base colours (`albedo`). What each measures, and the figures,
+//! base colours (`albedo`), and the per-frame update of an animated scene (`animation`). What
+//! each measures, and the figures,
 //! are in `docs/benchmarks.md`.
 
 mod albedo;
+mod animation;
 mod bvh;
 mod converge;
 mod curve;
@@ -18,6 +20,7 @@ pub mod stress;
 mod trace;
 
 pub use albedo::AlbedoArgs;
+pub use animation::AnimationBenchArgs;
 pub use bvh::BvhArgs;
 pub use converge::ConvergeArgs;
 pub use denoise::DenoiseArgs;
@@ -59,6 +62,9 @@ pub enum BenchCommand {
     /// The denoiser's network time on the device, beside Intel's Open Image Denoise on the
     /// same input where pyoidn is installed.
     Denoise(Box<DenoiseArgs>),
+    /// Host time of an animated scene's per-frame update: evaluating the clip, deforming
+    /// skinned and morphed meshes, refitting their BVHs and rebuilding the top level.
+    Animation(Box<AnimationBenchArgs>),
 }
 
 /// Runs a benchmark.
@@ -72,6 +78,7 @@ pub fn run(cmd: BenchCommand) -> Result<()> {
         BenchCommand::Stress(a) => stress::run(&a),
         BenchCommand::Albedo(a) => albedo::run(&a),
         BenchCommand::Denoise(a) => denoise::run(&a),
+        BenchCommand::Animation(a) => animation::run(&a),
     }
 }
 

@@ -98,6 +98,13 @@ impl Bvh {
             self.tri_indices.len(),
             "a refit needs the triangles the tree was built over"
         );
+        self.refit_with(|t| triangles[t]);
+    }
+
+    /// [`Bvh::refit`] reading triangle `t`'s corners from `corners(t)`: a deformed mesh is
+    /// refitted from its vertices and indices, without a list of its triangles (36 bytes a
+    /// triangle written and read again each frame).
+    pub fn refit_with(&mut self, corners: impl Fn(usize) -> [Vec3; 3] + Sync) {
         // Leaf boxes first, all nodes at once.
         let tri_indices = &self.tri_indices;
         self.nodes.par_iter_mut().for_each(|node| {
@@ -109,7 +116,7 @@ impl Bvh {
                     let count = hi[3].to_bits() as usize;
                     let b = tri_indices[first..first + count]
                         .iter()
-                        .flat_map(|&t| triangles[t as usize])
+                        .flat_map(|&t| corners(t as usize))
                         .fold(Aabb::EMPTY, Aabb::grow);
                     set_box(lo, hi, b);
                 }
@@ -132,11 +139,27 @@ impl Bvh {
     /// Refits for `triangles`, and builds the tree again when the refit left its SAH cost at
     /// [`REFIT_MAX_GROWTH`] times the cost of the last full build or more.
     pub fn refit_or_rebuild(&mut self, triangles: &[[Vec3; 3]]) -> Update {
-        self.refit(triangles);
+        self.refit_or_rebuild_with(triangles.len(), |t| triangles[t])
+    }
+
+    /// [`Bvh::refit_or_rebuild`] for the `count` triangles of `corners` (as
+    /// [`Bvh::refit_with`]); the list of triangles is made only for a rebuild.
+    pub fn refit_or_rebuild_with(
+        &mut self,
+        count: usize,
+        corners: impl Fn(usize) -> [Vec3; 3] + Sync,
+    ) -> Update {
+        assert_eq!(
+            count,
+            self.tri_indices.len(),
+            "a refit needs the triangles the tree was built over"
+        );
+        self.refit_with(&corners);
         if self.sah_cost < REFIT_MAX_GROWTH * self.built_sah_cost {
             return Update::Refitted;
         }
-        *self = build(triangles);
+        let triangles: Vec<[Vec3; 3]> = (0..count).into_par_iter().map(&corners).collect();
+        *self = build(&triangles);
         Update::Rebuilt
     }
 }

@@ -1,5 +1,6 @@
 //! The command line: `view` (default), `render`, `merge`, `devices`, `bench`.
 
+pub mod animate;
 mod devices;
 pub mod first_image;
 mod merge;
@@ -97,6 +98,9 @@ pub struct RenderArgs {
         conflicts_with_all = ["noise_threshold", "time_limit"]
     )]
     pub sample_start: Option<u32>,
+    /// Animation: the instant or the frames rendered.
+    #[command(flatten)]
+    pub animation: animate::AnimationArgs,
 }
 
 /// Options of `merge`.

@@ -1,12 +1,15 @@
-//! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary.
+//! `penumbra render SCENE -o OUT.{exr,png}`: a headless render with a JSON summary; with
+//! `--frames`, a sequence of the scene's animation, one image and one summary line a frame.
 
 use super::RenderArgs;
-use crate::args::EnvChoice;
+use super::animate::{self, Frame};
+use crate::args::{EnvChoice, Prepared};
 use crate::image_io::{Format, OutputFile, encode_exr, encode_exr_channels};
 use crate::render::background::{self, Background, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
 use crate::render::tonemap::{ToneMapper, encode_rgba_png, to_rgba8};
 use crate::shard::{Shard, ShardInfo};
+use crate::render::{RenderSettings, Renderer, SceneStats};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -21,10 +24,11 @@ pub const DEFAULT_SIZE: (u32, u32) = (640, 480);
 /// Renders and writes the image; prints the summary line on stdout.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
+    let frames = args.animation.frames(&args.output)?;
     // The output is checked (and opened) before the scene is read: a path that cannot be
-    // written fails now, not after the render.
-    let output = OutputFile::open(&args.output)?;
-    if args.aovs && output.format != Format::Exr {
+    // written fails now, not after the render (a sequence's first frame's).
+    let mut output = Some(OutputFile::open(&frames[0].output)?);
+    if args.aovs && output.as_ref().is_some_and(|o| o.format != Format::Exr) {
         anyhow::bail!(
             "{}: --aovs writes the guide buffers as EXR layers: the output must end in .exr",
             args.output.display()
@@ -43,6 +47,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let mut prepared = args.common.prepare(Some(&args.scene))?;
+    let clip = args.animation.clip(&prepared)?;
+    if let Some(c) = clip {
+        animate::pose(&mut prepared, c, frames[0].time.unwrap_or(0.0));
+    }
     settings.env_intensity *= prepared.env_scale;
     let environment = prepared.environment.take();
     let mut renderer = args.common.open_renderer(&settings)?;
@@ -73,7 +81,75 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         renderer.set_lens(settings.lens_radius, focus)?;
     }
 
-    renderer.set_next_sample(args.sample_start.unwrap_or(0));
+    let setup = Setup {
+        settings,
+        spp,
+        scene_stats,
+        started,
+    };
+    for (k, frame) in frames.iter().enumerate() {
+        // Each later frame: the scene posed anew and brought up to date on the renderer (the
+        // film restarts, the seed stays).
+        let mut update_ms = None;
+        if k > 0
+            && let Some(c) = clip
+        {
+            let t = Instant::now();
+            let applied = animate::pose(&mut prepared, c, frame.time.unwrap_or(0.0));
+            renderer.update_scene(&prepared.scene, &prepared.lights, applied.deformed > 0)?;
+            renderer.set_camera(&prepared.camera)?;
+            update_ms = Some(t.elapsed().as_secs_f64() * 1e3);
+        }
+        let output = match output.take() {
+            Some(first) => first,
+            None => OutputFile::open(&frame.output)?,
+        };
+        let animation = serde_json::json!({
+            "clips": animate::clips_json(&prepared),
+            "clip": clip.map(|c| prepared.scene.animation.clips[c].name.clone()),
+            "time": clip.map(|_| frame.time.unwrap_or(0.0)),
+            "frame": frame.number,
+            "scene_update_ms": update_ms,
+        });
+        render_frame(
+            args,
+            &setup,
+            &mut renderer,
+            &prepared,
+            frame,
+            output,
+            animation,
+        )?;
+    }
+    Ok(())
+}
+
+/// What every frame of a render shares.
+struct Setup {
+    settings: RenderSettings,
+    spp: u32,
+    scene_stats: SceneStats,
+    started: Instant,
+}
+
+/// Renders the loaded scene, writes `frame`'s image to `output` and prints its summary line
+/// with the fields of `animation` added.
+fn render_frame(
+    args: &RenderArgs,
+    setup: &Setup,
+    renderer: &mut Renderer,
+    prepared: &Prepared,
+    frame: &Frame,
+    output: OutputFile,
+    animation: serde_json::Value,
+) -> Result<()> {
+    let Setup {
+        settings,
+        spp,
+        scene_stats,
+        started,
+    } = setup;
+    let spp = *spp;
     let bar = ProgressBar::new(spp as u64).with_style(
         ProgressStyle::with_template(
             "{spinner} {bar:40} {pos}/{len} spp {elapsed_precise} eta {eta}",
@@ -86,6 +162,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut lines = (!std::io::stderr().is_terminal()).then(|| ProgressLines::new(spp));
     let start = Instant::now();
     let cpu_start = crate::cpu_time::process_cpu_seconds();
+    renderer.set_next_sample(args.sample_start.unwrap_or(0));
     let mut done = 0;
     // The fewest samples a call first, then calls sized by the time a sample took.
     let mut chunk = MIN_SAMPLES_PER_CALL;
@@ -140,21 +217,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     let background = args.common.background;
-    let mode = args.common.exposure_for(&prepared);
+    let mode = args.common.exposure_for(prepared);
     let exposure = exposure_stops(&image, &coverage, background, mode);
     let (w, h) = (settings.width, settings.height);
     let tonemap = args.common.exposure.tonemap;
     let alpha = background.cutout().then_some(&coverage[..]);
     let bytes = match (output.format, args.sample_start) {
         (Format::Exr, None) if args.aovs => {
-            encode_exr_channels(w, h, &image, alpha, &aov_channels(&mut renderer)?)?
+            encode_exr_channels(w, h, &image, alpha, &aov_channels(renderer)?)?
         }
         (Format::Exr, None) => encode_exr(w, h, &image, alpha)?,
         (Format::Exr, Some(sample_start)) => {
             let info = ShardInfo {
                 sample_start,
                 samples: done,
-                identity: shard_identity(args, &prepared, &renderer)?,
+                identity: shard_identity(args, prepared, renderer, frame.time)?,
                 counted: settings.cutout || settings.count_coverage,
                 background: background.name(),
                 exposure: (mode != ExposureMode::Auto).then(|| mode.stops(None)),
@@ -205,7 +282,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     });
     let mut summary = serde_json::json!({
         "scene": args.scene.display().to_string(),
-        "output": args.output.display().to_string(),
+        "output": frame.output.display().to_string(),
         "device": renderer.device.description(),
         "kernel": renderer.kernel(),
         "width": settings.width,
@@ -287,6 +364,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     ] {
         summary[key] = value;
     }
+    if let serde_json::Value::Object(fields) = animation {
+        for (key, value) in fields {
+            summary[key] = value;
+        }
+    }
     let taken = if adaptive.is_some() || done < spp {
         format!("{mean_spp:.1} of at most {spp} spp")
     } else {
@@ -294,7 +376,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     };
     eprintln!(
         "penumbra: wrote {}: {w}×{h} pixels, {taken}, rendered in {} ({} in all)",
-        args.output.display(),
+        frame.output.display(),
         duration(seconds),
         duration(started.elapsed().as_secs_f64())
     );
@@ -302,96 +384,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// The exposure in stops `mode` gives `image`: metered on the subject (without the
-/// background), on the straight colour when the background is cut out.
-pub(super) fn exposure_stops(
-    image: &[[f32; 3]],
-    coverage: &[f32],
-    background: Background,
-    mode: ExposureMode,
-) -> f32 {
-    let straight = background.cutout().then(|| unpremultiply(image, coverage));
-    let shown = straight.as_deref().unwrap_or(image);
-    mode.stops(exposure::meter_subject(shown, Some(coverage)).as_ref())
-}
-
-/// The PNG `render` writes: `image` exposed by `exposure` stops, tone-mapped, the background
-/// drawn where `coverage` is short of 1 when it is cut out.
-pub(super) fn encode_png(
-    w: u32,
-    h: u32,
-    image: &[[f32; 3]],
-    coverage: &[f32],
-    background: Background,
-    exposure: f32,
-    tonemap: ToneMapper,
-) -> Result<Vec<u8>> {
-    let straight = background.cutout().then(|| unpremultiply(image, coverage));
-    let shown = straight.as_deref().unwrap_or(image);
-    let mut rgba = to_rgba8(shown, exposure, tonemap);
-    background::apply(&mut rgba, coverage, background);
-    encode_rgba_png(w, h, &rgba)
-}
-
-/// The identity of a shard ([`crate::shard::identity`]): the scene file's bytes and every
-/// setting that changes the linear image — size, bounces, seed, strategy, Russian roulette,
-/// sky and environment, lens and focus, background cut out or not (`RenderSettings`), the
-/// camera, the lights (with their radius), the environment and the variant. Not in it: the
-/// device, the kernels and the BVH, which change the image only in rounding (a merge of
-/// shards from different ones is still the estimate of all their samples); files the scene
-/// refers to (a .gltf's buffers and images) and an environment file are named, not read.
-fn shard_identity(
-    args: &RenderArgs,
-    prepared: &crate::args::Prepared,
-    renderer: &crate::render::Renderer,
-) -> Result<String> {
-    let scene = std::fs::read(&args.scene)
-        .with_context(|| format!("{}: cannot read", args.scene.display()))?;
-    let texts = [
-        format!("{:?}", renderer.settings()),
-        format!("{:?}", prepared.camera),
-        format!("{:?}", prepared.lights),
-        format!("{:?}", renderer.environment().map(|m| &m.name)),
-        format!("{:?}", args.common.env),
-        format!("{:?}", prepared.scene.variant),
-        args.common.background.name(),
-    ];
-    let mut parts: Vec<&[u8]> = vec![&scene];
-    parts.extend(texts.iter().map(|t| t.as_bytes()));
-    Ok(crate::shard::identity(&parts))
-}
-
 /// Seconds for a person: "0.42 s", "12.3 s", "3 min 07 s".
-/// The guide buffers as named EXR channels (docs/aovs.md), with adaptive sampling's samples
-/// per pixel and error estimate.
-fn aov_channels(renderer: &mut crate::render::Renderer) -> Result<crate::image_io::Channels> {
-    let mut channels = Vec::new();
-    if let Some(aovs) = renderer.aovs()? {
-        for (layer, names, values) in [
-            ("albedo", ["R", "G", "B"], &aovs.albedo),
-            ("normal", ["X", "Y", "Z"], &aovs.normal),
-        ] {
-            for (c, name) in names.iter().enumerate() {
-                channels.push((
-                    format!("{layer}.{name}"),
-                    values.iter().map(|v| v[c]).collect(),
-                ));
-            }
-        }
-        channels.push(("depth.Z".to_string(), aovs.depth));
-    }
-    if let Some(errors) = renderer.pixel_errors()? {
-        channels.push(("error.Y".to_string(), errors));
-    }
-    if let Some(samples) = renderer.pixel_samples()? {
-        channels.push((
-            "samples.Y".to_string(),
-            samples.iter().map(|&s| s as f32).collect(),
-        ));
-    }
-    Ok(channels)
-}
-
 fn duration(seconds: f64) -> String {
     match seconds {
         s if s < 10.0 => format!("{s:.2} s"),
@@ -403,9 +396,9 @@ fn duration(seconds: f64) -> String {
     }
 }
 
-/// Sets pixels with a non-finite or negative channel to 0 and counts them: no such value may
-/// reach the file. The kernels drop non-finite samples and the film's fixed-point sums
-/// saturate (kernels/shared/film.h), so a mean is finite unless the film's readback changes.
+/// Sets pixels with a non-finite or negative channel to 0 and counts them: the kernels drop
+/// non-finite samples, but a film's sum of finite samples can still overflow f32, and no
+/// such value may reach the file.
 fn zero_nonfinite(image: &mut [[f32; 3]]) -> u64 {
     let mut count = 0;
     for p in image.iter_mut() {
@@ -471,6 +464,99 @@ impl ProgressLines {
             self.last = seconds;
         }
     }
+}
+
+/// The exposure in stops `mode` gives `image`: metered on the subject (without the
+/// background), on the straight colour when the background is cut out.
+pub(super) fn exposure_stops(
+    image: &[[f32; 3]],
+    coverage: &[f32],
+    background: Background,
+    mode: ExposureMode,
+) -> f32 {
+    let straight = background.cutout().then(|| unpremultiply(image, coverage));
+    let shown = straight.as_deref().unwrap_or(image);
+    mode.stops(exposure::meter_subject(shown, Some(coverage)).as_ref())
+}
+
+/// The PNG `render` writes: `image` exposed by `exposure` stops, tone-mapped, the background
+/// drawn where `coverage` is short of 1 when it is cut out.
+pub(super) fn encode_png(
+    w: u32,
+    h: u32,
+    image: &[[f32; 3]],
+    coverage: &[f32],
+    background: Background,
+    exposure: f32,
+    tonemap: ToneMapper,
+) -> Result<Vec<u8>> {
+    let straight = background.cutout().then(|| unpremultiply(image, coverage));
+    let shown = straight.as_deref().unwrap_or(image);
+    let mut rgba = to_rgba8(shown, exposure, tonemap);
+    background::apply(&mut rgba, coverage, background);
+    encode_rgba_png(w, h, &rgba)
+}
+
+/// The identity of a shard ([`crate::shard::identity`]): the scene file's bytes and every
+/// setting that changes the linear image — size, bounces, seed, strategy, Russian roulette,
+/// sky and environment, lens and focus, background cut out or not (`RenderSettings`), the
+/// camera, the lights (with their radius), the environment, the variant and the animation's
+/// instant. Not in it: the
+/// device, the kernels and the BVH, which change the image only in rounding (a merge of
+/// shards from different ones is still the estimate of all their samples); files the scene
+/// refers to (a .gltf's buffers and images) and an environment file are named, not read.
+fn shard_identity(
+    args: &RenderArgs,
+    prepared: &crate::args::Prepared,
+    renderer: &crate::render::Renderer,
+    time: Option<f64>,
+) -> Result<String> {
+    let scene = std::fs::read(&args.scene)
+        .with_context(|| format!("{}: cannot read", args.scene.display()))?;
+    let texts = [
+        format!("{:?}", renderer.settings()),
+        format!("{:?}", prepared.camera),
+        format!("{:?}", prepared.lights),
+        format!("{:?}", renderer.environment().map(|m| &m.name)),
+        format!("{:?}", args.common.env),
+        format!("{:?}", prepared.scene.variant),
+        args.common.background.name(),
+        format!("{time:?}"),
+    ];
+    let mut parts: Vec<&[u8]> = vec![&scene];
+    parts.extend(texts.iter().map(|t| t.as_bytes()));
+    Ok(crate::shard::identity(&parts))
+}
+
+/// Seconds for a person: "0.42 s", "12.3 s", "3 min 07 s".
+/// The guide buffers as named EXR channels (docs/aovs.md), with adaptive sampling's samples
+/// per pixel and error estimate.
+fn aov_channels(renderer: &mut crate::render::Renderer) -> Result<crate::image_io::Channels> {
+    let mut channels = Vec::new();
+    if let Some(aovs) = renderer.aovs()? {
+        for (layer, names, values) in [
+            ("albedo", ["R", "G", "B"], &aovs.albedo),
+            ("normal", ["X", "Y", "Z"], &aovs.normal),
+        ] {
+            for (c, name) in names.iter().enumerate() {
+                channels.push((
+                    format!("{layer}.{name}"),
+                    values.iter().map(|v| v[c]).collect(),
+                ));
+            }
+        }
+        channels.push(("depth.Z".to_string(), aovs.depth));
+    }
+    if let Some(errors) = renderer.pixel_errors()? {
+        channels.push(("error.Y".to_string(), errors));
+    }
+    if let Some(samples) = renderer.pixel_samples()? {
+        channels.push((
+            "samples.Y".to_string(),
+            samples.iter().map(|&s| s as f32).collect(),
+        ));
+    }
+    Ok(channels)
 }
 
 #[cfg(test)]

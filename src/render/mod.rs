@@ -28,7 +28,7 @@ pub use megakernel::KernelChoice;
 pub use readback::Aovs;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
-pub use update::InstanceUpdate;
+pub use update::{InstanceUpdate, SceneUpdate};
 pub use upload::{Accel, HostScene, gpu_camera, gpu_material, samples_textures};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
@@ -126,6 +126,9 @@ pub struct Renderer {
     /// The meshes whose SAH BLASes start building once the quick scene's first samples are
     /// in (see [`Renderer::swap_in_sah`]).
     sah_waiting: Option<Vec<Arc<crate::scene::Mesh>>>,
+    /// An animated scene's packed textures with a fingerprint of what they were packed from
+    /// (see `Renderer::texture_pack`).
+    texture_cache: Option<(u64, Arc<TexturePack>)>,
     /// Node arrays uploaded beyond those the kernels in use traverse (see
     /// [`Renderer::set_node_forms`]).
     extra_forms: NodeForms,
@@ -183,6 +186,7 @@ impl Renderer {
             quick_first: None,
             sah: None,
             sah_waiting: None,
+            texture_cache: None,
             extra_forms: NodeForms::NONE,
             next_sample: 0,
             readback: Vec::new(),

@@ -1,7 +1,8 @@
 //! Moving instances of a two-level scene without rebuilding it: the moved instances' transforms
 //! and a new TLAS, written over the old ones in the device buffers (no reallocation, no BLAS
 //! build). The meshes' triangles and shading data stay in object space on the device, so
-//! nothing else is written (a moved light also rewrites the small light table).
+//! nothing else is written (a moved light also rewrites the small light table). A scene whose
+//! meshes deformed, or a flat one, is loaded again ([`Renderer::update_scene`]).
 
 use super::instancing::{instanced_objects, render_from_world};
 use super::upload::piece_copies;
@@ -9,7 +10,7 @@ use super::{Accel, Renderer};
 use crate::bvh::WideBvh;
 use crate::cl::ClError;
 use crate::cl::types::DeviceWideNode;
-use crate::scene::{Scene, is_sane};
+use crate::scene::{Light, Scene, is_sane};
 use std::time::Instant;
 
 /// What [`Renderer::move_instances`] did.
@@ -23,7 +24,38 @@ pub struct InstanceUpdate {
     pub bytes: usize,
 }
 
+/// How [`Renderer::update_scene`] brought the device up to date.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum SceneUpdate {
+    /// Instances moved in place (two levels, no mesh changed).
+    Moved,
+    /// The scene was loaded again (deformed meshes, or a flat BVH).
+    Reloaded,
+}
+
 impl Renderer {
+    /// Brings the device up to date with `scene` (the loaded scene after an animation pose)
+    /// and `lights`: moved instances in place where only transforms changed and the scene is
+    /// on two levels, else the scene loaded again in a render space around its new bounds (as
+    /// a fresh load of this pose would be, so a sequence's frame is its single render), the old
+    /// buffers written in place where their sizes agree and the textures packed once
+    /// (kernels are kept when the scene's features stay the same). Resets the film.
+    pub fn update_scene(
+        &mut self,
+        scene: &Scene,
+        lights: &[Light],
+        deformed: bool,
+    ) -> Result<SceneUpdate, ClError> {
+        if !deformed && self.move_instances(scene)?.is_some() {
+            self.set_lights(lights)?;
+            return Ok(SceneUpdate::Moved);
+        }
+        let space = crate::scene::RenderFrame::around(&scene.bounds());
+        let old = self.scene.take().map(|(buffers, _)| buffers);
+        self.load_with(scene, lights, space, super::instancing::Blases::Sah, old)?;
+        Ok(SceneUpdate::Reloaded)
+    }
+
     /// Brings a two-level scene on the device up to date with the transforms of `scene`'s
     /// objects: the moved instances get their new transforms, the TLAS is rebuilt, and both
     /// are written over the old ones in place (the meshes stay as they are, in object space);

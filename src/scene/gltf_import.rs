@@ -3,8 +3,9 @@
 //! Materials, meshes and the texture table are read in the submodules of those names.
 
 use super::accessor::BufferData;
+use super::animation::{self, Animation, Driven, Rig, RigData};
 use super::compression;
-use super::pose::{check_nesting, node_matrix, node_pose, rest_worlds};
+use super::pose::{check_nesting, node_matrix};
 use super::variants;
 use super::{
     Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError, default_light_rig, limits,
@@ -21,7 +22,7 @@ mod meshes;
 mod texture_table;
 
 use materials::import_material;
-use meshes::{import_mesh, read_meshes_ahead};
+use meshes::{deforms, import_mesh, read_meshes_ahead};
 use texture_table::{TextureTable, decode_images, texture_sources};
 
 /// Vertical field of view of the automatic camera.
@@ -88,7 +89,9 @@ fn load_owned(
     };
     buffer_data.decoded_views = compression::decode_meshopt_views(root, &buffer_data.buffers)?;
     check_nesting(&document)?;
-    let rest = rest_worlds(&document, &parsed.precise_nodes);
+    let clips = animation::read_clips(root, &buffer_data, &mut warnings);
+    let mut animation = Animation::new(&document, &parsed.precise_nodes, clips);
+    let rest = animation.evaluate(None, 0.0);
 
     let mut table = TextureTable {
         sources: texture_sources(root),
@@ -139,7 +142,6 @@ fn load_owned(
         &roots,
         root,
         &buffer_data,
-        &rest,
         default_material,
         &normal_sets,
         variant_count,
@@ -196,10 +198,10 @@ fn load_owned(
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("mesh {}", mesh.index()));
             // Each mesh is read once, however many nodes place it, unless the node poses it
-            // (a skin or its own morph weights).
-            let pose = node_pose(&node, &mesh, root, &buffer_data, &rest)?;
-            let posed = node.skin().is_some() || node.weights().is_some();
+            // (a skin or morph targets): then it is read unposed and posed by its rig.
+            let posed = deforms(&node, &mesh);
             let ahead = (!posed).then(|| read_ahead.remove(&mesh.index())).flatten();
+            let mut rig = None;
             let m = match meshes.get(&mesh.index()).filter(|_| !posed) {
                 Some(m) => Arc::clone(m),
                 None if ahead.is_some() => {
@@ -211,11 +213,12 @@ fn load_owned(
                     m
                 }
                 None => {
+                    let mut data = RigData::default();
                     let mut m = import_mesh(
                         &mesh,
                         root,
                         &buffer_data,
-                        &pose,
+                        posed.then_some(&mut data),
                         default_material,
                         &normal_sets,
                         &mut warnings,
@@ -225,13 +228,31 @@ fn load_owned(
                         &format!("meshes[{}]", mesh.index()),
                         &mut warnings,
                     );
-                    let m = Arc::new(m);
-                    if !posed {
+                    if posed {
+                        let r = rig_of(&node, &mesh, m, data, &mut animation, root, &buffer_data)?;
+                        let mut m = r.base.clone();
+                        let joints = r
+                            .skin
+                            .map(|s| animation.joint_matrices(s, &rest))
+                            .unwrap_or_default();
+                        r.pose_into(&r.default_weights, &joints, &mut m);
+                        if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
+                            return Err(format!(
+                                "meshes[{}]: its morph targets or skin move POSITION {i} to a \
+                                 non-finite point",
+                                mesh.index()
+                            ));
+                        }
+                        rig = Some(Arc::new(r));
+                        Arc::new(m)
+                    } else {
+                        let m = Arc::new(m);
                         meshes.insert(mesh.index(), Arc::clone(&m));
+                        m
                     }
-                    m
                 }
             };
+            let skinned = rig.as_ref().is_some_and(|r| r.skin.is_some());
             if m.positions.iter().any(|p| {
                 let w = world.transform_point3(p.as_dvec3());
                 w.abs().max_element().partial_cmp(&limits::MAX_COORDINATE)
@@ -254,15 +275,18 @@ fn load_owned(
                 ));
             }
             if !m.indices.is_empty() {
+                if !animation.clips.is_empty() {
+                    animation.objects.push(Driven {
+                        object: scene.objects.len(),
+                        node: node.index(),
+                        rig,
+                    });
+                }
                 scene.objects.push(Object {
                     name,
                     // A skinned mesh is placed by its joints alone; its node's transform is
                     // ignored (glTF 2.0 § 3.7.3).
-                    world_from_object: if pose.joints.is_empty() {
-                        world
-                    } else {
-                        DMat4::IDENTITY
-                    },
+                    world_from_object: if skinned { DMat4::IDENTITY } else { world },
                     visible: true,
                     mesh: m,
                 });
@@ -270,13 +294,17 @@ fn load_owned(
         }
         if let Some(camera) = node.camera() {
             match import_camera(&camera, &world) {
-                Ok(c) => scene.cameras.push(c),
+                Ok(c) => {
+                    animation.cameras.push((scene.cameras.len(), node.index()));
+                    scene.cameras.push(c);
+                }
                 Err(why) => warn_once(&mut warnings, why),
             }
         }
         if let Some(light) = node.light()
             && let Some(l) = import_light(&light, &world, &mut warnings)
         {
+            animation.lights.push((scene.lights.len(), node.index()));
             scene.lights.push(l);
         }
         let children: Vec<gltf::Node> = node.children().collect();
@@ -302,7 +330,43 @@ fn load_owned(
         scene.default_rig = true;
     }
     scene.warnings = warnings;
+    if !animation.clips.is_empty() {
+        scene.animation = Arc::new(animation);
+    }
     Ok(scene)
+}
+
+/// The rig of `node`'s mesh `base` (read unposed with its `data`): its skin, read into
+/// `animation` and checked against the influences, and its default morph weights.
+fn rig_of(
+    node: &gltf::Node,
+    mesh: &gltf::Mesh,
+    base: Mesh,
+    data: RigData,
+    animation: &mut Animation,
+    root: &gltf::json::Root,
+    buffer_data: &BufferData,
+) -> Result<Rig, String> {
+    let mut skin = None;
+    if let Some(s) = node.skin() {
+        animation.read_skin(root, buffer_data, s.index())?;
+        skin = (!animation.skins[s.index()].joints.is_empty()).then_some(s.index());
+    }
+    let rig = Rig {
+        base,
+        data,
+        skin,
+        default_weights: node
+            .weights()
+            .or(mesh.weights())
+            .map(<[f32]>::to_vec)
+            .unwrap_or_default(),
+    };
+    if let Some(s) = skin {
+        let joints = animation.skins[s].joints.len();
+        rig.check_joints(joints, &format!("meshes[{}]", mesh.index()))?;
+    }
+    Ok(rig)
 }
 
 /// Adds `warning` unless the same one was given already (a node placed many times warns once).

@@ -1,11 +1,10 @@
 //! What the glTF specification calls invalid but penumbra can read anyway: each such value is
 //! one warning naming the element (the docs promise it), and the scene still loads. Checked on
 //! the validated document before anything reads it; the importer then uses the values as
-//! documented in docs/robustness.md (a camera's clip planes and a light's range are not used,
-//! animations are not played).
+//! documented in docs/robustness.md (a camera's clip planes and a light's range are not used).
+//! Broken animation channels are reported where the clips are read (`animation::read_clips`).
 
 use gltf::json;
-use json::validation::Checked::Valid;
 
 /// Appends a warning for each value of `root` that the specification forbids and penumbra
 /// tolerates. `glb_lengths`: a GLB file's header length and its real length.
@@ -64,9 +63,6 @@ pub fn warn_invalid(
                 &mut warn,
             );
         }
-    }
-    for (a, animation) in root.animations.iter().enumerate() {
-        animation_channels(root, a, animation, &mut warn);
     }
 }
 
@@ -170,47 +166,5 @@ fn node_transform(n: usize, node: &json::Node, warn: &mut impl FnMut(String)) {
              is read as affine",
             [m[3], m[7], m[11], m[15]]
         ));
-    }
-}
-
-/// Each channel of an animation must target a node in range with a valid path, and its
-/// sampler's output must have the accessor type the path needs. Animations are not played;
-/// a broken channel is only reported.
-fn animation_channels(
-    root: &json::Root,
-    a: usize,
-    animation: &json::Animation,
-    warn: &mut impl FnMut(String),
-) {
-    use json::accessor::Type;
-    use json::animation::Property;
-    for (c, channel) in animation.channels.iter().enumerate() {
-        let at = format!("animations[{a}].channels[{c}]");
-        let node = channel.target.node.value();
-        if node >= root.nodes.len() {
-            warn(format!("{at}.target.node: index out of range; ignored"));
-            continue;
-        }
-        let Valid(path) = channel.target.path else {
-            warn(format!("{at}.target.path: invalid value; ignored"));
-            continue;
-        };
-        let output = animation
-            .samplers
-            .get(channel.sampler.value())
-            .and_then(|s| root.accessors.get(s.output.value()));
-        let wanted = match path {
-            Property::Translation | Property::Scale => Type::Vec3,
-            Property::Rotation => Type::Vec4,
-            Property::MorphTargetWeights => Type::Scalar,
-        };
-        if let Some(accessor) = output
-            && let Valid(ty) = accessor.type_
-            && ty != wanted
-        {
-            warn(format!(
-                "{at}: its sampler's output is {ty:?}, the path needs {wanted:?}; ignored"
-            ));
-        }
     }
 }

@@ -4,6 +4,7 @@
 //! into world-space triangles (f32) whenever the scene changes.
 
 mod accessor;
+pub mod animation;
 mod basisu;
 mod bounds;
 pub mod bvh_report;
@@ -460,6 +461,9 @@ pub struct Scene {
     pub bounds_cache: BoundsCache,
     /// Quick BLASes that the first-view probe built, left for the renderer's first load.
     pub quick_blases: QuickBlases,
+    /// The file's clips and what poses the scene at any time of them (empty when the file has
+    /// no animations).
+    pub animation: Arc<animation::Animation>,
 }
 
 /// Quick BLASes ([`crate::bvh::quick_blas`]) of some of a scene's meshes, each with the mesh

@@ -179,8 +179,13 @@ pub fn problems(root: &json::Root) -> Vec<String> {
 /// [`SUPPORTED_EXTENSIONS`] instead of gltf-json's own list), POSITION without min/max
 /// (exporters often leave them out and nothing here reads them), and an accessor without a
 /// buffer view (Draco-compressed primitives have none; reading such an accessor fails there),
-/// and a texture whose only source is an extension's.
+/// a texture whose only source is an extension's, and anything in `animations`.
 fn tolerated(path: &str, error: JsonError) -> bool {
+    // A bad animation channel is skipped with a warning when the clips are read
+    // (`animation::read_clips`), not the whole file refused.
+    if path.starts_with("animations[") {
+        return true;
+    }
     match error {
         JsonError::Unsupported => path.starts_with("extensionsRequired"),
         JsonError::Missing => {

@@ -1,14 +1,15 @@
-//! glTF meshes into [`Mesh`]es: every primitive's attributes (accessors, Draco or meshopt
-//! data, morph targets and skins at the rest pose, tangents), the primitives of a mesh one
-//! after the other; large meshes read ahead in parallel while the node graph is walked.
+//! glTF meshes into [`Mesh`]es, unposed: every primitive's attributes (accessors, Draco or
+//! meshopt data, tangents) and, for a mesh that deforms, its skin influences and morph targets
+//! ([`RigData`]); the primitives of a mesh one after the other; large meshes read ahead in
+//! parallel while the node graph is walked.
 
 use super::super::accessor::{self, Attributes, BufferData};
+use super::super::animation::RigData;
 use super::super::compression;
-use super::super::pose::{Pose, apply_morph_targets, apply_skin, node_pose};
 use super::super::variants::{self, VariantRange};
 use super::super::{Mesh, limits, tangents};
 use super::colors::{pad_colors, read_colors};
-use glam::{DMat4, Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 use gltf::json::validation::Checked;
 use gltf::mesh::Mode;
 use rayon::prelude::*;
@@ -18,7 +19,7 @@ use std::collections::HashMap;
 pub(super) type ReadAhead = Result<(Mesh, Vec<String>), String>;
 
 /// The meshes that the nodes under `roots` place without a pose of the node's own (no skin, no
-/// morph weights), each read once, in parallel: what a scene of many distinct meshes spends
+/// morph targets), each read once, in parallel: what a scene of many distinct meshes spends
 /// most of its loading on (a 64 M-triangle scene of 3,125 meshes). The node walk takes each
 /// where it first places it, so the scene, its warnings and its errors are those of reading
 /// them there. Meshes are taken in walk order while their triangles (from the accessors'
@@ -28,7 +29,6 @@ pub(super) fn read_meshes_ahead(
     roots: &[gltf::Node],
     root: &gltf::json::Root,
     data: &BufferData,
-    rest: &[DMat4],
     default_material: u32,
     normal_sets: &[Option<(u32, bool)>],
     variant_count: usize,
@@ -44,8 +44,7 @@ pub(super) fn read_meshes_ahead(
             continue;
         }
         if let Some(mesh) = node.mesh()
-            && node.skin().is_none()
-            && node.weights().is_none()
+            && !deforms(&node, &mesh)
             && taken.insert(mesh.index())
         {
             triangles += mesh
@@ -72,31 +71,39 @@ pub(super) fn read_meshes_ahead(
         .map(|node| {
             let mesh = node.mesh().expect("a node placing a mesh");
             let mut warnings = vec![];
-            let read = node_pose(node, &mesh, root, data, rest).and_then(|pose| {
-                let mut m = import_mesh(
-                    &mesh,
-                    root,
-                    data,
-                    &pose,
-                    default_material,
-                    normal_sets,
-                    &mut warnings,
-                )?;
+            let read = import_mesh(
+                &mesh,
+                root,
+                data,
+                None,
+                default_material,
+                normal_sets,
+                &mut warnings,
+            )
+            .map(|mut m| {
                 let what = format!("meshes[{}]", mesh.index());
                 m.keep_variants(variant_count, &what, &mut warnings);
-                Ok(m)
+                m
             });
             (mesh.index(), read.map(|m| (m, warnings)))
         })
         .collect()
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Whether `node` poses its mesh itself: a skin, or morph targets (whose weights a node or
+/// an animation sets). Such a node gets its own copy of the mesh.
+pub(super) fn deforms(node: &gltf::Node, mesh: &gltf::Mesh) -> bool {
+    node.skin().is_some()
+        || node.weights().is_some()
+        || mesh.primitives().any(|p| p.morph_targets().len() > 0)
+}
+
+/// Reads `mesh` unposed; with `rig`, its skin influences and morph targets too.
 pub(super) fn import_mesh(
     mesh: &gltf::Mesh,
     root: &gltf::json::Root,
     data: &BufferData,
-    pose: &Pose,
+    mut rig: Option<&mut RigData>,
     default_material: u32,
     normal_sets: &[Option<(u32, bool)>],
     warnings: &mut Vec<String>,
@@ -133,7 +140,7 @@ pub(super) fn import_mesh(
             draco,
             path: what.clone(),
         };
-        let mut positions: Vec<Vec3> = attributes
+        let positions: Vec<Vec3> = attributes
             .floats::<3>("POSITION")?
             .ok_or_else(|| format!("{what}: POSITION is missing"))?
             .into_iter()
@@ -142,7 +149,7 @@ pub(super) fn import_mesh(
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("{what}: POSITION {i} is not finite"));
         }
-        let mut normals: Vec<Vec3> = attributes
+        let normals: Vec<Vec3> = attributes
             .floats::<3>("NORMAL")?
             .unwrap_or_default()
             .into_iter()
@@ -177,7 +184,7 @@ pub(super) fn import_mesh(
             .index()
             .map_or(default_material, |i| i as u32);
         let normal_set = normal_sets.get(material as usize).copied().flatten();
-        let mut file_tangents: Vec<Vec4> = match normal_set {
+        let file_tangents: Vec<Vec4> = match normal_set {
             Some(_) => attributes
                 .floats::<4>("TANGENT")?
                 .unwrap_or_default()
@@ -189,28 +196,8 @@ pub(super) fn import_mesh(
         if !file_tangents.is_empty() && file_tangents.len() != positions.len() {
             return Err(format!("{what}: TANGENT count differs from POSITION count"));
         }
-        // Pose the vertices: morph targets in the mesh's space, then the skin.
-        apply_morph_targets(
-            &attributes,
-            json,
-            &pose.weights,
-            &mut positions,
-            &mut normals,
-            &mut file_tangents,
-        )?;
-        if !pose.joints.is_empty() {
-            apply_skin(
-                &attributes,
-                &pose.joints,
-                &mut positions,
-                &mut normals,
-                &mut file_tangents,
-            )?;
-        }
-        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(format!(
-                "{what}: its morph targets or skin move POSITION {i} to a non-finite point"
-            ));
+        if let Some(rig) = rig.as_deref_mut() {
+            rig.read_primitive(&attributes, json, positions.len())?;
         }
         let flat: Vec<u32> = match (&attributes.draco, json.indices) {
             (Some(d), _) => d.indices.clone(),
