@@ -3,11 +3,11 @@
 //! [`Model`] and reports what changed in [`Actions`]; the window loop applies them.
 
 use super::camera::{CameraController, Mode};
+use super::exposure::HeldExposure;
 use super::frame_loop::{Changes, Film, Progress};
 use super::state::ViewState;
 use crate::render::SceneStats;
 use crate::render::background::Background;
-use crate::render::exposure::AutoExposure;
 use crate::render::tonemap::ToneMapper;
 use crate::scene::{EnvPreset, LightPreset, Scene};
 use egui::{Color32, RichText, Ui};
@@ -53,8 +53,10 @@ pub struct Info<'a> {
     pub scene_stats: Option<&'a SceneStats>,
     /// Scene file loading time.
     pub load_ms: f64,
-    /// Display frames per second.
-    pub fps: f64,
+    /// New images presented per second (not the panel's redraws).
+    pub images_per_second: f64,
+    /// Milliseconds from the last input to the first image after it.
+    pub latency_ms: Option<f64>,
     /// The file being loaded in the background.
     pub loading: Option<&'a std::path::Path>,
     /// The last screenshot's PNG path.
@@ -212,11 +214,12 @@ impl Gui {
             .converged_share
             .map_or_else(String::new, |c| format!(" · {:.0} % converged", c * 100.0));
         ui.label(format!(
-            "{} / {target} spp{converged} · {:.2} MS/s · {:.0} fps",
+            "{} / {target} spp{converged} · {:.2} MS/s",
             info.progress.spp,
             info.progress.samples_per_second * 1e-6,
-            info.fps
         ));
+        ui.label(live_figures(info))
+            .on_hover_text("new images shown per second (not redraws of the panel); the time from the last input to the first image rendered after it");
         if let Some(e) = info.device_error {
             ui.label(RichText::new(format!("device error: {e}")).color(Color32::LIGHT_RED));
         }
@@ -342,7 +345,7 @@ impl Gui {
                 ui.horizontal(|ui| {
                     let mut auto = v.auto_exposure.is_some();
                     if ui.checkbox(&mut auto, "auto").changed() {
-                        v.auto_exposure = auto.then(AutoExposure::default);
+                        v.auto_exposure = auto.then(HeldExposure::default);
                         v.incident_exposure = false;
                     }
                     let s = ui.add(egui::Slider::new(&mut v.exposure, -24.0..=24.0).text("stops"));
@@ -650,10 +653,13 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
                     s.bvh
                 ));
             }
-            let moving = if info.film.divisor > 1 {
-                format!(" (1/{} while moving)", info.film.divisor)
-            } else {
+            let moving = if info.film.full_quality {
                 String::new()
+            } else {
+                format!(
+                    " (preview: 1/{}, {} bounces)",
+                    info.film.divisor, info.film.bounces
+                )
             };
             ui.label(format!(
                 "film {}×{}{moving}",
@@ -670,8 +676,13 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
                 p.rays_per_second * 1e-6
             ));
             if let Some(plan) = p.plan {
+                let band = if plan.bands > 1 {
+                    format!(", band {}/{}", p.band + 1, plan.bands)
+                } else {
+                    String::new()
+                };
                 ui.label(format!(
-                    "last batch: {} spp in {:.1} ms (budget {:.0} ms)",
+                    "last batch: {} spp{band} in {:.1} ms (budget {:.0} ms)",
                     plan.spp,
                     p.batch_ms,
                     super::frame_loop::FRAME_BUDGET_MS
@@ -703,6 +714,17 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
                 ui.label(format!("saved {}", path.display()));
             }
         });
+}
+
+/// Image updates per second and the last input's latency, for the top of the panel.
+fn live_figures(info: &Info) -> String {
+    let latency = info
+        .latency_ms
+        .map_or_else(|| "–".to_string(), |ms| format!("{ms:.0} ms"));
+    format!(
+        "{:.1} images/s · input answered in {latency}",
+        info.images_per_second
+    )
 }
 
 fn controls_section(ui: &mut Ui) {

@@ -20,12 +20,25 @@ pub(super) struct Input {
     pub ctrl: bool,
     /// A button pressed while the overlay is shown, handled after egui's next pass.
     pub press: Option<MouseButton>,
+    /// When the earliest input not yet turned into a change arrived (for its latency).
+    pub event_at: Option<Instant>,
 }
 
 impl App {
     /// Handles a keyboard or mouse event. `typing`: egui has the keyboard (key releases still
     /// count); `wheel_free`: the wheel is not egui's.
     pub(super) fn input_event(&mut self, event: WindowEvent, typing: bool, wheel_free: bool) {
+        let acts = match &event {
+            WindowEvent::KeyboardInput { event, .. } => {
+                event.state == ElementState::Pressed && !event.repeat
+            }
+            WindowEvent::CursorMoved { .. } => self.input.look || self.input.pan,
+            WindowEvent::MouseInput { .. } | WindowEvent::MouseWheel { .. } => true,
+            _ => false,
+        };
+        if acts && self.input.event_at.is_none() {
+            self.input.event_at = Some(Instant::now());
+        }
         match event {
             WindowEvent::ModifiersChanged(m) => {
                 self.input.shift = m.state().shift_key();
@@ -104,10 +117,14 @@ impl App {
 
     pub(super) fn camera_moved(&mut self) {
         self.last_motion = Some(Instant::now());
-        self.frame_loop.invalidate(Changes {
-            camera: true,
-            ..Changes::default()
-        });
+        let at = self.change_time();
+        self.frame_loop.invalidate_at(
+            Changes {
+                camera: true,
+                ..Changes::default()
+            },
+            at,
+        );
     }
 
     fn key(&mut self, code: KeyCode, pressed: bool, repeat: bool) {
@@ -148,10 +165,14 @@ impl App {
     fn lights_changed(&mut self) {
         self.last_motion = Some(Instant::now());
         self.lights = self.model.view.lights();
-        self.frame_loop.invalidate(Changes {
-            lights: true,
-            ..Changes::default()
-        });
+        let at = self.change_time();
+        self.frame_loop.invalidate_at(
+            Changes {
+                lights: true,
+                ..Changes::default()
+            },
+            at,
+        );
     }
 
     /// Picks the object under the cursor (host BVH ray cast).

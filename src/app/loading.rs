@@ -3,10 +3,10 @@
 //! it; the environment map is loaded and uploaded here too.
 
 use super::camera::CameraController;
+use super::exposure::HeldExposure;
 use super::frame_loop::Changes;
 use super::gui::{EnvSource, Model};
 use super::{App, pick};
-use crate::render::exposure::AutoExposure;
 use crate::scene::{Scene, SceneError};
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, TryRecvError};
@@ -88,7 +88,7 @@ impl App {
                 self.autofocus = self.model.view.aperture > 0.0;
                 let view = &mut self.model.view;
                 if std::mem::take(&mut view.incident_exposure) {
-                    view.auto_exposure = Some(AutoExposure::default());
+                    view.auto_exposure = Some(HeldExposure::default());
                 }
                 if let Some(auto) = view.auto_exposure.as_mut() {
                     auto.reset();

@@ -56,6 +56,11 @@ pub struct ViewArgs {
     /// Start with the overlay hidden: the image fills the window; Tab shows it (default: off).
     #[arg(long)]
     pub no_overlay: bool,
+    /// Append one JSON line per image shown to this file (its size, samples, exposure, and for
+    /// the first image after an input the latency from the input in ms), for scripts and tests
+    /// (default: none).
+    #[arg(long, value_name = "PATH")]
+    pub stats_file: Option<PathBuf>,
 }
 
 /// Options of `render`.
@@ -156,6 +161,7 @@ fn view(args: ViewArgs) -> Result<()> {
         frames: args.frames,
         screenshot: args.screenshot,
         overlay: !args.no_overlay,
+        stats_file: args.stats_file,
     })
 }
 
