@@ -371,7 +371,8 @@ impl FrameLoop {
             divisor: plan.level.divisor,
             bounces: plan.level.bounces,
             full_quality: self.level.is_some_and(|(i, _)| i == 0),
-            answers: sample.answers,
+            // An image collected over one never shown answers its input when it is shown.
+            answers: sample.answers.or(self.film.answers),
             view: sample.view,
         };
         let p = &mut self.progress;

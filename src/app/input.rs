@@ -142,9 +142,33 @@ impl App {
                 self.model.camera.reset();
                 self.camera_moved();
             }
+            KeyCode::KeyH if !self.model.view.has_light_radius() => self.flash(
+                "H: no light here has a radius to change (the scene is lit by its environment \
+                 or emissive surfaces)",
+            ),
             KeyCode::KeyH => {
                 self.model.view.toggle_hard_shadows();
                 self.lights_changed();
+                let what = if self.model.view.shadows.hard {
+                    "hard shadows"
+                } else {
+                    "soft shadows"
+                };
+                self.flash(what);
+            }
+            KeyCode::KeyC => {
+                let c = &mut self.model.camera;
+                c.collision = !c.collision;
+                let what = if c.collision {
+                    "collision on: moves stop at walls"
+                } else {
+                    "collision off: moves pass through walls"
+                };
+                self.flash(what);
+            }
+            KeyCode::KeyV => {
+                let name = super::gui::next_view_name(&self.gui.views);
+                self.save_view(&name);
             }
             KeyCode::KeyO => {
                 let next = match self.model.camera.mode {
@@ -156,10 +180,43 @@ impl App {
             KeyCode::Equal | KeyCode::NumpadAdd => self.model.camera.scale_speed(1.0),
             KeyCode::Minus | KeyCode::NumpadSubtract => self.model.camera.scale_speed(-1.0),
             KeyCode::KeyQ if ctrl => self.quit = true,
-            KeyCode::Tab | KeyCode::F1 => self.overlay = !self.overlay,
+            KeyCode::Tab => self.overlay = !self.overlay,
+            KeyCode::F1 => self.gui.help = !self.gui.help,
             KeyCode::F12 => self.screenshot(),
             _ => {}
         }
+    }
+
+    /// Shows `text` in the middle of the image for a moment.
+    pub(super) fn flash(&mut self, text: &str) {
+        self.gui.flash = Some((text.to_string(), Instant::now()));
+    }
+
+    /// Saves the camera as `name` in the views file beside the scene and lists it.
+    pub(super) fn save_view(&mut self, name: &str) {
+        let Some(path) = self.scene_path.clone() else {
+            self.flash("views are saved beside a scene file: open one first");
+            return;
+        };
+        match crate::scene::views::save_view(&path, name, &self.model.camera.camera) {
+            Ok(file) => {
+                println!("penumbra: saved view '{name}' in {}", file.display());
+                self.flash(&format!("saved view '{name}'"));
+                self.load_views();
+            }
+            Err(e) => self.gui.file_error = Some(format!("{e:#}")),
+        }
+    }
+
+    /// Reads the scene's saved views for the overlay's list.
+    pub(super) fn load_views(&mut self) {
+        self.gui.views = match &self.scene_path {
+            Some(p) => crate::scene::views::load_views(p).unwrap_or_else(|e| {
+                log::warn!("{e:#}");
+                Vec::new()
+            }),
+            None => Vec::new(),
+        };
     }
 
     fn lights_changed(&mut self) {
@@ -193,7 +250,9 @@ impl App {
             Some(hit) => {
                 self.model.selected = Some(hit.object);
                 if self.model.camera.mode == Mode::Orbit {
-                    self.model.camera.set_pivot(hit.point);
+                    // The object's centre keeps it in frame while orbiting.
+                    let center = pick::object_center(&self.model.scene, hit.object);
+                    self.model.camera.set_pivot(center.unwrap_or(hit.point));
                 }
                 // With a lens, a click also focuses on the clicked point.
                 if self.model.view.aperture > 0.0 {

@@ -67,9 +67,18 @@ pub const CONTROLS: &[(&str, &str)] = &[
         "pick an object (orbit: also the pivot; with a lens: focus)",
     ),
     ("R", "reset the view"),
+    (
+        "C",
+        "collision on / off (on at the start inside interiors: moves stop at walls)",
+    ),
+    (
+        "V",
+        "save the view (beside the scene, for --view NAME; recall in Views)",
+    ),
     ("H", "hard / soft shadows"),
     ("F12", "screenshot (PNG + EXR in screenshots/)"),
-    ("Tab, F1", "hide / show the overlay"),
+    ("Tab", "hide / show the overlay"),
+    ("F1", "this list in a window"),
     ("Ctrl + Q", "quit (like closing the window)"),
     ("drop a file", "open a .gltf / .glb scene"),
 ];
@@ -120,6 +129,8 @@ pub struct ViewerConfig {
     pub overlay: bool,
     /// Append one JSON line per presented image here (`--stats-file`).
     pub stats_file: Option<PathBuf>,
+    /// The first view is inside an interior: collision starts on.
+    pub interior: bool,
 }
 
 /// The image's width over height in a window of `size` pixels, beside the overlay's panel
@@ -183,13 +194,16 @@ pub fn run(config: ViewerConfig) -> Result<()> {
     let mut view = view;
     view.background = config.background;
     view.tone_mapper = config.tone_mapper;
-    let camera = CameraController::new(config.camera, &bounds);
+    let mut camera = CameraController::new(config.camera, &bounds);
+    camera.collision = config.interior;
     let path_text = config
         .path
         .as_ref()
         .map(|p| p.display().to_string())
         .unwrap_or_default();
     let mut app = App {
+        scene_path: config.path.clone(),
+        seen_for: None,
         size,
         device: renderer.device.description(),
         frame_loop: FrameLoop::new(renderer),
@@ -225,6 +239,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         frame_key: None,
         shown_spp: 0,
     };
+    app.load_views();
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.fatal.take() {
         return Err(e);
@@ -274,6 +289,10 @@ struct Gfx {
 }
 
 struct App {
+    /// The scene file (views are saved beside it); `None` for the bundled scene.
+    scene_path: Option<PathBuf>,
+    /// The camera (eye, forward) the fly speed was last sized for.
+    seen_for: Option<(glam::DVec3, glam::DVec3)>,
     /// The window's inner size in physical pixels (the full film size).
     size: (u32, u32),
     device: String,
@@ -410,7 +429,8 @@ impl ApplicationHandler for App {
         // A batch due to finish is polled at once and the next one started without waiting for
         // a display frame, so the device never idles between bands.
         let due = self.frame_loop.expected_done();
-        if due.is_some_and(|t| t <= now) && self.step_frame_loop(now) {
+        // (Not when the step would build kernels: that waits for the notice in `redraw`.)
+        if due.is_some_and(|t| t <= now) && !self.builds_next() && self.step_frame_loop(now) {
             self.pump_image = true;
             self.wake = Some(now);
         }
@@ -550,7 +570,10 @@ impl App {
         self.last_redraw = now;
         self.input_at = None;
         self.poll_loader();
-        if self.model.camera.fly(&self.input.motion, dt) {
+        self.size_fly_speed();
+        let host = self.frame_loop.renderer.host_scene();
+        let obstacle = |o, d| host.and_then(|h| pick::distance_along(h, o, d));
+        if self.model.camera.fly(&self.input.motion, dt, &obstacle) {
             self.camera_moved();
         }
         let Some(actions) = self.overlay_pass(now) else {
@@ -624,6 +647,8 @@ impl App {
             if overlay {
                 actions = gui.ui(ui, model, &info);
             }
+            gui::help_window(ui.ctx(), &mut gui.help);
+            gui::flash(ui.ctx(), &gui.flash, panel);
             if compiling {
                 gui::notice(ui.ctx(), "Compiling kernels…", panel);
             }
@@ -657,6 +682,13 @@ impl App {
         }
         if let Some(path) = actions.open {
             self.open(path);
+        }
+        if let Some(name) = actions.save_view {
+            self.save_view(&name);
+        }
+        if let Some(camera) = actions.recall_view {
+            self.model.camera.camera = camera;
+            self.camera_moved();
         }
         if let Some(env) = actions.environment {
             // Applied in `redraw` once the "Compiling kernels…" notice is on screen if the
@@ -741,6 +773,23 @@ impl App {
                 event_loop.exit();
             }
         }
+    }
+
+    /// Sizes the fly speed by the distance to what the camera sees, when the camera changed.
+    fn size_fly_speed(&mut self) {
+        let cam = &self.model.camera.camera;
+        let key = (cam.eye, cam.forward);
+        if self.seen_for == Some(key) {
+            return;
+        }
+        let Some(host) = self.frame_loop.renderer.host_scene() else {
+            return;
+        };
+        let aspect = self.image_area().aspect();
+        if let Some(d) = pick::seen_distance(host, cam, aspect) {
+            self.model.camera.set_seen_distance(d);
+        }
+        self.seen_for = Some(key);
     }
 
     /// A new image is on screen: counts it, and measures the latency of the input it answers.

@@ -214,6 +214,14 @@ impl ViewState {
             .collect()
     }
 
+    /// Whether an enabled light has a radius the hard/soft toggle changes (point, spot and
+    /// directional lights; sphere lights keep theirs unless they follow the light radius).
+    pub fn has_light_radius(&self) -> bool {
+        self.rig
+            .iter()
+            .any(|l| l.enabled && (l.follows_light_radius || l.light.light_radius > 0.0))
+    }
+
     /// Flips hard shadows (the H key).
     pub fn toggle_hard_shadows(&mut self) {
         self.shadows.hard = !self.shadows.hard;

@@ -133,6 +133,15 @@ fn view(args: ViewArgs) -> Result<()> {
     let mut prepared = common.prepare_for(args.scene.as_deref(), aspect)?;
     settings.env_intensity *= prepared.env_scale;
     let exposure = common.exposure_for(&prepared);
+    // The first view knows an interior; a camera of the file's (or the command line's) counts
+    // as inside one when it stands within the scene's bounds.
+    let interior = match &prepared.first_view {
+        Some(f) => f.view.interior,
+        None => {
+            let (b, eye) = (prepared.scene.bounds(), prepared.camera.eye);
+            eye.cmpge(b.min).all() && eye.cmple(b.max).all()
+        }
+    };
     let environment = prepared.environment.take();
     let device = common.device_choice()?;
     // With a lens but no focus distance, focus on what the image centre sees once loaded.
@@ -162,6 +171,7 @@ fn view(args: ViewArgs) -> Result<()> {
         screenshot: args.screenshot,
         overlay: !args.no_overlay,
         stats_file: args.stats_file,
+        interior,
     })
 }
 
