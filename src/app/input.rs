@@ -149,12 +149,6 @@ impl App {
             KeyCode::KeyH => {
                 self.model.view.toggle_hard_shadows();
                 self.lights_changed();
-                let what = if self.model.view.shadows.hard {
-                    "hard shadows"
-                } else {
-                    "soft shadows"
-                };
-                self.flash(what);
             }
             KeyCode::KeyC => {
                 let c = &mut self.model.camera;
