@@ -81,6 +81,10 @@ pub struct CameraArgs {
     /// Vertical field of view in degrees (default: the camera's).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_fov)]
     pub fov: Option<f64>,
+    /// A view saved in the viewer (V), by name, from the views file beside the scene
+    /// (SCENE.views.json) (default: none).
+    #[arg(long, value_name = "NAME", conflicts_with_all = ["camera", "eye"])]
+    pub view: Option<String>,
 }
 
 impl CameraArgs {
@@ -487,6 +491,16 @@ impl CommonArgs {
             scene.select_variant(Some(v));
         }
         let mut camera = self.camera.choose(&scene)?;
+        if let Some(name) = &self.camera.view {
+            let Some(path) = path else {
+                bail!("--view {name}: views are saved beside a scene file; give one");
+            };
+            let fov = camera.yfov;
+            camera = crate::scene::views::find_view(path, name)?;
+            if self.camera.fov.is_some() {
+                camera.yfov = fov;
+            }
+        }
         // `--sky` alone is an explicit choice of lighting too: no automatic environment.
         let env_arg = match (&self.env.env, self.env.sky) {
             (None, Some(_)) => first_image::EnvArg::Off,
@@ -494,6 +508,7 @@ impl CommonArgs {
         };
         let camera_chosen = self.camera.camera.is_some()
             || self.camera.eye.is_some()
+            || self.camera.view.is_some()
             || scene.cameras[0].name != crate::scene::framing::AUTO_CAMERA;
         let own_lights = if scene.default_rig {
             Vec::new()

@@ -440,6 +440,54 @@ fn samples_in_one_call_or_many_make_the_same_image() {
     }
 }
 
+#[test]
+fn a_sample_rendered_in_bands_makes_the_image_of_whole_launches() {
+    // The viewer splits a slow device's sample into bands of work items (one launch each, at
+    // a global offset) so that input never waits for a whole sample: the bands must cover
+    // every pixel exactly once, each with the sample index of the whole launch.
+    use penumbra::render::{Band, KernelChoice, RenderSettings, Renderer};
+    use penumbra::scene::RenderFrame;
+    let choice = common::test_device().parse().unwrap();
+    let scene = penumbra::scene::load_or_bundled(None).unwrap();
+    let image = |kernel: KernelChoice, bands: u32| {
+        let mut r = Renderer::new(&choice).unwrap();
+        r.set_kernel(kernel).unwrap();
+        // 37 × 23: the last work-group (and lanes' tile) is partial.
+        r.set_settings(&RenderSettings {
+            width: 37,
+            height: 23,
+            bounces: 3,
+            ..Default::default()
+        })
+        .unwrap();
+        r.load_scene_in(&scene, &scene.lights, RenderFrame::default())
+            .unwrap();
+        r.set_camera(&scene.cameras[0]).unwrap();
+        for _ in 0..4 {
+            for index in 0..bands {
+                r.start_band(Band {
+                    index,
+                    count: bands,
+                })
+                .unwrap();
+                r.finish().unwrap();
+            }
+        }
+        assert_eq!(r.samples(), 4);
+        r.image().unwrap()
+    };
+    for kernel in [KernelChoice::Megakernel, KernelChoice::Wavefront] {
+        let whole = image(kernel, 1);
+        assert!(
+            whole.iter().any(|p| p[0] + p[1] + p[2] > 0.0),
+            "{kernel:?}: a black image"
+        );
+        for bands in [2, 3, 40] {
+            assert_eq!(image(kernel, bands), whole, "{kernel:?}: {bands} bands");
+        }
+    }
+}
+
 /// The megakernel's options for the lanes' tests: an image of 37 x 23 (its last work item
 /// partial) at `spp` samples and `bounces` bounces.
 fn lanes_image_args<'a>(spp: &'a str, bounces: &'a str) -> Vec<&'a str> {

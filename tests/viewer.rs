@@ -2,10 +2,16 @@
 //! keys and mouse move the camera, H toggles hard shadows, F12 and the overlay's button save
 //! screenshots, `--frames`/`--screenshot` end a run with the final frame. The saved images are
 //! checked: not blank, changed by camera moves, and sharper shadow edges with hard shadows.
+//! With `--stats-file` the viewer reports each image it shows: input is answered within the
+//! 100 ms budget (its own measurement, key event to present), images keep coming while a key
+//! is held, the automatic exposure holds while a room converges, and a view saved with V is
+//! rendered exactly by `render --view`.
 //!
 //! Each test starts its own `Xvfb :N` and kills it at the end; without Xvfb (or xdotool for
 //! the interactive test) the test prints why and passes, except under CI (`CI=true`), where it
 //! fails. The tests run one at a time (the machine may have two cores).
+
+mod common;
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -622,4 +628,242 @@ fn keys_and_mouse_drive_the_window() {
     assert!(last.exists() && last.with_extension("exr").exists());
     assert!(same_pixels(&last, &key), "the final frame differs");
     println!("total {:.1} s", t.elapsed().as_secs_f64());
+}
+
+/// A closed room 6 × 2.7 × 4 m (faces inward) with a point light below the ceiling and no
+/// camera: the first view stands inside it (an interior: collision on, exposure metered on the
+/// image).
+fn room(dir: &Path) -> PathBuf {
+    let mut g = common::Gltf::default();
+    let white = g.lambert([0.7; 3], [0.0; 3], 1.0, false);
+    let (positions, outward) = common::cuboid([-3.0, 0.0, -2.0], [3.0, 2.7, 2.0]);
+    let indices: Vec<u32> = outward.chunks(3).flat_map(|t| [t[0], t[2], t[1]]).collect();
+    let table = common::cuboid([-0.6, 0.0, -0.9], [0.6, 0.8, -0.2]);
+    let mesh = g.mesh(vec![
+        common::Prim::triangles(positions, indices, white),
+        common::Prim::triangles(table.0, table.1, white),
+    ]);
+    g.node(serde_json::json!({"mesh": mesh}));
+    g.lights
+        .push(serde_json::json!({"type": "point", "intensity": 30.0}));
+    g.node(
+        serde_json::json!({"extensions": {"KHR_lights_punctual": {"light": 0}},
+        "translation": [0.5, 2.4, 0.3]}),
+    );
+    g.write_glb(dir, "room")
+}
+
+/// The `--stats-file` lines written so far (one per image shown).
+fn stats_lines(path: &Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(path)
+        .unwrap_or_default()
+        .lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect()
+}
+
+/// Waits until the stats file holds a line that `done` accepts.
+fn wait_for_image(path: &Path, what: &str, done: impl Fn(&serde_json::Value) -> bool) {
+    let start = Instant::now();
+    while !stats_lines(path).iter().any(&done) {
+        assert!(start.elapsed() < STEP_TIMEOUT, "no image: {what}");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+#[test]
+fn input_is_answered_within_the_budget_and_moving_never_freezes_the_image() {
+    // The viewer measures each input's latency itself: from the key's X event to the present
+    // of the first image rendered after it (the `latency_ms` of --stats-file). On the 2-core
+    // CPU a full-size sample of a room takes far longer than 100 ms; the preview must still
+    // answer within the 100 ms the issue asks for.
+    let _serial = serial();
+    let Some(x) = Xvfb::start() else { return };
+    if !have("xdotool") {
+        return skip("xdotool is not installed");
+    }
+    let dir = common::output_dir("viewer_latency");
+    let room = room(&dir);
+    for scene in [None, Some(room)] {
+        let stats = dir.join("stats.jsonl");
+        let _ = std::fs::remove_file(&stats);
+        let mut args = vec!["view".to_string()];
+        args.extend(scene.iter().map(|p| p.display().to_string()));
+        args.extend(["--stats-file".into(), stats.display().to_string()]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let _viewer = Viewer::spawn(viewer_command(&x, &dir, &args));
+        wait_for_image(&stats, "the first image", |_| true);
+        let wid = x.find_window();
+        x.xdotool(&["windowfocus", "--sync", &wid]);
+        // At rest the preview climbs back to full quality, in bands of a sample.
+        wait_for_image(&stats, "full resolution", |l| l["divisor"] == 1);
+        for _ in 0..4 {
+            x.xdotool(&["keydown", "d"]);
+            std::thread::sleep(Duration::from_millis(150));
+            x.xdotool(&["keyup", "d"]);
+            std::thread::sleep(Duration::from_millis(1500));
+        }
+        // Held for two seconds: images keep coming.
+        let held_from = stats_lines(&stats).len();
+        x.xdotool(&["keydown", "a"]);
+        std::thread::sleep(Duration::from_secs(2));
+        x.xdotool(&["keyup", "a"]);
+        std::thread::sleep(Duration::from_millis(300));
+        let lines = stats_lines(&stats);
+        let latencies: Vec<f64> = lines
+            .iter()
+            .filter_map(|l| l["latency_ms"].as_f64())
+            .collect();
+        assert!(
+            latencies.len() >= 4,
+            "{scene:?}: the key presses were not answered: {latencies:?}"
+        );
+        let mut sorted = latencies.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted[sorted.len() / 2];
+        assert!(
+            median <= 100.0,
+            "{scene:?}: input answered in {latencies:?} ms (median {median:.0})"
+        );
+        let times: Vec<f64> = lines[held_from..]
+            .iter()
+            .map(|l| l["t"].as_f64().unwrap())
+            .collect();
+        assert!(
+            times.len() >= 10,
+            "{scene:?}: {} images in 2 s of moving",
+            times.len()
+        );
+        let gap = times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+        assert!(
+            gap < 0.5,
+            "{scene:?}: the image froze for {gap:.2} s while moving"
+        );
+    }
+}
+
+#[test]
+fn exposure_holds_while_the_image_converges() {
+    // A room's automatic exposure is decided from its first full image and held: the drift of
+    // the issue (−0.7 → −2.3 stops over a minute in an apartment) would show here as the
+    // samples grow sixteenfold.
+    let _serial = serial();
+    let Some(x) = Xvfb::start() else { return };
+    let dir = common::output_dir("viewer_exposure");
+    let room = room(&dir);
+    let stats = dir.join("stats.jsonl");
+    let _viewer = Viewer::spawn(viewer_command(
+        &x,
+        &dir,
+        &[
+            "view",
+            room.to_str().unwrap(),
+            "--width",
+            "400",
+            "--height",
+            "300",
+            "--no-overlay",
+            "--stats-file",
+            stats.to_str().unwrap(),
+        ],
+    ));
+    wait_for_image(&stats, "16 spp at full resolution", |l| {
+        l["divisor"] == 1 && l["spp"].as_u64().unwrap_or(0) >= 16
+    });
+    let full: Vec<_> = stats_lines(&stats)
+        .into_iter()
+        .filter(|l| l["divisor"] == 1)
+        .collect();
+    assert!(full.len() >= 3, "{full:?}");
+    let exposures: Vec<f64> = full
+        .iter()
+        .map(|l| l["exposure"].as_f64().unwrap())
+        .collect();
+    assert!(
+        exposures.iter().all(|&e| e == exposures[0]),
+        "the exposure moved while converging: {exposures:?}"
+    );
+}
+
+#[test]
+fn a_saved_view_is_restored_exactly_by_render_view() {
+    // V saves the camera beside the scene (room.glb.views.json, nothing else written);
+    // `render --view` renders the same pixels as the viewer showed from it.
+    let _serial = serial();
+    let Some(x) = Xvfb::start() else { return };
+    if !have("xdotool") {
+        return skip("xdotool is not installed");
+    }
+    let dir = common::output_dir("viewer_saved_view");
+    let room = room(&dir);
+    // V names the view "view 1" only in a scene without saved views.
+    let _ = std::fs::remove_file(dir.join("room.glb.views.json"));
+    let shown = dir.join("shown.png");
+    let same = [
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--spp",
+        "4",
+        "--exposure",
+        "0",
+    ];
+    let mut args = vec!["view", room.to_str().unwrap(), "--no-overlay"];
+    args.extend(same);
+    args.extend(["--screenshot", shown.to_str().unwrap()]);
+    let mut viewer = Viewer::spawn(viewer_command(&x, &dir, &args));
+    viewer.wait_for("reached 4 spp");
+    let wid = x.find_window();
+    x.xdotool(&["windowfocus", "--sync", &wid]);
+    // Turn and step aside, then save.
+    x.xdotool(&["mousemove", "--window", &wid, "80", "60"]);
+    x.xdotool(&["mousedown", "3"]);
+    x.xdotool(&["mousemove", "--window", &wid, "110", "70"]);
+    x.xdotool(&["mouseup", "3"]);
+    x.xdotool(&["keydown", "a"]);
+    std::thread::sleep(Duration::from_millis(300));
+    x.xdotool(&["keyup", "a"]);
+    viewer.wait_for("reached 4 spp");
+    x.xdotool(&["key", "v"]);
+    let line = viewer.wait_for("saved view");
+    assert!(line.contains("room.glb.views.json"), "{line}");
+    x.xdotool(&["key", "ctrl+q"]);
+    viewer.wait_for("saved");
+    assert!(viewer.wait_exit().success());
+    let rendered = dir.join("rendered.png");
+    let mut render = Command::new(binary());
+    render
+        .args([
+            "render",
+            room.to_str().unwrap(),
+            "-o",
+            rendered.to_str().unwrap(),
+        ])
+        .args(["--view", "view 1", "--device", &test_device()])
+        .args(same);
+    let out = run_to_exit(&mut render);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        same_pixels(&shown, &rendered),
+        "render --view differs from the viewer"
+    );
+    // A wrong name is one line naming the file and the views it has.
+    let out = run_to_exit(
+        Command::new(binary())
+            .args([
+                "render",
+                room.to_str().unwrap(),
+                "-o",
+                rendered.to_str().unwrap(),
+            ])
+            .args(["--view", "nope"]),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("view 1") && err.lines().count() == 1, "{err}");
 }

@@ -1,37 +1,88 @@
-//! The frame time budget: how much work (resolution and samples per pixel) one batch of kernel
-//! work gets so that the image keeps updating at an interactive rate on any device.
+//! The frame time budget: how much work one batch of kernel work gets so that input is answered
+//! within a frame's budget on any device, and how the preview climbs back to full quality.
 //!
-//! The cost of one sample per pixel is measured per resolution divisor (1, 2, 4, 8) in
-//! milliseconds per pixel, smoothed over batches. While the camera moves, the largest resolution
-//! whose single sample fits the budget is used; when it stops, the full resolution with as many
-//! samples as fit (at least one: a device too slow for one full-resolution sample within the
-//! budget still makes progress, the frame loop just polls longer).
+//! **Quality levels.** [`levels`] lists what a batch may render, from full quality down: the
+//! film at the full resolution or divided by 2, 4, 8 or 16 per side, with the full bounces or
+//! (from ¼ resolution down) one bounce. While the view moves, the first level whose one sample
+//! fits the budget is rendered; when it rests, each new image climbs one level, up to full
+//! quality, where as many samples as fit go into a batch.
+//!
+//! **The cost model.** Milliseconds per pixel-sample-depth (depth = bounces + 2, the most
+//! extension rays a path traces), per divisor (a small film pays a larger share of fixed
+//! costs), learned from every finished sample's wall time and smoothed; it starts empty for
+//! each device and scene. A divisor not measured yet borrows the nearest measured one.
+//!
+//! **Bands.** A sample whose estimate exceeds the budget is split into bands (one launch each,
+//! [`crate::render::Band`]) of about the budget, so that new input waits for one band at most.
 
-/// Resolution divisors the viewer may render at while moving (1 = full resolution).
-pub const DIVISORS: [u32; 4] = [1, 2, 4, 8];
+/// Resolution divisors (1 = full resolution).
+pub const DIVISORS: [u32; 5] = [1, 2, 4, 8, 16];
 
 /// Most samples per pixel one batch may hold, so a fast device still shows progress.
 pub const MAX_BATCH_SPP: u32 = 256;
 
+/// Most bands one sample is split into.
+pub const MAX_BANDS: u32 = 256;
+
 /// Weight of the newest measurement in the running estimate.
 const SMOOTHING: f64 = 0.5;
+
+/// The divisor from which the preview also drops to one bounce (a quarter of the resolution:
+/// below it the image loses its shapes, above it its light).
+const FEW_BOUNCES_FROM: u32 = 4;
+
+/// What a batch renders: a film size and the bounces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Level {
+    /// Resolution divisor (the film is the image area divided by it, rounded up).
+    pub divisor: u32,
+    /// Bounces after the first hit.
+    pub bounces: u32,
+}
+
+/// The quality levels for `bounces` full bounces, best first (see the module docs).
+pub fn levels(bounces: u32) -> Vec<Level> {
+    let mut out: Vec<Level> = Vec::new();
+    for divisor in DIVISORS {
+        if divisor < FEW_BOUNCES_FROM {
+            out.push(Level { divisor, bounces });
+        } else {
+            if divisor == FEW_BOUNCES_FROM {
+                out.push(Level { divisor, bounces });
+            }
+            out.push(Level {
+                divisor,
+                bounces: bounces.min(1),
+            });
+        }
+    }
+    out.dedup();
+    out
+}
 
 /// What the next batch renders.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Plan {
-    /// Resolution divisor (the film is the window size divided by it, rounded up).
-    pub divisor: u32,
+    /// The level.
+    pub level: Level,
     /// Samples per pixel of the batch (at least 1).
     pub spp: u32,
+    /// Bands the batch's one sample is split into (1: one launch; more only with `spp` 1).
+    pub bands: u32,
 }
 
 /// Measured costs and the budget they are held to.
 #[derive(Clone, Debug)]
 pub struct Budget {
-    /// Target duration of one batch in milliseconds.
+    /// Target duration of one batch (and the longest launch) in milliseconds.
     pub target_ms: f64,
-    /// Smoothed milliseconds per pixel-sample at each divisor of [`DIVISORS`].
-    ms_per_pixel_sample: [Option<f64>; DIVISORS.len()],
+    /// Smoothed milliseconds per pixel-sample-depth at each divisor of [`DIVISORS`].
+    cost: [Option<f64>; DIVISORS.len()],
+}
+
+/// The work of `spp` samples over `pixels` pixels at `bounces` bounces, in pixel-sample-depths.
+fn work(pixels: u64, spp: u32, bounces: u32) -> f64 {
+    pixels as f64 * spp.max(1) as f64 * (bounces as f64 + 2.0)
 }
 
 impl Budget {
@@ -39,68 +90,117 @@ impl Budget {
     pub fn new(target_ms: f64) -> Self {
         Self {
             target_ms,
-            ms_per_pixel_sample: [None; DIVISORS.len()],
+            cost: [None; DIVISORS.len()],
         }
     }
 
-    /// Records that `spp` samples over `pixels` pixels at `divisor` took `ms`.
-    pub fn record(&mut self, divisor: u32, pixels: u64, spp: u32, ms: f64) {
-        let Some(i) = DIVISORS.iter().position(|&d| d == divisor) else {
+    /// Whether nothing was measured yet (a new device or scene).
+    pub fn is_empty(&self) -> bool {
+        self.cost.iter().all(Option::is_none)
+    }
+
+    /// Records that `spp` samples over `pixels` pixels at `level` took `ms`.
+    pub fn record(&mut self, level: Level, pixels: u64, spp: u32, ms: f64) {
+        let Some(i) = DIVISORS.iter().position(|&d| d == level.divisor) else {
             return;
         };
-        let work = pixels as f64 * spp.max(1) as f64;
-        if work <= 0.0 || !ms.is_finite() || ms < 0.0 {
+        let w = work(pixels, spp, level.bounces);
+        if w <= 0.0 || !ms.is_finite() || ms < 0.0 {
             return;
         }
-        let cost = ms / work;
-        let slot = &mut self.ms_per_pixel_sample[i];
+        let cost = ms / w;
+        let slot = &mut self.cost[i];
         *slot = Some(match *slot {
             Some(old) => old + SMOOTHING * (cost - old),
             None => cost,
         });
     }
 
-    /// Estimated milliseconds of one sample per pixel over `pixels` pixels at `divisor`: the
+    /// Estimated milliseconds of one sample per pixel at `level` on a `full` sized image: the
     /// divisor's own measurement, else the nearest measured larger resolution (an optimistic
     /// guess, so smaller divisors get tried), else the nearest smaller one. `None` before any
     /// measurement.
-    pub fn estimate_ms(&self, divisor: u32, pixels: u64) -> Option<f64> {
-        let i = DIVISORS.iter().position(|&d| d == divisor)?;
-        let cost = self.ms_per_pixel_sample[i]
-            .or_else(|| self.ms_per_pixel_sample[..i].iter().rev().find_map(|c| *c))
-            .or_else(|| self.ms_per_pixel_sample[i + 1..].iter().find_map(|c| *c))?;
-        Some(cost * pixels as f64)
+    pub fn estimate_ms(&self, level: Level, full: (u32, u32)) -> Option<f64> {
+        let i = DIVISORS.iter().position(|&d| d == level.divisor)?;
+        let cost = self.cost[i]
+            .or_else(|| self.cost[..i].iter().rev().find_map(|c| *c))
+            .or_else(|| self.cost[i + 1..].iter().find_map(|c| *c))?;
+        let pixels = pixel_count(scaled(full, level.divisor));
+        Some(cost * work(pixels, 1, level.bounces))
     }
 
-    /// The plan for the next batch on a `full` sized window; `remaining` caps the samples when
-    /// a samples-per-pixel target is set.
-    pub fn plan(&self, full: (u32, u32), moving: bool, remaining: Option<u32>) -> Plan {
-        let candidates: &[u32] = if moving { &DIVISORS } else { &DIVISORS[..1] };
-        // The largest resolution whose one sample fits; the smallest one when none does.
-        let divisor = candidates
-            .iter()
-            .copied()
-            .find(|&d| {
-                self.estimate_ms(d, pixel_count(scaled(full, d)))
-                    .is_none_or(|ms| ms <= self.target_ms)
-            })
-            .unwrap_or(*candidates.last().unwrap_or(&1));
-        let spp = match self.estimate_ms(divisor, pixel_count(scaled(full, divisor))) {
-            Some(ms) if ms > 0.0 => (self.target_ms / ms)
-                .floor()
-                .clamp(1.0, MAX_BATCH_SPP as f64),
-            Some(_) => MAX_BATCH_SPP as f64,
-            None => 1.0,
-        } as u32;
-        let spp = match remaining {
-            Some(r) => spp.min(r).max(1),
-            None => spp,
+    /// The level (an index into `levels`) for the next batch on a `full` sized image.
+    /// `current` is the level of the film on screen and whether it has an image yet.
+    /// Moving: the best level whose one sample fits (the last when none does). Resting: one
+    /// level better than the current one once it has an image. Before any measurement: the
+    /// ¼-resolution level, so the first image of a scene comes quickly and measures the device.
+    pub fn level(
+        &self,
+        levels: &[Level],
+        full: (u32, u32),
+        moving: bool,
+        current: Option<(usize, bool)>,
+    ) -> usize {
+        let last = levels.len().saturating_sub(1);
+        if self.is_empty() {
+            return match current {
+                Some((i, true)) => i.saturating_sub(1).min(last),
+                Some((i, false)) => i.min(last),
+                None => levels
+                    .iter()
+                    .position(|l| l.divisor == FEW_BOUNCES_FROM)
+                    .unwrap_or(0),
+            };
+        }
+        if moving {
+            return levels
+                .iter()
+                .position(|&l| {
+                    self.estimate_ms(l, full)
+                        .is_none_or(|ms| ms <= self.target_ms)
+                })
+                .unwrap_or(last);
+        }
+        match current {
+            Some((i, true)) => i.saturating_sub(1).min(last),
+            Some((i, false)) => i.min(last),
+            None => 0,
+        }
+    }
+
+    /// Samples and bands for a batch at `level`; `remaining` caps the samples when a
+    /// samples-per-pixel target is set; `bands` whether the kernels can split a sample.
+    pub fn batch(
+        &self,
+        level: Level,
+        full: (u32, u32),
+        remaining: Option<u32>,
+        bands: bool,
+    ) -> Plan {
+        let (spp, count) = match self.estimate_ms(level, full) {
+            Some(ms) if ms > self.target_ms => {
+                let count = (ms / self.target_ms).ceil().min(MAX_BANDS as f64) as u32;
+                (1, if bands { count.max(1) } else { 1 })
+            }
+            Some(ms) if ms > 0.0 => (
+                (self.target_ms / ms)
+                    .floor()
+                    .clamp(1.0, MAX_BATCH_SPP as f64) as u32,
+                1,
+            ),
+            Some(_) => (MAX_BATCH_SPP, 1),
+            None => (1, 1),
         };
-        Plan { divisor, spp }
+        let spp = remaining.map_or(spp, |r| spp.min(r).max(1));
+        Plan {
+            level,
+            spp,
+            bands: count,
+        }
     }
 }
 
-/// The film size for a window size and a divisor (rounded up, at least 1×1).
+/// The film size for an image size and a divisor (rounded up, at least 1×1).
 pub fn scaled(full: (u32, u32), divisor: u32) -> (u32, u32) {
     let d = divisor.max(1);
     (full.0.div_ceil(d).max(1), full.1.div_ceil(d).max(1))
@@ -117,74 +217,123 @@ mod tests {
 
     const FULL: (u32, u32) = (640, 480);
 
+    fn full(bounces: u32) -> Level {
+        Level {
+            divisor: 1,
+            bounces,
+        }
+    }
+
     #[test]
-    fn the_first_batch_is_one_full_sample() {
+    fn levels_go_down_in_resolution_then_bounces() {
+        let l = levels(4);
+        let pairs: Vec<_> = l.iter().map(|l| (l.divisor, l.bounces)).collect();
+        assert_eq!(pairs, [(1, 4), (2, 4), (4, 4), (4, 1), (8, 1), (16, 1)]);
+        // Nothing to drop at one bounce or none.
+        assert_eq!(levels(0).len(), 5);
+        assert_eq!(levels(1).len(), 5);
+    }
+
+    #[test]
+    fn the_first_batch_of_a_scene_is_a_quick_quarter_resolution_image() {
         let b = Budget::new(30.0);
-        assert_eq!(b.plan(FULL, false, None), Plan { divisor: 1, spp: 1 });
-        assert_eq!(b.plan(FULL, true, None).spp, 1);
+        let l = levels(4);
+        let i = b.level(&l, FULL, false, None);
+        assert_eq!(
+            l[i],
+            Level {
+                divisor: 4,
+                bounces: 4
+            }
+        );
+        // Then it climbs, one level per image, measured or not.
+        assert_eq!(b.level(&l, FULL, false, Some((i, false))), i);
+        assert_eq!(b.level(&l, FULL, false, Some((i, true))), i - 1);
+        assert_eq!(
+            b.batch(l[i], FULL, None, true),
+            Plan {
+                level: l[i],
+                spp: 1,
+                bands: 1
+            }
+        );
     }
 
     #[test]
     fn samples_per_batch_follow_the_measured_time() {
         let mut b = Budget::new(30.0);
         // 4 spp took 20 ms: 5 ms per sample, so 6 fit the 30 ms budget.
-        b.record(1, pixel_count(FULL), 4, 20.0);
-        assert_eq!(b.plan(FULL, false, None).spp, 6);
-        // The device slows down (more bounces): the estimate follows, smoothed.
-        b.record(1, pixel_count(FULL), 1, 25.0);
-        assert_eq!(b.plan(FULL, false, None).spp, 2);
-        for _ in 0..10 {
-            b.record(1, pixel_count(FULL), 1, 25.0);
-        }
-        assert_eq!(b.plan(FULL, false, None).spp, 1);
+        b.record(full(4), pixel_count(FULL), 4, 20.0);
+        assert_eq!(b.batch(full(4), FULL, None, true).spp, 6);
+        // Fewer bounces cost less: 2 bounces are 4/6 of the depth of 4.
+        assert_eq!(b.batch(full(2), FULL, None, true).spp, 9);
+        // The device slows down: the estimate follows, smoothed.
+        b.record(full(4), pixel_count(FULL), 1, 25.0);
+        assert_eq!(b.batch(full(4), FULL, None, true).spp, 2);
     }
 
     #[test]
-    fn a_slow_device_still_renders_one_sample_at_full_resolution() {
+    fn a_sample_longer_than_the_budget_is_split_into_bands() {
         let mut b = Budget::new(30.0);
-        b.record(1, pixel_count(FULL), 1, 500.0);
-        assert_eq!(b.plan(FULL, false, None), Plan { divisor: 1, spp: 1 });
+        b.record(full(4), pixel_count(FULL), 1, 500.0);
+        let p = b.batch(full(4), FULL, None, true);
+        assert_eq!((p.spp, p.bands), (1, 17));
+        // Kernels that cannot split (the wavefront) get one band.
+        assert_eq!(b.batch(full(4), FULL, None, false).bands, 1);
     }
 
     #[test]
-    fn moving_on_a_slow_device_lowers_the_resolution() {
+    fn moving_on_a_slow_device_lowers_the_resolution_then_the_bounces() {
         let mut b = Budget::new(30.0);
-        b.record(1, pixel_count(FULL), 1, 400.0);
-        // 1/16 of the pixels costs 25 ms: divisor 4 is the largest that fits.
-        let p = b.plan(FULL, true, None);
-        assert_eq!(p, Plan { divisor: 4, spp: 1 });
-        // Slower than even 1/8 of the resolution allows: the smallest one, one sample.
-        b.record(1, pixel_count(FULL), 1, 10_000.0);
-        b.record(1, pixel_count(FULL), 1, 10_000.0);
-        b.record(1, pixel_count(FULL), 1, 10_000.0);
-        b.record(4, pixel_count(scaled(FULL, 4)), 1, 600.0);
-        b.record(8, pixel_count(scaled(FULL, 8)), 1, 150.0);
-        assert_eq!(b.plan(FULL, true, None), Plan { divisor: 8, spp: 1 });
-        // Standing still goes back to the full resolution.
-        assert_eq!(b.plan(FULL, false, None).divisor, 1);
-    }
-
-    #[test]
-    fn a_fast_device_moves_at_full_resolution() {
-        let mut b = Budget::new(30.0);
-        b.record(1, pixel_count(FULL), 8, 16.0);
+        let l = levels(4);
+        b.record(full(4), pixel_count(FULL), 1, 400.0);
+        // 1/16 of the pixels costs 25 ms: ¼ resolution with every bounce fits.
+        let i = b.level(&l, FULL, true, Some((0, true)));
         assert_eq!(
-            b.plan(FULL, true, None),
-            Plan {
-                divisor: 1,
-                spp: 15
+            l[i],
+            Level {
+                divisor: 4,
+                bounces: 4
             }
         );
+        // Twice as slow (smoothed): ¼ resolution fits only with one bounce (half the depth).
+        b.record(full(4), pixel_count(FULL), 1, 1200.0);
+        let i = b.level(&l, FULL, true, Some((0, true)));
+        assert_eq!(
+            l[i],
+            Level {
+                divisor: 4,
+                bounces: 1
+            }
+        );
+        // Slower than even 1/16 allows: the last level.
+        b.record(l[5], pixel_count(scaled(FULL, 16)), 1, 100.0);
+        b.record(l[4], pixel_count(scaled(FULL, 8)), 1, 400.0);
+        b.record(l[3], pixel_count(scaled(FULL, 4)), 1, 1600.0);
+        assert_eq!(b.level(&l, FULL, true, Some((0, true))), 5);
+        // At rest it climbs back one level per image, to full quality.
+        assert_eq!(b.level(&l, FULL, false, Some((5, true))), 4);
+        assert_eq!(b.level(&l, FULL, false, Some((1, true))), 0);
+        assert_eq!(b.level(&l, FULL, false, Some((0, true))), 0);
+    }
+
+    #[test]
+    fn a_fast_device_moves_at_full_quality() {
+        let mut b = Budget::new(30.0);
+        b.record(full(4), pixel_count(FULL), 8, 16.0);
+        let l = levels(4);
+        assert_eq!(b.level(&l, FULL, true, Some((3, true))), 0);
+        assert_eq!(b.batch(l[0], FULL, None, true).spp, 15);
     }
 
     #[test]
     fn the_target_caps_the_batch() {
         let mut b = Budget::new(30.0);
-        b.record(1, pixel_count(FULL), 1, 1.0);
-        assert_eq!(b.plan(FULL, false, Some(3)).spp, 3);
-        assert_eq!(b.plan(FULL, false, None).spp, 30);
-        b.record(1, pixel_count(FULL), 1, 0.0);
-        assert!(b.plan(FULL, false, None).spp <= MAX_BATCH_SPP);
+        b.record(full(4), pixel_count(FULL), 1, 1.0);
+        assert_eq!(b.batch(full(4), FULL, Some(3), true).spp, 3);
+        assert_eq!(b.batch(full(4), FULL, None, true).spp, 30);
+        b.record(full(4), pixel_count(FULL), 1, 0.0);
+        assert!(b.batch(full(4), FULL, None, true).spp <= MAX_BATCH_SPP);
     }
 
     #[test]

@@ -3,16 +3,20 @@
 //! overlay, the previous image) and polls; when the batch is done its image is read, the next
 //! batch is started at once (so kernel work overlaps the display of this image), and then the
 //! image is shown. Changes (camera, lights, scene, settings, window size) are collected and
-//! applied together between batches; every one of them resets the accumulation.
+//! applied together between batches; every one of them resets the accumulation. A sample too
+//! long for the budget goes in bands, one per batch (budget.rs); a change abandons the rest of
+//! the sample, so input waits for one band at most.
 
-use super::budget::{Budget, Plan, pixel_count, scaled};
+use super::budget::{Budget, Level, Plan, levels, pixel_count, scaled};
 use crate::cl::ClError;
-use crate::render::{RenderSettings, RenderStats, Renderer, SceneStats};
+use crate::render::{Band, KernelChoice, RenderSettings, RenderStats, Renderer, SceneStats};
 use crate::scene::{Camera, Light, RenderFrame, Scene};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
-/// The budget of one batch of kernel work in milliseconds.
-pub const FRAME_BUDGET_MS: f64 = 30.0;
+/// The budget of one batch of kernel work (and of the longest launch) in milliseconds: with the
+/// band in flight when input comes, the preview batch after it and the display, the next image
+/// is on screen within about 100 ms.
+pub const FRAME_BUDGET_MS: f64 = 25.0;
 
 /// What changed since the last batch.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -84,6 +88,16 @@ pub struct Film {
     pub spp: u32,
     /// Resolution divisor it was rendered at.
     pub divisor: u32,
+    /// Bounces it was rendered with.
+    pub bounces: u32,
+    /// Whether it is at full quality (full resolution and bounces).
+    pub full_quality: bool,
+    /// When the earliest change it is the first image of arrived (an input event); taken by
+    /// the window when it shows the image, to measure the input's latency.
+    pub answers: Option<Instant>,
+    /// Counts the views: changes of the camera, scene, lights or settings (not of the level
+    /// while the preview climbs back), so exposure can be decided once per view.
+    pub view: u64,
 }
 
 /// Figures for the overlay, as of the latest finished batch.
@@ -103,13 +117,29 @@ pub struct Progress {
     pub plan: Option<Plan>,
     /// The last batch's wall time in milliseconds.
     pub batch_ms: f64,
+    /// The last batch's band (from 0) when its sample went in bands.
+    pub band: u32,
     /// With adaptive sampling, the share of pixels the last convergence check stopped.
     pub converged_share: Option<f64>,
 }
 
+/// A sample (or a batch of samples) in progress, in one band or several.
+#[derive(Clone, Copy, Debug)]
+struct Sample {
+    plan: Plan,
+    /// The band the next batch renders.
+    next_band: u32,
+    /// Wall time of its bands so far.
+    ms: f64,
+    /// When the changes it shows first arrived.
+    answers: Option<Instant>,
+    /// The view it shows ([`Film::view`]).
+    view: u64,
+}
+
 struct Batch {
     started: Instant,
-    plan: Plan,
+    sample: Sample,
 }
 
 /// The renderer with its batches in flight and changes waiting.
@@ -118,9 +148,17 @@ pub struct FrameLoop {
     pub renderer: Renderer,
     budget: Budget,
     batch: Option<Batch>,
+    /// A sample whose next band waits to be started.
+    sample: Option<Sample>,
     pending: Changes,
-    /// Film size and divisor as applied to the renderer.
-    applied: Option<((u32, u32), u32)>,
+    /// When the earliest of the `pending` changes arrived.
+    pending_since: Option<Instant>,
+    /// Film size and level as applied to the renderer.
+    applied: Option<((u32, u32), Level)>,
+    /// The film's level (an index into `levels`) and whether it has an image yet.
+    level: Option<(usize, bool)>,
+    /// The current view ([`Film::view`]).
+    view: u64,
     /// Whether a scene was loaded into the renderer yet.
     loaded: bool,
     /// The latest image.
@@ -143,8 +181,12 @@ impl FrameLoop {
             renderer,
             budget: Budget::new(FRAME_BUDGET_MS),
             batch: None,
+            sample: None,
             pending: Changes::ALL,
+            pending_since: None,
             applied: None,
+            level: None,
+            view: 0,
             loaded: false,
             film: Film::default(),
             progress: Progress::default(),
@@ -160,7 +202,31 @@ impl FrameLoop {
 
     /// Records changes to apply before the next batch.
     pub fn invalidate(&mut self, changes: Changes) {
+        self.invalidate_at(changes, None);
+    }
+
+    /// Records changes to apply before the next batch, caused by an input event that arrived
+    /// `at` (`None`: not by one, e.g. a held key moving the camera on), whose latency the
+    /// first image after it measures.
+    pub fn invalidate_at(&mut self, changes: Changes, at: Option<Instant>) {
+        if changes.any()
+            && let Some(at) = at
+        {
+            self.pending_since = Some(self.pending_since.map_or(at, |t| t.min(at)));
+        }
         self.pending.merge(changes);
+    }
+
+    /// When the running batch should be done, by the budget's estimate; `None` when none runs.
+    pub fn expected_done(&self) -> Option<Instant> {
+        let batch = self.batch.as_ref()?;
+        let plan = batch.sample.plan;
+        let full = self.renderer.settings();
+        let ms = self
+            .budget
+            .estimate_ms(plan.level, (full.width, full.height))
+            .map_or(0.0, |ms| ms * plan.spp as f64 / plan.bands as f64);
+        Some(batch.started + Duration::from_secs_f64(ms.min(1e4) * 1e-3))
     }
 
     /// Whether a batch is running on the device.
@@ -172,37 +238,87 @@ impl FrameLoop {
     /// samples-per-pixel target reached at full resolution.
     pub fn converged(&self, spp_target: Option<u32>) -> bool {
         self.batch.is_none()
+            && self.sample.is_none()
             && !self.renderer.sah_pending()
             && !self.pending.any()
-            && self.applied.is_some_and(|(_, d)| d == 1)
+            && self.level.is_some_and(|(i, _)| i == 0)
             && spp_target.is_some_and(|t| self.renderer.samples() >= t)
     }
 
     /// One step, without waiting: collects a finished batch (returns true when a new image is
-    /// in [`FrameLoop::film`]), applies waiting changes and starts the next batch.
+    /// in [`FrameLoop::film`]), applies waiting changes and starts the next batch (the next
+    /// band of a sample in progress, unless a change abandons it).
     pub fn step(&mut self, world: &World) -> Result<bool, ClError> {
         if self.batch.is_some() && !self.renderer.is_finished()? {
             return Ok(false);
         }
         let new_image = self.collect()?;
-        self.apply(world)?;
+        if self.pending.any()
+            && let Some(s) = self.sample.take()
+            && let Some(t) = s.answers
+        {
+            // The abandoned sample's input is answered by the next image.
+            self.pending_since = Some(self.pending_since.map_or(t, |p| p.min(t)));
+        }
+        let sample = match self.sample.take() {
+            Some(s) => s,
+            None => match self.next_sample(world)? {
+                Some(s) => s,
+                None => return Ok(new_image),
+            },
+        };
+        let plan = sample.plan;
+        if plan.bands > 1 {
+            self.renderer.start_band(Band {
+                index: sample.next_band,
+                count: plan.bands,
+            })?;
+        } else {
+            self.renderer.start(plan.spp)?;
+        }
+        self.batch = Some(Batch {
+            started: Instant::now(),
+            sample,
+        });
+        Ok(new_image)
+    }
+
+    /// Chooses the level of the next sample, applies it with the waiting changes and plans the
+    /// batch; `None` when the samples-per-pixel target is reached.
+    fn next_sample(&mut self, world: &World) -> Result<Option<Sample>, ClError> {
+        let full = (world.settings.width, world.settings.height);
+        let levels = levels(world.settings.bounces);
+        let changed = self.pending.any();
+        let current = self.level.map(|(i, shown)| (i, shown && !changed));
+        let i = self
+            .budget
+            .level(&levels, full, world.moving, current)
+            .min(levels.len() - 1);
+        let level = levels[i];
+        let answers = if changed {
+            self.view += 1;
+            self.pending_since.take()
+        } else {
+            None
+        };
+        let reset = self.apply(world, level)?;
+        if reset || self.level.is_none_or(|(j, _)| j != i) {
+            self.level = Some((i, false));
+        }
         let remaining = world
             .spp_target
             .map(|t| t.saturating_sub(self.renderer.samples()));
         if remaining == Some(0) {
-            return Ok(new_image);
+            return Ok(None);
         }
-        let full = (world.settings.width, world.settings.height);
-        let mut plan = self.budget.plan(full, world.moving, remaining);
-        if let Some((_, divisor)) = self.applied {
-            plan.divisor = divisor;
-        }
-        self.renderer.start(plan.spp)?;
-        self.batch = Some(Batch {
-            started: Instant::now(),
-            plan,
-        });
-        Ok(new_image)
+        let bands = self.renderer.kernel() == KernelChoice::Megakernel;
+        Ok(Some(Sample {
+            plan: self.budget.batch(level, full, remaining, bands),
+            next_band: 0,
+            ms: 0.0,
+            answers,
+            view: self.view,
+        }))
     }
 
     /// Waits for the running batch and reads its image (on exit). Returns whether the image
@@ -218,10 +334,24 @@ impl FrameLoop {
         };
         self.renderer.finish()?;
         let ms = batch.started.elapsed().as_secs_f64() * 1e3;
+        let mut sample = batch.sample;
+        sample.ms += ms;
+        sample.next_band += 1;
+        self.progress.batch_ms = ms;
+        self.progress.band = batch.sample.next_band;
+        self.progress.plan = Some(sample.plan);
+        if sample.next_band < sample.plan.bands {
+            self.sample = Some(sample);
+            return Ok(false);
+        }
+        let plan = sample.plan;
         let settings = self.renderer.settings().clone();
         let size = (settings.width, settings.height);
         self.budget
-            .record(batch.plan.divisor, pixel_count(size), batch.plan.spp, ms);
+            .record(plan.level, pixel_count(size), plan.spp, sample.ms);
+        if let Some(level) = self.level.as_mut() {
+            level.1 = true;
+        }
         let spp = self.renderer.samples();
         // The last film's arrays take the new one in their allocations: a frame allocates no
         // film-sized memory.
@@ -238,14 +368,17 @@ impl FrameLoop {
             coverage,
             cutout: settings.cutout,
             spp,
-            divisor: batch.plan.divisor,
+            divisor: plan.level.divisor,
+            bounces: plan.level.bounces,
+            full_quality: self.level.is_some_and(|(i, _)| i == 0),
+            // An image collected over one never shown answers its input when it is shown.
+            answers: sample.answers.or(self.film.answers),
+            view: sample.view,
         };
         let p = &mut self.progress;
-        p.seconds += ms * 1e-3;
+        p.seconds += sample.ms * 1e-3;
         p.spp = spp;
         p.stats = self.renderer.stats().clone();
-        p.plan = Some(batch.plan);
-        p.batch_ms = ms;
         p.converged_share = self
             .renderer
             .active_pixels()
@@ -257,13 +390,14 @@ impl FrameLoop {
         Ok(true)
     }
 
-    /// Applies waiting changes and the resolution the budget wants; resets the film when
-    /// anything changed.
-    fn apply(&mut self, world: &World) -> Result<(), ClError> {
+    /// Applies waiting changes and `level`; returns whether the film was reset (anything
+    /// changed).
+    fn apply(&mut self, world: &World, level: Level) -> Result<bool, ClError> {
         let full = (world.settings.width, world.settings.height);
-        let divisor = self.budget.plan(full, world.moving, None).divisor;
+        let divisor = level.divisor;
         let size = scaled(full, divisor);
         let mut pending = std::mem::take(&mut self.pending);
+        let mut reset = false;
         // The SAH BLASes behind a quick first image are done: the scene goes to the device
         // again with them and the image restarts (unless the scene is reloaded anyway).
         if self.loaded
@@ -278,6 +412,7 @@ impl FrameLoop {
             self.scene_stats = Some(stats);
             // The upload reset the film and applied the camera and lights.
             self.progress = Progress::default();
+            reset = true;
         }
         if pending.any() {
             log::debug!(
@@ -286,14 +421,15 @@ impl FrameLoop {
                 size.1
             );
         }
-        if pending.settings || self.applied != Some((size, divisor)) {
+        if pending.settings || self.applied != Some((size, level)) {
             let settings = RenderSettings {
                 width: size.0,
                 height: size.1,
+                bounces: level.bounces,
                 ..world.settings.clone()
             };
             self.renderer.set_settings(&settings)?;
-            self.applied = Some((size, divisor));
+            self.applied = Some((size, level));
             // The camera's aspect follows the film.
             pending.camera = true;
         }
@@ -341,6 +477,8 @@ impl FrameLoop {
             );
             self.scene_stats = Some(stats);
             self.loaded = true;
+            // The cost model is per device and scene.
+            self.budget = Budget::new(self.budget.target_ms);
         } else if pending.lights {
             self.renderer.set_lights(world.lights)?;
         }
@@ -349,7 +487,8 @@ impl FrameLoop {
         }
         if pending.any() {
             self.progress = Progress::default();
+            reset = true;
         }
-        Ok(())
+        Ok(reset)
     }
 }

@@ -3,16 +3,18 @@
 //! [`Model`] and reports what changed in [`Actions`]; the window loop applies them.
 
 use super::camera::{CameraController, Mode};
+use super::exposure::HeldExposure;
 use super::frame_loop::{Changes, Film, Progress};
 use super::state::ViewState;
 use crate::render::SceneStats;
 use crate::render::background::Background;
-use crate::render::exposure::AutoExposure;
 use crate::render::tonemap::ToneMapper;
+use crate::scene::views::SavedView;
 use crate::scene::{EnvPreset, LightPreset, Scene};
 use egui::{Color32, RichText, Ui};
 use glam::{DMat4, DQuat, DVec3, EulerRot};
 use std::path::PathBuf;
+use std::time::Instant;
 
 /// What the overlay edits.
 pub struct Model {
@@ -56,8 +58,10 @@ pub struct Info<'a> {
     pub scene_stats: Option<&'a SceneStats>,
     /// Scene file loading time.
     pub load_ms: f64,
-    /// Display frames per second.
-    pub fps: f64,
+    /// New images presented per second (not the panel's redraws).
+    pub images_per_second: f64,
+    /// Milliseconds from the last input to the first image after it.
+    pub latency_ms: Option<f64>,
     /// The file being loaded in the background.
     pub loading: Option<&'a std::path::Path>,
     /// The last screenshot's PNG path.
@@ -79,6 +83,10 @@ pub struct Actions {
     pub environment: Option<EnvSource>,
     /// Hide the overlay.
     pub hide_overlay: bool,
+    /// Save the current camera under this name in the scene's views file.
+    pub save_view: Option<String>,
+    /// Go to this saved view.
+    pub recall_view: Option<crate::scene::Camera>,
 }
 
 /// A line in the middle of the window (e.g. while the kernels build).
@@ -154,6 +162,14 @@ pub struct Gui {
     /// The loaded environment map's name (`studio`, `outdoor` or the file's), if any; shows
     /// its controls.
     pub env_name: Option<String>,
+    /// The help window (F1) is open.
+    pub help: bool,
+    /// The scene's saved views.
+    pub views: Vec<SavedView>,
+    /// The name field of "save view".
+    view_name: String,
+    /// A message shown for a moment in the middle of the image, and when it was set.
+    pub flash: Option<(String, Instant)>,
 }
 
 impl Gui {
@@ -167,6 +183,10 @@ impl Gui {
             env_text: String::new(),
             env_error: None,
             env_name,
+            help: false,
+            views: Vec::new(),
+            view_name: String::new(),
+            flash: None,
         }
     }
 
@@ -191,6 +211,7 @@ impl Gui {
                         self.render_section(ui, m, &mut actions);
                         self.camera_section(ui, m, &mut actions);
                         self.lights_section(ui, m, &mut actions);
+                        self.views_section(ui, &mut actions);
                         self.scene_section(ui, m, info, &mut actions);
                         controls_section(ui);
                     });
@@ -206,6 +227,9 @@ impl Gui {
             if ui.button("Hide (Tab)").clicked() {
                 actions.hide_overlay = true;
             }
+            if ui.button("Keys (F1)").clicked() {
+                self.help = !self.help;
+            }
         });
         let target = m
             .view
@@ -216,11 +240,12 @@ impl Gui {
             .converged_share
             .map_or_else(String::new, |c| format!(" · {:.0} % converged", c * 100.0));
         ui.label(format!(
-            "{} / {target} spp{converged} · {:.2} MS/s · {:.0} fps",
+            "{} / {target} spp{converged} · {:.2} MS/s",
             info.progress.spp,
             info.progress.samples_per_second * 1e-6,
-            info.fps
         ));
+        ui.label(live_figures(info))
+            .on_hover_text("new images shown per second (not redraws of the panel); the time from the last input to the first image rendered after it");
         if let Some(e) = info.device_error {
             ui.label(RichText::new(format!("device error: {e}")).color(Color32::LIGHT_RED));
         }
@@ -346,7 +371,7 @@ impl Gui {
                 ui.horizontal(|ui| {
                     let mut auto = v.auto_exposure.is_some();
                     if ui.checkbox(&mut auto, "auto").changed() {
-                        v.auto_exposure = auto.then(AutoExposure::default);
+                        v.auto_exposure = auto.then(HeldExposure::default);
                         v.incident_exposure = false;
                     }
                     let s = ui.add(egui::Slider::new(&mut v.exposure, -24.0..=24.0).text("stops"));
@@ -360,6 +385,7 @@ impl Gui {
                     "exposure: automatic (metered on the image) or in stops (set at first from \
                      the light at the subject)",
                 );
+                exposure_lock(ui, v);
                 ui.horizontal_wrapped(|ui| {
                     ui.label("tone mapper");
                     for t in ToneMapper::ALL {
@@ -654,10 +680,13 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
                     s.bvh
                 ));
             }
-            let moving = if info.film.divisor > 1 {
-                format!(" (1/{} while moving)", info.film.divisor)
-            } else {
+            let moving = if info.film.full_quality {
                 String::new()
+            } else {
+                format!(
+                    " (preview: 1/{}, {} bounces)",
+                    info.film.divisor, info.film.bounces
+                )
             };
             ui.label(format!(
                 "film {}×{}{moving}",
@@ -674,8 +703,13 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
                 p.rays_per_second * 1e-6
             ));
             if let Some(plan) = p.plan {
+                let band = if plan.bands > 1 {
+                    format!(", band {}/{}", p.band + 1, plan.bands)
+                } else {
+                    String::new()
+                };
                 ui.label(format!(
-                    "last batch: {} spp in {:.1} ms (budget {:.0} ms)",
+                    "last batch: {} spp{band} in {:.1} ms (budget {:.0} ms)",
                     plan.spp,
                     p.batch_ms,
                     super::frame_loop::FRAME_BUDGET_MS
@@ -719,18 +753,105 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
         });
 }
 
+/// Image updates per second and the last input's latency, for the top of the panel.
+fn live_figures(info: &Info) -> String {
+    let latency = info
+        .latency_ms
+        .map_or_else(|| "–".to_string(), |ms| format!("{ms:.0} ms"));
+    format!(
+        "{:.1} images/s · input answered in {latency}",
+        info.images_per_second
+    )
+}
+
 fn controls_section(ui: &mut Ui) {
-    egui::CollapsingHeader::new("Keys and mouse")
+    egui::CollapsingHeader::new("Keys and mouse (F1)")
         .default_open(false)
-        .show(ui, |ui| {
-            egui::Grid::new("keys").striped(true).show(ui, |ui| {
-                for (key, what) in super::CONTROLS {
-                    ui.label(*key);
-                    ui.label(*what);
-                    ui.end_row();
-                }
-            });
+        .show(ui, key_list);
+}
+
+/// The keys and what they do, each row wrapping within the width it is given.
+fn key_list(ui: &mut Ui) {
+    for (key, what) in super::CONTROLS {
+        ui.horizontal_wrapped(|ui| {
+            ui.label(RichText::new(*key).strong());
+            ui.label(*what);
         });
+    }
+}
+
+/// The help window (F1): every key, readable in full, over the image.
+pub fn help_window(ctx: &egui::Context, open: &mut bool) {
+    egui::Window::new("Keys and mouse")
+        .open(open)
+        .collapsible(false)
+        .resizable(false)
+        .default_width(420.0)
+        .anchor(egui::Align2::RIGHT_TOP, egui::vec2(-10.0, 10.0))
+        .show(ctx, key_list);
+}
+
+/// A message in the middle of the image for [`FLASH_SECONDS`] (e.g. why a key did nothing).
+pub fn flash(ctx: &egui::Context, flash: &Option<(String, Instant)>, panel_width: f32) {
+    if let Some((text, at)) = flash
+        && at.elapsed().as_secs_f64() < FLASH_SECONDS
+    {
+        notice(ctx, text, panel_width);
+    }
+}
+
+/// How long a flashed message stays.
+pub const FLASH_SECONDS: f64 = 3.0;
+
+/// The exposure lock: automatic exposure keeps its value across views.
+fn exposure_lock(ui: &mut Ui, v: &mut super::state::ViewState) {
+    if let Some(auto) = v.auto_exposure.as_mut() {
+        ui.checkbox(&mut auto.locked, "lock exposure")
+            .on_hover_text("keep the automatic exposure when the view changes");
+    }
+}
+
+impl Gui {
+    /// Saved views (V saves one): recall by a click, save under a name.
+    fn views_section(&mut self, ui: &mut Ui, actions: &mut Actions) {
+        egui::CollapsingHeader::new("Views")
+            .default_open(false)
+            .show(ui, |ui| {
+                if self.views.is_empty() {
+                    ui.label(RichText::new("no saved views (V saves the camera)").weak());
+                }
+                ui.horizontal_wrapped(|ui| {
+                    for v in &self.views {
+                        if ui.button(&v.name).clicked() {
+                            actions.recall_view = Some(v.camera());
+                        }
+                    }
+                });
+                ui.horizontal(|ui| {
+                    ui.add(
+                        egui::TextEdit::singleline(&mut self.view_name)
+                            .hint_text("name")
+                            .desired_width(120.0),
+                    );
+                    if ui.button("Save view (V)").clicked() {
+                        let name = self.view_name.trim();
+                        actions.save_view = Some(if name.is_empty() {
+                            next_view_name(&self.views)
+                        } else {
+                            name.to_string()
+                        });
+                    }
+                });
+            });
+    }
+}
+
+/// "view N" for the first N not taken.
+pub fn next_view_name(views: &[SavedView]) -> String {
+    (1..)
+        .map(|n| format!("view {n}"))
+        .find(|name| views.iter().all(|v| &v.name != name))
+        .unwrap_or_default()
 }
 
 #[cfg(test)]

@@ -20,12 +20,25 @@ pub(super) struct Input {
     pub ctrl: bool,
     /// A button pressed while the overlay is shown, handled after egui's next pass.
     pub press: Option<MouseButton>,
+    /// When the earliest input not yet turned into a change arrived (for its latency).
+    pub event_at: Option<Instant>,
 }
 
 impl App {
     /// Handles a keyboard or mouse event. `typing`: egui has the keyboard (key releases still
     /// count); `wheel_free`: the wheel is not egui's.
     pub(super) fn input_event(&mut self, event: WindowEvent, typing: bool, wheel_free: bool) {
+        let acts = match &event {
+            WindowEvent::KeyboardInput { event, .. } => {
+                event.state == ElementState::Pressed && !event.repeat
+            }
+            WindowEvent::CursorMoved { .. } => self.input.look || self.input.pan,
+            WindowEvent::MouseInput { .. } | WindowEvent::MouseWheel { .. } => true,
+            _ => false,
+        };
+        if acts && self.input.event_at.is_none() {
+            self.input.event_at = Some(Instant::now());
+        }
         match event {
             WindowEvent::ModifiersChanged(m) => {
                 self.input.shift = m.state().shift_key();
@@ -104,10 +117,14 @@ impl App {
 
     pub(super) fn camera_moved(&mut self) {
         self.last_motion = Some(Instant::now());
-        self.frame_loop.invalidate(Changes {
-            camera: true,
-            ..Changes::default()
-        });
+        let at = self.change_time();
+        self.frame_loop.invalidate_at(
+            Changes {
+                camera: true,
+                ..Changes::default()
+            },
+            at,
+        );
     }
 
     fn key(&mut self, code: KeyCode, pressed: bool, repeat: bool) {
@@ -125,9 +142,27 @@ impl App {
                 self.model.camera.reset();
                 self.camera_moved();
             }
+            KeyCode::KeyH if !self.model.view.has_light_radius() => self.flash(
+                "H: no light here has a radius to change (the scene is lit by its environment \
+                 or emissive surfaces)",
+            ),
             KeyCode::KeyH => {
                 self.model.view.toggle_hard_shadows();
                 self.lights_changed();
+            }
+            KeyCode::KeyC => {
+                let c = &mut self.model.camera;
+                c.collision = !c.collision;
+                let what = if c.collision {
+                    "collision on: moves stop at walls"
+                } else {
+                    "collision off: moves pass through walls"
+                };
+                self.flash(what);
+            }
+            KeyCode::KeyV => {
+                let name = super::gui::next_view_name(&self.gui.views);
+                self.save_view(&name);
             }
             KeyCode::KeyO => {
                 let next = match self.model.camera.mode {
@@ -139,20 +174,57 @@ impl App {
             KeyCode::Equal | KeyCode::NumpadAdd => self.model.camera.scale_speed(1.0),
             KeyCode::Minus | KeyCode::NumpadSubtract => self.model.camera.scale_speed(-1.0),
             KeyCode::KeyQ if ctrl => self.quit = true,
-            KeyCode::Tab | KeyCode::F1 => self.overlay = !self.overlay,
+            KeyCode::Tab => self.overlay = !self.overlay,
+            KeyCode::F1 => self.gui.help = !self.gui.help,
             KeyCode::Space => self.model.timeline.toggle(),
             KeyCode::F12 => self.screenshot(),
             _ => {}
         }
     }
 
+    /// Shows `text` in the middle of the image for a moment.
+    pub(super) fn flash(&mut self, text: &str) {
+        self.gui.flash = Some((text.to_string(), Instant::now()));
+    }
+
+    /// Saves the camera as `name` in the views file beside the scene and lists it.
+    pub(super) fn save_view(&mut self, name: &str) {
+        let Some(path) = self.scene_path.clone() else {
+            self.flash("views are saved beside a scene file: open one first");
+            return;
+        };
+        match crate::scene::views::save_view(&path, name, &self.model.camera.camera) {
+            Ok(file) => {
+                println!("penumbra: saved view '{name}' in {}", file.display());
+                self.flash(&format!("saved view '{name}'"));
+                self.load_views();
+            }
+            Err(e) => self.gui.file_error = Some(format!("{e:#}")),
+        }
+    }
+
+    /// Reads the scene's saved views for the overlay's list.
+    pub(super) fn load_views(&mut self) {
+        self.gui.views = match &self.scene_path {
+            Some(p) => crate::scene::views::load_views(p).unwrap_or_else(|e| {
+                log::warn!("{e:#}");
+                Vec::new()
+            }),
+            None => Vec::new(),
+        };
+    }
+
     fn lights_changed(&mut self) {
         self.last_motion = Some(Instant::now());
         self.lights = self.model.view.lights();
-        self.frame_loop.invalidate(Changes {
-            lights: true,
-            ..Changes::default()
-        });
+        let at = self.change_time();
+        self.frame_loop.invalidate_at(
+            Changes {
+                lights: true,
+                ..Changes::default()
+            },
+            at,
+        );
     }
 
     /// Picks the object under the cursor (host BVH ray cast).
@@ -173,7 +245,9 @@ impl App {
             Some(hit) => {
                 self.model.selected = Some(hit.object);
                 if self.model.camera.mode == Mode::Orbit {
-                    self.model.camera.set_pivot(hit.point);
+                    // The object's centre keeps it in frame while orbiting.
+                    let center = pick::object_center(&self.model.scene, hit.object);
+                    self.model.camera.set_pivot(center.unwrap_or(hit.point));
                 }
                 // With a lens, a click also focuses on the clicked point.
                 if self.model.view.aperture > 0.0 {

@@ -3,10 +3,10 @@
 //! it; the environment map is loaded and uploaded here too.
 
 use super::camera::CameraController;
+use super::exposure::HeldExposure;
 use super::frame_loop::Changes;
 use super::gui::{EnvSource, Model};
 use super::{App, pick};
-use crate::render::exposure::AutoExposure;
 use crate::scene::{Scene, SceneError};
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, TryRecvError};
@@ -79,6 +79,7 @@ impl App {
                 message: "the loader stopped unexpectedly".into(),
             }),
         };
+        let opened = path.clone();
         self.loader = None;
         match result {
             Ok((mut scene, ms)) => {
@@ -88,7 +89,7 @@ impl App {
                 self.autofocus = self.model.view.aperture > 0.0;
                 let view = &mut self.model.view;
                 if std::mem::take(&mut view.incident_exposure) {
-                    view.auto_exposure = Some(AutoExposure::default());
+                    view.auto_exposure = Some(HeldExposure::default());
                 }
                 if let Some(auto) = view.auto_exposure.as_mut() {
                     auto.reset();
@@ -98,7 +99,8 @@ impl App {
                 }
                 let bounds = scene.bounds();
                 self.model.view.replace_scene_lights(&scene.lights, bounds);
-                let camera = CameraController::new(scene.cameras[0].clone(), &bounds);
+                let mut camera = CameraController::new(scene.cameras[0].clone(), &bounds);
+                camera.collision = self.model.camera.collision;
                 let view = self.model.view.clone();
                 if let Some(gfx) = &self.gfx {
                     gfx.window
@@ -109,6 +111,8 @@ impl App {
                 self.lights = self.model.view.lights();
                 self.gui.file_error = None;
                 self.device_error = None;
+                self.scene_path = Some(opened);
+                self.load_views();
                 self.frame_loop.invalidate(Changes::ALL);
             }
             Err(e) => self.gui.file_error = Some(e.to_string()),

@@ -4,6 +4,7 @@
 
 mod budget;
 mod camera;
+mod exposure;
 mod frame_loop;
 mod framework;
 mod gui;
@@ -15,10 +16,11 @@ mod pick;
 mod screenshot;
 mod state;
 mod timeline;
+mod stats;
 
 use crate::cl::DeviceChoice;
 use crate::render::background::{Background, unpremultiply};
-use crate::render::exposure::{ExposureMode, meter_subject};
+use crate::render::exposure::ExposureMode;
 use crate::render::tonemap::{ToneMapper, to_rgba8};
 use crate::render::{RenderSettings, Renderer};
 use crate::scene::{Camera, EnvMap, Light, Scene, Shadows};
@@ -48,6 +50,8 @@ const MOVING_FOR: Duration = Duration::from_millis(250);
 /// Display frame interval while something happens, and while only waiting for the device.
 const ACTIVE_INTERVAL: Duration = Duration::from_millis(16);
 const IDLE_INTERVAL: Duration = Duration::from_millis(33);
+/// How often a batch past its expected end is polled.
+const POLL_INTERVAL: Duration = Duration::from_millis(2);
 
 /// The controls, for the overlay and the docs.
 pub const CONTROLS: &[(&str, &str)] = &[
@@ -64,9 +68,18 @@ pub const CONTROLS: &[(&str, &str)] = &[
         "pick an object (orbit: also the pivot; with a lens: focus)",
     ),
     ("R", "reset the view"),
+    (
+        "C",
+        "collision on / off (on at the start inside interiors: moves stop at walls)",
+    ),
+    (
+        "V",
+        "save the view (beside the scene, for --view NAME; recall in Views)",
+    ),
     ("H", "hard / soft shadows"),
     ("F12", "screenshot (PNG + EXR in screenshots/)"),
-    ("Tab, F1", "hide / show the overlay"),
+    ("Tab", "hide / show the overlay"),
+    ("F1", "this list in a window"),
     ("Space", "play / pause the animation"),
     ("Ctrl + Q", "quit (like closing the window)"),
     ("drop a file", "open a .gltf / .glb scene"),
@@ -116,6 +129,10 @@ pub struct ViewerConfig {
     pub screenshot: Option<PathBuf>,
     /// Show the overlay at the start.
     pub overlay: bool,
+    /// Append one JSON line per presented image here (`--stats-file`).
+    pub stats_file: Option<PathBuf>,
+    /// The first view is inside an interior: collision starts on.
+    pub interior: bool,
 }
 
 /// The image's width over height in a window of `size` pixels, beside the overlay's panel
@@ -154,6 +171,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
              -o OUT.png` to render without one"
         )
     })?;
+    let stats = stats::ImageStats::new(config.stats_file.as_deref())?;
     let mut renderer = Renderer::new(&config.device)
         .context("cannot open the OpenCL device (see `penumbra devices`)")?;
     renderer.set_kernel(config.kernel)?;
@@ -178,13 +196,16 @@ pub fn run(config: ViewerConfig) -> Result<()> {
     let mut view = view;
     view.background = config.background;
     view.tone_mapper = config.tone_mapper;
-    let camera = CameraController::new(config.camera, &bounds);
+    let mut camera = CameraController::new(config.camera, &bounds);
+    camera.collision = config.interior;
     let path_text = config
         .path
         .as_ref()
         .map(|p| p.display().to_string())
         .unwrap_or_default();
     let mut app = App {
+        scene_path: config.path.clone(),
+        seen_for: None,
         size,
         device: renderer.device.description(),
         frame_loop: FrameLoop::new(renderer),
@@ -202,7 +223,8 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         wake: None,
         input_at: None,
         frames: 0,
-        fps: 0.0,
+        stats,
+        pump_image: false,
         display: Vec::new(),
         display_key: None,
         display_generation: 0,
@@ -219,6 +241,7 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         frame_key: None,
         shown_spp: 0,
     };
+    app.load_views();
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.fatal.take() {
         return Err(e);
@@ -268,6 +291,10 @@ struct Gfx {
 }
 
 struct App {
+    /// The scene file (views are saved beside it); `None` for the bundled scene.
+    scene_path: Option<PathBuf>,
+    /// The camera (eye, forward) the fly speed was last sized for.
+    seen_for: Option<(glam::DVec3, glam::DVec3)>,
     /// The window's inner size in physical pixels (the full film size).
     size: (u32, u32),
     device: String,
@@ -289,7 +316,10 @@ struct App {
     /// When input arrived that is not drawn yet.
     input_at: Option<Instant>,
     frames: u64,
-    fps: f64,
+    /// Presented images and input latency.
+    stats: stats::ImageStats,
+    /// A new image arrived between redraws (a batch collected while waiting): show it.
+    pump_image: bool,
     /// The film tone-mapped (RGBA8), as on screen.
     display: Vec<u8>,
     /// Exposure, tone mapper, samples, size and background of `display`.
@@ -379,9 +409,9 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        let Some(gfx) = self.gfx.as_ref() else {
+        if self.gfx.is_none() {
             return;
-        };
+        }
         let now = Instant::now();
         let active = self.input.motion.any()
             || self.input.look
@@ -399,9 +429,24 @@ impl ApplicationHandler for App {
             || self.frame_loop.busy();
         let mut next = (active || rendering || self.frames_limit.is_some())
             .then(|| self.last_redraw + interval);
-        for w in [self.wake, self.input_at].into_iter().flatten() {
+        // A batch due to finish is polled at once and the next one started without waiting for
+        // a display frame, so the device never idles between bands.
+        let due = self.frame_loop.expected_done();
+        // (Not when the step would build kernels: that waits for the notice in `redraw`.)
+        if due.is_some_and(|t| t <= now) && !self.builds_next() && self.step_frame_loop(now) {
+            self.pump_image = true;
+            self.wake = Some(now);
+        }
+        let poll = self
+            .frame_loop
+            .expected_done()
+            .map(|t| t.max(now + POLL_INTERVAL));
+        for w in [self.wake, self.input_at, poll].into_iter().flatten() {
             next = Some(next.map_or(w, |n| n.min(w)));
         }
+        let Some(gfx) = self.gfx.as_ref() else {
+            return;
+        };
         match next {
             Some(t) if t <= now => {
                 gfx.window.request_redraw();
@@ -527,11 +572,11 @@ impl App {
         let dt = (now - self.last_redraw).as_secs_f64().min(0.1);
         self.last_redraw = now;
         self.input_at = None;
-        if dt > 0.0 {
-            self.fps += 0.1 * (1.0 / dt - self.fps);
-        }
         self.poll_loader();
-        if self.model.camera.fly(&self.input.motion, dt) {
+        self.size_fly_speed();
+        let host = self.frame_loop.renderer.host_scene();
+        let obstacle = |o, d| host.and_then(|h| pick::distance_along(h, o, d));
+        if self.model.camera.fly(&self.input.motion, dt, &obstacle) {
             self.camera_moved();
         }
         let Some(actions) = self.overlay_pass(now) else {
@@ -562,10 +607,10 @@ impl App {
             if !self.builds_next() {
                 self.notice_frames = 0;
             }
-            new
+            new || std::mem::take(&mut self.pump_image)
         };
         self.autofocus_once();
-        self.update_display(new_image);
+        self.update_display(new_image, dt);
         if new_image {
             // The overlay above was drawn with the previous figures: draw once more.
             self.wake = Some(now);
@@ -576,6 +621,11 @@ impl App {
         if let Err(e) = self.present() {
             self.fail(event_loop, e);
             return;
+        }
+        // An input not answered by a change this frame is forgotten.
+        self.input.event_at = None;
+        if new_image {
+            self.image_presented();
         }
         self.frame_shown(event_loop);
     }
@@ -591,7 +641,8 @@ impl App {
             film: &self.frame_loop.film,
             scene_stats: self.frame_loop.scene_stats.as_ref(),
             load_ms: self.load_ms,
-            fps: self.fps,
+            images_per_second: self.stats.images_per_second(now),
+            latency_ms: self.stats.last_latency_ms,
             loading: self.loader.as_ref().map(|l| l.path.as_path()),
             last_screenshot: self.last_screenshot.as_deref(),
             device_error: self.device_error.as_deref(),
@@ -607,6 +658,8 @@ impl App {
             if overlay {
                 actions = gui.ui(ui, model, &info);
             }
+            gui::help_window(ui.ctx(), &mut gui.help);
+            gui::flash(ui.ctx(), &gui.flash, panel);
             if compiling {
                 gui::notice(ui.ctx(), "Compiling kernels…", panel);
             }
@@ -633,12 +686,20 @@ impl App {
         if actions.changes.lights || actions.changes.scene {
             self.lights = self.model.view.lights();
         }
-        self.frame_loop.invalidate(actions.changes);
+        let at = self.change_time();
+        self.frame_loop.invalidate_at(actions.changes, at);
         if actions.hide_overlay {
             self.overlay = false;
         }
         if let Some(path) = actions.open {
             self.open(path);
+        }
+        if let Some(name) = actions.save_view {
+            self.save_view(&name);
+        }
+        if let Some(camera) = actions.recall_view {
+            self.model.camera.camera = camera;
+            self.camera_moved();
         }
         if let Some(env) = actions.environment {
             // Applied in `redraw` once the "Compiling kernels…" notice is on screen if the
@@ -725,6 +786,45 @@ impl App {
         }
     }
 
+    /// Sizes the fly speed by the distance to what the camera sees, when the camera changed.
+    fn size_fly_speed(&mut self) {
+        let cam = &self.model.camera.camera;
+        let key = (cam.eye, cam.forward);
+        if self.seen_for == Some(key) {
+            return;
+        }
+        let Some(host) = self.frame_loop.renderer.host_scene() else {
+            return;
+        };
+        let aspect = self.image_area().aspect();
+        if let Some(d) = pick::seen_distance(host, cam, aspect) {
+            self.model.camera.set_seen_distance(d);
+        }
+        self.seen_for = Some(key);
+    }
+
+    /// A new image is on screen: counts it, and measures the latency of the input it answers.
+    fn image_presented(&mut self) {
+        let film = &mut self.frame_loop.film;
+        let answers = film.answers.take();
+        let line = stats::ImageLine {
+            t: 0.0,
+            spp: film.spp,
+            width: film.width,
+            height: film.height,
+            divisor: film.divisor,
+            bounces: film.bounces,
+            exposure: self.model.view.exposure,
+            latency_ms: None,
+        };
+        self.stats.image_shown(Instant::now(), answers, line);
+    }
+
+    /// The input event behind the change being recorded, if one is waiting for its image.
+    pub(super) fn change_time(&mut self) -> Option<Instant> {
+        self.input.event_at.take()
+    }
+
     /// Whether the next frame-loop step (or a deferred environment) builds kernels.
     fn builds_next(&self) -> bool {
         self.frame_loop.builds_next(&self.model.scene)
@@ -750,7 +850,7 @@ impl App {
     /// Tone-maps the film when the film, the exposure, the tone mapper or the background
     /// changed, and composes the window's frame (the image beside the panel) when that or the
     /// layout changed.
-    fn update_display(&mut self, new_image: bool) {
+    fn update_display(&mut self, new_image: bool, dt: f64) {
         let area = self.image_area();
         let Some(gfx) = self.gfx.as_mut() else {
             return;
@@ -759,14 +859,29 @@ impl App {
         if film.pixels.is_empty() {
             return;
         }
-        if new_image && let Some(auto) = self.model.view.auto_exposure.as_mut() {
-            // The subject without the background (the straight color when it is cut out).
-            let coverage = (!film.coverage.is_empty()).then_some(film.coverage.as_slice());
-            let metering = match coverage.filter(|_| film.cutout) {
-                Some(c) => meter_subject(&unpremultiply(&film.pixels, c), coverage),
-                None => meter_subject(&film.pixels, coverage),
-            };
-            self.model.view.exposure = auto.update(metering.as_ref());
+        let full_bounces = film.bounces == self.model.view.bounces;
+        if let Some(auto) = self.model.view.auto_exposure.as_mut() {
+            if new_image && full_bounces && auto.wants(film.view) {
+                // The subject without the background (the straight color when it is cut out).
+                let coverage = (!film.coverage.is_empty()).then_some(film.coverage.as_slice());
+                let width = film.width as usize;
+                let metering = match coverage.filter(|_| film.cutout) {
+                    Some(c) => exposure::meter_film(
+                        &unpremultiply(&film.pixels, c),
+                        coverage,
+                        width,
+                        film.spp,
+                    ),
+                    None => exposure::meter_film(&film.pixels, coverage, width, film.spp),
+                };
+                auto.decide(film.view, metering.as_ref());
+            }
+            if let Some(stops) = auto.advance(dt) {
+                self.model.view.exposure = stops;
+            }
+            if auto.settling() {
+                self.wake = Some(Instant::now() + ACTIVE_INTERVAL);
+            }
         }
         let v = &self.model.view;
         // A color background is painted into the display: its value is part of the key.

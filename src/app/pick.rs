@@ -1,6 +1,7 @@
 //! Picking: the object under the mouse, found by casting the pixel's primary ray through the
 //! host BVH (the same one the device traverses).
 
+use crate::bvh::Ray;
 use crate::render::camera::primary_ray;
 use crate::render::{HostScene, gpu_camera};
 use crate::scene::Camera;
@@ -26,6 +27,57 @@ pub fn pick(host: &HostScene, camera: &Camera, aspect: f32, fx: f32, fy: f32) ->
         object: host.object_of(&hit) as usize,
         point: host.space.world_point(point),
     })
+}
+
+/// Rays per side of the grid [`seen_distance`] casts over the image.
+const PROBE_GRID: usize = 5;
+
+/// The distance to the first surface from `origin` along the unit `direction` (world space),
+/// through the host BVH.
+pub fn distance_along(host: &HostScene, origin: DVec3, direction: DVec3) -> Option<f64> {
+    let o = host.space.point(origin);
+    // A direction of one world unit in render space, so that t is in world units.
+    let d = host.space.point(origin + direction) - o;
+    let ray = Ray {
+        origin: o,
+        direction: d,
+        tmin: 0.0,
+        tmax: f32::INFINITY,
+    };
+    host.intersect(&ray).map(|h| f64::from(h.t))
+}
+
+/// How far what the camera sees is: the median distance of the surfaces a grid of primary
+/// rays over the image hits; `None` when they all miss (an object seen from outside its
+/// bounds against the sky counts only the rays that hit it).
+pub fn seen_distance(host: &HostScene, camera: &Camera, aspect: f32) -> Option<f64> {
+    let mut hits: Vec<f64> = Vec::new();
+    for j in 0..PROBE_GRID {
+        for i in 0..PROBE_GRID {
+            let (fx, fy) = (
+                (i as f32 + 0.5) / PROBE_GRID as f32,
+                (j as f32 + 0.5) / PROBE_GRID as f32,
+            );
+            if let Some(p) = pick(host, camera, aspect, fx, fy) {
+                hits.push((p.point - camera.eye).length());
+            }
+        }
+    }
+    hits.sort_by(f64::total_cmp);
+    hits.get(hits.len() / 2).copied()
+}
+
+/// The centre of the world-space bounding box of `object`'s geometry.
+pub fn object_center(scene: &crate::scene::Scene, object: usize) -> Option<DVec3> {
+    let o = scene.objects.get(object)?;
+    let mut min = DVec3::splat(f64::INFINITY);
+    let mut max = DVec3::splat(f64::NEG_INFINITY);
+    for p in &o.mesh.positions {
+        let w = o.world_from_object.transform_point3(p.as_dvec3());
+        min = min.min(w);
+        max = max.max(w);
+    }
+    (min.is_finite() && max.is_finite()).then(|| 0.5 * (min + max))
 }
 
 #[cfg(test)]

@@ -1,9 +1,10 @@
 //! What the overlay controls, and how it maps onto the renderer: render settings, the light rig
 //! with its light radius, exposure and tone mapping.
 
+use super::exposure::HeldExposure;
 use crate::render::RenderSettings;
 use crate::render::background::Background;
-use crate::render::exposure::{AutoExposure, ExposureMode};
+use crate::render::exposure::ExposureMode;
 use crate::render::tonemap::ToneMapper;
 use crate::scene::framing::light_near_camera;
 use crate::scene::{
@@ -95,7 +96,7 @@ pub struct ViewState {
     /// Exposure in stops.
     pub exposure: f32,
     /// Automatic exposure (metered on the film) while set; the slider turns it off.
-    pub auto_exposure: Option<AutoExposure>,
+    pub auto_exposure: Option<HeldExposure>,
     /// Whether `exposure` is the first view's incident metering, untouched: a scene opened
     /// later, which the first view did not measure, is metered on the image instead.
     pub incident_exposure: bool,
@@ -134,7 +135,7 @@ impl ViewState {
             spp_target,
             shadows,
             exposure: exposure.stops(None),
-            auto_exposure: (exposure == ExposureMode::Auto).then(AutoExposure::default),
+            auto_exposure: (exposure == ExposureMode::Auto).then(HeldExposure::default),
             incident_exposure: matches!(exposure, ExposureMode::Incident(_)),
             tone_mapper: ToneMapper::default(),
             background: if base.cutout {
@@ -211,6 +212,14 @@ impl ViewState {
                 ..l.light.clone()
             })
             .collect()
+    }
+
+    /// Whether an enabled light has a radius the hard/soft toggle changes (point, spot and
+    /// directional lights; sphere lights keep theirs unless they follow the light radius).
+    pub fn has_light_radius(&self) -> bool {
+        self.rig
+            .iter()
+            .any(|l| l.enabled && (l.follows_light_radius || l.light.light_radius > 0.0))
     }
 
     /// Flips hard shadows (the H key).

@@ -71,6 +71,23 @@ fn global_size(n: usize, local: usize) -> usize {
     n.max(1).div_ceil(local) * local
 }
 
+/// Band `index` of `count` over `items` work items in groups of `local`: contiguous ranges
+/// of whole groups, so that rounding a band's launch up to whole groups never reaches into the
+/// next band (only the last band is rounded up, past the end, where the kernels return). The
+/// bands cover every item once; with more bands than groups the extra ones are empty.
+pub fn band_items(
+    items: usize,
+    local: usize,
+    index: usize,
+    count: usize,
+) -> std::ops::Range<usize> {
+    let groups = items.div_ceil(local.max(1));
+    let per_band = groups.div_ceil(count.max(1));
+    let start = (index * per_band * local).min(items);
+    let end = ((index + 1) * per_band * local).min(items);
+    start..end
+}
+
 impl Program {
     /// Builds the kernels for `features`.
     pub fn build(device: &Device, features: KernelFeatures) -> Result<Self, ClError> {
@@ -106,21 +123,26 @@ impl Program {
         n: usize,
         set: impl FnOnce(&mut ExecuteKernel),
     ) -> Result<Launch, ClError> {
-        self.run_local(device, stage, kernel, n, self.local_size, set)
+        self.run_local(device, stage, kernel, 0..n, self.local_size, set)
     }
 
+    /// Launches `kernel` over the work items `items` (a global offset when they do not start
+    /// at 0; the kernels read their item with `get_global_id`, which includes it).
     fn run_local(
         &self,
         device: &Device,
         stage: &'static str,
         kernel: &Kernel,
-        n: usize,
+        items: std::ops::Range<usize>,
         local_size: usize,
         set: impl FnOnce(&mut ExecuteKernel),
     ) -> Result<Launch, ClError> {
         let mut exec = ExecuteKernel::new(kernel);
         set(&mut exec);
-        exec.set_global_work_size(global_size(n, local_size))
+        if items.start > 0 {
+            exec.set_global_work_offset(items.start);
+        }
+        exec.set_global_work_size(global_size(items.len(), local_size))
             .set_local_work_size(local_size);
         // SAFETY: every wrapper below sets exactly the kernel's arguments, in order, with the
         // types the kernel declares; buffers outlive the launch because the queue is in order
@@ -464,8 +486,22 @@ impl Program {
         })
     }
 
+    /// The megakernel's work items for `frame` (a pixel each, or with lanes a LANES_TILE-square
+    /// of pixels: kernels/cpu/megakernel_lanes.cl) and its work-group size.
+    pub fn megakernel_items(&self, frame: &DeviceFrame) -> (usize, usize) {
+        let items = if self.features.lanes {
+            (frame.width as usize).div_ceil(LANES_TILE)
+                * (frame.height as usize).div_ceil(LANES_TILE)
+        } else {
+            (frame.width * frame.height) as usize
+        };
+        (items, self.mega_local_size)
+    }
+
     /// `megakernel`: `frame.samples_in_wave` whole paths per pixel, from the camera to their
-    /// end, added to the film; the ray counts go to the counters that `advance` reads.
+    /// end, added to the film, for the work items `items` (all of
+    /// [`Program::megakernel_items`], or a band of them from [`band_items`]); the ray counts go
+    /// to the counters that `advance` reads.
     #[allow(clippy::too_many_arguments)]
     pub fn megakernel(
         &self,
@@ -476,15 +512,8 @@ impl Program {
         scene: &SceneBuffers,
         film: &AdaptiveFilm,
         counters: &Buffer<u32>,
+        items: std::ops::Range<usize>,
     ) -> Result<Launch, ClError> {
-        let pixels = (frame.width * frame.height) as usize;
-        // With lanes a work item takes a LANES_TILE-square of pixels (kernels/cpu/megakernel_lanes.cl).
-        let items = if self.features.lanes {
-            (frame.width as usize).div_ceil(LANES_TILE)
-                * (frame.height as usize).div_ceil(LANES_TILE)
-        } else {
-            pixels
-        };
         let local = self.mega_local_size;
         self.run_local(
             device,
@@ -616,5 +645,26 @@ unsafe fn set_surfaces(e: &mut ExecuteKernel, scene: &SceneBuffers) {
             .set_arg(&scene.tex_refs.mem())
             .set_arg(&scene.textures.mem())
             .set_arg(&scene.texels.mem());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::band_items;
+
+    #[test]
+    fn bands_cover_every_item_once_in_whole_groups() {
+        for (items, local, count) in [(1000, 64, 3), (64, 64, 5), (4095, 1, 7), (10, 64, 2)] {
+            let bands: Vec<_> = (0..count)
+                .map(|i| band_items(items, local, i, count))
+                .collect();
+            let mut next = 0;
+            for b in &bands {
+                assert_eq!(b.start, next, "{items} items, {count} bands: {bands:?}");
+                assert!(b.start % local == 0 || b.is_empty());
+                next = b.end;
+            }
+            assert_eq!(next, items, "{bands:?}");
+        }
     }
 }

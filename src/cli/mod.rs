@@ -61,6 +61,11 @@ pub struct ViewArgs {
     /// Start with the overlay hidden: the image fills the window; Tab shows it (default: off).
     #[arg(long)]
     pub no_overlay: bool,
+    /// Append one JSON line per image shown to this file (its size, samples, exposure, and for
+    /// the first image after an input the latency from the input in ms), for scripts and tests
+    /// (default: none).
+    #[arg(long, value_name = "PATH")]
+    pub stats_file: Option<PathBuf>,
 }
 
 /// Options of `render`.
@@ -162,6 +167,15 @@ fn view(args: ViewArgs) -> Result<()> {
     let mut prepared = common.prepare_for(args.scene.as_deref(), aspect)?;
     settings.env_intensity *= prepared.env_scale;
     let exposure = common.exposure_for(&prepared);
+    // The first view knows an interior; a camera of the file's (or the command line's) counts
+    // as inside one when it stands within the scene's bounds.
+    let interior = match &prepared.first_view {
+        Some(f) => f.view.interior,
+        None => {
+            let (b, eye) = (prepared.scene.bounds(), prepared.camera.eye);
+            eye.cmpge(b.min).all() && eye.cmple(b.max).all()
+        }
+    };
     let environment = prepared.environment.take();
     let device = common.device_choice()?;
     // With a lens but no focus distance, focus on what the image centre sees once loaded.
@@ -190,6 +204,8 @@ fn view(args: ViewArgs) -> Result<()> {
         frames: args.frames,
         screenshot: args.screenshot,
         overlay: !args.no_overlay,
+        stats_file: args.stats_file,
+        interior,
     })
 }
 

@@ -72,11 +72,22 @@ impl Renderer {
             let n = left.min(CHECK_STEP - self.samples % CHECK_STEP);
             launches.extend(self.enqueue_samples(n)?);
             left -= n;
-            if self.samples.is_multiple_of(CHECK_STEP) && self.samples >= min_samples(threshold) {
-                launches.extend(self.enqueue_check(threshold)?);
-            }
+            launches.extend(self.enqueue_check_if_due(threshold)?);
         }
         Ok(launches)
+    }
+
+    /// Enqueues the convergence check when the samples so far end a step from
+    /// [`min_samples`] on; nothing otherwise.
+    pub(super) fn enqueue_check_if_due(
+        &mut self,
+        threshold: f32,
+    ) -> Result<Vec<(Stage, Launch)>, ClError> {
+        if self.samples.is_multiple_of(CHECK_STEP) && self.samples >= min_samples(threshold) {
+            self.enqueue_check(threshold)
+        } else {
+            Ok(Vec::new())
+        }
     }
 
     /// Enqueues the convergence check.

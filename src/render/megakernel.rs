@@ -4,7 +4,7 @@
 //! launches, which cost more than they save where there are only a few cores.
 
 use super::Renderer;
-use crate::cl::kernels::Launch;
+use crate::cl::kernels::{Launch, band_items};
 use crate::cl::types::DeviceFrame;
 use crate::cl::{ClError, Stage};
 use std::str::FromStr;
@@ -33,6 +33,27 @@ impl FromStr for KernelChoice {
                 "kernel '{s}' is not 'wavefront', 'megakernel' or 'auto'"
             )),
         }
+    }
+}
+
+/// Part of one sample's work: band `index` of `count` contiguous bands of the megakernel's work
+/// items (rows of pixels, or of lanes' tiles), so that on a slow device no single launch blocks
+/// the queue for longer than a frame's budget and new input waits for one band, not a sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Band {
+    /// Which band, from 0.
+    pub index: u32,
+    /// How many bands the sample is split into (at least 1).
+    pub count: u32,
+}
+
+impl Band {
+    /// The whole sample in one launch.
+    pub const WHOLE: Band = Band { index: 0, count: 1 };
+
+    /// Whether this is the sample's last band (after which it counts).
+    pub fn is_last(&self) -> bool {
+        self.index + 1 >= self.count
     }
 }
 
@@ -110,7 +131,9 @@ impl Renderer {
         // items compiles a variant the frames never use, and the first frame compiled again).
         let mut frame = self.settings.gpu_frame(self.light_count);
         frame.samples_in_wave = 0;
-        self.launch_megakernel(&frame)?;
+        self.launch_megakernel(&frame, Band::WHOLE)?;
+        // A launch with a global offset (a band of a sample) is another variant for PoCL.
+        self.launch_megakernel(&frame, Band { index: 1, count: 2 })?;
         self.device
             .queue
             .finish()
@@ -118,9 +141,13 @@ impl Renderer {
         Ok(t.elapsed().as_secs_f64() * 1e3)
     }
 
-    /// One megakernel launch for `frame`, then `advance` to move its ray counts into the
-    /// totals.
-    fn launch_megakernel(&self, frame: &DeviceFrame) -> Result<[(Stage, Launch); 2], ClError> {
+    /// One megakernel launch for `frame` over the work items of `band`, then `advance` to move
+    /// its ray counts into the totals.
+    fn launch_megakernel(
+        &self,
+        frame: &DeviceFrame,
+        band: Band,
+    ) -> Result<[(Stage, Launch); 2], ClError> {
         let (Some(program), Some((scene, _)), Some(f)) = (
             self.program.as_ref(),
             self.scene.as_ref(),
@@ -139,6 +166,8 @@ impl Renderer {
             },
             ..*frame
         };
+        let (items, local) = program.megakernel_items(frame);
+        let items = band_items(items, local, band.index as usize, band.count as usize);
         let l = program.megakernel(
             device,
             frame,
@@ -147,6 +176,7 @@ impl Renderer {
             scene,
             &f.film,
             counters,
+            items,
         )?;
         let a = program.advance(device, counters, &self.stats_buffer)?;
         Ok([(Stage::Megakernel, l), (Stage::Advance, a)])
@@ -166,12 +196,30 @@ impl Renderer {
             let mut frame = self.settings.gpu_frame(self.light_count);
             frame.samples_in_wave = n;
             frame.first_sample = self.next_sample + done;
-            launches.extend(self.launch_megakernel(&frame)?);
+            launches.extend(self.launch_megakernel(&frame, Band::WHOLE)?);
             done += n;
         }
         self.samples += spp;
         self.next_sample += spp;
         Ok(launches)
+    }
+
+    /// Enqueues `band` of the next sample; the sample counts once its last band is enqueued.
+    /// Every band renders the same sample index, so the bands of a sample together give the
+    /// film exactly what one whole launch does.
+    pub(super) fn enqueue_megakernel_band(
+        &mut self,
+        band: Band,
+    ) -> Result<Vec<(Stage, Launch)>, ClError> {
+        self.ensure_frame()?;
+        let mut frame = self.settings.gpu_frame(self.light_count);
+        frame.first_sample = self.next_sample;
+        let launches = self.launch_megakernel(&frame, band)?;
+        if band.is_last() {
+            self.samples += 1;
+            self.next_sample += 1;
+        }
+        Ok(launches.into())
     }
 }
 

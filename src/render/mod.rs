@@ -24,7 +24,7 @@ mod wavefront;
 pub use adaptive::{AdaptiveStats, min_samples};
 pub use instancing::BvhChoice;
 pub use lights::gpu_lights;
-pub use megakernel::KernelChoice;
+pub use megakernel::{Band, KernelChoice};
 pub use readback::Aovs;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;

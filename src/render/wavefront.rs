@@ -304,6 +304,30 @@ impl Renderer {
             .map_err(crate::cl::call_err("submitting the frame"))
     }
 
+    /// Enqueues `band` of one more sample per pixel and returns at once, like
+    /// [`Renderer::start`]; the sample counts (and adaptive sampling checks) once its last band
+    /// is enqueued. The megakernel splits its launch ([`Band`]); the wavefront, whose per-bounce
+    /// launches are short already, renders the whole sample at the last band and nothing before.
+    pub fn start_band(&mut self, band: super::Band) -> Result<(), ClError> {
+        let mut launches = if self.megakernel {
+            self.enqueue_megakernel_band(band)?
+        } else if band.is_last() {
+            self.enqueue_samples(1)?
+        } else {
+            Vec::new()
+        };
+        if band.is_last()
+            && let Some(threshold) = self.settings.noise_threshold
+        {
+            launches.extend(self.enqueue_check_if_due(threshold)?);
+        }
+        self.pending.extend(launches);
+        self.device
+            .queue
+            .flush()
+            .map_err(crate::cl::call_err("submitting the frame"))
+    }
+
     /// Whether the work [`Renderer::start`] enqueued is done (true when nothing is pending).
     /// Never waits, so a viewer can keep drawing while the device works; the queue is in
     /// order, so the last launch finishing means all have.

@@ -22,6 +22,7 @@ mod tangents;
 mod textures;
 mod validate;
 mod variants;
+pub mod views;
 
 pub use bounds::{ABSURD_COORDINATE, RenderFrame, is_sane, robust_bounds, robust_bounds_of};
 pub use env_presets::EnvPreset;
