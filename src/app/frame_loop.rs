@@ -84,6 +84,9 @@ pub struct Film {
     pub spp: u32,
     /// Resolution divisor it was rendered at.
     pub divisor: u32,
+    /// With [`FrameLoop::read_samples`] and adaptive sampling, the samples each pixel took;
+    /// else empty.
+    pub samples: Vec<u32>,
 }
 
 /// Figures for the overlay, as of the latest finished batch.
@@ -125,6 +128,8 @@ pub struct FrameLoop {
     loaded: bool,
     /// The latest image.
     pub film: Film,
+    /// Whether each film also reads adaptive sampling's samples per pixel (for the heat map).
+    pub read_samples: bool,
     /// Figures for the overlay.
     pub progress: Progress,
     /// Figures from the last BVH rebuild.
@@ -147,6 +152,7 @@ impl FrameLoop {
             applied: None,
             loaded: false,
             film: Film::default(),
+            read_samples: false,
             progress: Progress::default(),
             scene_stats: None,
         }
@@ -231,6 +237,10 @@ impl FrameLoop {
         let counted = settings.cutout || settings.count_coverage;
         self.renderer
             .image_into(&mut pixels, counted.then_some(&mut coverage))?;
+        let samples = match self.read_samples {
+            true => self.renderer.pixel_samples()?.unwrap_or_default(),
+            false => Vec::new(),
+        };
         self.film = Film {
             width: size.0,
             height: size.1,
@@ -239,6 +249,7 @@ impl FrameLoop {
             cutout: settings.cutout,
             spp,
             divisor: batch.plan.divisor,
+            samples,
         };
         let p = &mut self.progress;
         p.seconds += ms * 1e-3;
