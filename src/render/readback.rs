@@ -134,6 +134,15 @@ impl Renderer {
         (self.settings.aovs && f.aov_paths.len() > 1).then_some(&f.film.aovs)
     }
 
+    /// The film on the device, for a denoiser that reads it there: per pixel, rows from the
+    /// top, `.xyz` the sum of its samples' radiance and `.w` their count (with the background
+    /// cut out or coverage counted, the samples whose camera ray hit: then divide by
+    /// [`AovBuffers::albedo`]'s `.w`, the pixel's sample count, instead). `None` before the
+    /// first frame. Wait for the samples first ([`Renderer::finish`]).
+    pub fn film_buffer(&self) -> Option<&crate::cl::Buffer<[f32; 4]>> {
+        self.frame.as_ref().map(|f| &f.film.sum)
+    }
+
     /// Finishes the pending launches and reads the film into [`Renderer::readback`]; false
     /// when no frame exists yet.
     fn read_film(&mut self) -> Result<bool, ClError> {
