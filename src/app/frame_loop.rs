@@ -98,6 +98,9 @@ pub struct Film {
     /// Counts the views: changes of the camera, scene, lights or settings (not of the level
     /// while the preview climbs back), so exposure can be decided once per view.
     pub view: u64,
+    /// With [`FrameLoop::read_samples`] and adaptive sampling, the samples each pixel took;
+    /// else empty.
+    pub samples: Vec<u32>,
 }
 
 /// Figures for the overlay, as of the latest finished batch.
@@ -163,6 +166,8 @@ pub struct FrameLoop {
     loaded: bool,
     /// The latest image.
     pub film: Film,
+    /// Whether each film also reads adaptive sampling's samples per pixel (for the heat map).
+    pub read_samples: bool,
     /// Figures for the overlay.
     pub progress: Progress,
     /// Figures from the last BVH rebuild.
@@ -189,6 +194,7 @@ impl FrameLoop {
             view: 0,
             loaded: false,
             film: Film::default(),
+            read_samples: false,
             progress: Progress::default(),
             scene_stats: None,
         }
@@ -361,6 +367,10 @@ impl FrameLoop {
         let counted = settings.cutout || settings.count_coverage;
         self.renderer
             .image_into(&mut pixels, counted.then_some(&mut coverage))?;
+        let samples = match self.read_samples {
+            true => self.renderer.pixel_samples()?.unwrap_or_default(),
+            false => Vec::new(),
+        };
         self.film = Film {
             width: size.0,
             height: size.1,
@@ -374,6 +384,7 @@ impl FrameLoop {
             // An image collected over one never shown answers its input when it is shown.
             answers: sample.answers.or(self.film.answers),
             view: sample.view,
+            samples,
         };
         let p = &mut self.progress;
         p.seconds += sample.ms * 1e-3;

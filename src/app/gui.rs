@@ -281,6 +281,9 @@ impl Gui {
                     {
                         actions.changes.settings = true;
                     }
+                    if v.noise_threshold.is_some() {
+                        ui.checkbox(&mut v.show_samples, "show samples per pixel");
+                    }
                 });
                 ui.horizontal_wrapped(|ui| {
                     let mut endless = v.spp_target.is_none();

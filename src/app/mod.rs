@@ -323,7 +323,7 @@ struct App {
     /// The film tone-mapped (RGBA8), as on screen.
     display: Vec<u8>,
     /// Exposure, tone mapper, samples, size and background of `display`.
-    display_key: Option<(f32, ToneMapper, u32, usize, u64)>,
+    display_key: Option<(f32, ToneMapper, u32, usize, u64, bool)>,
     /// Counts the changes of `display`.
     display_generation: u64,
     /// The scene file being loaded in the background.
@@ -596,6 +596,8 @@ impl App {
         // Collect a finished batch and start the next one before showing this image. A step (or
         // an environment change) that builds kernels blocks for seconds with a cold cache: show
         // two frames that say so first.
+        let v = &self.model.view;
+        self.frame_loop.read_samples = v.show_samples && v.noise_threshold.is_some();
         let new_image = if self.builds_next() && self.notice_frames <= 2 {
             self.wake = Some(now);
             false
@@ -890,16 +892,22 @@ impl App {
             Background::Transparent => 1,
             Background::Color(c) => c.iter().fold(2u64, |h, x| h * 31 + x.to_bits() as u64),
         };
+        let heat = v.show_samples && film.samples.len() == film.pixels.len();
         let key = (
             v.exposure,
             v.tone_mapper,
             film.spp,
             film.pixels.len(),
             background,
+            heat,
         );
         if self.display_key != Some(key) || new_image {
             self.display_key = Some(key);
-            self.display = display_rgba(film, v.exposure, v.tone_mapper, v.background);
+            self.display = if heat {
+                samples_heat_rgba(&film.samples)
+            } else {
+                display_rgba(film, v.exposure, v.tone_mapper, v.background)
+            };
             self.display_generation += 1;
         }
         let frame_key = (self.display_generation, area, self.size);
@@ -928,6 +936,29 @@ impl App {
     }
 }
 
+/// Adaptive sampling's samples per pixel as RGBA8: from blue (the fewest any pixel took) through
+/// green to red (the most), so that converged regions read as cold.
+fn samples_heat_rgba(samples: &[u32]) -> Vec<u8> {
+    let lo = samples.iter().copied().min().unwrap_or(0) as f32;
+    let hi = samples.iter().copied().max().unwrap_or(0) as f32;
+    samples
+        .iter()
+        .flat_map(|&s| {
+            let t = if hi > lo {
+                (s as f32 - lo) / (hi - lo)
+            } else {
+                0.0
+            };
+            let rgb = [
+                (2.0 * t - 1.0).clamp(0.0, 1.0),
+                1.0 - (2.0 * t - 1.0).abs(),
+                (1.0 - 2.0 * t).clamp(0.0, 1.0),
+            ];
+            [rgb[0], rgb[1], rgb[2], 1.0].map(|c| (c * 255.0).round() as u8)
+        })
+        .collect()
+}
+
 /// The film as shown: exposed and tone-mapped RGBA8, with the background applied when it is
 /// cut out (alpha for transparent, the color painted behind).
 fn display_rgba(
@@ -946,4 +977,23 @@ fn display_rgba(
     );
     crate::render::background::apply(&mut rgba, &film.coverage, background);
     rgba
+}
+
+#[cfg(test)]
+mod tests {
+    use super::samples_heat_rgba;
+
+    #[test]
+    fn the_samples_heat_map_runs_from_blue_through_green_to_red() {
+        let rgba = samples_heat_rgba(&[16, 40, 64, 16]);
+        assert_eq!(&rgba[0..4], &[0, 0, 255, 255], "the fewest: blue");
+        assert_eq!(&rgba[4..8], &[0, 255, 0, 255], "half way: green");
+        assert_eq!(&rgba[8..12], &[255, 0, 0, 255], "the most: red");
+        assert_eq!(&rgba[12..16], &rgba[0..4]);
+        // One count everywhere (all converged at once): all blue, no division by zero.
+        assert_eq!(
+            samples_heat_rgba(&[32, 32]),
+            [0, 0, 255, 255, 0, 0, 255, 255]
+        );
+    }
 }

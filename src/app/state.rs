@@ -76,6 +76,9 @@ pub struct ViewState {
     pub bounces: u32,
     /// Adaptive sampling's noise threshold (`render --noise-threshold`); `None`: off.
     pub noise_threshold: Option<f32>,
+    /// With adaptive sampling, the display shows the samples each pixel took as a heat map
+    /// instead of the image.
+    pub show_samples: bool,
     /// Seed of the random sequence.
     pub seed: u32,
     /// Uniform sky radiance.
@@ -126,6 +129,7 @@ impl ViewState {
         let mut s = Self {
             bounces: base.bounces,
             noise_threshold: base.noise_threshold,
+            show_samples: false,
             seed: base.seed,
             sky: base.sky,
             env_intensity: base.env_intensity,
