@@ -52,7 +52,7 @@ inline Acc conv_accumulate(global const float* src0, int c0, const int up0,
 #pragma unroll
         for (int r = 0; r < DN_ROWS + 2; ++r) {
             if (r >= rows + 2)
-                break;
+                continue;
             // Input row y0 - 1 + r as three vectors: columns from x0 - 1, x0 and x0 + 1.
             vfloat v[3];
             if (up0 && from0) {
