@@ -17,26 +17,46 @@
 // Rows of a work item's block where it does not pool.
 #define DN_ROWS 4
 
-// Accumulates the 3x3 convolution of `c` channels of `src` (planes of `w` x `h`; read at half
-// the coordinates when `up`) for the block of `rows` rows whose top left pixel is (x0, y0) in
-// the convolution's resolution. `wt` points to the channels' weights: per input channel, 9
-// taps of DN_OCB values. Returns the weights after them.
-inline global const float* conv_channels(global const float* src, int c, const int up, int w,
-                                         int h, global const float* wt, int x0, int y0,
-                                         const int rows, vfloat acc[DN_OCB][DN_ROWS]) {
-    const int pitch = w + 2;
-    const int plane = tensor_plane(w, h);
-    for (int ic = 0; ic < c; ++ic) {
-        global const float* s = src + (size_t)ic * plane;
+// A work item's accumulators: DN_OCB output channels of DN_ROWS row vectors.
+typedef struct {
+    vfloat v[DN_OCB][DN_ROWS];
+} Acc;
+
+// The 3x3 convolution of concat(src0, src1) plus the bias for the block of `rows` rows whose
+// top left pixel is (x0, y0) in the convolution's resolution, before the ReLU. src0 has `c0`
+// channels and is read at half the coordinates when `up0`; src1 has `c1` at full resolution
+// (the weights' input channels are ordered so: the upsampled decoder features, then the
+// skip). `weights` holds, per block of DN_OCB output channels and input channel, 9 taps of
+// DN_OCB values. The accumulators are local to this one function so that the compiler keeps
+// them in registers: PoCL's CPU compiler treats every pointer as possibly aliasing an array
+// whose address is passed on, and stored them after every multiply-add.
+inline Acc conv_accumulate(global const float* src0, int c0, const int up0,
+                           global const float* src1, int c1, global const float* weights,
+                           global const float* bias, int ocb, int width, int height, int x0,
+                           int y0, const int rows) {
+    Acc acc;
+#pragma unroll
+    for (int o = 0; o < DN_OCB; ++o)
+#pragma unroll
+        for (int p = 0; p < DN_ROWS; ++p)
+            acc.v[o][p] = (vfloat)(bias[ocb + o]);
+    global const float* wt = weights + (size_t)ocb * (c0 + c1) * 9;
+    const int w0 = up0 ? width / 2 : width;
+    const int h0 = up0 ? height / 2 : height;
+    for (int ic = 0; ic < c0 + c1; ++ic) {
+        const int from0 = ic < c0;
+        const int w = from0 ? w0 : width;
+        const int pitch = w + 2;
+        global const float* s = from0 ? src0 + (size_t)ic * tensor_plane(w0, h0)
+                                      : src1 + (size_t)(ic - c0) * tensor_plane(width, height);
 #pragma unroll
         for (int r = 0; r < DN_ROWS + 2; ++r) {
             if (r >= rows + 2)
-                break;
+                continue;
             // Input row y0 - 1 + r as three vectors: columns from x0 - 1, x0 and x0 + 1.
             vfloat v[3];
-            if (up) {
-                const int yy = (y0 - 1 + r) >> 1;
-                upsampled_row(s + tensor_at(w, x0 >> 1, yy), v);
+            if (up0 && from0) {
+                upsampled_row(s + tensor_at(w, x0 >> 1, (y0 - 1 + r) >> 1), v);
             } else {
                 global const float* row = s + (y0 + r) * pitch + x0;
                 v[0] = vload_row(row);
@@ -53,30 +73,13 @@ inline global const float* conv_channels(global const float* src, int c, const i
                 for (int kx = 0; kx < 3; ++kx)
 #pragma unroll
                     for (int o = 0; o < DN_OCB; ++o)
-                        acc[o][p] = fma(v[kx], (vfloat)(wt[(ky * 3 + kx) * DN_OCB + o]), acc[o][p]);
+                        acc.v[o][p] = fma(v[kx], (vfloat)(wt[(ky * 3 + kx) * DN_OCB + o]),
+                                          acc.v[o][p]);
             }
         }
         wt += 9 * DN_OCB;
     }
-    return wt;
-}
-
-// The block's accumulators: the bias, then both sources' channels (src0's first, as the
-// weights' input channels are ordered: the upsampled decoder features, then the skip).
-inline void conv_block(global const float* src0, int c0, const int up0, global const float* src1,
-                       int c1, global const float* weights, global const float* bias, int ocb,
-                       int width, int height, int x0, int y0, const int rows,
-                       vfloat acc[DN_OCB][DN_ROWS]) {
-#pragma unroll
-    for (int o = 0; o < DN_OCB; ++o)
-#pragma unroll
-        for (int p = 0; p < DN_ROWS; ++p)
-            acc[o][p] = (vfloat)(bias[ocb + o]);
-    global const float* wt = weights + (size_t)ocb * (c0 + c1) * 9;
-    const int w0 = up0 ? width / 2 : width;
-    const int h0 = up0 ? height / 2 : height;
-    wt = conv_channels(src0, c0, up0, w0, h0, wt, x0, y0, rows, acc);
-    conv_channels(src1, c1, 0, width, height, wt, x0, y0, rows, acc);
+    return acc;
 }
 
 // The unpooled convolutions' body, written after the ReLU. `up0` is a constant in each kernel
@@ -89,8 +92,8 @@ inline void conv_rows(global const float* src0, int c0, const int up0, global co
     const int ocb = get_global_id(2) * DN_OCB;
     if (x0 >= width || y0 >= height)
         return;
-    vfloat acc[DN_OCB][DN_ROWS];
-    conv_block(src0, c0, up0, src1, c1, weights, bias, ocb, width, height, x0, y0, DN_ROWS, acc);
+    const Acc acc = conv_accumulate(src0, c0, up0, src1, c1, weights, bias, ocb, width, height,
+                                    x0, y0, DN_ROWS);
     const int plane = tensor_plane(width, height);
 #pragma unroll
     for (int o = 0; o < DN_OCB; ++o) {
@@ -98,7 +101,7 @@ inline void conv_rows(global const float* src0, int c0, const int up0, global co
 #pragma unroll
         for (int p = 0; p < DN_ROWS; ++p)
             if (y0 + p < height)
-                store_row(fmax(acc[o][p], 0.0f), d + tensor_at(width, x0, y0 + p), width - x0);
+                store_row(fmax(acc.v[o][p], 0.0f), d + tensor_at(width, x0, y0 + p), width - x0);
     }
 }
 
@@ -128,12 +131,12 @@ kernel void conv3x3_pool(global const float* src0, int c0, global const float* s
     const int ocb = get_global_id(2) * DN_OCB;
     if (x0 >= width || y0 >= height)
         return;
-    vfloat acc[DN_OCB][DN_ROWS];
-    conv_block(src0, c0, 0, src1, c1, weights, bias, ocb, width, height, x0, y0, 2, acc);
+    const Acc acc = conv_accumulate(src0, c0, 0, src1, c1, weights, bias, ocb, width, height,
+                                    x0, y0, 2);
     const int plane = tensor_plane(width / 2, height / 2);
 #pragma unroll
     for (int o = 0; o < DN_OCB; ++o) {
-        const vfloat m = fmax(fmax(acc[o][0], acc[o][1]), 0.0f);
+        const vfloat m = fmax(fmax(acc.v[o][0], acc.v[o][1]), 0.0f);
         store_half_row(pool_pairs(m), dst + (size_t)(ocb + o) * plane +
                                           tensor_at(width / 2, x0 / 2, y0 / 2),
                        (width - x0) / 2);

@@ -31,7 +31,7 @@ typedef uint16 vmask;
 typedef float16 ufloat; // the source an upsampled row's vectors are shuffled from
 #define vload_row(p) vload16(0, (p))
 #define vstore_row(v, p) vstore16((v), 0, (p))
-#define vstore_half(v, p) vstore8((v), 0, (p))
+#define vstore_pooled(v, p) vstore8((v), 0, (p))
 // Source lanes of the upsampled row's three vectors (see upsampled_row).
 #define UP_LEFT (vmask)(0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8)
 #define UP_CENTRE (vmask)(1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8, 8)
@@ -44,7 +44,7 @@ typedef uint2 vmask;
 typedef float4 ufloat;
 #define vload_row(p) vload2(0, (p))
 #define vstore_row(v, p) vstore2((v), 0, (p))
-#define vstore_half(v, p) (*(p) = (v))
+#define vstore_pooled(v, p) (*(p) = (v))
 #define UP_LEFT (vmask)(0, 1)
 #define UP_CENTRE (vmask)(1, 1)
 #define UP_RIGHT (vmask)(1, 2)
@@ -83,11 +83,11 @@ inline hfloat pool_pairs(vfloat v) {
 // Stores the first `n` lanes of a pooled half vector.
 inline void store_half_row(hfloat v, global float* p, int n) {
     if (n >= DN_VEC / 2) {
-        vstore_half(v, p);
+        vstore_pooled(v, p);
         return;
     }
     float lanes[DN_VEC / 2];
-    vstore_half(v, lanes);
+    vstore_pooled(v, lanes);
     for (int i = 0; i < n; ++i)
         p[i] = lanes[i];
 }

@@ -427,6 +427,37 @@ mod tests {
     }
 
     #[test]
+    fn a_tiled_image_matches_the_whole_one() {
+        let device = device();
+        let (w, h) = (320, 300);
+        let [c, a, n] = images(w, h);
+        let mut d = Denoiser::new(&device, Quality::Small).expect("denoiser");
+        let (whole, report) = d.denoise_host(&device, w, h, &c, &a, &n).expect("denoise");
+        assert_eq!(report.tiling.count(), 1);
+        // Room for a 288 x 304 tile but not for 320 x 304: two tiles across.
+        let per_pixel = d.network.tensor_bytes(64, 64) as f64 / 4096.0;
+        d.set_memory_limit((per_pixel * 300.0 * 304.0) as usize);
+        let (tiled, report) = d.denoise_host(&device, w, h, &c, &a, &n).expect("denoise");
+        assert_eq!(
+            (report.tiling.across, report.tiling.down),
+            (2, 1),
+            "{:?}",
+            report.tiling
+        );
+        // Each tile sees 96 pixels past its kept part, more than half the receptive field.
+        let tone = |v: f32| v / (1.0 + v);
+        let mse = whole
+            .iter()
+            .zip(&tiled)
+            .flat_map(|(p, q)| (0..3).map(move |k| (tone(p[k]) - tone(q[k])) as f64))
+            .map(|e| e * e)
+            .sum::<f64>()
+            / (3 * w * h) as f64;
+        let psnr = 10.0 * (1.0 / mse.max(1e-20)).log10();
+        assert!(psnr > 50.0, "tiled against whole: {psnr:.1} dB");
+    }
+
+    #[test]
     fn wrong_sizes_are_errors() {
         let device = device();
         let mut d = Denoiser::new(&device, Quality::Small).expect("denoiser");
