@@ -14,13 +14,46 @@ pub struct SavedView {
     /// The name `--view` takes.
     pub name: String,
     /// Eye position (scene units).
+    #[serde(with = "exact")]
     pub eye: [f64; 3],
     /// Unit view direction.
+    #[serde(with = "exact")]
     pub forward: [f64; 3],
     /// Unit up vector.
+    #[serde(with = "exact")]
     pub up: [f64; 3],
-    /// Vertical field of view in degrees.
-    pub yfov_degrees: f64,
+    /// Vertical field of view in radians (as the camera keeps it: degrees would not convert
+    /// back to the same bits).
+    #[serde(with = "exact")]
+    pub yfov_radians: [f64; 1],
+}
+
+/// f64 values written as the shortest decimal strings that read back to the same bits (Rust's
+/// `Display`) and read with `str::parse`, which is exact: serde_json's own number parser may be
+/// a unit in the last place off (its `float_roundtrip` feature, which is exact, also makes an
+/// f32 field of 1e39 in a glTF file an error instead of infinity), and a restored view must
+/// render bit for bit.
+mod exact {
+    use serde::de::Error;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer, const N: usize>(v: &[f64; N], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(v.iter().map(|x| x.to_string()))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>, const N: usize>(
+        d: D,
+    ) -> Result<[f64; N], D::Error> {
+        let texts = Vec::<String>::deserialize(d)?;
+        let values = texts
+            .iter()
+            .map(|t| t.parse::<f64>().map_err(|e| D::Error::custom(format!("{t:?}: {e}"))))
+            .collect::<Result<Vec<f64>, _>>()?;
+        let n = values.len();
+        values
+            .try_into()
+            .map_err(|_| D::Error::custom(format!("{n} numbers where {N} are needed")))
+    }
 }
 
 #[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
@@ -36,7 +69,7 @@ impl SavedView {
             eye: camera.eye.to_array(),
             forward: camera.forward.to_array(),
             up: camera.up.to_array(),
-            yfov_degrees: camera.yfov.to_degrees(),
+            yfov_radians: [camera.yfov],
         }
     }
 
@@ -47,7 +80,7 @@ impl SavedView {
             eye: DVec3::from(self.eye),
             forward: DVec3::from(self.forward),
             up: DVec3::from(self.up),
-            yfov: self.yfov_degrees.to_radians(),
+            yfov: self.yfov_radians[0],
         }
     }
 
@@ -57,8 +90,8 @@ impl SavedView {
             && finite(&self.forward)
             && finite(&self.up)
             && DVec3::from(self.forward).length() > 0.5
-            && self.yfov_degrees > 0.0
-            && self.yfov_degrees < 180.0
+            && self.yfov_radians[0] > 0.0
+            && self.yfov_radians[0] < std::f64::consts::PI
     }
 }
 
