@@ -11,6 +11,7 @@ use super::stats::{ImageError, image_error};
 use super::{device_json, device_line, plot};
 use crate::args::CommonArgs;
 use crate::date::today;
+use crate::denoise::{Denoiser, Quality};
 use crate::image_io::read_exr;
 use crate::render::Strategy;
 use anyhow::{Context, Result, bail};
@@ -50,6 +51,19 @@ pub struct ConvergeArgs {
     /// (`render --noise-threshold`), as a curve of its own named "CONFIG+adaptive".
     #[arg(long, value_parser = crate::args::parse_positive)]
     pub adaptive: Option<f32>,
+    /// Also denoise each step's image as `render --denoise` does, as a curve of its own named
+    /// "CONFIG+denoise" whose time adds that one denoising to the renders'. Both curves then
+    /// render with the guide buffers on.
+    #[arg(long)]
+    pub denoise: bool,
+    /// The denoiser's network with --denoise: full or small.
+    #[arg(
+        long,
+        value_name = "NETWORK",
+        default_value = "full",
+        requires = "denoise"
+    )]
+    pub denoiser: Quality,
     /// Write the steps as CSV here.
     #[arg(long)]
     pub csv: Option<PathBuf>,
@@ -127,6 +141,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     let mut settings = args.common.settings((ref_w, ref_h))?;
+    settings.aovs = args.denoise;
     let max_spp = args.common.sampling.spp.unwrap_or(1024);
     let configs = if args.configs.is_empty() {
         Config::ALL.to_vec()
@@ -162,8 +177,15 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         bail!("{source}: no light is left (no emissive triangles and --no-punctual)");
     }
     renderer.set_camera(&prepared.camera)?;
-    // Warm up: buffers, kernel caches, device clocks.
+    let mut denoiser = args
+        .denoise
+        .then(|| Denoiser::new(&renderer.device, args.denoiser))
+        .transpose()?;
+    // Warm up: buffers, kernel caches, device clocks (and the denoiser's tensors).
     renderer.render(1)?;
+    if let Some(d) = denoiser.as_mut() {
+        denoise(&mut renderer, d)?;
+    }
 
     let base_seed = settings.seed;
     let mut curves = Vec::new();
@@ -187,6 +209,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             None => config.name(),
         };
         let mut steps = Vec::new();
+        let mut denoised_steps = Vec::new();
         let mut seconds = 0.0;
         let mut spp = 0;
         let mut next = 1;
@@ -196,14 +219,27 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             renderer.render(next - spp)?;
             seconds += start.elapsed().as_secs_f64();
             spp = next;
+            let kernel_seconds = renderer.stats().kernel_ms() * 1e-3;
             let ImageError { rmse, relmse } = image_error(&renderer.image()?, &reference);
             steps.push(Step {
                 spp,
                 seconds,
-                kernel_seconds: renderer.stats().kernel_ms() * 1e-3,
+                kernel_seconds,
                 rmse,
                 relmse,
             });
+            if let Some(d) = denoiser.as_mut() {
+                // This step's image denoised: the renders' time and one denoising.
+                let (image, denoise_seconds) = denoise(&mut renderer, d)?;
+                let ImageError { rmse, relmse } = image_error(&image, &reference);
+                denoised_steps.push(Step {
+                    spp,
+                    seconds: seconds + denoise_seconds,
+                    kernel_seconds,
+                    rmse,
+                    relmse,
+                });
+            }
             next = (spp * 2).min(max_spp);
         }
         if renderer.stats().stack_overflows > 0 {
@@ -212,7 +248,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         if !args.json {
             eprintln!("penumbra: {name}: {spp} spp in {seconds:.2} s");
         }
+        let denoised_name = format!("{name}+denoise");
         curves.push(Curve::fit(name, steps, args.fit_from));
+        if !denoised_steps.is_empty() {
+            curves.push(Curve::fit(denoised_name, denoised_steps, args.fit_from));
+        }
     }
 
     let date = today();
@@ -247,6 +287,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             "max_spp": max_spp,
             "max_seconds": args.max_seconds,
             "noise_threshold": args.adaptive,
+            "denoiser": args.denoise.then(|| args.denoiser.name()),
             "fit_from": args.fit_from,
             "punctual_lights": prepared.lights.len(),
             "light_radius": if prepared.lights.is_empty() { 0.0 } else { prepared.shadows.point_radius() },
@@ -273,27 +314,27 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     );
     println!();
     println!(
-        "{:<10} {:>6} {:>10} {:>10} {:>12} {:>12}",
+        "{:<20} {:>6} {:>10} {:>10} {:>12} {:>12}",
         "config", "spp", "seconds", "kernel s", "RMSE", "relMSE"
     );
     for c in &curves {
         for s in &c.steps {
             println!(
-                "{:<10} {:>6} {:>10.4} {:>10.4} {:>12.4e} {:>12.4e}",
+                "{:<20} {:>6} {:>10.4} {:>10.4} {:>12.4e} {:>12.4e}",
                 c.config, s.spp, s.seconds, s.kernel_seconds, s.rmse, s.relmse
             );
         }
     }
     println!();
     println!(
-        "{:<10} {:>6} {:>12} {:>12} {:>11} {:>12}",
+        "{:<20} {:>6} {:>12} {:>12} {:>11} {:>12}",
         "config", "spp", "relMSE", "slope/time", "slope/spp", "efficiency"
     );
     let fmt = |s: Option<f64>| s.map_or_else(|| "-".into(), |v| format!("{v:.3}"));
     for c in &curves {
         let last = c.steps.last();
         println!(
-            "{:<10} {:>6} {:>12.4e} {:>12} {:>11} {:>12.4e}",
+            "{:<20} {:>6} {:>12.4e} {:>12} {:>11} {:>12.4e}",
             c.config,
             last.map_or(0, |s| s.spp),
             last.map_or(0.0, |s| s.relmse),
@@ -304,7 +345,26 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
     println!();
     println!("efficiency = 1 / (relMSE × seconds) at the last step; slope −1 = unbiased");
+    if args.denoise {
+        println!(
+            "CONFIG+denoise: each step's image denoised ({} network); its seconds add that \
+             one denoising to the renders'",
+            args.denoiser.name()
+        );
+    }
     Ok(())
+}
+
+/// The film denoised with the guide buffers (as `render --denoise` does it) and the seconds
+/// that took: reading the image and guides back, the network, reading the result.
+fn denoise(
+    renderer: &mut crate::render::Renderer,
+    denoiser: &mut Denoiser,
+) -> Result<(Vec<[f32; 3]>, f64)> {
+    let start = Instant::now();
+    let image = renderer.image()?;
+    let (out, _) = denoiser.denoise_render(renderer, &image)?;
+    Ok((out, start.elapsed().as_secs_f64()))
 }
 
 fn write_csv(path: &std::path::Path, curves: &[Curve]) -> Result<()> {

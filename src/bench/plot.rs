@@ -72,7 +72,11 @@ pub fn convergence(path: &Path, title: &str, subtitle: &str, curves: &[Curve]) -
         .map_err(|e| err(&e))?;
     chart
         .configure_mesh()
-        .x_desc("wall time of the renders (s)")
+        .x_desc(if curves.iter().any(|c| c.config.ends_with("+denoise")) {
+            "wall time of the renders, + denoising for the +denoise curves (s)"
+        } else {
+            "wall time of the renders (s)"
+        })
         .y_desc("relMSE against the reference")
         .x_label_formatter(&|v| format!("{v:.1e}"))
         .y_label_formatter(&|v| format!("{v:.0e}"))

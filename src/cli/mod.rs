@@ -103,6 +103,20 @@ pub struct RenderArgs {
         conflicts_with_all = ["noise_threshold", "time_limit"]
     )]
     pub sample_start: Option<u32>,
+    /// After the samples, denoise the image with Open Image Denoise's network on the device
+    /// (the guide buffers are kept for it): an .exr keeps the raw image and adds
+    /// denoised.R/G/B, a .png is the denoised image (default: off).
+    #[arg(long, conflicts_with = "sample_start")]
+    pub denoise: bool,
+    /// The denoiser's network: full, or small (about a third of the work, a little less
+    /// sharp) (default: full).
+    #[arg(
+        long,
+        value_name = "NETWORK",
+        default_value = "full",
+        requires = "denoise"
+    )]
+    pub denoiser: crate::denoise::Quality,
     /// Animation: the instant or the frames rendered.
     #[command(flatten)]
     pub animation: animate::AnimationArgs,
@@ -257,6 +271,43 @@ mod tests {
             ];
             let e = Cli::try_parse_from(line).expect_err("out of range");
             assert_eq!(e.exit_code(), 2, "{args:?}");
+        }
+    }
+
+    #[test]
+    fn denoise_takes_a_network_and_refuses_shards() {
+        let render = |extra: &[&str]| {
+            let mut line = vec!["penumbra", "render", "a.glb", "-o", "x.exr"];
+            line.extend_from_slice(extra);
+            Cli::try_parse_from(line)
+        };
+        let quality = |extra: &[&str]| match render(extra).expect("parses").command {
+            Some(Command::Render(r)) => (r.denoise, r.denoiser),
+            other => panic!("not a render: {other:?}"),
+        };
+        use crate::denoise::Quality;
+        assert_eq!(quality(&[]), (false, Quality::Full));
+        assert_eq!(quality(&["--denoise"]), (true, Quality::Full));
+        assert_eq!(
+            quality(&["--denoise", "--denoiser", "small"]),
+            (true, Quality::Small)
+        );
+        // A shard holds sums that only a merge makes an image of: nothing to denoise yet.
+        let e = render(&["--denoise", "--sample-start", "0"]).expect_err("a shard");
+        assert_eq!(e.kind(), clap::error::ErrorKind::ArgumentConflict);
+        assert_eq!(e.exit_code(), 2);
+        let line = usage_error(&e);
+        assert!(
+            line.contains("--denoise") && line.contains("--sample-start") && !line.contains('\n'),
+            "{line}"
+        );
+        // A network without --denoise, or one that does not exist, is a usage error too.
+        for extra in [
+            &["--denoiser", "small"][..],
+            &["--denoise", "--denoiser", "huge"],
+        ] {
+            let e = render(extra).expect_err("refused");
+            assert_eq!(e.exit_code(), 2, "{extra:?}");
         }
     }
 }

@@ -4,12 +4,13 @@
 use super::RenderArgs;
 use super::animate::{self, Frame};
 use crate::args::{EnvChoice, Prepared};
+use crate::denoise::{DenoiseReport, Denoiser};
 use crate::image_io::{Format, OutputFile, encode_exr, encode_exr_channels};
 use crate::render::background::{self, Background, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
 use crate::render::tonemap::{ToneMapper, encode_rgba_png, to_rgba8};
-use crate::shard::{Shard, ShardInfo};
 use crate::render::{RenderSettings, Renderer, SceneStats};
+use crate::shard::{Shard, ShardInfo};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -37,7 +38,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut settings = args.common.settings(DEFAULT_SIZE)?;
     args.strategy.apply(&mut settings);
     settings.noise_threshold = args.noise_threshold;
-    settings.aovs = args.aovs;
+    // The denoiser reads the guide buffers.
+    settings.aovs = args.aovs || args.denoise;
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
     if let Some(k) = args.sample_start
         && k.checked_add(spp).is_none()
@@ -81,11 +83,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         renderer.set_lens(settings.lens_radius, focus)?;
     }
 
-    let setup = Setup {
+    // The denoiser is built before the samples: its kernels fail now, not after the render.
+    let denoiser = if args.denoise {
+        let t = Instant::now();
+        let denoiser = Denoiser::new(&renderer.device, args.denoiser)?;
+        Some((denoiser, t.elapsed().as_secs_f64() * 1e3))
+    } else {
+        None
+    };
+    let mut setup = Setup {
         settings,
         spp,
         scene_stats,
         started,
+        denoiser,
     };
     for (k, frame) in frames.iter().enumerate() {
         // Each later frame: the scene posed anew and brought up to date on the renderer (the
@@ -113,7 +124,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         });
         render_frame(
             args,
-            &setup,
+            &mut setup,
             &mut renderer,
             &prepared,
             frame,
@@ -130,13 +141,15 @@ struct Setup {
     spp: u32,
     scene_stats: SceneStats,
     started: Instant,
+    /// With `--denoise`: the denoiser and the milliseconds its kernels and weights took to load.
+    denoiser: Option<(Denoiser, f64)>,
 }
 
 /// Renders the loaded scene, writes `frame`'s image to `output` and prints its summary line
 /// with the fields of `animation` added.
 fn render_frame(
     args: &RenderArgs,
-    setup: &Setup,
+    setup: &mut Setup,
     renderer: &mut Renderer,
     prepared: &Prepared,
     frame: &Frame,
@@ -148,6 +161,7 @@ fn render_frame(
         spp,
         scene_stats,
         started,
+        denoiser,
     } = setup;
     let spp = *spp;
     let bar = ProgressBar::new(spp as u64).with_style(
@@ -216,15 +230,26 @@ fn render_frame(
             args.scene.display()
         );
     }
+    let denoised = match denoiser {
+        Some((d, _)) => Some(denoise(renderer, d, &image)?),
+        None => None,
+    };
     let background = args.common.background;
     let mode = args.common.exposure_for(prepared);
-    let exposure = exposure_stops(&image, &coverage, background, mode);
+    // A PNG shows the denoised image, metered on itself: it is the better estimate of the
+    // converged image, whose metering the raw image's noise shifts (docs/denoiser.md).
+    let shown = denoised.as_ref().map_or(&image, |d| &d.image);
+    let exposure = exposure_stops(shown, &coverage, background, mode);
     let (w, h) = (settings.width, settings.height);
     let tonemap = args.common.exposure.tonemap;
     let alpha = background.cutout().then_some(&coverage[..]);
     let bytes = match (output.format, args.sample_start) {
-        (Format::Exr, None) if args.aovs => {
-            encode_exr_channels(w, h, &image, alpha, &aov_channels(renderer)?)?
+        (Format::Exr, None) if args.aovs || denoised.is_some() => {
+            let mut channels = denoised.as_ref().map_or_else(Vec::new, |d| d.channels());
+            if args.aovs {
+                channels.extend(aov_channels(renderer)?);
+            }
+            encode_exr_channels(w, h, &image, alpha, &channels)?
         }
         (Format::Exr, None) => encode_exr(w, h, &image, alpha)?,
         (Format::Exr, Some(sample_start)) => {
@@ -248,7 +273,7 @@ fn render_frame(
             }
             .encode()?
         }
-        (Format::Png, _) => encode_png(w, h, &image, &coverage, background, exposure, tonemap)?,
+        (Format::Png, _) => encode_png(w, h, shown, &coverage, background, exposure, tonemap)?,
     };
     output.write(&bytes)?;
     let adaptive = renderer.adaptive_stats()?;
@@ -364,6 +389,21 @@ fn render_frame(
     ] {
         summary[key] = value;
     }
+    summary["denoise"] = serde_json::json!(denoised.is_some());
+    if let (Some(d), Some((denoiser, build_ms))) = (&denoised, denoiser) {
+        summary["denoiser"] = serde_json::json!(denoiser.quality().name());
+        summary["denoiser_build_ms"] = serde_json::json!(build_ms);
+        summary["denoise_ms"] = serde_json::json!(d.ms);
+        summary["denoise_kernel_ms"] = serde_json::json!(d.report.kernel_ms);
+        let t = d.report.tiling;
+        summary["denoise_tiling"] = serde_json::json!({
+            "tiles": t.count(),
+            "across": t.across,
+            "down": t.down,
+            "tile_width": t.tile_w,
+            "tile_height": t.tile_h,
+        });
+    }
     if let serde_json::Value::Object(fields) = animation {
         for (key, value) in fields {
             summary[key] = value;
@@ -374,8 +414,11 @@ fn render_frame(
     } else {
         format!("{spp} spp")
     };
+    let denoised_in = denoised.as_ref().map_or_else(String::new, |d| {
+        format!(", denoised in {}", duration(d.ms * 1e-3))
+    });
     eprintln!(
-        "penumbra: wrote {}: {w}×{h} pixels, {taken}, rendered in {} ({} in all)",
+        "penumbra: wrote {}: {w}×{h} pixels, {taken}, rendered in {}{denoised_in} ({} in all)",
         frame.output.display(),
         duration(seconds),
         duration(started.elapsed().as_secs_f64())
@@ -497,6 +540,45 @@ pub(super) fn encode_png(
     encode_rgba_png(w, h, &rgba)
 }
 
+/// The denoised image of a render and what the summary says of the call.
+struct Denoised {
+    image: Vec<[f32; 3]>,
+    /// Wall time of the call: the guide buffers' read, the network and the image's read.
+    ms: f64,
+    report: DenoiseReport,
+}
+
+impl Denoised {
+    /// The EXR channels that hold it beside the raw image: `denoised.R/G/B`.
+    fn channels(&self) -> crate::image_io::Channels {
+        ["R", "G", "B"]
+            .iter()
+            .enumerate()
+            .map(|(c, name)| {
+                let plane = self.image.iter().map(|p| p[c]).collect();
+                (format!("denoised.{name}"), plane)
+            })
+            .collect()
+    }
+}
+
+/// Denoises `image` (the film read as linear RGB) with the renderer's guide buffers, on the
+/// renderer's device.
+fn denoise(
+    renderer: &mut Renderer,
+    denoiser: &mut Denoiser,
+    image: &[[f32; 3]],
+) -> Result<Denoised> {
+    let start = Instant::now();
+    let (mut out, report) = denoiser.denoise_render(renderer, image)?;
+    zero_nonfinite(&mut out);
+    Ok(Denoised {
+        image: out,
+        ms: start.elapsed().as_secs_f64() * 1e3,
+        report,
+    })
+}
+
 /// The identity of a shard ([`crate::shard::identity`]): the scene file's bytes and every
 /// setting that changes the linear image — size, bounces, seed, strategy, Russian roulette,
 /// sky and environment, lens and focus, background cut out or not (`RenderSettings`), the
@@ -528,7 +610,6 @@ fn shard_identity(
     Ok(crate::shard::identity(&parts))
 }
 
-/// Seconds for a person: "0.42 s", "12.3 s", "3 min 07 s".
 /// The guide buffers as named EXR channels (docs/aovs.md), with adaptive sampling's samples
 /// per pixel and error estimate.
 fn aov_channels(renderer: &mut crate::render::Renderer) -> Result<crate::image_io::Channels> {

@@ -11,6 +11,7 @@ pub mod tza;
 
 pub use crate::cl::FilmInput;
 use crate::cl::{Buffer, ClError, DenoiseKernels, Device, Launch};
+use crate::render::Renderer;
 use network::{Network, OUTPUT, Slot};
 pub use prepare::Tiling;
 
@@ -304,6 +305,22 @@ impl Denoiser {
             .collect();
         Ok((out, report))
     }
+
+    /// Denoises `image`, `renderer`'s film read as linear RGB ([`Renderer::image`]), with the
+    /// renderer's guide buffers, on its device (which must be this denoiser's). The renderer
+    /// keeps them with [`RenderSettings::aovs`](crate::render::RenderSettings::aovs).
+    pub fn denoise_render(
+        &mut self,
+        renderer: &mut Renderer,
+        image: &[[f32; 3]],
+    ) -> Result<(Vec<[f32; 3]>, DenoiseReport), DenoiseError> {
+        let aovs = renderer.aovs()?.ok_or_else(|| {
+            DenoiseError::Input("the render kept no guide buffers or took no sample".into())
+        })?;
+        let (w, h) = (renderer.settings().width, renderer.settings().height);
+        let (w, h) = (w as usize, h as usize);
+        self.denoise_host(&renderer.device, w, h, image, &aovs.albedo, &aovs.normal)
+    }
 }
 
 #[cfg(test)]
@@ -423,6 +440,48 @@ mod tests {
             }
             // The network changed the image: it is not the identity.
             assert!(got.iter().zip(&c).any(|(g, c)| (g[0] - c[0]).abs() > 0.05));
+        }
+    }
+
+    /// One very bright sample in a dark region (a firefly: a 16-spp pixel whose one sample
+    /// is 20,000 times the wall's radiance) is taken for noise and removed, as Intel's OIDN
+    /// does: no blotch is left around it (docs/denoiser.md, "Fireflies").
+    #[test]
+    fn an_isolated_firefly_leaves_no_blotch() {
+        let device = device();
+        let (w, h) = (64usize, 64usize);
+        // A dark diffuse wall at 16 spp: 0.05 with a few samples' noise.
+        let color: Vec<[f32; 3]> = (0..(w * h) as u32)
+            .map(|i| {
+                let jitter = (i.wrapping_mul(2_654_435_761) >> 20) as f32 / 4096.0;
+                [0.05 * (0.6 + 0.8 * jitter); 3]
+            })
+            .collect();
+        let (albedo, normal) = (
+            vec![[0.5; 3]; color.len()],
+            vec![[0.0, 0.0, 1.0]; color.len()],
+        );
+        let mut d = Denoiser::new(&device, Quality::Full).expect("denoiser");
+        let denoise = |d: &mut Denoiser, c: &[[f32; 3]]| {
+            d.denoise_host(&device, w, h, c, &albedo, &normal)
+                .expect("denoise")
+                .0
+        };
+        let clean = denoise(&mut d, &color);
+        let mut firefly = color.clone();
+        let centre = h / 2 * w + w / 2;
+        firefly[centre] = [0.05 + 1000.0 / 16.0; 3];
+        let out = denoise(&mut d, &firefly);
+        for y in h / 2 - 4..=h / 2 + 4 {
+            for x in w / 2 - 4..=w / 2 + 4 {
+                let i = y * w + x;
+                assert!(
+                    (out[i][1] - clean[i][1]).abs() <= 0.25 * clean[i][1],
+                    "({x}, {y}): {} beside {} without the firefly",
+                    out[i][1],
+                    clean[i][1]
+                );
+            }
         }
     }
 
