@@ -15,8 +15,8 @@ mod loading;
 mod pick;
 mod screenshot;
 mod state;
-mod timeline;
 mod stats;
+mod timeline;
 
 use crate::cl::DeviceChoice;
 use crate::render::background::{Background, unpremultiply};

@@ -47,7 +47,10 @@ mod exact {
         let texts = Vec::<String>::deserialize(d)?;
         let values = texts
             .iter()
-            .map(|t| t.parse::<f64>().map_err(|e| D::Error::custom(format!("{t:?}: {e}"))))
+            .map(|t| {
+                t.parse::<f64>()
+                    .map_err(|e| D::Error::custom(format!("{t:?}: {e}")))
+            })
             .collect::<Result<Vec<f64>, _>>()?;
         let n = values.len();
         values
