@@ -7,11 +7,9 @@
 //! images, for both networks, on three shared scenes. Without pyoidn it skips with a note
 //! (fails under CI=true); without PENUMBRA_SCENES it skips.
 //!
-//! Inputs: the colour is a 4-spp render (128 x 128) of each scene. The guides are made from a
-//! 64-spp render of the same view until the renderer writes albedo and normal layers: the
-//! albedo is that clean image compressed to [0, 1] (c / (1 + c)), the normal a height-field
-//! normal of its luminance (its gradient tilts (0, 0, 1)). Both carry the scene's edges and
-//! colours, as real guides do, and both denoisers see exactly the same ones.
+//! Inputs: a 4-spp render (128 x 128) of each scene with `--aovs`: its colour, and its albedo
+//! and normal layers (the renderer's own guide buffers, docs/aovs.md) as the guides; both
+//! denoisers see exactly the same ones.
 
 mod common;
 
@@ -40,25 +38,6 @@ fn psnr(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
     10.0 * (1.0 / mse.max(1e-20)).log10()
 }
 
-/// The guides made from a clean render (see the file's comment).
-fn guides(clean: &[[f32; 3]]) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
-    let albedo: Vec<[f32; 3]> = clean.iter().map(|p| p.map(|c| c / (1.0 + c))).collect();
-    let lum = |x: usize, y: usize| {
-        let p = albedo[y.min(SIZE - 1) * SIZE + x.min(SIZE - 1)];
-        0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
-    };
-    let mut normal = Vec::with_capacity(SIZE * SIZE);
-    for y in 0..SIZE {
-        for x in 0..SIZE {
-            let dx = 4.0 * (lum(x + 1, y) - lum(x.saturating_sub(1), y));
-            let dy = 4.0 * (lum(x, y + 1) - lum(x, y.saturating_sub(1)));
-            let len = (dx * dx + dy * dy + 1.0).sqrt();
-            normal.push([-dx / len, -dy / len, 1.0 / len]);
-        }
-    }
-    (albedo, normal)
-}
-
 #[test]
 fn the_network_agrees_with_intels_open_image_denoise() {
     let Some(scenes) = scenes_dir() else {
@@ -84,13 +63,12 @@ fn the_network_agrees_with_intels_open_image_denoise() {
     ] {
         let path = scenes.join(scene);
         let stem = path.file_stem().unwrap().to_string_lossy().to_string();
-        let render = |spp: &str| {
-            let out = dir.join(format!("{stem}_{spp}spp.exr"));
-            let args = ["--width", &size, "--height", &size, "--spp", spp];
-            render_exr(&path, &out, &args).1
-        };
-        let noisy = render("4");
-        let (albedo, normal) = guides(&render("64"));
+        let out = dir.join(format!("{stem}_4spp.exr"));
+        let args = ["--width", &size, "--height", &size, "--spp", "4", "--aovs"];
+        let noisy = render_exr(&path, &out, &args).1;
+        let (_, _, channels) = penumbra::image_io::read_exr_channels(&out).unwrap();
+        let albedo = layer(&channels, ["albedo.R", "albedo.G", "albedo.B"]);
+        let normal = layer(&channels, ["normal.X", "normal.Y", "normal.Z"]);
         for quality in [Quality::Full, Quality::Small] {
             let (intel, _) =
                 oidn::denoise(SIZE, SIZE, quality, "cpu", [&noisy, &albedo, &normal], 0)

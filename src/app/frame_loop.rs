@@ -101,6 +101,9 @@ pub struct Film {
     /// With [`FrameLoop::read_samples`] and adaptive sampling, the samples each pixel took;
     /// else empty.
     pub samples: Vec<u32>,
+    /// With [`FrameLoop::read_aovs`], the guide buffers of the same samples (for the
+    /// denoiser); else `None`.
+    pub aovs: Option<crate::render::Aovs>,
 }
 
 /// Figures for the overlay, as of the latest finished batch.
@@ -168,6 +171,8 @@ pub struct FrameLoop {
     pub film: Film,
     /// Whether each film also reads adaptive sampling's samples per pixel (for the heat map).
     pub read_samples: bool,
+    /// Whether each film also reads the guide buffers (for the denoiser).
+    pub read_aovs: bool,
     /// Figures for the overlay.
     pub progress: Progress,
     /// Figures from the last BVH rebuild.
@@ -195,6 +200,7 @@ impl FrameLoop {
             loaded: false,
             film: Film::default(),
             read_samples: false,
+            read_aovs: false,
             progress: Progress::default(),
             scene_stats: None,
         }
@@ -371,6 +377,10 @@ impl FrameLoop {
             true => self.renderer.pixel_samples()?.unwrap_or_default(),
             false => Vec::new(),
         };
+        let aovs = match self.read_aovs && settings.aovs {
+            true => self.renderer.aovs()?,
+            false => None,
+        };
         self.film = Film {
             width: size.0,
             height: size.1,
@@ -385,6 +395,7 @@ impl FrameLoop {
             answers: sample.answers.or(self.film.answers),
             view: sample.view,
             samples,
+            aovs,
         };
         let p = &mut self.progress;
         p.seconds += sample.ms * 1e-3;

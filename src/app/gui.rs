@@ -68,6 +68,8 @@ pub struct Info<'a> {
     pub last_screenshot: Option<&'a std::path::Path>,
     /// A device failure; rendering has stopped.
     pub device_error: Option<&'a str>,
+    /// How long the last denoising took, while the image is denoised.
+    pub denoise_ms: Option<f64>,
 }
 
 /// What the user asked for this frame.
@@ -285,6 +287,14 @@ impl Gui {
                         ui.checkbox(&mut v.show_samples, "show samples per pixel");
                     }
                 });
+                // The denoiser needs the guide buffers: turning it on or off builds the kernels.
+                if ui
+                    .checkbox(&mut v.denoise, "denoise (N)")
+                    .on_hover_text("Open Image Denoise's network on the device (docs/denoiser.md)")
+                    .changed()
+                {
+                    actions.changes.settings = true;
+                }
                 ui.horizontal_wrapped(|ui| {
                     let mut endless = v.spp_target.is_none();
                     if ui.checkbox(&mut endless, "endless").changed() {
@@ -761,8 +771,11 @@ fn live_figures(info: &Info) -> String {
     let latency = info
         .latency_ms
         .map_or_else(|| "–".to_string(), |ms| format!("{ms:.0} ms"));
+    let denoise = info
+        .denoise_ms
+        .map_or_else(String::new, |ms| format!(" · denoised in {ms:.0} ms"));
     format!(
-        "{:.1} images/s · input answered in {latency}",
+        "{:.1} images/s · input answered in {latency}{denoise}",
         info.images_per_second
     )
 }

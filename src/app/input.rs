@@ -177,6 +177,13 @@ impl App {
             KeyCode::Tab => self.overlay = !self.overlay,
             KeyCode::F1 => self.gui.help = !self.gui.help,
             KeyCode::Space => self.model.timeline.toggle(),
+            KeyCode::KeyN => {
+                self.model.view.denoise = !self.model.view.denoise;
+                self.frame_loop.invalidate(Changes {
+                    settings: true,
+                    ..Changes::default()
+                });
+            }
             KeyCode::F12 => self.screenshot(),
             _ => {}
         }

@@ -80,6 +80,7 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("F12", "screenshot (PNG + EXR in screenshots/)"),
     ("Tab", "hide / show the overlay"),
     ("F1", "this list in a window"),
+    ("N", "denoise the image on / off"),
     ("Space", "play / pause the animation"),
     ("Ctrl + Q", "quit (like closing the window)"),
     ("drop a file", "open a .gltf / .glb scene"),
@@ -196,6 +197,8 @@ pub fn run(config: ViewerConfig) -> Result<()> {
     let mut view = view;
     view.background = config.background;
     view.tone_mapper = config.tone_mapper;
+    // On by default where the network takes milliseconds (a GPU); a CPU takes seconds a frame.
+    view.denoise = renderer.device.info.is_gpu;
     let mut camera = CameraController::new(config.camera, &bounds);
     camera.collision = config.interior;
     let path_text = config
@@ -226,6 +229,9 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         stats,
         pump_image: false,
         display: Vec::new(),
+        denoiser: None,
+        denoised: None,
+        denoise_ms: None,
         display_key: None,
         display_generation: 0,
         loader: None,
@@ -290,6 +296,9 @@ struct Gfx {
     framework: Framework,
 }
 
+/// What a denoised image belongs to: the film's view, width and height.
+type FilmKey = (u64, u32, u32);
+
 struct App {
     /// The scene file (views are saved beside it); `None` for the bundled scene.
     scene_path: Option<PathBuf>,
@@ -322,8 +331,15 @@ struct App {
     pump_image: bool,
     /// The film tone-mapped (RGBA8), as on screen.
     display: Vec<u8>,
-    /// Exposure, tone mapper, samples, size and background of `display`.
-    display_key: Option<(f32, ToneMapper, u32, usize, u64, bool)>,
+    /// The denoiser, built on first use (and again for the other network).
+    denoiser: Option<crate::denoise::Denoiser>,
+    /// The latest denoised image and the view, width and height of the film it came from:
+    /// shown until a newer one of the same view is worth denoising (see `update_denoised`).
+    denoised: Option<(FilmKey, Vec<[f32; 3]>)>,
+    /// How long the last denoising took.
+    denoise_ms: Option<f64>,
+    /// Exposure, tone mapper, samples, size, background, heat map and denoised of `display`.
+    display_key: Option<(f32, ToneMapper, u32, usize, u64, bool, bool)>,
     /// Counts the changes of `display`.
     display_generation: u64,
     /// The scene file being loaded in the background.
@@ -518,7 +534,7 @@ impl App {
             width: film.width,
             height: film.height,
             rgba: &self.display,
-            linear: &film.pixels,
+            linear: self.shown_denoised().unwrap_or(&film.pixels),
             coverage: film.cutout.then_some(film.coverage.as_slice()),
         };
         match screenshot::save_timestamped(Path::new(screenshot::FOLDER), &shot) {
@@ -598,6 +614,7 @@ impl App {
         // two frames that say so first.
         let v = &self.model.view;
         self.frame_loop.read_samples = v.show_samples && v.noise_threshold.is_some();
+        self.frame_loop.read_aovs = v.denoise;
         let new_image = if self.builds_next() && self.notice_frames <= 2 {
             self.wake = Some(now);
             false
@@ -645,6 +662,7 @@ impl App {
             load_ms: self.load_ms,
             images_per_second: self.stats.images_per_second(now),
             latency_ms: self.stats.last_latency_ms,
+            denoise_ms: self.denoise_ms,
             loading: self.loader.as_ref().map(|l| l.path.as_path()),
             last_screenshot: self.last_screenshot.as_deref(),
             device_error: self.device_error.as_deref(),
@@ -852,7 +870,81 @@ impl App {
     /// Tone-maps the film when the film, the exposure, the tone mapper or the background
     /// changed, and composes the window's frame (the image beside the panel) when that or the
     /// layout changed.
+    /// The denoised image of the film on screen, when it is shown.
+    fn shown_denoised(&self) -> Option<&Vec<[f32; 3]>> {
+        let film = &self.frame_loop.film;
+        let key = (film.view, film.width, film.height);
+        self.denoised
+            .as_ref()
+            .filter(|(k, _)| self.model.view.denoise && *k == key)
+            .map(|(_, pixels)| pixels)
+    }
+
+    /// Denoises a new film when it is worth it: every image of a preview (the small network,
+    /// on images a fraction of the window's size), and at full quality the first image of a
+    /// view and each one whose samples per pixel doubled (the full network). Between those, the
+    /// last denoised image of the view stays on screen.
+    fn update_denoised(&mut self, new_image: bool) {
+        use crate::denoise::{Denoiser, Quality};
+        if !self.model.view.denoise {
+            self.denoised = None;
+            self.denoise_ms = None;
+            return;
+        }
+        let film = &self.frame_loop.film;
+        let Some(aovs) = film.aovs.as_ref().filter(|_| new_image) else {
+            return;
+        };
+        if aovs.albedo.len() != film.pixels.len() {
+            return;
+        }
+        let key = (film.view, film.width, film.height);
+        if self.denoised.as_ref().is_some_and(|(k, _)| *k != key) {
+            self.denoised = None;
+        }
+        let worth = !film.full_quality || film.spp.is_power_of_two() || self.denoised.is_none();
+        if !worth {
+            return;
+        }
+        let quality = if film.full_quality {
+            Quality::Full
+        } else {
+            Quality::Small
+        };
+        let device = &self.frame_loop.renderer.device;
+        if self
+            .denoiser
+            .as_ref()
+            .is_none_or(|d| d.quality() != quality)
+        {
+            match Denoiser::new(device, quality) {
+                Ok(d) => self.denoiser = Some(d),
+                Err(e) => {
+                    self.gui.file_error = Some(format!("denoiser: {e}"));
+                    self.model.view.denoise = false;
+                    return;
+                }
+            }
+        }
+        let Some(denoiser) = self.denoiser.as_mut() else {
+            return;
+        };
+        let t = Instant::now();
+        let (w, h) = (film.width as usize, film.height as usize);
+        match denoiser.denoise_host(device, w, h, &film.pixels, &aovs.albedo, &aovs.normal) {
+            Ok((pixels, _)) => {
+                self.denoised = Some((key, pixels));
+                self.denoise_ms = Some(t.elapsed().as_secs_f64() * 1e3);
+            }
+            Err(e) => {
+                self.gui.file_error = Some(format!("denoiser: {e}"));
+                self.model.view.denoise = false;
+            }
+        }
+    }
+
     fn update_display(&mut self, new_image: bool, dt: f64) {
+        self.update_denoised(new_image);
         let area = self.image_area();
         let Some(gfx) = self.gfx.as_mut() else {
             return;
@@ -893,6 +985,11 @@ impl App {
             Background::Color(c) => c.iter().fold(2u64, |h, x| h * 31 + x.to_bits() as u64),
         };
         let heat = v.show_samples && film.samples.len() == film.pixels.len();
+        let denoised = self
+            .denoised
+            .as_ref()
+            .filter(|(k, _)| v.denoise && *k == (film.view, film.width, film.height))
+            .map(|(_, pixels)| pixels);
         let key = (
             v.exposure,
             v.tone_mapper,
@@ -900,13 +997,20 @@ impl App {
             film.pixels.len(),
             background,
             heat,
+            denoised.is_some(),
         );
         if self.display_key != Some(key) || new_image {
             self.display_key = Some(key);
-            self.display = if heat {
-                samples_heat_rgba(&film.samples)
-            } else {
-                display_rgba(film, v.exposure, v.tone_mapper, v.background)
+            self.display = match denoised {
+                _ if heat => samples_heat_rgba(&film.samples),
+                Some(pixels) => {
+                    let shown = frame_loop::Film {
+                        pixels: pixels.clone(),
+                        ..film.clone()
+                    };
+                    display_rgba(&shown, v.exposure, v.tone_mapper, v.background)
+                }
+                None => display_rgba(film, v.exposure, v.tone_mapper, v.background),
             };
             self.display_generation += 1;
         }

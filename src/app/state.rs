@@ -79,6 +79,8 @@ pub struct ViewState {
     /// With adaptive sampling, the display shows the samples each pixel took as a heat map
     /// instead of the image.
     pub show_samples: bool,
+    /// The image is shown denoised (the guide buffers are rendered for it; docs/denoiser.md).
+    pub denoise: bool,
     /// Seed of the random sequence.
     pub seed: u32,
     /// Uniform sky radiance.
@@ -130,6 +132,7 @@ impl ViewState {
             bounces: base.bounces,
             noise_threshold: base.noise_threshold,
             show_samples: false,
+            denoise: false,
             seed: base.seed,
             sky: base.sky,
             env_intensity: base.env_intensity,
@@ -191,6 +194,7 @@ impl ViewState {
             lens_radius: self.aperture.max(0.0),
             focus_distance: self.focus_distance.max(1e-6),
             cutout: self.background.cutout(),
+            aovs: self.denoise || self.base.aovs,
             ..self.base.clone()
         }
     }
