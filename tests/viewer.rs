@@ -867,3 +867,59 @@ fn a_saved_view_is_restored_exactly_by_render_view() {
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("view 1") && err.lines().count() == 1, "{err}");
 }
+
+/// Grain: the mean absolute difference between each pixel and its 4×4 block's mean.
+fn grain(image: &Gray) -> f32 {
+    let blocks = image.blocks(4);
+    let bw = image.width / 4;
+    let (w, h) = (bw * 4, (image.height / 4) * 4);
+    let mut sum = 0.0;
+    for y in 0..h {
+        for x in 0..w {
+            sum += (image.at(x, y) - blocks[(y / 4) * bw + x / 4]).abs();
+        }
+    }
+    sum / (w * h) as f32
+}
+
+#[test]
+fn n_shows_the_image_denoised() {
+    let _serial = serial();
+    let Some(x) = Xvfb::start() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--width",
+        "320",
+        "--height",
+        "240",
+        "--spp",
+        "4",
+        "--no-overlay",
+        "--exposure",
+        "1.2",
+        "--tonemap",
+        "aces",
+    ];
+    let mut v = Viewer::spawn(viewer_command(&x, dir.path(), &args));
+    let wid = x.find_window();
+    x.xdotool(&["windowfocus", "--sync", &wid]);
+    v.wait_for("reached 4 spp");
+    x.xdotool(&["key", "F12"]);
+    let raw = load(&v.screenshot_path(dir.path()));
+    // N: the guide buffers are rendered, the image starts again and is shown denoised.
+    x.xdotool(&["key", "n"]);
+    v.wait_for("reached 4 spp");
+    std::thread::sleep(Duration::from_secs(1));
+    x.xdotool(&["key", "F12"]);
+    let denoised = load(&v.screenshot_path(dir.path()));
+    denoised.assert_not_blank("the denoised screenshot");
+    let (before, after) = (grain(&raw), grain(&denoised));
+    println!("grain at 4 spp: raw {before:.4}, denoised {after:.4}");
+    assert!(
+        after * 2.5 < before,
+        "grain raw {before:.4}, denoised {after:.4}"
+    );
+    // The same picture: block means agree.
+    let moved = picture_difference(&raw, &denoised);
+    assert!(moved < 0.05, "the denoised picture differs by {moved:.3}");
+}
