@@ -196,11 +196,23 @@ pub fn encode_exr_channels(
         );
         list.push(channel(name, values.clone()));
     }
+    encode_exr_layer(width, height, LayerAttributes::default(), list)
+}
+
+/// One EXR part of `channels` (any sample type, sorted by name as the format wants) with
+/// `attributes`, encoded in memory with [`EXR_ENCODING`].
+pub(crate) fn encode_exr_layer(
+    width: u32,
+    height: u32,
+    attributes: exr::meta::header::LayerAttributes,
+    channels: exr::prelude::SmallVec<[exr::image::AnyChannel<exr::image::FlatSamples>; 4]>,
+) -> Result<Vec<u8>> {
+    use exr::prelude::*;
     let layer = Layer::new(
         (width as usize, height as usize),
-        LayerAttributes::default(),
+        attributes,
         EXR_ENCODING,
-        AnyChannels::sort(list),
+        AnyChannels::sort(channels),
     );
     let mut bytes = std::io::Cursor::new(Vec::new());
     Image::from_layer(layer)
@@ -213,16 +225,7 @@ pub fn encode_exr_channels(
 /// Every float channel of an EXR file's first part by name, one value per pixel row by row
 /// from the top, with the image's width and height.
 pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, Channels)> {
-    use exr::prelude::*;
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .with_context(|| format!("{}: cannot read EXR", path.display()))?;
-    let layer = image.layer_data;
+    let layer = read_exr_layer(path)?;
     let channels = layer
         .channel_data
         .list

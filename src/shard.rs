@@ -10,7 +10,7 @@
 //! ([`film::image_into`]): the RGB(A) of a merge equals that of one render of the same samples.
 
 use crate::render::film::{self, FilmPixel};
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -141,18 +141,12 @@ impl Shard {
             Text::from(ATTRIBUTE),
             AttributeValue::Text(Text::from(serde_json::to_string(&self.info)?.as_str())),
         );
-        let layer = Layer::new(
-            (self.width as usize, self.height as usize),
+        crate::image_io::encode_exr_layer(
+            self.width,
+            self.height,
             attributes,
-            crate::image_io::EXR_ENCODING,
-            AnyChannels::sort(SmallVec::from_vec(channels)),
-        );
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        Image::from_layer(layer)
-            .write()
-            .to_buffered(&mut bytes)
-            .context("cannot encode EXR")?;
-        Ok(bytes.into_inner())
+            SmallVec::from_vec(channels),
+        )
     }
 
     /// Reads a shard EXR; one line naming the file and what is wrong otherwise.
