@@ -64,15 +64,24 @@ kernel void extend(global const DeviceBvhNode* nodes, global const DeviceTriangl
     SceneSurfaces surf = {shading,  uvs,      tangents, colors,
                           materials, tex_refs, textures, texels, instances};
     global const DevicePath* p = &paths[queue[i]];
-    DeviceHit hit = trace_scene(nodes, tris, instances, object_tris, &surf, p->origin.xyz,
-                                p->direction.xyz, 0.0f, INFINITY, false, &counters[COUNT_OVERFLOW]);
+    float3 o = p->origin.xyz, d = p->direction.xyz;
 #ifdef HAS_SINGLE_SIDED
-    // A camera ray (no BSDF sample made it, and it passed no surface: no flags) culls the
-    // backs of single-sided surfaces.
-    if (p->origin.w == 0.0f && as_uint(p->direction.w) == 0u) {
-        hit = camera_hit(nodes, tris, instances, object_tris, &surf, p->origin.xyz,
-                         p->direction.xyz, hit, &counters[COUNT_OVERFLOW]);
+    // A camera ray (no BSDF sample made it, and it passed no surface: no flags) culls the backs
+    // of single-sided surfaces as camera_hit does (path.h), written out here so that the kernel
+    // holds one inlined traversal instead of two (trace_scene, then camera_hit's).
+    bool culls = p->origin.w == 0.0f && as_uint(p->direction.w) == 0u;
+    float tmin = 0.0f;
+    DeviceHit hit;
+    for (uint k = 0u;; ++k) {
+        hit = trace_scene(nodes, tris, instances, object_tris, &surf, o, d, tmin, INFINITY, false,
+                          &counters[COUNT_OVERFLOW]);
+        if (!culls || k == MAX_CULLED || hit.prim == NO_HIT || !camera_culls(tris, &surf, hit, d))
+            break;
+        tmin = hit.t;
     }
+#else
+    DeviceHit hit = trace_scene(nodes, tris, instances, object_tris, &surf, o, d, 0.0f, INFINITY,
+                                false, &counters[COUNT_OVERFLOW]);
 #endif
     hits[i] = hit;
 }

@@ -607,7 +607,8 @@ inline bool camera_culls(global const DeviceTriangle* tris, const SceneSurfaces*
 // The hit a camera ray (o, d) sees, given the closest one, `hit`: the backs of single-sided
 // surfaces are passed as if absent, each further hit found beyond the last (as shadow rays
 // pass thin walls). Only camera rays cull: see docs/gltf-conformance.md for why the paths'
-// other rays meet both sides. The wavefront's `extend` and the megakernels use it this way.
+// other rays meet both sides. The megakernels use it this way; the wavefront's `extend` writes
+// the same loop out with a single traversal (stages.cl).
 #define DEFINE_CAMERA_HIT(NAME, NODES, TRACE)                                                  \
     inline DeviceHit NAME(NODES nodes, global const DeviceTriangle* tris,                         \
                           global const DeviceInstance* instances,                                 \
@@ -620,7 +621,6 @@ inline bool camera_culls(global const DeviceTriangle* tris, const SceneSurfaces*
         }                                                                                     \
         return hit;                                                                           \
     }
-DEFINE_CAMERA_HIT(camera_hit, global const DeviceBvhNode*, trace_scene)
 DEFINE_CAMERA_HIT(camera_hit_wide, global const DeviceWideNode*, trace_scene_wide)
 #ifdef SMALL_SCENE
 DEFINE_CAMERA_HIT(camera_hit_small, local const SmallScene*, trace_small_scene)
