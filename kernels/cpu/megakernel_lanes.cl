@@ -1,7 +1,7 @@
 // The path tracer as one kernel with its rays in vector lanes, for CPU devices with AVX-512 or
-// AVX2 (MEGA_LANES, set by the host: cl::lanes_megakernel in src/cl/program.rs): megakernel.cl's
-// estimator from the same random numbers, with the paths of a tile of pixels walking the 4-wide
-// BVH together, a ray a lane (traverse_lanes.h) or as packets (traverse_packet.h), and with
+// AVX2 (MEGA_LANES, set by the host: strategy::kernel_strategy in src/render/strategy.rs):
+// megakernel.cl's estimator from the same random numbers, with the paths of a tile of pixels
+// walking the 4-wide BVH together, a ray a lane (traverse_lanes.h) or as packets (traverse_packet.h), and with
 // LANES_SHADE their vertices shaded in batches (shade_lanes.h). Each pixel sums its samples in
 // megakernel.cl's order: the same image.
 
