@@ -24,7 +24,8 @@ typedef struct {
 // direction's coordinate x, or of +-1e-20 where x is nearer 0; f##pick(x, y, z, k) coordinate k
 // (0, 1 or 2) of (x, y, z); f##ray_axes(ax, ay, az, *kx, *ky, *kz) the axes of a direction of
 // magnitudes (ax, ay, az) that the watertight test permutes it to: kz the dominant one (the
-// first of equals but z), kx and ky the next ones round.
+// first of equals but z), kx and ky the next ones round; f##to_ray_axes(x, y, z, z0, z1, *px,
+// *py, *pz) (x, y, z) in those axes, by selects, for kz 0 (z0), 1 (z1) or 2 (neither).
 #define DEFINE_RAY_MATHS(Q, f, F, I)                                                               \
     Q F f##safe_rcp(F x) {                                                                         \
         return 1.0f / select(copysign((F)(1e-20f), x), x, fabs(x) > 1e-20f);                      \
@@ -34,6 +35,11 @@ typedef struct {
         *kz = select(select((I)(2), (I)(1), ay > az), select((I)(2), (I)(0), ax > az), ax > ay);   \
         *kx = select(select((I)(1), (I)(2), *kz == 1), (I)(0), *kz == 2);                          \
         *ky = select(select((I)(2), (I)(0), *kz == 1), (I)(1), *kz == 2);                          \
+    }                                                                                              \
+    Q void f##to_ray_axes(F x, F y, F z, I z0, I z1, F* px, F* py, F* pz) {                        \
+        *px = select(select(x, z, z1), y, z0);                                                     \
+        *py = select(select(y, x, z1), z, z0);                                                     \
+        *pz = select(select(z, y, z1), x, z0);                                                     \
     }
 
 DEFINE_RAY_MATHS(inline, , float, int)
@@ -45,9 +51,9 @@ DEFINE_RAY_MATHS(inline, , float, int)
 // (measured 2026-12-01). The program defines PERMUTE_BY_SELECT for devices other than CPUs.
 inline float4 ray_permute(float4 v, uint4 p) {
 #ifdef PERMUTE_BY_SELECT
-    bool z0 = p.z == 0u, z1 = p.z == 1u;
-    return (float4)(z0 ? v.y : z1 ? v.z : v.x, z0 ? v.z : z1 ? v.x : v.y,
-                    z0 ? v.x : z1 ? v.y : v.z, 0.0f);
+    float x, y, z;
+    to_ray_axes(v.x, v.y, v.z, p.z == 0u, p.z == 1u, &x, &y, &z);
+    return (float4)(x, y, z, 0.0f);
 #else
     return shuffle(v, p);
 #endif
