@@ -1,4 +1,5 @@
-// Random numbers (PCG-style hash chain) and sampling warps.
+// Random numbers (PCG-style hash chain) and sampling warps; what the CPU lanes use of them is
+// written once for both widths (DEFINE_SAMPLING_MATHS).
 #ifndef SHARED_RNG_H
 #define SHARED_RNG_H
 
