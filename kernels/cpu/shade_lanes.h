@@ -239,10 +239,18 @@ LANES_INLINE vfloat lv_length(LaneVec v) {
 // lanes_shadow_segment, lanes_goes_on), rng.h's sampling (lanes_rng_advance, lanes_rng_value,
 // lanes_onb, lanes_unit_circle, lanes_sample_cosine, lanes_sample_triangle), traverse.h's
 // surface point (lanes_barycentric, lanes_surface_point, lanes_triangle_normal,
-// lanes_offset_axis, lanes_offset_ray), bsdf.h's Lambertian BSDF (lanes_lambert_eval,
+// lanes_offset_step, lanes_offset_ray), bsdf.h's Lambertian BSDF (lanes_lambert_eval,
 // lanes_lambert_sample) and lights.h's emissive triangle sample (lanes_triangle_light_sample).
 DEFINE_VERTEX_MATHS(lanes, vfloat, vint, LaneVec, lv)
 DEFINE_SAMPLING_MATHS(LANES_INLINE, lanes_, vfloat, vint, vuint, LaneVec, lv)
+DEFINE_OFFSET_STEP(LANES_INLINE, lanes_, vfloat, vint)
+
+LANES_INLINE LaneVec lv_offset_step(LaneVec p, LaneVec offset) {
+    LaneVec r = {lanes_offset_step(p.x, offset.x), lanes_offset_step(p.y, offset.y),
+                 lanes_offset_step(p.z, offset.z)};
+    return r;
+}
+
 DEFINE_SURFACE_MATHS(LANES_INLINE, lanes_, vfloat, vint, vuint, LaneVec, lv)
 DEFINE_LAMBERT_MATHS(LANES_INLINE, lanes_, vfloat, vint, vuint, LaneVec, lv)
 DEFINE_TRIANGLE_LIGHT_MATHS(LANES_INLINE, lanes_, vfloat, vint, vuint, LaneVec, lv)

@@ -1075,7 +1075,7 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
         return select((F)(0.0f), cos_i * INV_PI_F, ok);                                            \
     }
 
-DEFINE_LAMBERT_MATHS(inline, , float, int, uint, float3, f3)
+DEFINE_LAMBERT_MATHS(SHADE_INLINE, , float, int, uint, float3, f3)
 
 inline float3 bsdf_eval(const SurfaceMaterial* m, float3 n, float3 wo_world, float3 wi_world,
                         float* pdf) {

@@ -52,7 +52,7 @@ typedef struct {
         return emits;                                                                              \
     }
 
-DEFINE_TRIANGLE_LIGHT_MATHS(inline, , float, int, uint, float3, f3)
+DEFINE_TRIANGLE_LIGHT_MATHS(SHADE_INLINE, , float, int, uint, float3, f3)
 
 // Spot cone attenuation as the glTF KHR_lights_punctual specification writes it.
 inline float spot_falloff(global const DeviceLight* l, float3 to_point) {

@@ -498,10 +498,6 @@ inline DeviceHit trace_scene(global const DeviceBvhNode* nodes, global const Dev
 //       Then normalize() as the OpenCL library computes it (the product by the reciprocal of
 //       the root of the squared length), less its rescaling for tiny or huge lengths: the
 //       largest coordinate is now in [1, 2);
-//   f##offset_axis(p, offset)  p + offset rounded one more float away from p: nextafter(po,
-//       +-INFINITY) on the bits, for finite po, one step of the magnitude away from zero where
-//       po's sign is the step's, towards zero where it is not, and from a zero the smallest
-//       number of the step's sign;
 //   f##offset_ray(p, err, n)  p, whose coordinates are off by at most err, moved off the surface
 //       along the geometric normal n (pointing to the side the ray leaves on) by the error bound
 //       projected on n, each coordinate then rounded one more ulp away (pbrt-v4's
@@ -535,20 +531,27 @@ inline DeviceHit trace_scene(global const DeviceBvhNode* nodes, global const Dev
         V n = v##_scale(cs, 1.0f / sqrt(cs.x * cs.x + cs.y * cs.y + cs.z * cs.z));                  \
         return v##_select(c, n, m > 0.0f);                                                         \
     }                                                                                              \
-    Q F f##offset_axis(F p, F offset) {                                                            \
+    Q V f##offset_ray(V p, V err, V n) {                                                           \
+        return v##_offset_step(p, v##_scale(n, v##_dot(v##_abs(n), err)));                         \
+    }
+
+// p + offset rounded one more float away from p, coordinate by coordinate, for floats (or float
+// vectors) F with integer masks I of their width: nextafter(po, +-INFINITY) on the bits, for
+// finite po, one step of the magnitude away from zero where po's sign is the step's, towards
+// zero where it is not, and from a zero the smallest number of the step's sign. For float3 it
+// is f3_offset_step, v##_offset_step of DEFINE_SURFACE_MATHS (the lanes' lv_offset_step applies
+// lanes_offset_step to each coordinate).
+#define DEFINE_OFFSET_STEP(Q, f, F, I)                                                             \
+    Q F f##offset_step(F p, F offset) {                                                            \
         F po = p + offset;                                                                         \
         I bits = as_##I(po);                                                                       \
         I away = (po > 0.0f) == (offset > 0.0f); /* the step goes away from zero */               \
         I stepped = select(bits - 1, bits + 1, away);                                              \
         stepped = select(stepped, select((I)(0x80000001), (I)(1), offset > 0.0f), po == 0.0f);     \
         return select(po, as_##F(stepped), offset != 0.0f);                                        \
-    }                                                                                              \
-    Q V f##offset_ray(V p, V err, V n) {                                                           \
-        F k = v##_dot(v##_abs(n), err);                                                            \
-        return v##_make(f##offset_axis(p.x, k * n.x), f##offset_axis(p.y, k * n.y),                \
-                        f##offset_axis(p.z, k * n.z));                                             \
     }
 
+DEFINE_OFFSET_STEP(inline, f3_, float3, int3)
 DEFINE_SURFACE_MATHS(inline, , float, int, uint, float3, f3)
 
 #endif  // SHARED_TRAVERSE_H

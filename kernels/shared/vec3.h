@@ -8,8 +8,8 @@
 // give 1, vector ones -1; select() takes either, and the bodies combine masks with & | and !,
 // never ~), unsigned integers U, and 3-vectors V with fields x, y, z whose operations are
 // named v##_make, v##_splat, v##_add, v##_sub, v##_mul, v##_scale, v##_div, v##_neg, v##_abs,
-// v##_max, v##_select, v##_dot, v##_cross, v##_length, v##_positive and v##_any (f3_* below;
-// the lanes' lv_*). The generators are DEFINE_SAMPLING_MATHS (rng.h), DEFINE_RAY_MATHS (F and
+// v##_max, v##_select, v##_dot, v##_cross, v##_length, v##_positive, v##_any and
+// v##_offset_step (f3_* below, f3_offset_step in traverse.h; the lanes' lv_*). The generators are DEFINE_SAMPLING_MATHS (rng.h), DEFINE_RAY_MATHS (F and
 // I only) and DEFINE_SURFACE_MATHS (traverse.h), DEFINE_LAMBERT_MATHS (bsdf.h),
 // DEFINE_TRIANGLE_LIGHT_MATHS (lights.h) and DEFINE_VERTEX_MATHS (path.h, with its own naming).
 //
