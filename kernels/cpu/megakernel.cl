@@ -129,7 +129,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             }
             if (!alive) break;
         }
-        mega_add_sample(&s, &sum, &counted, &nonfinite);
+        mega_add_sample(s.radiance, (s.flags & PATH_ESCAPED) != 0u, &sum, &counted, &nonfinite);
         if (frame.adaptive != 0u) half_add(s.radiance, frame.first_sample + j, &even, &evens);
 #ifdef AOVS
         aov_add(&s.aov, &aov_albedo_sum, &aov_normal_sum, &aov_depth_sum);

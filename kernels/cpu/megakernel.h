@@ -49,12 +49,13 @@ inline ShadeScene mega_shade_scene(DeviceEnvironment environment,
     return sc;
 }
 
-// A finished sample: its radiance added to the pixel's sum (a non-finite one dropped and
-// counted), and counted in the film's .w when its camera ray hit.
-inline void mega_add_sample(const PathState* s, ulong3* sum, uint* counted, uint* nonfinite) {
-    *counted += (s->flags & PATH_ESCAPED) == 0u;
-    if (all(isfinite(s->radiance))) {
-        film_add(sum, s->radiance);
+// A finished sample of radiance `radiance`: added to the pixel's sum (a non-finite one dropped
+// and counted), and counted in the film's .w unless its camera ray escaped.
+inline void mega_add_sample(float3 radiance, bool escaped, ulong3* sum, uint* counted,
+                            uint* nonfinite) {
+    *counted += !escaped;
+    if (all(isfinite(radiance))) {
+        film_add(sum, radiance);
     } else {
         ++*nonfinite;
     }

@@ -1,7 +1,7 @@
 // The path tracer as one kernel with its rays in vector lanes, for CPU devices with AVX-512 or
-// AVX2 (MEGA_LANES, set by the host: cl::lanes_megakernel in src/cl/program.rs): megakernel.cl's
-// estimator from the same random numbers, with the paths of a tile of pixels walking the 4-wide
-// BVH together, a ray a lane (traverse_lanes.h) or as packets (traverse_packet.h), and with
+// AVX2 (MEGA_LANES, set by the host: strategy::kernel_strategy in src/render/strategy.rs):
+// megakernel.cl's estimator from the same random numbers, with the paths of a tile of pixels
+// walking the 4-wide BVH together, a ray a lane (traverse_lanes.h) or as packets (traverse_packet.h), and with
 // LANES_SHADE their vertices shaded in batches (shade_lanes.h). Each pixel sums its samples in
 // megakernel.cl's order: the same image.
 
@@ -92,14 +92,10 @@ inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global ulong4
         float3 even = (float3)(0.0f);
         uint evens = 0u;
         for (; e < c->count && c->pixel[e] == p; ++e, ++samples) {
-            counted += ((c->escaped >> e) & 1u) == 0u;
+            mega_add_sample(c->result[e], ((c->escaped >> e) & 1u) != 0u, &sum, &counted,
+                            &W->nonfinite);
             // The index's parity from the chunk's bit: 0 for even, 1 for odd.
             half_add(c->result[e], ((c->even >> e) & 1u) ^ 1u, &even, &evens);
-            if (all(isfinite(c->result[e]))) {
-                film_add(&sum, c->result[e]);
-            } else {
-                ++W->nonfinite;
-            }
         }
         uint n = frame->background == BACKGROUND_ENV ? samples : counted;
         film[p] = (ulong4)(sum, f.w + n);

@@ -8,21 +8,18 @@
 //
 // It is path.h's shade_vertex for the scenes whose shading is simplest: every material
 // Lambertian, no textures, environment map, unlit materials, thin walls or two levels
-// (LANES_SHADE, set by the host: cl::lanes_shade in src/cl/program.rs). Each lane computes what
-// shade_vertex computes, operation for operation in the same order (the OpenCL library's dot,
-// cross and length spelled out as it computes them; PoCL's compiler fuses scalar products into
-// sums but not vector ones, so the few that it fuses in the scalar form are written fma()
-// here), draws the same random numbers, and samples an emissive triangle as sample_light does
-// (other lights by sample_light itself, lane by lane): the same paths, bit for bit
-// (tests/megakernel.rs compares the images). A chunk's camera hits, LANES or fewer at once, are
-// shaded here too. What does not depend on the material is path.h's, one definition for both
-// widths (DEFINE_VERTEX_MATHS: the MIS weights, Russian roulette's probability, the shading
-// normal, the light sample's test, contribution and shadow segment, whether the path goes on).
-// The rest is still written here a second time, in vectors, operation for operation: the hit's
-// point, error bound and normal and the offset rays (traverse.h's surface_point,
-// triangle_normal, offset_ray), the Lambertian BSDF's evaluation and cosine sample (bsdf.h's
-// LAMBERT_ONLY forms, rng.h's unit_circle and onb) and an emissive triangle's sample
-// (lights.h); a change to those is made in both places.
+// (LANES_SHADE, set by the host: strategy::kernel_strategy in src/render/strategy.rs). Each lane
+// computes what shade_vertex computes, draws the same random numbers, and samples an emissive
+// triangle as sample_light does (other lights by sample_light itself, lane by lane): the same
+// paths, bit for bit (tests/megakernel.rs compares the images). A chunk's camera hits, LANES or
+// fewer at once, are shaded here too. The maths is the scalar path's, each function defined once
+// for both widths by its generator (shared/vec3.h): the vertex's MIS weights, Russian
+// roulette, normals, light sample test and shadow segment (path.h), the random numbers, onb and
+// cosine and triangle sampling (rng.h), the hit's point, error bound and normal and the offset
+// rays (traverse.h), the Lambertian BSDF's evaluation and sample (bsdf.h) and an emissive
+// triangle's sample (lights.h). What is written here is only the lanes' own: the batch, the
+// loads of triangles, materials and normals as rows, and the order of shade_vertex's steps
+// over masks instead of branches.
 // Batches took 11.7 % fewer instructions on the 1 M-triangle room and about 12 % less time
 // (AMD Zen 3, AVX2, 2026-12-04); shading the lanes done at each return instead (commit 29fe987)
 // was no faster: too few to fill the vectors.
@@ -30,10 +27,13 @@
 #define CPU_SHADE_LANES_H
 
 #include "shared/types.h"
+#include "shared/vec3.h"
 #include "shared/rng.h"
 #include "shared/textures.h"
+#include "shared/traverse.h"
 #include "cpu/simd.h"
 #include "cpu/traverse_lanes.h"
+#include "shared/bsdf.h"
 #include "shared/lights.h"
 #include "shared/path.h"
 
@@ -44,7 +44,7 @@
     defined(HAS_CLEARCOAT) || defined(HAS_SHEEN) || defined(HAS_DIFFUSE_TRANSMISSION) ||     \
     defined(HAS_ANISOTROPY) || defined(HAS_DISPERSION) || defined(SMALL_SCENE) ||            \
     defined(HAS_IRIDESCENCE) || defined(HAS_VERTEX_COLORS)
-#error "LANES_SHADE is for the lanes of scenes whose shading is simplest (cl::lanes_shade)"
+#error "LANES_SHADE is for the lanes of scenes whose shading is simplest (strategy::kernel_strategy)"
 #endif
 
 // A batch of vertices to shade, field by field: entry e is a path's state (a PathState's fields
@@ -113,6 +113,8 @@ LANES_INLINE bool shade_batch_get(const ShadeBatch* B, int e, PathState* s, Shad
     return alive;
 }
 
+// A 3-vector a lane, with shared/vec3.h's operations (lv_*), each as the OpenCL library
+// computes it on float3.
 typedef struct {
     vfloat x, y, z;
 } LaneVec;
@@ -128,6 +130,16 @@ LANES_INLINE void lv_store(LaneVec v, float* x, float* y, float* z) {
     vstore_lanes(v.z, 0, z);
 }
 
+LANES_INLINE LaneVec lv_make(vfloat x, vfloat y, vfloat z) {
+    LaneVec r = {x, y, z};
+    return r;
+}
+
+LANES_INLINE LaneVec lv_splat(vfloat s) {
+    LaneVec r = {s, s, s};
+    return r;
+}
+
 LANES_INLINE LaneVec lv_select(LaneVec a, LaneVec b, vint m) {
     LaneVec r = {select(a.x, b.x, m), select(a.y, b.y, m), select(a.z, b.z, m)};
     return r;
@@ -135,6 +147,11 @@ LANES_INLINE LaneVec lv_select(LaneVec a, LaneVec b, vint m) {
 
 LANES_INLINE LaneVec lv_neg(LaneVec a) {
     LaneVec r = {-a.x, -a.y, -a.z};
+    return r;
+}
+
+LANES_INLINE LaneVec lv_add(LaneVec a, LaneVec b) {
+    LaneVec r = {a.x + b.x, a.y + b.y, a.z + b.z};
     return r;
 }
 
@@ -157,6 +174,27 @@ LANES_INLINE LaneVec lv_div(LaneVec a, vfloat s) {
     LaneVec r = {a.x / s, a.y / s, a.z / s};
     return r;
 }
+
+LANES_INLINE LaneVec lv_abs(LaneVec a) {
+    LaneVec r = {fabs(a.x), fabs(a.y), fabs(a.z)};
+    return r;
+}
+
+LANES_INLINE LaneVec lv_max(LaneVec a, LaneVec b) {
+    LaneVec r = {fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)};
+    return r;
+}
+
+// The OpenCL library's cross of float3: each coordinate's two products, then their difference.
+LANES_INLINE LaneVec lv_cross(LaneVec a, LaneVec b) {
+    vfloat c1 = a.y * b.z, c2 = a.z * b.y;
+    vfloat c3 = a.z * b.x, c4 = a.x * b.z;
+    vfloat c5 = a.x * b.y, c6 = a.y * b.x;
+    LaneVec r = {c1 - c2, c3 - c4, c5 - c6};
+    return r;
+}
+
+LANES_INLINE bool lv_any(vint m) { return lanes_any(m); }
 
 // The lanes where some component is positive.
 LANES_INLINE vint lv_positive(LaneVec a) {
@@ -195,102 +233,33 @@ LANES_INLINE vfloat lv_length(LaneVec v) {
     return select(len, (vfloat)(0.0f), zero);
 }
 
-// path.h's vertex maths in every lane: lanes_power_heuristic, lanes_emitter_pdf,
-// lanes_light_sample_weight, lanes_survival, lanes_shading_normal, lanes_side_normal,
-// lanes_light_sample_faces, lanes_light_contribution, lanes_shadow_segment, lanes_goes_on.
+// The maths shared with one ray at a time, in every lane (shared/vec3.h): path.h's vertex maths
+// (lanes_power_heuristic, lanes_emitter_pdf, lanes_light_sample_weight, lanes_survival,
+// lanes_shading_normal, lanes_side_normal, lanes_light_sample_faces, lanes_light_contribution,
+// lanes_shadow_segment, lanes_goes_on), rng.h's sampling (lanes_rng_advance, lanes_rng_value,
+// lanes_onb, lanes_unit_circle, lanes_sample_cosine, lanes_sample_triangle), traverse.h's
+// surface point (lanes_barycentric, lanes_surface_point, lanes_triangle_normal,
+// lanes_offset_step, lanes_offset_ray), bsdf.h's Lambertian BSDF (lanes_lambert_eval,
+// lanes_lambert_sample) and lights.h's emissive triangle sample (lanes_triangle_light_sample).
 DEFINE_VERTEX_MATHS(lanes, vfloat, vint, LaneVec, lv)
+DEFINE_SAMPLING_MATHS(LANES_INLINE, lanes_, vfloat, vint, vuint, LaneVec, lv)
+DEFINE_OFFSET_STEP(LANES_INLINE, lanes_, vfloat, vint)
 
-
-// rng_next in the lanes of m (the others' states kept; their numbers are meaningless).
-LANES_INLINE vfloat lanes_rng_next(vuint* state, vint m) {
-    vuint s = *state * 747796405u + 2891336453u;
-    vuint word = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
-    word = (word >> 22u) ^ word;
-    *state = select(*state, s, m);
-    return convert_vfloat(word >> 8u) * (1.0f / 16777216.0f);
-}
-
-// offset_ray (traverse.h) in every lane, one axis: the point's coordinate p moved by the
-// offset k along the normal's coordinate n, then one float further away.
-LANES_INLINE vfloat lanes_offset_axis(vfloat p, vfloat k, vfloat n) {
-    vfloat offset = k * n;
-    vfloat po = p + offset;
-    vint bits = as_vint(po);
-    vint away = (po > 0.0f) == (offset > 0.0f);
-    vint stepped = select(bits - 1, bits + 1, away);
-    stepped = select(stepped, select((vint)(0x80000001), (vint)(1), offset > 0.0f), po == 0.0f);
-    return select(po, as_vfloat(stepped), offset != 0.0f);
-}
-
-// offset_ray (traverse.h) in every lane.
-LANES_INLINE LaneVec lanes_offset_ray(LaneVec p, LaneVec err, LaneVec n) {
-    LaneVec an = {fabs(n.x), fabs(n.y), fabs(n.z)};
-    vfloat k = lv_dot(an, err);
-    LaneVec r = {lanes_offset_axis(p.x, k, n.x), lanes_offset_axis(p.y, k, n.y),
-                 lanes_offset_axis(p.z, k, n.z)};
+LANES_INLINE LaneVec lv_offset_step(LaneVec p, LaneVec offset) {
+    LaneVec r = {lanes_offset_step(p.x, offset.x), lanes_offset_step(p.y, offset.y),
+                 lanes_offset_step(p.z, offset.z)};
     return r;
 }
 
-// unit_circle (rng.h) in every lane: (cos, sin) of 2 pi u, fused where the scalar form is.
-LANES_INLINE void lanes_unit_circle(vfloat u, vfloat* cx, vfloat* cy) {
-    vfloat q = rint(4.0f * u);
-    vfloat x = fma(q, (vfloat)(-0.25f), u) * (2.0f * PI_F);
-    vfloat x2 = x * x;
-    vfloat s = fma(x * x2,
-                    fma(x2, fma(x2, fma(x2, (vfloat)(1.0f / 362880.0f), (vfloat)(-1.0f / 5040.0f)),
-                                (vfloat)(1.0f / 120.0f)),
-                        (vfloat)(-1.0f / 6.0f)),
-                    x);
-    vfloat c = fma(x2,
-                    fma(x2, fma(x2, fma(x2, (vfloat)(1.0f / 40320.0f), (vfloat)(-1.0f / 720.0f)),
-                                (vfloat)(1.0f / 24.0f)),
-                        (vfloat)(-0.5f)),
-                    (vfloat)(1.0f));
-    vuint k = convert_vuint(q) & 3u;
-    vint odd = as_vint(k & 1u) != 0, back = as_vint(k & 2u) != 0;
-    vfloat px = select(c, -s, odd), py = select(s, c, odd);
-    *cx = select(px, -px, back);
-    *cy = select(py, -py, back);
-}
+DEFINE_SURFACE_MATHS(LANES_INLINE, lanes_, vfloat, vint, vuint, LaneVec, lv)
+DEFINE_LAMBERT_MATHS(LANES_INLINE, lanes_, vfloat, vint, vuint, LaneVec, lv)
+DEFINE_TRIANGLE_LIGHT_MATHS(LANES_INLINE, lanes_, vfloat, vint, vuint, LaneVec, lv)
 
-// surface_point (traverse.h) in every lane: the point at barycentrics (u, v) and its error bound.
-LANES_INLINE LaneVec lanes_surface_point(LaneVec v0, LaneVec v1, LaneVec v2, vfloat u, vfloat v,
-                                         LaneVec* err) {
-    const float gamma7 = 7.0f * 0x1p-24f / (1.0f - 7.0f * 0x1p-24f);
-    const float gamma64 = 64.0f * 0x1p-24f / (1.0f - 64.0f * 0x1p-24f);
-    vfloat w = 1.0f - u - v;
-    LaneVec p = {w * v0.x + u * v1.x + v * v2.x, w * v0.y + u * v1.y + v * v2.y,
-                 w * v0.z + u * v1.z + v * v2.z};
-    vfloat ex = fmax(fmax(fabs(v0.x - p.x), fabs(v1.x - p.x)), fabs(v2.x - p.x));
-    vfloat ey = fmax(fmax(fabs(v0.y - p.y), fabs(v1.y - p.y)), fabs(v2.y - p.y));
-    vfloat ez = fmax(fmax(fabs(v0.z - p.z), fabs(v1.z - p.z)), fabs(v2.z - p.z));
-    vfloat reach = fmax(fmax(ex, ey), ez);
-    err->x = gamma7 * (fabs(w * v0.x) + fabs(u * v1.x) + fabs(v * v2.x)) + gamma64 * reach;
-    err->y = gamma7 * (fabs(w * v0.y) + fabs(u * v1.y) + fabs(v * v2.y)) + gamma64 * reach;
-    err->z = gamma7 * (fabs(w * v0.z) + fabs(u * v1.z) + fabs(v * v2.z)) + gamma64 * reach;
-    return p;
-}
-
-// triangle_normal (traverse.h) in the lanes of m: the library's cross, scaled by a power of
-// two, normalized.
-LANES_INLINE LaneVec lanes_triangle_normal(LaneVec v0, LaneVec v1, LaneVec v2, vint m) {
-    LaneVec a = {v1.x - v0.x, v1.y - v0.y, v1.z - v0.z};
-    LaneVec b = {v2.x - v0.x, v2.y - v0.y, v2.z - v0.z};
-    vfloat c1 = a.y * b.z, c2 = a.z * b.y;
-    vfloat c3 = a.z * b.x, c4 = a.x * b.z;
-    vfloat c5 = a.x * b.y, c6 = a.y * b.x;
-    LaneVec c = {c1 - c2, c3 - c4, c5 - c6};
-    vfloat mc = fmax(fmax(fabs(c.x), fabs(c.y)), fabs(c.z));
-    vuint e = (as_vuint(mc) >> 23u) & 0xffu;
-    vint normal_e = (e - 1u) < (vuint)(253u);
-    vfloat scale = as_vfloat((254u - e) << 23u);
-    if (lanes_any(m & ~normal_e)) {
-        scale = select(ldexp((vfloat)(1.0f), -ilogb(mc)), scale, normal_e);
-    }
-    LaneVec cs = {c.x * scale, c.y * scale, c.z * scale};
-    vfloat inv = 1.0f / sqrt(cs.x * cs.x + cs.y * cs.y + cs.z * cs.z);
-    LaneVec n = {cs.x * inv, cs.y * inv, cs.z * inv};
-    return lv_select(c, n, mc > 0.0f);
+// rng_next in the lanes of m (the others' states kept; their numbers are meaningless).
+LANES_INLINE vfloat lanes_rng_next(vuint* state, vint m) {
+    vuint s = lanes_rng_advance(*state);
+    *state = select(*state, s, m);
+    return lanes_rng_value(s);
 }
 
 // A triangle's vertices (words 0-11 of each lane's DeviceTriangle at word offset off[l]) and its
@@ -355,7 +324,7 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
         vfloat w0 = 1.0f - hu - hv;
         LaneVec perr;
         LaneVec p = lanes_surface_point(v0, v1, v2, hu, hv, &perr);
-        LaneVec ng = lanes_triangle_normal(v0, v1, v2, m);
+        LaneVec ng = lanes_triangle_normal(v0, v1, v2);
         vint front = lv_dot(ng, wo) > 0.0f;
         // The material's base color and emission (lanes outside m read material 0).
         int moff[LANES];
@@ -406,8 +375,8 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
             float n8_[LANES];
             for (int l = 0; l < LANES; ++l) n8_[l] = shw[soff[l] + 8];
             vfloat n8 = vload_lanes(0, n8_);
-            LaneVec sn = {w0 * N[0] + hu * N[3] + hv * N[6], w0 * N[1] + hu * N[4] + hv * N[7],
-                          w0 * N[2] + hu * N[5] + hv * n8};
+            LaneVec sn = lanes_barycentric(lv_make(N[0], N[1], N[2]), lv_make(N[3], N[4], N[5]),
+                                           lv_make(N[6], N[7], n8), w0, hu, hv);
             ns = lanes_shading_normal(sn, ng);
         }
         LaneVec base = {MB[0], MB[1], MB[2]};
@@ -470,54 +439,41 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
 #ifdef HAS_TRIANGLE_LIGHTS
             vint tl = vload_lanes(0, tri_light);
             if (lanes_any(tl)) {
-                // sample_light's emissive triangle, lane by lane as it computes it.
+                // sample_light's emissive triangle, in vectors.
                 LaneVec t0, t1, t2;
                 vint lmat, unused;
                 lanes_triangle_rows(sc->tris, lprim, &t0, &t1, &t2, &lmat, &unused);
-                vfloat su = sqrt(u1);
-                vfloat bx = su * (1.0f - u2), by = su * u2;
+                vfloat b1, b2;
+                lanes_sample_triangle(u1, u2, &b1, &b2);
                 LaneVec q_err;
-                LaneVec q = lanes_surface_point(t0, t1, t2, bx, by, &q_err);
-                LaneVec lng = lanes_triangle_normal(t0, t1, t2, tl);
-                LaneVec d = {q.x - p.x, q.y - p.y, q.z - p.z};
-                vfloat dist2 = lv_dot(d, d);
-                vint far = tl & ~(dist2 <= 0.0f);  // else nothing (pdf 0), wi +z, target p
-                vfloat distance = sqrt(dist2);
-                LaneVec lwi = {d.x / distance, d.y / distance, d.z / distance};
-                LaneVec pq = {p.x - q.x, p.y - q.y, p.z - q.z};
-                LaneVec ltarget =
-                    lanes_offset_ray(q, q_err, lv_select(lv_neg(lng), lng, lv_dot(lng, pq) > 0.0f));
+                LaneVec q = lanes_surface_point(t0, t1, t2, b1, b2, &q_err);
+                LaneVec lng = lanes_triangle_normal(t0, t1, t2);
                 int loff[LANES];
-                vstore_lanes(select((vint)(0), lmat * (vint)(sizeof(DeviceMaterial) / 4), far),
+                vstore_lanes(select((vint)(0), lmat * (vint)(sizeof(DeviceMaterial) / 4), tl),
                              0, loff);
                 vfloat E[4];
                 lanes_rows4((global const float*)surf->materials, loff, 4, E);
-                vfloat cos_l = -lv_dot(lng, lwi);
                 vint two_sided = (as_vint(E[3]) & (vint)(MATERIAL_DOUBLE_SIDED)) != 0;
-                vint emits = far & (two_sided | ~(cos_l <= 0.0f));
-                cos_l = fabs(cos_l);
-                emits &= ~(cos_l <= 0.0f);
-                vfloat lp = vload_lanes(0, lsel) * dist2 / (vload_lanes(0, larea) * cos_l);
-                LaneVec one = {(vfloat)(0.0f), (vfloat)(0.0f), (vfloat)(1.0f)};
-                wi = lv_select(wi, lv_select(one, lwi, far), tl);
-                ls_dist = select(ls_dist, select(zero, distance, far), tl);
-                target = lv_select(target, lv_select(p, ltarget, far), tl);
-                on_surface = select(on_surface, far, tl);
-                ls_pdf = select(ls_pdf, select(zero, lp, emits), tl);
-                LaneVec lrad = {E[0] / lp, E[1] / lp, E[2] / lp};
-                lr = lv_select(lr, lv_select((LaneVec){zero, zero, zero}, lrad, emits), tl);
+                LaneVec lwi, ltarget;
+                vfloat ldist, lp;
+                vint lon;
+                vint emits = lanes_triangle_light_sample(
+                    p, q, q_err, lng, vload_lanes(0, lsel), vload_lanes(0, larea), two_sided, &lwi,
+                    &ldist, &ltarget, &lon, &lp);
+                wi = lv_select(wi, lwi, tl);
+                ls_dist = select(ls_dist, ldist, tl);
+                target = lv_select(target, ltarget, tl);
+                on_surface = select(on_surface, lon, tl);
+                ls_pdf = select(ls_pdf, lp, tl);
+                LaneVec lrad = lv_div(lv_make(E[0], E[1], E[2]), lp);
+                lr = lv_select(lr, lv_select(lv_splat(zero), lrad, emits), tl);
             }
 #endif
             vfloat side = lv_dot(wi, ng);
             vint ok = m & lanes_light_sample_faces(side, wi, ns, lr);
             if (lanes_any(ok)) {
-                // bsdf_eval, Lambertian.
-                vfloat cos_i = lv_dot(wi, ns);
-                vint lit = (lv_dot(wo, ns) > 0.0f) & (cos_i > 0.0f);
-                vfloat bsdf_pdf = select(zero, cos_i * INV_PI_F, lit);
-                vfloat fc = cos_i * INV_PI_F;
-                LaneVec f = {select(zero, base.x * fc, lit), select(zero, base.y * fc, lit),
-                             select(zero, base.z * fc, lit)};
+                vfloat bsdf_pdf;
+                LaneVec f = lanes_lambert_eval(base, ns, wo, wi, &bsdf_pdf);
                 vfloat weight = lanes_light_sample_weight(
                     ls_pdf, bsdf_pdf, (vint)(frame->strategy == STRATEGY_MIS ? -1 : 0));
                 LaneVec c = lanes_light_contribution(thr, f, lr, weight);
@@ -546,28 +502,9 @@ LANES_INLINE void lanes_shade(const DeviceFrame* frame, const ShadeScene* sc, Sh
         if (lanes_any(m)) {
             vfloat u1 = lanes_rng_next(&rng, m);
             vfloat u2 = lanes_rng_next(&rng, m);
-            vint ok0 = lv_dot(wo, ns) > 0.0f;
-            vfloat r = sqrt(u1);
-            vfloat ccx, ccy;
-            lanes_unit_circle(u2, &ccx, &ccy);
-            LaneVec wl = {r * ccx, r * ccy, sqrt(fmax(0.0f, 1.0f - u1))};
-            vint ok1 = ok0 & (wl.z > 0.0f);
-            // onb (rng.h) around ns, fused where the compiler fuses the scalar form.
-            vfloat s = select((vfloat)(-1.0f), (vfloat)(1.0f), ns.z >= 0.0f);
-            vfloat a = -1.0f / (s + ns.z);
-            vfloat c = ns.x * ns.y * a;
-            LaneVec tt = {fma(s * ns.x * ns.x, a, (vfloat)(1.0f)), s * c, -s * ns.x};
-            LaneVec bb = {c, fma(ns.y * ns.y, a, s), -ns.y};
-            LaneVec wi = {wl.x * tt.x + wl.y * bb.x + wl.z * ns.x,
-                          wl.x * tt.y + wl.y * bb.y + wl.z * ns.y,
-                          wl.x * tt.z + wl.y * bb.z + wl.z * ns.z};
-            wi = lv_select(ns, wi, ok1);
-            vfloat cos_i = lv_dot(wi, ns);
-            vint ok2 = ok1 & (cos_i > 0.0f);
-            vfloat pdf = select(zero, cos_i * INV_PI_F, ok2);
-            thr.x = thr.x * select(zero, base.x, ok2);
-            thr.y = thr.y * select(zero, base.y, ok2);
-            thr.z = thr.z * select(zero, base.z, ok2);
+            LaneVec wi, weight;
+            vfloat pdf = lanes_lambert_sample(base, ns, wo, u1, u2, &wi, &weight);
+            thr = lv_mul(thr, weight);
             vfloat side = lv_dot(wi, ng);
             vint go = m & lanes_goes_on(pdf, side, wi, ns, thr);
             vint rr = go & (bounce >= (vuint)(frame->rr_depth));

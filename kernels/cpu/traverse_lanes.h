@@ -1,6 +1,6 @@
 // Rays in vector lanes, for the CPU megakernel (MEGA_LANES: set by the host on CPU devices with
-// AVX-512 or AVX2, for flat scenes without alpha that are not small; src/cl/program.rs,
-// lanes_megakernel): sixteen independent rays walk the 4-wide BVH together, one ray a lane,
+// AVX-512 or AVX2, for flat scenes without alpha; strategy::kernel_strategy in
+// src/render/strategy.rs): sixteen independent rays walk the 4-wide BVH together, one ray a lane,
 // each at its own node, the lanes' nodes and triangles loaded as rows and transposed into
 // vectors (lanes_rows8; LANES_GATHERS: by gathers). One ray at a time, a walk
 // waits on memory at nearly every node it visits in a large scene (about 45 % of a diffuse
@@ -129,10 +129,9 @@ LANES_INLINE void lanes_rays_put(LanesRays* R, int lane, float3 o, float3 d, flo
     R->taken |= 1u << lane;
 }
 
-// A component of each lane's vector (x, y, z) picked by the lane's axis k (0, 1, 2).
-LANES_INLINE vfloat lanes_pick(vfloat x, vfloat y, vfloat z, vint k) {
-    return select(select(x, y, k == (vint)(1)), z, k == (vint)(2));
-}
+// traverse.h's ray set-up in every lane (shared/vec3.h): lanes_safe_rcp, lanes_pick (a component
+// of each lane's vector (x, y, z) picked by the lane's axis k), lanes_ray_axes.
+DEFINE_RAY_MATHS(LANES_INLINE, lanes_, vfloat, vint)
 
 // A ray's origin and safe reciprocal direction in every lane, as the slab test reads them.
 typedef struct {
@@ -162,20 +161,15 @@ typedef struct {
 } LanesPrepared;
 
 // prepare_ray lane by lane on the rays from (ox, oy, oz) along (dx, dy, dz), by selects (no
-// branch on the dominant axis; one division an axis for all the lanes): prepare_ray's values
-// bit for bit.
+// branch on the dominant axis; one division an axis for all the lanes) and with prepare_ray's
+// arithmetic (DEFINE_RAY_MATHS): its values bit for bit.
 LANES_INLINE LanesPrepared lanes_prepare_rays(vfloat ox, vfloat oy, vfloat oz, vfloat dx,
                                               vfloat dy, vfloat dz) {
-    const vfloat tiny = (vfloat)(1e-20f), one = (vfloat)(1.0f);
-    const vint two = (vint)(2);
     LanesPrepared r;
-    vfloat ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
-    r.ix = one / select(copysign(tiny, dx), dx, ax > tiny);
-    r.iy = one / select(copysign(tiny, dy), dy, ay > tiny);
-    r.iz = one / select(copysign(tiny, dz), dz, az > tiny);
-    r.kz = select(select(two, (vint)(1), ay > az), select(two, (vint)(0), ax > az), ax > ay);
-    r.kx = select(select((vint)(1), two, r.kz == (vint)(1)), (vint)(0), r.kz == two);
-    r.ky = select(select(two, (vint)(0), r.kz == (vint)(1)), (vint)(1), r.kz == two);
+    r.ix = lanes_safe_rcp(dx);
+    r.iy = lanes_safe_rcp(dy);
+    r.iz = lanes_safe_rcp(dz);
+    lanes_ray_axes(fabs(dx), fabs(dy), fabs(dz), &r.kx, &r.ky, &r.kz);
     vfloat rz = lanes_pick(r.ix, r.iy, r.iz, r.kz);
     r.sx = lanes_pick(dx, dy, dz, r.kx) * rz;
     r.sy = lanes_pick(dx, dy, dz, r.ky) * rz;

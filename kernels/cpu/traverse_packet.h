@@ -109,23 +109,23 @@ LANES_INLINE void packet_order(const float* key, uint* a, uint* b) {
     }
 }
 
-// A triangle's vertices relative to each lane's origin (px, py, pz) in its permuted axes, the
+// A triangle's vertex v relative to each lane's origin (px, py, pz) in its permuted axes, the
 // permutation named by the dominant axis (z0: x is, z1: y is; else z).
+LANES_INLINE void packet_vertex(float4 v, vint z0, vint z1, vfloat px, vfloat py, vfloat pz,
+                                vfloat* X, vfloat* Y, vfloat* Z) {
+    lanes_to_ray_axes((vfloat)(v.x), (vfloat)(v.y), (vfloat)(v.z), z0, z1, X, Y, Z);
+    *X = *X - px;
+    *Y = *Y - py;
+    *Z = *Z - pz;
+}
+
+// A triangle's vertices relative to each lane's origin in its permuted axes (packet_vertex).
 LANES_INLINE LanesTriangle packet_triangle(DeviceTriangle tri, vint z0, vint z1, vfloat px,
                                            vfloat py, vfloat pz) {
     LanesTriangle T;
-    vfloat vx = (vfloat)(tri.v0.x), vy = (vfloat)(tri.v0.y), vz = (vfloat)(tri.v0.z);
-    T.aX = select(select(vx, vz, z1), vy, z0) - px;
-    T.aY = select(select(vy, vx, z1), vz, z0) - py;
-    T.aZ = select(select(vz, vy, z1), vx, z0) - pz;
-    vx = (vfloat)(tri.v1.x), vy = (vfloat)(tri.v1.y), vz = (vfloat)(tri.v1.z);
-    T.bX = select(select(vx, vz, z1), vy, z0) - px;
-    T.bY = select(select(vy, vx, z1), vz, z0) - py;
-    T.bZ = select(select(vz, vy, z1), vx, z0) - pz;
-    vx = (vfloat)(tri.v2.x), vy = (vfloat)(tri.v2.y), vz = (vfloat)(tri.v2.z);
-    T.cX = select(select(vx, vz, z1), vy, z0) - px;
-    T.cY = select(select(vy, vx, z1), vz, z0) - py;
-    T.cZ = select(select(vz, vy, z1), vx, z0) - pz;
+    packet_vertex(tri.v0, z0, z1, px, py, pz, &T.aX, &T.aY, &T.aZ);
+    packet_vertex(tri.v1, z0, z1, px, py, pz, &T.bX, &T.bY, &T.bZ);
+    packet_vertex(tri.v2, z0, z1, px, py, pz, &T.cX, &T.cY, &T.cZ);
     return T;
 }
 

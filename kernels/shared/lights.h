@@ -3,6 +3,7 @@
 #define SHARED_LIGHTS_H
 
 #include "shared/types.h"
+#include "shared/vec3.h"
 #include "shared/rng.h"
 #include "shared/textures.h"
 #include "shared/traverse.h"
@@ -20,6 +21,38 @@ typedef struct {
                         // the shading point, where the shadow ray ends
     bool on_surface;    // whether `target` is set (the light is geometry the shadow ray could hit)
 } LightSample;
+
+// An emissive triangle's light sample for every lane width (shared/vec3.h), from the point q
+// sampled on the light (error bound q_err, geometric normal ng) for the shading point p, with
+// the light's selection probability sel, its area and whether it emits from both sides:
+// f##triangle_light_sample(p, q, q_err, ng, sel, area, two_sided, *wi, *distance, *target,
+// *on_surface, *pdf) sets the unit direction to q, its distance, the shadow ray's end (q moved
+// a few ulps off the light, on p's side, so that the ray can neither hit the light itself nor
+// stop short of an occluder, at any scale) and *on_surface where p and q are apart (elsewhere
+// +z, 0, p and false), and the solid-angle pdf where the light faces p (else 0); returns
+// whether it does (the sample then brings the light's emission over that pdf).
+#define DEFINE_TRIANGLE_LIGHT_MATHS(Q, f, F, I, U, V, v)                                          \
+    Q I f##triangle_light_sample(V p, V q, V q_err, V ng, F sel, F area, I two_sided, V* wi,       \
+                                 F* distance, V* target, I* on_surface, F* pdf) {                  \
+        V d = v##_sub(q, p);                                                                       \
+        F dist2 = v##_dot(d, d);                                                                   \
+        I apart = !(dist2 <= 0.0f);                                                                \
+        F dist = sqrt(dist2);                                                                      \
+        V dir = v##_div(d, dist);                                                                  \
+        V out = v##_select(v##_neg(ng), ng, v##_dot(ng, v##_sub(p, q)) > 0.0f);                    \
+        *wi = v##_select(v##_make((F)(0.0f), (F)(0.0f), (F)(1.0f)), dir, apart);                   \
+        *distance = select((F)(0.0f), dist, apart);                                                \
+        *target = v##_select(p, f##offset_ray(q, q_err, out), apart);                              \
+        *on_surface = apart;                                                                       \
+        F cos_l = -v##_dot(ng, dir);                                                               \
+        I emits = apart & (two_sided | !(cos_l <= 0.0f));                                          \
+        cos_l = fabs(cos_l);                                                                       \
+        emits = emits & !(cos_l <= 0.0f);                                                          \
+        *pdf = select((F)(0.0f), sel * dist2 / (area * cos_l), emits);                             \
+        return emits;                                                                              \
+    }
+
+DEFINE_TRIANGLE_LIGHT_MATHS(SHADE_INLINE, , float, int, uint, float3, f3)
 
 // Spot cone attenuation as the glTF KHR_lights_punctual specification writes it.
 inline float spot_falloff(global const DeviceLight* l, float3 to_point) {
@@ -93,32 +126,24 @@ SHADE_INLINE LightSample sample_light(global const DeviceLight* lights,
         float3 world_err;
         t = instance_triangle(&inst, t, &world_err);
 #endif
-        float2 b = sample_triangle(u1, u2);
+        float b1, b2;
+        sample_triangle(u1, u2, &b1, &b2);
         float3 q_err;
-        float3 q = surface_point(t.v0.xyz, t.v1.xyz, t.v2.xyz, b.x, b.y, &q_err);
+        float3 q = surface_point(t.v0.xyz, t.v1.xyz, t.v2.xyz, b1, b2, &q_err);
         float3 ng = flat_normal(surf, prim, t);
 #ifdef TWO_LEVEL
         q_err += world_err;
         ng *= instance_normal_sign(&inst);
 #endif
-        float3 d = q - p;
-        float dist2 = dot(d, d);
-        if (dist2 <= 0.0f) return s;
-        s.distance = sqrt(dist2);
-        s.wi = d / s.distance;
-        // End the shadow ray a few ulps off the light, on the shading point's side, so that it
-        // can neither hit the light itself nor stop short of an occluder, at any scale.
-        s.target = offset_ray(q, q_err, dot(ng, p - q) > 0.0f ? ng : -ng);
-        s.on_surface = true;
         global const DeviceMaterial* m = &materials[as_uint(t.v0.w)];
-        float cos_l = -dot(ng, s.wi);
         bool two_sided = (as_uint(m->emission.w) & MATERIAL_DOUBLE_SIDED) != 0u;
-        if (!two_sided && cos_l <= 0.0f) return s;
-        cos_l = fabs(cos_l);
-        if (cos_l <= 0.0f) return s;
-        s.pdf = select * dist2 / (area * cos_l);
+        int on_surface;
+        bool emits = triangle_light_sample(p, q, q_err, ng, select, area, two_sided, &s.wi,
+                                           &s.distance, &s.target, &on_surface, &s.pdf);
+        s.on_surface = on_surface;
+        if (!emits) return s;
 #ifdef HAS_TEXTURES
-        TexCoords tc = texcoords_at(surf->uvs[prim], b.x, b.y);
+        TexCoords tc = texcoords_at(surf->uvs[prim], b1, b2);
         s.radiance = textured_emission(m, surf, &tc) / s.pdf;
 #else
         s.radiance = m->emission.xyz / s.pdf;

@@ -11,6 +11,7 @@
 #define SHARED_PATH_H
 
 #include "shared/types.h"
+#include "shared/vec3.h"
 #include "shared/rng.h"
 #include "shared/textures.h"
 #include "shared/traverse.h"
@@ -31,8 +32,7 @@ inline bool frame_sky_black(const DeviceFrame* frame) {
 // vectors, so that the estimator's multiple importance sampling, Russian roulette and the
 // vertex's normals and rays change in one place. DEFINE_VERTEX_MATHS(f, F, I, V, v) defines, for
 // floats F with masks I (a comparison's type; scalar comparisons give 1, vector ones -1, and
-// select() takes either) and 3-vectors V whose operations are named v##_sub, v##_mul, v##_scale,
-// v##_div, v##_neg, v##_select, v##_dot, v##_length and v##_positive (f3_* below on float3;
+// select() takes either) and 3-vectors V with the operations of shared/vec3.h (f3_* on float3,
 // the lanes' lv_*):
 //   f##_power_heuristic(a, b)   the power heuristic's weight of a sample of pdf a against b;
 //   f##_emitter_pdf(sel, area, t, cos_l)  light sampling's solid-angle pdf of an emissive
@@ -97,17 +97,6 @@ inline bool frame_sky_black(const DeviceFrame* frame) {
     SHADE_INLINE I f##_goes_on(F pdf, F side, V wi, V ns, V throughput) {                          \
         return (pdf > 0.0f) & (side * v##_dot(wi, ns) > 0.0f) & v##_positive(throughput);          \
     }
-
-// DEFINE_VERTEX_MATHS's vector operations on float3.
-inline float3 f3_sub(float3 a, float3 b) { return a - b; }
-inline float3 f3_mul(float3 a, float3 b) { return a * b; }
-inline float3 f3_scale(float3 a, float s) { return a * s; }
-inline float3 f3_div(float3 a, float s) { return a / s; }
-inline float3 f3_neg(float3 a) { return -a; }
-inline float3 f3_select(float3 a, float3 b, int m) { return m ? b : a; }
-inline float f3_dot(float3 a, float3 b) { return dot(a, b); }
-inline float f3_length(float3 a) { return length(a); }
-inline int f3_positive(float3 a) { return a.x > 0.0f || a.y > 0.0f || a.z > 0.0f; }
 
 DEFINE_VERTEX_MATHS(vertex, float, int, float3, f3)
 
@@ -335,7 +324,7 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
     {
         // A flat-shaded triangle's corner normals are 0: n has length 0 and ns stays ng.
         global const float* sh = surf->shading[hit.prim].n;
-        float3 n = w0 * vload3(0, sh) + hit.u * vload3(1, sh) + hit.v * vload3(2, sh);
+        float3 n = barycentric(vload3(0, sh), vload3(1, sh), vload3(2, sh), w0, hit.u, hit.v);
 #ifdef TWO_LEVEL
         n = instance_normal(&inst, n);
 #endif

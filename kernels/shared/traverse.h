@@ -5,6 +5,7 @@
 #define SHARED_TRAVERSE_H
 
 #include "shared/types.h"
+#include "shared/vec3.h"
 #include "shared/textures.h"
 
 #pragma OPENCL FP_CONTRACT OFF
@@ -19,9 +20,29 @@ typedef struct {
     float3 shear;  // (dx/dz, dy/dz, 1/dz) in the permuted frame
 } RayPrep;
 
-inline float safe_rcp(float x) {
-    return 1.0f / (fabs(x) > 1e-20f ? x : copysign(1e-20f, x));
-}
+// A ray's set-up for every lane width (shared/vec3.h): f##safe_rcp(x) the reciprocal of a
+// direction's coordinate x, or of +-1e-20 where x is nearer 0; f##pick(x, y, z, k) coordinate k
+// (0, 1 or 2) of (x, y, z); f##ray_axes(ax, ay, az, *kx, *ky, *kz) the axes of a direction of
+// magnitudes (ax, ay, az) that the watertight test permutes it to: kz the dominant one (the
+// first of equals but z), kx and ky the next ones round; f##to_ray_axes(x, y, z, z0, z1, *px,
+// *py, *pz) (x, y, z) in those axes, by selects, for kz 0 (z0), 1 (z1) or 2 (neither).
+#define DEFINE_RAY_MATHS(Q, f, F, I)                                                               \
+    Q F f##safe_rcp(F x) {                                                                         \
+        return 1.0f / select(copysign((F)(1e-20f), x), x, fabs(x) > 1e-20f);                      \
+    }                                                                                              \
+    Q F f##pick(F x, F y, F z, I k) { return select(select(x, y, k == 1), z, k == 2); }            \
+    Q void f##ray_axes(F ax, F ay, F az, I* kx, I* ky, I* kz) {                                    \
+        *kz = select(select((I)(2), (I)(1), ay > az), select((I)(2), (I)(0), ax > az), ax > ay);   \
+        *kx = select(select((I)(1), (I)(2), *kz == 1), (I)(0), *kz == 2);                          \
+        *ky = select(select((I)(2), (I)(0), *kz == 1), (I)(1), *kz == 2);                          \
+    }                                                                                              \
+    Q void f##to_ray_axes(F x, F y, F z, I z0, I z1, F* px, F* py, F* pz) {                        \
+        *px = select(select(x, z, z1), y, z0);                                                     \
+        *py = select(select(y, x, z1), z, z0);                                                     \
+        *pz = select(select(z, y, z1), x, z0);                                                     \
+    }
+
+DEFINE_RAY_MATHS(inline, , float, int)
 
 // v's coordinates in the ray's permuted order (kx, ky, kz), a rotation named by kz. A CPU
 // does this in one shuffle instruction; NVIDIA's compiler turns shuffle() with a mask that
@@ -30,9 +51,9 @@ inline float safe_rcp(float x) {
 // (measured 2026-12-01). The program defines PERMUTE_BY_SELECT for devices other than CPUs.
 inline float4 ray_permute(float4 v, uint4 p) {
 #ifdef PERMUTE_BY_SELECT
-    bool z0 = p.z == 0u, z1 = p.z == 1u;
-    return (float4)(z0 ? v.y : z1 ? v.z : v.x, z0 ? v.z : z1 ? v.x : v.y,
-                    z0 ? v.x : z1 ? v.y : v.z, 0.0f);
+    float x, y, z;
+    to_ray_axes(v.x, v.y, v.z, p.z == 0u, p.z == 1u, &x, &y, &z);
+    return (float4)(x, y, z, 0.0f);
 #else
     return shuffle(v, p);
 #endif
@@ -43,18 +64,17 @@ inline RayPrep prepare_ray(float3 o, float3 d) {
     r.origin = o;
     r.inv = (float3)(safe_rcp(d.x), safe_rcp(d.y), safe_rcp(d.z));
     float3 a = fabs(d);
-    uint kz = a.x > a.y ? (a.x > a.z ? 0u : 2u) : (a.y > a.z ? 1u : 2u);
     // The axes rotated so that z is the dominant one. (Woop et al. also swap x and y where the
     // direction's z is negative, to keep the winding; that only negates the edge functions and
     // their sum exactly, and this test takes either sign.)
-    uint kx = (kz + 1u) % 3u;
-    uint ky = (kx + 1u) % 3u;
+    int kx, ky, kz;
+    ray_axes(a.x, a.y, a.z, &kx, &ky, &kz);
     float4 d4 = (float4)(d, 0.0f);
-    r.perm = (uint4)(kx, ky, kz, 3u);
+    r.perm = (uint4)((uint)kx, (uint)ky, (uint)kz, 3u);
     float4 p = ray_permute(d4, r.perm);
     // No division of its own: the shear's x and y scale by the reciprocal of its z, which is
     // the box test's reciprocal of the dominant axis (src/bvh/traverse.rs computes the same).
-    float iz = kz == 0u ? r.inv.x : kz == 1u ? r.inv.y : r.inv.z;
+    float iz = pick(r.inv.x, r.inv.y, r.inv.z, kz);
     r.shear = (float3)(p.x * iz, p.y * iz, iz);
     return r;
 }
@@ -460,58 +480,78 @@ inline DeviceHit trace_scene(global const DeviceBvhNode* nodes, global const Dev
 #endif
 }
 
-// The point at barycentrics (u, v) of a triangle and a bound on how far a spawned ray's origin
-// must move off it, per coordinate: pbrt-v4's gamma(7) times the barycentric sum of the
-// vertices' magnitudes (the rounding of p), plus gamma(64) times the triangle's extent around p
-// in every coordinate, which stands in for pbrt's conservative t check in the ray-triangle test
-// (a point exactly on a triangle in the plane x = 0 has no rounding error, yet the sheared
-// ray-triangle test can still find it at a tiny positive t). Both follow the vertices, not a
-// scene-wide epsilon, so they hold at any scale and offset.
-inline float3 surface_point(float3 v0, float3 v1, float3 v2, float u, float v, float3* err) {
-    float w = 1.0f - u - v;
-    const float gamma7 = 7.0f * 0x1p-24f / (1.0f - 7.0f * 0x1p-24f);
-    const float gamma64 = 64.0f * 0x1p-24f / (1.0f - 64.0f * 0x1p-24f);
-    float3 p = w * v0 + u * v1 + v * v2;
-    float3 extent = fmax(fmax(fabs(v0 - p), fabs(v1 - p)), fabs(v2 - p));
-    float reach = fmax(fmax(extent.x, extent.y), extent.z);
-    *err = gamma7 * (fabs(w * v0) + fabs(u * v1) + fabs(v * v2)) + gamma64 * reach;
-    return p;
-}
+// A surface point's arithmetic for every lane width (shared/vec3.h):
+//   f##barycentric(a, b, c, w, bu, bv)  w a + bu b + bv c;
+//   f##surface_point(v0, v1, v2, bu, bv, *err)  the point at barycentrics (bu, bv) of a triangle
+//       and a bound on how far a spawned ray's origin must move off it, per coordinate:
+//       pbrt-v4's gamma(7) times the barycentric sum of the vertices' magnitudes (the rounding of
+//       p), plus gamma(64) times the triangle's extent around p in every coordinate, which
+//       stands in for pbrt's conservative t check in the ray-triangle test (a point exactly on a
+//       triangle in the plane x = 0 has no rounding error, yet the sheared ray-triangle test can
+//       still find it at a tiny positive t). Both follow the vertices, not a scene-wide epsilon,
+//       so they hold at any scale and offset;
+//   f##triangle_normal(v0, v1, v2)  the unit geometric normal of a triangle (counter-clockwise
+//       front), or its cross product where that is 0. The cross product is scaled by a power of
+//       two before normalizing, so triangles of 1e-10 or 1e10 units do not underflow or
+//       overflow its squared length: 2^-ilogb(m) from m's exponent bits where m is normal and
+//       the power too (ldexp's general form, three multiplications, elsewhere): the same value.
+//       Then normalize() as the OpenCL library computes it (the product by the reciprocal of
+//       the root of the squared length), less its rescaling for tiny or huge lengths: the
+//       largest coordinate is now in [1, 2);
+//   f##offset_ray(p, err, n)  p, whose coordinates are off by at most err, moved off the surface
+//       along the geometric normal n (pointing to the side the ray leaves on) by the error bound
+//       projected on n, each coordinate then rounded one more ulp away (pbrt-v4's
+//       OffsetRayOrigin). A ray from the result can neither re-hit the surface it leaves nor
+//       start behind it; tests/stress.rs checks this from 1e-8 to 1e8 through `spawn_test`.
+#define DEFINE_SURFACE_MATHS(Q, f, F, I, U, V, v)                                                 \
+    Q V f##barycentric(V a, V b, V c, F w, F bu, F bv) {                                           \
+        return v##_add(v##_add(v##_scale(a, w), v##_scale(b, bu)), v##_scale(c, bv));              \
+    }                                                                                              \
+    Q V f##surface_point(V v0, V v1, V v2, F bu, F bv, V* err) {                                   \
+        F w = 1.0f - bu - bv;                                                                      \
+        const float gamma7 = 7.0f * 0x1p-24f / (1.0f - 7.0f * 0x1p-24f);                           \
+        const float gamma64 = 64.0f * 0x1p-24f / (1.0f - 64.0f * 0x1p-24f);                        \
+        V p = f##barycentric(v0, v1, v2, w, bu, bv);                                               \
+        V extent = v##_max(v##_max(v##_abs(v##_sub(v0, p)), v##_abs(v##_sub(v1, p))),             \
+                           v##_abs(v##_sub(v2, p)));                                               \
+        F reach = fmax(fmax(extent.x, extent.y), extent.z);                                        \
+        V magnitude = v##_add(v##_add(v##_abs(v##_scale(v0, w)), v##_abs(v##_scale(v1, bu))),      \
+                              v##_abs(v##_scale(v2, bv)));                                         \
+        *err = v##_add(v##_scale(magnitude, gamma7), v##_splat(gamma64 * reach));                  \
+        return p;                                                                                  \
+    }                                                                                              \
+    Q V f##triangle_normal(V v0, V v1, V v2) {                                                     \
+        V c = v##_cross(v##_sub(v1, v0), v##_sub(v2, v0));                                         \
+        F m = fmax(fmax(fabs(c.x), fabs(c.y)), fabs(c.z));                                         \
+        U e = (as_##U(m) >> 23u) & 0xffu;                                                          \
+        I normal_e = e - 1u < 253u;                                                                \
+        F scale = as_##F((254u - e) << 23u);                                                       \
+        if (v##_any(!normal_e)) scale = select(ldexp((F)(1.0f), -ilogb(m)), scale, normal_e);      \
+        V cs = v##_scale(c, scale);                                                                \
+        V n = v##_scale(cs, 1.0f / sqrt(cs.x * cs.x + cs.y * cs.y + cs.z * cs.z));                  \
+        return v##_select(c, n, m > 0.0f);                                                         \
+    }                                                                                              \
+    Q V f##offset_ray(V p, V err, V n) {                                                           \
+        return v##_offset_step(p, v##_scale(n, v##_dot(v##_abs(n), err)));                         \
+    }
 
-// The unit geometric normal of a triangle (counter-clockwise front). The cross product is
-// scaled by a power of two before normalizing, so triangles of 1e-10 or 1e10 units do not
-// underflow or overflow its squared length.
-inline float3 triangle_normal(float3 v0, float3 v1, float3 v2) {
-    float3 c = cross(v1 - v0, v2 - v0);
-    float m = fmax(fmax(fabs(c.x), fabs(c.y)), fabs(c.z));
-    if (!(m > 0.0f)) return c;
-    // 2^-ilogb(m) from m's exponent bits where m is normal and the power too (ldexp's general
-    // form, three multiplications, elsewhere): the same value.
-    uint e = (as_uint(m) >> 23) & 0xffu;
-    float scale = e - 1u < 253u ? as_float((254u - e) << 23) : ldexp(1.0f, -ilogb(m));
-    // normalize() as the OpenCL library computes it (the product by the reciprocal of the
-    // root of the squared length), less its rescaling for tiny or huge lengths: the largest
-    // coordinate is now in [1, 2).
-    c *= scale;
-    return c * (1.0f / sqrt(c.x * c.x + c.y * c.y + c.z * c.z));
-}
+// p + offset rounded one more float away from p, coordinate by coordinate, for floats (or float
+// vectors) F with integer masks I of their width: nextafter(po, +-INFINITY) on the bits, for
+// finite po, one step of the magnitude away from zero where po's sign is the step's, towards
+// zero where it is not, and from a zero the smallest number of the step's sign. For float3 it
+// is f3_offset_step, v##_offset_step of DEFINE_SURFACE_MATHS (the lanes' lv_offset_step applies
+// lanes_offset_step to each coordinate).
+#define DEFINE_OFFSET_STEP(Q, f, F, I)                                                             \
+    Q F f##offset_step(F p, F offset) {                                                            \
+        F po = p + offset;                                                                         \
+        I bits = as_##I(po);                                                                       \
+        I away = (po > 0.0f) == (offset > 0.0f); /* the step goes away from zero */               \
+        I stepped = select(bits - 1, bits + 1, away);                                              \
+        stepped = select(stepped, select((I)(0x80000001), (I)(1), offset > 0.0f), po == 0.0f);     \
+        return select(po, as_##F(stepped), offset != 0.0f);                                        \
+    }
 
-// Moves p, whose coordinates are off by at most err, off the surface along the geometric
-// normal n (pointing to the side the ray leaves on) by the error bound projected on n, then
-// rounds each moved coordinate one more ulp away from p (pbrt-v4's OffsetRayOrigin). A ray
-// from the result can neither re-hit the surface it leaves nor start behind it; tests/stress.rs
-// checks this from 1e-8 to 1e8 through `spawn_test`.
-inline float3 offset_ray(float3 p, float3 err, float3 n) {
-    float3 offset = dot(fabs(n), err) * n;
-    float3 po = p + offset;
-    // nextafter(po, +-INFINITY) on the bits, for finite po: one step of the magnitude away from
-    // zero where po's sign is the step's, towards zero where it is not, and from a zero the
-    // smallest number of the step's sign.
-    int3 bits = as_int3(po);
-    int3 away = (po > 0.0f) == (offset > 0.0f);  // -1 where the step goes away from zero
-    int3 stepped = select(bits - 1, bits + 1, away);
-    stepped = select(stepped, select((int3)(0x80000001), (int3)(1), offset > 0.0f), po == 0.0f);
-    return select(po, as_float3(stepped), offset != 0.0f);
-}
+DEFINE_OFFSET_STEP(inline, f3_, float3, int3)
+DEFINE_SURFACE_MATHS(inline, , float, int, uint, float3, f3)
 
 #endif  // SHARED_TRAVERSE_H

@@ -193,65 +193,103 @@ inline bool intersect_leaf4(const RayPrep* r, global const DeviceTriangle* tris,
     hit->prim = first + k;
     return any_hit;
 }
-#define INTERSECT_LEAF(r, tris, surf, first, count, tmin, o, d, any_hit, hit)                  \
-    ((count) - 3u <= 1u ? intersect_leaf4(r, tris, surf, first, count, tmin, o, d, any_hit, hit) \
-                   : intersect_leaf(r, tris, surf, first, count, tmin, o, d, any_hit, hit))
-#else
-#define INTERSECT_LEAF intersect_leaf
 #endif
 
+// The test of a leaf of `count` triangles from `first`: four at once where it holds three or
+// four (and the scene no alpha), else one by one. Returns whether the walk ends (any_hit and a
+// hit), as intersect_leaf does.
+inline bool intersect_wide_leaf(const RayPrep* r, global const DeviceTriangle* tris,
+                                const SceneSurfaces* surf, uint first, uint count, float tmin,
+                                float3 o, float3 d, bool any_hit, DeviceHit* hit) {
+#ifndef HAS_ALPHA
+    if (count - 3u <= 1u) {
+        return intersect_leaf4(r, tris, surf, first, count, tmin, o, d, any_hit, hit);
+    }
+#endif
+    return intersect_leaf(r, tris, surf, first, count, tmin, o, d, any_hit, hit);
+}
+
+// Child slot s of wide node n: a node index, or for a leaf the complement of its first
+// triangle; and the leaf's triangle count (0: an interior node).
+inline int wide_child(global const DeviceWideNode* n, uint s) {
+    return ((global const int*)&n->child)[s];
+}
+
+inline uint wide_count(global const DeviceWideNode* n, uint s) {
+    return ((global const uint*)&n->count)[s];
+}
+
+// The children of a wide node that a ray reaches, nearest first: their entry distances
+// d0 <= d1 <= d2 <= d3 (INFINITY for those not reached) and slots s0 .. s3. Scalars, not arrays,
+// so that they stay in registers.
+typedef struct {
+    float d0, d1, d2, d3;
+    uint s0, s1, s2, s3;
+} WideOrder;
+
 // Compare-and-swap of two (entry distance, slot) pairs, ordered by distance and then slot, so
-// that the network below sorts as a stable sort would (the host reference's order).
-#define WIDE_ORDER(A, B)                                           \
-    if (d##B < d##A || (d##B == d##A && s##B < s##A)) {            \
-        float td = d##A;                                           \
-        d##A = d##B;                                               \
-        d##B = td;                                                 \
-        uint ts = s##A;                                            \
-        s##A = s##B;                                               \
-        s##B = ts;                                                 \
+// that the network of wide_sort_children sorts as a stable sort would (the host reference's
+// order).
+inline void wide_order(float* da, uint* sa, float* db, uint* sb) {
+    if (*db < *da || (*db == *da && *sb < *sa)) {
+        float td = *da;
+        *da = *db;
+        *db = td;
+        uint ts = *sa;
+        *sa = *sb;
+        *sb = ts;
     }
+}
 
-// The children of wide node n that `mask` reaches, sorted: declares their entry distances
-// d0 <= d1 <= d2 <= d3 (INFINITY for those not reached, from `near`) and slots s0 .. s3.
-#define WIDE_SORT_CHILDREN(n, near, mask)                           \
-    float4 dist = select((float4)(INFINITY), near, mask);          \
-    float d0 = dist.x, d1 = dist.y, d2 = dist.z, d3 = dist.w;      \
-    uint s0 = 0u, s1 = 1u, s2 = 2u, s3 = 3u;                       \
-    WIDE_ORDER(0, 1)                                               \
-    WIDE_ORDER(2, 3)                                               \
-    WIDE_ORDER(0, 2)                                               \
-    WIDE_ORDER(1, 3)                                               \
-    WIDE_ORDER(1, 2)
+// The children of a node that `mask` reaches (their entry distances in `near`), sorted by a
+// five-exchange network.
+inline WideOrder wide_sort_children(float4 near, int4 mask) {
+    float4 dist = select((float4)(INFINITY), near, mask);
+    WideOrder c = {dist.x, dist.y, dist.z, dist.w, 0u, 1u, 2u, 3u};
+    wide_order(&c.d0, &c.s0, &c.d1, &c.s1);
+    wide_order(&c.d2, &c.s2, &c.d3, &c.s3);
+    wide_order(&c.d0, &c.s0, &c.d2, &c.s2);
+    wide_order(&c.d1, &c.s1, &c.d3, &c.s3);
+    wide_order(&c.d1, &c.s1, &c.d2, &c.s2);
+    return c;
+}
 
-// A leaf among the sorted children, tested on the spot when it starts before the hit so far.
-#define WIDE_LEAF(D, S)                                                                     \
-    if (D < hit->t && counts[S] > 0u &&                                                     \
-        INTERSECT_LEAF(r, tris, surf, (uint)(~children[S]), counts[S], tmin, o, d, any_hit, \
-                       hit)) {                                                              \
-        return true;                                                                        \
+// A leaf among the sorted children (entry distance dist, slot s of node n), tested on the spot
+// when it starts before the hit so far. Returns whether the walk ends.
+inline bool wide_leaf(float dist, uint s, global const DeviceWideNode* n, const RayPrep* r,
+                      global const DeviceTriangle* tris, const SceneSurfaces* surf, float tmin,
+                      float3 o, float3 d, bool any_hit, DeviceHit* hit) {
+    return dist < hit->t && wide_count(n, s) > 0u &&
+           intersect_wide_leaf(r, tris, surf, (uint)(~wide_child(n, s)), wide_count(n, s), tmin,
+                               o, d, any_hit, hit);
+}
+
+// An interior child among the sorted ones (entry distance dist, slot s of node n), pushed with
+// its distance when it starts before the hit at t; *next is then its node.
+inline void wide_push(float dist, uint s, global const DeviceWideNode* n, float t, uint* stack,
+                      float* stack_d, uint* sp, uint* next) {
+    if (dist < t && wide_count(n, s) == 0u) {
+        *next = (uint)wide_child(n, s);
+        stack[*sp] = *next;
+        stack_d[(*sp)++] = dist;
     }
+}
 
-// An interior child among the sorted ones, pushed with its entry distance (farthest first).
-#define WIDE_PUSH(D, S)                            \
-    if (D < hit->t && counts[S] == 0u) {           \
-        next = (uint)children[S];                  \
-        stack[sp] = next;                          \
-        stack_d[sp++] = D;                         \
+// For any hit: child slot s of node n, when `bits` has it, tested if a leaf, else pushed (to be
+// entered whatever its distance: the walk ends at the first hit). Returns whether a hit ends
+// the walk.
+inline bool wide_any(uint bits, uint s, global const DeviceWideNode* n, const RayPrep* r,
+                     global const DeviceTriangle* tris, const SceneSurfaces* surf, float tmin,
+                     float3 o, float3 d, DeviceHit* hit, uint* stack, float* stack_d, uint* sp) {
+    if (((bits >> s) & 1u) == 0u) return false;
+    if (wide_count(n, s) == 0u) {
+        stack[*sp] = (uint)wide_child(n, s);
+        stack_d[(*sp)++] = -INFINITY;
+        return false;
     }
-
-// For any hit: child S, when reached, tested if a leaf, else pushed (to be entered whatever its
-// distance: the walk ends at the first hit).
-#define WIDE_ANY(S)                                                                            \
-    if ((bits >> S) & 1u) {                                                                    \
-        if (counts[S] == 0u) {                                                                 \
-            stack[sp] = (uint)children[S];                                                     \
-            stack_d[sp++] = -INFINITY;                                                         \
-        } else if (INTERSECT_LEAF(r, tris, surf, (uint)(~children[S]), counts[S], tmin, o, d, \
-                                  true, hit)) {                                                \
-            return true;                                                                       \
-        }                                                                                      \
-    }
+    return intersect_wide_leaf(r, tris, surf, (uint)(~wide_child(n, s)), wide_count(n, s), tmin,
+                               o, d, true, hit);
+}
 
 // The lanes of a mask as bits (lane i: bit i). On x86 one movmskps (a kmov from the compare's
 // AVX-512 mask): OpenCL's any() became a dozen instructions and two branches there.
@@ -271,7 +309,7 @@ inline uint wide_bits(int4 mask) {
 // beyond the hit found meanwhile is skipped; the nearest of them is entered at once, its index
 // from a register rather than read back from the stack. The visiting order is
 // src/bvh/wide.rs's. With
-// any_hit the children are not sorted (WIDE_ANY): bunnies' shadow rays ran 20-25 % faster
+// any_hit the children are not sorted (wide_any): bunnies' shadow rays ran 20-25 % faster
 // (2-core dev machine, 2026-12-01), and a shadow test's result does not depend on which
 // hit is found first (path.h's shadow tests walk thin walls again nearest first).
 inline bool traverse_wide_bvh(global const DeviceWideNode* nodes, uint root,
@@ -292,33 +330,33 @@ inline bool traverse_wide_bvh(global const DeviceWideNode* nodes, uint root,
         if (bits != 0u && any_hit) {
             // Any hit ends the walk, so the order of the children does not matter: they are
             // taken in slot order, without sorting (as Embree's occlusion walk takes them).
-            global const int* children = (global const int*)&n->child;
-            global const uint* counts = (global const uint*)&n->count;
             if (sp + 4u > WIDE_STACK_SIZE + 1u) {
                 atomic_inc(overflow);
                 return true;
             }
-            WIDE_ANY(0)
-            WIDE_ANY(1)
-            WIDE_ANY(2)
-            WIDE_ANY(3)
+            if (wide_any(bits, 0u, n, r, tris, surf, tmin, o, d, hit, stack, stack_d, &sp) ||
+                wide_any(bits, 1u, n, r, tris, surf, tmin, o, d, hit, stack, stack_d, &sp) ||
+                wide_any(bits, 2u, n, r, tris, surf, tmin, o, d, hit, stack, stack_d, &sp) ||
+                wide_any(bits, 3u, n, r, tris, surf, tmin, o, d, hit, stack, stack_d, &sp)) {
+                return true;
+            }
         } else if (bits != 0u) {
-            global const int* children = (global const int*)&n->child;
-            global const uint* counts = (global const uint*)&n->count;
-            WIDE_SORT_CHILDREN(n, near, mask)
-            WIDE_LEAF(d0, s0)
-            WIDE_LEAF(d1, s1)
-            WIDE_LEAF(d2, s2)
-            WIDE_LEAF(d3, s3)
+            WideOrder c = wide_sort_children(near, mask);
+            if (wide_leaf(c.d0, c.s0, n, r, tris, surf, tmin, o, d, any_hit, hit) ||
+                wide_leaf(c.d1, c.s1, n, r, tris, surf, tmin, o, d, any_hit, hit) ||
+                wide_leaf(c.d2, c.s2, n, r, tris, surf, tmin, o, d, any_hit, hit) ||
+                wide_leaf(c.d3, c.s3, n, r, tris, surf, tmin, o, d, any_hit, hit)) {
+                return true;
+            }
             if (sp + 4u > WIDE_STACK_SIZE + 1u) {
                 atomic_inc(overflow);
                 return true;
             }
             uint before = sp, next = 0u;
-            WIDE_PUSH(d3, s3)
-            WIDE_PUSH(d2, s2)
-            WIDE_PUSH(d1, s1)
-            WIDE_PUSH(d0, s0)
+            wide_push(c.d3, c.s3, n, hit->t, stack, stack_d, &sp, &next);
+            wide_push(c.d2, c.s2, n, hit->t, stack, stack_d, &sp, &next);
+            wide_push(c.d1, c.s1, n, hit->t, stack, stack_d, &sp, &next);
+            wide_push(c.d0, c.s0, n, hit->t, stack, stack_d, &sp, &next);
             // The nearest pushed child is entered at once (it starts before the hit: no leaf
             // was tested since it was pushed), its address from a register, not the stack.
             if (sp != before) {
@@ -336,10 +374,6 @@ inline bool traverse_wide_bvh(global const DeviceWideNode* nodes, uint root,
         node = stack[sp];
     }
 }
-#undef WIDE_LEAF
-#undef WIDE_PUSH
-#undef WIDE_ANY
-#undef INTERSECT_LEAF
 
 // Closest hit (any_hit = false) or first hit (any_hit = true), as traverse() in traverse.h.
 inline DeviceHit traverse_wide(global const DeviceWideNode* nodes, global const DeviceTriangle* tris,
@@ -351,51 +385,58 @@ inline DeviceHit traverse_wide(global const DeviceWideNode* nodes, global const 
     return hit;
 }
 
-// A top-level child among the sorted ones, pushed with its entry distance (farthest first):
-// an interior node, or a leaf's pieces (INSTANCE_BIT, traverse.h).
-#define TOP_WIDE_PUSH(D, S)                                                         \
-    if (D < hit.t) {                                                                \
-        if (counts[S] == 0u) {                                                      \
-            stack[sp] = (uint)children[S];                                          \
-            stack_d[sp++] = D;                                                      \
-        } else {                                                                    \
-            uint first = (uint)(~children[S]);                                      \
-            for (uint i = first + counts[S]; i > first; --i) {                      \
-                if (sp == TOP_WIDE_STACK) {                                         \
-                    atomic_inc(overflow);                                           \
-                    return hit;                                                     \
-                }                                                                   \
-                stack[sp] = (i - 1u) | INSTANCE_BIT;                                \
-                stack_d[sp++] = D;                                                  \
-            }                                                                       \
-        }                                                                           \
-    }
-
 #define TOP_WIDE_STACK (WIDE_STACK_SIZE + 4)
 
-#ifdef HAS_TRIANGLE_PIECES
-// A top-level leaf of one triangle piece among the sorted children, tested on the spot (as
-// WIDE_LEAF tests a leaf) when it starts before the hit so far; its distance is then made
-// infinite so that TOP_WIDE_PUSH passes it over.
-#define TOP_WIDE_TRIANGLE(D, S)                                                           \
-    if (D < hit.t && counts[S] == 1u) {                                                   \
-        uint slot = (uint)(~children[S]);                                                 \
-        global const DeviceInstance* piece = &instances[slot];                               \
-        if (piece->flags & INSTANCE_PIECE_TRIANGLE) {                                     \
-            if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris, \
-                                         surf, &world, o, d, tmin, any_hit, &hit)) {      \
-                return hit;                                                               \
-            }                                                                             \
-            D = INFINITY;                                                                 \
-        }                                                                                 \
+// A top-level child among the sorted ones (entry distance dist, slot s of node n), pushed with
+// its distance when it starts before the hit at t: an interior node, or a leaf's pieces
+// (INSTANCE_BIT, traverse.h). Returns false when the stack overflowed (counted in *overflow).
+inline bool top_wide_push(float dist, uint s, global const DeviceWideNode* n, float t,
+                          uint* stack, float* stack_d, uint* sp, volatile global uint* overflow) {
+    if (!(dist < t)) return true;
+    uint count = wide_count(n, s);
+    if (count == 0u) {
+        stack[*sp] = (uint)wide_child(n, s);
+        stack_d[(*sp)++] = dist;
+        return true;
     }
-#else
-#define TOP_WIDE_TRIANGLE(D, S)
+    uint first = (uint)(~wide_child(n, s));
+    for (uint i = first + count; i > first; --i) {
+        if (*sp == TOP_WIDE_STACK) {
+            atomic_inc(overflow);
+            return false;
+        }
+        stack[*sp] = (i - 1u) | INSTANCE_BIT;
+        stack_d[(*sp)++] = dist;
+    }
+    return true;
+}
+
+#ifdef HAS_TRIANGLE_PIECES
+// A top-level leaf of one triangle piece among the sorted children (entry distance *dist, slot s
+// of node n), tested on the spot (as wide_leaf tests a leaf) when it starts before the hit so
+// far; *dist is then made infinite so that top_wide_push passes it over. Returns whether the
+// walk ends.
+inline bool top_wide_triangle(float* dist, uint s, global const DeviceWideNode* n,
+                              global const DeviceInstance* instances,
+                              global const DeviceTriangle* object_tris, const SceneSurfaces* surf,
+                              const RayPrep* world, float3 o, float3 d, float tmin, bool any_hit,
+                              DeviceHit* hit) {
+    if (!(*dist < hit->t && wide_count(n, s) == 1u)) return false;
+    uint slot = (uint)(~wide_child(n, s));
+    global const DeviceInstance* piece = &instances[slot];
+    if (!(piece->flags & INSTANCE_PIECE_TRIANGLE)) return false;
+    if (intersect_piece_triangle(piece->root, piece->wide_root, slot, object_tris, surf, world, o,
+                                 d, tmin, any_hit, hit)) {
+        return true;
+    }
+    *dist = INFINITY;
+    return false;
+}
 #endif
 
 // Two levels through wide nodes: the top level (from node 0; its leaves name pieces in
 // `instances`) walked nearest first as traverse_wide_bvh walks a tree: a leaf of a small
-// mesh's triangle is tested on the spot as the flat loop tests its leaves (TOP_WIDE_TRIANGLE:
+// mesh's triangle is tested on the spot as the flat loop tests its leaves (top_wide_triangle:
 // through the stack, primary rays in the bunny room ran about 10 % slower), and any other
 // piece the ray reaches before the hit so far is entered: the ray is carried into the
 // instance's object space, and the instance's bottom level walked from its wide_root by
@@ -443,21 +484,29 @@ inline DeviceHit traverse_wide_two_level(global const DeviceWideNode* nodes,
             float4 near;
             int4 mask = wide_reach(n, &w, tmin, hit.t, &near);
             if (wide_bits(mask) != 0u) {
-                WIDE_SORT_CHILDREN(n, near, mask)
-                global const int* children = (global const int*)&n->child;
-                global const uint* counts = (global const uint*)&n->count;
-                TOP_WIDE_TRIANGLE(d0, s0)
-                TOP_WIDE_TRIANGLE(d1, s1)
-                TOP_WIDE_TRIANGLE(d2, s2)
-                TOP_WIDE_TRIANGLE(d3, s3)
+                WideOrder c = wide_sort_children(near, mask);
+#ifdef HAS_TRIANGLE_PIECES
+                if (top_wide_triangle(&c.d0, c.s0, n, instances, object_tris, surf, &world, o, d,
+                                      tmin, any_hit, &hit) ||
+                    top_wide_triangle(&c.d1, c.s1, n, instances, object_tris, surf, &world, o, d,
+                                      tmin, any_hit, &hit) ||
+                    top_wide_triangle(&c.d2, c.s2, n, instances, object_tris, surf, &world, o, d,
+                                      tmin, any_hit, &hit) ||
+                    top_wide_triangle(&c.d3, c.s3, n, instances, object_tris, surf, &world, o, d,
+                                      tmin, any_hit, &hit)) {
+                    return hit;
+                }
+#endif
                 if (sp + 4u > TOP_WIDE_STACK) {
                     atomic_inc(overflow);
                     return hit;
                 }
-                TOP_WIDE_PUSH(d3, s3)
-                TOP_WIDE_PUSH(d2, s2)
-                TOP_WIDE_PUSH(d1, s1)
-                TOP_WIDE_PUSH(d0, s0)
+                if (!top_wide_push(c.d3, c.s3, n, hit.t, stack, stack_d, &sp, overflow) ||
+                    !top_wide_push(c.d2, c.s2, n, hit.t, stack, stack_d, &sp, overflow) ||
+                    !top_wide_push(c.d1, c.s1, n, hit.t, stack, stack_d, &sp, overflow) ||
+                    !top_wide_push(c.d0, c.s0, n, hit.t, stack, stack_d, &sp, overflow)) {
+                    return hit;
+                }
             }
         }
         // The nearest pushed entry that still starts before the hit.
@@ -469,10 +518,6 @@ inline DeviceHit traverse_wide_two_level(global const DeviceWideNode* nodes,
         node = stack[sp];
     }
 }
-#undef WIDE_ORDER
-#undef WIDE_SORT_CHILDREN
-#undef TOP_WIDE_PUSH
-#undef TOP_WIDE_TRIANGLE
 
 // The scene's traversal through wide nodes: flat, or with TWO_LEVEL two levels.
 inline DeviceHit trace_scene_wide(global const DeviceWideNode* nodes, global const DeviceTriangle* tris,

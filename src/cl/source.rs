@@ -31,6 +31,10 @@ const KERNELS: &[(&str, &str)] = &[
         include_str!("../../kernels/shared/types.h"),
     ),
     (
+        "kernels/shared/vec3.h",
+        include_str!("../../kernels/shared/vec3.h"),
+    ),
+    (
         "kernels/shared/rng.h",
         include_str!("../../kernels/shared/rng.h"),
     ),
