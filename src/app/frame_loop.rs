@@ -4,8 +4,9 @@
 //! batch is started at once (so kernel work overlaps the display of this image), and then the
 //! image is shown. Changes (camera, lights, scene, settings, window size) are collected and
 //! applied together between batches; every one of them resets the accumulation. A sample too
-//! long for the budget goes in bands, one per batch (budget.rs); a change abandons the rest of
-//! the sample, so input waits for one band at most.
+//! long for the budget goes in bands, one per batch (budget.rs), the rest of it split finer
+//! when a band runs over the budget; a change abandons the rest of the sample, so input waits
+//! for one band at most.
 
 use super::budget::{Budget, Level, Plan, levels, pixel_count, scaled};
 use super::heat::HeatMap;
@@ -358,6 +359,11 @@ impl FrameLoop {
         self.progress.band = batch.sample.next_band;
         self.progress.plan = Some(sample.plan);
         if sample.next_band < sample.plan.bands {
+            // A band over the budget: the rest of the sample goes in smaller bands.
+            (sample.plan, sample.next_band) =
+                sample
+                    .plan
+                    .split_rest(sample.next_band, ms, self.budget.target_ms);
             self.sample = Some(sample);
             return Ok(false);
         }
