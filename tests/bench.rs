@@ -164,8 +164,41 @@ fn converge_error_falls_as_samples_grow() {
         );
     }
     let csv_text = std::fs::read_to_string(&csv).unwrap();
-    assert!(csv_text.starts_with("config,spp,seconds,kernel_seconds,rmse,relmse\n"));
+    assert!(csv_text.starts_with("config,spp,seconds,kernel_seconds,rmse,relmse,cpu_seconds\n"));
     assert_eq!(csv_text.lines().count(), 1 + 2 * 7);
+    // The process's CPU seconds (the renderer's own cost on a shared machine) go forward too.
+    for c in curves {
+        let cpu: Vec<f64> = c["steps"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s["cpu_seconds"].as_f64().unwrap())
+            .collect();
+        assert!(cpu.windows(2).all(|w| w[1] >= w[0]), "{cpu:?}");
+    }
+    // With --adaptive the table ends with the time each curve takes to the adaptive run's
+    // relMSE, and the ratio.
+    let out = penumbra(&[
+        "bench",
+        "converge",
+        "--reference",
+        s(&reference),
+        "--configs",
+        "mis+rr",
+        "--spp",
+        "256",
+        "--adaptive",
+        "0.1",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success()
+            && text
+                .lines()
+                .any(|l| { l.starts_with("mis+rr+adaptive: to relMSE") && l.contains("CPU s (") }),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let png = std::fs::read(&plot).unwrap();
     assert!(
         png.starts_with(b"\x89PNG") && png.len() > 10_000,

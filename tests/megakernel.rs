@@ -444,12 +444,13 @@ fn samples_in_one_call_or_many_make_the_same_image() {
 fn a_sample_rendered_in_bands_makes_the_image_of_whole_launches() {
     // The viewer splits a slow device's sample into bands of work items (one launch each, at
     // a global offset) so that input never waits for a whole sample: the bands must cover
-    // every pixel exactly once, each with the sample index of the whole launch.
+    // every pixel exactly once, each with the sample index of the whole launch, also when the
+    // rest of a sample is split finer after a band that ran over its budget.
     use penumbra::render::{Band, KernelChoice, RenderSettings, Renderer};
     use penumbra::scene::RenderFrame;
     let choice = common::test_device().parse().unwrap();
     let scene = penumbra::scene::load_or_bundled(None).unwrap();
-    let image = |kernel: KernelChoice, bands: u32| {
+    let image = |kernel: KernelChoice, bands: &[Band]| {
         let mut r = Renderer::new(&choice).unwrap();
         r.set_kernel(kernel).unwrap();
         // 37 × 23: the last work-group (and lanes' tile) is partial.
@@ -464,12 +465,8 @@ fn a_sample_rendered_in_bands_makes_the_image_of_whole_launches() {
             .unwrap();
         r.set_camera(&scene.cameras[0]).unwrap();
         for _ in 0..4 {
-            for index in 0..bands {
-                r.start_band(Band {
-                    index,
-                    count: bands,
-                })
-                .unwrap();
+            for &band in bands {
+                r.start_band(band).unwrap();
                 r.finish().unwrap();
             }
         }
@@ -477,13 +474,19 @@ fn a_sample_rendered_in_bands_makes_the_image_of_whole_launches() {
         r.image().unwrap()
     };
     for kernel in [KernelChoice::Megakernel, KernelChoice::Wavefront] {
-        let whole = image(kernel, 1);
+        let whole = image(kernel, &[Band::WHOLE]);
         assert!(
             whole.iter().any(|p| p[0] + p[1] + p[2] > 0.0),
             "{kernel:?}: a black image"
         );
-        for bands in [2, 3, 40] {
-            assert_eq!(image(kernel, bands), whole, "{kernel:?}: {bands} bands");
+        let even =
+            |count: u32| -> Vec<Band> { (0..count).map(|index| Band { index, count }).collect() };
+        // One band of 3, then the rest in bands 4 times finer: 4..12 of 12.
+        let split: Vec<Band> = std::iter::once(Band { index: 0, count: 3 })
+            .chain((4..12).map(|index| Band { index, count: 12 }))
+            .collect();
+        for bands in [even(2), even(3), even(40), split] {
+            assert_eq!(image(kernel, &bands), whole, "{kernel:?}: {bands:?}");
         }
     }
 }

@@ -653,6 +653,18 @@ fn room(dir: &Path) -> PathBuf {
     g.write_glb(dir, "room")
 }
 
+/// A test driving the window: the one-at-a-time lock, a private X server, and the test's output
+/// folder; `None` (skipped, with the reason) without Xvfb or xdotool.
+fn interactive(name: &str) -> Option<(std::sync::MutexGuard<'static, ()>, Xvfb, PathBuf)> {
+    let lock = serial();
+    let x = Xvfb::start()?;
+    if !have("xdotool") {
+        skip("xdotool is not installed");
+        return None;
+    }
+    Some((lock, x, common::output_dir(name)))
+}
+
 /// The `--stats-file` lines written so far (one per image shown).
 fn stats_lines(path: &Path) -> Vec<serde_json::Value> {
     std::fs::read_to_string(path)
@@ -677,12 +689,9 @@ fn input_is_answered_within_the_budget_and_moving_never_freezes_the_image() {
     // of the first image rendered after it (the `latency_ms` of --stats-file). On the 2-core
     // CPU a full-size sample of a room takes far longer than 100 ms; the preview must still
     // answer within the 100 ms the issue asks for.
-    let _serial = serial();
-    let Some(x) = Xvfb::start() else { return };
-    if !have("xdotool") {
-        return skip("xdotool is not installed");
-    }
-    let dir = common::output_dir("viewer_latency");
+    let Some((_serial, x, dir)) = interactive("viewer_latency") else {
+        return;
+    };
     let room = room(&dir);
     for scene in [None, Some(room)] {
         let stats = dir.join("stats.jsonl");
@@ -922,4 +931,117 @@ fn n_shows_the_image_denoised() {
     // The same picture: block means agree.
     let moved = picture_difference(&raw, &denoised);
     assert!(moved < 0.05, "the denoised picture differs by {moved:.3}");
+}
+
+/// Where `rgb` lies on the heat maps' palette (blue 0, green ½, red 1), or `None` off it.
+fn heat(rgb: [u8; 3]) -> Option<f32> {
+    let [r, g, b] = rgb.map(f32::from);
+    let on_palette = r.min(b) <= 1.0 && (r + g + b - 255.0).abs() <= 2.0;
+    on_palette.then(|| match r > 0.0 {
+        true => 0.5 + r / 510.0,
+        false => g / 510.0,
+    })
+}
+
+/// The mean heat over the block of `rgb` (width `w`) from `(x0, y0)` to `(x1, y1)` in
+/// fractions of the image.
+fn mean_heat(rgb: &image::RgbImage, (x0, y0): (f32, f32), (x1, y1): (f32, f32)) -> f32 {
+    let (w, h) = (rgb.width() as f32, rgb.height() as f32);
+    let (mut sum, mut n) = (0.0, 0.0);
+    for y in (y0 * h) as u32..(y1 * h) as u32 {
+        for x in (x0 * w) as u32..(x1 * w) as u32 {
+            sum += heat(rgb.get_pixel(x, y).0).unwrap();
+            n += 1.0;
+        }
+    }
+    sum / n
+}
+
+#[test]
+fn m_shows_the_samples_and_error_heat_maps() {
+    // With adaptive sampling (here at threshold 0.05 from the command line) M shows the
+    // samples each pixel took, then each pixel's error estimate against the threshold (blue a
+    // quarter of it or less, green at it, red four times or more), then the image again. On
+    // the bundled box at 64 spp the void around the box (black: no variance, error 0) is blue
+    // in both maps, having stopped at the minimum of 48 samples, while inside the box, lit
+    // walls and shadows alike (their errors measured alike), most pixels keep sampling.
+    let Some((_serial, x, dir)) = interactive("viewer_heat_maps") else {
+        return;
+    };
+    let stats = dir.join("stats.jsonl");
+    let _ = std::fs::remove_file(&stats);
+    let _ = std::fs::remove_dir_all(dir.join("screenshots"));
+    let options = "--width 320 --height 240 --spp 64 --noise-threshold 0.05 --no-overlay";
+    let args: Vec<&str> = options
+        .split(' ')
+        .chain(["--stats-file", stats.to_str().unwrap()])
+        .collect();
+    let mut v = Viewer::spawn(viewer_command(&x, &dir, &args));
+    let wid = x.find_window();
+    x.xdotool(&["windowfocus", "--sync", &wid]);
+    v.wait_for("reached 64 spp");
+    x.xdotool(&["key", "F12"]);
+    let image = v.screenshot_path(&dir);
+    let first = stats_lines(&stats);
+    assert!(
+        first.iter().all(|l| l["heat_map"].is_null()),
+        "a heat map before M"
+    );
+    let converged = first
+        .iter()
+        .rev()
+        .find_map(|l| l["converged_share"].as_f64())
+        .expect("the converged share in the stats");
+    // The void around the box is a quarter of the window.
+    assert!((0.2..0.9).contains(&converged), "{converged} converged");
+    x.xdotool(&["key", "m"]);
+    wait_for_image(&stats, "the samples map", |l| {
+        l["heat_map"] == "samples per pixel"
+    });
+    x.xdotool(&["key", "F12"]);
+    let samples = image::open(v.screenshot_path(&dir)).unwrap().to_rgb8();
+    // Two counts: 48 (blue) and 64 (red).
+    assert!(
+        samples
+            .pixels()
+            .all(|p| p.0 == [0, 0, 255] || p.0 == [255, 0, 0]),
+        "the samples map has other colours than blue (48) and red (64)"
+    );
+    let corner = (0.0, 0.0);
+    let (void, inside) = ((0.02, 0.05), ((0.4, 0.4), (0.6, 0.6)));
+    assert_eq!(mean_heat(&samples, corner, void), 0.0, "the void: blue");
+    assert!(
+        mean_heat(&samples, inside.0, inside.1) > 0.5,
+        "the box: mostly red"
+    );
+    x.xdotool(&["key", "m"]);
+    wait_for_image(&stats, "the error map", |l| l["heat_map"] == "error");
+    x.xdotool(&["key", "F12"]);
+    let error = image::open(v.screenshot_path(&dir)).unwrap().to_rgb8();
+    let off: Vec<_> = error.pixels().filter(|p| heat(p.0).is_none()).collect();
+    assert!(
+        off.is_empty(),
+        "{} pixels off the palette, e.g. {:?}",
+        off.len(),
+        off.first()
+    );
+    let (void_heat, box_heat) = (
+        mean_heat(&error, corner, void),
+        mean_heat(&error, inside.0, inside.1),
+    );
+    println!("error map: void {void_heat:.2}, box {box_heat:.2}; {converged:.2} converged");
+    assert_eq!(void_heat, 0.0, "the void's error is not 0");
+    assert!(
+        box_heat > 0.25,
+        "the box's error map is cold: {box_heat:.2}"
+    );
+    // M again: the image.
+    x.xdotool(&["key", "m"]);
+    std::thread::sleep(Duration::from_secs(1));
+    x.xdotool(&["key", "F12"]);
+    let back = v.screenshot_path(&dir);
+    assert!(
+        same_pixels(&image, &back),
+        "the image after the maps is another"
+    );
 }

@@ -14,6 +14,8 @@
 //!
 //! **Bands.** A sample whose estimate exceeds the budget is split into bands (one launch each,
 //! [`crate::render::Band`]) of about the budget, so that new input waits for one band at most.
+//! A band that still runs over the budget (the estimate was low, or the device slowed down)
+//! has the rest of its sample split as many times finer ([`Plan::split_rest`]).
 
 /// Resolution divisors (1 = full resolution).
 pub const DIVISORS: [u32; 5] = [1, 2, 4, 8, 16];
@@ -70,6 +72,29 @@ pub struct Plan {
     /// Bands the batch's one sample is split into (1: one launch; more only with `spp` 1).
     pub bands: u32,
 }
+
+impl Plan {
+    /// After `done` bands of this plan, the last of which took `band_ms`: the plan for the rest
+    /// of the sample, and the index of its next band. A band over `target_ms` splits the rest
+    /// into bands ⌈band_ms / target_ms⌉ times finer (band k·m of bands·m starts where band k
+    /// of bands did), up to [`MAX_SPLIT_BANDS`] in all; otherwise the plan stands.
+    pub fn split_rest(self, done: u32, band_ms: f64, target_ms: f64) -> (Plan, u32) {
+        let factor = (band_ms / target_ms).ceil();
+        if self.bands <= 1 || done >= self.bands || factor.is_nan() || factor <= 1.0 {
+            return (self, done);
+        }
+        let most = (MAX_SPLIT_BANDS / self.bands).max(1);
+        let m = (factor.min(most as f64) as u32).max(1);
+        let plan = Plan {
+            bands: self.bands * m,
+            ..self
+        };
+        (plan, done * m)
+    }
+}
+
+/// Most bands a re-planned sample is split into.
+pub const MAX_SPLIT_BANDS: u32 = 16 * MAX_BANDS;
 
 /// Measured costs and the budget they are held to.
 #[derive(Clone, Debug)]
@@ -280,6 +305,29 @@ mod tests {
         assert_eq!((p.spp, p.bands), (1, 17));
         // Kernels that cannot split (the wavefront) get one band.
         assert_eq!(b.batch(full(4), FULL, None, false).bands, 1);
+    }
+
+    #[test]
+    fn a_band_over_the_budget_splits_the_rest_of_its_sample() {
+        let plan = Plan {
+            level: full(4),
+            spp: 1,
+            bands: 4,
+        };
+        // Band 1 of 4 (the second) took 70 ms of a 30 ms budget: the rest in bands 3 times
+        // finer, the next being band 6 of 12, which starts where band 2 of 4 did.
+        assert_eq!(
+            plan.split_rest(2, 70.0, 30.0),
+            (Plan { bands: 12, ..plan }, 6)
+        );
+        // Within the budget, or a whole sample: the plan stands.
+        assert_eq!(plan.split_rest(2, 29.0, 30.0), (plan, 2));
+        let whole = Plan { bands: 1, ..plan };
+        assert_eq!(whole.split_rest(1, 500.0, 30.0), (whole, 1));
+        // Never more than MAX_SPLIT_BANDS; a non-finite time changes nothing.
+        let (p, next) = plan.split_rest(1, 1e9, 30.0);
+        assert_eq!((p.bands, next), (MAX_SPLIT_BANDS, MAX_SPLIT_BANDS / 4));
+        assert_eq!(plan.split_rest(1, f64::NAN, 30.0), (plan, 1));
     }
 
     #[test]

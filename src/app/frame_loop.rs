@@ -4,10 +4,12 @@
 //! batch is started at once (so kernel work overlaps the display of this image), and then the
 //! image is shown. Changes (camera, lights, scene, settings, window size) are collected and
 //! applied together between batches; every one of them resets the accumulation. A sample too
-//! long for the budget goes in bands, one per batch (budget.rs); a change abandons the rest of
-//! the sample, so input waits for one band at most.
+//! long for the budget goes in bands, one per batch (budget.rs), the rest of it split finer
+//! when a band runs over the budget; a change abandons the rest of the sample, so input waits
+//! for one band at most.
 
 use super::budget::{Budget, Level, Plan, levels, pixel_count, scaled};
+use super::heat::HeatMap;
 use crate::cl::ClError;
 use crate::render::{Band, KernelChoice, RenderSettings, RenderStats, Renderer, SceneStats};
 use crate::scene::{Camera, Light, RenderFrame, Scene};
@@ -98,9 +100,12 @@ pub struct Film {
     /// Counts the views: changes of the camera, scene, lights or settings (not of the level
     /// while the preview climbs back), so exposure can be decided once per view.
     pub view: u64,
-    /// With [`FrameLoop::read_samples`] and adaptive sampling, the samples each pixel took;
-    /// else empty.
+    /// With [`FrameLoop::heat_map`] on samples and adaptive sampling, the samples each pixel
+    /// took; else empty.
     pub samples: Vec<u32>,
+    /// With [`FrameLoop::heat_map`] on error and adaptive sampling, each pixel's error
+    /// estimate; else empty.
+    pub errors: Vec<f32>,
     /// With [`FrameLoop::read_aovs`], the guide buffers of the same samples (for the
     /// denoiser); else `None`.
     pub aovs: Option<crate::render::Aovs>,
@@ -169,8 +174,9 @@ pub struct FrameLoop {
     loaded: bool,
     /// The latest image.
     pub film: Film,
-    /// Whether each film also reads adaptive sampling's samples per pixel (for the heat map).
-    pub read_samples: bool,
+    /// The heat map whose data each film also reads (adaptive sampling's samples per pixel or
+    /// error estimates).
+    pub heat_map: HeatMap,
     /// Whether each film also reads the guide buffers (for the denoiser).
     pub read_aovs: bool,
     /// Figures for the overlay.
@@ -199,7 +205,7 @@ impl FrameLoop {
             view: 0,
             loaded: false,
             film: Film::default(),
-            read_samples: false,
+            heat_map: HeatMap::Off,
             read_aovs: false,
             progress: Progress::default(),
             scene_stats: None,
@@ -353,6 +359,11 @@ impl FrameLoop {
         self.progress.band = batch.sample.next_band;
         self.progress.plan = Some(sample.plan);
         if sample.next_band < sample.plan.bands {
+            // A band over the budget: the rest of the sample goes in smaller bands.
+            (sample.plan, sample.next_band) =
+                sample
+                    .plan
+                    .split_rest(sample.next_band, ms, self.budget.target_ms);
             self.sample = Some(sample);
             return Ok(false);
         }
@@ -373,10 +384,7 @@ impl FrameLoop {
         let counted = settings.cutout || settings.count_coverage;
         self.renderer
             .image_into(&mut pixels, counted.then_some(&mut coverage))?;
-        let samples = match self.read_samples {
-            true => self.renderer.pixel_samples()?.unwrap_or_default(),
-            false => Vec::new(),
-        };
+        let (samples, errors) = self.heat_data()?;
         let aovs = match self.read_aovs && settings.aovs {
             true => self.renderer.aovs()?,
             false => None,
@@ -395,6 +403,7 @@ impl FrameLoop {
             answers: sample.answers.or(self.film.answers),
             view: sample.view,
             samples,
+            errors,
             aovs,
         };
         let p = &mut self.progress;
@@ -409,6 +418,47 @@ impl FrameLoop {
             p.samples_per_second = pixel_count(size) as f64 * spp as f64 / p.seconds;
             p.rays_per_second = (p.stats.extension_rays + p.stats.shadow_rays) as f64 / p.seconds;
         }
+        Ok(true)
+    }
+
+    /// The data of [`FrameLoop::heat_map`] for the film the renderer holds: its samples per pixel
+    /// or its error estimates (empty without adaptive sampling).
+    fn heat_data(&mut self) -> Result<(Vec<u32>, Vec<f32>), ClError> {
+        Ok(match self.heat_map {
+            HeatMap::Off => (Vec::new(), Vec::new()),
+            HeatMap::Samples => (
+                self.renderer.pixel_samples()?.unwrap_or_default(),
+                Vec::new(),
+            ),
+            HeatMap::Error => (
+                Vec::new(),
+                self.renderer.pixel_errors()?.unwrap_or_default(),
+            ),
+        })
+    }
+
+    /// Reads the heat map's data into the film at once when no batch runs (the image rests, or
+    /// its target is reached) and the film lacks it; returns whether it did. While batches run,
+    /// the next one's film brings it.
+    pub fn read_heat_map(&mut self) -> Result<bool, ClError> {
+        let film = &self.film;
+        let pixels = film.pixels.len();
+        let missing = match self.heat_map {
+            HeatMap::Off => false,
+            HeatMap::Samples => film.samples.len() != pixels,
+            HeatMap::Error => film.errors.len() != pixels,
+        };
+        let settings = self.renderer.settings();
+        let same_film = (settings.width, settings.height) == (film.width, film.height);
+        if !missing || pixels == 0 || self.batch.is_some() || !same_film {
+            return Ok(false);
+        }
+        let (samples, errors) = self.heat_data()?;
+        if samples.is_empty() && errors.is_empty() {
+            return Ok(false);
+        }
+        self.film.samples = samples;
+        self.film.errors = errors;
         Ok(true)
     }
 

@@ -5,6 +5,7 @@
 use super::camera::{CameraController, Mode};
 use super::exposure::HeldExposure;
 use super::frame_loop::{Changes, Film, Progress};
+use super::heat::{self, HeatMap};
 use super::state::ViewState;
 use crate::render::SceneStats;
 use crate::render::background::Background;
@@ -210,7 +211,7 @@ impl Gui {
                         // Statistics first: visible without scrolling in a 600 px window.
                         stats_section(ui, m, info);
                         m.timeline.section(ui, &m.scene);
-                        self.render_section(ui, m, &mut actions);
+                        self.render_section(ui, m, info, &mut actions);
                         self.camera_section(ui, m, &mut actions);
                         self.lights_section(ui, m, &mut actions);
                         self.views_section(ui, &mut actions);
@@ -253,7 +254,7 @@ impl Gui {
         }
     }
 
-    fn render_section(&mut self, ui: &mut Ui, m: &mut Model, actions: &mut Actions) {
+    fn render_section(&mut self, ui: &mut Ui, m: &mut Model, info: &Info, actions: &mut Actions) {
         egui::CollapsingHeader::new("Render")
             .default_open(true)
             .show(ui, |ui| {
@@ -268,7 +269,7 @@ impl Gui {
                     // Adaptive sampling: converged pixels stop (docs/adaptive-sampling.md).
                     let mut adaptive = v.noise_threshold.is_some();
                     if ui.checkbox(&mut adaptive, "adaptive").changed() {
-                        v.noise_threshold = adaptive.then_some(0.01);
+                        v.noise_threshold = adaptive.then_some(DEFAULT_NOISE_THRESHOLD);
                         actions.changes.settings = true;
                     }
                     if let Some(t) = v.noise_threshold.as_mut()
@@ -283,10 +284,11 @@ impl Gui {
                     {
                         actions.changes.settings = true;
                     }
-                    if v.noise_threshold.is_some() {
-                        ui.checkbox(&mut v.show_samples, "show samples per pixel");
-                    }
                 });
+                if let Some(threshold) = v.noise_threshold {
+                    heat_map_choice(ui, &mut v.heat_map);
+                    heat_legend(ui, v.heat_map, threshold, info.film);
+                }
                 // The denoiser needs the guide buffers: turning it on or off builds the kernels.
                 if ui
                     .checkbox(&mut v.denoise, "denoise (N)")
@@ -710,6 +712,9 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
                 .spp_target
                 .map_or_else(|| "endless".to_string(), |t| format!("target {t}"));
             ui.label(format!("{} spp ({target}) in {:.2} s", p.spp, p.seconds));
+            if let Some(t) = m.view.noise_threshold {
+                ui.label(adaptive_line(t, p.converged_share, info.film));
+            }
             ui.label(format!(
                 "{:.3} M samples/s · {:.3} M rays/s",
                 p.samples_per_second * 1e-6,
@@ -818,6 +823,79 @@ pub fn flash(ctx: &egui::Context, flash: &Option<(String, Instant)>, panel_width
 
 /// How long a flashed message stays.
 pub const FLASH_SECONDS: f64 = 3.0;
+
+/// Adaptive sampling's figures: the converged share at the last check, and what the heat map
+/// read (the mean samples per pixel, or the mean error).
+fn adaptive_line(threshold: f32, converged: Option<f64>, film: &Film) -> String {
+    let mut line = match converged {
+        Some(c) => format!("adaptive {threshold}: {:.0} % converged", c * 100.0),
+        None => format!("adaptive {threshold}: no check yet"),
+    };
+    if !film.samples.is_empty() {
+        let mean =
+            film.samples.iter().map(|&s| f64::from(s)).sum::<f64>() / film.samples.len() as f64;
+        line += &format!(" · mean {mean:.1} spp");
+    }
+    if !film.errors.is_empty() {
+        line += &format!(" · mean error {:.4}", heat::mean_error(&film.errors));
+    }
+    line
+}
+
+/// The noise threshold the adaptive box (and M, turning adaptive sampling on) starts with.
+pub const DEFAULT_NOISE_THRESHOLD: f32 = 0.01;
+
+/// What the display shows with adaptive sampling: the image or one of its heat maps (M).
+fn heat_map_choice(ui: &mut Ui, map: &mut HeatMap) {
+    ui.horizontal_wrapped(|ui| {
+        ui.label("show (M):");
+        for choice in [HeatMap::Off, HeatMap::Samples, HeatMap::Error] {
+            ui.radio_value(map, choice, choice.name());
+        }
+    });
+}
+
+/// The heat map's key: the palette as a bar with what its ends and middle mean.
+fn heat_legend(ui: &mut Ui, map: HeatMap, threshold: f32, film: &Film) {
+    let (lo, mid, hi) = match map {
+        HeatMap::Off => return,
+        HeatMap::Samples if film.samples.is_empty() => return,
+        HeatMap::Error if film.errors.is_empty() => return,
+        HeatMap::Samples => {
+            let (lo, hi) = heat::samples_range(&film.samples);
+            (
+                format!("{lo} spp"),
+                format!("{} spp", (lo + hi) / 2),
+                format!("{hi} spp"),
+            )
+        }
+        HeatMap::Error => (
+            format!("≤ {}", threshold / heat::ERROR_SPAN),
+            format!("{threshold} (threshold)"),
+            format!("≥ {} or none yet", threshold * heat::ERROR_SPAN),
+        ),
+    };
+    let width = ui.available_width().min(260.0);
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(width, 12.0), egui::Sense::hover());
+    let steps = 32;
+    for i in 0..steps {
+        let [r, g, b] = heat::palette((i as f32 + 0.5) / steps as f32);
+        let x0 = rect.left() + rect.width() * i as f32 / steps as f32;
+        let x1 = rect.left() + rect.width() * (i + 1) as f32 / steps as f32;
+        ui.painter().rect_filled(
+            egui::Rect::from_x_y_ranges(x0..=x1, rect.y_range()),
+            0.0,
+            Color32::from_rgb(r, g, b),
+        );
+    }
+    ui.label(format!("blue {lo} · green {mid} · red {hi}"));
+    if map == HeatMap::Error {
+        ui.label(
+            "the relative error adaptive sampling judges pixels by: a pixel stops when it and \
+             its 8 neighbours are under the threshold",
+        );
+    }
+}
 
 /// The exposure lock: automatic exposure keeps its value across views.
 fn exposure_lock(ui: &mut Ui, v: &mut super::state::ViewState) {

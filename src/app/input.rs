@@ -1,8 +1,9 @@
 //! Keyboard and mouse: window events become camera moves (fly, look, pan, orbit, zoom) and the
-//! viewer's actions (pick, focus, hard shadows, screenshot, overlay, quit).
+//! viewer's actions (pick, focus, hard shadows, heat maps, screenshot, overlay, quit).
 
 use super::camera::{Mode, Motion};
 use super::frame_loop::Changes;
+use super::heat::HeatMap;
 use super::{App, pick};
 use glam::DVec3;
 use std::time::Instant;
@@ -184,9 +185,36 @@ impl App {
                     ..Changes::default()
                 });
             }
+            KeyCode::KeyM => self.next_heat_map(),
             KeyCode::F12 => self.screenshot(),
             _ => {}
         }
+    }
+
+    /// M: image, samples per pixel, error, image. The maps need adaptive sampling: with it off,
+    /// M turns it on at the overlay's default threshold (the image restarts) and says so.
+    fn next_heat_map(&mut self) {
+        let v = &mut self.model.view;
+        v.heat_map = v.heat_map.next();
+        let turned_on = v.heat_map != HeatMap::Off && v.noise_threshold.is_none();
+        if turned_on {
+            v.noise_threshold = Some(super::gui::DEFAULT_NOISE_THRESHOLD);
+            self.frame_loop.invalidate(Changes {
+                settings: true,
+                ..Changes::default()
+            });
+        }
+        let v = &self.model.view;
+        let text = match (v.heat_map, turned_on) {
+            (HeatMap::Off, _) => "the image".to_string(),
+            (map, true) => format!(
+                "{}: adaptive sampling on (noise threshold {})",
+                map.name(),
+                v.noise_threshold.unwrap_or_default()
+            ),
+            (map, false) => map.name().to_string(),
+        };
+        self.flash(&text);
     }
 
     /// Shows `text` in the middle of the image for a moment.

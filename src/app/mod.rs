@@ -8,6 +8,7 @@ mod exposure;
 mod frame_loop;
 mod framework;
 mod gui;
+mod heat;
 mod input;
 mod layout;
 mod light_editor;
@@ -42,6 +43,18 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
+
+/// Exposure, tone mapper, samples, size, background, heat map (with the error map's threshold,
+/// as bits) and denoised of the displayed frame.
+type DisplayKey = (
+    f32,
+    ToneMapper,
+    u32,
+    usize,
+    u64,
+    Option<(heat::HeatMap, u32)>,
+    bool,
+);
 
 /// The window size when `--width`/`--height` are not given.
 pub const DEFAULT_SIZE: (u32, u32) = (960, 600);
@@ -81,6 +94,10 @@ pub const CONTROLS: &[(&str, &str)] = &[
     ("Tab", "hide / show the overlay"),
     ("F1", "this list in a window"),
     ("N", "denoise the image on / off"),
+    (
+        "M",
+        "heat maps: samples per pixel, error, image (turns adaptive sampling on)",
+    ),
     ("Space", "play / pause the animation"),
     ("Ctrl + Q", "quit (like closing the window)"),
     ("drop a file", "open a .gltf / .glb scene"),
@@ -338,8 +355,8 @@ struct App {
     denoised: Option<(FilmKey, Vec<[f32; 3]>)>,
     /// How long the last denoising took.
     denoise_ms: Option<f64>,
-    /// Exposure, tone mapper, samples, size, background, heat map and denoised of `display`.
-    display_key: Option<(f32, ToneMapper, u32, usize, u64, bool, bool)>,
+    /// What `display` shows.
+    display_key: Option<DisplayKey>,
     /// Counts the changes of `display`.
     display_generation: u64,
     /// The scene file being loaded in the background.
@@ -613,7 +630,10 @@ impl App {
         // an environment change) that builds kernels blocks for seconds with a cold cache: show
         // two frames that say so first.
         let v = &self.model.view;
-        self.frame_loop.read_samples = v.show_samples && v.noise_threshold.is_some();
+        self.frame_loop.heat_map = match v.noise_threshold {
+            Some(_) => v.heat_map,
+            None => heat::HeatMap::Off,
+        };
         self.frame_loop.read_aovs = v.denoise;
         let new_image = if self.builds_next() && self.notice_frames <= 2 {
             self.wake = Some(now);
@@ -747,7 +767,9 @@ impl App {
             spp_target: self.model.view.spp_target,
             moving: self.moving(now),
         };
-        match self.frame_loop.step(&world) {
+        // A heat map turned on while no batch runs reads its data from the film at once.
+        let step = self.frame_loop.step(&world);
+        match step.and_then(|new| Ok(self.frame_loop.read_heat_map()? || new)) {
             Ok(new) => new,
             Err(e) => {
                 let message = e.to_string();
@@ -836,6 +858,11 @@ impl App {
             bounces: film.bounces,
             exposure: self.model.view.exposure,
             latency_ms: None,
+            heat_map: self
+                .display_key
+                .and_then(|k| k.5)
+                .map(|(map, _)| map.name()),
+            converged_share: self.frame_loop.progress.converged_share,
         };
         self.stats.image_shown(Instant::now(), answers, line);
     }
@@ -984,7 +1011,17 @@ impl App {
             Background::Transparent => 1,
             Background::Color(c) => c.iter().fold(2u64, |h, x| h * 31 + x.to_bits() as u64),
         };
-        let heat = v.show_samples && film.samples.len() == film.pixels.len();
+        // A heat map replaces the image once the film carries its data; the error map's scale
+        // is the threshold.
+        let heat = match (v.heat_map, v.noise_threshold) {
+            (heat::HeatMap::Samples, Some(_)) if film.samples.len() == film.pixels.len() => {
+                Some((heat::HeatMap::Samples, 0.0))
+            }
+            (heat::HeatMap::Error, Some(t)) if film.errors.len() == film.pixels.len() => {
+                Some((heat::HeatMap::Error, t))
+            }
+            _ => None,
+        };
         let denoised = self
             .denoised
             .as_ref()
@@ -996,21 +1033,24 @@ impl App {
             film.spp,
             film.pixels.len(),
             background,
-            heat,
+            heat.map(|(h, t)| (h, t.to_bits())),
             denoised.is_some(),
         );
         if self.display_key != Some(key) || new_image {
             self.display_key = Some(key);
-            self.display = match denoised {
-                _ if heat => samples_heat_rgba(&film.samples),
-                Some(pixels) => {
+            self.display = match (heat, denoised) {
+                (Some((heat::HeatMap::Error, threshold)), _) => {
+                    heat::error_rgba(&film.errors, threshold)
+                }
+                (Some(_), _) => heat::samples_rgba(&film.samples),
+                (None, Some(pixels)) => {
                     let shown = frame_loop::Film {
                         pixels: pixels.clone(),
                         ..film.clone()
                     };
                     display_rgba(&shown, v.exposure, v.tone_mapper, v.background)
                 }
-                None => display_rgba(film, v.exposure, v.tone_mapper, v.background),
+                (None, None) => display_rgba(film, v.exposure, v.tone_mapper, v.background),
             };
             self.display_generation += 1;
         }
@@ -1040,29 +1080,6 @@ impl App {
     }
 }
 
-/// Adaptive sampling's samples per pixel as RGBA8: from blue (the fewest any pixel took) through
-/// green to red (the most), so that converged regions read as cold.
-fn samples_heat_rgba(samples: &[u32]) -> Vec<u8> {
-    let lo = samples.iter().copied().min().unwrap_or(0) as f32;
-    let hi = samples.iter().copied().max().unwrap_or(0) as f32;
-    samples
-        .iter()
-        .flat_map(|&s| {
-            let t = if hi > lo {
-                (s as f32 - lo) / (hi - lo)
-            } else {
-                0.0
-            };
-            let rgb = [
-                (2.0 * t - 1.0).clamp(0.0, 1.0),
-                1.0 - (2.0 * t - 1.0).abs(),
-                (1.0 - 2.0 * t).clamp(0.0, 1.0),
-            ];
-            [rgb[0], rgb[1], rgb[2], 1.0].map(|c| (c * 255.0).round() as u8)
-        })
-        .collect()
-}
-
 /// The film as shown: exposed and tone-mapped RGBA8, with the background applied when it is
 /// cut out (alpha for transparent, the color painted behind).
 fn display_rgba(
@@ -1081,23 +1098,4 @@ fn display_rgba(
     );
     crate::render::background::apply(&mut rgba, &film.coverage, background);
     rgba
-}
-
-#[cfg(test)]
-mod tests {
-    use super::samples_heat_rgba;
-
-    #[test]
-    fn the_samples_heat_map_runs_from_blue_through_green_to_red() {
-        let rgba = samples_heat_rgba(&[16, 40, 64, 16]);
-        assert_eq!(&rgba[0..4], &[0, 0, 255, 255], "the fewest: blue");
-        assert_eq!(&rgba[4..8], &[0, 255, 0, 255], "half way: green");
-        assert_eq!(&rgba[8..12], &[255, 0, 0, 255], "the most: red");
-        assert_eq!(&rgba[12..16], &rgba[0..4]);
-        // One count everywhere (all converged at once): all blue, no division by zero.
-        assert_eq!(
-            samples_heat_rgba(&[32, 32]),
-            [0, 0, 255, 255, 0, 0, 255, 255]
-        );
-    }
 }

@@ -76,9 +76,8 @@ pub struct ViewState {
     pub bounces: u32,
     /// Adaptive sampling's noise threshold (`render --noise-threshold`); `None`: off.
     pub noise_threshold: Option<f32>,
-    /// With adaptive sampling, the display shows the samples each pixel took as a heat map
-    /// instead of the image.
-    pub show_samples: bool,
+    /// With adaptive sampling, the display shows a heat map instead of the image (M cycles).
+    pub heat_map: super::heat::HeatMap,
     /// The image is shown denoised (the guide buffers are rendered for it; docs/denoiser.md).
     pub denoise: bool,
     /// Seed of the random sequence.
@@ -131,7 +130,7 @@ impl ViewState {
         let mut s = Self {
             bounces: base.bounces,
             noise_threshold: base.noise_threshold,
-            show_samples: false,
+            heat_map: super::heat::HeatMap::Off,
             denoise: false,
             seed: base.seed,
             sky: base.sky,

@@ -32,6 +32,10 @@ pub struct ImageLine {
     /// When it is the first image after input: milliseconds from the input event to its
     /// present.
     pub latency_ms: Option<f64>,
+    /// The heat map shown instead of the image ("samples per pixel" or "error"), if any.
+    pub heat_map: Option<&'static str>,
+    /// With adaptive sampling, the share of pixels converged at the last check.
+    pub converged_share: Option<f64>,
 }
 
 /// Presented images and input latencies.
@@ -111,6 +115,8 @@ mod tests {
             bounces: 4,
             exposure: 0.0,
             latency_ms: None,
+            heat_map: None,
+            converged_share: None,
         }
     }
 

@@ -6,14 +6,15 @@
 //! reference are recorded. An unbiased estimator's MSE falls as 1/time: slope −1 on log–log
 //! axes. A curve that flattens is bias (or a reference that does not match the render).
 
-use super::curve::{Curve, Step};
+use super::curve::{Curve, Step, time_to};
 use super::stats::{ImageError, image_error};
 use super::{device_json, device_line, plot};
 use crate::args::CommonArgs;
+use crate::cpu_time::process_cpu_seconds;
 use crate::date::today;
 use crate::denoise::{Denoiser, Quality};
 use crate::image_io::read_exr;
-use crate::render::Strategy;
+use crate::render::{RenderSettings, Strategy, min_samples};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -183,6 +184,15 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         .transpose()?;
     // Warm up: buffers, kernel caches, device clocks (and the denoiser's tensors).
     renderer.render(1)?;
+    if let Some(threshold) = args.adaptive {
+        // And the convergence check's kernels, whose first launch PoCL compiles (about 0.2 s,
+        // which the first adaptive curve would otherwise carry).
+        renderer.set_settings(&RenderSettings {
+            noise_threshold: Some(threshold),
+            ..settings.clone()
+        })?;
+        renderer.render(min_samples(threshold))?;
+    }
     if let Some(d) = denoiser.as_mut() {
         denoise(&mut renderer, d)?;
     }
@@ -211,13 +221,17 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         let mut steps = Vec::new();
         let mut denoised_steps = Vec::new();
         let mut seconds = 0.0;
+        let mut cpu_seconds = 0.0;
         let mut spp = 0;
         let mut next = 1;
         // An adaptive render ends where no pixel is left active.
         while spp < max_spp && seconds <= args.max_seconds && renderer.active_pixels() != Some(0) {
-            let start = Instant::now();
+            let (start, cpu_start) = (Instant::now(), process_cpu_seconds());
             renderer.render(next - spp)?;
             seconds += start.elapsed().as_secs_f64();
+            if let (Some(a), Some(b)) = (cpu_start, process_cpu_seconds()) {
+                cpu_seconds += b - a;
+            }
             spp = next;
             let kernel_seconds = renderer.stats().kernel_ms() * 1e-3;
             let ImageError { rmse, relmse } = image_error(&renderer.image()?, &reference);
@@ -225,6 +239,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
                 spp,
                 seconds,
                 kernel_seconds,
+                cpu_seconds,
                 rmse,
                 relmse,
             });
@@ -236,6 +251,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
                     spp,
                     seconds: seconds + denoise_seconds,
                     kernel_seconds,
+                    cpu_seconds,
                     rmse,
                     relmse,
                 });
@@ -345,6 +361,11 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
     }
     println!();
     println!("efficiency = 1 / (relMSE × seconds) at the last step; slope −1 = unbiased");
+    for (uniform, adaptive) in curves.iter().zip(&curves[1..]) {
+        if let Some(line) = adaptive_gain(uniform, adaptive) {
+            println!("{line}");
+        }
+    }
     if args.denoise {
         println!(
             "CONFIG+denoise: each step's image denoised ({} network); its seconds add that \
@@ -353,6 +374,28 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// For an adaptive curve after its uniform one: the time each takes to the adaptive run's last
+/// relMSE, in wall and CPU seconds (the uniform curve interpolated, or extended as 1 / time),
+/// and the ratio, the speed-up of adaptive sampling at equal error.
+fn adaptive_gain(uniform: &Curve, adaptive: &Curve) -> Option<String> {
+    if adaptive.config != format!("{}+adaptive", uniform.config) {
+        return None;
+    }
+    let last = adaptive.steps.last()?;
+    let wall = time_to(&uniform.steps, last.relmse, |s| s.seconds)?;
+    let cpu = time_to(&uniform.steps, last.relmse, |s| s.cpu_seconds)?;
+    Some(format!(
+        "{}: to relMSE {:.4e} uniform {wall:.2} s / adaptive {:.2} s wall ({:.2}×), \
+         {cpu:.2} / {:.2} CPU s ({:.2}×)",
+        adaptive.config,
+        last.relmse,
+        last.seconds,
+        wall / last.seconds.max(1e-12),
+        last.cpu_seconds,
+        cpu / last.cpu_seconds.max(1e-12),
+    ))
 }
 
 /// The film denoised with the guide buffers (as `render --denoise` does it) and the seconds
@@ -368,12 +411,12 @@ fn denoise(
 }
 
 fn write_csv(path: &std::path::Path, curves: &[Curve]) -> Result<()> {
-    let mut out = String::from("config,spp,seconds,kernel_seconds,rmse,relmse\n");
+    let mut out = String::from("config,spp,seconds,kernel_seconds,rmse,relmse,cpu_seconds\n");
     for c in curves {
         for s in &c.steps {
             out.push_str(&format!(
-                "{},{},{},{},{},{}\n",
-                c.config, s.spp, s.seconds, s.kernel_seconds, s.rmse, s.relmse
+                "{},{},{},{},{},{},{}\n",
+                c.config, s.spp, s.seconds, s.kernel_seconds, s.rmse, s.relmse, s.cpu_seconds
             ));
         }
     }

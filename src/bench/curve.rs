@@ -13,6 +13,9 @@ pub struct Step {
     pub seconds: f64,
     /// Kernel time of the renders so far, from profiling events.
     pub kernel_seconds: f64,
+    /// CPU time of the process (all threads) over the renders so far: on a CPU device shared
+    /// with other work, the renderer's own cost, which wall time mixes with the neighbours'.
+    pub cpu_seconds: f64,
     /// Root mean squared error against the reference.
     pub rmse: f64,
     /// Mean of (x − r)² / (r² + 0.01) over pixels and channels.
@@ -70,9 +73,52 @@ impl Curve {
     }
 }
 
+/// The time `steps` (in order of spp) take to reach `relmse`, by `time` (wall or CPU seconds):
+/// interpolated on log–log axes between the steps around it, or past the last step extended as
+/// an unbiased estimator's relMSE ∝ 1 / time; `None` when the first step is already below it
+/// or a time is not positive.
+pub fn time_to(steps: &[Step], relmse: f64, time: fn(&Step) -> f64) -> Option<f64> {
+    let first = steps.first()?;
+    if relmse > first.relmse || relmse <= 0.0 {
+        return None;
+    }
+    for pair in steps.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        if (b.relmse..=a.relmse).contains(&relmse) && time(a) > 0.0 && time(b) > 0.0 {
+            let f = (relmse / a.relmse).ln() / (b.relmse / a.relmse).ln();
+            let f = if f.is_finite() { f } else { 0.0 };
+            return Some((time(a).ln() + f * (time(b) / time(a)).ln()).exp());
+        }
+    }
+    let last = steps.last()?;
+    (time(last) > 0.0 && relmse <= last.relmse).then(|| time(last) * last.relmse / relmse)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_time_to_a_relmse_follows_the_curve_and_past_it_one_over_time() {
+        let step = |spp: u32, seconds: f64, relmse: f64| Step {
+            spp,
+            seconds,
+            kernel_seconds: 0.0,
+            cpu_seconds: 2.0 * seconds,
+            rmse: 0.0,
+            relmse,
+        };
+        let steps = [step(1, 1.0, 1.0), step(2, 2.0, 0.5), step(4, 4.0, 0.25)];
+        let wall = |s: &Step| s.seconds;
+        // On the curve: exact at a step, log-log between steps.
+        assert_eq!(time_to(&steps, 0.5, wall), Some(2.0));
+        assert!((time_to(&steps, 0.7, wall).unwrap() - 1.0 / 0.7).abs() < 1e-12);
+        // Past the last step: relMSE ∝ 1 / time; by CPU time, twice the wall time here.
+        assert!((time_to(&steps, 0.1, wall).unwrap() - 10.0).abs() < 1e-12);
+        assert!((time_to(&steps, 0.1, |s| s.cpu_seconds).unwrap() - 20.0).abs() < 1e-12);
+        // Above the first step's relMSE: unknown.
+        assert_eq!(time_to(&steps, 2.0, wall), None);
+    }
 
     #[test]
     fn a_one_over_n_curve_fits_slope_minus_one() {
@@ -83,6 +129,7 @@ mod tests {
                     spp,
                     seconds: 0.01 * spp as f64,
                     kernel_seconds: 0.0,
+                    cpu_seconds: 0.0,
                     rmse: 0.0,
                     relmse: 0.5 / spp as f64,
                 }

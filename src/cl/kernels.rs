@@ -74,17 +74,20 @@ fn global_size(n: usize, local: usize) -> usize {
 /// Band `index` of `count` over `items` work items in groups of `local`: contiguous ranges
 /// of whole groups, so that rounding a band's launch up to whole groups never reaches into the
 /// next band (only the last band is rounded up, past the end, where the kernels return). The
-/// bands cover every item once; with more bands than groups the extra ones are empty.
+/// bands cover every item once; with more bands than groups some are empty. A band starts at
+/// group ⌊index · groups / count⌋, so band k·m of count·m starts where band k of count does:
+/// the rest of a sample can be split m times finer after any band.
 pub fn band_items(
     items: usize,
     local: usize,
     index: usize,
     count: usize,
 ) -> std::ops::Range<usize> {
-    let groups = items.div_ceil(local.max(1));
-    let per_band = groups.div_ceil(count.max(1));
-    let start = (index * per_band * local).min(items);
-    let end = ((index + 1) * per_band * local).min(items);
+    let local = local.max(1);
+    let groups = items.div_ceil(local);
+    let count = count.max(1);
+    let start = (index * groups / count * local).min(items);
+    let end = ((index + 1) * groups / count * local).min(items);
     start..end
 }
 
@@ -665,6 +668,27 @@ mod tests {
                 next = b.end;
             }
             assert_eq!(next, items, "{bands:?}");
+        }
+    }
+
+    #[test]
+    fn the_rest_of_a_sample_split_finer_still_covers_every_item_once() {
+        // k bands of `count` done, the rest in bands m times finer (the viewer re-plans a
+        // sample whose band ran over its budget).
+        for (items, local, count, k, m) in
+            [(1000, 64, 3, 1, 4), (37, 8, 5, 2, 3), (4095, 1, 7, 6, 9)]
+        {
+            let mut covered = vec![0u32; items];
+            let done = (0..k).map(|i| band_items(items, local, i, count));
+            let rest = (k * m..count * m).map(|i| band_items(items, local, i, count * m));
+            for b in done.chain(rest) {
+                covered[b].iter_mut().for_each(|c| *c += 1);
+            }
+            assert!(
+                covered.iter().all(|&c| c == 1),
+                "{items} items, {count} then {} bands",
+                count * m
+            );
         }
     }
 }

@@ -66,6 +66,10 @@ pub struct ViewArgs {
     /// (default: none).
     #[arg(long, value_name = "PATH")]
     pub stats_file: Option<PathBuf>,
+    /// Start with adaptive sampling at this noise threshold, as the overlay's adaptive box sets
+    /// it (M shows its heat maps) (default: off).
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::args::parse_positive)]
+    pub noise_threshold: Option<f32>,
 }
 
 /// Options of `render`.
@@ -177,6 +181,7 @@ fn view(args: ViewArgs) -> Result<()> {
     crate::app::preflight(args.screenshot.as_deref())?;
     let common = &args.common;
     let mut settings = common.settings(DEFAULT_SIZE)?;
+    settings.noise_threshold = args.noise_threshold;
     let aspect = crate::app::image_aspect((settings.width, settings.height), !args.no_overlay);
     let mut prepared = common.prepare_for(args.scene.as_deref(), aspect)?;
     settings.env_intensity *= prepared.env_scale;
