@@ -177,8 +177,9 @@ pub struct FrameLoop {
     pub read_samples: bool,
     /// Whether films are denoised (the guide buffers must be rendered: `RenderSettings::aovs`).
     pub denoise: bool,
-    /// The denoiser, built on first use (and again for the other network).
-    denoiser: Option<Denoiser>,
+    /// The denoisers, each network's built on its first use and kept: the camera stopping
+    /// and moving again switches between them.
+    denoisers: Vec<Denoiser>,
     /// The view, size and network of the last film denoised.
     last_denoised: Option<((u64, u32, u32), Quality)>,
     /// Why denoising failed (then [`FrameLoop::denoise`] is off), for the window to say.
@@ -211,7 +212,7 @@ impl FrameLoop {
             film: Film::default(),
             read_samples: false,
             denoise: false,
-            denoiser: None,
+            denoisers: Vec::new(),
             last_denoised: None,
             denoise_error: None,
             progress: Progress::default(),
@@ -454,15 +455,13 @@ impl FrameLoop {
             return None;
         }
         let result = (|| {
-            if self
-                .denoiser
-                .as_ref()
-                .is_none_or(|d| d.quality() != quality)
-            {
-                self.denoiser = None;
-                self.denoiser = Some(Denoiser::new(&self.renderer.device, quality)?);
+            if !self.denoisers.iter().any(|d| d.quality() == quality) {
+                self.denoisers
+                    .push(Denoiser::new(&self.renderer.device, quality)?);
             }
-            let denoiser = self.denoiser.as_mut().expect("built above");
+            let denoiser = (self.denoisers.iter_mut())
+                .find(|d| d.quality() == quality)
+                .expect("built above");
             let start = Instant::now();
             let (pixels, _) = denoiser.denoise_film(&mut self.renderer)?;
             Ok::<_, crate::denoise::DenoiseError>((pixels, start.elapsed().as_secs_f64() * 1e3))
