@@ -192,3 +192,95 @@ fn render_denoise_writes_the_raw_and_the_denoised_image() {
         );
     }
 }
+
+/// The device path (`Denoiser::denoise_film`: the network's input made from the film's
+/// fixed-point sums and the guide sums where they lie) gives the host path's image
+/// (`Renderer::image` and `Renderer::aovs` read back, then `Denoiser::denoise_host`) to f32
+/// rounding, on the bundled box seen from further back (the sky around it) at 48 x 32, for
+/// each way a pixel's count is known: the film's
+/// own count (8 spp; and with adaptive sampling, 48 spp at most, where pixels took different
+/// numbers of samples); the hits counted with the background cut out (every pixel's samples);
+/// and both, where the count is the one adaptive sampling's state records.
+#[test]
+fn the_film_denoised_on_the_device_is_the_host_paths_image() {
+    use penumbra::render::{RenderSettings, Renderer};
+    use penumbra::scene::RenderFrame;
+    let choice = common::test_device().parse().unwrap();
+    let scene = penumbra::scene::load_or_bundled(None).unwrap();
+    let mut r = Renderer::new(&choice).unwrap();
+    let mut denoiser = Denoiser::new(&r.device, Quality::Small).expect("the denoiser");
+    let mut camera = scene.cameras[0].clone();
+    camera.eye -= camera.forward * 1.5;
+    let base = RenderSettings {
+        width: 48,
+        height: 32,
+        aovs: true,
+        ..Default::default()
+    };
+    let modes = [
+        ("own count", base.clone()),
+        (
+            "cut out",
+            RenderSettings {
+                cutout: true,
+                ..base.clone()
+            },
+        ),
+        (
+            "adaptive",
+            RenderSettings {
+                noise_threshold: Some(1.0),
+                ..base.clone()
+            },
+        ),
+        (
+            "adaptive, cut out",
+            RenderSettings {
+                cutout: true,
+                noise_threshold: Some(1.0),
+                ..base.clone()
+            },
+        ),
+    ];
+    for (name, settings) in modes {
+        r.set_settings(&settings).unwrap();
+        r.load_scene_in(&scene, &scene.lights, RenderFrame::default())
+            .unwrap();
+        r.set_camera(&camera).unwrap();
+        // Adaptive sampling checks after 16 samples, then every 16.
+        let calls = if settings.noise_threshold.is_some() {
+            3
+        } else {
+            1
+        };
+        for _ in 0..calls {
+            r.render(if calls > 1 { 16 } else { 8 }).unwrap();
+        }
+        if settings.noise_threshold.is_some() {
+            let taken = r.pixel_samples().unwrap().unwrap();
+            let (lo, hi) = (taken.iter().min().unwrap(), taken.iter().max().unwrap());
+            assert!(lo < hi, "{name}: every pixel took {lo} samples");
+        }
+        let image = r.image().unwrap();
+        if settings.cutout {
+            // Pixels where some samples missed: their count is not the film's.
+            let partial = r.coverage().unwrap().iter().filter(|&&c| c < 1.0).count();
+            assert!(partial > 100, "{name}: {partial} pixels show the sky");
+        }
+        let aovs = r.aovs().unwrap().unwrap();
+        let (host, _) = denoiser
+            .denoise_host(&r.device, 48, 32, &image, &aovs.albedo, &aovs.normal)
+            .unwrap();
+        let (device, _) = denoiser.denoise_film(&mut r).unwrap();
+        let worst = (host.iter().zip(&device))
+            .flat_map(|(h, d)| (0..3).map(move |k| (h[k] - d[k]).abs() / (1e-3 + h[k].abs())))
+            .fold(0.0f32, f32::max);
+        eprintln!("{name}: largest relative difference {worst:.2e}");
+        assert!(
+            worst < 1e-4,
+            "{name}: the device path differs by {worst:.2e}"
+        );
+        // Not the raw image: the network ran.
+        assert!(psnr(&device, &image) < 60.0, "{name}");
+    }
+}

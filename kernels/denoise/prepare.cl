@@ -3,17 +3,39 @@
 // autoexposure's block luminances, the network's input tile (exposed colour through the PU
 // curve, albedo clamped to [0, 1], normal mapped from [-1, 1] to [0, 1], zero outside the
 // image) and the output tile back to linear radiance.
+//
+// The colour is read from a float image or straight from the renderer's film, and the guides
+// from sums over a count; src/cl/kernels/denoise.rs (`ColorSource`) sets the arguments.
 
+#include "shared/film.h"
 #include "denoise/tensor.h"
 #include "denoise/transfer.h"
 
-// Pixel `i` of a film: `scale` times its value, or its value over its sample count (.w) with
-// `by_count` (0 where it has no sample).
-inline float3 film_value(global const float4* film, int i, float scale, int by_count) {
-    const float4 v = film[i];
-    if (by_count)
-        return v.w > 0.0f ? v.xyz / v.w : (float3)(0.0f);
-    return v.xyz * scale;
+// Where the colour comes from (`color_mode`): the image's .xyz, or the film's fixed-point sum
+// (kernels/shared/film.h) over the pixel's own sample count, which is the film's .w, `taken`
+// (every pixel took as many; the film's .w counts the hits), or the samples adaptive sampling's
+// state records (kernels/shared/adaptive.h).
+#define DN_COLOR_IMAGE 0
+#define DN_COLOR_FILM 1
+#define DN_COLOR_TAKEN 2
+#define DN_COLOR_STATE 3
+
+// Pixel `i`'s colour, the mean of its samples (0 where it has none).
+inline float3 color_value(global const float4* image, global const ulong4* film,
+                          global const uint* state, int mode, float taken, int i) {
+    if (mode == DN_COLOR_IMAGE)
+        return image[i].xyz;
+    const float4 sum = film_float(film[i]);
+    const float n = mode == DN_COLOR_FILM    ? sum.w
+                    : mode == DN_COLOR_TAKEN ? taken
+                                             : (float)(state[i] & PIXEL_SAMPLES);
+    return sum.xyz / fmax(n, 1.0f);
+}
+
+// Pixel `i`'s guide: its sum over the sample count in `counts[i].w` (the albedo sums' .w;
+// 1 for an image of means).
+inline float3 guide_value(global const float4* sums, global const float4* counts, int i) {
+    return sums[i].xyz / fmax(counts[i].w, 1.0f);
 }
 
 // NaN to zero, then clamped to [lo, hi].
@@ -23,7 +45,8 @@ inline float3 sanitize(float3 v, float lo, float hi) {
 
 // The mean luminance of each of `bins_w` x `bins_h` blocks (at most 16 x 16 pixels) of the
 // colour, after sanitising; global size: the blocks.
-kernel void denoise_exposure_bins(global const float4* color, float scale, int by_count,
+kernel void denoise_exposure_bins(global const float4* image, global const ulong4* film,
+                                  global const uint* state, int color_mode, float taken,
                                   int width, int height, int bins_w, int bins_h,
                                   global float* bins) {
     const int i = get_global_id(0);
@@ -38,8 +61,8 @@ kernel void denoise_exposure_bins(global const float4* color, float scale, int b
     float sum = 0.0f;
     for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
-            const float3 c = sanitize(film_value(color, y * width + x, scale, by_count), 0.0f,
-                                      FLT_MAX);
+            const float3 c = sanitize(
+                color_value(image, film, state, color_mode, taken, y * width + x), 0.0f, FLT_MAX);
             sum += 0.212671f * c.x + 0.715160f * c.y + 0.072169f * c.z;
         }
     }
@@ -48,10 +71,9 @@ kernel void denoise_exposure_bins(global const float4* color, float scale, int b
 
 // The network's 9-channel input tile (`tile_w` x `tile_h`): the image's pixels from
 // (src_x, src_y) on, `w` x `h` of them, placed at (off_x, off_y) in the tile, zero elsewhere.
-kernel void denoise_input(global const float4* color, float color_scale, int color_by_count,
-                          global const float4* albedo, float albedo_scale, int albedo_by_count,
-                          global const float4* normal, float normal_scale, int normal_by_count,
-                          int width, int src_x, int src_y, int off_x, int off_y, int w, int h,
+kernel void denoise_input(global const float4* image, global const ulong4* film,
+                          global const uint* state, int color_mode, float taken,
+                          global const float4* albedo, global const float4* normal, int width, int src_x, int src_y, int off_x, int off_y, int w, int h,
                           int tile_w, int tile_h, float exposure, float pu_norm,
                           global float* dst) {
     const int x = get_global_id(0);
@@ -63,11 +85,11 @@ kernel void denoise_input(global const float4* color, float color_scale, int col
     float3 c = (float3)(0.0f), a = (float3)(0.0f), n = (float3)(0.0f);
     if (ix >= 0 && ix < w && iy >= 0 && iy < h) {
         const int i = (src_y + iy) * width + src_x + ix;
-        c = sanitize(film_value(color, i, color_scale, color_by_count) * exposure, 0.0f,
+        c = sanitize(color_value(image, film, state, color_mode, taken, i) * exposure, 0.0f,
                      FLT_MAX);
         c = (float3)(pu_forward(c.x), pu_forward(c.y), pu_forward(c.z)) * pu_norm;
-        a = sanitize(film_value(albedo, i, albedo_scale, albedo_by_count), 0.0f, 1.0f);
-        n = sanitize(film_value(normal, i, normal_scale, normal_by_count), -1.0f, 1.0f);
+        a = sanitize(guide_value(albedo, albedo, i), 0.0f, 1.0f);
+        n = sanitize(guide_value(normal, albedo, i), -1.0f, 1.0f);
         n = n * 0.5f + 0.5f;
     }
     const int plane = tensor_plane(tile_w, tile_h);

@@ -12,6 +12,12 @@
 //! costs), learned from every finished sample's wall time and smoothed; it starts empty for
 //! each device and scene. A divisor not measured yet borrows the nearest measured one.
 //!
+//! **Denoising.** With the viewer's denoise toggle each preview image is also denoised (the
+//! small network) before it is shown: milliseconds per pixel of that, per divisor, are learned
+//! the same way, and while the view moves a level fits when its sample and its denoising
+//! together fit the budget, so the preview lowers its resolution further when the denoising
+//! takes time.
+//!
 //! **Bands.** A sample whose estimate exceeds the budget is split into bands (one launch each,
 //! [`crate::render::Band`]) of about the budget, so that new input waits for one band at most.
 //! A band that still runs over the budget (the estimate was low, or the device slowed down)
@@ -103,6 +109,8 @@ pub struct Budget {
     pub target_ms: f64,
     /// Smoothed milliseconds per pixel-sample-depth at each divisor of [`DIVISORS`].
     cost: [Option<f64>; DIVISORS.len()],
+    /// Smoothed milliseconds per pixel of denoising a preview image, at each divisor.
+    denoise: [Option<f64>; DIVISORS.len()],
 }
 
 /// The work of `spp` samples over `pixels` pixels at `bounces` bounces, in pixel-sample-depths.
@@ -116,6 +124,7 @@ impl Budget {
         Self {
             target_ms,
             cost: [None; DIVISORS.len()],
+            denoise: [None; DIVISORS.len()],
         }
     }
 
@@ -133,12 +142,33 @@ impl Budget {
         if w <= 0.0 || !ms.is_finite() || ms < 0.0 {
             return;
         }
-        let cost = ms / w;
-        let slot = &mut self.cost[i];
-        *slot = Some(match *slot {
-            Some(old) => old + SMOOTHING * (cost - old),
-            None => cost,
-        });
+        smooth(&mut self.cost[i], ms / w);
+    }
+
+    /// Records that denoising a preview image of `pixels` pixels at `level` took `ms`.
+    pub fn record_denoise(&mut self, level: Level, pixels: u64, ms: f64) {
+        let Some(i) = DIVISORS.iter().position(|&d| d == level.divisor) else {
+            return;
+        };
+        if pixels > 0 && ms.is_finite() && ms >= 0.0 {
+            smooth(&mut self.denoise[i], ms / pixels as f64);
+        }
+    }
+
+    /// Forgets the denoising costs (the toggle is off: previews are not denoised).
+    pub fn forget_denoise(&mut self) {
+        self.denoise = [None; DIVISORS.len()];
+    }
+
+    /// Estimated milliseconds of denoising a preview image at `level` on a `full` sized image,
+    /// borrowed as [`Budget::estimate_ms`] borrows; 0 before any measurement.
+    pub fn denoise_ms(&self, level: Level, full: (u32, u32)) -> f64 {
+        let Some(i) = DIVISORS.iter().position(|&d| d == level.divisor) else {
+            return 0.0;
+        };
+        nearest(&self.denoise, i).map_or(0.0, |cost| {
+            cost * pixel_count(scaled(full, level.divisor)) as f64
+        })
     }
 
     /// Estimated milliseconds of one sample per pixel at `level` on a `full` sized image: the
@@ -147,16 +177,15 @@ impl Budget {
     /// measurement.
     pub fn estimate_ms(&self, level: Level, full: (u32, u32)) -> Option<f64> {
         let i = DIVISORS.iter().position(|&d| d == level.divisor)?;
-        let cost = self.cost[i]
-            .or_else(|| self.cost[..i].iter().rev().find_map(|c| *c))
-            .or_else(|| self.cost[i + 1..].iter().find_map(|c| *c))?;
+        let cost = nearest(&self.cost, i)?;
         let pixels = pixel_count(scaled(full, level.divisor));
         Some(cost * work(pixels, 1, level.bounces))
     }
 
     /// The level (an index into `levels`) for the next batch on a `full` sized image.
     /// `current` is the level of the film on screen and whether it has an image yet.
-    /// Moving: the best level whose one sample fits (the last when none does). Resting: one
+    /// Moving: the best level whose one sample, with its denoising, fits (the last when none
+    /// does). Resting: one
     /// level better than the current one once it has an image. Before any measurement: the
     /// ¼-resolution level, so the first image of a scene comes quickly and measures the device.
     pub fn level(
@@ -182,7 +211,7 @@ impl Budget {
                 .iter()
                 .position(|&l| {
                     self.estimate_ms(l, full)
-                        .is_none_or(|ms| ms <= self.target_ms)
+                        .is_none_or(|ms| ms + self.denoise_ms(l, full) <= self.target_ms)
                 })
                 .unwrap_or(last);
         }
@@ -223,6 +252,22 @@ impl Budget {
             bands: count,
         }
     }
+}
+
+/// `cost` folded into a smoothed estimate.
+fn smooth(slot: &mut Option<f64>, cost: f64) {
+    *slot = Some(match *slot {
+        Some(old) => old + SMOOTHING * (cost - old),
+        None => cost,
+    });
+}
+
+/// The cost at divisor index `i`: its own, else the nearest measured larger resolution's (an
+/// optimistic guess, so smaller divisors get tried), else the nearest smaller one's.
+fn nearest(costs: &[Option<f64>], i: usize) -> Option<f64> {
+    costs[i]
+        .or_else(|| costs[..i].iter().rev().find_map(|c| *c))
+        .or_else(|| costs[i + 1..].iter().find_map(|c| *c))
 }
 
 /// The film size for an image size and a divisor (rounded up, at least 1×1).
@@ -363,6 +408,29 @@ mod tests {
         assert_eq!(b.level(&l, FULL, false, Some((5, true))), 4);
         assert_eq!(b.level(&l, FULL, false, Some((1, true))), 0);
         assert_eq!(b.level(&l, FULL, false, Some((0, true))), 0);
+    }
+
+    #[test]
+    fn moving_with_the_denoiser_lowers_the_resolution_by_its_time() {
+        let mut b = Budget::new(30.0);
+        let l = levels(4);
+        b.record(full(4), pixel_count(FULL), 1, 400.0);
+        // A sample at ¼ resolution takes 25 ms: it fits alone.
+        assert_eq!(b.level(&l, FULL, true, Some((0, true))), 2);
+        // Denoising that 160 x 120 preview took 12 ms: 37 ms together do not fit; at ¼
+        // resolution with one bounce (12.5 ms) and the same denoising they do.
+        let quarter = pixel_count(scaled(FULL, 4));
+        b.record_denoise(l[2], quarter, 12.0);
+        assert!((b.denoise_ms(l[2], FULL) - 12.0).abs() < 1e-9);
+        assert_eq!(b.level(&l, FULL, true, Some((0, true))), 3);
+        // Denoising three times slower (smoothed: 24 ms): 1/8 resolution, whose denoising
+        // is borrowed per pixel (6 ms) beside a 3.1 ms sample.
+        b.record_denoise(l[2], quarter, 36.0);
+        assert_eq!(b.level(&l, FULL, true, Some((0, true))), 4);
+        // The toggle off: the denoising no longer counts.
+        b.forget_denoise();
+        assert_eq!(b.denoise_ms(l[2], FULL), 0.0);
+        assert_eq!(b.level(&l, FULL, true, Some((0, true))), 2);
     }
 
     #[test]

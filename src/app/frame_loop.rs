@@ -6,11 +6,13 @@
 //! applied together between batches; every one of them resets the accumulation. A sample too
 //! long for the budget goes in bands, one per batch (budget.rs), the rest of it split finer
 //! when a band runs over the budget; a change abandons the rest of the sample, so input waits
-//! for one band at most.
+//! for one band at most. With the denoise toggle, the film is denoised on the device between
+//! reading it and starting the next batch (`denoise_film`).
 
 use super::budget::{Budget, Level, Plan, levels, pixel_count, scaled};
 use super::heat::HeatMap;
 use crate::cl::ClError;
+use crate::denoise::{Denoiser, Quality};
 use crate::render::{Band, KernelChoice, RenderSettings, RenderStats, Renderer, SceneStats};
 use crate::scene::{Camera, Light, RenderFrame, Scene};
 use std::time::{Duration, Instant};
@@ -106,9 +108,9 @@ pub struct Film {
     /// With [`FrameLoop::heat_map`] on error and adaptive sampling, each pixel's error
     /// estimate; else empty.
     pub errors: Vec<f32>,
-    /// With [`FrameLoop::read_aovs`], the guide buffers of the same samples (for the
-    /// denoiser); else `None`.
-    pub aovs: Option<crate::render::Aovs>,
+    /// With [`FrameLoop::denoise`], when this film was worth denoising: its denoised image
+    /// (linear, as `pixels`) and the milliseconds the host waited for it; else `None`.
+    pub denoised: Option<(Vec<[f32; 3]>, f64)>,
 }
 
 /// Figures for the overlay, as of the latest finished batch.
@@ -146,6 +148,8 @@ struct Sample {
     answers: Option<Instant>,
     /// The view it shows ([`Film::view`]).
     view: u64,
+    /// Whether the camera moved when it was planned.
+    moving: bool,
 }
 
 struct Batch {
@@ -177,8 +181,15 @@ pub struct FrameLoop {
     /// The heat map whose data each film also reads (adaptive sampling's samples per pixel or
     /// error estimates).
     pub heat_map: HeatMap,
-    /// Whether each film also reads the guide buffers (for the denoiser).
-    pub read_aovs: bool,
+    /// Whether films are denoised (the guide buffers must be rendered: `RenderSettings::aovs`).
+    pub denoise: bool,
+    /// The denoisers, each network's built on its first use and kept: the camera stopping
+    /// and moving again switches between them.
+    denoisers: Vec<Denoiser>,
+    /// The view, size and network of the last film denoised.
+    last_denoised: Option<((u64, u32, u32), Quality)>,
+    /// Why denoising failed (then [`FrameLoop::denoise`] is off), for the window to say.
+    pub denoise_error: Option<String>,
     /// Figures for the overlay.
     pub progress: Progress,
     /// Figures from the last BVH rebuild.
@@ -206,7 +217,10 @@ impl FrameLoop {
             loaded: false,
             film: Film::default(),
             heat_map: HeatMap::Off,
-            read_aovs: false,
+            denoise: false,
+            denoisers: Vec::new(),
+            last_denoised: None,
+            denoise_error: None,
             progress: Progress::default(),
             scene_stats: None,
         }
@@ -308,6 +322,9 @@ impl FrameLoop {
         let levels = levels(world.settings.bounces);
         let changed = self.pending.any();
         let current = self.level.map(|(i, shown)| (i, shown && !changed));
+        if !self.denoise {
+            self.budget.forget_denoise();
+        }
         let i = self
             .budget
             .level(&levels, full, world.moving, current)
@@ -336,6 +353,7 @@ impl FrameLoop {
             ms: 0.0,
             answers,
             view: self.view,
+            moving: world.moving,
         }))
     }
 
@@ -385,8 +403,9 @@ impl FrameLoop {
         self.renderer
             .image_into(&mut pixels, counted.then_some(&mut coverage))?;
         let (samples, errors) = self.heat_data()?;
-        let aovs = match self.read_aovs && settings.aovs {
-            true => self.renderer.aovs()?,
+        let full_quality = self.level.is_some_and(|(i, _)| i == 0);
+        let denoised = match self.denoise && settings.aovs {
+            true => self.denoise_film((sample.view, size.0, size.1), &sample, full_quality),
             false => None,
         };
         self.film = Film {
@@ -398,13 +417,13 @@ impl FrameLoop {
             spp,
             divisor: plan.level.divisor,
             bounces: plan.level.bounces,
-            full_quality: self.level.is_some_and(|(i, _)| i == 0),
+            full_quality,
             // An image collected over one never shown answers its input when it is shown.
             answers: sample.answers.or(self.film.answers),
             view: sample.view,
             samples,
             errors,
-            aovs,
+            denoised,
         };
         let p = &mut self.progress;
         p.seconds += sample.ms * 1e-3;
@@ -460,6 +479,60 @@ impl FrameLoop {
         self.film.samples = samples;
         self.film.errors = errors;
         Ok(true)
+    }
+
+    /// Denoises the film just finished, on the device where it lies, when it is worth it:
+    /// every preview image and every image while the camera moves (the small network), and at
+    /// full quality the first image of a view, the first after the camera stopped and each one
+    /// whose samples per pixel doubled (the full network). A preview's time goes into the
+    /// budget, so that the preview lowers its resolution while the denoising takes time. `None`
+    /// when not worth it (the last denoised image of the view stays on screen) or on an error,
+    /// which turns denoising off and is kept in [`FrameLoop::denoise_error`].
+    fn denoise_film(
+        &mut self,
+        key: (u64, u32, u32),
+        sample: &Sample,
+        full_quality: bool,
+    ) -> Option<(Vec<[f32; 3]>, f64)> {
+        let quality = match full_quality && !sample.moving {
+            true => Quality::Full,
+            false => Quality::Small,
+        };
+        let worth = quality == Quality::Small
+            || self.last_denoised != Some((key, Quality::Full))
+            || self.renderer.samples().is_power_of_two();
+        if !worth {
+            return None;
+        }
+        let result = (|| {
+            if !self.denoisers.iter().any(|d| d.quality() == quality) {
+                self.denoisers
+                    .push(Denoiser::new(&self.renderer.device, quality)?);
+            }
+            let denoiser = (self.denoisers.iter_mut())
+                .find(|d| d.quality() == quality)
+                .expect("built above");
+            let start = Instant::now();
+            let (pixels, _) = denoiser.denoise_film(&mut self.renderer)?;
+            Ok::<_, crate::denoise::DenoiseError>((pixels, start.elapsed().as_secs_f64() * 1e3))
+        })();
+        match result {
+            Ok((pixels, ms)) => {
+                self.last_denoised = Some((key, quality));
+                if quality == Quality::Small {
+                    let level = sample.plan.level;
+                    self.budget
+                        .record_denoise(level, pixel_count((key.1, key.2)), ms);
+                }
+                Some((pixels, ms))
+            }
+            Err(e) => {
+                self.denoise_error = Some(e.to_string());
+                self.denoise = false;
+                self.last_denoised = None;
+                None
+            }
+        }
     }
 
     /// Applies waiting changes and `level`; returns whether the film was reset (anything

@@ -246,7 +246,6 @@ pub fn run(config: ViewerConfig) -> Result<()> {
         stats,
         pump_image: false,
         display: Vec::new(),
-        denoiser: None,
         denoised: None,
         denoise_ms: None,
         display_key: None,
@@ -348,10 +347,9 @@ struct App {
     pump_image: bool,
     /// The film tone-mapped (RGBA8), as on screen.
     display: Vec<u8>,
-    /// The denoiser, built on first use (and again for the other network).
-    denoiser: Option<crate::denoise::Denoiser>,
     /// The latest denoised image and the view, width and height of the film it came from:
-    /// shown until a newer one of the same view is worth denoising (see `update_denoised`).
+    /// shown until the frame loop denoises a newer one of the same view
+    /// (`FrameLoop::denoise_film`).
     denoised: Option<(FilmKey, Vec<[f32; 3]>)>,
     /// How long the last denoising took.
     denoise_ms: Option<f64>,
@@ -634,7 +632,7 @@ impl App {
             Some(_) => v.heat_map,
             None => heat::HeatMap::Off,
         };
-        self.frame_loop.read_aovs = v.denoise;
+        self.frame_loop.denoise = v.denoise;
         let new_image = if self.builds_next() && self.notice_frames <= 2 {
             self.wake = Some(now);
             false
@@ -907,71 +905,32 @@ impl App {
             .map(|(_, pixels)| pixels)
     }
 
-    /// Denoises a new film when it is worth it: every image of a preview (the small network,
-    /// on images a fraction of the window's size), and at full quality the first image of a
-    /// view and each one whose samples per pixel doubled (the full network). Between those, the
-    /// last denoised image of the view stays on screen.
-    fn update_denoised(&mut self, new_image: bool) {
-        use crate::denoise::{Denoiser, Quality};
+    /// Takes the new film's denoised image, which the frame loop made on the device when it
+    /// was worth it; between those, the last denoised image of the view stays on screen. A
+    /// denoiser that failed turns the toggle off and says why.
+    fn update_denoised(&mut self) {
+        if let Some(e) = self.frame_loop.denoise_error.take() {
+            self.gui.file_error = Some(format!("denoiser: {e}"));
+            self.model.view.denoise = false;
+        }
         if !self.model.view.denoise {
             self.denoised = None;
             self.denoise_ms = None;
             return;
         }
-        let film = &self.frame_loop.film;
-        let Some(aovs) = film.aovs.as_ref().filter(|_| new_image) else {
-            return;
-        };
-        if aovs.albedo.len() != film.pixels.len() {
-            return;
-        }
+        let film = &mut self.frame_loop.film;
         let key = (film.view, film.width, film.height);
         if self.denoised.as_ref().is_some_and(|(k, _)| *k != key) {
             self.denoised = None;
         }
-        let worth = !film.full_quality || film.spp.is_power_of_two() || self.denoised.is_none();
-        if !worth {
-            return;
-        }
-        let quality = if film.full_quality {
-            Quality::Full
-        } else {
-            Quality::Small
-        };
-        let device = &self.frame_loop.renderer.device;
-        if self
-            .denoiser
-            .as_ref()
-            .is_none_or(|d| d.quality() != quality)
-        {
-            match Denoiser::new(device, quality) {
-                Ok(d) => self.denoiser = Some(d),
-                Err(e) => {
-                    self.gui.file_error = Some(format!("denoiser: {e}"));
-                    self.model.view.denoise = false;
-                    return;
-                }
-            }
-        }
-        let Some(denoiser) = self.denoiser.as_mut() else {
-            return;
-        };
-        let t = Instant::now();
-        let (w, h) = (film.width as usize, film.height as usize);
-        match denoiser.denoise_host(device, w, h, &film.pixels, &aovs.albedo, &aovs.normal) {
-            Ok((pixels, _)) => {
-                self.denoised = Some((key, pixels));
-                self.denoise_ms = Some(t.elapsed().as_secs_f64() * 1e3);
-            }
-            Err(e) => {
-                self.gui.file_error = Some(format!("denoiser: {e}"));
-                self.model.view.denoise = false;
-            }
+        if let Some((pixels, ms)) = film.denoised.take() {
+            self.denoised = Some((key, pixels));
+            self.denoise_ms = Some(ms);
         }
     }
 
     fn update_display(&mut self, new_image: bool, dt: f64) {
-        self.update_denoised(new_image);
+        self.update_denoised();
         let area = self.image_area();
         let Some(gfx) = self.gfx.as_mut() else {
             return;

@@ -399,14 +399,14 @@ fn adaptive_gain(uniform: &Curve, adaptive: &Curve) -> Option<String> {
 }
 
 /// The film denoised with the guide buffers (as `render --denoise` does it) and the seconds
-/// that took: reading the image and guides back, the network, reading the result.
+/// that took: the network's input made from the film on the device, the network, reading the
+/// result.
 fn denoise(
     renderer: &mut crate::render::Renderer,
     denoiser: &mut Denoiser,
 ) -> Result<(Vec<[f32; 3]>, f64)> {
     let start = Instant::now();
-    let image = renderer.image()?;
-    let (out, _) = denoiser.denoise_render(renderer, &image)?;
+    let (out, _) = denoiser.denoise_film(renderer)?;
     Ok((out, start.elapsed().as_secs_f64()))
 }
 

@@ -1,14 +1,21 @@
 //! `penumbra bench denoise`: the denoiser's network time on the device (OpenCL profiling
-//! events, a warm-up run discarded) on a synthetic noisy image, and, where `pyoidn` is
-//! installed, Intel's Open Image Denoise on the same input (its CPU device, or CUDA with
-//! `--oidn-device cuda`), with the ratio.
+//! events, a warm-up run discarded) on a synthetic noisy image, the time the host waits from a
+//! film on the device to the denoised image in host memory (`render --denoise`'s path) beside
+//! the host path's (the images uploaded, denoised, read back), and,
+//! where `pyoidn` is installed, Intel's Open Image Denoise on the same input (its CPU device,
+//! or CUDA with `--oidn-device cuda`), with the ratio.
 
 use super::{device_json, device_line};
-use crate::cl::{Device, DeviceChoice};
+use crate::cl::types::FILM_FRACTION_BITS;
+use crate::cl::{Buffer, Device, DeviceChoice};
 use crate::date::today;
-use crate::denoise::{Denoiser, Quality, oidn};
+use crate::denoise::{ColorSource, DenoiseInput, Denoiser, FilmCount, GuideSums, Quality, oidn};
 use anyhow::{Result, bail};
 use clap::Args;
+use std::time::Instant;
+
+/// Samples per pixel of the film the synthetic image is written into.
+const FILM_SPP: u32 = 16;
 
 /// Options of `bench denoise`.
 #[derive(Args, Debug, Clone)]
@@ -64,6 +71,80 @@ pub fn synthetic(width: usize, height: usize) -> [Vec<[f32; 3]>; 3] {
     [c, a, n]
 }
 
+/// A film and its guide sums in host memory, laid out as the renderer keeps them.
+struct HostFilm {
+    /// Fixed-point colour sums with the count (kernels/shared/film.h).
+    sums: Vec<[u64; 4]>,
+    /// Albedo sums with the count (kernels/shared/aovs.h).
+    albedo: Vec<[f32; 4]>,
+    /// Normal sums.
+    normal: Vec<[f32; 4]>,
+}
+
+/// The synthetic image as the renderer's film and guide buffers hold it after `spp` samples.
+fn as_film(images: &[Vec<[f32; 3]>; 3], spp: u32) -> HostFilm {
+    let n = spp as f32;
+    let one = (1u64 << FILM_FRACTION_BITS) as f64;
+    let fixed = |v: f32| (f64::from(v * n) * one).round() as u64;
+    let sums = |image: &[[f32; 3]], w: f32| {
+        image
+            .iter()
+            .map(|p| [p[0] * n, p[1] * n, p[2] * n, w])
+            .collect()
+    };
+    HostFilm {
+        sums: images[0]
+            .iter()
+            .map(|c| [fixed(c[0]), fixed(c[1]), fixed(c[2]), u64::from(spp)])
+            .collect(),
+        albedo: sums(&images[1], n),
+        normal: sums(&images[2], 0.0),
+    }
+}
+
+/// The synthetic image as a film on the device, and the output buffer.
+struct DeviceFilm {
+    film: Buffer<[u64; 4]>,
+    albedo: Buffer<[f32; 4]>,
+    normal: Buffer<[f32; 4]>,
+    output: Buffer<[f32; 4]>,
+}
+
+impl DeviceFilm {
+    fn new(device: &Device, images: &[Vec<[f32; 3]>; 3], pixels: usize) -> Result<Self> {
+        let host = as_film(images, FILM_SPP);
+        Ok(Self {
+            film: Buffer::from_slice(device, &host.sums)?,
+            albedo: Buffer::from_slice(device, &host.albedo)?,
+            normal: Buffer::from_slice(device, &host.normal)?,
+            output: Buffer::new(device, pixels)?,
+        })
+    }
+
+    /// Milliseconds the host waits from the film on the device to the denoised image in host
+    /// memory (`render --denoise`'s path).
+    fn denoise(
+        &self,
+        device: &Device,
+        denoiser: &mut Denoiser,
+        (width, height): (usize, usize),
+    ) -> Result<f64> {
+        let input = DenoiseInput {
+            width,
+            height,
+            color: ColorSource::Film(&self.film, FilmCount::Own),
+            guides: GuideSums {
+                albedo: &self.albedo,
+                normal: &self.normal,
+            },
+        };
+        let start = Instant::now();
+        denoiser.denoise(device, &input, &self.output)?;
+        self.output.read(device)?;
+        Ok(start.elapsed().as_secs_f64() * 1e3)
+    }
+}
+
 /// Runs the benchmark and prints a summary and one JSON line.
 pub fn run(args: &DenoiseArgs) -> Result<()> {
     let quality: Quality = args.quality.parse().map_err(anyhow::Error::msg)?;
@@ -83,11 +164,20 @@ pub fn run(args: &DenoiseArgs) -> Result<()> {
     let images = synthetic(w, h);
     let mut denoiser = Denoiser::new(&device, quality)?;
     println!("device: {}", device_line(&device));
+    let film = DeviceFilm::new(&device, &images, w * h)?;
     let mut times = Vec::new();
+    // Wall times, runs interleaved: the host path (the images uploaded, denoised, read back)
+    // and the film's (`render --denoise`).
+    let (mut host_ms, mut wait_ms) = (f64::MAX, f64::MAX);
     let mut report = None;
     for run in 0..=args.runs {
+        let start = Instant::now();
         let (_, r) = denoiser.denoise_host(&device, w, h, &images[0], &images[1], &images[2])?;
+        let host = start.elapsed().as_secs_f64() * 1e3;
+        let wait = film.denoise(&device, &mut denoiser, (w, h))?;
         if run > 0 {
+            host_ms = host_ms.min(host);
+            wait_ms = wait_ms.min(wait);
             times.push((r.kernel_ms, r.conv_ms));
         }
         report = Some(r);
@@ -106,6 +196,11 @@ pub fn run(args: &DenoiseArgs) -> Result<()> {
         report.tiling.tile_h,
         best.0,
         best.1,
+        args.runs
+    );
+    println!(
+        "from a {FILM_SPP}-spp film on the device to the denoised image in host memory: {wait_ms:.1} ms; \
+         from images in host memory (uploaded): {host_ms:.1} ms; best of {}",
         args.runs
     );
     let mut oidn_ms = None;
@@ -143,6 +238,8 @@ pub fn run(args: &DenoiseArgs) -> Result<()> {
             "tiles": report.tiling.count(),
             "ms": best.0,
             "conv_ms": best.1,
+            "wait_ms": wait_ms,
+            "host_path_ms": host_ms,
             "gflops": gflops,
             "oidn_device": args.oidn_device,
             "oidn_ms": oidn_ms,

@@ -15,7 +15,7 @@ use opencl3::kernel::{ExecuteKernel, Kernel};
 use std::sync::OnceLock;
 use test_program::TestKernels;
 
-pub use denoise::{ConvArgs, DenoiseKernels, FilmInput, TileWindow};
+pub use denoise::{ColorSource, ConvArgs, DenoiseKernels, FilmCount, GuideSums, TileWindow};
 
 // Also named from here by the renderer, the scene loader and the benchmarks.
 pub use super::host_memory::{OpeningMemory, map_file};

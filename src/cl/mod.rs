@@ -22,7 +22,9 @@ pub(crate) static CL_SETUP: std::sync::Mutex<()> = std::sync::Mutex::new(());
 pub use buffer::Buffer;
 pub use device::{Device, DeviceChoice, DeviceInfo, list_devices};
 pub use host_memory::{OpeningMemory, map_file};
-pub use kernels::{ConvArgs, DenoiseKernels, FilmInput, Launch, Program, TileWindow};
+pub use kernels::{
+    ColorSource, ConvArgs, DenoiseKernels, FilmCount, GuideSums, Launch, Program, TileWindow,
+};
 pub use program::{KernelFeatures, build_denoise_program, build_program, build_test_program};
 pub use scene_buffers::{EnvBuffers, NodeForms, SceneBuffers};
 pub use stage::Stage;

@@ -231,7 +231,7 @@ fn render_frame(
         );
     }
     let denoised = match denoiser {
-        Some((d, _)) => Some(denoise(renderer, d, &image)?),
+        Some((d, _)) => Some(denoise(renderer, d)?),
         None => None,
     };
     let background = args.common.background;
@@ -543,7 +543,8 @@ pub(super) fn encode_png(
 /// The denoised image of a render and what the summary says of the call.
 struct Denoised {
     image: Vec<[f32; 3]>,
-    /// Wall time of the call: the guide buffers' read, the network and the image's read.
+    /// The time the host waited from the film to the denoised image: the network's input made
+    /// from the film on the device, the network, the image's read.
     ms: f64,
     report: DenoiseReport,
 }
@@ -562,15 +563,10 @@ impl Denoised {
     }
 }
 
-/// Denoises `image` (the film read as linear RGB) with the renderer's guide buffers, on the
-/// renderer's device.
-fn denoise(
-    renderer: &mut Renderer,
-    denoiser: &mut Denoiser,
-    image: &[[f32; 3]],
-) -> Result<Denoised> {
+/// Denoises the renderer's film with its guide buffers where they are, on its device.
+fn denoise(renderer: &mut Renderer, denoiser: &mut Denoiser) -> Result<Denoised> {
     let start = Instant::now();
-    let (mut out, report) = denoiser.denoise_render(renderer, image)?;
+    let (mut out, report) = denoiser.denoise_film(renderer)?;
     zero_nonfinite(&mut out);
     Ok(Denoised {
         image: out,

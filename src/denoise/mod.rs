@@ -1,16 +1,18 @@
 //! The denoiser: Open Image Denoise's `rt` U-Net for HDR colour with albedo and normal
 //! (Intel's trained weights, bundled in assets/oidn/), run by penumbra's own OpenCL kernels on
-//! the device that holds the film. `Denoiser::denoise` reads film buffers already on the device
-//! and writes a film-sized buffer there; `Denoiser::denoise_host` does the same for images in
-//! host memory. docs/denoiser.md describes the design.
+//! the device that holds the film. `Denoiser::denoise_film` reads the renderer's film and guide
+//! buffers where they are and reads back only the denoised image; `Denoiser::denoise` is its
+//! device-side core (a film-sized output buffer), and `Denoiser::denoise_host` denoises images
+//! in host memory (benchmarks, the comparison with Intel's library). docs/denoiser.md describes
+//! the design.
 
 pub mod network;
 pub mod oidn;
 pub mod prepare;
 pub mod tza;
 
-pub use crate::cl::FilmInput;
 use crate::cl::{Buffer, ClError, DenoiseKernels, Device, Launch};
+pub use crate::cl::{ColorSource, FilmCount, GuideSums};
 use crate::render::Renderer;
 use network::{Network, OUTPUT, Slot};
 pub use prepare::Tiling;
@@ -93,9 +95,9 @@ pub struct DenoiseReport {
 /// (about 1.4 GB) fit, so 1080p is one tile; at most a quarter of the device's memory.
 const DEFAULT_MEMORY: usize = 1536 << 20;
 
-/// One image to denoise, on the denoiser's device: colour (linear HDR RGB), albedo and
-/// normal (first-hit guides, normal in [-1, 1]), each `width` x `height` RGBA f32 pixels,
-/// row-major, with how a pixel's value is made of its buffer ([`FilmInput`]).
+/// One image to denoise, on the denoiser's device, `width` x `height` pixels, row-major: the
+/// noisy linear HDR colour ([`ColorSource`]) and the first-hit guides ([`GuideSums`]: albedo,
+/// and the normal in [-1, 1]).
 #[derive(Clone, Copy)]
 pub struct DenoiseInput<'a> {
     /// Pixels across.
@@ -103,11 +105,9 @@ pub struct DenoiseInput<'a> {
     /// Pixels down.
     pub height: usize,
     /// The noisy colour.
-    pub color: FilmInput<'a>,
-    /// The albedo guide.
-    pub albedo: FilmInput<'a>,
-    /// The normal guide.
-    pub normal: FilmInput<'a>,
+    pub color: ColorSource<'a>,
+    /// The albedo and normal guides.
+    pub guides: GuideSums<'a>,
 }
 
 /// The denoiser on one device: its kernels, the network's weights and, once used, the tensors
@@ -119,6 +119,8 @@ pub struct Denoiser {
     memory_limit: usize,
     /// The exposure blocks' buffer.
     bins: Option<Buffer<f32>>,
+    /// [`Denoiser::denoise_film`]'s output, film-sized.
+    output: Option<Buffer<[f32; 4]>>,
 }
 
 impl Denoiser {
@@ -136,6 +138,7 @@ impl Denoiser {
             quality,
             memory_limit: DEFAULT_MEMORY.min((device_memory / 4).max(64 << 20)),
             bins: None,
+            output: None,
         })
     }
 
@@ -174,8 +177,7 @@ impl Denoiser {
             width,
             height,
             color,
-            albedo,
-            normal,
+            guides,
         } = *input;
         let pixels = width * height;
         if pixels == 0 {
@@ -183,10 +185,15 @@ impl Denoiser {
                 "an empty image ({width}x{height})"
             )));
         }
+        let color_len = match color {
+            ColorSource::Image(b) => b.len(),
+            ColorSource::Film(f, FilmCount::State(s)) => f.len().min(s.len()),
+            ColorSource::Film(f, _) => f.len(),
+        };
         for (name, len) in [
-            ("colour", color.buffer.len()),
-            ("albedo", albedo.buffer.len()),
-            ("normal", normal.buffer.len()),
+            ("colour", color_len),
+            ("albedo", guides.albedo.len()),
+            ("normal", guides.normal.len()),
             ("output", output.len()),
         ] {
             if len < pixels {
@@ -209,17 +216,18 @@ impl Denoiser {
         let bin_buffer = self.bins.as_ref().expect("allocated above");
         launches.push(
             self.kernels
-                .exposure_bins(device, color, width, height, bins, bin_buffer)?,
+                .exposure_bins(device, color, guides, width, height, bins, bin_buffer)?,
         );
         let exposure = prepare::exposure_from_bins(&bin_buffer.read(device)?);
 
         let tiling = self.tiling(width, height);
         self.network.prepare(device, tiling.tile_w, tiling.tile_h)?;
-        let (pu_max, input) = (prepare::pu_max(), [color, albedo, normal]);
+        let pu_max = prepare::pu_max();
         for (window, kept) in tiling.windows(width, height) {
             launches.push(self.kernels.input(
                 device,
-                input,
+                color,
+                guides,
                 width,
                 window,
                 exposure,
@@ -282,45 +290,63 @@ impl Denoiser {
             let rgba: Vec<[f32; 4]> = rgb.iter().map(|&[r, g, b]| [r, g, b, 1.0]).collect();
             Buffer::from_slice(device, &rgba)
         };
+        // Means: each guide is its sum over a count of 1 (the albedo's `.w`).
         let (c, a, n) = (upload(color)?, upload(albedo)?, upload(normal)?);
         let output = Buffer::new(device, pixels)?;
-        let film = |buffer| FilmInput {
-            buffer,
-            scale: 1.0,
-            by_count: false,
-        };
         let input = DenoiseInput {
             width,
             height,
-            color: film(&c),
-            albedo: film(&a),
-            normal: film(&n),
+            color: ColorSource::Image(&c),
+            guides: GuideSums {
+                albedo: &a,
+                normal: &n,
+            },
         };
         let report = self.denoise(device, &input, &output)?;
-        let out = output
-            .read(device)?
-            .into_iter()
-            .take(pixels)
-            .map(|[r, g, b, _]| [r, g, b])
-            .collect();
-        Ok((out, report))
+        Ok((rgb(output.read(device)?, pixels), report))
     }
 
-    /// Denoises `image`, `renderer`'s film read as linear RGB ([`Renderer::image`]), with the
-    /// renderer's guide buffers, on its device (which must be this denoiser's). The renderer
-    /// keeps them with [`RenderSettings::aovs`](crate::render::RenderSettings::aovs).
-    pub fn denoise_render(
+    /// Denoises `renderer`'s film (the mean of each pixel's own samples, as
+    /// [`Renderer::image`] reads it) with its guide buffers, where they lie on its device (which
+    /// must be this denoiser's): the network's input is made from the film's sums on the device,
+    /// its output stays in a film-sized buffer there, and only the denoised RGB image is read
+    /// back. The renderer keeps the guides with
+    /// [`RenderSettings::aovs`](crate::render::RenderSettings::aovs). Waits for the samples.
+    pub fn denoise_film(
         &mut self,
         renderer: &mut Renderer,
-        image: &[[f32; 3]],
     ) -> Result<(Vec<[f32; 3]>, DenoiseReport), DenoiseError> {
-        let aovs = renderer.aovs()?.ok_or_else(|| {
+        renderer.finish()?;
+        let (w, h) = (renderer.settings().width, renderer.settings().height);
+        let pixels = w as usize * h as usize;
+        if self.output.as_ref().is_none_or(|b| b.len() != pixels) {
+            self.output = None;
+            self.output = Some(Buffer::new(&renderer.device, pixels)?);
+        }
+        let (color, guides) = renderer.denoise_sources().ok_or_else(|| {
             DenoiseError::Input("the render kept no guide buffers or took no sample".into())
         })?;
-        let (w, h) = (renderer.settings().width, renderer.settings().height);
-        let (w, h) = (w as usize, h as usize);
-        self.denoise_host(&renderer.device, w, h, image, &aovs.albedo, &aovs.normal)
+        let input = DenoiseInput {
+            width: w as usize,
+            height: h as usize,
+            color,
+            guides,
+        };
+        let output = self.output.take().expect("allocated above");
+        let result = self
+            .denoise(&renderer.device, &input, &output)
+            .and_then(|report| Ok((rgb(output.read(&renderer.device)?, pixels), report)));
+        self.output = Some(output);
+        result
     }
+}
+
+/// The first `pixels` RGB values of an RGBA image.
+fn rgb(rgba: Vec<[f32; 4]>, pixels: usize) -> Vec<[f32; 3]> {
+    rgba.into_iter()
+        .take(pixels)
+        .map(|[r, g, b, _]| [r, g, b])
+        .collect()
 }
 
 #[cfg(test)]

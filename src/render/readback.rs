@@ -2,9 +2,9 @@
 //! the guide buffers.
 
 use super::{Renderer, film};
-use crate::cl::ClError;
 use crate::cl::kernels::AovBuffers;
 use crate::cl::types::PIXEL_SAMPLES;
+use crate::cl::{ClError, ColorSource, FilmCount, GuideSums};
 
 /// The guide buffers for a denoiser, averaged over each pixel's samples, row by row from the
 /// top (docs/aovs.md).
@@ -114,6 +114,27 @@ impl Renderer {
     pub fn aov_buffers(&self) -> Option<&AovBuffers> {
         let f = self.frame.as_ref()?;
         (self.settings.aovs && f.aov_paths.len() > 1).then_some(&f.film.aovs)
+    }
+
+    /// The film and the guide buffers as a denoiser reads them on the device: each pixel's
+    /// colour is its sums over its own sample count, as [`Renderer::image`] divides them (the
+    /// film's count, or with the hits counted every pixel's samples, or with adaptive sampling
+    /// those its state records); the guides are [`Renderer::aov_buffers`]. `None` where
+    /// `aov_buffers` is. Wait for the samples first ([`Renderer::finish`]).
+    pub fn denoise_sources(&self) -> Option<(ColorSource<'_>, GuideSums<'_>)> {
+        let f = self.frame.as_ref()?;
+        let aovs = self.aov_buffers()?;
+        let counted = self.settings.cutout || self.settings.count_coverage;
+        let count = match (counted, self.settings.noise_threshold) {
+            (false, _) => FilmCount::Own,
+            (true, None) => FilmCount::Taken(self.samples),
+            (true, Some(_)) => FilmCount::State(&f.film.state),
+        };
+        let guides = GuideSums {
+            albedo: &aovs.albedo,
+            normal: &aovs.normal,
+        };
+        Some((ColorSource::Film(&f.film.sum, count), guides))
     }
 
     /// The film's raw pixels: each pixel's fixed-point sums and count, exact (a shard's data).

@@ -10,16 +10,76 @@ use opencl3::kernel::{ExecuteKernel, Kernel};
 /// A 2D kernel's work-group (the preparation kernels).
 const GROUP_2D: [usize; 2] = [16, 4];
 
-/// A film-like buffer the denoiser reads: RGBA f32 per pixel, row-major, and how a pixel's
-/// value is made of it.
+/// Where the denoiser reads each pixel's colour (kernels/denoise/prepare.cl, `color_value`).
 #[derive(Clone, Copy)]
-pub struct FilmInput<'a> {
-    /// The pixels (`.w` is a sample count where `by_count`, else ignored).
-    pub buffer: &'a Buffer<[f32; 4]>,
-    /// The factor on `.xyz` when not `by_count` (e.g. 1 / samples for a sum, 1 for a mean).
-    pub scale: f32,
-    /// The value is `.xyz / .w` (a sum over its per-pixel sample count; 0 where `.w` is 0).
-    pub by_count: bool,
+pub enum ColorSource<'a> {
+    /// Linear RGB, RGBA f32 per pixel: `.xyz` is the value, `.w` is ignored.
+    Image(&'a Buffer<[f32; 4]>),
+    /// The renderer's film as it accumulates (kernels/shared/film.h): per pixel the fixed-point
+    /// sum of its samples, divided by its own sample count.
+    Film(&'a Buffer<[u64; 4]>, FilmCount<'a>),
+}
+
+/// How a film pixel's sample count is known.
+#[derive(Clone, Copy)]
+pub enum FilmCount<'a> {
+    /// The film's `.w`: it counts the samples.
+    Own,
+    /// Every pixel took this many (the film's `.w` counts only the hits).
+    Taken(u32),
+    /// Each pixel took the samples its adaptive state records (`PIXEL_SAMPLES` bits;
+    /// kernels/shared/adaptive.h).
+    State(&'a Buffer<u32>),
+}
+
+impl ColorSource<'_> {
+    /// The kernels' `color_mode` (`DN_COLOR_*`) and `taken`.
+    fn mode(&self) -> (i32, f32) {
+        match self {
+            ColorSource::Image(_) => (0, 0.0),
+            ColorSource::Film(_, FilmCount::Own) => (1, 0.0),
+            ColorSource::Film(_, FilmCount::Taken(n)) => (2, *n as f32),
+            ColorSource::Film(_, FilmCount::State(_)) => (3, 0.0),
+        }
+    }
+
+    /// Sets the colour's five arguments: the image, the film, the states (a buffer the mode
+    /// does not read stands in for those it has not), the mode and `taken`.
+    ///
+    /// # Safety
+    /// Only for kernels whose next five parameters are exactly those.
+    unsafe fn set_args(&self, e: &mut ExecuteKernel, placeholder: &Buffer<[f32; 4]>) {
+        let (mode, taken) = self.mode();
+        let (mut image, mut film, mut state) =
+            (placeholder.mem(), placeholder.mem(), placeholder.mem());
+        match self {
+            ColorSource::Image(b) => image = b.mem(),
+            ColorSource::Film(f, count) => {
+                film = f.mem();
+                if let FilmCount::State(s) = count {
+                    state = s.mem();
+                }
+            }
+        }
+        // SAFETY: the caller's kernel declares these five parameters next, in this order.
+        unsafe {
+            e.set_arg(&image)
+                .set_arg(&film)
+                .set_arg(&state)
+                .set_arg(&mode)
+                .set_arg(&taken);
+        }
+    }
+}
+
+/// The guides the denoiser reads: per pixel sums over the count in the albedo's `.w` (1 for
+/// images of means), RGBA f32 (kernels/shared/aovs.h's layout).
+#[derive(Clone, Copy)]
+pub struct GuideSums<'a> {
+    /// `.xyz` the albedos' sum, `.w` the count.
+    pub albedo: &'a Buffer<[f32; 4]>,
+    /// `.xyz` the normals' sum (`.w` unused).
+    pub normal: &'a Buffer<[f32; 4]>,
 }
 
 /// One convolution's operands: `dst = relu(conv3x3(concat(upsample?(src0), src1)) + bias)`,
@@ -178,17 +238,18 @@ impl DenoiseKernels {
     }
 
     /// `denoise_exposure_bins`: the mean luminance of `bins` = (across, down) blocks of the
-    /// `width` x `height` colour.
+    /// `width` x `height` colour; `guides` only stand in for buffers the colour has not.
+    #[allow(clippy::too_many_arguments)]
     pub fn exposure_bins(
         &self,
         device: &Device,
-        color: FilmInput,
+        color: ColorSource,
+        guides: GuideSums,
         width: usize,
         height: usize,
         bins: (usize, usize),
         out: &Buffer<f32>,
     ) -> Result<Launch, ClError> {
-        let by_count = color.by_count as i32;
         let ints = [width as i32, height as i32, bins.0 as i32, bins.1 as i32];
         launch(
             device,
@@ -197,9 +258,7 @@ impl DenoiseKernels {
             &[bins.0 * bins.1],
             &[64],
             |e| unsafe {
-                e.set_arg(&color.buffer.mem())
-                    .set_arg(&color.scale)
-                    .set_arg(&by_count);
+                color.set_args(e, guides.albedo);
                 for i in &ints {
                     e.set_arg(i);
                 }
@@ -213,14 +272,14 @@ impl DenoiseKernels {
     pub fn input(
         &self,
         device: &Device,
-        inputs: [FilmInput; 3],
+        color: ColorSource,
+        guides: GuideSums,
         width: usize,
         tile: TileWindow,
         exposure: f32,
         pu_norm: f32,
         dst: &Buffer<f32>,
     ) -> Result<Launch, ClError> {
-        let flags = inputs.map(|i| i.by_count as i32);
         let ints = [
             width,
             tile.image_x,
@@ -240,11 +299,9 @@ impl DenoiseKernels {
             &[tile.tile_w, tile.tile_h],
             &GROUP_2D,
             |e| unsafe {
-                for (input, flag) in inputs.iter().zip(&flags) {
-                    e.set_arg(&input.buffer.mem())
-                        .set_arg(&input.scale)
-                        .set_arg(flag);
-                }
+                color.set_args(e, guides.albedo);
+                e.set_arg(&guides.albedo.mem())
+                    .set_arg(&guides.normal.mem());
                 for i in &ints {
                     e.set_arg(i);
                 }
