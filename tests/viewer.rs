@@ -70,36 +70,26 @@ impl Xvfb {
             skip("Xvfb is not installed (apt-get install xvfb)");
             return None;
         }
-        let base = 200 + std::process::id() % 500;
-        for n in base..base + 40 {
-            if Path::new(&format!("/tmp/.X{n}-lock")).exists() {
-                continue;
-            }
-            let mut child = Command::new("Xvfb")
-                .arg(format!(":{n}"))
-                .args(["-screen", "0", "1024x768x24", "-nolisten", "tcp"])
-                .stdout(Stdio::null())
-                .stderr(Stdio::null())
-                .spawn()
-                .expect("Xvfb starts");
-            let socket = PathBuf::from(format!("/tmp/.X11-unix/X{n}"));
-            let start = Instant::now();
-            while start.elapsed() < Duration::from_secs(10) {
-                if let Ok(Some(_)) = child.try_wait() {
-                    break; // taken meanwhile: try the next number
-                }
-                if socket.exists() {
-                    return Some(Xvfb {
-                        child,
-                        display: format!(":{n}"),
-                    });
-                }
-                std::thread::sleep(Duration::from_millis(50));
-            }
+        // Xvfb picks a free display itself and writes its number once it accepts connections
+        // (-displayfd): tests starting at once can neither take the same number nor connect
+        // before the server is up.
+        let mut child = Command::new("Xvfb")
+            .args(["-displayfd", "1", "-screen", "0", "1024x768x24", "-nolisten", "tcp"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("Xvfb starts");
+        let mut line = String::new();
+        let stdout = child.stdout.take().expect("Xvfb's stdout is piped");
+        let _ = BufReader::new(stdout).read_line(&mut line);
+        let Ok(n) = line.trim().parse::<u32>() else {
             let _ = child.kill();
-            let _ = child.wait();
-        }
-        panic!("no free X display number in {base}..{}", base + 40);
+            panic!("Xvfb did not report a display number (it wrote {line:?})");
+        };
+        Some(Xvfb {
+            child,
+            display: format!(":{n}"),
+        })
     }
 
     /// What the window `wid` shows, grabbed from the X server with ImageMagick's `import`.
