@@ -298,9 +298,7 @@ impl Shard {
         if self.film.is_empty() {
             self.film = film;
         } else {
-            for (p, q) in self.film.iter_mut().zip(&film) {
-                *p = film::add(*p, *q);
-            }
+            film::add_films(&mut self.film, &film);
         }
     }
 }
