@@ -201,11 +201,20 @@ fn view(args: ViewArgs) -> Result<()> {
     let devices = common.device.device_set()?;
     let device = devices.primary();
     if !matches!(devices, crate::cl::DeviceSet::One(_)) {
+        let given = common
+            .device
+            .device
+            .as_deref()
+            .unwrap_or("(PENUMBRA_DEVICE)");
+        let which = match &device {
+            crate::cl::DeviceChoice::Index(i) => format!("device {i}"),
+            _ => "the first GPU, else the first device".into(),
+        };
         crate::message::print(
             "note",
             &format!(
-                "the viewer renders on one device of {devices:?}: {device:?}, its first GPU \
-                 (else its first device); `penumbra render` renders on them all"
+                "--device {given}: the viewer renders on one device, {which} (a list's first \
+                 GPU, else its first device); `penumbra render` renders on them all"
             ),
         );
     }
