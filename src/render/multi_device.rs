@@ -143,39 +143,64 @@ fn work(
     loop {
         let (from, n) = {
             let mut p = pool.lock().unwrap_or_else(|e| e.into_inner());
-            let left = p.end - p.next;
-            let time_up = plan
-                .time_limit
-                .is_some_and(|limit| started.elapsed().as_secs_f64() >= limit);
-            if left == 0 || time_up || p.failed {
+            if p.failed {
                 break;
             }
-            let total: f64 = p.speeds.iter().flatten().sum();
-            let speed = p.speeds[me];
-            if speed.is_some_and(|s| !plan.keep_all && s < DROP_SHARE * total) {
-                share.dropped = true;
-                break;
-            }
-            let n = match speed {
-                Some(s) => {
-                    let own = (f64::from(left) * s / total / 2.0).ceil() as u32;
-                    let mut n = (plan.call_size)(1.0 / s).min(own);
-                    if let Some(limit) = plan.time_limit {
-                        let seconds = limit - started.elapsed().as_secs_f64();
-                        n = n.min((seconds * s).ceil() as u32);
-                    }
-                    n
+            let seconds_left = (plan.time_limit).map(|l| l - started.elapsed().as_secs_f64());
+            match next_batch(p.end - p.next, me, &p.speeds, plan, seconds_left) {
+                Next::Claim(n) => {
+                    p.next += n;
+                    (p.next - n, n)
                 }
-                None => left.div_ceil(2 * p.speeds.len() as u32),
+                Next::Drop => {
+                    share.dropped = true;
+                    break;
+                }
+                Next::Done => break,
             }
-            .clamp(1, left);
-            p.next += n;
-            (p.next - n, n)
         };
         let speed = batch(renderer, from, n, &mut share)?;
         pool.lock().unwrap_or_else(|e| e.into_inner()).speeds[me] = Some(speed);
     }
     Ok(share)
+}
+
+/// What a device does when it is free.
+#[derive(Debug, PartialEq)]
+enum Next {
+    /// Render this many samples a pixel, the next of the pool.
+    Claim(u32),
+    /// Stop: too slow beside the others.
+    Drop,
+    /// Stop: no sample left, or no time.
+    Done,
+}
+
+/// The next batch of device `me`, with `left` samples a pixel in the pool, the devices'
+/// measured `speeds` (samples a pixel per second) and `seconds_left` before the time limit.
+fn next_batch(
+    left: u32,
+    me: usize,
+    speeds: &[Option<f64>],
+    plan: &Plan,
+    seconds_left: Option<f64>,
+) -> Next {
+    if left == 0 || seconds_left.is_some_and(|s| s <= 0.0) {
+        return Next::Done;
+    }
+    let total: f64 = speeds.iter().flatten().sum();
+    let n = match speeds[me] {
+        Some(s) if !plan.keep_all && s < DROP_SHARE * total => return Next::Drop,
+        Some(s) => {
+            // About a call's time, at most half this device's share of what is left, and
+            // what fits in the time left.
+            let own = (f64::from(left) * s / total / 2.0).ceil() as u32;
+            let timed = seconds_left.map_or(u32::MAX, |t| (t * s).ceil() as u32);
+            (plan.call_size)(1.0 / s).min(own).min(timed)
+        }
+        None => left.div_ceil(2 * speeds.len() as u32),
+    };
+    Next::Claim(n.clamp(1, left))
 }
 
 /// The sum of the renderers' films: the film of all their samples.
@@ -186,4 +211,76 @@ pub fn film_sum(renderers: &mut [Renderer]) -> Result<Vec<film::FilmPixel>, ClEr
         film::add_films(&mut sum, &r.film()?);
     }
     Ok(sum)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(keep_all: bool) -> Plan {
+        Plan {
+            start: 0,
+            spp: 1000,
+            keep_all,
+            time_limit: None,
+            // A call of 2 s.
+            call_size: |seconds| (2.0 / seconds) as u32,
+        }
+    }
+
+    #[test]
+    fn batches_fill_a_call_and_shrink_towards_the_end() {
+        let speeds = [Some(10.0), Some(10.0)];
+        // 2 s at 10 samples a second.
+        assert_eq!(
+            next_batch(500, 0, &speeds, &plan(false), None),
+            Next::Claim(20)
+        );
+        // Half of this device's half of 30.
+        assert_eq!(
+            next_batch(30, 0, &speeds, &plan(false), None),
+            Next::Claim(8)
+        );
+        assert_eq!(
+            next_batch(1, 1, &speeds, &plan(false), None),
+            Next::Claim(1)
+        );
+        assert_eq!(next_batch(0, 1, &speeds, &plan(false), None), Next::Done);
+        // Unmeasured: a quarter of what is left between two devices.
+        assert_eq!(
+            next_batch(10, 0, &[None, None], &plan(false), None),
+            Next::Claim(3)
+        );
+        // Half a second left: 5 samples.
+        assert_eq!(
+            next_batch(500, 0, &speeds, &plan(false), Some(0.5)),
+            Next::Claim(5)
+        );
+        assert_eq!(
+            next_batch(500, 0, &speeds, &plan(false), Some(0.0)),
+            Next::Done
+        );
+    }
+
+    #[test]
+    fn a_slow_device_drops_out_unless_listed() {
+        // 1 of 31 samples a second: under a tenth.
+        let speeds = [Some(30.0), Some(1.0)];
+        assert_eq!(next_batch(500, 1, &speeds, &plan(false), None), Next::Drop);
+        assert!(matches!(
+            next_batch(500, 0, &speeds, &plan(false), None),
+            Next::Claim(_)
+        ));
+        // Listed by hand, it keeps its share: a half of its 1/31 of 500.
+        assert_eq!(
+            next_batch(500, 1, &speeds, &plan(true), None),
+            Next::Claim(2)
+        );
+        // A fifth of the total stays.
+        let speeds = [Some(4.0), Some(1.0)];
+        assert!(matches!(
+            next_batch(500, 1, &speeds, &plan(false), None),
+            Next::Claim(_)
+        ));
+    }
 }
