@@ -4,7 +4,7 @@
 //! `CommonArgs` flattens every group a rendering command takes; a command that needs fewer
 //! (`bench trace`) flattens only those.
 
-use crate::cl::DeviceChoice;
+use crate::cl::{DeviceChoice, DeviceSet};
 use crate::cli::first_image;
 use crate::render::background::Background;
 use crate::render::exposure::ExposureMode;
@@ -26,16 +26,35 @@ pub const MAX_BOUNCES: u32 = 256;
 /// The OpenCL device.
 #[derive(Args, Debug, Clone, Default)]
 pub struct DeviceArgs {
-    /// OpenCL device: gpu, cpu or an index from `penumbra devices`, also read from
+    /// OpenCL device: gpu, cpu or an index from `penumbra devices`; for `render`, also all
+    /// or a list of indices (0,2) whose devices share the samples; also read from
     /// PENUMBRA_DEVICE (default: the first GPU, else the first CPU).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_device)]
     pub device: Option<String>,
 }
 
+/// A `--device` that names devices there are: a list of indices is checked against
+/// `penumbra devices` (without OpenCL, the opening says so later).
+fn parse_device(s: &str) -> Result<String, String> {
+    let set: DeviceSet = s.parse()?;
+    if let Ok(devices) = crate::cl::list_devices() {
+        set.indices(&devices)?;
+    }
+    Ok(s.to_string())
+}
+
 impl DeviceArgs {
-    /// The device choice from `--device` or `PENUMBRA_DEVICE`.
+    /// The devices from `--device` or `PENUMBRA_DEVICE`.
+    pub fn device_set(&self) -> Result<DeviceSet> {
+        DeviceSet::from_arg_or_env(self.device.as_deref()).map_err(anyhow::Error::msg)
+    }
+
+    /// The device of a command that renders on one; `all` or a list is refused.
     pub fn device_choice(&self) -> Result<DeviceChoice> {
-        DeviceChoice::from_arg_or_env(self.device.as_deref()).map_err(anyhow::Error::msg)
+        match self.device_set()? {
+            DeviceSet::One(choice) => Ok(choice),
+            set => bail!("--device {set:?}: this command renders on one device"),
+        }
     }
 }
 
@@ -390,7 +409,16 @@ impl Default for CommonArgs {
 impl CommonArgs {
     /// Opens the chosen device with the chosen kernel shape and `settings`.
     pub fn open_renderer(&self, settings: &RenderSettings) -> Result<Renderer> {
-        let mut renderer = Renderer::new(&self.device_choice()?)?;
+        self.open_renderer_on(&self.device_choice()?, settings)
+    }
+
+    /// Opens `device` with the chosen kernel shape and `settings`.
+    pub fn open_renderer_on(
+        &self,
+        device: &DeviceChoice,
+        settings: &RenderSettings,
+    ) -> Result<Renderer> {
+        let mut renderer = Renderer::new(device)?;
         renderer.set_kernel(self.kernel)?;
         renderer.set_bvh_choice(self.bvh);
         renderer.set_settings(settings)?;

@@ -20,7 +20,8 @@ fn main() {
         // One line: the error and its causes, outermost first.
         let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
         print("error", &chain.join(": "));
-        std::process::exit(1);
+        let usage = e.downcast_ref::<penumbra::cli::UsageError>().is_some();
+        std::process::exit(if usage { 2 } else { 1 });
     }
 }
 

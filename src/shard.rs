@@ -151,36 +151,101 @@ impl Shard {
 
     /// Reads a shard EXR; one line naming the file and what is wrong otherwise.
     pub fn read(path: &Path) -> Result<Shard> {
-        use exr::prelude::*;
+        let mut shard = Shard::read_header(path)?;
+        shard.film = vec![[0; 4]; shard.width as usize * shard.height as usize];
+        let info = shard.add_file(path)?;
+        shard.info = info;
+        Ok(shard)
+    }
+
+    /// Adds the film of the shard EXR at `path` (of this shard's size) to this shard's film,
+    /// and returns that shard's header. The film's channels are read straight from the file's
+    /// blocks as they are decompressed (on every core), each pixel's halves joined and added
+    /// where they land: no channel is copied out whole, and the image channels are skipped.
+    pub fn add_file(&mut self, path: &Path) -> Result<ShardInfo> {
+        use exr::block::reader::ChunksReader;
         let shown = path.display();
-        let layer = crate::image_io::read_exr_layer(path)?;
-        let info = info_of(path, &layer.attributes)?;
-        let channel = |name: &str| {
-            layer
-                .channel_data
-                .list
-                .iter()
-                .find(|c| c.name.eq(name))
-                .and_then(|c| match &c.sample_data {
-                    FlatSamples::U32(v) => Some(v),
-                    _ => None,
-                })
-                .ok_or_else(|| anyhow::anyhow!("{shown}: the shard has no u32 channel {name}"))
+        let cannot = |e: exr::error::Error| anyhow::anyhow!("{shown}: cannot read EXR: {e}");
+        let file = std::fs::File::open(path).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
+        let reader = exr::block::read(std::io::BufReader::new(file), false).map_err(cannot)?;
+        let Some(header) = reader.meta_data().headers.first() else {
+            bail!("{shown}: an EXR without layers");
         };
-        let pixels = layer.size.area();
-        let mut film = vec![[0u64; 4]; pixels];
-        for (lane, (hi, lo)) in FILM_CHANNELS.iter().enumerate() {
-            let (hi, lo) = (channel(hi)?, channel(lo)?);
-            for (i, p) in film.iter_mut().enumerate() {
-                p[lane] = u64::from(hi[i]) << 32 | u64::from(lo[i]);
-            }
+        let info = info_of(path, &header.own_attributes)?;
+        let (w, h) = (header.layer_size.width(), header.layer_size.height());
+        if (w, h) != (self.width as usize, self.height as usize) || self.film.len() != w * h {
+            bail!(
+                "{shown}: {w}×{h} pixels, not {}×{}",
+                self.width,
+                self.height
+            );
         }
-        Ok(Shard {
-            width: layer.size.width() as u32,
-            height: layer.size.height() as u32,
-            info,
-            film,
-        })
+        // Each channel's place in a block's line: lines hold each channel's samples in turn,
+        // in the header's (sorted) order.
+        let channels = &header.channels.list;
+        let place = |name: &str| {
+            let at = channels.iter().position(|c| c.name.eq(name));
+            match at.map(|i| (i, channels[i].sample_type)) {
+                Some((i, exr::meta::attribute::SampleType::U32)) => Ok(i),
+                _ => Err(anyhow::anyhow!(
+                    "{shown}: the shard has no u32 channel {name}"
+                )),
+            }
+        };
+        let mut lanes = [(0, 0); 4];
+        for (lane, (hi, lo)) in FILM_CHANNELS.iter().enumerate() {
+            lanes[lane] = (place(hi)?, place(lo)?);
+        }
+        let sizes: Vec<usize> = channels
+            .iter()
+            .map(|c| c.sample_type.bytes_per_sample())
+            .collect();
+        let film = &mut self.film;
+        reader
+            .all_chunks(false)
+            .map_err(cannot)?
+            .decompress_parallel(false, |_, block| {
+                let (x0, y0) = (
+                    block.index.pixel_position.x(),
+                    block.index.pixel_position.y(),
+                );
+                let (bw, bh) = (
+                    block.index.pixel_size.width(),
+                    block.index.pixel_size.height(),
+                );
+                if block.index.layer != 0 || x0 + bw > w || y0 + bh > h {
+                    return Err(exr::error::Error::Invalid(
+                        "a block outside the image".into(),
+                    ));
+                }
+                // Where each channel starts in a line of the block.
+                let mut starts = Vec::with_capacity(sizes.len());
+                let mut line_bytes = 0;
+                for s in &sizes {
+                    starts.push(line_bytes);
+                    line_bytes += s * bw;
+                }
+                if block.data.len() != line_bytes * bh {
+                    return Err(exr::error::Error::Invalid(
+                        "a block of the wrong size".into(),
+                    ));
+                }
+                for (row, line) in block.data.chunks_exact(line_bytes).enumerate() {
+                    let pixels = &mut film[(y0 + row) * w + x0..][..bw];
+                    for (lane, &(hi, lo)) in lanes.iter().enumerate() {
+                        let his = line[starts[hi]..][..4 * bw].chunks_exact(4);
+                        let los = line[starts[lo]..][..4 * bw].chunks_exact(4);
+                        for (p, (hi, lo)) in pixels.iter_mut().zip(his.zip(los)) {
+                            let half =
+                                |b: &[u8]| u64::from(u32::from_ne_bytes([b[0], b[1], b[2], b[3]]));
+                            p[lane] = p[lane].saturating_add(half(hi) << 32 | half(lo));
+                        }
+                    }
+                }
+                Ok(())
+            })
+            .map_err(cannot)?;
+        Ok(info)
     }
 
     /// Reads only a shard EXR's header (no pixel): a shard with an empty film.
@@ -291,20 +356,6 @@ pub fn check<N: std::fmt::Display>(shards: &mut [(N, Shard)]) -> Result<Shard> {
     Ok(sum)
 }
 
-impl Shard {
-    /// Adds `film` (another shard's, of the same size) to this shard's film; an empty film
-    /// (from [`check`]) takes it as it is.
-    pub fn add_film(&mut self, film: Vec<FilmPixel>) {
-        if self.film.is_empty() {
-            self.film = film;
-        } else {
-            for (p, q) in self.film.iter_mut().zip(&film) {
-                *p = film::add(*p, *q);
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -349,8 +400,9 @@ mod tests {
         let mut shards = vec![named(shard(8, 4, 3)), named(shard(0, 8, 5))];
         let mut m = check(&mut shards).unwrap();
         assert_eq!((m.info.sample_start, m.info.samples), (0, 12));
+        m.film = vec![[0; 4]; 2];
         for (_, s) in shards {
-            m.add_film(s.film);
+            film::add_films(&mut m.film, &s.film);
         }
         assert_eq!(m.film[0], [8 << 33, 8, 0, 12]);
     }

@@ -265,10 +265,11 @@ fn absurd_options_fail_with_one_clear_line() {
         assert!(!err.contains("panicked"), "{err}");
         assert!(err.contains(expect), "{args:?}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-        // A number outside an option's range is a usage error (2); the rest is bad input (1).
+        // A number outside an option's range, or a device that is not there, is a usage
+        // error (2); the rest is bad input (1).
         let usage = matches!(
             args[0],
-            "--width" | "--bounces" | "--spp" | "--light-radius"
+            "--width" | "--bounces" | "--spp" | "--light-radius" | "--device"
         );
         assert_eq!(
             o.status.code(),

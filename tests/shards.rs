@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{output_dir, penumbra, white_sphere_under_panel};
+use common::{channel_bits, output_dir, penumbra, white_sphere_under_panel};
 use std::path::{Path, PathBuf};
 
 const KERNELS: [&str; 2] = ["megakernel", "wavefront"];
@@ -51,25 +51,6 @@ fn merge(shards: &[&Path], out: &Path) -> (i32, String) {
         o.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&o.stderr).into_owned(),
     )
-}
-
-/// The bits of every channel of an EXR's first layer, by channel name.
-fn channel_bits(path: &Path) -> Vec<(String, Vec<u32>)> {
-    use exr::prelude::*;
-    penumbra::image_io::read_exr_layer(path)
-        .unwrap()
-        .channel_data
-        .list
-        .iter()
-        .map(|c| {
-            let bits = match &c.sample_data {
-                FlatSamples::F32(v) => v.iter().map(|x| x.to_bits()).collect(),
-                FlatSamples::U32(v) => v.clone(),
-                FlatSamples::F16(v) => v.iter().map(|x| u32::from(x.to_bits())).collect(),
-            };
-            (c.name.to_string(), bits)
-        })
-        .collect()
 }
 
 /// The RGB(A) channels' bits of an EXR.

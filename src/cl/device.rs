@@ -36,6 +36,19 @@ impl FromStr for DeviceChoice {
 }
 
 impl DeviceChoice {
+    /// The device among `devices` that the choice names.
+    fn pick<'a>(&self, devices: &'a [DeviceInfo]) -> Option<&'a DeviceInfo> {
+        match self {
+            Self::Auto => devices
+                .iter()
+                .find(|d| d.is_gpu)
+                .or_else(|| devices.first()),
+            Self::Gpu => devices.iter().find(|d| d.is_gpu),
+            Self::Cpu => devices.iter().find(|d| !d.is_gpu),
+            Self::Index(i) => devices.get(*i),
+        }
+    }
+
     /// The choice from the command line, else from `PENUMBRA_DEVICE`, else automatic.
     pub fn from_arg_or_env(arg: Option<&str>) -> Result<Self, String> {
         match arg {
@@ -46,6 +59,103 @@ impl DeviceChoice {
             },
         }
     }
+}
+
+/// Which devices render (`--device`): one device, every device, or a list of indices.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum DeviceSet {
+    /// One device.
+    One(DeviceChoice),
+    /// Every device `penumbra devices` lists (`all`).
+    All,
+    /// These indices of `penumbra devices`, in this order (`0,2`); an index may repeat, which
+    /// opens the device once more (its own context and queue).
+    List(Vec<usize>),
+}
+
+impl FromStr for DeviceSet {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s.trim().eq_ignore_ascii_case("all") {
+            return Ok(Self::All);
+        }
+        if !s.contains(',') {
+            return s.parse().map(Self::One).map_err(|_| {
+                format!(
+                    "device '{s}' is not 'gpu', 'cpu', 'all', an index from `penumbra devices` \
+                     or a list of indices (0,2)"
+                )
+            });
+        }
+        s.split(',')
+            .map(|item| {
+                item.trim().parse().map_err(|_| {
+                    format!(
+                        "device list '{s}': '{}' is not an index from `penumbra devices`",
+                        item.trim()
+                    )
+                })
+            })
+            .collect::<Result<_, _>>()
+            .map(Self::List)
+    }
+}
+
+impl DeviceSet {
+    /// The choice from the command line, else from `PENUMBRA_DEVICE`, else automatic.
+    pub fn from_arg_or_env(arg: Option<&str>) -> Result<Self, String> {
+        match arg {
+            Some(a) => a.parse(),
+            None => match std::env::var("PENUMBRA_DEVICE") {
+                Ok(v) => v.parse().map_err(|e| format!("PENUMBRA_DEVICE: {e}")),
+                Err(_) => Ok(Self::One(DeviceChoice::Auto)),
+            },
+        }
+    }
+
+    /// The devices of the set among `devices` (`penumbra devices`' list), as indices; an index
+    /// that is not in it is one line naming it and the devices there are.
+    pub fn indices(&self, devices: &[DeviceInfo]) -> Result<Vec<usize>, String> {
+        match self {
+            Self::One(choice) => (choice.pick(devices))
+                .map(|d| vec![d.index])
+                .ok_or_else(|| no_match(choice, devices)),
+            Self::All => Ok(devices.iter().map(|d| d.index).collect()),
+            Self::List(list) => match list.iter().find(|&&i| i >= devices.len()) {
+                Some(&i) => Err(no_match(&DeviceChoice::Index(i), devices)),
+                None => Ok(list.clone()),
+            },
+        }
+    }
+
+    /// The one device a single-device command (the viewer) takes from the set: the device
+    /// itself, else the set's first GPU, else its first device.
+    pub fn primary(&self) -> DeviceChoice {
+        match self {
+            Self::One(choice) => choice.clone(),
+            Self::All => DeviceChoice::Auto,
+            Self::List(list) => {
+                let gpu = list_devices().ok().and_then(|devices| {
+                    list.iter()
+                        .copied()
+                        .find(|&i| devices.get(i).is_some_and(|d| d.is_gpu))
+                });
+                DeviceChoice::Index(gpu.unwrap_or(list[0]))
+            }
+        }
+    }
+}
+
+/// The line that says no device among `devices` matches `choice`, naming those there are.
+fn no_match(choice: &DeviceChoice, devices: &[DeviceInfo]) -> String {
+    let names: Vec<String> = devices
+        .iter()
+        .map(|d| format!("{}: {}", d.index, d.name))
+        .collect();
+    format!(
+        "no OpenCL device matches {choice:?} (devices: {})",
+        names.join(", ")
+    )
 }
 
 /// One OpenCL device as `penumbra devices` lists it.
@@ -68,7 +178,7 @@ pub struct DeviceInfo {
     /// Global memory in bytes.
     pub memory: u64,
     /// The device handle.
-    pub id: opencl3::types::cl_device_id,
+    pub handle: ClDevice,
 }
 
 /// Every device of every platform, in platform order.
@@ -95,7 +205,7 @@ pub fn list_devices() -> Result<Vec<DeviceInfo>, ClError> {
                 driver: d.driver_version().unwrap_or_default(),
                 compute_units: d.max_compute_units().unwrap_or(0),
                 memory: d.global_mem_size().unwrap_or(0),
-                id,
+                handle: d,
             });
         }
     }
@@ -139,27 +249,9 @@ impl Device {
     pub fn open(choice: &DeviceChoice) -> Result<Self, ClError> {
         let _setup = super::CL_SETUP.lock().unwrap_or_else(|e| e.into_inner());
         let devices = list_devices()?;
-        let info = match choice {
-            DeviceChoice::Auto => devices
-                .iter()
-                .find(|d| d.is_gpu)
-                .or_else(|| devices.first())
-                .cloned(),
-            DeviceChoice::Gpu => devices.iter().find(|d| d.is_gpu).cloned(),
-            DeviceChoice::Cpu => devices.iter().find(|d| !d.is_gpu).cloned(),
-            DeviceChoice::Index(i) => devices.get(*i).cloned(),
-        }
-        .ok_or_else(|| {
-            let names: Vec<String> = devices
-                .iter()
-                .map(|d| format!("{}: {}", d.index, d.name))
-                .collect();
-            ClError::Device(format!(
-                "no OpenCL device matches {choice:?} (devices: {})",
-                names.join(", ")
-            ))
-        })?;
-        let device = ClDevice::new(info.id);
+        let info = (choice.pick(&devices).cloned())
+            .ok_or_else(|| ClError::Device(no_match(choice, &devices)))?;
+        let device = info.handle;
         let context = Context::from_device(&device).map_err(call_err("creating the context"))?;
         #[allow(deprecated)] // clCreateCommandQueue keeps OpenCL 1.2 devices working.
         let queue = CommandQueue::create_default(&context, CL_QUEUE_PROFILING_ENABLE)
@@ -188,5 +280,21 @@ mod tests {
         assert_eq!("CPU".parse::<DeviceChoice>(), Ok(DeviceChoice::Cpu));
         assert_eq!("2".parse::<DeviceChoice>(), Ok(DeviceChoice::Index(2)));
         assert!("fastest".parse::<DeviceChoice>().is_err());
+    }
+
+    #[test]
+    fn parses_device_sets() {
+        assert_eq!("all".parse::<DeviceSet>(), Ok(DeviceSet::All));
+        assert_eq!(
+            "gpu".parse::<DeviceSet>(),
+            Ok(DeviceSet::One(DeviceChoice::Gpu))
+        );
+        assert_eq!(
+            "0, 2,0".parse::<DeviceSet>(),
+            Ok(DeviceSet::List(vec![0, 2, 0]))
+        );
+        let e = "0,x".parse::<DeviceSet>().unwrap_err();
+        assert!(e.contains("'x' is not an index"), "{e}");
+        assert!("0,".parse::<DeviceSet>().is_err());
     }
 }

@@ -20,7 +20,7 @@ pub mod types;
 pub(crate) static CL_SETUP: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 pub use buffer::Buffer;
-pub use device::{Device, DeviceChoice, DeviceInfo, list_devices};
+pub use device::{Device, DeviceChoice, DeviceInfo, DeviceSet, list_devices};
 pub use host_memory::{OpeningMemory, map_file};
 pub use kernels::{
     ColorSource, ConvArgs, DenoiseKernels, FilmCount, GuideSums, Launch, Program, TileWindow,

@@ -26,7 +26,10 @@ pub fn run() -> Result<()> {
             d.driver.trim()
         );
     }
-    println!("* = default (first GPU, else first CPU); choose with --device gpu|cpu|INDEX");
+    println!(
+        "* = default (first GPU, else first CPU); choose with --device gpu|cpu|INDEX, or for \
+         render all|INDEX,INDEX… (several at once)"
+    );
     if let Some(c) = chosen.filter(|c| *c != DeviceChoice::Auto) {
         println!("PENUMBRA_DEVICE selects {c:?}");
     }

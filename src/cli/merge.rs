@@ -28,7 +28,8 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     let started = Instant::now();
     let output = OutputFile::open(&args.output)?;
     // The headers first: shards that do not belong together are refused before any pixel is
-    // read; then one film at a time, so that a merge holds two films, not one per shard.
+    // read; then each shard's film is added to the sum as its blocks are decompressed, so that
+    // a merge holds one film, not one per shard.
     let mut shards = args
         .shards
         .iter()
@@ -36,12 +37,11 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let count = shards.len();
     let mut merged = shard::check(&mut shards)?;
+    merged.film = vec![[0; 4]; merged.width as usize * merged.height as usize];
     for (name, header) in &shards {
-        let s = Shard::read(name.0)?;
-        if s.info != header.info {
+        if merged.add_file(name.0)? != header.info {
             anyhow::bail!("{name}: changed while it was merged");
         }
-        merged.add_film(s.film);
     }
     let (w, h) = (merged.width, merged.height);
     let bytes = match output.format {

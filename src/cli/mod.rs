@@ -138,6 +138,12 @@ pub struct MergeArgs {
     pub output: PathBuf,
 }
 
+/// A command-line usage error found after parsing, such as options that do not go together
+/// with several devices: `main` exits with code 2, as for clap's.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
 /// One line for a command-line usage error (`penumbra: error: …`, exit code 2): clap's first
 /// line without its `error: ` prefix, and where to find the usage.
 pub fn usage_error(e: &clap::Error) -> String {
@@ -196,7 +202,27 @@ fn view(args: ViewArgs) -> Result<()> {
         }
     };
     let environment = prepared.environment.take();
-    let device = common.device_choice()?;
+    // The viewer renders on one device: of several, the first GPU (else the first device).
+    let devices = common.device.device_set()?;
+    let device = devices.primary();
+    if !matches!(devices, crate::cl::DeviceSet::One(_)) {
+        let given = common
+            .device
+            .device
+            .as_deref()
+            .unwrap_or("(PENUMBRA_DEVICE)");
+        let which = match &device {
+            crate::cl::DeviceChoice::Index(i) => format!("device {i}"),
+            _ => "the first GPU, else the first device".into(),
+        };
+        crate::message::print(
+            "note",
+            &format!(
+                "--device {given}: the viewer renders on one device, {which} (a list's first \
+                 GPU, else its first device); `penumbra render` renders on them all"
+            ),
+        );
+    }
     // With a lens but no focus distance, focus on what the image centre sees once loaded.
     let autofocus = settings.lens_radius > 0.0 && common.lens.focus_distance.is_none();
     crate::app::run(ViewerConfig {

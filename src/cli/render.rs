@@ -4,12 +4,13 @@
 use super::RenderArgs;
 use super::animate::{self, Frame};
 use crate::args::{EnvChoice, Prepared};
+use crate::cl::{DeviceChoice, DeviceSet};
 use crate::denoise::{DenoiseReport, Denoiser};
 use crate::image_io::{Format, OutputFile, encode_exr, encode_exr_channels};
 use crate::render::background::{self, Background, unpremultiply};
 use crate::render::exposure::{self, ExposureMode};
 use crate::render::tonemap::{ToneMapper, encode_rgba_png, to_rgba8};
-use crate::render::{RenderSettings, Renderer, SceneStats};
+use crate::render::{RenderSettings, Renderer, SceneStats, film, multi_device};
 use crate::shard::{Shard, ShardInfo};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -25,6 +26,9 @@ pub const DEFAULT_SIZE: (u32, u32) = (640, 480);
 /// Renders and writes the image; prints the summary line on stdout.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let started = Instant::now();
+    // The devices first: a list that names none, or options one device must take, are
+    // refused before the output is opened.
+    let devices = device_choices(args)?;
     let frames = args.animation.frames(&args.output)?;
     // The output is checked (and opened) before the scene is read: a path that cannot be
     // written fails now, not after the render (a sequence's first frame's).
@@ -54,14 +58,26 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         animate::pose(&mut prepared, c, frames[0].time.unwrap_or(0.0));
     }
     settings.env_intensity *= prepared.env_scale;
-    let environment = prepared.environment.take();
-    let mut renderer = args.common.open_renderer(&settings)?;
-    if let Some(EnvChoice::Map(map)) = environment {
-        renderer.set_environment(Some(map))?;
+    let environment = match prepared.environment.take() {
+        Some(EnvChoice::Map(map)) => Some(map),
+        _ => None,
+    };
+    // Each device its own renderer: context, kernels and the scene on it.
+    let mut renderers = Vec::new();
+    let mut scene_stats = None;
+    for device in &devices {
+        let mut renderer = args.common.open_renderer_on(device, &settings)?;
+        if let Some(map) = &environment {
+            renderer.set_environment(Some(map.clone()))?;
+        }
+        let stats = renderer
+            .load_scene(&prepared.scene, &prepared.lights)
+            .with_context(|| format!("{}", args.scene.display()))?;
+        renderer.set_camera(&prepared.camera)?;
+        scene_stats.get_or_insert(stats);
+        renderers.push(renderer);
     }
-    let scene_stats = renderer
-        .load_scene(&prepared.scene, &prepared.lights)
-        .with_context(|| format!("{}", args.scene.display()))?;
+    let scene_stats = scene_stats.expect("at least one device");
     if scene_stats.dropped_triangles > 0 {
         log::warn!(
             "{}: {} triangles with a non-finite or absurd (beyond 1e30) vertex dropped",
@@ -69,10 +85,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             scene_stats.dropped_triangles
         );
     }
-    renderer.set_camera(&prepared.camera)?;
     if settings.lens_radius > 0.0 && args.common.lens.focus_distance.is_none() {
-        // Focus on what the image centre sees (else the scene's centre).
-        let focus = renderer
+        // Focus on what the image centre sees (else the scene's centre), the same on every
+        // device.
+        let focus = renderers[0]
             .focus_distance_at(settings.width as f32 * 0.5, settings.height as f32 * 0.5)
             .unwrap_or_else(|| {
                 let bounds = prepared.scene.bounds();
@@ -80,13 +96,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                     .dot(prepared.camera.forward)
                     .max(1e-3 * bounds.diagonal()) as f32
             });
-        renderer.set_lens(settings.lens_radius, focus)?;
+        for renderer in &mut renderers {
+            renderer.set_lens(settings.lens_radius, focus)?;
+        }
     }
 
     // The denoiser is built before the samples: its kernels fail now, not after the render.
     let denoiser = if args.denoise {
         let t = Instant::now();
-        let denoiser = Denoiser::new(&renderer.device, args.denoiser)?;
+        let denoiser = Denoiser::new(&renderers[0].device, args.denoiser)?;
         Some((denoiser, t.elapsed().as_secs_f64() * 1e3))
     } else {
         None
@@ -107,8 +125,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         {
             let t = Instant::now();
             let applied = animate::pose(&mut prepared, c, frame.time.unwrap_or(0.0));
-            renderer.update_scene(&prepared.scene, &prepared.lights, applied.deformed > 0)?;
-            renderer.set_camera(&prepared.camera)?;
+            for renderer in &mut renderers {
+                renderer.update_scene(&prepared.scene, &prepared.lights, applied.deformed > 0)?;
+                renderer.set_camera(&prepared.camera)?;
+            }
             update_ms = Some(t.elapsed().as_secs_f64() * 1e3);
         }
         let output = match output.take() {
@@ -125,7 +145,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         render_frame(
             args,
             &mut setup,
-            &mut renderer,
+            &mut renderers,
             &prepared,
             frame,
             output,
@@ -133,6 +153,40 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         )?;
     }
     Ok(())
+}
+
+/// The devices `--device` names, one renderer each; several only where each device's film can
+/// be summed: not with adaptive sampling, whose convergence is decided on one film, nor with
+/// guide buffers (`--aovs`, `--denoise`), whose sums are floats that a sum of films would
+/// round in another order.
+fn device_choices(args: &RenderArgs) -> Result<Vec<DeviceChoice>> {
+    let set = args.common.device.device_set()?;
+    let indices = match &set {
+        DeviceSet::One(choice) => return Ok(vec![choice.clone()]),
+        set => set
+            .indices(&crate::cl::list_devices()?)
+            .map_err(anyhow::Error::msg)?,
+    };
+    if indices.len() > 1 {
+        for (given, option) in [
+            (args.noise_threshold.is_some(), "--noise-threshold"),
+            (args.aovs, "--aovs"),
+            (args.denoise, "--denoise"),
+        ] {
+            if given {
+                return Err(super::UsageError(format!(
+                    "{option} renders on one device, not on --device {}",
+                    args.common
+                        .device
+                        .device
+                        .as_deref()
+                        .unwrap_or("(PENUMBRA_DEVICE)")
+                ))
+                .into());
+            }
+        }
+    }
+    Ok(indices.into_iter().map(DeviceChoice::Index).collect())
 }
 
 /// What every frame of a render shares.
@@ -150,7 +204,7 @@ struct Setup {
 fn render_frame(
     args: &RenderArgs,
     setup: &mut Setup,
-    renderer: &mut Renderer,
+    renderers: &mut [Renderer],
     prepared: &Prepared,
     frame: &Frame,
     output: OutputFile,
@@ -176,41 +230,33 @@ fn render_frame(
     let mut lines = (!std::io::stderr().is_terminal()).then(|| ProgressLines::new(spp));
     let start = Instant::now();
     let cpu_start = crate::cpu_time::process_cpu_seconds();
-    renderer.set_next_sample(args.sample_start.unwrap_or(0));
-    let mut done = 0;
-    // The fewest samples a call first, then calls sized by the time a sample took.
-    let mut chunk = MIN_SAMPLES_PER_CALL;
-    while done < spp {
-        // The last check left no pixel active: more samples would add nothing.
-        if renderer.active_pixels() == Some(0) {
-            break;
-        }
-        if args
-            .time_limit
-            .is_some_and(|limit| start.elapsed().as_secs_f64() >= limit)
-        {
-            break;
-        }
-        let mut n = chunk.min(spp - done);
-        if let Some(limit) = args.time_limit {
-            // The call sized to end near the limit, at a sample's time measured so far.
-            let left = limit - start.elapsed().as_secs_f64();
-            let per_sample = start.elapsed().as_secs_f64() / f64::from(done.max(1));
-            if done > 0 && per_sample > 0.0 {
-                n = n.min(((left / per_sample).ceil() as u32).max(1));
-            } else {
-                n = n.min(1);
+    let sample_start = args.sample_start.unwrap_or(0);
+    let shares = if let [renderer] = renderers {
+        let done = render_samples(args, renderer, spp, &bar, &mut lines)?;
+        let seconds = start.elapsed().as_secs_f64();
+        vec![multi_device::Share {
+            samples: done,
+            seconds,
+            dropped: false,
+        }]
+    } else {
+        let plan = multi_device::Plan {
+            start: sample_start,
+            spp,
+            keep_all: matches!(args.common.device.device_set()?, DeviceSet::List(_)),
+            time_limit: args.time_limit,
+            call_size: samples_per_call,
+        };
+        let lines = std::sync::Mutex::new(lines);
+        let progress = |done: u32| {
+            bar.set_position(done as u64);
+            if let Some(l) = lines.lock().unwrap_or_else(|e| e.into_inner()).as_mut() {
+                l.update(done, start.elapsed().as_secs_f64());
             }
-        }
-        let call = Instant::now();
-        renderer.render(n)?;
-        chunk = samples_per_call(call.elapsed().as_secs_f64() / f64::from(n));
-        done += n;
-        bar.set_position(done as u64);
-        if let Some(l) = lines.as_mut() {
-            l.update(done, start.elapsed().as_secs_f64());
-        }
-    }
+        };
+        multi_device::render(renderers, &plan, &progress)?
+    };
+    let done: u32 = shares.iter().map(|s| s.samples).sum();
     let seconds = start.elapsed().as_secs_f64();
     // Process CPU time of the render (on a CPU device, the kernels' threads are ours).
     let cpu_seconds = cpu_start
@@ -222,7 +268,28 @@ fn render_frame(
     // without the background. With the background cut out, the straight color is metered and
     // tone-mapped.
     let (mut image, mut coverage) = (Vec::new(), Vec::new());
-    renderer.image_into(&mut image, Some(&mut coverage))?;
+    // Several devices: their films summed, the film of all their samples.
+    let mut summed = None;
+    if renderers.len() > 1 {
+        let film = multi_device::film_sum(renderers)?;
+        let counted = settings.cutout || settings.count_coverage;
+        let taken = |_| f64::from(done);
+        film::image_into(&film, counted, taken, &mut image, Some(&mut coverage));
+        summed = Some(film);
+    }
+    let mut stats = renderers[0].stats().clone();
+    for r in &renderers[1..] {
+        stats.add(r.stats());
+    }
+    let device = (renderers.iter())
+        .map(|r| r.device.description())
+        .collect::<Vec<_>>()
+        .join(" + ");
+    let indices: Vec<usize> = renderers.iter().map(|r| r.device.info.index).collect();
+    let renderer = &mut renderers[0];
+    if summed.is_none() {
+        renderer.image_into(&mut image, Some(&mut coverage))?;
+    }
     let nonfinite_pixels = zero_nonfinite(&mut image);
     if nonfinite_pixels > 0 {
         log::warn!(
@@ -263,13 +330,16 @@ fn render_frame(
                 tonemap: tonemap.arg_name().into(),
                 scene: args.scene.display().to_string(),
                 kernel: format!("{:?}", renderer.kernel()).to_lowercase(),
-                device: renderer.device.description(),
+                device: device.clone(),
             };
             Shard {
                 width: w,
                 height: h,
                 info,
-                film: renderer.film()?,
+                film: match summed.take() {
+                    Some(film) => film,
+                    None => renderer.film()?,
+                },
             }
             .encode()?
         }
@@ -277,7 +347,6 @@ fn render_frame(
     };
     output.write(&bytes)?;
     let adaptive = renderer.adaptive_stats()?;
-    let stats = renderer.stats();
     if stats.stack_overflows > 0 {
         anyhow::bail!(
             "{}: {} traversal stack overflow(s): the image is wrong",
@@ -308,7 +377,7 @@ fn render_frame(
     let mut summary = serde_json::json!({
         "scene": args.scene.display().to_string(),
         "output": frame.output.display().to_string(),
-        "device": renderer.device.description(),
+        "device": device,
         "kernel": renderer.kernel(),
         "width": settings.width,
         "height": settings.height,
@@ -389,6 +458,19 @@ fn render_frame(
     ] {
         summary[key] = value;
     }
+    let w_h = f64::from(w) * f64::from(h);
+    summary["devices"] = (shares.iter().zip(&indices))
+        .map(|(share, index)| {
+            serde_json::json!({
+                "index": index,
+                "samples": share.samples,
+                "share": f64::from(share.samples) / f64::from(done.max(1)),
+                "seconds": share.seconds,
+                "samples_per_second": w_h * f64::from(share.samples) / share.seconds.max(1e-9),
+                "dropped": share.dropped,
+            })
+        })
+        .collect();
     summary["denoise"] = serde_json::json!(denoised.is_some());
     if let (Some(d), Some((denoiser, build_ms))) = (&denoised, denoiser) {
         summary["denoiser"] = serde_json::json!(denoiser.quality().name());
@@ -417,14 +499,84 @@ fn render_frame(
     let denoised_in = denoised.as_ref().map_or_else(String::new, |d| {
         format!(", denoised in {}", duration(d.ms * 1e-3))
     });
+    let on_devices = if shares.len() > 1 {
+        let parts: Vec<String> = (shares.iter().zip(&indices))
+            .map(|(share, index)| {
+                let rate = w_h * f64::from(share.samples) / share.seconds.max(1e-9);
+                format!(
+                    "{index}: {} spp ({:.0} %, {:.2} M samples/s{})",
+                    share.samples,
+                    100.0 * f64::from(share.samples) / f64::from(done.max(1)),
+                    rate * 1e-6,
+                    if share.dropped {
+                        ", dropped: too slow"
+                    } else {
+                        ""
+                    }
+                )
+            })
+            .collect();
+        format!(" on devices {}", parts.join(", "))
+    } else {
+        String::new()
+    };
     eprintln!(
-        "penumbra: wrote {}: {w}×{h} pixels, {taken}, rendered in {}{denoised_in} ({} in all)",
+        "penumbra: wrote {}: {w}×{h} pixels, {taken}, rendered in {}{on_devices}{denoised_in} ({} in all)",
         frame.output.display(),
         duration(seconds),
         duration(started.elapsed().as_secs_f64())
     );
     println!("{summary}");
     Ok(())
+}
+
+/// Renders `spp` samples a pixel on one device, in calls sized to the time a sample takes,
+/// stopping early at `--time-limit` or once adaptive sampling left no pixel active; returns
+/// the samples a pixel taken.
+fn render_samples(
+    args: &RenderArgs,
+    renderer: &mut Renderer,
+    spp: u32,
+    bar: &ProgressBar,
+    lines: &mut Option<ProgressLines>,
+) -> Result<u32> {
+    let start = Instant::now();
+    renderer.set_next_sample(args.sample_start.unwrap_or(0));
+    let mut done = 0;
+    // The fewest samples a call first, then calls sized by the time a sample took.
+    let mut chunk = MIN_SAMPLES_PER_CALL;
+    while done < spp {
+        // The last check left no pixel active: more samples would add nothing.
+        if renderer.active_pixels() == Some(0) {
+            break;
+        }
+        if args
+            .time_limit
+            .is_some_and(|limit| start.elapsed().as_secs_f64() >= limit)
+        {
+            break;
+        }
+        let mut n = chunk.min(spp - done);
+        if let Some(limit) = args.time_limit {
+            // The call sized to end near the limit, at a sample's time measured so far.
+            let left = limit - start.elapsed().as_secs_f64();
+            let per_sample = start.elapsed().as_secs_f64() / f64::from(done.max(1));
+            if done > 0 && per_sample > 0.0 {
+                n = n.min(((left / per_sample).ceil() as u32).max(1));
+            } else {
+                n = n.min(1);
+            }
+        }
+        let call = Instant::now();
+        renderer.render(n)?;
+        chunk = samples_per_call(call.elapsed().as_secs_f64() / f64::from(n));
+        done += n;
+        bar.set_position(done as u64);
+        if let Some(l) = lines.as_mut() {
+            l.update(done, start.elapsed().as_secs_f64());
+        }
+    }
+    Ok(done)
 }
 
 /// Seconds for a person: "0.42 s", "12.3 s", "3 min 07 s".

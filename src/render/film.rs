@@ -27,6 +27,13 @@ pub fn add(a: FilmPixel, b: FilmPixel) -> FilmPixel {
     std::array::from_fn(|c| a[c].saturating_add(b[c]))
 }
 
+/// Adds the film `b` to the film `a`, pixel by pixel ([`add`]): the film of both's samples.
+pub fn add_films(a: &mut [FilmPixel], b: &[FilmPixel]) {
+    for (p, q) in a.iter_mut().zip(b) {
+        *p = add(*p, *q);
+    }
+}
+
 /// The image (each pixel's mean, linear RGB) into `image` and, when asked, each pixel's coverage
 /// into `coverage`, from the film. `taken(i)` is the number of samples pixel `i` took. With
 /// `counted`, a pixel's count is the samples whose camera ray hit: the mean is over all samples

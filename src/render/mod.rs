@@ -10,6 +10,7 @@ pub mod instancing;
 mod lights;
 mod load;
 mod megakernel;
+pub mod multi_device;
 mod nodes;
 mod readback;
 mod sah;

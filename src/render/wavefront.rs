@@ -78,6 +78,19 @@ impl RenderStats {
     pub fn kernel_ms(&self) -> f64 {
         self.stage_ms.iter().map(|(_, ms)| ms).sum()
     }
+
+    /// Adds `other`'s counts and stage times: the work of two devices' renders.
+    pub fn add(&mut self, other: &RenderStats) {
+        self.extension_rays += other.extension_rays;
+        self.shadow_rays += other.shadow_rays;
+        self.nonfinite_samples += other.nonfinite_samples;
+        self.stack_overflows += other.stack_overflows;
+        for (i, (_, ms)) in other.stage_ms.iter().enumerate() {
+            if *ms > 0.0 {
+                self.stage_ms.add(Stage::ALL[i], *ms);
+            }
+        }
+    }
 }
 
 /// Per-resolution device buffers.

@@ -377,6 +377,25 @@ pub fn penumbra_env(args: &[&str], env: &[(&str, &str)]) -> Output {
         .expect("the penumbra binary runs")
 }
 
+/// The bits of every channel of an EXR's first layer, by channel name.
+pub fn channel_bits(path: &Path) -> Vec<(String, Vec<u32>)> {
+    use exr::prelude::*;
+    penumbra::image_io::read_exr_layer(path)
+        .unwrap()
+        .channel_data
+        .list
+        .iter()
+        .map(|c| {
+            let bits = match &c.sample_data {
+                FlatSamples::F32(v) => v.iter().map(|x| x.to_bits()).collect(),
+                FlatSamples::U32(v) => v.clone(),
+                FlatSamples::F16(v) => v.iter().map(|x| u32::from(x.to_bits())).collect(),
+            };
+            (c.name.to_string(), bits)
+        })
+        .collect()
+}
+
 /// Runs a render and returns (the JSON summary, the linear image).
 pub fn render_exr(scene: &Path, out: &Path, extra: &[&str]) -> (Value, Vec<[f32; 3]>) {
     render_exr_env(scene, out, extra, &[])
