@@ -136,6 +136,12 @@ impl Bvh {
         self.sah_cost = self.sah();
     }
 
+    /// Whether refits have taken the SAH cost to [`REFIT_MAX_GROWTH`] times the cost of the
+    /// last full build or more: the tree should be built again.
+    pub fn needs_rebuild(&self) -> bool {
+        self.sah_cost >= REFIT_MAX_GROWTH * self.built_sah_cost
+    }
+
     /// Refits for `triangles`, and builds the tree again when the refit left its SAH cost at
     /// [`REFIT_MAX_GROWTH`] times the cost of the last full build or more.
     pub fn refit_or_rebuild(&mut self, triangles: &[[Vec3; 3]]) -> Update {
@@ -155,7 +161,7 @@ impl Bvh {
             "a refit needs the triangles the tree was built over"
         );
         self.refit_with(&corners);
-        if self.sah_cost < REFIT_MAX_GROWTH * self.built_sah_cost {
+        if !self.needs_rebuild() {
             return Update::Refitted;
         }
         let triangles: Vec<[Vec3; 3]> = (0..count).into_par_iter().map(&corners).collect();

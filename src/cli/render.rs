@@ -102,14 +102,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         // Each later frame: the scene posed anew and brought up to date on the renderer (the
         // film restarts, the seed stays).
         let mut update_ms = None;
+        let mut update = None;
         if k > 0
             && let Some(c) = clip
         {
             let t = Instant::now();
             let applied = animate::pose(&mut prepared, c, frame.time.unwrap_or(0.0));
-            renderer.update_scene(&prepared.scene, &prepared.lights, applied.deformed > 0)?;
+            let u =
+                renderer.update_scene(&prepared.scene, &prepared.lights, applied.deformed > 0)?;
             renderer.set_camera(&prepared.camera)?;
             update_ms = Some(t.elapsed().as_secs_f64() * 1e3);
+            update = Some(u.kind);
         }
         let output = match output.take() {
             Some(first) => first,
@@ -121,6 +124,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "time": clip.map(|_| frame.time.unwrap_or(0.0)),
             "frame": frame.number,
             "scene_update_ms": update_ms,
+            "scene_update": update,
         });
         render_frame(
             args,

@@ -12,6 +12,7 @@ mod load;
 mod megakernel;
 mod nodes;
 mod readback;
+mod refit;
 mod sah;
 mod settings;
 pub mod strategy;
@@ -28,7 +29,7 @@ pub use megakernel::{Band, KernelChoice};
 pub use readback::Aovs;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
-pub use update::{InstanceUpdate, SceneUpdate};
+pub use update::{InstanceUpdate, SceneUpdate, UpdateKind};
 pub use upload::{Accel, HostScene, gpu_camera, gpu_material, samples_textures};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
