@@ -97,6 +97,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         scene_stats,
         started,
         denoiser,
+        clip,
     };
     for (k, frame) in frames.iter().enumerate() {
         // Each later frame: the scene posed anew and brought up to date on the renderer (the
@@ -125,12 +126,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "frame": frame.number,
             "scene_update_ms": update_ms,
             "scene_update": update,
+            "shutter": args.animation.shutter.unwrap_or(0.0),
         });
         render_frame(
             args,
             &mut setup,
             &mut renderer,
-            &prepared,
+            &mut prepared,
             frame,
             output,
             animation,
@@ -147,6 +149,27 @@ struct Setup {
     started: Instant,
     /// With `--denoise`: the denoiser and the milliseconds its kernels and weights took to load.
     denoiser: Option<(Denoiser, f64)>,
+    /// The clip played, if any.
+    clip: Option<usize>,
+}
+
+/// Poses `prepared` at `time` of `clip` and brings the renderer up to date, keeping its film
+/// when `held` (a shutter's later poses).
+fn shutter_pose(
+    renderer: &mut Renderer,
+    prepared: &mut Prepared,
+    clip: usize,
+    time: f64,
+    held: bool,
+) -> Result<()> {
+    let applied = animate::pose(prepared, clip, time);
+    renderer.hold_film(held);
+    let updated = renderer
+        .update_scene(&prepared.scene, &prepared.lights, applied.deformed > 0)
+        .and_then(|_| renderer.set_camera(&prepared.camera));
+    renderer.hold_film(false);
+    updated?;
+    Ok(())
 }
 
 /// Renders the loaded scene, writes `frame`'s image to `output` and prints its summary line
@@ -155,17 +178,29 @@ fn render_frame(
     args: &RenderArgs,
     setup: &mut Setup,
     renderer: &mut Renderer,
-    prepared: &Prepared,
+    prepared: &mut Prepared,
     frame: &Frame,
     output: OutputFile,
     animation: serde_json::Value,
 ) -> Result<()> {
+    // The shutter's poses (one without --shutter), each rendering its share of the samples
+    // into the same film.
+    let poses = match setup.clip {
+        Some(_) => args
+            .animation
+            .shutter_poses(frame.time.unwrap_or(0.0), setup.spp),
+        None => vec![(0.0, setup.spp)],
+    };
+    if let (Some(c), [first, _, ..]) = (setup.clip, &poses[..]) {
+        shutter_pose(renderer, prepared, c, first.0, false)?;
+    }
     let Setup {
         settings,
         spp,
         scene_stats,
         started,
         denoiser,
+        clip,
     } = setup;
     let spp = *spp;
     let bar = ProgressBar::new(spp as u64).with_style(
@@ -184,7 +219,15 @@ fn render_frame(
     let mut done = 0;
     // The fewest samples a call first, then calls sized by the time a sample took.
     let mut chunk = MIN_SAMPLES_PER_CALL;
+    let (mut pose, mut pose_end) = (0, poses[0].1);
     while done < spp {
+        if done == pose_end
+            && let (Some(c), Some(&(time, samples))) = (*clip, poses.get(pose + 1))
+        {
+            pose += 1;
+            pose_end += samples;
+            shutter_pose(renderer, prepared, c, time, true)?;
+        }
         // The last check left no pixel active: more samples would add nothing.
         if renderer.active_pixels() == Some(0) {
             break;
@@ -195,7 +238,7 @@ fn render_frame(
         {
             break;
         }
-        let mut n = chunk.min(spp - done);
+        let mut n = chunk.min(spp - done).min(pose_end - done);
         if let Some(limit) = args.time_limit {
             // The call sized to end near the limit, at a sample's time measured so far.
             let left = limit - start.elapsed().as_secs_f64();
