@@ -31,7 +31,7 @@ pub struct AnimationArgs {
     pub fps: Option<f32>,
     /// Motion blur: the shutter stays open this many seconds from each image's instant, the
     /// samples spread over the poses in between (default: 0, no blur).
-    #[arg(long, value_parser = parse_shutter)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_shutter)]
     pub shutter: Option<f64>,
 }
 
@@ -125,7 +125,7 @@ impl AnimationArgs {
         let source = &prepared.scene.source;
         if animation.clips.is_empty() {
             bail!(
-                "{source}: --time, --clip and --frames need a scene with animations; it has none"
+                "{source}: --time, --clip, --frames and --shutter need a scene with animations; it has none"
             );
         }
         match &self.clip {
