@@ -767,3 +767,208 @@ fn a_sequence_renders_each_frame_as_its_instant() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("0 'move'"));
 }
+
+/// A glowing bar (x from -0.3 to 0.3) that the clip "slide" moves along +x by 0.6 a second
+/// for 2 s (LINEAR), seen straight on from z = 3 against black, with no other light.
+fn sliding_bar() -> Gltf {
+    let mut g = Gltf::default();
+    let glow = g.lambert([0.0; 3], [1.0; 3], 1.0, false);
+    let (bar, bar_idx) = cuboid([-0.3, -0.2, -0.1], [0.3, 0.2, 0.1]);
+    let b = g.mesh(vec![Prim::triangles(bar, bar_idx, glow)]);
+    g.node(json!({"mesh": b}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [0.3, 0.0, 3.0]}));
+    let times = scalars(&mut g, &[0.0, 2.0]);
+    let moves = g.float_accessor(&[[0.0, 0.0, 0.0], [1.2, 0.0, 0.0]]);
+    g.extra.insert(
+        "animations".into(),
+        json!([{"name": "slide",
+            "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+            "samplers": [{"input": times, "output": moves}]}]),
+    );
+    g
+}
+
+/// The mean brightness of each column of the image's middle row band (64 × 48 pixels).
+fn column_profile(px: &[[f32; 3]]) -> Vec<f64> {
+    (0..64)
+        .map(|x| {
+            (20..28)
+                .map(|y| px[y * 64 + x].iter().map(|&c| f64::from(c)).sum::<f64>())
+                .sum::<f64>()
+                / 8.0
+        })
+        .collect()
+}
+
+/// The first and last columns brighter than `level`.
+fn lit_extent(profile: &[f64], level: f64) -> (usize, usize) {
+    let lit: Vec<usize> = (0..profile.len()).filter(|&x| profile[x] > level).collect();
+    (lit[0], *lit.last().unwrap())
+}
+
+/// With `--shutter 0.5` the bar (travelling half its width) is smeared from where it is at
+/// 0 s to where it is at 0.5 s: the
+/// blurred image is lit from the left edge of the first pose to the right edge of the last,
+/// the columns the bar only crosses lie between black and its full brightness and fall off
+/// across the travel, and the columns it covers all along are as bright as the still bar.
+/// `--shutter 0` is the render without a shutter, bit for bit.
+#[test]
+fn a_shutter_smears_a_moving_bar_between_its_start_and_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = sliding_bar().write_glb(dir.path(), "bar");
+    let opts = |extra: &[&str]| -> Vec<String> {
+        let mut v: Vec<String> = [
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--spp",
+            "32",
+            "--background",
+            "0,0,0",
+            "--env",
+            "none",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        v.extend(extra.iter().map(|s| s.to_string()));
+        v
+    };
+    let run = |name: &str, extra: &[&str]| {
+        let o = opts(extra);
+        let o: Vec<&str> = o.iter().map(String::as_str).collect();
+        common::render_exr(&scene, &dir.path().join(name), &o)
+    };
+    let (_, start) = run("start.exr", &["--time", "0"]);
+    let (_, end) = run("end.exr", &["--time", "0.5"]);
+    let (summary, blur) = run("blur.exr", &["--time", "0", "--shutter", "0.5"]);
+    assert_eq!(summary["shutter"], 0.5);
+    let (start, end, blur) = (
+        column_profile(&start),
+        column_profile(&end),
+        column_profile(&blur),
+    );
+    let full = start.iter().copied().fold(0.0, f64::max);
+    let level = 0.02 * full;
+    let (a0, a1) = lit_extent(&start, level);
+    let (b0, b1) = lit_extent(&end, level);
+    let (s0, s1) = lit_extent(&blur, level);
+    eprintln!("start {a0}..{a1}, end {b0}..{b1}, blurred {s0}..{s1}");
+    assert!(
+        b0 > a0 + 5 && b0 + 4 < a1,
+        "the bar moves half its width: {a0}..{a1} -> {b0}..{b1}"
+    );
+    assert!(
+        s0.abs_diff(a0) <= 1 && s1.abs_diff(b1) <= 1,
+        "smeared {s0}..{s1}"
+    );
+    // Covered all along (lit at the start and at the end): as bright as the still bar.
+    let covered: Vec<f64> = blur[b0 + 1..a1].iter().map(|b| b / full).collect();
+    assert!(covered.iter().all(|f| (f - 1.0).abs() < 0.1), "{covered:?}");
+    // Crossed only: partly lit, less the further right (the bar arrives later).
+    let crossed: Vec<f64> = blur[a1 + 2..b1 - 1].iter().map(|b| b / full).collect();
+    assert!(crossed.len() >= 4, "{crossed:?}");
+    assert!(crossed.iter().all(|&f| f > 0.03 && f < 0.97), "{crossed:?}");
+    assert!(crossed[0] > crossed[crossed.len() - 1] + 0.3, "{crossed:?}");
+    // A shutter of 0 is no shutter.
+    run("none.exr", &["--time", "0.5"]);
+    run("zero.exr", &["--time", "0.5", "--shutter", "0"]);
+    assert!(
+        std::fs::read(dir.path().join("none.exr")).unwrap()
+            == std::fs::read(dir.path().join("zero.exr")).unwrap()
+    );
+}
+
+/// Frames of the Fox after the first are brought up to date by refitting the flat BVH (the
+/// summary says so), and each is bit for bit the single render of its instant, which loads
+/// the pose afresh and builds its BVH anew (same seed, same device).
+#[test]
+fn the_foxs_refitted_frames_are_its_fresh_renders() {
+    let Some(scenes) = scenes_dir() else {
+        eprintln!("skipped: PENUMBRA_SCENES is not set");
+        return;
+    };
+    let fox = scenes.join("Fox/Fox.glb");
+    let dir = tempfile::tempdir().unwrap();
+    let pattern = dir.path().join("fox_#.exr");
+    let lines = render(
+        &fox,
+        &pattern,
+        &["--frames", "2..4", "--fps", "5", "--clip", "Run"],
+    );
+    assert_eq!(lines[0]["scene_update"], Value::Null);
+    for line in &lines[1..] {
+        assert_eq!(line["scene_update"], "refitted", "{line}");
+    }
+    for frame in [3, 4] {
+        let single = dir.path().join(format!("single_{frame}.exr"));
+        let time = format!("{}", f64::from(frame) / 5.0);
+        render(&fox, &single, &["--time", &time, "--clip", "Run"]);
+        assert!(
+            std::fs::read(dir.path().join(format!("fox_{frame}.exr"))).unwrap()
+                == std::fs::read(&single).unwrap(),
+            "frame {frame} differs from its fresh render"
+        );
+    }
+}
+
+/// A morph target that stretches a row of small triangles to half again its length, every
+/// other one sliding 1 along it: the refitted BVH's leaves and nodes then span the stretch,
+/// its cost passes the bound and the frame is built again ("rebuilt"), while a stretch of a
+/// thousandth stays a refit; both frames render as their fresh loads do.
+#[test]
+fn a_stretching_pose_rebuilds_the_bvh_past_the_refit_bound() {
+    let mut g = Gltf::default();
+    let white = g.lambert([0.7; 3], [0.0; 3], 1.0, false);
+    // 200 small triangles in a row along x (0.01 apart); the target slides every other one
+    // by 1 along x.
+    let (mut positions, mut indices, mut slide) = (vec![], vec![], vec![]);
+    for i in 0..200u32 {
+        let x = i as f32 * 0.01;
+        positions.extend([[x, 0.0, 0.0], [x + 0.008, 0.0, 0.0], [x, 0.3, 0.0]]);
+        indices.extend([3 * i, 3 * i + 1, 3 * i + 2]);
+        let dx = if i % 2 == 0 { 0.0 } else { 1.0 };
+        slide.extend([[dx, 0.0, 0.0]; 3]);
+    }
+    let m = g.mesh(vec![Prim::triangles(positions, indices, white)]);
+    let target = g.float_accessor(&slide);
+    g.meshes[m]["primitives"][0]["targets"] = json!([{"POSITION": target}]);
+    g.node(json!({"mesh": m, "weights": [0.0]}));
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 1.2, "znear": 0.01}}));
+    g.node(json!({"camera": 0, "translation": [1.0, 2.0, 8.0]}));
+    g.lights
+        .push(json!({"type": "point", "intensity": 300.0, "color": [1.0, 1.0, 1.0]}));
+    g.node(json!({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [1.0, 3.0, 4.0]}));
+    // Weight 0 at 0 s, 0.001 at 1 s (a slide of 0.001: a refit), 1 from 2 s (the clip lasts
+    // 3 s, so that 2 s does not wrap to its start).
+    let times = scalars(&mut g, &[0.0, 1.0, 2.0, 3.0]);
+    let weights = scalars(&mut g, &[0.0, 0.001, 1.0, 1.0]);
+    g.extra.insert(
+        "animations".into(),
+        json!([{"name": "stretch",
+            "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}],
+            "samplers": [{"input": times, "output": weights}]}]),
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let scene = g.write_glb(dir.path(), "strip");
+    let lines = render(
+        &scene,
+        &dir.path().join("s_#.exr"),
+        &["--frames", "0..2", "--fps", "1"],
+    );
+    assert_eq!(lines[1]["scene_update"], "refitted");
+    assert_eq!(lines[2]["scene_update"], "rebuilt");
+    for frame in [1, 2] {
+        let single = dir.path().join(format!("single_{frame}.exr"));
+        render(&scene, &single, &["--time", &frame.to_string()]);
+        assert!(
+            std::fs::read(dir.path().join(format!("s_{frame}.exr"))).unwrap()
+                == std::fs::read(&single).unwrap(),
+            "frame {frame} differs from its fresh render"
+        );
+    }
+}

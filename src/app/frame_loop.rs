@@ -580,19 +580,26 @@ impl FrameLoop {
         }
         // Rebase the render space around the eye when the camera travelled far from its origin.
         let far = self.loaded && self.renderer.space().is_far(world.camera.eye);
-        // Objects moved, hidden or shown in a two-level scene (a scene change alone: a new file
-        // comes with new lights and settings too): new instance transforms and a new TLAS,
-        // written in place; the overlay's "BVH rebuild" shows that update's time. Anything else
-        // (other geometry, a flat BVH) reloads the scene.
+        // Objects moved, hidden or shown, or a new pose of the animation (a scene change alone:
+        // a new file comes with new lights and settings too): `Renderer::update_scene`, as
+        // `render --frames` does: moved instances of a two-level scene, a flat BVH refitted
+        // with what changed written in place, or a reload; the overlay shows its BVH and
+        // upload times.
         let moved = if pending.scene && self.loaded && !far && !pending.lights && !pending.settings
         {
-            self.renderer.move_instances(world.scene)?
+            let animation = &world.scene.animation;
+            let deformed = animation.objects.iter().any(|d| d.rig.is_some());
+            Some(
+                self.renderer
+                    .update_scene(world.scene, world.lights, deformed)?,
+            )
         } else {
             None
         };
         if let Some(update) = moved {
             if let Some(stats) = self.scene_stats.as_mut() {
-                stats.bvh_build_ms = update.ms;
+                stats.bvh_build_ms = update.bvh_ms;
+                stats.upload_ms = update.flatten_ms + update.upload_ms;
             }
         } else if pending.scene || !self.loaded || far {
             let mut space = RenderFrame::around(&world.scene.bounds());

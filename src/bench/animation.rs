@@ -1,15 +1,15 @@
-//! `penumbra bench animation SCENE`: the host's per-frame scene update of an animated scene,
-//! stage by stage: evaluating the clip (node transforms, joint matrices), deforming the
-//! skinned and morphed meshes, refitting their BVHs from the vertices (a full build when the
-//! refit tree's SAH cost has doubled) and rebuilding the top level over every object. Frames step through the
+//! `penumbra bench animation SCENE`: the per-frame scene update of an animated scene on the
+//! renderer, stage by stage: evaluating the clip (node transforms, joint matrices), deforming
+//! the skinned and morphed meshes (skin/morph), flattening the posed triangles into render
+//! space, the BVH work (a flat scene's refit, or the build of a rebuild or reload; two levels'
+//! TLAS) and the upload of what changed (`Renderer::update_scene`). Frames step through the
 //! clip at `--fps`; the first (warm-up) is discarded.
 
-use crate::bvh::{Blas, Bvh, TwoLevel, Update, build};
+use crate::args::DeviceArgs;
+use crate::render::{RenderSettings, Renderer, UpdateKind};
 use crate::scene::load;
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::Args;
-use glam::Vec3;
-use rayon::prelude::*;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -27,6 +27,9 @@ pub struct AnimationBenchArgs {
     /// Frames a second: frame n is at n / fps seconds (looping).
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
+    /// The OpenCL device the scene is updated on.
+    #[command(flatten)]
+    pub device: DeviceArgs,
 }
 
 /// Milliseconds of each stage, per frame.
@@ -34,8 +37,9 @@ pub struct AnimationBenchArgs {
 struct Stages {
     evaluate: Vec<f64>,
     deform: Vec<f64>,
-    refit: Vec<f64>,
-    tlas: Vec<f64>,
+    flatten: Vec<f64>,
+    bvh: Vec<f64>,
+    upload: Vec<f64>,
     total: Vec<f64>,
 }
 
@@ -55,92 +59,63 @@ pub fn run(args: &AnimationBenchArgs) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("{}: --clip: {e}", args.scene.display()))?,
         None => 0,
     };
-    let deforming: Vec<usize> = animation
-        .objects
-        .iter()
-        .filter(|d| d.rig.is_some())
-        .map(|d| d.object)
-        .collect();
-    let triangles = |scene: &crate::scene::Scene, o: usize| -> Vec<[Vec3; 3]> {
-        let m = &scene.objects[o].mesh;
-        m.indices
-            .par_iter()
-            .map(|t| t.map(|i| m.positions[i as usize]))
-            .collect()
-    };
-    // Each deforming mesh's BVH, and a top level over every object.
-    let mut trees: Vec<Bvh> = deforming
-        .iter()
-        .map(|&o| build(&triangles(&scene, o)))
-        .collect();
-    let blases: Vec<Blas> = scene
-        .objects
-        .iter()
-        .map(|o| Blas::of_mesh(&o.mesh.positions, &o.mesh.indices))
-        .collect();
-    let instances: Vec<(u32, glam::DMat4)> = scene
-        .objects
-        .iter()
-        .enumerate()
-        .map(|(i, o)| (i as u32, o.world_from_object))
-        .collect();
-    let mut two = TwoLevel::from_blases(blases, &instances);
+    let mut renderer = Renderer::new(&args.device.device_choice()?)?;
+    renderer.set_settings(&RenderSettings {
+        width: 64,
+        height: 64,
+        ..RenderSettings::default()
+    })?;
+    let lights = scene.lights.clone();
+    let loaded = renderer
+        .load_scene(&scene, &lights)
+        .with_context(|| args.scene.display().to_string())?;
     let mut stages = Stages::default();
-    let mut rebuilds = 0;
+    let mut kinds: std::collections::BTreeMap<String, u32> = Default::default();
+    let mut bytes = 0usize;
     for frame in 0..=args.frames {
         let started = Instant::now();
         let t = animation.clip_time(clip, f64::from(frame) / args.fps, true);
         let applied = animation.apply(&mut scene, Some(clip), t);
-        let refitting = Instant::now();
-        let updates: Vec<Update> = trees
-            .iter_mut()
-            .zip(&deforming)
-            .map(|(tree, &o)| {
-                let m = &scene.objects[o].mesh;
-                tree.refit_or_rebuild_with(m.indices.len(), |t| {
-                    m.indices[t].map(|i| m.positions[i as usize])
-                })
-            })
-            .collect();
-        let refit_ms = refitting.elapsed().as_secs_f64() * 1e3;
-        let top = Instant::now();
-        for (i, o) in scene.objects.iter().enumerate() {
-            two.place(i, o.world_from_object);
-        }
-        two.rebuild_tlas();
-        let tlas_ms = top.elapsed().as_secs_f64() * 1e3;
+        let update = renderer.update_scene(&scene, &lights, applied.deformed > 0)?;
         if frame == 0 {
             continue;
         }
-        rebuilds += updates.iter().filter(|&&u| u == Update::Rebuilt).count();
+        *kinds.entry(kind_name(update.kind).into()).or_default() += 1;
+        bytes += update.bytes;
         stages.evaluate.push(applied.evaluate_ms);
         stages.deform.push(applied.deform_ms);
-        stages.refit.push(refit_ms);
-        stages.tlas.push(tlas_ms);
+        stages.flatten.push(update.flatten_ms);
+        stages.bvh.push(update.bvh_ms);
+        stages.upload.push(update.upload_ms);
         stages.total.push(started.elapsed().as_secs_f64() * 1e3);
     }
-    let deformed_triangles: usize = deforming
+    let deformed_triangles: usize = animation
+        .objects
         .iter()
-        .map(|&o| scene.objects[o].mesh.indices.len())
+        .filter(|d| d.rig.is_some())
+        .map(|d| scene.objects[d.object].mesh.indices.len())
         .sum();
     let threads = rayon::current_num_threads();
     let cpu = cpu_name();
+    let device = renderer.device.description();
     println!(
-        "{}: clip '{}' ({:.2} s), {} objects, {deformed_triangles} deformed triangles, \
-         {} frames at {} fps, {threads} threads on {cpu}",
+        "{}: clip '{}' ({:.2} s), {} objects, {deformed_triangles} deformed triangles, {} BVH, \
+         {} frames at {} fps, {threads} threads on {cpu}, device {device}",
         args.scene.display(),
         animation.clips[clip].name,
         animation.clips[clip].duration,
         scene.objects.len(),
+        loaded.bvh,
         args.frames,
         args.fps,
     );
     println!("| stage | mean ms | max ms |\n|---|---|---|");
     let rows = [
         ("evaluate", &stages.evaluate),
-        ("deform", &stages.deform),
-        ("refit/rebuild", &stages.refit),
-        ("top level", &stages.tlas),
+        ("skin/morph", &stages.deform),
+        ("flatten", &stages.flatten),
+        ("refit/rebuild", &stages.bvh),
+        ("upload", &stages.upload),
         ("total", &stages.total),
     ];
     let mut json = serde_json::json!({
@@ -149,9 +124,13 @@ pub fn run(args: &AnimationBenchArgs) -> Result<()> {
         "frames": args.frames,
         "objects": scene.objects.len(),
         "deformed_triangles": deformed_triangles,
-        "rebuilds": rebuilds,
+        "bvh": loaded.bvh,
+        "updates": kinds,
+        "bytes_per_frame": bytes / args.frames.max(1) as usize,
         "threads": threads,
         "cpu": cpu,
+        "device": device,
+        "date": crate::date::today(),
     });
     for (name, values) in rows {
         let mean = values.iter().sum::<f64>() / values.len().max(1) as f64;
@@ -159,8 +138,22 @@ pub fn run(args: &AnimationBenchArgs) -> Result<()> {
         println!("| {name} | {mean:.3} | {max:.3} |");
         json[format!("{}_ms", name.replace(['/', ' '], "_"))] = serde_json::json!(mean);
     }
+    println!(
+        "updates: {kinds:?}, {:.1} MB written a frame",
+        bytes as f64 / 1e6 / args.frames.max(1) as f64
+    );
     println!("{json}");
     Ok(())
+}
+
+/// The update's name in the table and the JSON.
+fn kind_name(kind: UpdateKind) -> &'static str {
+    match kind {
+        UpdateKind::Moved => "moved",
+        UpdateKind::Refitted => "refitted",
+        UpdateKind::Rebuilt => "rebuilt",
+        UpdateKind::Reloaded => "reloaded",
+    }
 }
 
 /// The host CPU's model name (Linux), else "unknown CPU".

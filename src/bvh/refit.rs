@@ -3,7 +3,7 @@
 //! made it too slow to traverse.
 
 use super::sah_split::TRAVERSAL_COST;
-use super::{Aabb, Bvh, Child, build};
+use super::{Aabb, Bvh, Child, WideBvh, build};
 use crate::cl::types::DeviceBvhNode;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -136,6 +136,12 @@ impl Bvh {
         self.sah_cost = self.sah();
     }
 
+    /// Whether refits have taken the SAH cost to [`REFIT_MAX_GROWTH`] times the cost of the
+    /// last full build or more: the tree should be built again.
+    pub fn needs_rebuild(&self) -> bool {
+        self.sah_cost >= REFIT_MAX_GROWTH * self.built_sah_cost
+    }
+
     /// Refits for `triangles`, and builds the tree again when the refit left its SAH cost at
     /// [`REFIT_MAX_GROWTH`] times the cost of the last full build or more.
     pub fn refit_or_rebuild(&mut self, triangles: &[[Vec3; 3]]) -> Update {
@@ -155,12 +161,43 @@ impl Bvh {
             "a refit needs the triangles the tree was built over"
         );
         self.refit_with(&corners);
-        if self.sah_cost < REFIT_MAX_GROWTH * self.built_sah_cost {
+        if !self.needs_rebuild() {
             return Update::Refitted;
         }
         let triangles: Vec<[Vec3; 3]> = (0..count).into_par_iter().map(&corners).collect();
         *self = build(&triangles);
         Update::Rebuilt
+    }
+}
+
+impl WideBvh {
+    /// Recomputes every box for `ordered` (the triangles in BVH order, as its leaves name
+    /// them), keeping the tree: leaves' boxes first, all at once, then interior boxes from
+    /// the back (a node's children come after it).
+    pub fn refit(&mut self, ordered: &[[Vec3; 3]]) {
+        self.nodes.par_iter_mut().for_each(|node| {
+            for slot in 0..4 {
+                if node.count[slot] > 0 {
+                    let first = !node.child[slot] as usize;
+                    let b = ordered[first..first + node.count[slot] as usize]
+                        .iter()
+                        .flatten()
+                        .fold(Aabb::EMPTY, |b, &v| b.grow(v));
+                    super::wide::set_box(node, slot, b);
+                }
+            }
+        });
+        for index in (0..self.nodes.len()).rev() {
+            for slot in 0..4 {
+                let node = &self.nodes[index];
+                if node.count[slot] == 0 && node.child[slot] > 0 {
+                    let b = self
+                        .children(node.child[slot] as u32)
+                        .fold(Aabb::EMPTY, |b, (c, _)| b.union(c));
+                    super::wide::set_box(&mut self.nodes[index], slot, b);
+                }
+            }
+        }
     }
 }
 
@@ -245,6 +282,49 @@ mod tests {
         for ray in super::super::build::tests::random_rays(500, 17) {
             let x = bvh.intersect(&ray, &a).map(|h| h.t);
             let y = fresh.intersect(&ray, &b).map(|h| h.t);
+            assert_eq!(x, y, "{ray:?}");
+        }
+    }
+
+    #[test]
+    fn a_refitted_wide_tree_holds_every_moved_triangle_and_finds_the_same_hits() {
+        let tris = random_triangles(5000, 7);
+        let bvh = build(&tris);
+        let order = |t: &[[Vec3; 3]]| -> Vec<[Vec3; 3]> {
+            bvh.tri_indices.iter().map(|&i| t[i as usize]).collect()
+        };
+        let mut wide = WideBvh::collapse_for_cpu(&bvh);
+        let mut same = wide.clone();
+        same.refit(&order(&tris));
+        assert!(same.nodes.iter().zip(&wide.nodes).all(|(a, b)| a == b));
+        let moved_flat: Vec<[Vec3; 3]> = tris
+            .iter()
+            .map(|t| t.map(|v| v + Vec3::new((v.y * 2.3).sin(), 0.0, (v.x * 1.1).cos()) * 0.4))
+            .collect();
+        let moved = order(&moved_flat);
+        wide.refit(&moved);
+        // Every leaf's box holds its triangles, every node's box its children's.
+        for node in 0..wide.nodes.len() as u32 {
+            for (b, child) in wide.children(node) {
+                let inner = match child {
+                    Child::Leaf { first, count } => moved[first as usize..(first + count) as usize]
+                        .iter()
+                        .flatten()
+                        .fold(Aabb::EMPTY, |b, &v| b.grow(v)),
+                    Child::Node(n) => wide.children(n).fold(Aabb::EMPTY, |b, (c, _)| b.union(c)),
+                };
+                assert_eq!(b.union(inner), b, "node {node}");
+            }
+        }
+        let fresh = build(&moved_flat);
+        let fresh_order: Vec<[Vec3; 3]> = fresh
+            .tri_indices
+            .iter()
+            .map(|&i| moved_flat[i as usize])
+            .collect();
+        for ray in super::super::build::tests::random_rays(500, 3) {
+            let x = wide.intersect(&ray, &moved).map(|h| h.t);
+            let y = fresh.intersect(&ray, &fresh_order).map(|h| h.t);
             assert_eq!(x, y, "{ray:?}");
         }
     }

@@ -106,12 +106,7 @@ impl WideBvh {
             slots_of(binary, &mut slots);
             let mut out = DeviceWideNode::default();
             for (i, &(bounds, child)) in slots.iter().enumerate() {
-                out.min_x[i] = bounds.min.x;
-                out.min_y[i] = bounds.min.y;
-                out.min_z[i] = bounds.min.z;
-                out.max_x[i] = bounds.max.x;
-                out.max_y[i] = bounds.max.y;
-                out.max_z[i] = bounds.max.z;
+                set_box(&mut out, i, bounds);
                 match child {
                     Child::Leaf { first, count } => {
                         out.child[i] = !(first as i32);
@@ -441,6 +436,16 @@ pub fn frontier(bvh: &Bvh, binary: u32, width: usize, merge: u32) -> Vec<(Aabb, 
         slots.extend((0..2).map(|side| child(node, side)));
     }
     slots
+}
+
+/// Writes box `b` into slot `slot` of a wide node.
+pub(super) fn set_box(node: &mut DeviceWideNode, slot: usize, b: Aabb) {
+    node.min_x[slot] = b.min.x;
+    node.min_y[slot] = b.min.y;
+    node.min_z[slot] = b.min.z;
+    node.max_x[slot] = b.max.x;
+    node.max_y[slot] = b.max.y;
+    node.max_z[slot] = b.max.z;
 }
 
 #[cfg(test)]

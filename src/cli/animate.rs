@@ -29,7 +29,18 @@ pub struct AnimationArgs {
     /// Frames a second of --frames (default: 24).
     #[arg(long, value_parser = crate::args::parse_positive)]
     pub fps: Option<f32>,
+    /// Motion blur: the shutter stays open this many seconds from each image's instant, the
+    /// samples spread over the poses in between (default: 0, no blur).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_shutter)]
+    pub shutter: Option<f64>,
 }
+
+/// Poses a shutter interval is rendered at, at most (fewer with fewer samples a pixel): each
+/// pose renders its share of the samples into the same film, so the image is the average of
+/// the poses at the middles of [`SHUTTER_POSES`] equal parts of the interval. 16 keeps a
+/// blurred edge's steps within 1/16 of the way it travels (below the noise of a few hundred
+/// samples) for 16 scene updates a frame (the Fox: about 16 ms on 2 cores).
+pub const SHUTTER_POSES: u32 = 16;
 
 /// One image to render: its frame number (none for a single image), its instant on the clip's
 /// timeline and its file.
@@ -79,7 +90,29 @@ impl AnimationArgs {
 
     /// Whether any option asks for an animated instant.
     pub fn wanted(&self) -> bool {
-        self.time.is_some() || self.clip.is_some() || self.frames.is_some()
+        self.time.is_some() || self.clip.is_some() || self.frames.is_some() || self.blurs()
+    }
+
+    /// Whether the shutter stays open (`--shutter` above 0).
+    pub fn blurs(&self) -> bool {
+        self.shutter.is_some_and(|s| s > 0.0)
+    }
+
+    /// The shutter's poses for an image of `spp` samples a pixel starting at `time`: the
+    /// instant of each, and the samples each renders (the first ones one more); one pose at
+    /// `time` without a shutter.
+    pub fn shutter_poses(&self, time: f64, spp: u32) -> Vec<(f64, u32)> {
+        let open = self.shutter.unwrap_or(0.0);
+        if !self.blurs() || spp == 0 {
+            return vec![(time, spp)];
+        }
+        let k = SHUTTER_POSES.min(spp);
+        (0..k)
+            .map(|i| {
+                let t = time + open * (f64::from(i) + 0.5) / f64::from(k);
+                (t, spp / k + u32::from(i < spp % k))
+            })
+            .collect()
     }
 
     /// The clip to play in `prepared`'s scene; `None` when nothing asks for one. Errors when
@@ -92,7 +125,7 @@ impl AnimationArgs {
         let source = &prepared.scene.source;
         if animation.clips.is_empty() {
             bail!(
-                "{source}: --time, --clip and --frames need a scene with animations; it has none"
+                "{source}: --time, --clip, --frames and --shutter need a scene with animations; it has none"
             );
         }
         match &self.clip {
@@ -158,6 +191,16 @@ fn parse_time(s: &str) -> Result<f64, String> {
     }
 }
 
+/// A shutter interval in seconds: a finite number ≥ 0.
+fn parse_shutter(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!(
+            "'{s}' is not a shutter interval in seconds (a number >= 0)"
+        )),
+    }
+}
+
 /// `A..B`, frame numbers with A ≤ B.
 fn parse_range(s: &str) -> Result<(u32, u32), String> {
     let bad = || format!("'{s}' is not a frame range A..B (0..47)");
@@ -200,5 +243,24 @@ mod tests {
         assert_eq!(frames[2].time, Some(0.4));
         let err = args.frames(Path::new("out.png")).unwrap_err();
         assert!(err.to_string().contains("needs #s"), "{err}");
+    }
+
+    #[test]
+    fn a_shutter_spreads_the_samples_over_poses_at_the_middles_of_its_parts() {
+        let open = |shutter| AnimationArgs {
+            shutter: Some(shutter),
+            ..AnimationArgs::default()
+        };
+        assert_eq!(open(0.0).shutter_poses(1.0, 64), vec![(1.0, 64)]);
+        assert!(!open(0.0).wanted());
+        let poses = open(0.5).shutter_poses(1.0, 37);
+        assert_eq!(poses.len(), SHUTTER_POSES as usize);
+        assert_eq!(poses.iter().map(|p| p.1).sum::<u32>(), 37);
+        assert_eq!((poses[0].1, poses[15].1), (3, 2));
+        assert!((poses[0].0 - (1.0 + 0.5 / 32.0)).abs() < 1e-12);
+        assert!((poses[15].0 - (1.5 - 0.5 / 32.0)).abs() < 1e-12);
+        // Fewer samples than poses: one sample a pose.
+        assert_eq!(open(1.0).shutter_poses(0.0, 4).len(), 4);
+        assert!(parse_shutter("-1").is_err() && parse_shutter("nan").is_err());
     }
 }

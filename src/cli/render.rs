@@ -115,21 +115,30 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         scene_stats,
         started,
         denoiser,
+        clip,
     };
     for (k, frame) in frames.iter().enumerate() {
         // Each later frame: the scene posed anew and brought up to date on the renderer (the
         // film restarts, the seed stays).
         let mut update_ms = None;
+        let mut update = None;
         if k > 0
             && let Some(c) = clip
         {
             let t = Instant::now();
             let applied = animate::pose(&mut prepared, c, frame.time.unwrap_or(0.0));
+            let mut kinds = Vec::new();
             for renderer in &mut renderers {
-                renderer.update_scene(&prepared.scene, &prepared.lights, applied.deformed > 0)?;
+                let u = renderer.update_scene(
+                    &prepared.scene,
+                    &prepared.lights,
+                    applied.deformed > 0,
+                )?;
                 renderer.set_camera(&prepared.camera)?;
+                kinds.push(u.kind);
             }
             update_ms = Some(t.elapsed().as_secs_f64() * 1e3);
+            update = kinds.first().copied();
         }
         let output = match output.take() {
             Some(first) => first,
@@ -141,12 +150,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "time": clip.map(|_| frame.time.unwrap_or(0.0)),
             "frame": frame.number,
             "scene_update_ms": update_ms,
+            "scene_update": update,
+            "shutter": args.animation.shutter.unwrap_or(0.0),
         });
         render_frame(
             args,
             &mut setup,
             &mut renderers,
-            &prepared,
+            &mut prepared,
             frame,
             output,
             animation,
@@ -172,6 +183,7 @@ fn device_choices(args: &RenderArgs) -> Result<Vec<DeviceChoice>> {
             (args.noise_threshold.is_some(), "--noise-threshold"),
             (args.aovs, "--aovs"),
             (args.denoise, "--denoise"),
+            (args.animation.shutter.is_some_and(|s| s > 0.0), "--shutter"),
         ] {
             if given {
                 return Err(super::UsageError(format!(
@@ -197,6 +209,27 @@ struct Setup {
     started: Instant,
     /// With `--denoise`: the denoiser and the milliseconds its kernels and weights took to load.
     denoiser: Option<(Denoiser, f64)>,
+    /// The clip played, if any.
+    clip: Option<usize>,
+}
+
+/// Poses `prepared` at `time` of `clip` and brings the renderer up to date, keeping its film
+/// when `held` (a shutter's later poses).
+fn shutter_pose(
+    renderer: &mut Renderer,
+    prepared: &mut Prepared,
+    clip: usize,
+    time: f64,
+    held: bool,
+) -> Result<()> {
+    let applied = animate::pose(prepared, clip, time);
+    renderer.hold_film(held);
+    let updated = renderer
+        .update_scene(&prepared.scene, &prepared.lights, applied.deformed > 0)
+        .and_then(|_| renderer.set_camera(&prepared.camera));
+    renderer.hold_film(false);
+    updated?;
+    Ok(())
 }
 
 /// Renders the loaded scene, writes `frame`'s image to `output` and prints its summary line
@@ -205,17 +238,29 @@ fn render_frame(
     args: &RenderArgs,
     setup: &mut Setup,
     renderers: &mut [Renderer],
-    prepared: &Prepared,
+    prepared: &mut Prepared,
     frame: &Frame,
     output: OutputFile,
     animation: serde_json::Value,
 ) -> Result<()> {
+    // The shutter's poses (one without --shutter), each rendering its share of the samples
+    // into the same film.
+    let poses = match setup.clip {
+        Some(_) => args
+            .animation
+            .shutter_poses(frame.time.unwrap_or(0.0), setup.spp),
+        None => vec![(0.0, setup.spp)],
+    };
+    if let (Some(c), [first, _, ..]) = (setup.clip, &poses[..]) {
+        shutter_pose(&mut renderers[0], prepared, c, first.0, false)?;
+    }
     let Setup {
         settings,
         spp,
         scene_stats,
         started,
         denoiser,
+        clip,
     } = setup;
     let spp = *spp;
     let bar = ProgressBar::new(spp as u64).with_style(
@@ -232,7 +277,8 @@ fn render_frame(
     let cpu_start = crate::cpu_time::process_cpu_seconds();
     let sample_start = args.sample_start.unwrap_or(0);
     let shares = if let [renderer] = renderers {
-        let done = render_samples(args, renderer, spp, &bar, &mut lines)?;
+        let poses = Poses { clip: *clip, list: &poses };
+        let done = render_samples(args, renderer, prepared, &poses, spp, &bar, &mut lines)?;
         let seconds = start.elapsed().as_secs_f64();
         vec![multi_device::Share {
             samples: done,
@@ -536,6 +582,8 @@ fn render_frame(
 fn render_samples(
     args: &RenderArgs,
     renderer: &mut Renderer,
+    prepared: &mut Prepared,
+    poses: &Poses,
     spp: u32,
     bar: &ProgressBar,
     lines: &mut Option<ProgressLines>,
@@ -545,7 +593,15 @@ fn render_samples(
     let mut done = 0;
     // The fewest samples a call first, then calls sized by the time a sample took.
     let mut chunk = MIN_SAMPLES_PER_CALL;
+    let (mut pose, mut pose_end) = (0, poses.list[0].1);
     while done < spp {
+        if done == pose_end
+            && let (Some(c), Some(&(time, samples))) = (poses.clip, poses.list.get(pose + 1))
+        {
+            pose += 1;
+            pose_end += samples;
+            shutter_pose(renderer, prepared, c, time, true)?;
+        }
         // The last check left no pixel active: more samples would add nothing.
         if renderer.active_pixels() == Some(0) {
             break;
@@ -556,7 +612,7 @@ fn render_samples(
         {
             break;
         }
-        let mut n = chunk.min(spp - done);
+        let mut n = chunk.min(spp - done).min(pose_end - done);
         if let Some(limit) = args.time_limit {
             // The call sized to end near the limit, at a sample's time measured so far.
             let left = limit - start.elapsed().as_secs_f64();
@@ -577,6 +633,13 @@ fn render_samples(
         }
     }
     Ok(done)
+}
+
+/// A frame's shutter poses: the clip and each pose's time and share of the samples (one pose,
+/// the frame's own, without `--shutter`).
+struct Poses<'a> {
+    clip: Option<usize>,
+    list: &'a [(f64, u32)],
 }
 
 /// Seconds for a person: "0.42 s", "12.3 s", "3 min 07 s".

@@ -13,6 +13,7 @@ mod megakernel;
 pub mod multi_device;
 mod nodes;
 mod readback;
+mod refit;
 mod sah;
 mod settings;
 pub mod strategy;
@@ -29,7 +30,7 @@ pub use megakernel::{Band, KernelChoice};
 pub use readback::Aovs;
 pub use settings::{RenderSettings, Strategy};
 pub use textures::TexturePack;
-pub use update::{InstanceUpdate, SceneUpdate};
+pub use update::{InstanceUpdate, SceneUpdate, UpdateKind};
 pub use upload::{Accel, HostScene, gpu_camera, gpu_material, samples_textures};
 pub use wavefront::{RenderStats, Stage, StageTimes};
 
@@ -136,6 +137,8 @@ pub struct Renderer {
     /// The index in the random sequence of the next sample `render` takes: 0 after a reset,
     /// advanced by every sample rendered ([`Renderer::set_next_sample`]).
     next_sample: u32,
+    /// Whether resets keep the film ([`Renderer::hold_film`]).
+    film_held: bool,
     /// The film as last read back (sums and counts), kept for the next read.
     readback: Vec<film::FilmPixel>,
     /// Adaptive sampling's pixel states as last read back (`PIXEL_*` bits).
@@ -190,6 +193,7 @@ impl Renderer {
             texture_cache: None,
             extra_forms: NodeForms::NONE,
             next_sample: 0,
+            film_held: false,
             readback: Vec::new(),
             state_readback: Vec::new(),
             adaptive_checked: false,
@@ -414,10 +418,20 @@ impl Renderer {
         &self.settings
     }
 
-    /// Clears the film and the counters.
+    /// Keeps the film, the sample count and the sequence's next sample through later scene,
+    /// camera and settings changes while `held` (a shutter's poses render into one film);
+    /// releasing it changes nothing until the next reset.
+    pub fn hold_film(&mut self, held: bool) {
+        self.film_held = held;
+    }
+
+    /// Clears the film and the counters (not while the film is held: [`Renderer::hold_film`]).
     pub fn reset(&mut self) -> Result<(), ClError> {
         if !self.pending.is_empty() {
             self.finish()?;
+        }
+        if self.film_held {
+            return Ok(());
         }
         self.samples = 0;
         self.next_sample = 0;

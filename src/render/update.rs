@@ -1,10 +1,12 @@
-//! Moving instances of a two-level scene without rebuilding it: the moved instances' transforms
-//! and a new TLAS, written over the old ones in the device buffers (no reallocation, no BLAS
+//! Bringing the scene on the device to a new pose ([`Renderer::update_scene`]), and moving
+//! instances of a two-level scene without rebuilding it: the moved instances' transforms and a
+//! new TLAS, written over the old ones in the device buffers (no reallocation, no BLAS
 //! build). The meshes' triangles and shading data stay in object space on the device, so
-//! nothing else is written (a moved light also rewrites the small light table). A scene whose
-//! meshes deformed, or a flat one, is loaded again ([`Renderer::update_scene`]).
+//! nothing else is written (a moved light also rewrites the small light table). A flat scene
+//! is refitted (`render/refit.rs`); a two-level one whose meshes deformed is loaded again.
 
 use super::instancing::{instanced_objects, render_from_world};
+use super::refit::NoRefit;
 use super::upload::piece_copies;
 use super::{Accel, Renderer};
 use crate::bvh::WideBvh;
@@ -26,34 +28,88 @@ pub struct InstanceUpdate {
 
 /// How [`Renderer::update_scene`] brought the device up to date.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub enum SceneUpdate {
-    /// Instances moved in place (two levels, no mesh changed).
+#[serde(rename_all = "lowercase")]
+pub enum UpdateKind {
+    /// Instances moved in place (two levels, no mesh changed): a new TLAS, no mesh BVH.
     Moved,
-    /// The scene was loaded again (deformed meshes, or a flat BVH).
+    /// A flat scene's BVH refitted over its posed triangles, what changed written in place.
+    Refitted,
+    /// The refit took the BVH past its cost bound ([`crate::bvh::REFIT_MAX_GROWTH`]): the
+    /// scene was built and loaded again.
+    Rebuilt,
+    /// The scene was loaded again (a deformed mesh on two levels, or other triangles placed).
     Reloaded,
+}
+
+/// What [`Renderer::update_scene`] did and what it took (host time, ms).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct SceneUpdate {
+    /// How.
+    pub kind: UpdateKind,
+    /// The render space found and the posed triangles flattened (a refit's).
+    pub flatten_ms: f64,
+    /// BVH work: the refit, the TLAS, or the whole build of a reload.
+    pub bvh_ms: f64,
+    /// Writing to the device (a reload's textures, lights and kernels check included).
+    pub upload_ms: f64,
+    /// Bytes written to the device (a reload: every scene buffer).
+    pub bytes: usize,
 }
 
 impl Renderer {
     /// Brings the device up to date with `scene` (the loaded scene after an animation pose)
-    /// and `lights`: moved instances in place where only transforms changed and the scene is
-    /// on two levels, else the scene loaded again in a render space around its new bounds (as
-    /// a fresh load of this pose would be, so a sequence's frame is its single render), the old
-    /// buffers written in place where their sizes agree and the textures packed once
-    /// (kernels are kept when the scene's features stay the same). Resets the film.
+    /// and `lights`, in the render space a fresh load of this pose would take (so a
+    /// sequence's frame is its single render), in the cheapest way that gives the same
+    /// image: moved instances in place where only transforms changed and the scene is on two
+    /// levels; a flat scene's BVH refitted and what changed written in place
+    /// (`render/refit.rs`), built again when the refit took it past its cost bound; else the
+    /// scene loaded again, the old buffers written in place where their sizes agree and the
+    /// textures packed once (kernels are kept when the scene's features stay the same).
+    /// Resets the film.
     pub fn update_scene(
         &mut self,
         scene: &Scene,
         lights: &[Light],
         deformed: bool,
     ) -> Result<SceneUpdate, ClError> {
-        if !deformed && self.move_instances(scene)?.is_some() {
-            self.set_lights(lights)?;
-            return Ok(SceneUpdate::Moved);
-        }
+        let t = Instant::now();
         let space = crate::scene::RenderFrame::around(&scene.bounds());
+        // Moving instances keeps the render space: only a space a fresh load would take too.
+        if !deformed
+            && space == self.space()
+            && let Some(u) = self.move_instances(scene)?
+        {
+            self.set_lights(lights)?;
+            return Ok(SceneUpdate {
+                kind: UpdateKind::Moved,
+                flatten_ms: 0.0,
+                bvh_ms: u.ms,
+                upload_ms: t.elapsed().as_secs_f64() * 1e3 - u.ms,
+                bytes: u.bytes,
+            });
+        }
+        let kind = match self.refit_flat(scene, lights)? {
+            Ok(r) => {
+                return Ok(SceneUpdate {
+                    kind: UpdateKind::Refitted,
+                    flatten_ms: r.flatten_ms,
+                    bvh_ms: r.refit_ms,
+                    upload_ms: r.upload_ms,
+                    bytes: r.bytes,
+                });
+            }
+            Err(NoRefit::TooCostly) => UpdateKind::Rebuilt,
+            Err(NoRefit::Changed) => UpdateKind::Reloaded,
+        };
         let old = self.scene.take().map(|(buffers, _)| buffers);
-        self.load_with(scene, lights, space, super::instancing::Blases::Sah, old)?;
-        Ok(SceneUpdate::Reloaded)
+        let stats = self.load_with(scene, lights, space, super::instancing::Blases::Sah, old)?;
+        Ok(SceneUpdate {
+            kind,
+            flatten_ms: 0.0,
+            bvh_ms: stats.bvh_build_ms,
+            upload_ms: t.elapsed().as_secs_f64() * 1e3 - stats.bvh_build_ms,
+            bytes: stats.device_bytes,
+        })
     }
 
     /// Brings a two-level scene on the device up to date with the transforms of `scene`'s

@@ -7,11 +7,12 @@ use super::structs::{gpu_material, luminance, samples_textures};
 use super::triangles::{
     FlatStructs, emissive_triangles, object_triangles, split_by, triangle_area,
 };
-use crate::bvh::{Ray, TwoLevel};
+use crate::bvh::{Ray, TwoLevel, WideBvh};
 use crate::cl::types::*;
 use crate::scene::{Material, Mesh, RenderFrame, Scene, WorldTriangle, robust_bounds_of};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use std::mem::take;
 
 /// The device arrays [`HostScene::fill_meshes`] writes every mesh's structs into: triangles,
 /// shading, texture coordinates, tangents and colours (the last three may be empty).
@@ -78,6 +79,43 @@ pub struct HostScene {
     pub space: RenderFrame,
     /// The middle and the diagonal of the robust bounds of the triangles.
     middle: (Vec3, f32),
+    /// Flat, after a pose was refitted ([`HostScene::refit_flat`]): the device structs as
+    /// last written, so that the next pose writes only what differs.
+    pub posed: Option<PosedArrays>,
+    /// The lists of the pose before, whose memory the next pose is written into.
+    pub spare: Option<PosedArrays>,
+}
+
+/// A flat scene's pose-dependent device structs in BVH order: triangles, corner normals and
+/// tangents (empty without normal maps). Texture coordinates and colours do not change with
+/// a pose. The lists are written again at the next pose (their memory faulted in once: fresh
+/// lists cost a quarter of a 1 M-triangle update in page faults, 2026-12-07).
+pub struct PosedArrays {
+    /// Vertices, material, light and object.
+    pub triangles: Vec<DeviceTriangle>,
+    /// Corner normals.
+    pub shading: Vec<DeviceTriShading>,
+    /// Tangents; empty without normal maps.
+    pub tangents: Vec<DeviceTriTangents>,
+    /// The 4-wide nodes as on the device, when it has them: refitted after the first pose
+    /// ([`WideBvh::refit`]) rather than collapsed again (the optimal collapse took a third of a
+    /// 1 M-triangle update, 2026-12-07).
+    pub wide: Option<WideBvh>,
+    /// The lists the pose was flattened into, in object order.
+    flattened: FlatStructs,
+}
+
+/// What [`HostScene::refit_flat`] made of a new pose of a flat scene.
+pub enum FlatRefit {
+    /// The BVH refitted; the pose's device structs, and the host time of flattening and of the
+    /// refit (ms).
+    Refitted(Box<PosedArrays>, f64, f64),
+    /// The refit took the BVH's SAH cost past [`crate::bvh::REFIT_MAX_GROWTH`] times its
+    /// build's: the scene must be built again.
+    TooCostly,
+    /// The pose placed other triangles (an object shown or hidden, a triangle dropped or
+    /// kept, another mesh): the scene must be loaded again.
+    Changed,
 }
 
 impl HostScene {
@@ -101,16 +139,7 @@ impl HostScene {
     /// the device structs one object at a time (never the whole scene's [`WorldTriangle`]s
     /// at once), and the number of triangles dropped ([`Scene::flatten`]).
     pub fn flatten(scene: &Scene, space: &RenderFrame, materials: &[Material]) -> (Self, usize) {
-        let visible = || scene.objects.iter().filter(|o| o.visible);
-        // Tangents are kept when some kept triangle has them (as `flat` decides).
-        let maybe_mapped = visible().any(|o| !o.mesh.tangents.is_empty());
-        let textured = samples_textures(materials);
-        let colored = visible().any(|o| !o.mesh.colors.is_empty());
-        let mut structs = FlatStructs::new(scene.triangle_count(), maybe_mapped, textured, colored);
-        let dropped = scene.flatten_each(space, |world| structs.add(world));
-        if !structs.mapped {
-            structs.tangents = Vec::new();
-        }
+        let (structs, dropped) = flat_structs(scene, space, materials, None);
         (
             Self::flat_from(structs, materials, render_middle(scene, space)),
             dropped,
@@ -150,24 +179,7 @@ impl HostScene {
         } else {
             gather(colors, &bvh.tri_indices)
         };
-        let mut emissive = Vec::new();
-        for (order, (tri, v)) in triangles.iter_mut().zip(&vertices).enumerate() {
-            let m = &materials[tri.v0[3].to_bits() as usize];
-            let area = triangle_area(v);
-            if m.is_emissive() && area > 0.0 {
-                let sides = if m.double_sided { 2.0 } else { 1.0 };
-                let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
-                tri.v1[3] = f32::from_bits(emissive.len() as u32);
-                emissive.push(Emitter {
-                    prim: order as u32,
-                    instance: 0,
-                    area,
-                    power,
-                    centroid: v.iter().sum::<Vec3>() / 3.0,
-                    material: tri.v0[3].to_bits(),
-                });
-            }
-        }
+        let emissive = flat_emitters(&mut triangles, &vertices, materials);
         let objects = triangles.par_iter().map(|t| t.v2[3].to_bits()).collect();
         Self {
             vertices,
@@ -212,7 +224,84 @@ impl HostScene {
             emissive,
             space: RenderFrame::default(),
             middle,
+            posed: None,
+            spare: None,
         }
+    }
+
+    /// A flat scene brought to `scene`'s new pose in render space `space` with the same
+    /// triangles placed: every visible triangle flattened anew (as a fresh load would, so the
+    /// device structs are the same numbers), the BVH refitted over them (its topology and
+    /// triangle order kept), the emissive triangles measured again. Leaves the host scene as
+    /// it was unless it returns [`FlatRefit::Refitted`] (after [`FlatRefit::TooCostly`] its
+    /// tree is spoilt: the scene is loaded again). `tangents`: whether the device holds
+    /// tangents.
+    pub fn refit_flat(
+        &mut self,
+        scene: &Scene,
+        space: RenderFrame,
+        materials: &[Material],
+        tangents: bool,
+    ) -> FlatRefit {
+        let Accel::Flat(bvh) = &mut self.accel else {
+            return FlatRefit::Changed;
+        };
+        let t = std::time::Instant::now();
+        let mut spare = self.spare.take();
+        let reuse = spare.as_mut().map(|l| take(&mut l.flattened));
+        let (structs, _) = flat_structs(scene, &space, materials, reuse);
+        // The same triangles of the same objects, in the order the tree holds them.
+        let same = structs.vertices.len() == bvh.tri_indices.len()
+            && structs.tangents.is_empty() != tangents
+            && bvh
+                .tri_indices
+                .par_iter()
+                .zip(&self.objects)
+                .all(|(&i, &o)| structs.triangles[i as usize].v2[3].to_bits() == o);
+        if !same {
+            return FlatRefit::Changed;
+        }
+        let flatten_ms = t.elapsed().as_secs_f64() * 1e3;
+        let t = std::time::Instant::now();
+        let vertices = &structs.vertices;
+        bvh.refit_with(|i| vertices[i]);
+        if bvh.needs_rebuild() {
+            return FlatRefit::TooCostly;
+        }
+        let refit_ms = t.elapsed().as_secs_f64() * 1e3;
+        let t = std::time::Instant::now();
+        let order = &bvh.tri_indices;
+        /// `v` in the order `order`, into `out`'s memory.
+        fn gather<T: Copy + Send + Sync>(v: &[T], order: &[u32], mut out: Vec<T>) -> Vec<T> {
+            out.clear();
+            out.par_extend(order.par_iter().map(|&i| v[i as usize]));
+            out
+        }
+        let mut arrays = spare.unwrap_or_else(|| PosedArrays {
+            triangles: Vec::new(),
+            shading: Vec::new(),
+            tangents: Vec::new(),
+            wide: None,
+            flattened: FlatStructs::default(),
+        });
+        let mut triangles = gather(&structs.triangles, order, take(&mut arrays.triangles));
+        let vertices = gather(vertices, order, take(&mut self.vertices));
+        self.emissive = flat_emitters(&mut triangles, &vertices, materials);
+        arrays.triangles = triangles;
+        arrays.shading = gather(&structs.shading, order, take(&mut arrays.shading));
+        if tangents {
+            arrays.tangents = gather(&structs.tangents, order, take(&mut arrays.tangents));
+        }
+        arrays.flattened = structs;
+        self.vertices = vertices;
+        self.space = space;
+        self.middle = render_middle(scene, &space);
+        self.materials = materials.iter().map(gpu_material).collect();
+        FlatRefit::Refitted(
+            Box::new(arrays),
+            flatten_ms + t.elapsed().as_secs_f64() * 1e3,
+            refit_ms,
+        )
     }
 
     /// Fills the device structs of a two-level scene: every mesh's triangles and shading data
@@ -408,6 +497,62 @@ impl HostScene {
             }
         }
     }
+}
+
+/// The flat form's device structs of `scene`'s visible objects in render space `space`, in
+/// object order, converted one object at a time (never the whole scene's [`WorldTriangle`]s
+/// at once), and the number of triangles dropped ([`Scene::flatten`]).
+/// `reuse`: the lists of an earlier pose, whose memory is written again (the texture
+/// coordinates and colours are then not made).
+pub(super) fn flat_structs(
+    scene: &Scene,
+    space: &RenderFrame,
+    materials: &[Material],
+    reuse: Option<FlatStructs>,
+) -> (FlatStructs, usize) {
+    let visible = || scene.objects.iter().filter(|o| o.visible);
+    // Tangents are kept when some kept triangle has them (as `flat` decides).
+    let maybe_mapped = visible().any(|o| !o.mesh.tangents.is_empty());
+    let textured = samples_textures(materials);
+    let colored = visible().any(|o| !o.mesh.colors.is_empty());
+    let capacity = scene.triangle_count();
+    let mut structs = match reuse {
+        Some(old) => old.cleared(capacity, maybe_mapped),
+        None => FlatStructs::new(capacity, maybe_mapped, textured, colored),
+    };
+    let dropped = scene.flatten_each(space, |world| structs.add(world));
+    if !structs.mapped {
+        structs.tangents = Vec::new();
+    }
+    (structs, dropped)
+}
+
+/// The emissive triangles of a flat scene's `triangles` (BVH order, world vertices
+/// `vertices`), in that order: each one's light index written into its `v1.w`.
+pub(super) fn flat_emitters(
+    triangles: &mut [DeviceTriangle],
+    vertices: &[[Vec3; 3]],
+    materials: &[Material],
+) -> Vec<Emitter> {
+    let mut emissive = Vec::new();
+    for (order, (tri, v)) in triangles.iter_mut().zip(vertices).enumerate() {
+        let m = &materials[tri.v0[3].to_bits() as usize];
+        let area = triangle_area(v);
+        if m.is_emissive() && area > 0.0 {
+            let sides = if m.double_sided { 2.0 } else { 1.0 };
+            let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
+            tri.v1[3] = f32::from_bits(emissive.len() as u32);
+            emissive.push(Emitter {
+                prim: order as u32,
+                instance: 0,
+                area,
+                power,
+                centroid: v.iter().sum::<Vec3>() / 3.0,
+                material: tri.v0[3].to_bits(),
+            });
+        }
+    }
+    emissive
 }
 
 /// The light-table entry of an emissive triangle with world vertices `v`.

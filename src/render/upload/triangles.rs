@@ -129,6 +129,7 @@ pub(super) fn object_triangles(
 
 /// The flat form's device structs in object order, filled a list of [`WorldTriangle`]s at a
 /// time.
+#[derive(Default)]
 pub(super) struct FlatStructs {
     pub(super) triangles: Vec<DeviceTriangle>,
     pub(super) shading: Vec<DeviceTriShading>,
@@ -165,6 +166,30 @@ impl FlatStructs {
             keep_tangents,
             keep_colors,
             mapped: false,
+        }
+    }
+
+    /// These lists emptied for another pose of the same triangles, their memory kept: the
+    /// texture coordinates and colours, which a pose does not change, are not made again.
+    pub(super) fn cleared(mut self, capacity: usize, keep_tangents: bool) -> Self {
+        self.triangles.clear();
+        self.triangles.reserve(capacity);
+        self.shading.clear();
+        self.shading.reserve(capacity);
+        self.vertices.clear();
+        self.vertices.reserve(capacity);
+        self.tangents.clear();
+        if keep_tangents {
+            self.tangents.reserve(capacity);
+        }
+        Self {
+            uvs: Vec::new(),
+            colors: Vec::new(),
+            keep_uvs: false,
+            keep_colors: false,
+            keep_tangents,
+            mapped: false,
+            ..self
         }
     }
 
