@@ -1202,6 +1202,75 @@ fn directional_albedo_never_exceeds_one() {
     );
 }
 
+/// The directional albedo of `m` seen from `wo` (energy: refracted weights times eta², as in
+/// `directional_albedo_never_exceeds_one`) per channel, with its standard error.
+fn albedo(d: &BsdfKernels, m: &Mat, wo: V, count: usize, seed: u32) -> [(f64, f64); 3] {
+    let s = d.sample(m, wo, [0.0, 0.0, 1.0], false, count, seed);
+    let eta = m.ior as f64;
+    std::array::from_fn(|ch| {
+        let w: Vec<f64> =
+            s.wi.iter()
+                .zip(&s.w)
+                .map(|(wi, w)| {
+                    let refracted = wi[2] < 0.0 && m.thickness > 0.0;
+                    w[ch] as f64 * if refracted { eta * eta } else { 1.0 }
+                })
+                .collect();
+        let mean = w.iter().sum::<f64>() / count as f64;
+        let var = w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / count as f64;
+        (mean, (var / count as f64).sqrt())
+    })
+}
+
+#[test]
+fn a_film_of_no_thickness_or_of_the_base_index_reflects_as_the_plain_material() {
+    // A viewer sees no film on these: one of thickness 0 is no film (the extension's rule,
+    // and the film Fresnel's), and a film of the base's own index has no second interface to
+    // interfere with. Each gives the plain material's directional albedo within noise and
+    // 1 %. The diffuse base under a vanishing film was once layered under the film's largest
+    // reflectance (a white base under a 2.5 film of no thickness: albedo 0.76 at cos 0.2), and
+    // Schlick's Fresnel at the film's lower face left fringes where it has the base's index
+    // (0.97).
+    let d = BsdfKernels::new();
+    let white = [1.0f32; 3];
+    let count = 1 << 16;
+    let mut dense = Mat::dielectric([0.4; 3], 0.1);
+    dense.ior = 2.0;
+    for plain in [
+        Mat::dielectric(white, 0.3),
+        dense,
+        Mat::metal([0.4; 3], 0.1),
+        Mat::glass(0.1, 1.0),
+        Mat::glass(0.3, 0.0),
+    ] {
+        for film in [
+            plain.iridescent(1.0, 2.5, 0.0),
+            plain.iridescent(1.0, 1.3, 0.0),
+            plain.iridescent(1.0, plain.ior, 400.0),
+        ] {
+            if film.iridescence[2] > 0.0 && plain.metallic > 0.0 {
+                continue; // a metal's index is complex: no film matches it
+            }
+            for (k, mu) in [0.2f64, 0.5, 0.9, 1.0].into_iter().enumerate() {
+                let wo = direction_at([0.0, 0.0, 1.0], mu.acos().to_degrees());
+                let a = albedo(&d, &plain, wo, count, 900 + k as u32);
+                let b = albedo(&d, &film, wo, count, 900 + k as u32);
+                for ch in 0..3 {
+                    let noise = 4.0 * (a[ch].1.powi(2) + b[ch].1.powi(2)).sqrt();
+                    assert!(
+                        (a[ch].0 - b[ch].0).abs() <= noise + 0.01,
+                        "{plain:?} under {:?} at cos {mu}: albedo {} against {} plain",
+                        film.iridescence,
+                        b[ch].0,
+                        a[ch].0
+                    );
+                    assert!(b[ch].0 <= 1.0 + noise, "{film:?}: albedo {}", b[ch].0);
+                }
+            }
+        }
+    }
+}
+
 /// A white Lambertian base under a clear coat keeps at least what the glTF spec's layering
 /// keeps, `(1 - c F(mu)) + c F(mu) E(mu)` (fresnel_coat with the coat's Fresnel-free GGX lobe of
 /// albedo E), and never more than all of it.

@@ -370,11 +370,27 @@ inline float film_sq(float x) {
     return x * x;
 }
 
+// Below this thickness (nm) a film is no film: the base alone (the sample viewer's blend of the
+// film's index to the outside's would leave a Schlick interface of f0 = 0 there).
+#define FILM_MIN_THICKNESS 0.03f
+
+// The exact (unpolarised) Fresnel reflectance of an interface from index n_i to n_t (per
+// channel), seen at cos_i: 0 at every angle where the indices are equal, 1 past the critical
+// angle.
+inline float3 film_interface(float cos_i, float n_i, float3 n_t) {
+    float3 eta = n_t / n_i;
+    float3 sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
+    float3 cos_t = sqrt(fmax(1.0f - sin2_t, 0.0f));
+    float3 rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    float3 rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    float3 f = 0.5f * (rs * rs + rp * rp);
+    return (float3)(sin2_t.x >= 1.0f ? 1.0f : f.x, sin2_t.y >= 1.0f ? 1.0f : f.y,
+                    sin2_t.z >= 1.0f ? 1.0f : f.z);
+}
+
 // The film's reflectance (RGB, in [0, 1]) at cos_1 over a base of normal reflectance f0.
 inline float3 film_fresnel(float cos_1, float film_ior, float d, float3 f0) {
-    // A vanishing film is no film: the base's own Schlick Fresnel (the sample viewer's blend of
-    // the film's index to the outside's would leave a Schlick interface of f0 = 0 there).
-    if (d < 0.03f) return f0 + (1.0f - f0) * schlick_weight(cos_1);
+    if (d < FILM_MIN_THICKNESS) return f0 + (1.0f - f0) * schlick_weight(cos_1);
     float n2 = film_ior;
     float sin2_2 = film_sq(1.0f / n2) * (1.0f - cos_1 * cos_1);
     float cos2_2 = 1.0f - sin2_2;
@@ -389,13 +405,15 @@ inline float3 film_fresnel(float cos_1, float film_ior, float d, float3 f0) {
     // Second interface (film to base); the base's index from its reflectance.
     float3 sf0 = sqrt(clamp(f0, 0.0f, 0.9999f));
     float3 n3 = (1.0f + sf0) / (1.0f - sf0);
-    float3 r1 = (n3 - n2) / (n3 + n2);
-    r1 *= r1;
-    float3 r23 = r1 + (1.0f - r1) * schlick_weight(cos_2);
+    // The film's lower face by the exact Fresnel (the sample viewer's Schlick leaves
+    // (1 - cos)^5 where film and base have one index, and fringes of 2 % at grazing angles).
+    float3 r23 = film_interface(cos_2, n2, n3);
     float3 phi23 = (float3)(n3.x < n2 ? PI_F : 0.0f, n3.y < n2 ? PI_F : 0.0f, n3.z < n2 ? PI_F : 0.0f);
     float opd = 2.0f * n2 * d * cos_2;
     float3 phi = phi21 + phi23;
-    float3 r123 = clamp(r12 * r23, 1e-5f, 0.9999f);
+    // No floor on r12 r23 (the sample viewer's 1e-5 keeps fringes of ±0.6 % where the film's
+    // index is the base's and there is no second interface to interfere with).
+    float3 r123 = clamp(r12 * r23, 0.0f, 0.9999f);
     float3 s123 = sqrt(r123);
     float3 rs = t121 * t121 * r23 / (1.0f - r123);
     float3 color = r12 + rs;
@@ -768,10 +786,10 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float3 wo) {
     l.f0_layer = bsdf_max3(l.f0);
 #ifdef HAS_IRIDESCENCE
     // The diffuse base lies under the film at its largest reflectance (any thickness), so it
-    // never takes light the film reflects.
-    l.iridescence = clamp(m->iridescence, 0.0f, 1.0f);
-    l.film_ior = fmax(m->iridescence_ior, 1.0f);
+    // never takes light the film reflects. A vanishing film leaves the plain material.
     l.film_thickness = fmax(m->iridescence_thickness, 0.0f);
+    l.iridescence = l.film_thickness < FILM_MIN_THICKNESS ? 0.0f : clamp(m->iridescence, 0.0f, 1.0f);
+    l.film_ior = fmax(m->iridescence_ior, 1.0f);
     if (l.iridescence > 0.0f) {
         float f_max = fmax(l.f0_layer, film_max_reflectance(l.film_ior, l.f0_layer));
         l.f0_layer = mix(l.f0_layer, f_max, l.iridescence);

@@ -6,6 +6,7 @@ use super::accessor::BufferData;
 use super::animation::{self, Animation, Driven, Rig, RigData};
 use super::compression;
 use super::pose::{check_nesting, node_matrix};
+use super::repeats::{self, Layering};
 use super::variants;
 use super::{
     Camera, Light, LightKind, Material, Mesh, Object, Scene, SceneError, default_light_rig, limits,
@@ -130,6 +131,7 @@ fn load_owned(
     scene.materials.push(Material::default());
     scene.variants = variants::names(document.extension_value("KHR_materials_variants"));
     let variant_count = scene.variants.len();
+    let layering: Vec<Layering> = scene.materials.iter().map(Layering::of).collect();
 
     let roots: Vec<gltf::Node> = match document
         .default_scene()
@@ -145,17 +147,27 @@ fn load_owned(
         default_material,
         &normal_sets,
         variant_count,
+        &layering,
     );
+    // The nodes an animation moves; what they or their children place is never a repeat.
+    let mut animated = vec![false; root.nodes.len()];
+    for channel in animation.clips.iter().flat_map(|c| &c.channels) {
+        animated[channel.node] = true;
+    }
     // Depth first in document order: the stack pops the last entry, so push in reverse.
-    let mut stack: Vec<(gltf::Node, DMat4, usize)> = roots
+    // Each entry: the node, its parent's world transform, its depth, whether an animation
+    // moves it.
+    let mut stack: Vec<(gltf::Node, DMat4, usize, bool)> = roots
         .into_iter()
         .rev()
-        .map(|n| (n, DMat4::IDENTITY, 0))
+        .map(|n| (n, DMat4::IDENTITY, 0, false))
         .collect();
     let mut meshes: HashMap<usize, Arc<Mesh>> = HashMap::new();
+    let mut placements = repeats::Placements::default();
     let mut placed = 0usize;
     let mut triangles = 0usize;
-    while let Some((node, parent, depth)) = stack.pop() {
+    while let Some((node, parent, depth, moved)) = stack.pop() {
+        let moved = moved || animated[node.index()];
         let at = format!("nodes[{}]", node.index());
         placed += 1;
         if placed > limits::MAX_NODE_INSTANCES {
@@ -223,11 +235,11 @@ fn load_owned(
                         &normal_sets,
                         &mut warnings,
                     )?;
-                    m.keep_variants(
-                        variant_count,
-                        &format!("meshes[{}]", mesh.index()),
-                        &mut warnings,
-                    );
+                    let what = format!("meshes[{}]", mesh.index());
+                    m.keep_variants(variant_count, &what, &mut warnings);
+                    if !posed {
+                        repeats::drop_repeated_triangles(&mut m, &layering, &what, &mut warnings);
+                    }
                     if posed {
                         let r = rig_of(&node, &mesh, m, data, &mut animation, root, &buffer_data)?;
                         let mut m = r.base.clone();
@@ -267,14 +279,16 @@ fn load_owned(
                 );
                 continue;
             }
-            triangles += m.indices.len();
+            // A repeat places nothing new; its camera, light and children still count.
+            let repeat = !posed && !moved && placements.repeats(&m, &world, &at);
+            triangles += if repeat { 0 } else { m.indices.len() };
             if triangles > limits::MAX_TRIANGLES {
                 return Err(format!(
                     "{at}: the scene has more than {} triangles after instancing",
                     limits::MAX_TRIANGLES
                 ));
             }
-            if !m.indices.is_empty() {
+            if !repeat && !m.indices.is_empty() {
                 if !animation.clips.is_empty() {
                     animation.objects.push(Driven {
                         object: scene.objects.len(),
@@ -309,9 +323,10 @@ fn load_owned(
         }
         let children: Vec<gltf::Node> = node.children().collect();
         for child in children.into_iter().rev() {
-            stack.push((child, world, depth + 1));
+            stack.push((child, world, depth + 1, moved));
         }
     }
+    warnings.extend(placements.warning());
 
     drop(buffer_data);
     drop(buffers);

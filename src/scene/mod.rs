@@ -17,6 +17,7 @@ mod lenient;
 mod lights;
 pub mod limits;
 mod pose;
+mod repeats;
 mod sources;
 mod tangents;
 mod textures;

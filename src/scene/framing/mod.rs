@@ -178,9 +178,10 @@ pub const FLAT_RATIO: f64 = 0.2;
 /// more front faces does not tell: ClearCoatTest shows more from behind); else from the only
 /// side where an 8 × 8 grid of
 /// rays finds surfaces that show (front faces, or double-sided ones: a single-sided board
-/// shows nothing from behind), else from +X.
+/// shows nothing from behind), else from +X. A backdrop ([`without_backdrop`]) does not count:
+/// the board in front of it decides.
 pub fn flat_facing(probe: &Probe, lights: &[Light]) -> Option<DVec3> {
-    let b = probe.bounds;
+    let b = without_backdrop(probe).unwrap_or(probe.bounds);
     let e = (b.max - b.min).max(DVec3::ZERO);
     let mut order = [0usize, 1, 2];
     order.sort_by(|&i, &k| e[i].total_cmp(&e[k]));
@@ -222,6 +223,40 @@ pub fn flat_facing(probe: &Probe, lights: &[Light]) -> Option<DVec3> {
         -1.0
     };
     Some(axis * sign)
+}
+
+/// The bounds of every object but a backdrop: one object whose bounds hold all the others'
+/// (a cyclorama behind a board of samples, TransmissionRoughnessTest's), clipped to the
+/// probe's bounds; `None` when there is no such object.
+fn without_backdrop(probe: &Probe) -> Option<Bounds> {
+    let tris = &probe.tris;
+    let objects = tris.starts.len().saturating_sub(1);
+    if objects < 2 {
+        return None;
+    }
+    let boxes: Vec<Bounds> = (0..objects)
+        .map(|o| {
+            let mut b = Bounds::default();
+            tris.visit(tris.starts[o]..tris.starts[o + 1], |_, v, _| {
+                v.iter().for_each(|p| b.grow(p.as_dvec3()))
+            });
+            b
+        })
+        .collect();
+    let holds = |a: &Bounds, b: &Bounds| {
+        b.is_empty() || (a.min.cmple(b.min).all() && a.max.cmpge(b.max).all())
+    };
+    let backdrop = (0..objects).find(|&o| {
+        !boxes[o].is_empty() && (0..objects).all(|k| k == o || holds(&boxes[o], &boxes[k]))
+    })?;
+    let mut rest = Bounds::default();
+    for (k, b) in boxes.iter().enumerate() {
+        if k != backdrop && !b.is_empty() {
+            rest.grow(b.min.max(probe.bounds.min));
+            rest.grow(b.max.min(probe.bounds.max));
+        }
+    }
+    (!rest.is_empty()).then_some(rest)
 }
 
 /// A camera looking at the middle of `bounds` from direction `dir` (unit, subject to eye), at
@@ -332,8 +367,27 @@ pub fn first_view_with(
                     None => (outside(object()), false),
                 },
                 Shell::OpenSide(d) => {
-                    // Straight into the opening, a little from above.
-                    (outside((d + DVec3::Y * 0.15).normalize()), false)
+                    // Straight into the opening, a little from above; a board standing inside
+                    // that faces the opening, straight at it, all of it in the frame.
+                    match flat_facing(probe, lights).filter(|f| f.dot(d) > 0.5) {
+                        Some(dir) => {
+                            let board = without_backdrop(probe).unwrap_or(bounds);
+                            let corners: Vec<Vec3> = (0..8)
+                                .map(|i| {
+                                    let pick = |bit: usize, k: usize| {
+                                        if i & bit == 0 {
+                                            board.min[k]
+                                        } else {
+                                            board.max[k]
+                                        }
+                                    };
+                                    DVec3::new(pick(1, 0), pick(2, 1), pick(4, 2)).as_vec3()
+                                })
+                                .collect();
+                            (fit(&board, &corners, dir, super::AUTO_YFOV, aspect), false)
+                        }
+                        None => (outside((d + DVec3::Y * 0.15).normalize()), false),
+                    }
                 }
                 Shell::Object => (outside(object()), false),
             }

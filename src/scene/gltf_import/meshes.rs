@@ -6,6 +6,7 @@
 use super::super::accessor::{self, Attributes, BufferData};
 use super::super::animation::RigData;
 use super::super::compression;
+use super::super::repeats::{self, Layering};
 use super::super::variants::{self, VariantRange};
 use super::super::{Mesh, limits, tangents};
 use super::colors::{pad_colors, read_colors};
@@ -24,7 +25,8 @@ pub(super) type ReadAhead = Result<(Mesh, Vec<String>), String>;
 /// where it first places it, so the scene, its warnings and its errors are those of reading
 /// them there. Meshes are taken in walk order while their triangles (from the accessors'
 /// counts) stay within [`limits::MAX_TRIANGLES`]: a file over the limit still fails at the node
-/// that crosses it, not after reading every mesh.
+/// that crosses it, not after reading every mesh. Each loses its repeated triangles
+/// ([`repeats`], `layering` by material).
 pub(super) fn read_meshes_ahead(
     roots: &[gltf::Node],
     root: &gltf::json::Root,
@@ -32,6 +34,7 @@ pub(super) fn read_meshes_ahead(
     default_material: u32,
     normal_sets: &[Option<(u32, bool)>],
     variant_count: usize,
+    layering: &[Layering],
 ) -> HashMap<usize, ReadAhead> {
     // The first node placing each mesh, depth first in document order, each node once.
     let mut seen = vec![false; root.nodes.len()];
@@ -83,6 +86,7 @@ pub(super) fn read_meshes_ahead(
             .map(|mut m| {
                 let what = format!("meshes[{}]", mesh.index());
                 m.keep_variants(variant_count, &what, &mut warnings);
+                repeats::drop_repeated_triangles(&mut m, layering, &what, &mut warnings);
                 m
             });
             (mesh.index(), read.map(|m| (m, warnings)))
