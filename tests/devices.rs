@@ -121,6 +121,11 @@ fn bad_device_lists_are_refused_before_rendering() {
         ("0,0", &["--aovs"], "--aovs renders on one device"),
         ("0,0", &["--noise-threshold", "0.1"], "--noise-threshold"),
         ("0,0", &["--denoise"], "--denoise renders on one device"),
+        (
+            "0,0",
+            &["--shutter", "0.1"],
+            "--shutter renders on one device",
+        ),
     ] {
         let _ = std::fs::remove_file(&out);
         let mut args = vec![

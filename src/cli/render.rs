@@ -277,7 +277,10 @@ fn render_frame(
     let cpu_start = crate::cpu_time::process_cpu_seconds();
     let sample_start = args.sample_start.unwrap_or(0);
     let shares = if let [renderer] = renderers {
-        let poses = Poses { clip: *clip, list: &poses };
+        let poses = Poses {
+            clip: *clip,
+            list: &poses,
+        };
         let done = render_samples(args, renderer, prepared, &poses, spp, &bar, &mut lines)?;
         let seconds = start.elapsed().as_secs_f64();
         vec![multi_device::Share {
