@@ -22,9 +22,6 @@ use std::time::Instant;
 /// devices' drivers.
 pub const DROP_SHARE: f64 = 0.1;
 
-/// The most samples a pixel of a device's first batch, the batch that measures its speed.
-pub const FIRST_BATCH: u32 = 8;
-
 /// What the devices render.
 #[derive(Clone, Copy, Debug)]
 pub struct Plan {
@@ -70,12 +67,11 @@ pub fn render(
 ) -> Result<Vec<Share>, ClError> {
     let devices = renderers.len() as u32;
     let end = plan.start + plan.spp;
-    // The first batches: fixed ranges, one a device, so each is measured; one sample each
-    // under a time limit, which a first batch may not overrun.
-    let first = match plan.time_limit {
-        Some(_) => 1,
-        None => (plan.spp / (2 * devices)).clamp(1, FIRST_BATCH),
-    };
+    // The first batches: fixed ranges of one sample a pixel, one a device, so each is
+    // measured at the least cost: a slow device's first batch is what the others may wait
+    // for at the end (on an H100 machine, 8 samples on its 16 host cores took 1.39 s of a
+    // render the GPU alone finished in 0.96 s).
+    let first = 1;
     let firsts: Vec<(u32, u32)> = (0..devices)
         .map(|i| {
             let from = (plan.start + i * first).min(end);
