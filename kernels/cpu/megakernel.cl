@@ -48,10 +48,10 @@ inline DeviceHit mega_trace(const MegaTracer* T, float3 o, float3 d, float tmax,
 inline DeviceHit mega_camera_hit(const MegaTracer* T, float3 o, float3 d, DeviceHit hit) {
 #ifdef SMALL_SCENE
     return camera_hit_small(T->small, T->tris, T->instances, T->object_tris, T->surf, o, d, hit,
-                            T->overflow);
+                            true, true, T->overflow);
 #else
     return camera_hit_wide(T->nodes, T->tris, T->instances, T->object_tris, T->surf, o, d, hit,
-                           T->overflow);
+                           true, true, T->overflow);
 #endif
 }
 #endif

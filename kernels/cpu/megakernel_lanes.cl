@@ -185,7 +185,7 @@ inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const Device
         hit[e] = packet_hit(&P, (int)e);
 #ifdef HAS_SINGLE_SIDED
         hit[e] = camera_hit_wide(nodes, sc->tris, instances, object_tris, &sc->surf, s[e].origin,
-                                 s[e].direction, hit[e], overflow);
+                                 s[e].direction, hit[e], true, true, overflow);
 #endif
     }
     ShadowQuery q[LANES];

@@ -67,18 +67,10 @@ kernel void extend(global const DeviceBvhNode* nodes, global const DeviceTriangl
     float3 o = p->origin.xyz, d = p->direction.xyz;
 #ifdef HAS_SINGLE_SIDED
     // A camera ray (no BSDF sample made it, and it passed no surface: no flags) culls the backs
-    // of single-sided surfaces as camera_hit does (path.h), written out here so that the kernel
-    // holds one inlined traversal instead of two (trace_scene, then camera_hit's).
+    // of single-sided surfaces.
     bool culls = p->origin.w == 0.0f && as_uint(p->direction.w) == 0u;
-    float tmin = 0.0f;
-    DeviceHit hit;
-    for (uint k = 0u;; ++k) {
-        hit = trace_scene(nodes, tris, instances, object_tris, &surf, o, d, tmin, INFINITY, false,
-                          &counters[COUNT_OVERFLOW]);
-        if (!culls || k == MAX_CULLED || hit.prim == NO_HIT || !camera_culls(tris, &surf, hit, d))
-            break;
-        tmin = hit.t;
-    }
+    DeviceHit hit = camera_hit(nodes, tris, instances, object_tris, &surf, o, d, no_hit(INFINITY),
+                               false, culls, &counters[COUNT_OVERFLOW]);
 #else
     DeviceHit hit = trace_scene(nodes, tris, instances, object_tris, &surf, o, d, 0.0f, INFINITY,
                                 false, &counters[COUNT_OVERFLOW]);
