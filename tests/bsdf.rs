@@ -242,6 +242,19 @@ struct Samples {
     w: Vec<[f32; 4]>,
 }
 
+impl Samples {
+    /// Channel `ch` of each sample's weight as energy: a refracted one (through a solid, `m`
+    /// with a thickness) times eta², undoing the radiance compression by eta².
+    fn energy(&self, m: &Mat, eta: f64, ch: usize) -> Vec<f64> {
+        (self.wi.iter().zip(&self.w))
+            .map(|(wi, w)| {
+                let refracted = wi[2] < 0.0 && m.thickness > 0.0;
+                w[ch] as f64 * if refracted { eta * eta } else { 1.0 }
+            })
+            .collect()
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Small vector math in f64
 
@@ -1162,14 +1175,7 @@ fn directional_albedo_never_exceeds_one() {
             // inside); energy is what it carries times eta^2.
             let eta = if *inside { 1.0 / m.ior } else { m.ior } as f64;
             for ch in 0..3 {
-                let w: Vec<f64> =
-                    s.wi.iter()
-                        .zip(&s.w)
-                        .map(|(wi, w)| {
-                            let refracted = wi[2] < 0.0 && m.thickness > 0.0;
-                            w[ch] as f64 * if refracted { eta * eta } else { 1.0 }
-                        })
-                        .collect();
+                let w = s.energy(m, eta, ch);
                 assert!(
                     w.iter().all(|x| x.is_finite() && *x >= 0.0),
                     "{name}: weights"
@@ -1208,14 +1214,7 @@ fn albedo(d: &BsdfKernels, m: &Mat, wo: V, count: usize, seed: u32) -> [(f64, f6
     let s = d.sample(m, wo, [0.0, 0.0, 1.0], false, count, seed);
     let eta = m.ior as f64;
     std::array::from_fn(|ch| {
-        let w: Vec<f64> =
-            s.wi.iter()
-                .zip(&s.w)
-                .map(|(wi, w)| {
-                    let refracted = wi[2] < 0.0 && m.thickness > 0.0;
-                    w[ch] as f64 * if refracted { eta * eta } else { 1.0 }
-                })
-                .collect();
+        let w = s.energy(m, eta, ch);
         let mean = w.iter().sum::<f64>() / count as f64;
         let var = w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / count as f64;
         (mean, (var / count as f64).sqrt())
