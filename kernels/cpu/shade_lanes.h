@@ -16,7 +16,7 @@
 // for both widths by its generator (shared/vec3.h): the vertex's MIS weights, Russian
 // roulette, normals, light sample test and shadow segment (path.h), the random numbers, onb and
 // cosine and triangle sampling (rng.h), the hit's point, error bound and normal and the offset
-// rays (traverse.h), the Lambertian BSDF's evaluation and sample (bsdf.h) and an emissive
+// rays (traverse.h), the Lambertian BSDF's evaluation and sample (lambert.h) and an emissive
 // triangle's sample (lights.h). What is written here is only the lanes' own: the batch, the
 // loads of triangles, materials and normals as rows, and the order of shade_vertex's steps
 // over masks instead of branches.
@@ -34,6 +34,7 @@
 #include "cpu/simd.h"
 #include "cpu/traverse_lanes.h"
 #include "shared/bsdf.h"
+#include "shared/lambert.h"
 #include "shared/lights.h"
 #include "shared/path.h"
 
@@ -239,7 +240,7 @@ LANES_INLINE vfloat lv_length(LaneVec v) {
 // lanes_shadow_segment, lanes_goes_on), rng.h's sampling (lanes_rng_advance, lanes_rng_value,
 // lanes_onb, lanes_unit_circle, lanes_sample_cosine, lanes_sample_triangle), traverse.h's
 // surface point (lanes_barycentric, lanes_surface_point, lanes_triangle_normal,
-// lanes_offset_step, lanes_offset_ray), bsdf.h's Lambertian BSDF (lanes_lambert_eval,
+// lanes_offset_step, lanes_offset_ray), lambert.h's Lambertian BSDF (lanes_lambert_eval,
 // lanes_lambert_sample) and lights.h's emissive triangle sample (lanes_triangle_light_sample).
 DEFINE_VERTEX_MATHS(lanes, vfloat, vint, LaneVec, lv)
 DEFINE_SAMPLING_MATHS(LANES_INLINE, lanes_, vfloat, vint, vuint, LaneVec, lv)

@@ -380,7 +380,7 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
 #ifdef HAS_DISPERSION
     // A dispersive volume: its index is that of the path's wavelength, picked at the first
     // such surface (weighted by its RGB response over its pdf) and kept in the flags' high
-    // bits to the end of the path (bsdf.h, "KHR_materials_dispersion").
+    // bits to the end of the path (material.h, "KHR_materials_dispersion").
     if (mat->aniso.w > 0.0f && m.transmission > 0.0f && m.thickness > 0.0f) {
         uint wavelength = s->flags >> PATH_WAVELENGTH_SHIFT;
         if (wavelength == 0u) {

@@ -10,7 +10,7 @@
 // named v##_make, v##_splat, v##_add, v##_sub, v##_mul, v##_scale, v##_div, v##_neg, v##_abs,
 // v##_max, v##_select, v##_dot, v##_cross, v##_length, v##_positive, v##_any and
 // v##_offset_step (f3_* below, f3_offset_step in traverse.h; the lanes' lv_*). The generators are DEFINE_SAMPLING_MATHS (rng.h), DEFINE_RAY_MATHS (F and
-// I only) and DEFINE_SURFACE_MATHS (traverse.h), DEFINE_LAMBERT_MATHS (bsdf.h),
+// I only) and DEFINE_SURFACE_MATHS (traverse.h), DEFINE_LAMBERT_MATHS (lambert.h),
 // DEFINE_TRIANGLE_LIGHT_MATHS (lights.h) and DEFINE_VERTEX_MATHS (path.h, with its own naming).
 //
 // Both forms must compute the same bits: each body is one operation per expression in the

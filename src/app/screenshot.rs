@@ -1,9 +1,12 @@
 //! Screenshots: the displayed frame as PNG (exposure, tone curve and sRGB, without the overlay)
-//! and the film as EXR (linear radiance), side by side with the same name.
+//! and the film as EXR (linear radiance), side by side with the same name: on F12, and at the
+//! exit with `--screenshot`.
 
+use super::App;
+use super::display::display_rgba;
 use crate::image_io::{unique_path, write_exr, write_exr_rgba};
 use crate::render::tonemap::write_rgba_png;
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
@@ -61,6 +64,68 @@ pub fn save_at(png: &Path, shot: &Shot) -> Result<PathBuf> {
         None => write_exr(&exr, shot.width, shot.height, shot.linear)?,
     }
     Ok(exr)
+}
+
+impl App {
+    /// Saves the image on screen (PNG, exactly the film: the panel and nothing else around it)
+    /// and the film (EXR) into `screenshots/` under a new name.
+    pub(super) fn screenshot(&mut self) {
+        let film = &self.frame_loop.film;
+        if film.pixels.is_empty() || self.display.len() != film.pixels.len() * 4 {
+            self.gui.file_error = Some("no frame to save yet".into());
+            return;
+        }
+        let shot = Shot {
+            width: film.width,
+            height: film.height,
+            rgba: &self.display,
+            linear: self.shown_denoised().unwrap_or(&film.pixels),
+            coverage: film.cutout.then_some(film.coverage.as_slice()),
+        };
+        match save_timestamped(Path::new(FOLDER), &shot) {
+            Ok(png) => {
+                println!(
+                    "penumbra: saved {} and {} ({}×{})",
+                    png.display(),
+                    png.with_extension("exr").display(),
+                    film.width,
+                    film.height
+                );
+                self.last_screenshot = Some(png);
+            }
+            Err(e) => self.gui.file_error = Some(format!("{e:#}")),
+        }
+    }
+
+    /// On exit with `--screenshot`: waits for the running batch and saves the final frame.
+    pub(super) fn save_final(&mut self, path: &Path) -> Result<()> {
+        if let Err(e) = self.frame_loop.wait() {
+            log::warn!("the last batch failed: {e}");
+        }
+        let film = &self.frame_loop.film;
+        if film.pixels.is_empty() {
+            bail!("--screenshot {}: no frame was rendered", path.display());
+        }
+        let v = &self.model.view;
+        let rgba = display_rgba(film, v.exposure, v.tone_mapper, v.background);
+        let shot = Shot {
+            width: film.width,
+            height: film.height,
+            rgba: &rgba,
+            linear: &film.pixels,
+            coverage: film.cutout.then_some(film.coverage.as_slice()),
+        };
+        let exr = save_at(path, &shot)?;
+        println!(
+            "penumbra: saved {} and {} ({}×{}, {} spp)",
+            path.display(),
+            exr.display(),
+            film.width,
+            film.height,
+            film.spp
+        );
+        Ok(())
+    }
 }
 
 #[cfg(test)]

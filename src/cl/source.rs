@@ -59,6 +59,26 @@ const KERNELS: &[(&str, &str)] = &[
         include_str!("../../kernels/shared/bsdf_tables.h"),
     ),
     (
+        "kernels/shared/material.h",
+        include_str!("../../kernels/shared/material.h"),
+    ),
+    (
+        "kernels/shared/microfacet.h",
+        include_str!("../../kernels/shared/microfacet.h"),
+    ),
+    (
+        "kernels/shared/thin_film.h",
+        include_str!("../../kernels/shared/thin_film.h"),
+    ),
+    (
+        "kernels/shared/bsdf_layers.h",
+        include_str!("../../kernels/shared/bsdf_layers.h"),
+    ),
+    (
+        "kernels/shared/lambert.h",
+        include_str!("../../kernels/shared/lambert.h"),
+    ),
+    (
         "kernels/shared/surface.h",
         include_str!("../../kernels/shared/surface.h"),
     ),
