@@ -2,6 +2,7 @@
 
 use super::{ClError, Device};
 use opencl3::device::CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT;
+use std::path::Path;
 
 /// The scene features that decide which kernel code is compiled in.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -199,6 +200,9 @@ fn build_with(
         options.push(' ');
         options.push_str(&extra);
     }
+    if let Some(dir) = std::env::var_os("PENUMBRA_DUMP_PROGRAMS") {
+        dump_program(Path::new(&dir), source, &options);
+    }
     let _setup = super::CL_SETUP.lock().unwrap_or_else(|e| e.into_inner());
     let mut program = opencl3::program::Program::create_from_source(&device.context, source)
         .map_err(|e| ClError::Build(format!("cannot create the program: {e}")))?;
@@ -220,6 +224,25 @@ fn build_with(
         }
     }
     Ok(program)
+}
+
+/// Writes a program's source (`program-HASH.cl`) and its build options (`program-HASH.options`)
+/// into `dir`, as they go to the compiler, for reading the kernels' code offline
+/// (`scripts/ptx_proxy.sh` compiles them for NVIDIA's PTX with clang). A failure is a warning.
+fn dump_program(dir: &Path, source: &str, options: &str) {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    (source, options).hash(&mut hasher);
+    let stem = dir.join(format!("program-{:016x}", hasher.finish()));
+    let written = std::fs::create_dir_all(dir)
+        .and_then(|()| std::fs::write(stem.with_extension("cl"), source))
+        .and_then(|()| std::fs::write(stem.with_extension("options"), options.trim()));
+    if let Err(e) = written {
+        log::warn!(
+            "PENUMBRA_DUMP_PROGRAMS: cannot write {}: {e}",
+            stem.display()
+        );
+    }
 }
 
 /// The register cap for NVIDIA's compiler, where it pays. The two-level traversal needs a few
@@ -272,6 +295,34 @@ mod tests {
             .to_string();
         assert!(err.contains("kernels/broken.cl:2"), "{err}");
         assert!(!err.contains('\n'), "one line: {err}");
+    }
+
+    #[test]
+    fn a_dumped_program_is_its_source_and_options() {
+        let dir = tempfile::tempdir().unwrap();
+        dump_program(dir.path(), "kernel void f() {}\n", " -DA -DB");
+        dump_program(dir.path(), "kernel void f() {}\n", " -DA");
+        let mut names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names.len(),
+            4,
+            "two programs, each source and options: {names:?}"
+        );
+        let options: Vec<_> = names
+            .iter()
+            .filter(|n| n.ends_with(".options"))
+            .map(|n| std::fs::read_to_string(dir.path().join(n)).unwrap())
+            .collect();
+        assert!(options.contains(&"-DA -DB".to_string()) && options.contains(&"-DA".to_string()));
+        let source = names.iter().find(|n| n.ends_with(".cl")).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join(source)).unwrap(),
+            "kernel void f() {}\n"
+        );
     }
 
     #[test]
