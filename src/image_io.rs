@@ -71,9 +71,19 @@ impl OutputFile {
     }
 
     /// Replaces the file's bytes with `bytes`, every write checked.
-    pub fn write(mut self, bytes: &[u8]) -> Result<()> {
+    pub fn write(self, bytes: &[u8]) -> Result<()> {
+        self.write_with(|out| out.write_all(bytes))
+    }
+
+    /// Replaces the file's bytes with what `fill` writes (buffered: it may write in small
+    /// pieces and seek), every write checked: an image streamed from its pixels, with no copy
+    /// of the whole file in memory.
+    pub fn write_with(
+        mut self,
+        fill: impl FnOnce(&mut std::io::BufWriter<&mut std::fs::File>) -> std::io::Result<()>,
+    ) -> Result<()> {
         let mut file = self.file.take().expect("written once");
-        let result = replace_contents(&mut file, bytes);
+        let result = replace_contents(&mut file, fill);
         if result.is_err() && self.created {
             let _ = std::fs::remove_file(&self.path);
         }
@@ -100,16 +110,22 @@ fn os_message(e: &std::io::Error) -> String {
     }
 }
 
-/// Writes `bytes` from the start of `file`, cutting what was there, and (for a regular file)
-/// waits until they are on disk: an error of any step is returned, so that a full disk or
-/// device (`/dev/full`) is never reported as a success.
-fn replace_contents(file: &mut std::fs::File, bytes: &[u8]) -> std::io::Result<()> {
+/// Writes what `fill` writes from the start of `file`, cutting what was there, and (for a
+/// regular file) waits until it is on disk: an error of any step is returned, so that a full
+/// disk or device (`/dev/full`) is never reported as a success.
+fn replace_contents(
+    file: &mut std::fs::File,
+    fill: impl FnOnce(&mut std::io::BufWriter<&mut std::fs::File>) -> std::io::Result<()>,
+) -> std::io::Result<()> {
     let regular = file.metadata()?.is_file();
     if regular {
         file.set_len(0)?;
         file.rewind()?;
     }
-    file.write_all(bytes)?;
+    let mut out = std::io::BufWriter::with_capacity(1 << 20, &mut *file);
+    fill(&mut out)?;
+    out.into_inner()
+        .map_err(std::io::IntoInnerError::into_error)?;
     file.flush()?;
     if regular {
         file.sync_all()?;
@@ -121,7 +137,7 @@ fn replace_contents(file: &mut std::fs::File, bytes: &[u8]) -> std::io::Result<(
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     let mut file = std::fs::File::create(path)
         .map_err(|e| anyhow::anyhow!("{}: cannot write: {}", path.display(), os_message(&e)))?;
-    replace_contents(&mut file, bytes)
+    replace_contents(&mut file, |out| out.write_all(bytes))
         .map_err(|e| anyhow::anyhow!("{}: cannot write: {}", path.display(), os_message(&e)))
 }
 

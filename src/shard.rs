@@ -55,6 +55,17 @@ pub struct ShardInfo {
     pub device: String,
 }
 
+/// What a channel of a shard's EXR holds.
+#[derive(Clone, Copy, Debug)]
+enum Holds {
+    /// The image's red, green or blue (f32).
+    Image(usize),
+    /// The coverage, the alpha of a cut-out background (f32).
+    Coverage,
+    /// The film's sums or count: lane `lane`'s bits from `shift` on, 32 of them (u32).
+    Film { lane: usize, shift: u32 },
+}
+
 /// A shard: its size, header and film.
 #[derive(Clone, Debug)]
 pub struct Shard {
@@ -107,46 +118,140 @@ impl Shard {
         self.info.counted && self.info.background != "env"
     }
 
-    /// The shard as an EXR file's bytes.
+    /// The shard as an EXR file's bytes ([`Shard::write_exr`]).
     pub fn encode(&self) -> Result<Vec<u8>> {
-        use exr::prelude::*;
-        let (image, coverage) = self.image();
-        let mut channels: Vec<AnyChannel<FlatSamples>> = (0..3)
-            .map(|c| {
-                AnyChannel::new(
-                    ["R", "G", "B"][c],
-                    FlatSamples::F32(image.iter().map(|p| p[c]).collect()),
-                )
-            })
-            .collect();
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        self.write_exr(&mut bytes)
+            .map_err(|e| anyhow::anyhow!("cannot encode EXR: {e}"))?;
+        Ok(bytes.into_inner())
+    }
+
+    /// The channels of the shard's EXR in the file's order (sorted by name), each with what it
+    /// holds.
+    fn channels(&self) -> Vec<(&'static str, Holds)> {
+        let mut channels = vec![
+            ("R", Holds::Image(0)),
+            ("G", Holds::Image(1)),
+            ("B", Holds::Image(2)),
+        ];
         if self.has_alpha() {
             // Premultiplied, as `render` writes it.
-            channels.push(AnyChannel::new("A", FlatSamples::F32(coverage)));
+            channels.push(("A", Holds::Coverage));
         }
         for (lane, (hi, lo)) in FILM_CHANNELS.iter().enumerate() {
-            let part = |shift: u32| {
-                FlatSamples::U32(
-                    self.film
-                        .iter()
-                        .map(|p| (p[lane] >> shift) as u32)
-                        .collect(),
-                )
-            };
-            channels.push(AnyChannel::new(*hi, part(32)));
-            channels.push(AnyChannel::new(*lo, part(0)));
+            channels.push((hi, Holds::Film { lane, shift: 32 }));
+            channels.push((lo, Holds::Film { lane, shift: 0 }));
         }
+        channels.sort_by_key(|(name, _)| *name);
+        channels
+    }
+
+    /// Writes the shard as an uncompressed scan-line EXR, line by line from the film (no whole
+    /// channel or file is built in memory). Uncompressed because a merge reads every film
+    /// channel of every shard: RLE's decoding was most of a merge's time (docs/farm.md), and
+    /// its film sums, noise in their low bits, hardly compress.
+    pub fn write_exr(&self, out: impl std::io::Write + std::io::Seek) -> std::io::Result<()> {
+        let w = self.width as usize;
+        if self.film.len() != w * self.height as usize {
+            return Err(std::io::Error::other("the film is not of the shard's size"));
+        }
+        self.write_exr_rows(out, |y, row| {
+            row.copy_from_slice(&self.film[y * w..][..w]);
+            Ok(())
+        })
+    }
+
+    /// [`Shard::write_exr`] of a film that `fill_row(y, row)` gives row by row, top to bottom
+    /// (`row` zeroed before each call), instead of this shard's `film`.
+    pub fn write_exr_rows(
+        &self,
+        out: impl std::io::Write + std::io::Seek,
+        mut fill_row: impl FnMut(usize, &mut [FilmPixel]) -> std::io::Result<()>,
+    ) -> std::io::Result<()> {
+        use exr::block::{BlockIndex, UncompressedBlock, writer::ChunksWriter};
+        use exr::meta::attribute::{ChannelDescription, SampleType};
+        use exr::prelude::*;
+        let (w, h) = (self.width as usize, self.height as usize);
+        if w == 0 || h == 0 {
+            return Err(std::io::Error::other("a shard of no pixels"));
+        }
+        let channels = self.channels();
+        let descriptions = channels
+            .iter()
+            .map(|(name, sample)| {
+                let kind = match sample {
+                    Holds::Film { .. } => SampleType::U32,
+                    _ => SampleType::F32,
+                };
+                ChannelDescription::named(*name, kind)
+            })
+            .collect();
         let mut attributes = LayerAttributes::default();
+        let info = serde_json::to_string(&self.info).map_err(std::io::Error::other)?;
         // The only custom attribute: the header's bytes do not depend on a map's order.
         attributes.other.insert(
             Text::from(ATTRIBUTE),
-            AttributeValue::Text(Text::from(serde_json::to_string(&self.info)?.as_str())),
+            AttributeValue::Text(Text::from(info.as_str())),
         );
-        crate::image_io::encode_exr_layer(
-            self.width,
-            self.height,
-            attributes,
-            SmallVec::from_vec(channels),
+        let header = exr::meta::header::Header::new(Text::from(""), (w, h), descriptions)
+            .with_encoding(
+                Compression::Uncompressed,
+                exr::meta::BlockDescription::ScanLines,
+                LineOrder::Increasing,
+            )
+            .with_attributes(attributes);
+        let samples = f64::from(self.info.samples);
+        let (mut image, mut coverage) = (Vec::new(), Vec::new());
+        let mut row = vec![[0; 4]; w];
+        exr::block::write(
+            out,
+            std::iter::once(header).collect(),
+            true,
+            |meta, writer| {
+                let mut blocks = writer.sequential_blocks_compressor(&meta);
+                // One line a block, its channels one after the other (native byte order: the
+                // writer makes it little-endian).
+                for y in 0..h {
+                    row.fill([0; 4]);
+                    fill_row(y, &mut row)?;
+                    let row = &row;
+                    film::image_into(
+                        row,
+                        self.info.counted,
+                        |_| samples,
+                        &mut image,
+                        Some(&mut coverage),
+                    );
+                    let mut data = Vec::with_capacity(channels.len() * 4 * w);
+                    for (_, sample) in &channels {
+                        match *sample {
+                            Holds::Image(c) => {
+                                data.extend(image.iter().flat_map(|p| p[c].to_ne_bytes()));
+                            }
+                            Holds::Coverage => {
+                                data.extend(coverage.iter().flat_map(|a| a.to_ne_bytes()));
+                            }
+                            Holds::Film { lane, shift } => data.extend(
+                                row.iter()
+                                    .flat_map(|p| ((p[lane] >> shift) as u32).to_ne_bytes()),
+                            ),
+                        }
+                    }
+                    let index = BlockIndex {
+                        layer: 0,
+                        pixel_position: Vec2(0, y),
+                        pixel_size: Vec2(w, 1),
+                        level: Vec2(0, 0),
+                    };
+                    blocks.compress_block(y, UncompressedBlock { index, data })?;
+                }
+                Ok(())
+            },
         )
+        .map_err(|e| match e {
+            exr::error::Error::Io(e) => e,
+            e => std::io::Error::other(e.to_string()),
+        })
     }
 
     /// Reads a shard EXR; one line naming the file and what is wrong otherwise.
@@ -165,86 +270,16 @@ impl Shard {
     pub fn add_file(&mut self, path: &Path) -> Result<ShardInfo> {
         use exr::block::reader::ChunksReader;
         let shown = path.display();
-        let cannot = |e: exr::error::Error| anyhow::anyhow!("{shown}: cannot read EXR: {e}");
-        let file = std::fs::File::open(path).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
-        let reader = exr::block::read(std::io::BufReader::new(file), false).map_err(cannot)?;
-        let Some(header) = reader.meta_data().headers.first() else {
-            bail!("{shown}: an EXR without layers");
-        };
-        let info = info_of(path, &header.own_attributes)?;
-        let (w, h) = (header.layer_size.width(), header.layer_size.height());
-        if (w, h) != (self.width as usize, self.height as usize) || self.film.len() != w * h {
-            bail!(
-                "{shown}: {w}×{h} pixels, not {}×{}",
-                self.width,
-                self.height
-            );
-        }
-        // Each channel's place in a block's line: lines hold each channel's samples in turn,
-        // in the header's (sorted) order.
-        let channels = &header.channels.list;
-        let place = |name: &str| {
-            let at = channels.iter().position(|c| c.name.eq(name));
-            match at.map(|i| (i, channels[i].sample_type)) {
-                Some((i, exr::meta::attribute::SampleType::U32)) => Ok(i),
-                _ => Err(anyhow::anyhow!(
-                    "{shown}: the shard has no u32 channel {name}"
-                )),
-            }
-        };
-        let mut lanes = [(0, 0); 4];
-        for (lane, (hi, lo)) in FILM_CHANNELS.iter().enumerate() {
-            lanes[lane] = (place(hi)?, place(lo)?);
-        }
-        let sizes: Vec<usize> = channels
-            .iter()
-            .map(|c| c.sample_type.bytes_per_sample())
-            .collect();
+        let (reader, info, layout) = open_blocks(path, self.width, self.height)?;
         let film = &mut self.film;
+        if film.len() != layout.width * self.height as usize {
+            bail!("{shown}: the film to add to is not of the shard's size");
+        }
         reader
             .all_chunks(false)
-            .map_err(cannot)?
-            .decompress_parallel(false, |_, block| {
-                let (x0, y0) = (
-                    block.index.pixel_position.x(),
-                    block.index.pixel_position.y(),
-                );
-                let (bw, bh) = (
-                    block.index.pixel_size.width(),
-                    block.index.pixel_size.height(),
-                );
-                if block.index.layer != 0 || x0 + bw > w || y0 + bh > h {
-                    return Err(exr::error::Error::Invalid(
-                        "a block outside the image".into(),
-                    ));
-                }
-                // Where each channel starts in a line of the block.
-                let mut starts = Vec::with_capacity(sizes.len());
-                let mut line_bytes = 0;
-                for s in &sizes {
-                    starts.push(line_bytes);
-                    line_bytes += s * bw;
-                }
-                if block.data.len() != line_bytes * bh {
-                    return Err(exr::error::Error::Invalid(
-                        "a block of the wrong size".into(),
-                    ));
-                }
-                for (row, line) in block.data.chunks_exact(line_bytes).enumerate() {
-                    let pixels = &mut film[(y0 + row) * w + x0..][..bw];
-                    for (lane, &(hi, lo)) in lanes.iter().enumerate() {
-                        let his = line[starts[hi]..][..4 * bw].chunks_exact(4);
-                        let los = line[starts[lo]..][..4 * bw].chunks_exact(4);
-                        for (p, (hi, lo)) in pixels.iter_mut().zip(his.zip(los)) {
-                            let half =
-                                |b: &[u8]| u64::from(u32::from_ne_bytes([b[0], b[1], b[2], b[3]]));
-                            p[lane] = p[lane].saturating_add(half(hi) << 32 | half(lo));
-                        }
-                    }
-                }
-                Ok(())
-            })
-            .map_err(cannot)?;
+            .map_err(|e| cannot_read(path, e))?
+            .decompress_parallel(false, |_, block| layout.add_block(film, &block))
+            .map_err(|e| cannot_read(path, e))?;
         Ok(info)
     }
 
@@ -261,6 +296,215 @@ impl Shard {
             info: info_of(path, &header.own_attributes)?,
             film: Vec::new(),
         })
+    }
+}
+
+/// An EXR reader of the shard at `path`, past its header, with the header's [`ShardInfo`] and
+/// where its film lies in a block; one line naming the file and the problem otherwise, also
+/// when it is not of `width` × `height` pixels.
+fn open_blocks(
+    path: &Path,
+    width: u32,
+    height: u32,
+) -> Result<(
+    exr::block::reader::Reader<std::io::BufReader<std::fs::File>>,
+    ShardInfo,
+    FilmLayout,
+)> {
+    let shown = path.display();
+    let file = std::fs::File::open(path).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
+    let reader =
+        exr::block::read(std::io::BufReader::new(file), false).map_err(|e| cannot_read(path, e))?;
+    let Some(header) = reader.meta_data().headers.first() else {
+        bail!("{shown}: an EXR without layers");
+    };
+    let info = info_of(path, &header.own_attributes)?;
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    if (w, h) != (width as usize, height as usize) {
+        bail!("{shown}: {w}×{h} pixels, not {width}×{height}");
+    }
+    let layout = FilmLayout::of(path, header)?;
+    Ok((reader, info, layout))
+}
+
+/// `path`'s EXR error as one line.
+fn cannot_read(path: &Path, e: exr::error::Error) -> anyhow::Error {
+    anyhow::anyhow!("{}: cannot read EXR: {e}", path.display())
+}
+
+/// Where a shard EXR's film lies in its blocks: lines hold each channel's samples in turn, in
+/// the header's (sorted) order.
+struct FilmLayout {
+    /// The image's width and height in pixels.
+    width: usize,
+    height: usize,
+    /// Each film lane's high and low channel: the bytes a pixel of the channels before it in a
+    /// line (a line of `n` pixels holds the channel from this times `n` on).
+    lanes: [(usize, usize); 4],
+    /// The bytes of a pixel, all channels.
+    pixel_bytes: usize,
+}
+
+impl FilmLayout {
+    /// The layout of the shard EXR at `path` with this `header`; one line if a film channel
+    /// is missing or not u32.
+    fn of(path: &Path, header: &exr::meta::header::Header) -> Result<FilmLayout> {
+        let channels = &header.channels.list;
+        let before = |i: usize| -> usize {
+            let sizes = channels[..i].iter();
+            sizes.map(|c| c.sample_type.bytes_per_sample()).sum()
+        };
+        let place = |name: &str| {
+            let at = channels.iter().position(|c| c.name.eq(name));
+            match at.map(|i| (i, channels[i].sample_type)) {
+                Some((i, exr::meta::attribute::SampleType::U32)) => Ok(before(i)),
+                _ => Err(anyhow::anyhow!(
+                    "{}: the shard has no u32 channel {name}",
+                    path.display()
+                )),
+            }
+        };
+        let mut lanes = [(0, 0); 4];
+        for (lane, (hi, lo)) in FILM_CHANNELS.iter().enumerate() {
+            lanes[lane] = (place(hi)?, place(lo)?);
+        }
+        Ok(FilmLayout {
+            width: header.layer_size.width(),
+            height: header.layer_size.height(),
+            lanes,
+            pixel_bytes: before(channels.len()),
+        })
+    }
+
+    /// Adds a decompressed block's film to `film` (the whole image's), each pixel's halves
+    /// joined and added where they land.
+    fn add_block(
+        &self,
+        film: &mut [FilmPixel],
+        block: &exr::block::UncompressedBlock,
+    ) -> exr::error::UnitResult {
+        let (x0, y0) = (
+            block.index.pixel_position.x(),
+            block.index.pixel_position.y(),
+        );
+        let (bw, bh) = (
+            block.index.pixel_size.width(),
+            block.index.pixel_size.height(),
+        );
+        if block.index.layer != 0 || x0 + bw > self.width || y0 + bh > self.height {
+            return Err(exr::error::Error::Invalid(
+                "a block outside the image".into(),
+            ));
+        }
+        let rows = &mut film[y0 * self.width..];
+        self.add_lines(rows, (self.width, x0), (bw, bh), &block.data)
+    }
+
+    /// Adds the film of `data`, `lines` lines of `bw` pixels, into `rows` (of `stride` pixels a
+    /// row) from column `x0` on.
+    fn add_lines(
+        &self,
+        rows: &mut [FilmPixel],
+        (stride, x0): (usize, usize),
+        (bw, lines): (usize, usize),
+        data: &[u8],
+    ) -> exr::error::UnitResult {
+        // A line holds each channel's `bw` samples in turn.
+        let line_bytes = self.pixel_bytes * bw;
+        if lines == 0
+            || data.len() != line_bytes * lines
+            || (lines - 1) * stride + x0 + bw > rows.len()
+        {
+            return Err(exr::error::Error::Invalid(
+                "a block of the wrong size".into(),
+            ));
+        }
+        for (row, line) in data.chunks_exact(line_bytes).enumerate() {
+            let pixels = &mut rows[row * stride + x0..][..bw];
+            for (lane, &(hi, lo)) in self.lanes.iter().enumerate() {
+                let his = line[hi * bw..][..4 * bw].chunks_exact(4);
+                let los = line[lo * bw..][..4 * bw].chunks_exact(4);
+                for (p, (hi, lo)) in pixels.iter_mut().zip(his.zip(los)) {
+                    let half = |b: &[u8]| u64::from(u32::from_ne_bytes([b[0], b[1], b[2], b[3]]));
+                    p[lane] = p[lane].saturating_add(half(hi) << 32 | half(lo));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A shard EXR read one line at a time, top to bottom, to add its film to a merge's line by
+/// line: a merge then holds a line of each shard and of the output, not whole films (a 4K
+/// film is 265 MB of fresh memory, whose page faults took most of a merge's CPU time).
+pub struct LineReader {
+    path: std::path::PathBuf,
+    blocks: exr::block::reader::SequentialBlockDecompressor<
+        exr::block::reader::AllChunksReader<std::io::BufReader<std::fs::File>>,
+    >,
+    layout: FilmLayout,
+    /// The next line.
+    y: usize,
+}
+
+impl LineReader {
+    /// Opens the shard EXR at `path`, of `shard`'s size and header (read before:
+    /// [`Shard::read_header`]); `None` when its blocks are not single lines in increasing
+    /// order (another encoder's, tiles or several lines a block): read it whole then
+    /// ([`Shard::add_file`]).
+    pub fn open(path: &Path, shard: &Shard) -> Result<Option<LineReader>> {
+        use exr::block::reader::ChunksReader;
+        use exr::meta::{BlockDescription, attribute::LineOrder};
+        let (reader, info, layout) = open_blocks(path, shard.width, shard.height)?;
+        if info != shard.info {
+            bail!("{}: changed while it was merged", path.display());
+        }
+        let header = &reader.meta_data().headers[0];
+        let by_line = header.blocks == BlockDescription::ScanLines
+            && header.compression.scan_lines_per_block() == 1
+            && header.line_order == LineOrder::Increasing;
+        if !by_line {
+            return Ok(None);
+        }
+        let blocks = reader
+            .all_chunks(false)
+            .map_err(|e| cannot_read(path, e))?
+            .sequential_decompressor(false);
+        Ok(Some(LineReader {
+            path: path.to_path_buf(),
+            blocks,
+            layout,
+            y: 0,
+        }))
+    }
+
+    /// Adds the film of the shard's next line to `row`.
+    pub fn add_line(&mut self, row: &mut [FilmPixel]) -> Result<()> {
+        let path = &self.path;
+        let block = match self.blocks.next() {
+            Some(block) => block.map_err(|e| cannot_read(path, e))?,
+            None => bail!("{}: line {} is missing", path.display(), self.y),
+        };
+        let index = block.index;
+        if (
+            index.layer,
+            index.pixel_position.x(),
+            index.pixel_position.y(),
+        ) != (0, 0, self.y)
+            || index.pixel_size.width() != row.len()
+            || index.pixel_size.height() != 1
+        {
+            bail!(
+                "{}: its blocks are not the lines in order (line {} expected)",
+                path.display(),
+                self.y
+            );
+        }
+        self.y += 1;
+        let width = row.len();
+        self.layout
+            .add_lines(row, (width, 0), (width, 1), &block.data)
+            .map_err(|e| cannot_read(path, e))
     }
 }
 
@@ -392,6 +636,69 @@ mod tests {
         // The RGB channels are the image, as a plain EXR reader sees it.
         let (_, _, rgb) = crate::image_io::read_exr(&path).unwrap();
         assert_eq!(rgb, s.image().0);
+    }
+
+    /// `s` as an RLE EXR in 64-pixel tiles, the same channels and header: a shard as another
+    /// tool may rewrite it.
+    fn encode_in_tiles(s: &Shard) -> Vec<u8> {
+        use exr::prelude::*;
+        let (image, coverage) = s.image();
+        let channels = s.channels().into_iter().map(|(name, holds)| {
+            let samples = match holds {
+                Holds::Image(c) => FlatSamples::F32(image.iter().map(|p| p[c]).collect()),
+                Holds::Coverage => FlatSamples::F32(coverage.clone()),
+                Holds::Film { lane, shift } => {
+                    FlatSamples::U32(s.film.iter().map(|p| (p[lane] >> shift) as u32).collect())
+                }
+            };
+            AnyChannel::new(name, samples)
+        });
+        let mut attributes = LayerAttributes::default();
+        let info = serde_json::to_string(&s.info).unwrap();
+        attributes.other.insert(
+            Text::from(ATTRIBUTE),
+            AttributeValue::Text(Text::from(info.as_str())),
+        );
+        crate::image_io::encode_exr_layer(s.width, s.height, attributes, channels.collect())
+            .unwrap()
+    }
+
+    #[test]
+    fn shards_in_lines_are_read_a_line_at_a_time_others_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        // Distinct sums in every pixel and lane, high halves included.
+        let mut s = shard(0, 8, 0);
+        (s.width, s.height) = (70, 3);
+        s.film = (0..70 * 3u64)
+            .map(|i| [i << 33 | i, i * 7, (i << 40) + 3, 8])
+            .collect();
+        let lines = dir.path().join("lines.exr");
+        std::fs::write(&lines, s.encode().unwrap()).unwrap();
+        let tiles = dir.path().join("tiles.exr");
+        std::fs::write(&tiles, encode_in_tiles(&s)).unwrap();
+        let header = Shard::read_header(&lines).unwrap();
+        let mut reader = LineReader::open(&lines, &header)
+            .unwrap()
+            .expect("a line a block");
+        let mut film = Vec::new();
+        for _ in 0..3 {
+            let mut row = vec![[0; 4]; 70];
+            reader.add_line(&mut row).unwrap();
+            film.extend(row);
+        }
+        assert_eq!(film, s.film);
+        let mut row = vec![[0; 4]; 70];
+        assert!(
+            reader
+                .add_line(&mut row)
+                .unwrap_err()
+                .to_string()
+                .contains("line 3 is missing")
+        );
+        // Tiles: not a line a block, read whole, to the same film.
+        assert!(LineReader::open(&tiles, &header).unwrap().is_none());
+        assert_eq!(Shard::read(&tiles).unwrap().film, s.film);
+        assert_eq!(Shard::read(&lines).unwrap().film, s.film);
     }
 
     #[test]

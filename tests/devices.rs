@@ -109,6 +109,51 @@ fn every_device_and_shards_on_two_devices_match_one() {
 }
 
 #[test]
+fn devices_are_set_up_at_once_and_each_reports_its_setup() {
+    let dir = output_dir("devices_setup");
+    let scene = white_sphere_under_panel(&dir, 8, 16);
+    let out = dir.join("twice.exr");
+    let o = penumbra_env(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--spp",
+            "12",
+            "--device",
+            "0,0",
+        ],
+        &[],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let s: Value = serde_json::from_slice(&o.stdout).expect("one JSON line on stdout");
+    // Each device built its own BVH and kernels, and says so.
+    let devices = s["devices"].as_array().expect("a devices list");
+    let mut sum_ms = 0.0;
+    for d in devices {
+        for key in ["bvh_build_ms", "kernel_build_ms", "setup_ms"] {
+            assert!(d[key].as_f64().is_some_and(|ms| ms > 0.0), "{key}: {d}");
+        }
+        sum_ms += d["setup_ms"].as_f64().unwrap();
+    }
+    // The setups ran at once: together they took less than one after the other would have.
+    let setup_ms = s["setup_ms"].as_f64().expect("setup_ms");
+    assert!(
+        setup_ms < sum_ms,
+        "{setup_ms} ms against {sum_ms} ms one after the other"
+    );
+    assert_eq!(err.matches("compiling kernels").count(), 1, "{err}");
+    // The line on stderr gives each device's setup.
+    assert_eq!(err.matches("set up in").count(), 2, "{err}");
+}
+
+#[test]
 fn bad_device_lists_are_refused_before_rendering() {
     let dir = output_dir("devices_refused");
     let scene = white_sphere_under_panel(&dir, 8, 16);

@@ -7,7 +7,7 @@ use crate::image_io::{Format, OutputFile};
 use crate::render::background::Background;
 use crate::render::exposure::ExposureMode;
 use crate::render::tonemap::ToneMapper;
-use crate::shard::{self, Shard};
+use crate::shard::{self, LineReader, Shard};
 use anyhow::{Result, anyhow};
 use std::path::Path;
 use std::time::Instant;
@@ -28,8 +28,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     let started = Instant::now();
     let output = OutputFile::open(&args.output)?;
     // The headers first: shards that do not belong together are refused before any pixel is
-    // read; then each shard's film is added to the sum as its blocks are decompressed, so that
-    // a merge holds one film, not one per shard.
+    // read.
     let mut shards = args
         .shards
         .iter()
@@ -37,15 +36,48 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let count = shards.len();
     let mut merged = shard::check(&mut shards)?;
-    merged.film = vec![[0; 4]; merged.width as usize * merged.height as usize];
+    let (w, h) = (merged.width, merged.height);
+    if output.format == Format::Exr {
+        // Shards stored a line a block (as `render` writes them) are added and written a line
+        // at a time: no whole film in memory.
+        let lines = shards
+            .iter()
+            .map(|(name, header)| LineReader::open(name.0, header))
+            .collect::<Result<Option<Vec<_>>>>()?;
+        if let Some(mut lines) = lines {
+            // A shard's error while the output is written: reported as itself, not as a
+            // failed write.
+            let mut failed = None;
+            let written = output.write_with(|out| {
+                merged.write_exr_rows(out, |_, row| {
+                    for shard in &mut lines {
+                        if let Err(e) = shard.add_line(row) {
+                            let line = e.to_string();
+                            failed = Some(e);
+                            return Err(std::io::Error::other(line));
+                        }
+                    }
+                    Ok(())
+                })
+            });
+            if let Some(e) = failed {
+                return Err(e);
+            }
+            written?;
+            report(args, count, &merged, started);
+            return Ok(());
+        }
+    }
+    // The headers were checked: each shard's film is now added to the sum as its blocks are
+    // decompressed, so that a merge holds one film, not one per shard.
+    merged.film = vec![[0; 4]; w as usize * h as usize];
     for (name, header) in &shards {
         if merged.add_file(name.0)? != header.info {
             anyhow::bail!("{name}: changed while it was merged");
         }
     }
-    let (w, h) = (merged.width, merged.height);
-    let bytes = match output.format {
-        Format::Exr => merged.encode()?,
+    match output.format {
+        Format::Exr => output.write_with(|out| merged.write_exr(out))?,
         Format::Png => {
             let info = &merged.info;
             let background: Background = info.background.parse().map_err(|e: String| {
@@ -65,10 +97,18 @@ pub fn run(args: &MergeArgs) -> Result<()> {
                 .exposure
                 .map_or(ExposureMode::Auto, ExposureMode::Manual);
             let exposure = exposure_stops(&image, &coverage, background, mode);
-            encode_png(w, h, &image, &coverage, background, exposure, tonemap)?
+            output.write(&encode_png(
+                w, h, &image, &coverage, background, exposure, tonemap,
+            )?)?;
         }
-    };
-    output.write(&bytes)?;
+    }
+    report(args, count, &merged, started);
+    Ok(())
+}
+
+/// The line on stderr saying what a merge wrote.
+fn report(args: &MergeArgs, count: usize, merged: &Shard, started: Instant) {
+    let (w, h) = (merged.width, merged.height);
     let info = &merged.info;
     eprintln!(
         "penumbra: wrote {}: {count} shards, {w}×{h} pixels, samples {}…{} ({} spp), in {:.2} s",
@@ -78,5 +118,4 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         info.samples,
         started.elapsed().as_secs_f64()
     );
-    Ok(())
 }

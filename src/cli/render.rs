@@ -62,22 +62,38 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Some(EnvChoice::Map(map)) => Some(map),
         _ => None,
     };
-    // Each device its own renderer: context, kernels and the scene on it.
-    let mut renderers = Vec::new();
-    let mut scene_stats = None;
-    for device in &devices {
-        let mut renderer = args.common.open_renderer_on(device, &settings)?;
-        if let Some(map) = &environment {
-            renderer.set_environment(Some(map.clone()))?;
-        }
-        let stats = renderer
-            .load_scene(&prepared.scene, &prepared.lights)
-            .with_context(|| format!("{}", args.scene.display()))?;
-        renderer.set_camera(&prepared.camera)?;
-        scene_stats.get_or_insert(stats);
-        renderers.push(renderer);
-    }
-    let scene_stats = scene_stats.expect("at least one device");
+    // Each device its own renderer: context, kernels and the scene on it, all set up at once,
+    // each on its own thread: the first sample waits for the slowest device (PoCL's kernel
+    // build takes about 8 s), not for the sum. One device says it compiles kernels.
+    let setup_started = Instant::now();
+    let set_up = std::thread::scope(|scope| {
+        let threads: Vec<_> = (devices.iter().enumerate())
+            .map(|(i, device)| {
+                let (settings, prepared, environment) = (&settings, &prepared, &environment);
+                scope.spawn(move || -> Result<(Renderer, DeviceSetup)> {
+                    let t = Instant::now();
+                    let mut renderer = args.common.open_renderer_on(device, settings)?;
+                    renderer.announce_builds(i == 0);
+                    if let Some(map) = environment {
+                        renderer.set_environment(Some(map.clone()))?;
+                    }
+                    let stats = renderer
+                        .load_scene(&prepared.scene, &prepared.lights)
+                        .with_context(|| format!("{}", args.scene.display()))?;
+                    renderer.set_camera(&prepared.camera)?;
+                    let ms = t.elapsed().as_secs_f64() * 1e3;
+                    Ok((renderer, DeviceSetup { stats, ms }))
+                })
+            })
+            .collect();
+        (threads.into_iter())
+            .map(|t| t.join().expect("a device's setup does not panic"))
+            .collect::<Result<Vec<_>>>()
+    })?;
+    let setup_ms = setup_started.elapsed().as_secs_f64() * 1e3;
+    let (mut renderers, device_setups): (Vec<Renderer>, Vec<DeviceSetup>) =
+        set_up.into_iter().unzip();
+    let scene_stats = device_setups[0].stats.clone();
     if scene_stats.dropped_triangles > 0 {
         log::warn!(
             "{}: {} triangles with a non-finite or absurd (beyond 1e30) vertex dropped",
@@ -113,6 +129,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         settings,
         spp,
         scene_stats,
+        device_setups,
+        setup_ms,
         started,
         denoiser,
         clip,
@@ -206,11 +224,22 @@ struct Setup {
     settings: RenderSettings,
     spp: u32,
     scene_stats: SceneStats,
+    /// Each device's setup.
+    device_setups: Vec<DeviceSetup>,
+    /// Wall milliseconds of the devices' setup, all at once (the slowest device's).
+    setup_ms: f64,
     started: Instant,
     /// With `--denoise`: the denoiser and the milliseconds its kernels and weights took to load.
     denoiser: Option<(Denoiser, f64)>,
     /// The clip played, if any.
     clip: Option<usize>,
+}
+
+/// One device's setup: its scene's figures (BVH, upload and kernel build times) and the wall
+/// milliseconds it took, the renderer opened included.
+struct DeviceSetup {
+    stats: SceneStats,
+    ms: f64,
 }
 
 /// Poses `prepared` at `time` of `clip` and brings the renderer up to date, keeping its film
@@ -258,6 +287,8 @@ fn render_frame(
         settings,
         spp,
         scene_stats,
+        device_setups,
+        setup_ms,
         started,
         denoiser,
         clip,
@@ -508,10 +539,15 @@ fn render_frame(
         summary[key] = value;
     }
     let w_h = f64::from(w) * f64::from(h);
-    summary["devices"] = (shares.iter().zip(&indices))
-        .map(|(share, index)| {
+    summary["setup_ms"] = serde_json::json!(setup_ms);
+    summary["devices"] = (shares.iter().zip(&indices).zip(device_setups.iter()))
+        .map(|((share, index), setup)| {
             serde_json::json!({
                 "index": index,
+                "setup_ms": setup.ms,
+                "bvh_build_ms": setup.stats.bvh_build_ms,
+                "upload_ms": setup.stats.upload_ms,
+                "kernel_build_ms": setup.stats.kernel_build_ms,
                 "samples": share.samples,
                 "share": f64::from(share.samples) / f64::from(done.max(1)),
                 "seconds": share.seconds,
@@ -549,14 +585,15 @@ fn render_frame(
         format!(", denoised in {}", duration(d.ms * 1e-3))
     });
     let on_devices = if shares.len() > 1 {
-        let parts: Vec<String> = (shares.iter().zip(&indices))
-            .map(|(share, index)| {
+        let parts: Vec<String> = (shares.iter().zip(&indices).zip(device_setups.iter()))
+            .map(|((share, index), setup)| {
                 let rate = w_h * f64::from(share.samples) / share.seconds.max(1e-9);
                 format!(
-                    "{index}: {} spp ({:.0} %, {:.2} M samples/s{})",
+                    "{index}: {} spp ({:.0} %, {:.2} M samples/s, set up in {}{})",
                     share.samples,
                     100.0 * f64::from(share.samples) / f64::from(done.max(1)),
                     rate * 1e-6,
+                    duration(setup.ms * 1e-3),
                     if share.dropped {
                         ", dropped: too slow"
                     } else {

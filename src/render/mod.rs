@@ -118,6 +118,8 @@ pub struct Renderer {
     megakernel: bool,
     /// The acceleration structure the next scene load builds.
     bvh_choice: BvhChoice,
+    /// A kernel build says so on stderr ([`Renderer::announce_builds`]).
+    announce_builds: bool,
     /// Overrides the device's small-mesh rule (see [`Renderer::set_small_mesh`]).
     small_mesh: Option<usize>,
     /// Distinct triangles from which a two-level scene is loaded with quick BLASes first (see
@@ -186,6 +188,7 @@ impl Renderer {
             pending: Vec::new(),
             megakernel: false,
             bvh_choice: BvhChoice::Auto,
+            announce_builds: true,
             small_mesh: None,
             quick_first: None,
             sah: None,
@@ -284,7 +287,9 @@ impl Renderer {
             return Ok(0.0);
         }
         // A cold build takes seconds (the drivers cache built programs on disk: see README).
-        eprintln!("penumbra: compiling kernels…");
+        if self.announce_builds {
+            eprintln!("penumbra: compiling kernels…");
+        }
         let t = Instant::now();
         self.program = Some(Program::build(&self.device, features)?);
         Ok(t.elapsed().as_secs_f64() * 1e3)
@@ -490,6 +495,12 @@ impl Renderer {
     /// The acceleration structure on the host.
     pub fn accel(&self) -> Option<&Accel> {
         self.scene.as_ref().map(|(_, h)| &h.accel)
+    }
+
+    /// Whether a kernel build says so on stderr (by default it does): of several devices set
+    /// up at once, one says it.
+    pub fn announce_builds(&mut self, on: bool) {
+        self.announce_builds = on;
     }
 
     /// Chooses the acceleration structure of the scenes loaded from now on.
