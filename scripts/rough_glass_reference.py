@@ -1,22 +1,26 @@
 #!/usr/bin/env python3
 """Mitsuba 3 references of rough glass with a volume (roughdielectric), for tests/rough_glass.rs.
 
-Two fixtures, each built from the data below; tests/rough_glass.rs builds the same glTF (the
+Three fixtures, each built from the data below; tests/rough_glass.rs builds the same glTF (the
 same corners, faces, materials and camera) and renders it with penumbra:
 
   cubes  three glass cubes (ior 1.5, roughness 0.1, 0.3, 0.6, white, no absorption) under a
          uniform white sky of radiance 1, seen from above and in front: a white furnace. Rough
          single-scattering GGX loses energy at each interface; Mitsuba has the same loss.
+  sphere a flat-faced glass sphere (ior 1.5, roughness 0.6; 32 rings, 64 segments) under the
+         white sky: the white furnace of a rough sphere.
   slab   two glass slabs (ior 1.5, roughness 0.1 and 0.5) in front of a square emitter of
          radiance 4 on a black sky: the emitter seen blurred through each slab.
 
-    python3 scripts/rough_glass_reference.py --fixture cubes --spp 16384 \
+    python3 scripts/rough_glass_reference.py --fixture cubes --spp 4096 \
         --out tests/references/rough-glass-cubes-mitsuba.exr
-    python3 scripts/rough_glass_reference.py --fixture slab --spp 16384 \
+    python3 scripts/rough_glass_reference.py --fixture slab --spp 4096 \
         --out tests/references/rough-glass-slab-mitsuba.exr
+    python3 scripts/rough_glass_reference.py --fixture sphere --spp 4096 \
+        --out tests/references/rough-glass-sphere-mitsuba.exr
 
 Needs: pip install mitsuba==3.9.1 drjit==1.5.0  (the default variant scalar_rgb needs no LLVM;
-       made with it on 2 CPU cores: 114 s for cubes, 75 s for slab)
+       made with it on 2 CPU cores: 114 s for cubes, 75 s for slab, 36 s for sphere)
 
 Mapping (glTF -> Mitsuba):
   * metallic 0, KHR_materials_transmission 1, KHR_materials_ior n, KHR_materials_volume
@@ -60,6 +64,26 @@ def cuboid(lo, hi):
     return p, idx
 
 
+def sphere(radius, rings, segments):
+    """A UV sphere at the origin: corners and outward-wound triangles (the same as
+    tests/common/mod.rs `sphere`, whose normals the fixture leaves out: flat faces)."""
+    p = []
+    for r in range(rings + 1):
+        theta = math.pi * r / rings
+        for s in range(segments + 1):
+            phi = 2.0 * math.pi * s / segments
+            p.append([radius * math.sin(theta) * math.cos(phi), radius * math.cos(theta),
+                      radius * math.sin(theta) * math.sin(phi)])
+    idx = []
+    w = segments + 1
+    for r in range(rings):
+        for s in range(segments):
+            a = r * w + s
+            b = a + w
+            idx += [a, a + 1, b, a + 1, b + 1, b]
+    return p, idx
+
+
 def fixture(name):
     """The fixture's objects (corners, triangles, material), sky radiance and camera."""
     if name == "cubes":
@@ -79,7 +103,11 @@ def fixture(name):
         objects.append((p, [0, 1, 2, 0, 2, 3], {"emission": 4.0}))
         camera = {"eye": [0.0, 0.0, 2.4], "target": [0.0, 0.0, 0.0], "yfov_deg": 34.0}
         return objects, 0.0, camera
-    raise SystemExit(f"unknown fixture {name!r} (cubes or slab)")
+    if name == "sphere":
+        p, i = sphere(1.0, 32, 64)
+        camera = {"eye": [0.0, 0.0, 4.0], "target": [0.0, 0.0, 0.0], "yfov_deg": 40.0}
+        return [(p, i, {"glass": 0.6})], 1.0, camera
+    raise SystemExit(f"unknown fixture {name!r} (cubes, slab or sphere)")
 
 
 def make_mesh(path, positions, indices, material):
@@ -117,7 +145,7 @@ def build_scene(name, spp_per_pass, tmp):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description="Mitsuba 3 references of rough glass")
-    ap.add_argument("--fixture", required=True, choices=["cubes", "slab"])
+    ap.add_argument("--fixture", required=True, choices=["cubes", "slab", "sphere"])
     ap.add_argument("--spp", type=int, default=16384, help="total samples per pixel")
     ap.add_argument("--pass-spp", type=int, default=256, help="samples per pixel per pass")
     ap.add_argument("--variant", default="scalar_rgb")
