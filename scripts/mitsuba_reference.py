@@ -44,7 +44,9 @@ import cornell_box  # noqa: E402  (same directory)
 import drjit as dr  # noqa: E402
 import mitsuba as mi  # noqa: E402
 
-mi.set_variant("llvm_ad_rgb")
+# The variant of this script; one that imports it may have chosen its own first.
+if mi.variant() is None:
+    mi.set_variant("llvm_ad_rgb")
 
 
 def _rgb(c):
@@ -72,6 +74,30 @@ def make_mesh(obj, material, twosided=False):
     return mesh
 
 
+def scene_dict(width, height, spp_per_pass, bounces, eye, target, up, yfov_deg, near, far):
+    """A Mitsuba scene dict with penumbra's settings and no shapes: a 'path' integrator of
+    max_depth bounces + 2 with Russian roulette off, a pinhole 'perspective' sensor from eye
+    towards target (vertical fov yfov_deg) and a linear RGB 'hdrfilm' with a box filter."""
+    return {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": bounces + 2, "rr_depth": bounces + 100,
+                       "hide_emitters": False},
+        "sensor": {
+            "type": "perspective",
+            "fov_axis": "y",
+            "fov": yfov_deg,
+            "near_clip": near,
+            "far_clip": far,
+            "to_world": mi.ScalarTransform4f().look_at(origin=list(eye), target=list(target),
+                                                       up=list(up)),
+            "sampler": {"type": "independent", "sample_count": spp_per_pass},
+            "film": {"type": "hdrfilm", "width": width, "height": height,
+                     "rfilter": {"type": "box"}, "pixel_format": "rgb",
+                     "component_format": "float32"},
+        },
+    }
+
+
 def build_scene(width, height, spp_per_pass, bounces, sc=None, twosided=False):
     """The Mitsuba scene of a cornell_box.scene()-style description (the Cornell box itself
     when `sc` is None); `twosided` as in make_mesh."""
@@ -79,24 +105,8 @@ def build_scene(width, height, spp_per_pass, bounces, sc=None, twosided=False):
     cam = sc["camera"]
     eye = cam["eye"]
     target = tuple(e + f for e, f in zip(eye, cam["forward"]))
-    d = {
-        "type": "scene",
-        "integrator": {"type": "path", "max_depth": bounces + 2, "rr_depth": bounces + 100,
-                       "hide_emitters": False},
-        "sensor": {
-            "type": "perspective",
-            "fov_axis": "y",
-            "fov": cam["yfov_deg"],
-            "near_clip": cam["znear"],
-            "far_clip": cam["zfar"],
-            "to_world": mi.ScalarTransform4f().look_at(origin=list(eye), target=list(target),
-                                                       up=list(cam["up"])),
-            "sampler": {"type": "independent", "sample_count": spp_per_pass},
-            "film": {"type": "hdrfilm", "width": width, "height": height,
-                     "rfilter": {"type": "box"}, "pixel_format": "rgb",
-                     "component_format": "float32"},
-        },
-    }
+    d = scene_dict(width, height, spp_per_pass, bounces, eye, target, cam["up"],
+                   cam["yfov_deg"], cam["znear"], cam["zfar"])
     for obj in sc["meshes"]:
         d["mesh_" + obj["name"]] = make_mesh(obj, sc["materials"][obj["material"]], twosided)
     for i, pl in enumerate(sc["point_lights"]):

@@ -9,8 +9,9 @@
 //                 (f0 from ior × specularColor, scaled by specularFactor) and the metal (f0 = base
 //                 color) mixed by metallic, with Kulla–Conty multiple scattering (a cosine lobe)
 //   transmission  the dielectric's transmitted share, tinted by base color: rough refraction
-//                 through a volume (Walter et al. 2007, radiance scaled by 1/eta^2), or straight
-//                 through a thin wall (both faces' Fresnel)
+//                 through a volume (Walter et al. 2007, radiance scaled by 1/eta^2), straight
+//                 through a volume of index 1 (a delta lobe whatever the roughness), or through a
+//                 thin wall (both faces' Fresnel)
 //   clear coat    (HAS_CLEARCOAT, KHR_materials_clearcoat) a GGX dielectric layer of ior 1.5 over
 //                 all the above, in the frame of its own normal, single scattering: it reflects
 //                 c A_c(mu) (A_c its directional albedo). The diffuse base sees coat and specular
@@ -158,7 +159,9 @@ inline float3 base_eval(const SurfaceMaterial* m, const BsdfLobes* l, float3 wo,
     float g1 = 1.0f / (1.0f + lambda_o);
     float inv_cos_o = 1.0f / fmax(wo.z, 1e-20f);
     float3 refl, trans;
-    if (wi.z > 0.0f || l->thin) {
+    if (wi.z < 0.0f && l->straight) {
+        // Straight transmission is a delta lobe: nothing to evaluate.
+    } else if (wi.z > 0.0f || l->thin) {
         // Reflection, or thin-wall transmission: the reflection mirrored through the surface.
         float3 wr = (float3)(wi.x, wi.y, fabs(wi.z));
         float3 h = normalize(wo + wr);
@@ -355,24 +358,29 @@ SHADE_INLINE float3 bsdf_sample(const SurfaceMaterial* m, float3 n, float3 wo_wo
         bsdf_gloss(m, &l, cos_oh, &refl, &trans);
         float pr = reflect_probability(refl, trans);
         bool reflect = u.z < pr;
+        bool delta = l.delta || (l.straight && !reflect);
         if (reflect || l.thin) {
             wi = 2.0f * cos_oh * h - wo;
             if (wi.z <= 0.0f) return (float3)(0.0f);
             if (!reflect) wi.z = -wi.z;
+        } else if (l.straight) {
+            wi = -wo;
         } else {
             float c2 = refracted_cos2(cos_oh, l.eta);
             if (c2 <= 0.0f) return (float3)(0.0f);
             wi = (cos_oh / l.eta - sqrt(c2)) * h - wo / l.eta;
             if (wi.z >= 0.0f) return (float3)(0.0f);
         }
-        if (l.delta) {
+        if (delta) {
+            // A delta lobe: its weight is the chosen share's, over the probability of choosing
+            // it (for a straight lobe under a rough surface, on average over the microfacets).
             float chosen = (1.0f - p_cos) * (reflect ? pr : 1.0f - pr);
             if (!(chosen > 0.0f)) return (float3)(0.0f);
             *wi_world = normalize(wi.x * t + wi.y * b + wi.z * n);
             *pdf = chosen;
             *specular = true;
             float3 w = (reflect ? refl : trans) / chosen;
-            w = reflect || l.thin ? w : w / (l.eta * l.eta);
+            w = reflect || l.thin || l.straight ? w : w / (l.eta * l.eta);
 #ifdef HAS_SHEEN
             if (l.sheen_max > 0.0f) {
                 *pdf *= p_under_sheen;

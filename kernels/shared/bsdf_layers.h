@@ -20,7 +20,9 @@ typedef struct {
     float transmission;
     float specular;    // specularFactor
     bool delta;        // glossy lobes are perfect mirror / refraction
-    bool thin;         // transmission goes straight through (thin wall, or eta close to 1)
+    bool thin;         // a thin wall: transmission is the reflection mirrored through it
+    bool straight;     // a volume of eta close to 1: every microfacet refracts wo straight on,
+                       // so its transmission is a delta lobe along -wo whatever the roughness
     float3 f0;         // dielectric normal-incidence reflectance before specularFactor
     float f0_layer;    // max3(f0): the channel whose specular albedo scales the diffuse layer
     float ms_layer;    // Kulla–Conty colour of the dielectric layer at f0_layer
@@ -355,7 +357,8 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float3 wo) {
     l.metallic = clamp(m->metallic, 0.0f, 1.0f);
     l.transmission = clamp(m->transmission, 0.0f, 1.0f);
     l.specular = clamp(m->specular_factor, 0.0f, 1.0f);
-    l.thin = m->thickness <= 0.0f || fabs(l.eta - 1.0f) < 1e-3f;
+    l.thin = m->thickness <= 0.0f;
+    l.straight = !l.thin && fabs(l.eta - 1.0f) < 1e-3f;
     float r = (l.eta - 1.0f) / (l.eta + 1.0f);
     l.f0 = fmin(r * r * m->specular_color, 1.0f);
     l.f0_layer = bsdf_max3(l.f0);
