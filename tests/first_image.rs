@@ -481,11 +481,12 @@ fn bench_albedo_measures_the_chart_as_the_defaults_show_it() {
     assert!(means[0] < means[1] && 2.0 * means[0] < means[2], "{out}");
 }
 
-/// A silver sphere (metal, roughness 0.1) at x = −1.2 and a clear glass sphere (thin-walled
-/// transmission) at x = +1.2, radius 1, on nothing, seen by their own camera from z = 6;
-/// `sun` adds a directional light from above and in front (as IridescenceSuzanne has). A
-/// glTF viewer shows both under a bright, even environment: the metal light grey with soft
-/// reflections, the glass clear, the world behind it bright.
+/// A silver sphere (metal, roughness 0.1) at x = −2.4, a white one (dielectric, base colour
+/// 0.8, roughness 0.5) at x = 0 and a clear glass sphere (thin-walled transmission) at x =
+/// +2.4, radius 1, on nothing, seen by their own camera from z = 9; `sun` adds a directional
+/// light from above and in front (as IridescenceSuzanne has). A glTF viewer shows them under
+/// a bright, even environment: the metal light grey with soft reflections, the white sphere
+/// white and shaded, not blown out, the glass clear, the world behind it bright.
 fn shiny_spheres_glb(dir: &std::path::Path, sun: bool) -> PathBuf {
     let mut g = common::Gltf::default();
     g.materials
@@ -498,7 +499,11 @@ fn shiny_spheres_glb(dir: &std::path::Path, sun: bool) -> PathBuf {
         "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0,
         "roughnessFactor": 0.0},
         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}}}));
-    for (material, x) in [(0, -1.2f32), (1, 1.2)] {
+    g.materials
+        .push(serde_json::json!({"pbrMetallicRoughness": {
+        "baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0,
+        "roughnessFactor": 0.5}}));
+    for (material, x) in [(0, -2.4f32), (2, 0.0), (1, 2.4)] {
         let (positions, normals, indices) = common::sphere(1.0, 24, 48, false);
         let mesh = g.mesh(vec![common::Prim {
             positions,
@@ -512,7 +517,7 @@ fn shiny_spheres_glb(dir: &std::path::Path, sun: bool) -> PathBuf {
     g.cameras.push(
         serde_json::json!({"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.01}}),
     );
-    g.node(serde_json::json!({"camera": 0, "translation": [0.0, 0.0, 6.0]}));
+    g.node(serde_json::json!({"camera": 0, "translation": [0.0, 0.0, 9.0]}));
     if sun {
         g.lights
             .push(serde_json::json!({"type": "directional", "intensity": 3.0}));
@@ -545,9 +550,11 @@ fn disc_luma(png: &std::path::Path, x: f64, y: f64, radius: f64) -> f64 {
 /// Metal and glass with nothing around them read as a viewer shows them, with no options: the
 /// silver sphere light, not near black, and the clear glass sphere showing a bright world
 /// through it, whether the scene has no light of its own (the environment lights it) or one
-/// sun that lights its side but surrounds nothing (the environment is a fill). Seen from z = 6
-/// with a vertical field of 0.6 rad, each sphere's disc spans about 0.55 of the height and its
-/// centre lies 0.22 of the width from the middle; the middle 0.4 of each disc is measured.
+/// sun that lights its side but surrounds nothing (the environment is a fill); the white
+/// sphere beside them is neither blown out nor dark. Seen from z = 9 with a vertical field of
+/// 0.6 rad, each sphere's disc spans about 0.36 of the height and the outer ones' centres lie
+/// 0.32 of the width from the middle; the middle 0.4 of each disc is measured. (In the studio
+/// HDRI, the default before the neutral room, the metal and the glass read near black.)
 #[test]
 fn metal_and_glass_with_nothing_around_them_read_light() {
     let dir = output_dir("first_image_shiny");
@@ -568,15 +575,18 @@ fn metal_and_glass_with_nothing_around_them_read_light() {
         ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        let metal = disc_luma(&png, 0.5 - 0.22, 0.5, 0.11);
-        let glass = disc_luma(&png, 0.5 + 0.22, 0.5, 0.11);
+        let metal = disc_luma(&png, 0.5 - 0.32, 0.5, 0.07);
+        let white = disc_luma(&png, 0.5, 0.5, 0.07);
+        let glass = disc_luma(&png, 0.5 + 0.32, 0.5, 0.07);
         eprintln!(
-            "sun {sun}: metal {metal:.3}, glass {glass:.3}, environment {}, fill {}",
+            "sun {sun}: metal {metal:.3}, white {white:.3}, glass {glass:.3}, environment {}, \
+             fill {}",
             s["environment"], s["first_view"]["environment_fill"]
         );
         assert!(
-            metal > 0.35 && glass > 0.35,
-            "sun {sun}: the metal's mean luma {metal:.3}, the glass's {glass:.3}: {s}"
+            metal > 0.35 && glass > 0.35 && white > 0.35 && white < 0.9,
+            "sun {sun}: mean luma of the metal {metal:.3}, the white sphere {white:.3}, the \
+             glass {glass:.3}: {s}"
         );
     }
 }
