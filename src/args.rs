@@ -206,13 +206,14 @@ pub struct EnvArgs {
     /// Uniform sky radiance as linear R,G,B (or one value for gray) (default: black).
     #[arg(long, value_parser = parse_color)]
     pub sky: Option<[f32; 3]>,
-    /// Environment light: `studio` or `outdoor` (bundled), `none`, an equirectangular .hdr or
-    /// .exr image (importance-sampled), or a uniform color R,G,B / gray value (like --sky).
-    /// Any environment replaces the default light rig (default: studio when the scene's own
-    /// lights do not light the view, else none; docs/first-image.md).
+    /// Environment light: `neutral`, `studio` or `outdoor` (bundled), `none`, an
+    /// equirectangular .hdr or .exr image (importance-sampled), or a uniform color R,G,B / gray
+    /// value (like --sky). Any environment replaces the default light rig (default: neutral
+    /// when the scene's own lights do not light the view or do not surround its metal and
+    /// glass, else none; docs/first-image.md).
     #[arg(
         long,
-        value_name = "studio|outdoor|none|FILE|COLOR",
+        value_name = "neutral|studio|outdoor|none|FILE|COLOR",
         conflicts_with = "sky",
         value_parser = parse_env
     )]

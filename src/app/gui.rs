@@ -162,7 +162,7 @@ pub struct Gui {
     pub env_text: String,
     /// The last error about an environment map.
     pub env_error: Option<String>,
-    /// The loaded environment map's name (`studio`, `outdoor` or the file's), if any; shows
+    /// The loaded environment map's name (`neutral`, `studio`, `outdoor` or the file's), if any; shows
     /// its controls.
     pub env_name: Option<String>,
     /// The help window (F1) is open.

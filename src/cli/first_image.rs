@@ -6,8 +6,11 @@
 
 /// An environment added to a view its own lights light (for its metal and glass) is a fill:
 /// scaled so that a white diffuse surface under it shows this share of what the scene's key
-/// light gives it (one stop below).
-pub const ENV_FILL: f64 = 0.5;
+/// light gives it. As much as the key: a glTF viewer adds its environment (radiance about 1)
+/// and the scene's lights each at its own level, and IridescenceSuzanne's sun of 3 lux gives a
+/// white surface about what its environment does (at one stop below, its metal and glass
+/// read a stop darker than the Khronos screenshot shows them).
+pub const ENV_FILL: f64 = 1.0;
 
 use crate::scene::framing::{self, FirstView};
 use crate::scene::{Camera, EnvMap, EnvPreset, Light, Scene};
@@ -105,7 +108,7 @@ pub fn decide(scene: &Scene, lights: &[Light], camera: Option<&Camera>, aspect: 
     // Metal and glass that the scene's own lights and walls do not surround reflect the world:
     // an environment (as a fill) shows what they are. A room lit by its own lamps keeps them.
     let fill = view.lit && reaches && !view.interior && view.shine_needs_environment();
-    let environment = ((!view.lit && reaches) || fill).then_some(EnvPreset::Studio);
+    let environment = ((!view.lit && reaches) || fill).then_some(EnvPreset::Neutral);
     // Inside a room, daylight through the windows is not enough: add a ceiling lamp and a light
     // at the camera unless the scene's own lights reach the view; so too in a closed room
     // without lights of its own. A closed room with lights of its own keeps them alone, lit

@@ -239,7 +239,13 @@ pub(super) fn light_test(
     let mut seen: Vec<f64> = samples.iter().filter_map(|s| s.1).collect();
     let coverage = (subject.len() + seen.len()) as f64 / samples.len() as f64;
     let shiny: Vec<usize> = samples.iter().filter_map(|s| s.2).collect();
-    let shiny_share = shiny.len() as f64 / subject.len().max(1) as f64;
+    // Over every sample that meets something: glass with nothing behind it is seen too (over
+    // the opaque points alone, two glass spheres on nothing made a share of 2).
+    let seen_any = samples
+        .iter()
+        .filter(|s| s.0.is_some() || s.1.is_some() || s.2.is_some())
+        .count();
+    let shiny_share = shiny.len() as f64 / seen_any.max(1) as f64;
     let shiny_sky = shiny.iter().sum::<usize>() as f64 / (shiny.len().max(1) * SKY_RAYS) as f64;
     if subject.is_empty() {
         return LightTest {

@@ -68,7 +68,8 @@ pub struct FirstView {
     /// subject points they light (0 when they light none): what an incident light meter at
     /// the subject reads.
     pub key_irradiance: f64,
-    /// The share of the subject points that are metal or glass (glass in front included).
+    /// The share of what the camera sees (the probe rays that meet something) that is metal
+    /// or glass (glass in front of the subject included).
     pub shiny_share: f64,
     /// The share of the hemisphere rays from those points that leave the scene.
     pub shiny_sky: f64,

@@ -633,9 +633,104 @@ fn a_flat_subject_is_seen_facing_it() {
     assert!(flat_facing(&probe, &[]).is_none());
 }
 
+/// A board of labelled squares in front of a cyclorama, as TransmissionRoughnessTest is built:
+/// a board 2 × 1.5 and 0.04 thick standing across z, six coloured squares (each its own
+/// object) on its front, and behind and under it one object, a floor sweeping up into a back
+/// wall, whose bounds hold the board. A viewer shows the board facing it, every square
+/// in the frame. The backdrop is the one object whose bounds hold every other's: it does not
+/// count against the flat-subject rule (counted, the scene's bounds, 6 × 3 × 5, are no board,
+/// and the lit-side search sees the board from some 25° above and aside).
+#[test]
+fn a_board_before_a_backdrop_is_seen_facing_it() {
+    let board = cuboid(
+        Vec3::new(-1.0, 0.0, -0.02),
+        Vec3::new(1.0, 1.5, 0.02),
+        false,
+    );
+    let mut parts = vec![(board, Material::default())];
+    for i in 0..6 {
+        let lo = Vec3::new(
+            -0.9 + 0.6 * (i % 3) as f32,
+            0.15 + 0.7 * (i / 3) as f32,
+            0.02,
+        );
+        let label = Material {
+            base_color: [0.2 + 0.15 * i as f32, 0.8 - 0.1 * i as f32, 0.3, 1.0],
+            ..Material::default()
+        };
+        parts.push((cuboid(lo, lo + Vec3::new(0.5, 0.5, 0.01), false), label));
+    }
+    // The cyclorama: a floor sweeping up into the back wall in eight steps of a quarter circle.
+    let sweep = |k: usize| {
+        let a = k as f32 / 8.0 * std::f32::consts::FRAC_PI_2;
+        (-2.0 - a.sin(), 1.0 - a.cos())
+    };
+    let mut backdrop = Vec::new();
+    let mut strip = |(z0, y0): (f32, f32), (z1, y1): (f32, f32)| {
+        let [a, b, c, d] = [
+            Vec3::new(-3.0, y0, z0),
+            Vec3::new(3.0, y0, z0),
+            Vec3::new(3.0, y1, z1),
+            Vec3::new(-3.0, y1, z1),
+        ];
+        backdrop.extend([[a, b, c], [a, c, d]]);
+    };
+    strip((2.0, 0.0), (-2.0, 0.0));
+    for k in 0..8 {
+        strip(sweep(k), sweep(k + 1));
+    }
+    strip((-3.0, 1.0), (-3.0, 3.0));
+    parts.push((backdrop, Material::default()));
+    let scene = scene_of(&parts);
+
+    // Counted, the backdrop makes the scene no board; left out, the board and its squares are.
+    let probe = Probe::new(&scene);
+    let e = probe.bounds.max - probe.bounds.min;
+    assert!(e.min_element() > FLAT_RATIO * e.max_element(), "{e:?}");
+    let rest = probe
+        .frame
+        .world_bounds(&without_backdrop(&probe).expect("the cyclorama is a backdrop"));
+    assert!(
+        (rest.min - DVec3::new(-1.0, 0.0, -0.02)).length() < 1e-4,
+        "{rest:?}"
+    );
+    assert!(
+        (rest.max - DVec3::new(1.0, 1.5, 0.03)).length() < 1e-4,
+        "{rest:?}"
+    );
+
+    let aspect = 4.0 / 3.0;
+    let view = first_view(&scene, &[], None, aspect);
+    let c = &view.camera;
+    // Facing the board: looking along −z within 2°.
+    assert!(
+        c.forward.dot(DVec3::NEG_Z) > 2f64.to_radians().cos(),
+        "{view:?}"
+    );
+    // All of the board in the frame.
+    let right = c.forward.cross(c.up).normalize();
+    let up = right.cross(c.forward);
+    let tan_y = (c.yfov * 0.5).tan();
+    for i in 0..8 {
+        let corner = DVec3::new(
+            if i & 1 == 0 { -1.0 } else { 1.0 },
+            if i & 2 == 0 { 0.0 } else { 1.5 },
+            if i & 4 == 0 { -0.02 } else { 0.03 },
+        );
+        let q = corner - c.eye;
+        let depth = q.dot(c.forward);
+        assert!(
+            depth > 0.0
+                && q.dot(right).abs() <= tan_y * aspect * depth
+                && q.dot(up).abs() <= tan_y * depth,
+            "the board's corner {corner} is out of the frame: {c:?}"
+        );
+    }
+}
+
 /// A metal cube on a white floor under a lamp: the lamp lights the view, but most of what the
 /// cube mirrors is the world, black without an environment, so the view asks for one (as a
-/// fill: a viewer shows the cube mirroring the studio and the floor lit by the lamp). The same
+/// fill: a viewer shows the cube mirroring the neutral room and the floor lit by the lamp). The same
 /// cube and lamp inside a closed room mirror the lit walls: the room keeps its own light. A
 /// white cube instead of the metal one asks for nothing.
 #[test]
