@@ -11,7 +11,7 @@ pub mod oidn;
 pub mod prepare;
 pub mod tza;
 
-use crate::cl::{Buffer, ClError, DenoiseKernels, Device, Launch};
+use crate::cl::{Buffer, ClError, DenoiseKernels, Device, Launch, PlaneCurve};
 pub use crate::cl::{ColorSource, FilmCount, GuideSums};
 use crate::render::Renderer;
 use network::{Network, OUTPUT, Slot};
@@ -296,10 +296,15 @@ impl Denoiser {
             for (prefilter, first) in &self.prefilters {
                 let k = &self.kernels;
                 let own = prefilter.tensor(Slot::Input);
-                launches.push(k.planes(device, input, *first, own, 0, window, f32::MAX)?);
+                // OIDN filters the albedo in sRGB, the normal as it is.
+                let (into, back) = match first {
+                    3 => (PlaneCurve::ToSrgb, PlaneCurve::FromSrgb),
+                    _ => (PlaneCurve::Linear, PlaneCurve::Linear),
+                };
+                launches.push(k.planes(device, input, *first, own, 0, window, f32::MAX, into)?);
                 launches.extend(prefilter.run(device, k)?);
                 let out = prefilter.tensor(OUTPUT);
-                launches.push(k.planes(device, out, 0, input, *first, window, 1.0)?);
+                launches.push(k.planes(device, out, 0, input, *first, window, 1.0, back)?);
             }
             launches.extend(self.network.run(device, &self.kernels)?);
             launches.push(self.kernels.output(
@@ -502,12 +507,22 @@ mod tests {
                     h: th,
                     v: v[first * plane..(first + 3) * plane].to_vec(),
                 };
+                // The albedo through the sRGB curve and back (OIDN's albedo filter).
+                let srgb = first == 3;
+                let mut guide = guide;
+                if srgb {
+                    guide
+                        .v
+                        .iter_mut()
+                        .for_each(|x| *x = prepare::srgb_forward(*x));
+                }
                 let out = reference::network(&guide, &tza::parse(bytes).unwrap());
                 for k in 0..3 {
                     for y in 0..h {
                         for x in 0..w {
                             let i = (k * th + y) * tw + x;
-                            v[first * plane + i] = out.v[i].min(1.0);
+                            let o = out.v[i].min(1.0);
+                            v[first * plane + i] = if srgb { prepare::srgb_inverse(o) } else { o };
                         }
                     }
                 }

@@ -109,6 +109,17 @@ pub struct ConvArgs<'a> {
     pub pool: bool,
 }
 
+/// How [`DenoiseKernels::planes`] maps each value (`DN_PLANES_*` in kernels/denoise/prepare.cl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlaneCurve {
+    /// As it is.
+    Linear = 0,
+    /// Into the sRGB curve.
+    ToSrgb = 1,
+    /// Out of the sRGB curve.
+    FromSrgb = 2,
+}
+
 /// Where one tile of the image goes in the network's input, and back.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TileWindow {
@@ -355,7 +366,8 @@ impl DenoiseKernels {
     }
 
     /// `denoise_planes`: three planes of one tile's tensor `src` from plane `src_first` into
-    /// `dst` from plane `dst_first`, capped at `hi`, zero outside the tile's image window.
+    /// `dst` from plane `dst_first`, capped at `hi`, mapped by `curve`, zero outside the
+    /// tile's image window.
     #[allow(clippy::too_many_arguments)]
     pub fn planes(
         &self,
@@ -366,7 +378,9 @@ impl DenoiseKernels {
         dst_first: usize,
         tile: TileWindow,
         hi: f32,
+        curve: PlaneCurve,
     ) -> Result<Launch, ClError> {
+        let curve = curve as i32;
         let (src_first, dst_first) = (src_first as i32, dst_first as i32);
         let ints = [
             tile.tile_w,
@@ -391,7 +405,7 @@ impl DenoiseKernels {
                 for i in &ints {
                     e.set_arg(i);
                 }
-                e.set_arg(&hi);
+                e.set_arg(&hi).set_arg(&curve);
             },
         )
     }
