@@ -11,6 +11,9 @@ DEST=assets/oidn
 declare -A SHA256=(
     [rt_hdr_alb_nrm.tza]=e586ef2ff48d7fbb7611986405220ed8fc5c13ca79bfc40be4dc742fbf959e1a
     [rt_hdr_alb_nrm_small.tza]=980ea307e7825cae23ed8b1addf8de62ece84b61094795a5631ebf1c91b2e1a7
+    [rt_hdr_calb_cnrm_large.tza]=08130cdc4f33b7a513d0073757f089ac830f900613bb5bad72ca42c52b934465
+    [rt_alb.tza]=752c9a8d57884d660ae375a7c853cad8a44f77d559bb282f0ef39f8e758601a4
+    [rt_nrm.tza]=fb8f7f5571332b602406f88a0b570d809dd3c06aebb530f5d048828f57490bc7
 )
 
 if [[ "${1:-}" != "--check" ]]; then

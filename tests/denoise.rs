@@ -4,7 +4,8 @@
 //! penumbra's denoiser against Intel's Open Image Denoise: the same colour, albedo and normal
 //! inputs through OIDN 2.5.1's `RT` filter (the pinned pyoidn wheel, scripts/install_oidn.sh)
 //! and through penumbra's OpenCL network must agree to PSNR >= 40 dB on the tone-mapped
-//! images, for both networks, on three shared scenes. Without pyoidn it skips with a note
+//! images, for the three networks (`large` after prefiltering the guides, as OIDN's `cleanAux`
+//! path does), on three shared scenes. Without pyoidn it skips with a note
 //! (fails under CI=true); without PENUMBRA_SCENES it skips.
 //!
 //! Inputs: a 4-spp render (128 x 128) of each scene with `--aovs`: its colour, and its albedo
@@ -69,7 +70,7 @@ fn the_network_agrees_with_intels_open_image_denoise() {
         let (_, _, channels) = penumbra::image_io::read_exr_channels(&out).unwrap();
         let albedo = layer(&channels, ["albedo.R", "albedo.G", "albedo.B"]);
         let normal = layer(&channels, ["normal.X", "normal.Y", "normal.Z"]);
-        for quality in [Quality::Full, Quality::Small] {
+        for quality in [Quality::Full, Quality::Small, Quality::Large] {
             let (intel, _) =
                 oidn::denoise(SIZE, SIZE, quality, "cpu", [&noisy, &albedo, &normal], 0)
                     .expect("Open Image Denoise runs");

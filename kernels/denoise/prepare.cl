@@ -116,3 +116,35 @@ kernel void denoise_output(global const float* src, int tile_w, int tile_h, int 
     v = (float3)(pu_inverse(v.x * pu_max), pu_inverse(v.y * pu_max), pu_inverse(v.z * pu_max));
     out[(dst_y + y) * width + dst_x + x] = (float4)(v * output_scale, 1.0f);
 }
+
+// How `denoise_planes` maps a value: as it is, into the sRGB curve, or out of it.
+#define DN_PLANES_LINEAR 0
+#define DN_PLANES_TO_SRGB 1
+#define DN_PLANES_FROM_SRGB 2
+
+// Three planes of a `tile_w` x `tile_h` tensor, from `src`'s plane `src_first` on into `dst`'s
+// plane `dst_first` on, each value capped at `hi` and mapped by `curve` (DN_PLANES_*), inside
+// the window of the image (`w` x `h` from (x0, y0)) and zero outside it: a guide into its
+// prefilter's input, and the prefilter's output back into the denoising network's input. OIDN
+// filters the albedo in sRGB and clamps its output to [0, 1]; the normal linearly, mapping
+// its output x to 2x - 1 clamped to [-1, 1], which the input maps back: min(x, 1), as the ReLU
+// leaves x >= 0.
+kernel void denoise_planes(global const float* src, int src_first, global float* dst,
+                           int dst_first, int tile_w, int tile_h, int x0, int y0, int w, int h,
+                           float hi, int curve) {
+    const int x = get_global_id(0);
+    const int y = get_global_id(1);
+    if (x >= tile_w || y >= tile_h)
+        return;
+    const int plane = tensor_plane(tile_w, tile_h);
+    const int at = tensor_at(tile_w, x, y);
+    const bool inside = x >= x0 && x < x0 + w && y >= y0 && y < y0 + h;
+    for (int k = 0; k < 3; ++k) {
+        float v = fmin(src[(src_first + k) * plane + at], hi);
+        if (curve == DN_PLANES_TO_SRGB)
+            v = srgb_forward(v);
+        else if (curve == DN_PLANES_FROM_SRGB)
+            v = srgb_inverse(v);
+        dst[(dst_first + k) * plane + at] = inside ? v : 0.0f;
+    }
+}

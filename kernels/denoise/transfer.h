@@ -34,4 +34,14 @@ inline float pu_inverse(float x) {
     return exp((x - PU_G) / PU_E) - PU_F;
 }
 
+// The sRGB curve, which OIDN's albedo prefilter (`rt_alb`) works in: its input is the albedo
+// encoded, its output decoded. Host twin: `prepare::srgb_forward` / `srgb_inverse`.
+inline float srgb_forward(float y) {
+    return y <= 0.0031308f ? 12.92f * y : 1.055f * pow(y, 1.0f / 2.4f) - 0.055f;
+}
+
+inline float srgb_inverse(float x) {
+    return x <= 0.04045f ? x / 12.92f : pow((x + 0.055f) / 1.055f, 2.4f);
+}
+
 #endif

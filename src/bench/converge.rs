@@ -57,7 +57,7 @@ pub struct ConvergeArgs {
     /// render with the guide buffers on.
     #[arg(long)]
     pub denoise: bool,
-    /// The denoiser's network with --denoise: full or small.
+    /// The denoiser's network with --denoise: full, small or large.
     #[arg(
         long,
         value_name = "NETWORK",

@@ -30,7 +30,7 @@ pub struct DenoiseArgs {
     /// Image height (default: 600).
     #[arg(long, default_value_t = 600)]
     pub height: usize,
-    /// Network: full or small (default: full).
+    /// Network: full, small or large (default: full).
     #[arg(long, default_value = "full")]
     pub quality: String,
     /// Timed runs after the warm-up (default: 3).

@@ -15,7 +15,9 @@ use opencl3::kernel::{ExecuteKernel, Kernel};
 use std::sync::OnceLock;
 use test_program::TestKernels;
 
-pub use denoise::{ColorSource, ConvArgs, DenoiseKernels, FilmCount, GuideSums, TileWindow};
+pub use denoise::{
+    ColorSource, ConvArgs, DenoiseKernels, FilmCount, GuideSums, PlaneCurve, TileWindow,
+};
 
 // Also named from here by the renderer, the scene loader and the benchmarks.
 pub use super::host_memory::{OpeningMemory, map_file};

@@ -23,7 +23,8 @@ pub use buffer::Buffer;
 pub use device::{Device, DeviceChoice, DeviceInfo, DeviceSet, list_devices};
 pub use host_memory::{OpeningMemory, map_file};
 pub use kernels::{
-    ColorSource, ConvArgs, DenoiseKernels, FilmCount, GuideSums, Launch, Program, TileWindow,
+    ColorSource, ConvArgs, DenoiseKernels, FilmCount, GuideSums, Launch, PlaneCurve, Program,
+    TileWindow,
 };
 pub use program::{KernelFeatures, build_denoise_program, build_program, build_test_program};
 pub use scene_buffers::{EnvBuffers, NodeForms, SceneBuffers};

@@ -112,8 +112,9 @@ pub struct RenderArgs {
     /// denoised.R/G/B, a .png is the denoised image (default: off).
     #[arg(long, conflicts_with = "sample_start")]
     pub denoise: bool,
-    /// The denoiser's network: full, or small (about a third of the work, a little less
-    /// sharp) (default: full).
+    /// The denoiser's network: full, small (about a third of the work, a little less sharp),
+    /// or large (prefilters the albedo and normal guides, then a network about 5 times the
+    /// full one's work: closer to the converged image) (default: full).
     #[arg(
         long,
         value_name = "NETWORK",

@@ -11,7 +11,7 @@ pub mod oidn;
 pub mod prepare;
 pub mod tza;
 
-use crate::cl::{Buffer, ClError, DenoiseKernels, Device, Launch};
+use crate::cl::{Buffer, ClError, DenoiseKernels, Device, Launch, PlaneCurve};
 pub use crate::cl::{ColorSource, FilmCount, GuideSums};
 use crate::render::Renderer;
 use network::{Network, OUTPUT, Slot};
@@ -24,9 +24,16 @@ pub mod weights {
     pub const FULL: &[u8] = include_bytes!("../../assets/oidn/rt_hdr_alb_nrm.tza");
     /// `rt_hdr_alb_nrm_small.tza`: the small network.
     pub const SMALL: &[u8] = include_bytes!("../../assets/oidn/rt_hdr_alb_nrm_small.tza");
+    /// `rt_hdr_calb_cnrm_large.tza`: the large network, for prefiltered (clean) guides.
+    pub const LARGE: &[u8] = include_bytes!("../../assets/oidn/rt_hdr_calb_cnrm_large.tza");
+    /// `rt_alb.tza`: the albedo guide's prefilter.
+    pub const ALBEDO: &[u8] = include_bytes!("../../assets/oidn/rt_alb.tza");
+    /// `rt_nrm.tza`: the normal guide's prefilter.
+    pub const NORMAL: &[u8] = include_bytes!("../../assets/oidn/rt_nrm.tza");
 }
 
-/// Which trained network runs: OIDN's `high`/`balanced` weights or its `fast` ones.
+/// Which trained networks run: OIDN's `high`/`balanced` weights for noisy guides, its `fast`
+/// ones, or its `high` weights for clean guides after prefiltering them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Quality {
     /// `rt_hdr_alb_nrm`: about 250 kFLOP a pixel.
@@ -34,6 +41,11 @@ pub enum Quality {
     Full,
     /// `rt_hdr_alb_nrm_small`: about a third of that, a little less sharp.
     Small,
+    /// The albedo and normal guides prefiltered by `rt_alb` and `rt_nrm`, then
+    /// `rt_hdr_calb_cnrm_large` (OIDN's `UNetLarge`): about 5 times the full network's work,
+    /// closer to the converged image where the guides are noisy at few samples
+    /// (docs/denoiser.md, "How good").
+    Large,
 }
 
 impl Quality {
@@ -42,6 +54,7 @@ impl Quality {
         match self {
             Quality::Full => "full",
             Quality::Small => "small",
+            Quality::Large => "large",
         }
     }
 
@@ -49,7 +62,13 @@ impl Quality {
         match self {
             Quality::Full => weights::FULL,
             Quality::Small => weights::SMALL,
+            Quality::Large => weights::LARGE,
         }
+    }
+
+    /// Whether the guides are prefiltered before the colour is denoised.
+    pub fn prefilters_guides(self) -> bool {
+        self == Quality::Large
     }
 }
 
@@ -59,7 +78,10 @@ impl std::str::FromStr for Quality {
         match s {
             "full" => Ok(Quality::Full),
             "small" => Ok(Quality::Small),
-            other => Err(format!("denoiser '{other}' is not 'full' or 'small'")),
+            "large" => Ok(Quality::Large),
+            other => Err(format!(
+                "denoiser '{other}' is not 'full', 'small' or 'large'"
+            )),
         }
     }
 }
@@ -115,6 +137,9 @@ pub struct DenoiseInput<'a> {
 pub struct Denoiser {
     kernels: DenoiseKernels,
     network: Network,
+    /// The albedo's and the normal's prefilters, with the first plane of their guide in the
+    /// network's input ([`Quality::prefilters_guides`]).
+    prefilters: Vec<(Network, usize)>,
     quality: Quality,
     memory_limit: usize,
     /// The exposure blocks' buffer.
@@ -128,13 +153,30 @@ impl Denoiser {
     /// that its film buffers can be passed to [`Denoiser::denoise`]).
     pub fn new(device: &Device, quality: Quality) -> Result<Self, DenoiseError> {
         let kernels = DenoiseKernels::build(device)?;
-        let tensors =
-            tza::parse(quality.weights()).map_err(|e| DenoiseError::Weights(e.to_string()))?;
-        let network = Network::new(device, &kernels, &tensors).map_err(DenoiseError::Weights)?;
+        let load = |bytes: &[u8], input_channels: usize| {
+            let tensors = tza::parse(bytes).map_err(|e| DenoiseError::Weights(e.to_string()))?;
+            let network =
+                Network::new(device, &kernels, &tensors).map_err(DenoiseError::Weights)?;
+            if network.input_channels() != input_channels {
+                return Err(DenoiseError::Weights(format!(
+                    "a network takes {} input channels, not {input_channels}",
+                    network.input_channels()
+                )));
+            }
+            Ok(network)
+        };
+        let network = load(quality.weights(), network::INPUT_CHANNELS)?;
+        let mut prefilters = Vec::new();
+        if quality.prefilters_guides() {
+            // The albedo is the input's planes 3-5, the normal 6-8 (kernels/denoise/prepare.cl).
+            prefilters.push((load(weights::ALBEDO, 3)?, 3));
+            prefilters.push((load(weights::NORMAL, 3)?, 6));
+        }
         let device_memory = device.info.memory as usize;
         Ok(Self {
             kernels,
             network,
+            prefilters,
             quality,
             memory_limit: DEFAULT_MEMORY.min((device_memory / 4).max(64 << 20)),
             bins: None,
@@ -154,7 +196,13 @@ impl Denoiser {
 
     /// How a `width` x `height` image will be tiled.
     pub fn tiling(&self, width: usize, height: usize) -> Tiling {
-        let per_pixel = self.network.tensor_bytes(64, 64) as f64 / (64.0 * 64.0);
+        let bytes = self.network.tensor_bytes(64, 64)
+            + self
+                .prefilters
+                .iter()
+                .map(|(n, _)| n.tensor_bytes(64, 64))
+                .sum::<usize>();
+        let per_pixel = bytes as f64 / (64.0 * 64.0);
         let max_pixels = (self.memory_limit as f64 / per_pixel) as usize;
         Tiling::new(width, height, max_pixels)
     }
@@ -162,7 +210,12 @@ impl Denoiser {
     /// Multiply-adds of the network over a `width` x `height` image's tiles, times two.
     pub fn flops(&self, width: usize, height: usize) -> f64 {
         let t = self.tiling(width, height);
-        self.network.flops(t.tile_w, t.tile_h) * t.count() as f64
+        let prefilters: f64 = self
+            .prefilters
+            .iter()
+            .map(|(n, _)| n.flops(t.tile_w, t.tile_h))
+            .sum();
+        (self.network.flops(t.tile_w, t.tile_h) + prefilters) * t.count() as f64
     }
 
     /// Denoises `input` into `output` (RGBA f32 per pixel, row-major, `.w` = 1; at least
@@ -222,6 +275,9 @@ impl Denoiser {
 
         let tiling = self.tiling(width, height);
         self.network.prepare(device, tiling.tile_w, tiling.tile_h)?;
+        for (prefilter, _) in &mut self.prefilters {
+            prefilter.prepare(device, tiling.tile_w, tiling.tile_h)?;
+        }
         let pu_max = prepare::pu_max();
         for (window, kept) in tiling.windows(width, height) {
             launches.push(self.kernels.input(
@@ -234,6 +290,22 @@ impl Denoiser {
                 1.0 / pu_max,
                 self.network.tensor(Slot::Input),
             )?);
+            // Each guide through its prefilter and back, as OIDN's prefiltered guides are
+            // prepared for the network that takes clean ones.
+            let input = self.network.tensor(Slot::Input);
+            for (prefilter, first) in &self.prefilters {
+                let k = &self.kernels;
+                let own = prefilter.tensor(Slot::Input);
+                // OIDN filters the albedo in sRGB, the normal as it is.
+                let (into, back) = match first {
+                    3 => (PlaneCurve::ToSrgb, PlaneCurve::FromSrgb),
+                    _ => (PlaneCurve::Linear, PlaneCurve::Linear),
+                };
+                launches.push(k.planes(device, input, *first, own, 0, window, f32::MAX, into)?);
+                launches.extend(prefilter.run(device, k)?);
+                let out = prefilter.tensor(OUTPUT);
+                launches.push(k.planes(device, out, 0, input, *first, window, 1.0, back)?);
+            }
             launches.extend(self.network.run(device, &self.kernels)?);
             launches.push(self.kernels.output(
                 device,
@@ -425,6 +497,37 @@ mod tests {
                 }
             }
         }
+        if q.prefilters_guides() {
+            // Each guide's planes through its prefilter, capped at 1 and zero outside the image.
+            for (bytes, first) in [(weights::ALBEDO, 3), (weights::NORMAL, 6)] {
+                let plane = tw * th;
+                let guide = Planes {
+                    c: 3,
+                    w: tw,
+                    h: th,
+                    v: v[first * plane..(first + 3) * plane].to_vec(),
+                };
+                // The albedo through the sRGB curve and back (OIDN's albedo filter).
+                let srgb = first == 3;
+                let mut guide = guide;
+                if srgb {
+                    guide
+                        .v
+                        .iter_mut()
+                        .for_each(|x| *x = prepare::srgb_forward(*x));
+                }
+                let out = reference::network(&guide, &tza::parse(bytes).unwrap());
+                for k in 0..3 {
+                    for y in 0..h {
+                        for x in 0..w {
+                            let i = (k * th + y) * tw + x;
+                            let o = out.v[i].min(1.0);
+                            v[first * plane + i] = if srgb { prepare::srgb_inverse(o) } else { o };
+                        }
+                    }
+                }
+            }
+        }
         let weights = tza::parse(q.weights()).unwrap();
         let out = reference::network(
             &Planes {
@@ -445,11 +548,11 @@ mod tests {
     }
 
     #[test]
-    fn both_networks_denoise_as_the_host_reference_does() {
+    fn every_network_denoises_as_the_host_reference_does() {
         let device = device();
         let (w, h) = (40, 24);
         let [c, a, n] = images(w, h);
-        for q in [Quality::Full, Quality::Small] {
+        for q in [Quality::Full, Quality::Small, Quality::Large] {
             let mut d = Denoiser::new(&device, q).expect("denoiser");
             let (got, report) = d.denoise_host(&device, w, h, &c, &a, &n).expect("denoise");
             assert_eq!(report.tiling.count(), 1);
@@ -471,7 +574,8 @@ mod tests {
 
     /// One very bright sample in a dark region (a firefly: a 16-spp pixel whose one sample
     /// is 20,000 times the wall's radiance) is taken for noise and removed, as Intel's OIDN
-    /// does: no blotch is left around it (docs/denoiser.md, "Fireflies").
+    /// does: no blotch is left around it (docs/denoiser.md, "Fireflies"), with either network
+    /// that `render --denoise` may run.
     #[test]
     fn an_isolated_firefly_leaves_no_blotch() {
         let device = device();
@@ -487,26 +591,28 @@ mod tests {
             vec![[0.5; 3]; color.len()],
             vec![[0.0, 0.0, 1.0]; color.len()],
         );
-        let mut d = Denoiser::new(&device, Quality::Full).expect("denoiser");
-        let denoise = |d: &mut Denoiser, c: &[[f32; 3]]| {
-            d.denoise_host(&device, w, h, c, &albedo, &normal)
-                .expect("denoise")
-                .0
-        };
-        let clean = denoise(&mut d, &color);
         let mut firefly = color.clone();
         let centre = h / 2 * w + w / 2;
         firefly[centre] = [0.05 + 1000.0 / 16.0; 3];
-        let out = denoise(&mut d, &firefly);
-        for y in h / 2 - 4..=h / 2 + 4 {
-            for x in w / 2 - 4..=w / 2 + 4 {
-                let i = y * w + x;
-                assert!(
-                    (out[i][1] - clean[i][1]).abs() <= 0.25 * clean[i][1],
-                    "({x}, {y}): {} beside {} without the firefly",
-                    out[i][1],
-                    clean[i][1]
-                );
+        for q in [Quality::Full, Quality::Large] {
+            let mut d = Denoiser::new(&device, q).expect("denoiser");
+            let mut denoise = |c: &[[f32; 3]]| {
+                d.denoise_host(&device, w, h, c, &albedo, &normal)
+                    .expect("denoise")
+                    .0
+            };
+            let clean = denoise(&color);
+            let out = denoise(&firefly);
+            for y in h / 2 - 4..=h / 2 + 4 {
+                for x in w / 2 - 4..=w / 2 + 4 {
+                    let i = y * w + x;
+                    assert!(
+                        (out[i][1] - clean[i][1]).abs() <= 0.25 * clean[i][1],
+                        "{q:?} ({x}, {y}): {} beside {} without the firefly",
+                        out[i][1],
+                        clean[i][1]
+                    );
+                }
             }
         }
     }

@@ -5,12 +5,18 @@
 //! encoder's output of that resolution and convolve twice; every convolution is 3x3 with a bias
 //! and a ReLU, the last one included. Here the upsampling and concatenation are fused into the
 //! decoder convolution's reads and the pool into the encoder convolution's writes.
+//!
+//! The large weights (`rt_hdr_calb_cnrm_large`, OIDN's `high` quality with clean guides) are
+//! OIDN's `UNetLarge`: two convolutions at each encoder level, the second pooled, wider
+//! channels (64 to 256) and a third full-resolution decoder convolution (`LARGE_STEPS`). The
+//! guide prefilters (`rt_alb`, `rt_nrm`) are the standard layer list on 3 input channels.
 
 use super::tza::Tensor;
 use crate::cl::{Buffer, ClError, ConvArgs, DenoiseKernels, Device};
 use std::collections::HashMap;
 
-/// Channels of the network's input: colour, albedo and normal.
+/// Channels of the denoising networks' input: colour, albedo and normal (the guide
+/// prefilters take 3).
 pub const INPUT_CHANNELS: usize = 9;
 
 /// The network's tensors, each at a resolution (`level`: halved that many times). Decoder
@@ -90,17 +96,11 @@ const fn up(name: &'static str, src0: Slot, skip: Slot, dst: Slot) -> Step {
     }
 }
 
-/// The network in execution order.
-pub const STEPS: [Step; 16] = {
+/// The decoder both networks share, from the bottom level up to the full-resolution tensor
+/// before the last convolution.
+const DECODER: [Step; 8] = {
     use Slot::*;
     [
-        step("enc_conv0", Input, Full1, false),
-        step("enc_conv1", Full1, Pool1, true),
-        step("enc_conv2", Pool1, Pool2, true),
-        step("enc_conv3", Pool2, Pool3, true),
-        step("enc_conv4", Pool3, Bottom1, true),
-        step("enc_conv5a", Bottom1, Bottom2, false),
-        step("enc_conv5b", Bottom2, Bottom1, false),
         up("dec_conv4a", Bottom1, Pool3, Decoder(3, false)),
         step("dec_conv4b", Decoder(3, false), Decoder(3, true), false),
         up("dec_conv3a", Decoder(3, true), Pool2, Decoder(2, false)),
@@ -109,9 +109,71 @@ pub const STEPS: [Step; 16] = {
         step("dec_conv2b", Decoder(1, false), Decoder(1, true), false),
         up("dec_conv1a", Decoder(1, true), Input, Full2),
         step("dec_conv1b", Full2, Full1, false),
-        step("dec_conv0", Full1, Full2, false),
     ]
 };
+
+/// `encoder`, then [`DECODER`], then `last`: `N` steps.
+const fn network<const N: usize>(encoder: &[Step], last: Step) -> [Step; N] {
+    assert!(encoder.len() + DECODER.len() + 1 == N);
+    let mut out = [last; N];
+    let mut i = 0;
+    while i < encoder.len() {
+        out[i] = encoder[i];
+        i += 1;
+    }
+    while i < encoder.len() + DECODER.len() {
+        out[i] = DECODER[i - encoder.len()];
+        i += 1;
+    }
+    out
+}
+
+/// The network in execution order (OIDN's `UNet`).
+pub const STEPS: [Step; 16] = {
+    use Slot::*;
+    network(
+        &[
+            step("enc_conv0", Input, Full1, false),
+            step("enc_conv1", Full1, Pool1, true),
+            step("enc_conv2", Pool1, Pool2, true),
+            step("enc_conv3", Pool2, Pool3, true),
+            step("enc_conv4", Pool3, Bottom1, true),
+            step("enc_conv5a", Bottom1, Bottom2, false),
+            step("enc_conv5b", Bottom2, Bottom1, false),
+        ],
+        step("dec_conv0", Full1, Full2, false),
+    )
+};
+
+/// OIDN's `UNetLarge` in execution order. The first convolution of each encoder level below
+/// the input writes the decoder's first tensor of that level, free until the decoder runs.
+pub const LARGE_STEPS: [Step; 19] = {
+    use Slot::*;
+    network(
+        &[
+            step("enc_conv1a", Input, Full1, false),
+            step("enc_conv1b", Full1, Pool1, true),
+            step("enc_conv2a", Pool1, Decoder(1, false), false),
+            step("enc_conv2b", Decoder(1, false), Pool2, true),
+            step("enc_conv3a", Pool2, Decoder(2, false), false),
+            step("enc_conv3b", Decoder(2, false), Pool3, true),
+            step("enc_conv4a", Pool3, Decoder(3, false), false),
+            step("enc_conv4b", Decoder(3, false), Bottom1, true),
+            step("enc_conv5a", Bottom1, Bottom2, false),
+            step("enc_conv5b", Bottom2, Bottom1, false),
+        ],
+        step("dec_conv1c", Full1, Full2, false),
+    )
+};
+
+/// The layer list the weights are for: `UNetLarge`'s when they hold its first convolution.
+pub fn steps_for(weights: &HashMap<String, Tensor>) -> &'static [Step] {
+    if weights.contains_key("enc_conv1a.weight") {
+        &LARGE_STEPS
+    } else {
+        &STEPS
+    }
+}
 
 /// The slot holding the network's output (channels 0-2).
 pub const OUTPUT: Slot = Slot::Full2;
@@ -131,6 +193,8 @@ struct Layer {
 /// The network's weights on the device and, once an image size is known, its tensors.
 pub struct Network {
     layers: Vec<Layer>,
+    /// Channels of the input slot: 9 for the denoising networks, 3 for the guide prefilters.
+    input_channels: usize,
     /// Channels each slot holds at most (padded), by slot.
     channels: Vec<(Slot, usize)>,
     tensors: Option<Tensors>,
@@ -176,11 +240,17 @@ impl Network {
         weights: &HashMap<String, Tensor>,
     ) -> Result<Self, String> {
         let ocb = kernels.ocb;
+        let steps = steps_for(weights);
+        let first = format!("{}.weight", steps[0].name);
+        let input_channels = match weights.get(&first).map(|w| w.dims.as_slice()) {
+            Some(&[_, c, ..]) => c,
+            _ => return Err(format!("the weights have no tensor '{first}'")),
+        };
         // Real (unpadded) output channels of each slot's last writer, as a reader sees them.
-        let mut produced: Vec<(Slot, usize)> = vec![(Slot::Input, INPUT_CHANNELS)];
-        let mut channels: Vec<(Slot, usize)> = vec![(Slot::Input, INPUT_CHANNELS)];
+        let mut produced: Vec<(Slot, usize)> = vec![(Slot::Input, input_channels)];
+        let mut channels: Vec<(Slot, usize)> = vec![(Slot::Input, input_channels)];
         let mut layers = Vec::new();
-        for s in STEPS {
+        for &s in steps {
             let get = |suffix: &str| {
                 let name = format!("{}.{suffix}", s.name);
                 weights
@@ -242,9 +312,15 @@ impl Network {
         }
         Ok(Self {
             layers,
+            input_channels,
             channels,
             tensors: None,
         })
+    }
+
+    /// Channels of the input tensor the weights expect.
+    pub fn input_channels(&self) -> usize {
+        self.input_channels
     }
 
     /// Device bytes the tensors take for a `width` x `height` tile.
@@ -464,7 +540,7 @@ pub(crate) mod reference {
     /// The whole network on a prepared input.
     pub fn network(input: &Planes, weights: &HashMap<String, Tensor>) -> Planes {
         let mut slots: Vec<(Slot, Planes)> = vec![(Slot::Input, input.clone())];
-        for s in STEPS {
+        for &s in steps_for(weights) {
             let get = |slot: Slot| {
                 slots
                     .iter()

@@ -20,15 +20,18 @@ pub fn available() -> bool {
         .is_ok_and(|s| s.success())
 }
 
-/// OIDN's quality setting that runs `quality`'s weights.
+/// The script's setting that runs `quality`'s weights: OIDN's quality, or `large` for the
+/// guides prefiltered at `balanced` (rt_alb, rt_nrm) and then `high` with clean guides.
 fn quality_name(quality: Quality) -> &'static str {
     match quality {
         Quality::Full => "high",
         Quality::Small => "fast",
+        Quality::Large => "large",
     }
 }
 
-/// Runs OIDN's `RT` filter (hdr, albedo, normal) on OIDN's `device` (`cpu` or `cuda`); then,
+/// Runs OIDN's `RT` filter (hdr, albedo, normal; for [`Quality::Large`] after filtering the
+/// albedo and the normal, with `cleanAux`) on OIDN's `device` (`cpu` or `cuda`); then,
 /// with `runs` > 0, times that many more executions. Returns the denoised image and the times
 /// in milliseconds.
 pub fn denoise(

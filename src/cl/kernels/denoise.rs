@@ -109,6 +109,17 @@ pub struct ConvArgs<'a> {
     pub pool: bool,
 }
 
+/// How [`DenoiseKernels::planes`] maps each value (`DN_PLANES_*` in kernels/denoise/prepare.cl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlaneCurve {
+    /// As it is.
+    Linear = 0,
+    /// Into the sRGB curve.
+    ToSrgb = 1,
+    /// Out of the sRGB curve.
+    FromSrgb = 2,
+}
+
 /// Where one tile of the image goes in the network's input, and back.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TileWindow {
@@ -138,6 +149,7 @@ pub struct DenoiseKernels {
     exposure_bins: Kernel,
     input: Kernel,
     output: Kernel,
+    planes: Kernel,
     /// Output channels a convolution's work item computes (`DN_OCB`).
     pub ocb: usize,
     /// Neighbouring columns a convolution's work item computes (`DN_VEC`).
@@ -193,6 +205,7 @@ impl DenoiseKernels {
             exposure_bins: kernel(&program, "denoise_exposure_bins")?,
             input: kernel(&program, "denoise_input")?,
             output: kernel(&program, "denoise_output")?,
+            planes: kernel(&program, "denoise_planes")?,
             ocb,
             vec,
             group_x,
@@ -348,6 +361,51 @@ impl DenoiseKernels {
                 e.set_arg(&pu_max)
                     .set_arg(&output_scale)
                     .set_arg(&out.mem());
+            },
+        )
+    }
+
+    /// `denoise_planes`: three planes of one tile's tensor `src` from plane `src_first` into
+    /// `dst` from plane `dst_first`, capped at `hi`, mapped by `curve`, zero outside the
+    /// tile's image window.
+    #[allow(clippy::too_many_arguments)]
+    pub fn planes(
+        &self,
+        device: &Device,
+        src: &Buffer<f32>,
+        src_first: usize,
+        dst: &Buffer<f32>,
+        dst_first: usize,
+        tile: TileWindow,
+        hi: f32,
+        curve: PlaneCurve,
+    ) -> Result<Launch, ClError> {
+        let curve = curve as i32;
+        let (src_first, dst_first) = (src_first as i32, dst_first as i32);
+        let ints = [
+            tile.tile_w,
+            tile.tile_h,
+            tile.tile_x,
+            tile.tile_y,
+            tile.w,
+            tile.h,
+        ]
+        .map(|v| v as i32);
+        launch(
+            device,
+            "denoise_planes",
+            &self.planes,
+            &[tile.tile_w, tile.tile_h],
+            &GROUP_2D,
+            |e| unsafe {
+                e.set_arg(&src.mem())
+                    .set_arg(&src_first)
+                    .set_arg(&dst.mem())
+                    .set_arg(&dst_first);
+                for i in &ints {
+                    e.set_arg(i);
+                }
+                e.set_arg(&hi).set_arg(&curve);
             },
         )
     }
