@@ -617,6 +617,12 @@ impl Scene {
         (out, dropped)
     }
 
+    /// Object `i` placed in the render space of `frame` (its vertices and normals
+    /// transformed once), from which its triangles are read as [`Scene::flatten`] makes them.
+    pub fn place(&self, i: usize, frame: &RenderFrame) -> Placed<'_> {
+        Placed::new(i as u32, &self.objects[i], frame, true)
+    }
+
     /// Object `i`'s triangles in the render space of `frame`, in its mesh's order, as
     /// [`Scene::flatten`] gives them (whether or not the object is visible).
     pub fn flatten_object(&self, i: usize, frame: &RenderFrame) -> Flattened {
@@ -781,8 +787,8 @@ pub(crate) fn world_points(o: &Object) -> Vec<DVec3> {
 }
 
 /// An object's vertices (and normals, when asked for) in render space, from which its
-/// flattened triangles are made one by one.
-struct Placed<'a> {
+/// flattened triangles are made one by one ([`Scene::place`]).
+pub struct Placed<'a> {
     object: u32,
     o: &'a Object,
     /// Render-space vertices.
@@ -868,21 +874,62 @@ impl<'a> Placed<'a> {
         if self.flip { [a, c, b] } else { [a, b, c] }
     }
 
-    fn world_triangle(&self, ti: usize) -> WorldTriangle {
-        let o = self.o;
-        let m = o.world_from_object;
+    /// Triangles with a non-finite or absurd vertex, which [`Scene::flatten`] drops.
+    pub fn dropped(&self) -> usize {
+        self.dropped
+    }
+
+    /// Mesh triangle `ti`'s render-space corners and corner normals (the geometric normal
+    /// where the mesh has none or a vertex's is zero), and whether the normals came from the
+    /// file: the geometry of its [`WorldTriangle`], made without the rest.
+    #[inline]
+    pub fn shape(&self, ti: usize) -> ([Vec3; 3], [Vec3; 3], bool) {
         let idx = self.corners(ti);
         let v = idx.map(|i| self.world[i as usize]);
-        let geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+        let geometric = || (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
         let smooth = !self.normals.is_empty();
         let n = if smooth {
-            idx.map(|i| {
-                let n = self.normals[i as usize];
-                if n == Vec3::ZERO { geometric } else { n }
-            })
+            let n = idx.map(|i| self.normals[i as usize]);
+            // The geometric normal only where a corner has none (most triangles need none).
+            if n.contains(&Vec3::ZERO) {
+                let g = geometric();
+                n.map(|n| if n == Vec3::ZERO { g } else { n })
+            } else {
+                n
+            }
         } else {
-            [geometric; 3]
+            [geometric(); 3]
         };
+        (v, n, smooth)
+    }
+
+    /// Mesh triangle `ti`'s world-space tangents (w = bitangent sign), when the mesh has them.
+    pub fn tangents(&self, ti: usize) -> Option<[Vec4; 3]> {
+        let m = self.o.world_from_object;
+        let flip = self.flip;
+        self.o.mesh.tangents.get(ti).map(|t| {
+            let corners = if flip { [t[0], t[2], t[1]] } else { *t };
+            corners.map(|t| {
+                let d = m
+                    .transform_vector3(t.truncate().as_dvec3())
+                    .normalize_or_zero()
+                    .as_vec3();
+                // A mirroring transform flips the bitangent too.
+                d.extend(if flip { -t.w } else { t.w })
+            })
+        })
+    }
+
+    /// Mesh triangle `ti`'s material.
+    #[inline]
+    pub fn material(&self, ti: usize) -> u32 {
+        self.o.mesh.materials[ti]
+    }
+
+    fn world_triangle(&self, ti: usize) -> WorldTriangle {
+        let o = self.o;
+        let idx = self.corners(ti);
+        let (v, n, smooth) = self.shape(ti);
         let uv = if o.mesh.uvs.is_empty() {
             [Vec2::ZERO; 3]
         } else {
@@ -894,25 +941,13 @@ impl<'a> Placed<'a> {
             idx.map(|i| o.mesh.uvs1[i as usize])
         };
         let colors = (!o.mesh.colors.is_empty()).then(|| idx.map(|i| o.mesh.colors[i as usize]));
-        let flip = self.flip;
-        let tangents = o.mesh.tangents.get(ti).map(|t| {
-            let corners = if flip { [t[0], t[2], t[1]] } else { *t };
-            corners.map(|t| {
-                let d = m
-                    .transform_vector3(t.truncate().as_dvec3())
-                    .normalize_or_zero()
-                    .as_vec3();
-                // A mirroring transform flips the bitangent too.
-                d.extend(if flip { -t.w } else { t.w })
-            })
-        });
         WorldTriangle {
             v,
             n,
             smooth,
             uv,
             uv1,
-            tangents,
+            tangents: self.tangents(ti),
             colors,
             material: o.mesh.materials[ti],
             object: self.object,
