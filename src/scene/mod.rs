@@ -658,13 +658,22 @@ impl Scene {
         {
             return b;
         }
+        use rayon::prelude::*;
         let visible: Vec<&Object> = self.objects.iter().filter(|o| o.visible).collect();
         // Each pass over an object transforms its vertices once, not each triangle's corners
-        // (the same values: about a sixth of the transforms on a closed mesh).
+        // (the same values: about a sixth of the transforms on a closed mesh); up to
+        // BOUNDS_KEPT_VERTICES vertices in all, once for the three passes (a posed frame of
+        // a 1 M-triangle animation finds its bounds anew).
+        let total: usize = visible.iter().map(|o| o.mesh.positions.len()).sum();
+        let kept: Option<Vec<Vec<DVec3>>> = (total <= BOUNDS_KEPT_VERTICES)
+            .then(|| visible.par_iter().map(|o| world_points(o)).collect());
         let b = robust_bounds_of(visible.len(), &|k| {
-            let o = visible[k];
-            let world = world_points(o);
-            o.mesh
+            let world = match &kept {
+                Some(worlds) => std::borrow::Cow::Borrowed(&worlds[k][..]),
+                None => std::borrow::Cow::Owned(world_points(visible[k])),
+            };
+            visible[k]
+                .mesh
                 .indices
                 .iter()
                 .map(move |t| t.map(|i| world[i as usize]))
@@ -776,6 +785,10 @@ impl WorldObject {
     }
 }
 
+/// The most vertices whose world positions [`Scene::bounds`] keeps for its three passes
+/// (24 bytes each: 96 MB).
+const BOUNDS_KEPT_VERTICES: usize = 1 << 22;
+
 /// Object `o`'s vertices in world space (f64), each transformed once.
 pub(crate) fn world_points(o: &Object) -> Vec<DVec3> {
     let m = o.world_from_object;
@@ -869,7 +882,8 @@ impl<'a> Placed<'a> {
 
     /// Triangle `ti`'s corners, two swapped under a mirroring transform to keep front faces
     /// in front.
-    fn corners(&self, ti: usize) -> [u32; 3] {
+    #[inline]
+    pub fn corners(&self, ti: usize) -> [u32; 3] {
         let [a, b, c] = self.o.mesh.indices[ti];
         if self.flip { [a, c, b] } else { [a, b, c] }
     }
@@ -884,7 +898,13 @@ impl<'a> Placed<'a> {
     /// file: the geometry of its [`WorldTriangle`], made without the rest.
     #[inline]
     pub fn shape(&self, ti: usize) -> ([Vec3; 3], [Vec3; 3], bool) {
-        let idx = self.corners(ti);
+        self.shape_at(self.corners(ti))
+    }
+
+    /// [`Placed::shape`] of the triangle with corners `idx` (as [`Placed::corners`] gives
+    /// them).
+    #[inline]
+    pub fn shape_at(&self, idx: [u32; 3]) -> ([Vec3; 3], [Vec3; 3], bool) {
         let v = idx.map(|i| self.world[i as usize]);
         let geometric = || (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
         let smooth = !self.normals.is_empty();
@@ -918,6 +938,11 @@ impl<'a> Placed<'a> {
                 d.extend(if flip { -t.w } else { t.w })
             })
         })
+    }
+
+    /// Whether the object's transform mirrors (two corners of each triangle swapped).
+    pub fn mirrors(&self) -> bool {
+        self.flip
     }
 
     /// Mesh triangle `ti`'s material.

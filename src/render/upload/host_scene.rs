@@ -88,6 +88,11 @@ pub struct HostScene {
     /// Flat: how many slots of the tree each object has, by object index (found at the first
     /// pose written in place, [`HostScene::repose_flat`]; empty before).
     pub(super) object_slots: Vec<u32>,
+    /// Flat, with `object_slots`: each slot's mesh triangle and its corners (as
+    /// [`crate::scene::Placed::corners`]) in tree order, read in order at each pose, and the
+    /// meshes' index lists they were read from (address, length and whether the object
+    /// mirrors, by object).
+    pub(super) slot_corners: (Vec<super::repose::SlotCorners>, Vec<(usize, usize, bool)>),
 }
 
 /// A flat scene's pose-dependent device structs in BVH order: triangles, corner normals and
@@ -255,6 +260,7 @@ impl HostScene {
             posed: None,
             spare: None,
             object_slots: vec![],
+            slot_corners: Default::default(),
         }
     }
 

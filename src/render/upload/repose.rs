@@ -14,6 +14,13 @@ use rayon::prelude::*;
 /// Elements compared and written together: a run of changed chunks is one write.
 pub const CHUNK: usize = 4096;
 
+/// A tree slot's mesh triangle and its corners (object-local vertex indices).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SlotCorners {
+    triangle: u32,
+    corners: [u32; 3],
+}
+
 impl HostScene {
     /// [`HostScene::refit_flat`] of a pose that places every triangle of the same objects as
     /// the scene on the device, none dropped: writes the pose's device structs over the last
@@ -76,9 +83,39 @@ impl HostScene {
         if fresh {
             self.posed = Some(PosedArrays::filled(n, tangents));
         }
+        // Each slot's triangle and corners, read once per mesh (a pointer chase and a cache
+        // miss a triangle at every pose was most of the writing's time).
+        let meshes: Vec<(usize, usize, bool)> = scene
+            .objects
+            .iter()
+            .zip(&placed)
+            .map(|(o, p)| {
+                let mirrors = p.as_ref().is_some_and(Placed::mirrors);
+                (
+                    o.mesh.indices.as_ptr() as usize,
+                    o.mesh.indices.len(),
+                    mirrors,
+                )
+            })
+            .collect();
+        if self.slot_corners.1 != meshes {
+            let (tri_indices, objects) = (&bvh.tri_indices, &self.objects);
+            let slots = (0..n)
+                .into_par_iter()
+                .map(|k| {
+                    let o = objects[k] as usize;
+                    let triangle = tri_indices[k] - firsts[o];
+                    let corners = placed[o]
+                        .as_ref()
+                        .map_or([0; 3], |p| p.corners(triangle as usize));
+                    SlotCorners { triangle, corners }
+                })
+                .collect();
+            self.slot_corners = (slots, meshes);
+        }
         let posed = self.posed.as_mut()?;
         let emissive: Vec<bool> = materials.iter().map(Material::is_emissive).collect();
-        let (tri_indices, objects) = (&bvh.tri_indices, &self.objects);
+        let (slots, objects) = (&self.slot_corners.0, &self.objects);
         let chunks = n.div_ceil(CHUNK);
         let mut tangent_chunks: Vec<&mut [DeviceTriTangents]> = if tangents {
             posed.tangents.chunks_mut(CHUNK).collect()
@@ -98,9 +135,10 @@ impl HostScene {
                 for j in 0..tris.len() {
                     let k = c * CHUNK + j;
                     let o = objects[k] as usize;
-                    let ti = (tri_indices[k] - firsts[o]) as usize;
+                    let SlotCorners { triangle, corners } = slots[k];
+                    let ti = triangle as usize;
                     let Some(p) = &placed[o] else { continue };
-                    let (v, normals, smooth) = p.shape(ti);
+                    let (v, normals, smooth) = p.shape_at(corners);
                     let material = p.material(ti);
                     // An emitter keeps its light until the light table is made again.
                     let light = if emissive[material as usize] {
@@ -271,6 +309,18 @@ mod tests {
                 assert_eq!(hit(&host), hit(&fresh), "pose {wave}, ray {k}");
             }
         }
+        // The first grid mirrored too: its triangles' corners are read swapped.
+        let mut mirrored = grid(0.7);
+        mirrored.objects[0].world_from_object = DMat4::from_scale(DVec3::new(1.0, 1.0, -1.0));
+        let space = RenderFrame::around(&mirrored.bounds());
+        let written = host.repose_flat(&mirrored, space, &mirrored.materials, false);
+        assert!(matches!(written, Some(Ok(_))));
+        let (fresh, _) = HostScene::flatten(&mirrored, &space, &mirrored.materials);
+        let p = host.posed.as_ref().unwrap();
+        assert_eq!(
+            structs(&p.triangles, &p.shading),
+            structs(&fresh.triangles, &fresh.shading)
+        );
         // Another set of objects is not written in place.
         let mut hidden = grid(0.7);
         hidden.objects[1].visible = false;
