@@ -90,9 +90,8 @@ pub struct HostScene {
     pub(super) object_slots: Vec<u32>,
     /// Flat, with `object_slots`: each slot's mesh triangle and its corners (as
     /// [`crate::scene::Placed::corners`]) in tree order, read in order at each pose, and the
-    /// meshes' index lists they were read from (address, length and whether the object
-    /// mirrors, by object).
-    pub(super) slot_corners: (Vec<super::repose::SlotCorners>, Vec<(usize, usize, bool)>),
+    /// index lists they were read from and whether each object mirrored, by object.
+    pub(super) slot_corners: (Vec<super::repose::SlotCorners>, SlotSources),
 }
 
 /// A flat scene's pose-dependent device structs in BVH order: triangles, corner normals and
@@ -137,6 +136,9 @@ pub struct Dirty {
     /// Chunks of tangents.
     pub tangents: Vec<bool>,
 }
+
+/// The objects' index lists and mirroring that [`HostScene::slot_corners`] were read from.
+pub(super) type SlotSources = (Vec<Vec<[u32; 3]>>, Vec<bool>);
 
 /// What [`HostScene::refit_flat`] made of a new pose of a flat scene.
 pub enum FlatRefit {

@@ -83,22 +83,23 @@ impl HostScene {
         if fresh {
             self.posed = Some(PosedArrays::filled(n, tangents));
         }
-        // Each slot's triangle and corners, read once per mesh (a pointer chase and a cache
-        // miss a triangle at every pose was most of the writing's time).
-        let meshes: Vec<(usize, usize, bool)> = scene
-            .objects
+        // Each slot's triangle and corners, read again only when an object's index list or
+        // mirroring changed (a pointer chase and a cache miss a triangle at every pose was
+        // half the writing's time). The lists are compared whole, not by address: a freed
+        // list's memory may hold another one.
+        let mirrors: Vec<bool> = placed
             .iter()
-            .zip(&placed)
-            .map(|(o, p)| {
-                let mirrors = p.as_ref().is_some_and(Placed::mirrors);
-                (
-                    o.mesh.indices.as_ptr() as usize,
-                    o.mesh.indices.len(),
-                    mirrors,
-                )
-            })
+            .map(|p| p.as_ref().is_some_and(Placed::mirrors))
             .collect();
-        if self.slot_corners.1 != meshes {
+        let (_, (kept, kept_mirrors)) = &self.slot_corners;
+        let same = kept.len() == scene.objects.len()
+            && *kept_mirrors == mirrors
+            && scene
+                .objects
+                .par_iter()
+                .zip(kept)
+                .all(|(o, k)| o.mesh.indices == *k);
+        if !same {
             let (tri_indices, objects) = (&bvh.tri_indices, &self.objects);
             let slots = (0..n)
                 .into_par_iter()
@@ -111,7 +112,12 @@ impl HostScene {
                     SlotCorners { triangle, corners }
                 })
                 .collect();
-            self.slot_corners = (slots, meshes);
+            let lists = scene
+                .objects
+                .iter()
+                .map(|o| o.mesh.indices.clone())
+                .collect();
+            self.slot_corners = (slots, (lists, mirrors));
         }
         let posed = self.posed.as_mut()?;
         let emissive: Vec<bool> = materials.iter().map(Material::is_emissive).collect();
