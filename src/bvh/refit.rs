@@ -105,8 +105,38 @@ impl Bvh {
     /// refitted from its vertices and indices, without a list of its triangles (36 bytes a
     /// triangle written and read again each frame).
     pub fn refit_with(&mut self, corners: impl Fn(usize) -> [Vec3; 3] + Sync) {
-        // Leaf boxes first, all nodes at once.
-        let tri_indices = &self.tri_indices;
+        let tri_indices = std::mem::take(&mut self.tri_indices);
+        self.refit_leaves(|first, count| {
+            tri_indices[first..first + count]
+                .iter()
+                .flat_map(|&t| corners(t as usize))
+                .fold(Aabb::EMPTY, Aabb::grow)
+        });
+        self.tri_indices = tri_indices;
+    }
+
+    /// [`Bvh::refit`] from `ordered`, the triangles in the tree's order (`ordered[k]` is
+    /// triangle `tri_indices[k]`): each leaf's box from its run of them, no index followed.
+    ///
+    /// # Panics
+    /// When `ordered` is not as long as the list the tree was built over.
+    pub fn refit_ordered(&mut self, ordered: &[[Vec3; 3]]) {
+        assert_eq!(
+            ordered.len(),
+            self.tri_indices.len(),
+            "a refit needs the triangles the tree was built over"
+        );
+        self.refit_leaves(|first, count| {
+            ordered[first..first + count]
+                .iter()
+                .flatten()
+                .fold(Aabb::EMPTY, |b, &v| b.grow(v))
+        });
+    }
+
+    /// Sets every leaf's box to `leaf(first, count)` (all nodes at once), then every interior
+    /// box from its children's; updates `sah_cost`.
+    fn refit_leaves(&mut self, leaf: impl Fn(usize, usize) -> Aabb + Sync) {
         self.nodes.par_iter_mut().for_each(|node| {
             for side in 0..2 {
                 let (lo, hi) = sides(node, side);
@@ -114,11 +144,7 @@ impl Bvh {
                 if index < 0 {
                     let first = !index as usize;
                     let count = hi[3].to_bits() as usize;
-                    let b = tri_indices[first..first + count]
-                        .iter()
-                        .flat_map(|&t| corners(t as usize))
-                        .fold(Aabb::EMPTY, Aabb::grow);
-                    set_box(lo, hi, b);
+                    set_box(lo, hi, leaf(first, count));
                 }
             }
         });

@@ -4,12 +4,11 @@
 //! made the tree too costly to traverse, or a pose that places other triangles, loads the
 //! scene again ([`Renderer::update_scene`]).
 
-use super::upload::FlatRefit;
+use super::upload::{CHUNK, FlatRefit};
 use super::{Accel, Renderer, lights};
 use crate::bvh::WideBvh;
 use crate::cl::{Buffer, ClError, Device};
 use crate::scene::{Light, RenderFrame, Scene};
-use rayon::prelude::*;
 use std::time::Instant;
 
 /// What [`Renderer::refit_flat`] did, stage by stage (host time, ms).
@@ -24,9 +23,6 @@ pub struct RefitTimes {
     /// Bytes written to the device.
     pub bytes: usize,
 }
-
-/// Elements compared and written together: a run of changed chunks is one write.
-const CHUNK: usize = 4096;
 
 /// Why a flat scene could not be refitted.
 pub enum NoRefit {
@@ -57,9 +53,9 @@ impl Renderer {
         let materials: Vec<_> = scene.materials.iter().map(|m| space.material(m)).collect();
         let space_ms = t.elapsed().as_secs_f64() * 1e3;
         let tangents = buffers.tangents.len() == buffers.triangles.len();
-        let (arrays, flatten_ms, refit_ms) =
+        let (dirty, flatten_ms, refit_ms) =
             match host.refit_flat(scene, space, &materials, tangents) {
-                FlatRefit::Refitted(arrays, flatten_ms, refit_ms) => (arrays, flatten_ms, refit_ms),
+                FlatRefit::Refitted(dirty, flatten_ms, refit_ms) => (dirty, flatten_ms, refit_ms),
                 FlatRefit::TooCostly => return Ok(Err(NoRefit::TooCostly)),
                 FlatRefit::Changed => return Ok(Err(NoRefit::Changed)),
             };
@@ -68,10 +64,10 @@ impl Renderer {
         let Accel::Flat(bvh) = &host.accel else {
             return Ok(Err(NoRefit::Changed));
         };
+        let Some(posed) = host.posed.as_mut() else {
+            return Ok(Err(NoRefit::Changed));
+        };
         let device = &self.device;
-        let mut old = host.posed.take();
-        let mut arrays = *arrays;
-        arrays.wide = None;
         let mut bytes = 0;
         let mut wide_ms = 0.0;
         if buffers.forms.binary {
@@ -79,7 +75,7 @@ impl Renderer {
         }
         if buffers.forms.wide {
             let fitting = Instant::now();
-            let wide = match old.as_mut().and_then(|o| o.wide.take()) {
+            let wide = match posed.wide.take() {
                 Some(mut wide) => {
                     wide.refit(&host.vertices);
                     wide
@@ -88,33 +84,25 @@ impl Renderer {
             };
             wide_ms = fitting.elapsed().as_secs_f64() * 1e3;
             bytes += replace(&mut buffers.wide_nodes, device, &wide.nodes)?;
-            arrays.wide = Some(wide);
+            posed.wide = Some(wide);
         }
-        let last = old.as_ref();
         bytes += write_changed(
             &mut buffers.triangles,
             device,
-            last.map(|o| &o.triangles[..]),
-            &arrays.triangles,
+            &posed.triangles,
+            &dirty.triangles,
         )?;
-        bytes += write_changed(
-            &mut buffers.shading,
-            device,
-            last.map(|o| &o.shading[..]),
-            &arrays.shading,
-        )?;
+        bytes += write_changed(&mut buffers.shading, device, &posed.shading, &dirty.shading)?;
         if tangents {
             bytes += write_changed(
                 &mut buffers.tangents,
                 device,
-                last.map(|o| &o.tangents[..]),
-                &arrays.tangents,
+                &posed.tangents,
+                &dirty.tangents,
             )?;
         }
         bytes += std::mem::size_of_val(host.materials.as_slice());
         buffers.materials.write(device, &host.materials)?;
-        host.spare = old;
-        host.posed = Some(arrays);
         self.lights = lights.to_vec();
         self.upload_lights()?;
         if let Some(c) = self.world_camera.clone() {
@@ -144,35 +132,29 @@ fn replace<T: bytemuck::Pod>(
     Ok(std::mem::size_of_val(data))
 }
 
-/// Writes the chunks of `new` that differ from `old` (the last data written) over `buffer`,
-/// a run of changed chunks at a time; all of `new` without `old` or when a length differs.
-/// The bytes written.
-fn write_changed<T: bytemuck::Pod + Send + Sync>(
+/// Writes the chunks of `data` marked in `dirty` ([`CHUNK`] elements each) over `buffer`, a
+/// run of them at a time; all of `data` when the buffer's length differs. The bytes written.
+fn write_changed<T: bytemuck::Pod>(
     buffer: &mut Buffer<T>,
     device: &Device,
-    old: Option<&[T]>,
-    new: &[T],
+    data: &[T],
+    dirty: &[bool],
 ) -> Result<usize, ClError> {
-    let Some(old) = old.filter(|o| o.len() == new.len() && buffer.len() == new.len()) else {
-        return replace(buffer, device, new);
-    };
-    let changed: Vec<bool> = new
-        .par_chunks(CHUNK)
-        .zip(old.par_chunks(CHUNK))
-        .map(|(a, b)| bytemuck::cast_slice::<T, u8>(a) != bytemuck::cast_slice::<T, u8>(b))
-        .collect();
+    if buffer.len() != data.len() {
+        return replace(buffer, device, data);
+    }
     let mut bytes = 0;
     let mut c = 0;
-    while c < changed.len() {
-        if !changed[c] {
+    while c < dirty.len() {
+        if !dirty[c] {
             c += 1;
             continue;
         }
         let first = c;
-        while c < changed.len() && changed[c] {
+        while c < dirty.len() && dirty[c] {
             c += 1;
         }
-        let run = &new[first * CHUNK..(c * CHUNK).min(new.len())];
+        let run = &data[first * CHUNK..(c * CHUNK).min(data.len())];
         buffer.write_at(device, first * CHUNK, run)?;
         bytes += std::mem::size_of_val(run);
     }

@@ -617,6 +617,12 @@ impl Scene {
         (out, dropped)
     }
 
+    /// Object `i` placed in the render space of `frame` (its vertices and normals
+    /// transformed once), from which its triangles are read as [`Scene::flatten`] makes them.
+    pub fn place(&self, i: usize, frame: &RenderFrame) -> Placed<'_> {
+        Placed::new(i as u32, &self.objects[i], frame, true)
+    }
+
     /// Object `i`'s triangles in the render space of `frame`, in its mesh's order, as
     /// [`Scene::flatten`] gives them (whether or not the object is visible).
     pub fn flatten_object(&self, i: usize, frame: &RenderFrame) -> Flattened {
@@ -652,13 +658,22 @@ impl Scene {
         {
             return b;
         }
+        use rayon::prelude::*;
         let visible: Vec<&Object> = self.objects.iter().filter(|o| o.visible).collect();
         // Each pass over an object transforms its vertices once, not each triangle's corners
-        // (the same values: about a sixth of the transforms on a closed mesh).
+        // (the same values: about a sixth of the transforms on a closed mesh); up to
+        // BOUNDS_KEPT_VERTICES vertices in all, once for the three passes (a posed frame of
+        // a 1 M-triangle animation finds its bounds anew).
+        let total: usize = visible.iter().map(|o| o.mesh.positions.len()).sum();
+        let kept: Option<Vec<Vec<DVec3>>> = (total <= BOUNDS_KEPT_VERTICES)
+            .then(|| visible.par_iter().map(|o| world_points(o)).collect());
         let b = robust_bounds_of(visible.len(), &|k| {
-            let o = visible[k];
-            let world = world_points(o);
-            o.mesh
+            let world = match &kept {
+                Some(worlds) => std::borrow::Cow::Borrowed(&worlds[k][..]),
+                None => std::borrow::Cow::Owned(world_points(visible[k])),
+            };
+            visible[k]
+                .mesh
                 .indices
                 .iter()
                 .map(move |t| t.map(|i| world[i as usize]))
@@ -770,6 +785,10 @@ impl WorldObject {
     }
 }
 
+/// The most vertices whose world positions [`Scene::bounds`] keeps for its three passes
+/// (24 bytes each: 96 MB).
+const BOUNDS_KEPT_VERTICES: usize = 1 << 22;
+
 /// Object `o`'s vertices in world space (f64), each transformed once.
 pub(crate) fn world_points(o: &Object) -> Vec<DVec3> {
     let m = o.world_from_object;
@@ -781,8 +800,8 @@ pub(crate) fn world_points(o: &Object) -> Vec<DVec3> {
 }
 
 /// An object's vertices (and normals, when asked for) in render space, from which its
-/// flattened triangles are made one by one.
-struct Placed<'a> {
+/// flattened triangles are made one by one ([`Scene::place`]).
+pub struct Placed<'a> {
     object: u32,
     o: &'a Object,
     /// Render-space vertices.
@@ -863,26 +882,79 @@ impl<'a> Placed<'a> {
 
     /// Triangle `ti`'s corners, two swapped under a mirroring transform to keep front faces
     /// in front.
-    fn corners(&self, ti: usize) -> [u32; 3] {
+    #[inline]
+    pub fn corners(&self, ti: usize) -> [u32; 3] {
         let [a, b, c] = self.o.mesh.indices[ti];
         if self.flip { [a, c, b] } else { [a, b, c] }
     }
 
-    fn world_triangle(&self, ti: usize) -> WorldTriangle {
-        let o = self.o;
-        let m = o.world_from_object;
-        let idx = self.corners(ti);
+    /// Triangles with a non-finite or absurd vertex, which [`Scene::flatten`] drops.
+    pub fn dropped(&self) -> usize {
+        self.dropped
+    }
+
+    /// Mesh triangle `ti`'s render-space corners and corner normals (the geometric normal
+    /// where the mesh has none or a vertex's is zero), and whether the normals came from the
+    /// file: the geometry of its [`WorldTriangle`], made without the rest.
+    #[inline]
+    pub fn shape(&self, ti: usize) -> ([Vec3; 3], [Vec3; 3], bool) {
+        self.shape_at(self.corners(ti))
+    }
+
+    /// [`Placed::shape`] of the triangle with corners `idx` (as [`Placed::corners`] gives
+    /// them).
+    #[inline]
+    pub fn shape_at(&self, idx: [u32; 3]) -> ([Vec3; 3], [Vec3; 3], bool) {
         let v = idx.map(|i| self.world[i as usize]);
-        let geometric = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+        let geometric = || (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
         let smooth = !self.normals.is_empty();
         let n = if smooth {
-            idx.map(|i| {
-                let n = self.normals[i as usize];
-                if n == Vec3::ZERO { geometric } else { n }
-            })
+            let n = idx.map(|i| self.normals[i as usize]);
+            // The geometric normal only where a corner has none (most triangles need none).
+            if n.contains(&Vec3::ZERO) {
+                let g = geometric();
+                n.map(|n| if n == Vec3::ZERO { g } else { n })
+            } else {
+                n
+            }
         } else {
-            [geometric; 3]
+            [geometric(); 3]
         };
+        (v, n, smooth)
+    }
+
+    /// Mesh triangle `ti`'s world-space tangents (w = bitangent sign), when the mesh has them.
+    pub fn tangents(&self, ti: usize) -> Option<[Vec4; 3]> {
+        let m = self.o.world_from_object;
+        let flip = self.flip;
+        self.o.mesh.tangents.get(ti).map(|t| {
+            let corners = if flip { [t[0], t[2], t[1]] } else { *t };
+            corners.map(|t| {
+                let d = m
+                    .transform_vector3(t.truncate().as_dvec3())
+                    .normalize_or_zero()
+                    .as_vec3();
+                // A mirroring transform flips the bitangent too.
+                d.extend(if flip { -t.w } else { t.w })
+            })
+        })
+    }
+
+    /// Whether the object's transform mirrors (two corners of each triangle swapped).
+    pub fn mirrors(&self) -> bool {
+        self.flip
+    }
+
+    /// Mesh triangle `ti`'s material.
+    #[inline]
+    pub fn material(&self, ti: usize) -> u32 {
+        self.o.mesh.materials[ti]
+    }
+
+    fn world_triangle(&self, ti: usize) -> WorldTriangle {
+        let o = self.o;
+        let idx = self.corners(ti);
+        let (v, n, smooth) = self.shape(ti);
         let uv = if o.mesh.uvs.is_empty() {
             [Vec2::ZERO; 3]
         } else {
@@ -894,25 +966,13 @@ impl<'a> Placed<'a> {
             idx.map(|i| o.mesh.uvs1[i as usize])
         };
         let colors = (!o.mesh.colors.is_empty()).then(|| idx.map(|i| o.mesh.colors[i as usize]));
-        let flip = self.flip;
-        let tangents = o.mesh.tangents.get(ti).map(|t| {
-            let corners = if flip { [t[0], t[2], t[1]] } else { *t };
-            corners.map(|t| {
-                let d = m
-                    .transform_vector3(t.truncate().as_dvec3())
-                    .normalize_or_zero()
-                    .as_vec3();
-                // A mirroring transform flips the bitangent too.
-                d.extend(if flip { -t.w } else { t.w })
-            })
-        });
         WorldTriangle {
             v,
             n,
             smooth,
             uv,
             uv1,
-            tangents,
+            tangents: self.tangents(ti),
             colors,
             material: o.mesh.materials[ti],
             object: self.object,

@@ -3,6 +3,7 @@
 //! triangles of the light table, and the host reference traversal for picking and tests.
 
 use super::accel::{Accel, InstanceLayout};
+use super::repose::{CHUNK, changed_chunks};
 use super::structs::{gpu_material, luminance, samples_textures};
 use super::triangles::{
     FlatStructs, emissive_triangles, object_triangles, split_by, triangle_area,
@@ -78,12 +79,19 @@ pub struct HostScene {
     /// The map from world space to the render space the triangles are in.
     pub space: RenderFrame,
     /// The middle and the diagonal of the robust bounds of the triangles.
-    middle: (Vec3, f32),
+    pub(super) middle: (Vec3, f32),
     /// Flat, after a pose was refitted ([`HostScene::refit_flat`]): the device structs as
     /// last written, so that the next pose writes only what differs.
     pub posed: Option<PosedArrays>,
     /// The lists of the pose before, whose memory the next pose is written into.
     pub spare: Option<PosedArrays>,
+    /// Flat: how many slots of the tree each object has, by object index (found at the first
+    /// pose written in place, [`HostScene::repose_flat`]; empty before).
+    pub(super) object_slots: Vec<u32>,
+    /// Flat, with `object_slots`: each slot's mesh triangle and its corners (as
+    /// [`crate::scene::Placed::corners`]) in tree order, read in order at each pose, and the
+    /// index lists they were read from and whether each object mirrored, by object.
+    pub(super) slot_corners: (Vec<super::repose::SlotCorners>, SlotSources),
 }
 
 /// A flat scene's pose-dependent device structs in BVH order: triangles, corner normals and
@@ -105,11 +113,38 @@ pub struct PosedArrays {
     flattened: FlatStructs,
 }
 
+impl PosedArrays {
+    /// Lists of `n` zeroed structs (tangents too when `tangents`), to be written in place.
+    pub(super) fn filled(n: usize, tangents: bool) -> Self {
+        Self {
+            triangles: vec![DeviceTriangle::default(); n],
+            shading: vec![DeviceTriShading::default(); n],
+            tangents: vec![DeviceTriTangents::default(); if tangents { n } else { 0 }],
+            wide: None,
+            flattened: FlatStructs::default(),
+        }
+    }
+}
+
+/// Which chunks ([`CHUNK`] elements) of a pose's device lists ([`PosedArrays`]) differ from
+/// the last pose's, to be written: triangles, corner normals and tangents (empty without).
+pub struct Dirty {
+    /// Chunks of triangles.
+    pub triangles: Vec<bool>,
+    /// Chunks of corner normals.
+    pub shading: Vec<bool>,
+    /// Chunks of tangents.
+    pub tangents: Vec<bool>,
+}
+
+/// The objects' index lists and mirroring that [`HostScene::slot_corners`] were read from.
+pub(super) type SlotSources = (Vec<Vec<[u32; 3]>>, Vec<bool>);
+
 /// What [`HostScene::refit_flat`] made of a new pose of a flat scene.
 pub enum FlatRefit {
-    /// The BVH refitted; the pose's device structs, and the host time of flattening and of the
-    /// refit (ms).
-    Refitted(Box<PosedArrays>, f64, f64),
+    /// The BVH refitted, the pose's device structs in [`HostScene::posed`]; which of their
+    /// chunks changed, and the host time of flattening and of the refit (ms).
+    Refitted(Dirty, f64, f64),
     /// The refit took the BVH's SAH cost past [`crate::bvh::REFIT_MAX_GROWTH`] times its
     /// build's: the scene must be built again.
     TooCostly,
@@ -179,7 +214,7 @@ impl HostScene {
         } else {
             gather(colors, &bvh.tri_indices)
         };
-        let emissive = flat_emitters(&mut triangles, &vertices, materials);
+        let emissive = flat_emitters(&mut triangles, &vertices, materials, None);
         let objects = triangles.par_iter().map(|t| t.v2[3].to_bits()).collect();
         Self {
             vertices,
@@ -226,6 +261,8 @@ impl HostScene {
             middle,
             posed: None,
             spare: None,
+            object_slots: vec![],
+            slot_corners: Default::default(),
         }
     }
 
@@ -243,6 +280,13 @@ impl HostScene {
         materials: &[Material],
         tangents: bool,
     ) -> FlatRefit {
+        match self.repose_flat(scene, space, materials, tangents) {
+            Some(Ok((dirty, flatten_ms, refit_ms))) => {
+                return FlatRefit::Refitted(dirty, flatten_ms, refit_ms);
+            }
+            Some(Err(())) => return FlatRefit::TooCostly,
+            None => {}
+        }
         let Accel::Flat(bvh) = &mut self.accel else {
             return FlatRefit::Changed;
         };
@@ -277,28 +321,35 @@ impl HostScene {
             out.par_extend(order.par_iter().map(|&i| v[i as usize]));
             out
         }
-        let mut arrays = spare.unwrap_or_else(|| PosedArrays {
-            triangles: Vec::new(),
-            shading: Vec::new(),
-            tangents: Vec::new(),
-            wide: None,
-            flattened: FlatStructs::default(),
-        });
+        let mut arrays = spare.unwrap_or_else(|| PosedArrays::filled(0, false));
         let mut triangles = gather(&structs.triangles, order, take(&mut arrays.triangles));
         let vertices = gather(vertices, order, take(&mut self.vertices));
-        self.emissive = flat_emitters(&mut triangles, &vertices, materials);
+        self.emissive = flat_emitters(&mut triangles, &vertices, materials, None);
         arrays.triangles = triangles;
         arrays.shading = gather(&structs.shading, order, take(&mut arrays.shading));
         if tangents {
             arrays.tangents = gather(&structs.tangents, order, take(&mut arrays.tangents));
         }
         arrays.flattened = structs;
+        // What differs from the last pose written (all of it without one).
+        let mut old = self.posed.take();
+        let last = old.as_ref();
+        let empty = PosedArrays::filled(0, false);
+        let last_or_empty = last.unwrap_or(&empty);
+        let dirty = Dirty {
+            triangles: changed_chunks(&arrays.triangles, &last_or_empty.triangles),
+            shading: changed_chunks(&arrays.shading, &last_or_empty.shading),
+            tangents: changed_chunks(&arrays.tangents, &last_or_empty.tangents),
+        };
+        arrays.wide = old.as_mut().and_then(|o| o.wide.take());
+        self.spare = old;
+        self.posed = Some(arrays);
         self.vertices = vertices;
         self.space = space;
         self.middle = render_middle(scene, &space);
         self.materials = materials.iter().map(gpu_material).collect();
         FlatRefit::Refitted(
-            Box::new(arrays),
+            dirty,
             flatten_ms + t.elapsed().as_secs_f64() * 1e3,
             refit_ms,
         )
@@ -528,28 +579,47 @@ pub(super) fn flat_structs(
 }
 
 /// The emissive triangles of a flat scene's `triangles` (BVH order, world vertices
-/// `vertices`), in that order: each one's light index written into its `v1.w`.
+/// `vertices`), in that order: each one's light index written into its `v1.w`, and -1 into that
+/// of a triangle of an emissive material with no area. With `dirty`, the chunks whose
+/// triangles this changed are marked.
 pub(super) fn flat_emitters(
     triangles: &mut [DeviceTriangle],
     vertices: &[[Vec3; 3]],
     materials: &[Material],
+    mut dirty: Option<&mut [bool]>,
 ) -> Vec<Emitter> {
     let mut emissive = Vec::new();
-    for (order, (tri, v)) in triangles.iter_mut().zip(vertices).enumerate() {
+    if !materials.iter().any(Material::is_emissive) {
+        return emissive;
+    }
+    // The triangles of emissive materials found in parallel, numbered in order.
+    let candidates: Vec<u32> = (0..triangles.len() as u32)
+        .into_par_iter()
+        .filter(|&k| materials[triangles[k as usize].v0[3].to_bits() as usize].is_emissive())
+        .collect();
+    for k in candidates {
+        let (tri, v) = (&mut triangles[k as usize], &vertices[k as usize]);
         let m = &materials[tri.v0[3].to_bits() as usize];
         let area = triangle_area(v);
-        if m.is_emissive() && area > 0.0 {
+        let mut light = u32::MAX;
+        if area > 0.0 {
             let sides = if m.double_sided { 2.0 } else { 1.0 };
             let power = luminance(m.emission) * area * std::f32::consts::PI * sides;
-            tri.v1[3] = f32::from_bits(emissive.len() as u32);
+            light = emissive.len() as u32;
             emissive.push(Emitter {
-                prim: order as u32,
+                prim: k,
                 instance: 0,
                 area,
                 power,
                 centroid: v.iter().sum::<Vec3>() / 3.0,
                 material: tri.v0[3].to_bits(),
             });
+        }
+        if tri.v1[3].to_bits() != light {
+            tri.v1[3] = f32::from_bits(light);
+            if let Some(d) = dirty.as_deref_mut() {
+                d[k as usize / CHUNK] = true;
+            }
         }
     }
     emissive

@@ -219,16 +219,28 @@ impl FlatStructs {
 /// emissive triangles (-1: none). A flat-shaded triangle's normals are zero (the kernels then
 /// take its geometric normal).
 fn device_triangle(t: &WorldTriangle, light: i32) -> (DeviceTriangle, DeviceTriShading) {
-    let n = if t.smooth {
-        t.n.map(|n| n.to_array())
+    device_shape(&t.v, &t.n, t.smooth, [t.material, light as u32, t.object])
+}
+
+/// [`device_triangle`] of a triangle's corners `v`, corner normals `n` (`smooth`: from the
+/// file) and its material, light and object (the `.w` lanes' bits).
+#[inline]
+pub(super) fn device_shape(
+    v: &[Vec3; 3],
+    n: &[Vec3; 3],
+    smooth: bool,
+    [material, light, object]: [u32; 3],
+) -> (DeviceTriangle, DeviceTriShading) {
+    let n = if smooth {
+        n.map(|n| n.to_array())
     } else {
         [[0.0; 3]; 3]
     };
     (
         DeviceTriangle {
-            v0: f4(t.v[0], f32::from_bits(t.material)),
-            v1: f4(t.v[1], f32::from_bits(light as u32)),
-            v2: f4(t.v[2], f32::from_bits(t.object)),
+            v0: f4(v[0], f32::from_bits(material)),
+            v1: f4(v[1], f32::from_bits(light)),
+            v2: f4(v[2], f32::from_bits(object)),
         },
         DeviceTriShading { n },
     )
@@ -255,7 +267,13 @@ fn device_colors(t: &WorldTriangle) -> DeviceTriColors {
 
 /// A triangle's tangents on the device (zero without).
 fn device_tangents(t: &WorldTriangle) -> DeviceTriTangents {
-    let c = t.tangents.unwrap_or_default().map(|v| v.to_array());
+    tangents_of(t.tangents)
+}
+
+/// [`device_tangents`] of a triangle's tangents.
+#[inline]
+pub(super) fn tangents_of(tangents: Option<[Vec4; 3]>) -> DeviceTriTangents {
+    let c = tangents.unwrap_or_default().map(|v| v.to_array());
     DeviceTriTangents {
         t0: c[0],
         t1: c[1],
