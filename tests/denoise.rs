@@ -3,8 +3,9 @@
 //!
 //! penumbra's denoiser against Intel's Open Image Denoise: the same colour, albedo and normal
 //! inputs through OIDN 2.5.1's `RT` filter (the pinned pyoidn wheel, scripts/install_oidn.sh)
-//! and through penumbra's OpenCL network must agree to PSNR >= 40 dB on the tone-mapped
-//! images, for the three networks (`large` after prefiltering the guides, as OIDN's `cleanAux`
+//! and through penumbra's OpenCL network must agree to PSNR >= 100 dB on the tone-mapped
+//! images (the goal asks 40; every correct path agrees to 132-135 dB on PoCL, while a wrong
+//! transfer curve in `large`'s albedo prefilter still scored 40-50 dB), for the three networks (`large` after prefiltering the guides, as OIDN's `cleanAux`
 //! path does), on three shared scenes. Without pyoidn it skips with a note
 //! (fails under CI=true); without PENUMBRA_SCENES it skips.
 //!
@@ -20,6 +21,8 @@ use penumbra::denoise::{Denoiser, Quality, oidn};
 use std::path::Path;
 
 const SIZE: usize = 128;
+/// The agreement required with Intel's OIDN, in dB (see the file's header).
+const AGREE_DB: f64 = 100.0;
 
 /// The tone curve the comparison is made on: Reinhard, then a 2.2 gamma.
 fn tone(v: f32) -> f32 {
@@ -84,15 +87,15 @@ fn the_network_agrees_with_intels_open_image_denoise() {
                 "{stem} {}: penumbra vs OIDN {agree:.1} dB (noisy input vs OIDN {change:.1} dB)",
                 quality.name()
             );
-            if agree < 40.0 {
+            if agree < AGREE_DB {
                 for (name, image) in [("penumbra", &ours), ("oidn", &intel)] {
                     let out = dir.join(format!("{stem}_{}_{name}.exr", quality.name()));
                     penumbra::image_io::write_exr(&out, SIZE as u32, SIZE as u32, image).unwrap();
                 }
             }
             assert!(
-                agree >= 40.0,
-                "{stem} {}: penumbra's denoised image is {agree:.1} dB from OIDN's (< 40); \
+                agree >= AGREE_DB,
+                "{stem} {}: penumbra's denoised image is {agree:.1} dB from OIDN's (< {AGREE_DB}); \
                  both written to {}",
                 quality.name(),
                 dir.display()
