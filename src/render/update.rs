@@ -239,12 +239,15 @@ impl Renderer {
     }
 }
 
+/// Each distinct mesh with its BLAS, for [`Blases::Built`].
+type MeshBlases = Vec<(Arc<Mesh>, Blas)>;
+
 /// The BLASes of `scene`'s distinct meshes in [`super::instancing::plan`]'s order (for
 /// [`Blases::Built`]), made from those of `host`, the two-level scene on the device before the
 /// pose: each mesh's old BLAS refitted over it in its own space, the same topology (built anew
 /// past its cost bound: [`Blas::refit_over`]); with whether any was built anew. `None` when the
 /// instances place other objects or a mesh's index list changed: the scene is built again.
-fn refit_blases(scene: &Scene, host: &HostScene) -> Option<(Vec<(Arc<Mesh>, Blas)>, bool)> {
+fn refit_blases(scene: &Scene, host: &HostScene) -> Option<(MeshBlases, bool)> {
     let Accel::TwoLevel(two) = &host.accel else {
         return None;
     };
