@@ -109,9 +109,15 @@ impl Renderer {
             Err(NoRefit::TooCostly) => UpdateKind::Rebuilt,
             Err(NoRefit::Changed) => UpdateKind::Reloaded,
         };
+        // Quick BLASes whose SAH trees are still to come are not refitted: the load builds
+        // SAH trees, which refits then keep.
+        let pending = self.sah_pending();
         let old = self.scene.take();
         let fitting = Instant::now();
-        let refitted = old.as_ref().and_then(|(_, host)| refit_blases(scene, host));
+        let refitted = old
+            .as_ref()
+            .filter(|_| !pending)
+            .and_then(|(_, host)| refit_blases(scene, host));
         let refit_ms = fitting.elapsed().as_secs_f64() * 1e3;
         let (kind, how) = match refitted {
             Some((built, rebuilt)) => {
