@@ -887,6 +887,20 @@ fn a_shutter_smears_a_moving_bar_between_its_start_and_end() {
 /// the pose afresh and builds its BVH anew (same seed, same device).
 #[test]
 fn the_foxs_refitted_frames_are_its_fresh_renders() {
+    fox_frames_refit_as_fresh_renders("flat");
+}
+
+/// On two levels the Fox's skinned mesh has its BLAS refitted in its own space (the summary
+/// says "refitted", not "reloaded"), and each frame is bit for bit its fresh render on two
+/// levels, whose BLAS is built anew.
+#[test]
+fn the_foxs_frames_on_two_levels_refit_its_blas_and_are_its_fresh_renders() {
+    fox_frames_refit_as_fresh_renders("two-level");
+}
+
+/// Renders frames 2 to 4 of the Fox's Run clip with `--bvh bvh`, checks that the later ones
+/// were refits, and compares frames 3 and 4 with single renders of their instants.
+fn fox_frames_refit_as_fresh_renders(bvh: &str) {
     let Some(scenes) = scenes_dir() else {
         eprintln!("skipped: PENUMBRA_SCENES is not set");
         return;
@@ -897,16 +911,25 @@ fn the_foxs_refitted_frames_are_its_fresh_renders() {
     let lines = render(
         &fox,
         &pattern,
-        &["--frames", "2..4", "--fps", "5", "--clip", "Run"],
+        &[
+            "--frames", "2..4", "--fps", "5", "--clip", "Run", "--bvh", bvh,
+        ],
     );
     assert_eq!(lines[0]["scene_update"], Value::Null);
+    for line in &lines {
+        assert_eq!(line["bvh"], bvh, "{line}");
+    }
     for line in &lines[1..] {
         assert_eq!(line["scene_update"], "refitted", "{line}");
     }
     for frame in [3, 4] {
         let single = dir.path().join(format!("single_{frame}.exr"));
         let time = format!("{}", f64::from(frame) / 5.0);
-        render(&fox, &single, &["--time", &time, "--clip", "Run"]);
+        render(
+            &fox,
+            &single,
+            &["--time", &time, "--clip", "Run", "--bvh", bvh],
+        );
         assert!(
             std::fs::read(dir.path().join(format!("fox_{frame}.exr"))).unwrap()
                 == std::fs::read(&single).unwrap(),
@@ -921,6 +944,19 @@ fn the_foxs_refitted_frames_are_its_fresh_renders() {
 /// thousandth stays a refit; both frames render as their fresh loads do.
 #[test]
 fn a_stretching_pose_rebuilds_the_bvh_past_the_refit_bound() {
+    stretch_rebuilds_past_the_bound("flat");
+}
+
+/// [`a_stretching_pose_rebuilds_the_bvh_past_the_refit_bound`] on two levels: the morphed
+/// mesh's BLAS is refitted in its own space, and built anew past the bound.
+#[test]
+fn a_stretching_pose_on_two_levels_rebuilds_the_blas_past_the_refit_bound() {
+    stretch_rebuilds_past_the_bound("two-level");
+}
+
+/// Renders the stretching strip's frames 0 to 2 with `--bvh bvh`: frame 1 a refit, frame 2 a
+/// rebuild, each its fresh render.
+fn stretch_rebuilds_past_the_bound(bvh: &str) {
     let mut g = Gltf::default();
     let white = g.lambert([0.7; 3], [0.0; 3], 1.0, false);
     // 200 small triangles in a row along x (0.01 apart); the target slides every other one
@@ -958,13 +994,18 @@ fn a_stretching_pose_rebuilds_the_bvh_past_the_refit_bound() {
     let lines = render(
         &scene,
         &dir.path().join("s_#.exr"),
-        &["--frames", "0..2", "--fps", "1"],
+        &["--frames", "0..2", "--fps", "1", "--bvh", bvh],
     );
+    assert_eq!(lines[2]["bvh"], bvh);
     assert_eq!(lines[1]["scene_update"], "refitted");
     assert_eq!(lines[2]["scene_update"], "rebuilt");
     for frame in [1, 2] {
         let single = dir.path().join(format!("single_{frame}.exr"));
-        render(&scene, &single, &["--time", &frame.to_string()]);
+        render(
+            &scene,
+            &single,
+            &["--time", &frame.to_string(), "--bvh", bvh],
+        );
         assert!(
             std::fs::read(dir.path().join(format!("s_{frame}.exr"))).unwrap()
                 == std::fs::read(&single).unwrap(),

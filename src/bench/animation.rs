@@ -6,7 +6,7 @@
 //! clip at `--fps`; the first (warm-up) is discarded.
 
 use crate::args::DeviceArgs;
-use crate::render::{RenderSettings, Renderer, UpdateKind};
+use crate::render::{BvhChoice, RenderSettings, Renderer, UpdateKind};
 use crate::scene::load;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -27,6 +27,9 @@ pub struct AnimationBenchArgs {
     /// Frames a second: frame n is at n / fps seconds (looping).
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
+    /// Acceleration structure: flat, two-level or auto (as `render --bvh`).
+    #[arg(long, default_value = "auto")]
+    pub bvh: BvhChoice,
     /// The OpenCL device the scene is updated on.
     #[command(flatten)]
     pub device: DeviceArgs,
@@ -60,6 +63,7 @@ pub fn run(args: &AnimationBenchArgs) -> Result<()> {
         None => 0,
     };
     let mut renderer = Renderer::new(&args.device.device_choice()?)?;
+    renderer.set_bvh_choice(args.bvh);
     renderer.set_settings(&RenderSettings {
         width: 64,
         height: 64,

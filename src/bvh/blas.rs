@@ -2,7 +2,7 @@
 //! copied or read from the mesh through [`IndexedMesh`], the view of a mesh this module needs
 //! (the scene's meshes provide it; `bvh` knows nothing of scenes).
 
-use super::{Aabb, Bvh, Hit, Ray, build, build_indexed};
+use super::{Aabb, Bvh, Hit, Ray, Update, build, build_indexed};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -81,6 +81,33 @@ impl Blas {
     /// (no copy of them in BVH order either): the same tree.
     pub fn of_shared_mesh<M: IndexedMesh + 'static>(mesh: &Arc<M>) -> Self {
         Self::over_mesh(build_indexed(mesh.positions(), mesh.indices()), mesh)
+    }
+
+    /// This BLAS's tree refitted over `mesh`, a deformed copy of the mesh the BLAS reads (the
+    /// same index list, its vertices moved), in `mesh`'s own space, reading `mesh` from then on;
+    /// built anew over it when the refit took the tree's SAH cost to
+    /// [`super::REFIT_MAX_GROWTH`] times its last build's or more. `None` when the BLAS does
+    /// not read a mesh with `mesh`'s index list (a copied or other mesh).
+    pub fn refit_over<M: IndexedMesh + 'static>(&self, mesh: &Arc<M>) -> Option<(Self, Update)> {
+        let BlasTriangles::Mesh(old) = &self.triangles else {
+            return None;
+        };
+        // A mesh the BLAS still holds cannot have been deformed in place (`Arc::make_mut`
+        // copies a shared mesh).
+        if std::ptr::addr_eq(Arc::as_ptr(old), Arc::as_ptr(mesh)) {
+            return Some((self.clone(), Update::Refitted));
+        }
+        let indices = mesh.indices();
+        if old.indices() != indices {
+            return None;
+        }
+        let positions = mesh.positions();
+        let mut bvh = self.bvh.clone();
+        bvh.refit_with(|t| indices[t].map(|v| positions[v as usize]));
+        if bvh.needs_rebuild() {
+            return Some((Self::of_shared_mesh(mesh), Update::Rebuilt));
+        }
+        Some((Self::over_mesh(bvh, mesh), Update::Refitted))
     }
 
     /// Triangles.

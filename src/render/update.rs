@@ -3,16 +3,19 @@
 //! new TLAS, written over the old ones in the device buffers (no reallocation, no BLAS
 //! build). The meshes' triangles and shading data stay in object space on the device, so
 //! nothing else is written (a moved light also rewrites the small light table). A flat scene
-//! is refitted (`render/refit.rs`); a two-level one whose meshes deformed is loaded again.
+//! is refitted (`render/refit.rs`); a two-level one whose meshes deformed has their BLASes refitted
+//! and is loaded again over them (every buffer written again in place; no BLAS built).
 
-use super::instancing::{instanced_objects, render_from_world};
+use super::instancing::{Blases, instanced_objects, render_from_world};
 use super::refit::NoRefit;
-use super::upload::piece_copies;
+use super::upload::{HostScene, piece_copies};
 use super::{Accel, Renderer};
-use crate::bvh::WideBvh;
+use crate::bvh::{Blas, Update, WideBvh};
 use crate::cl::ClError;
 use crate::cl::types::DeviceWideNode;
-use crate::scene::{Light, Scene, is_sane};
+use crate::scene::{Light, Mesh, Object, Scene, distinct_meshes, is_sane};
+use rayon::prelude::*;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// What [`Renderer::move_instances`] did.
@@ -32,12 +35,15 @@ pub struct InstanceUpdate {
 pub enum UpdateKind {
     /// Instances moved in place (two levels, no mesh changed): a new TLAS, no mesh BVH.
     Moved,
-    /// A flat scene's BVH refitted over its posed triangles, what changed written in place.
+    /// A flat scene's BVH refitted over its posed triangles, what changed written in place; or
+    /// a two-level scene's deformed meshes' BLASes refitted in their own spaces, the TLAS built
+    /// again and the scene's buffers written again in place (no BLAS built).
     Refitted,
-    /// The refit took the BVH past its cost bound ([`crate::bvh::REFIT_MAX_GROWTH`]): the
-    /// scene was built and loaded again.
+    /// The refit took the BVH past its cost bound ([`crate::bvh::REFIT_MAX_GROWTH`]): a flat
+    /// scene was built and loaded again; on two levels, the deformed meshes' BLASes were
+    /// refitted, the ones past the bound built anew, and the scene loaded again over them.
     Rebuilt,
-    /// The scene was loaded again (a deformed mesh on two levels, or other triangles placed).
+    /// The scene was loaded again (other triangles placed).
     Reloaded,
 }
 
@@ -103,13 +109,35 @@ impl Renderer {
             Err(NoRefit::TooCostly) => UpdateKind::Rebuilt,
             Err(NoRefit::Changed) => UpdateKind::Reloaded,
         };
-        let old = self.scene.take().map(|(buffers, _)| buffers);
-        let stats = self.load_with(scene, lights, space, super::instancing::Blases::Sah, old)?;
+        // Quick BLASes whose SAH trees are still to come are not refitted: the load builds
+        // SAH trees, which refits then keep.
+        let pending = self.sah_pending();
+        let old = self.scene.take();
+        let fitting = Instant::now();
+        let refitted = old
+            .as_ref()
+            .filter(|_| !pending)
+            .and_then(|(_, host)| refit_blases(scene, host));
+        let refit_ms = fitting.elapsed().as_secs_f64() * 1e3;
+        let (kind, how) = match refitted {
+            Some((built, rebuilt)) => {
+                let kind = if rebuilt {
+                    UpdateKind::Rebuilt
+                } else {
+                    UpdateKind::Refitted
+                };
+                (kind, Blases::Built(built))
+            }
+            None => (kind, Blases::Sah),
+        };
+        let old = old.map(|(buffers, _)| buffers);
+        let stats = self.load_with(scene, lights, space, how, old)?;
+        let bvh_ms = refit_ms + stats.bvh_build_ms;
         Ok(SceneUpdate {
             kind,
             flatten_ms: 0.0,
-            bvh_ms: stats.bvh_build_ms,
-            upload_ms: t.elapsed().as_secs_f64() * 1e3 - stats.bvh_build_ms,
+            bvh_ms,
+            upload_ms: t.elapsed().as_secs_f64() * 1e3 - bvh_ms,
             bytes: stats.device_bytes,
         })
     }
@@ -215,4 +243,40 @@ impl Renderer {
         self.reset()?;
         Ok(Some(update))
     }
+}
+
+/// Each distinct mesh with its BLAS, for [`Blases::Built`].
+type MeshBlases = Vec<(Arc<Mesh>, Blas)>;
+
+/// The BLASes of `scene`'s distinct meshes in [`super::instancing::plan`]'s order (for
+/// [`Blases::Built`]), made from those of `host`, the two-level scene on the device before the
+/// pose: each mesh's old BLAS refitted over it in its own space, the same topology (built anew
+/// past its cost bound: [`Blas::refit_over`]); with whether any was built anew. `None` when the
+/// instances place other objects or a mesh's index list changed: the scene is built again.
+fn refit_blases(scene: &Scene, host: &HostScene) -> Option<(MeshBlases, bool)> {
+    let Accel::TwoLevel(two) = &host.accel else {
+        return None;
+    };
+    let objects = instanced_objects(scene);
+    if objects != host.layout.objects || two.instances.len() != objects.len() {
+        return None;
+    }
+    let placed: Vec<&Object> = objects
+        .iter()
+        .map(|&o| &scene.objects[o as usize])
+        .collect();
+    // A mesh that deformation split from others (each deformed object gets its own copy)
+    // refits the BLAS its instance had.
+    let (meshes, _) = distinct_meshes(&placed);
+    let built: Vec<((Arc<Mesh>, Blas), Update)> = meshes
+        .par_iter()
+        .map(|&i| {
+            let mesh = &placed[i].mesh;
+            let old = two.blases.get(two.instances[i].blas as usize)?;
+            let (blas, update) = old.refit_over(mesh)?;
+            Some(((Arc::clone(mesh), blas), update))
+        })
+        .collect::<Option<_>>()?;
+    let rebuilt = built.iter().any(|(_, u)| *u == Update::Rebuilt);
+    Some((built.into_iter().map(|(b, _)| b).collect(), rebuilt))
 }
