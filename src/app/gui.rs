@@ -336,7 +336,8 @@ impl Gui {
                     }
                 });
                 ui.horizontal_wrapped(|ui| {
-                    ui.label("environment");
+                    // Short labels keep each choice row on one line in the panel's width.
+                    ui.label("env").on_hover_text("environment light");
                     for p in EnvPreset::ALL {
                         let on = self.env_name.as_deref() == Some(p.name());
                         if ui.selectable_label(on, p.name()).clicked() && !on {
@@ -402,9 +403,11 @@ impl Gui {
                 );
                 exposure_lock(ui, v);
                 ui.horizontal_wrapped(|ui| {
-                    ui.label("tone mapper");
+                    ui.label("tone").on_hover_text("tone mapper");
                     for t in ToneMapper::ALL {
-                        ui.selectable_value(&mut v.tone_mapper, t, t.name());
+                        let short = t.name().trim_start_matches("Khronos ");
+                        ui.selectable_value(&mut v.tone_mapper, t, short)
+                            .on_hover_text(t.name());
                     }
                 });
                 ui.horizontal_wrapped(|ui| {
