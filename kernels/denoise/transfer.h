@@ -35,7 +35,7 @@ inline float pu_inverse(float x) {
 }
 
 // The sRGB curve, which OIDN's albedo prefilter (`rt_alb`) works in: its input is the albedo
-// encoded, its output decoded. Host twin: `prepare::srgb_forward` / `srgb_inverse`.
+// encoded, its output decoded. Host twin: `tonemap::srgb_encode` / `srgb_decode`.
 inline float srgb_forward(float y) {
     return y <= 0.0031308f ? 12.92f * y : 1.055f * pow(y, 1.0f / 2.4f) - 0.055f;
 }

@@ -426,6 +426,7 @@ mod tests {
     use super::network::reference::{self, Planes};
     use super::*;
     use crate::cl::DeviceChoice;
+    use crate::render::tonemap::{srgb_decode, srgb_encode};
 
     fn device() -> Device {
         let choice = std::env::var("PENUMBRA_TEST_DEVICE").unwrap_or_else(|_| "cpu".into());
@@ -511,10 +512,7 @@ mod tests {
                 let srgb = first == 3;
                 let mut guide = guide;
                 if srgb {
-                    guide
-                        .v
-                        .iter_mut()
-                        .for_each(|x| *x = prepare::srgb_forward(*x));
+                    guide.v.iter_mut().for_each(|x| *x = srgb_encode(*x));
                 }
                 let out = reference::network(&guide, &tza::parse(bytes).unwrap());
                 for k in 0..3 {
@@ -522,7 +520,7 @@ mod tests {
                         for x in 0..w {
                             let i = (k * th + y) * tw + x;
                             let o = out.v[i].min(1.0);
-                            v[first * plane + i] = if srgb { prepare::srgb_inverse(o) } else { o };
+                            v[first * plane + i] = if srgb { srgb_decode(o) } else { o };
                         }
                     }
                 }

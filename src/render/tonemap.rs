@@ -96,6 +96,16 @@ pub fn srgb_encode(x: f32) -> f32 {
     }
 }
 
+/// The inverse of [`srgb_encode`]. Both are also the curve OIDN's albedo prefilter works in
+/// (the denoiser's host twin of kernels/denoise/transfer.h's `srgb_forward` / `srgb_inverse`).
+pub fn srgb_decode(x: f32) -> f32 {
+    if x <= 0.04045 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// Exposure (in stops), tone curve and sRGB encoding of a whole image into RGBA8.
 pub fn to_rgba8(image: &[[f32; 3]], exposure: f32, mapper: ToneMapper) -> Vec<u8> {
     use rayon::prelude::*;
