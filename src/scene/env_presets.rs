@@ -76,7 +76,10 @@ const NEUTRAL_LAMPS: [([f32; 3], f32, f32); 3] = [
 /// above its horizon but for two lamps: a metal sphere in it, seen from glTF's front, reads
 /// near black.)
 pub fn neutral_room(width: u32, height: u32) -> EnvMap {
-    let lamps = NEUTRAL_LAMPS.map(|(d, r, l)| (Vec3::from(d).normalize(), r.cos(), l));
+    // Each lamp's centre, the cosines of its radius and of 80 % of it (a soft edge: full inside
+    // the inner cone, none outside the radius), and its radiance.
+    let lamps =
+        NEUTRAL_LAMPS.map(|(d, r, l)| (Vec3::from(d).normalize(), r.cos(), (0.8 * r).cos(), l));
     let smooth = |e0: f32, e1: f32, x: f32| {
         let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
         t * t * (3.0 - 2.0 * t)
@@ -89,10 +92,8 @@ pub fn neutral_room(width: u32, height: u32) -> EnvMap {
             let d = EnvMap::direction(u, v);
             let walls = 0.55 + 0.25 * d.y.max(0.0);
             let mut l = 0.35 + (walls - 0.35) * smooth(-horizon, horizon, d.y);
-            for (centre, cos_radius, radiance) in lamps {
-                // A soft edge: full inside 80% of the radius, none outside it.
-                let inner = (0.8 * cos_radius.acos()).cos();
-                l += radiance * smooth(cos_radius, inner, d.dot(centre));
+            for (centre, cos_radius, cos_inner, radiance) in lamps {
+                l += radiance * smooth(cos_radius, cos_inner, d.dot(centre));
             }
             [l; 3]
         })
