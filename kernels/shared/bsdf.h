@@ -8,7 +8,8 @@
 //   reflection    GGX microfacets, height-correlated Smith G2, Schlick Fresnel: the dielectric
 //                 (f0 from ior × specularColor, scaled by specularFactor) and the metal (f0 = base
 //                 color) mixed by metallic, with Kulla–Conty multiple scattering (a cosine lobe)
-//   transmission  the dielectric's transmitted share, tinted by base color: rough refraction
+//   transmission  the dielectric's transmitted share, tinted by base color (a volume's boundary
+//                 by its square root at each crossing: once a traversal): rough refraction
 //                 through a volume (Walter et al. 2007, radiance scaled by 1/eta^2), straight
 //                 through a volume of index 1 (a delta lobe whatever the roughness), or through a
 //                 thin wall (both faces' Fresnel)
@@ -92,7 +93,7 @@ inline void bsdf_gloss(const SurfaceMaterial* m, const BsdfLobes* l, float cos_o
     bool tir = !l->thin && refracted_cos2(cos_oh, l->eta) <= 0.0f;
     *trans = tir ? (float3)(0.0f)
                  : (dielectric * l->transmission * (1.0f - l->specular * bsdf_max3(fr_trans))) *
-                       m->base_color;
+                       transmission_tint(m, l);
 }
 
 // Whether the surface lets light straight through (a smooth thin wall that transmits), so that

@@ -58,6 +58,16 @@ typedef struct {
 #endif
 } BsdfLobes;
 
+// What one crossing of the dielectric's boundary lets through, per channel: a thin wall's base
+// color, a volume boundary's square root of it. Light passing through a volume crosses its
+// boundary twice, in and out, and so is tinted by base color once, as the Sample Viewer tints it
+// and as Cycles' Principled BSDF does (its transmission tint is sqrt(base color)); the volume
+// spec's "coloured foil" gives a whole object one colour whatever its thickness
+// (docs/materials.md, "Glass, thin walls and volumes").
+inline float3 transmission_tint(const SurfaceMaterial* m, const BsdfLobes* l) {
+    return l->thin ? m->base_color : sqrt(fmax(m->base_color, 0.0f));
+}
+
 // The GGX distribution, Smith's Lambda and visible-normal sampling of the glossy lobes.
 inline float lobe_d(const BsdfLobes* l, float3 h) {
 #ifdef HAS_ANISOTROPY
@@ -424,7 +434,7 @@ inline BsdfLobes bsdf_lobes(const SurfaceMaterial* m, float3 wo) {
     float d_est = luminance(l.diffuse) * (1.0f - a_avg) + luminance(l.ms) * (1.0f - e_avg.x);
     float r_est = luminance(dielectric * spec_dielectric + l.metallic * spec_metal);
     float t_est = dielectric * l.transmission * (1.0f - bsdf_max3(spec_dielectric)) *
-                  luminance(m->base_color);
+                  luminance(transmission_tint(m, &l));
 #ifdef HAS_DIFFUSE_TRANSMISSION
     // KHR_materials_diffuse_transmission: that share of the diffuse base goes through, tinted.
     float dt = clamp(m->diffuse_transmission, 0.0f, 1.0f);

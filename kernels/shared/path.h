@@ -475,7 +475,15 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
     float side = dot(wi, ng);
     bool alive = vertex_goes_on(pdf, side, wi, ns, throughput);
     if (alive && bounce >= frame->rr_depth) {
-        float q = vertex_survival(throughput.x, throughput.y, throughput.z);
+        // Inside a volume of index n the throughput carries the 1/n^2 that radiance lost coming
+        // in and gets back going out; the roulette judges the path without it (pbrt's eta
+        // scale), or it would cull light inside glass for a loss that is not one.
+        float3 judged = throughput;
+        if (m.transmission > 0.0f && m.thickness > 0.0f && (side < 0.0f) == front) {
+            float n = front ? m.ior : 1.0f / m.ior;
+            judged *= n * n;
+        }
+        float q = vertex_survival(judged.x, judged.y, judged.z);
         if (rng_next(&rng) >= q) {
             alive = false;
         } else {
