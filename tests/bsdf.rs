@@ -1003,6 +1003,53 @@ fn delta_lobes_reflect_and_refract_exactly() {
     assert!(diffuse > 8000, "mostly diffuse: {diffuse}");
 }
 
+/// Base color tints light once per pass through glass: smooth glass of base color
+/// (0.5, 0.7, 0.9) refracts into a volume, and out of it, with weights whose channels stand as
+/// the square roots of the base color's (two crossings make one tint), and through a thin wall
+/// as the base color's (one crossing); the reflection is not tinted.
+#[test]
+fn a_volume_boundary_tints_by_the_square_root_of_base_color() {
+    let d = BsdfKernels::new();
+    let n = [0.0, 0.0, 1.0];
+    let c = [0.5f64, 0.7, 0.9];
+    let wo = direction_at(n, 30.0);
+    for (name, thickness, inside) in [
+        ("into a volume", 1.0, false),
+        ("out of a volume", 1.0, true),
+        ("through a thin wall", 0.0, false),
+    ] {
+        let mut m = Mat::glass(0.0, thickness);
+        m.base = c.map(|x| x as f32);
+        let s = d.sample(&m, wo, n, inside, 2000, 7);
+        let (mut passed, mut reflected) = (0, 0);
+        for w in &s.w {
+            let ratios = [w[0] as f64 / w[2] as f64, w[1] as f64 / w[2] as f64];
+            if (ratios[0] - 1.0).abs() < 1e-5 && (ratios[1] - 1.0).abs() < 1e-5 {
+                reflected += 1;
+                continue;
+            }
+            passed += 1;
+            let tint: Vec<f64> = if thickness > 0.0 {
+                c.iter().map(|x| x.sqrt()).collect()
+            } else {
+                c.to_vec()
+            };
+            for k in 0..2 {
+                let expected = tint[k] / tint[2];
+                assert!(
+                    (ratios[k] / expected - 1.0).abs() < 1e-4,
+                    "{name}: weight {w:?}, channel ratio {} where {expected} is the tint's",
+                    ratios[k]
+                );
+            }
+        }
+        assert!(
+            passed > 1500 && reflected > 0,
+            "{name}: {passed} passed, {reflected} reflected"
+        );
+    }
+}
+
 #[test]
 fn directional_albedo_never_exceeds_one() {
     let d = BsdfKernels::new();
