@@ -33,7 +33,9 @@ L=$OUT/log.txt
 SIZE=${SIZE:-320x240}
 mkdir -p /tmp/bisect-images
 "$P" devices >> "$L" 2>&1
-for scene in ${SCENES:-"$dir/scenes/CornellBox/CornellBox.glb $dir/scenes/DreamApartment/dream-apartment.glb"}; do
+scenes=${SCENES:-"$dir/scenes/CornellBox/CornellBox.glb $dir/scenes/DreamApartment/dream-apartment.glb"}
+# Word splitting of the list is wanted here (paths without spaces).
+for scene in $scenes; do
     s=$(basename "${scene%.*}")
     for k in ${KERNELS:-megakernel wavefront}; do
         ref=
