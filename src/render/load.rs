@@ -252,6 +252,7 @@ impl Renderer {
         let (mesh_triangles, mesh_tangents) = planned.mesh_triangles();
         let mesh_colors = !planned.meshes.is_empty() && planned.colored();
         let host = &mut planned.host;
+        host.layout.mesh_tangents = mesh_tangents;
         let (nodes, wide_nodes, instances) = device_accel(host, forms);
         log::debug!(
             "device nodes: {:.0} ms",

@@ -3,6 +3,7 @@
 
 mod adaptive;
 pub mod background;
+mod blas_refit;
 pub mod camera;
 pub mod exposure;
 pub mod film;
