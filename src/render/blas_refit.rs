@@ -8,7 +8,7 @@
 //! ranges, texture coordinates, colours and textures stay as they are on the device.
 
 use super::instancing::{instanced_objects, render_from_world};
-use super::upload::{HostScene, gpu_material};
+use super::upload::{HostScene, PosedMesh, gpu_material};
 use super::{Accel, Renderer, lights};
 use crate::bvh::{Blas, Update, WideBvh};
 use crate::cl::ClError;
@@ -85,15 +85,15 @@ pub(super) fn refit_blases(scene: &Scene, host: &HostScene) -> Option<RefittedBl
     })
 }
 
-/// A deformed BLAS's device data: its index, the BLAS, its binary nodes (empty when the
-/// device lacks them), its 4-wide nodes with the tree they were made from (when the device has
-/// them) and its mesh's triangles, shading data and tangents.
+/// A deformed BLAS's device nodes: its index, its mesh, the BLAS, its binary nodes (empty
+/// when the device lacks them) and its 4-wide nodes with the tree they were made from (when
+/// the device has them).
 type DeformedBlas = (
     usize,
+    Arc<Mesh>,
     Blas,
     Vec<crate::cl::types::DeviceBvhNode>,
     Option<(Vec<DeviceWideNode>, WideBvh)>,
-    super::upload::PosedMesh,
 );
 
 impl Renderer {
@@ -126,7 +126,7 @@ impl Renderer {
         if layout.wide_blases.len() != two.blases.len() {
             layout.wide_blases = vec![None; two.blases.len()];
         }
-        // Each deformed BLAS's nodes in its place and its mesh's structs, in parallel; its
+        // Each deformed BLAS's nodes in its place, in parallel: its binary nodes rebased, its
         // 4-wide tree as on the device (collapsed from the BLAS before the pose, the first
         // time) refitted.
         let deformed: Vec<_> = (refitted.blases)
@@ -151,17 +151,22 @@ impl Renderer {
                     let root = layout_now.wide_roots[b];
                     (two_now.device_wide_blas(b, &wide, root), wide)
                 });
-                let tangents = layout_now.mesh_tangents;
-                let structs = HostScene::mesh_structs(&blas, &mesh, &materials, tangents);
-                (b, blas, nodes, wide, structs)
+                (b, mesh, blas, nodes, wide)
             })
             .collect();
         let nodes_ms = t.elapsed().as_secs_f64() * 1e3;
+        // The deformed meshes' device structs (object space, BLAS order), in parallel.
+        let tangents = layout.mesh_tangents;
+        let structs: Vec<PosedMesh> = made
+            .par_iter()
+            .map(|(_, mesh, blas, ..)| HostScene::mesh_structs(blas, mesh, &materials, tangents))
+            .collect();
         let device = &self.device;
         let mut bytes = 0;
         let mut written = |n: usize| bytes += n;
         // The deformed meshes' ranges: nodes, triangles, shading data, tangents.
-        for (b, blas, nodes, wide, (tris, shading, tangents)) in made {
+        for ((b, _, blas, nodes, wide), (tris, shading, tangents)) in made.into_iter().zip(structs)
+        {
             let first = two.firsts[b] as usize;
             if forms.binary {
                 let root = layout.roots[b] as usize;

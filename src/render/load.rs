@@ -158,6 +158,7 @@ impl Renderer {
             meshes,
             instances,
             device_bytes: buffers.bytes(),
+            written_bytes: buffers.bytes(),
         };
         self.scene = Some((buffers, host));
         // The SAH BLASes start once the quick scene's first image is in ([`Renderer::swap_in_sah`]),
