@@ -921,6 +921,12 @@ fn fox_frames_refit_as_fresh_renders(bvh: &str) {
     }
     for line in &lines[1..] {
         assert_eq!(line["scene_update"], "refitted", "{line}");
+        // Only what the pose changed is written: the skinned mesh's triangles, shading data
+        // and BLAS nodes, the TLAS, the instances, materials and lights (not the textures'
+        // mip chains, nor the texture coordinates of a reload).
+        let (written, scene) = (&line["scene_update_bytes"], &line["device_bytes"]);
+        let (written, scene) = (written.as_u64().unwrap(), scene.as_u64().unwrap());
+        assert!(written > 0 && written * 20 < scene, "{line}");
     }
     for frame in [3, 4] {
         let single = dir.path().join(format!("single_{frame}.exr"));
@@ -1005,6 +1011,84 @@ fn stretch_rebuilds_past_the_bound(bvh: &str) {
             &scene,
             &single,
             &["--time", &frame.to_string(), "--bvh", bvh],
+        );
+        assert!(
+            std::fs::read(dir.path().join(format!("s_{frame}.exr"))).unwrap()
+                == std::fs::read(&single).unwrap(),
+            "frame {frame} differs from its fresh render"
+        );
+    }
+}
+
+/// On two levels, a morphed small mesh (at most 64 triangles: its instance's triangles are
+/// world-space pieces of the TLAS) that glows, and a larger morphed mesh beside it: each
+/// later frame is written in place ("refitted", far fewer bytes than the scene holds: the
+/// morphed meshes' ranges, their pieces and the light table measured again) and is bit for
+/// bit its fresh render.
+#[test]
+fn morphed_small_and_glowing_meshes_on_two_levels_are_written_in_place_as_fresh_renders() {
+    let mut g = Gltf::default();
+    let glow = g.lambert([0.2; 3], [4.0, 3.0, 2.0], 1.0, true);
+    let white = g.lambert([0.7; 3], [0.0; 3], 1.0, false);
+    // A strip of `n` quads along x, `width` wide, its far edge 0.5 up, with a target lifting
+    // that edge by `lift` (its triangles stretch a little, none slides: a refit).
+    let strip = |g: &mut Gltf, n: u32, width: f32, z: f32, lift: f32, material: usize| {
+        let (mut positions, mut indices, mut target) = (vec![], vec![], vec![]);
+        for i in 0..=n {
+            let x = i as f32 * width / n as f32;
+            positions.extend([[x, 0.0, z], [x, 0.5, z - 0.5]]);
+            target.extend([[0.0, 0.0, 0.0], [0.0, lift, 0.0]]);
+        }
+        for i in 0..n {
+            let v = 2 * i;
+            indices.extend([v, v + 2, v + 1, v + 1, v + 2, v + 3]);
+        }
+        let m = g.mesh(vec![Prim::triangles(positions, indices, material)]);
+        let target = g.float_accessor(&target);
+        g.meshes[m]["primitives"][0]["targets"] = json!([{"POSITION": target}]);
+        g.node(json!({"mesh": m, "weights": [0.0]}))
+    };
+    let small = strip(&mut g, 16, 2.0, 0.0, 0.15, glow); // 32 triangles
+    let large = strip(&mut g, 100, 3.0, 1.5, -0.15, white); // 200 triangles
+    g.cameras
+        .push(json!({"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.01}}));
+    g.node(
+        json!({"camera": 0, "translation": [1.5, 2.5, 5.0], "rotation": [-0.25, 0.0, 0.0, 0.968]}),
+    );
+    let times = scalars(&mut g, &[0.0, 1.0, 2.0, 3.0]);
+    let weights = scalars(&mut g, &[0.0, 0.5, 1.0, 1.0]);
+    let channel = |node: usize| json!({"sampler": 0, "target": {"node": node, "path": "weights"}});
+    g.extra.insert(
+        "animations".into(),
+        json!([{"name": "lift",
+            "channels": [channel(small), channel(large)],
+            "samplers": [{"input": times, "output": weights}]}]),
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let scene = g.write_glb(dir.path(), "strips");
+    let args = ["--bvh", "two-level"];
+    let lines = render(
+        &scene,
+        &dir.path().join("s_#.exr"),
+        &[&["--frames", "0..2", "--fps", "1"][..], &args[..]].concat(),
+    );
+    for line in &lines[1..] {
+        assert_eq!(line["bvh"], "two-level", "{line}");
+        assert_eq!(line["scene_update"], "refitted", "{line}");
+        let written = line["scene_update_bytes"].as_u64().unwrap();
+        let scene = line["device_bytes"].as_u64().unwrap();
+        assert!(written > 0 && written < scene, "{line}");
+    }
+    // The strips moved: each frame differs from the one before.
+    let image = |frame: u32| std::fs::read(dir.path().join(format!("s_{frame}.exr"))).unwrap();
+    assert!(image(0) != image(1) && image(1) != image(2));
+    for frame in [1, 2] {
+        let single = dir.path().join(format!("single_{frame}.exr"));
+        let time = frame.to_string();
+        render(
+            &scene,
+            &single,
+            &[&["--time", &time][..], &args[..]].concat(),
         );
         assert!(
             std::fs::read(dir.path().join(format!("s_{frame}.exr"))).unwrap()

@@ -600,6 +600,7 @@ impl FrameLoop {
             if let Some(stats) = self.scene_stats.as_mut() {
                 stats.bvh_build_ms = update.bvh_ms;
                 stats.upload_ms = update.flatten_ms + update.upload_ms;
+                stats.written_bytes = update.bytes;
             }
         } else if pending.scene || !self.loaded || far {
             let mut space = RenderFrame::around(&world.scene.bounds());

@@ -740,10 +740,13 @@ fn stats_section(ui: &mut Ui, m: &Model, info: &Info) {
                 && let Some(s) = info.scene_stats
             {
                 // A pose's host time, then the device update it caused (the last BVH build or
-                // instance update, and the upload).
+                // instance update, and the upload with the bytes it wrote).
                 ui.label(format!(
-                    "scene update: pose {:.2} ms · BVH {:.1} ms · upload {:.1} ms",
-                    m.timeline.pose_ms, s.bvh_build_ms, s.upload_ms
+                    "scene update: pose {:.2} ms · BVH {:.1} ms · upload {:.1} ms ({})",
+                    m.timeline.pose_ms,
+                    s.bvh_build_ms,
+                    s.upload_ms,
+                    memory_size(s.written_bytes)
                 ));
             }
             if p.stats.nonfinite_samples > 0 {

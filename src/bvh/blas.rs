@@ -94,7 +94,7 @@ impl Blas {
         };
         // A mesh the BLAS still holds cannot have been deformed in place (`Arc::make_mut`
         // copies a shared mesh).
-        if std::ptr::addr_eq(Arc::as_ptr(old), Arc::as_ptr(mesh)) {
+        if self.reads(mesh) {
             return Some((self.clone(), Update::Refitted));
         }
         let indices = mesh.indices();
@@ -108,6 +108,12 @@ impl Blas {
             return Some((Self::of_shared_mesh(mesh), Update::Rebuilt));
         }
         Some((Self::over_mesh(bvh, mesh), Update::Refitted))
+    }
+
+    /// Whether the BLAS reads its triangles from `mesh` itself (not a copy of it).
+    pub fn reads<M: IndexedMesh + 'static>(&self, mesh: &Arc<M>) -> bool {
+        matches!(&self.triangles, BlasTriangles::Mesh(old)
+            if std::ptr::addr_eq(Arc::as_ptr(old), Arc::as_ptr(mesh)))
     }
 
     /// Triangles.

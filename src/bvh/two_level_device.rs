@@ -2,7 +2,7 @@
 //! of the node arrays (so that a rebuilt TLAS is written over the old one in place), then every
 //! BLAS's, rebased, in the binary and the 4-wide forms.
 
-use super::{TwoLevel, WideBvh};
+use super::{Blas, TwoLevel, WideBvh};
 use crate::cl::types::{DeviceBvhNode, DeviceWideNode};
 use rayon::prelude::*;
 
@@ -26,25 +26,7 @@ impl TwoLevel {
         for b in &self.blases {
             debug_assert_eq!(roots[firsts.len()], nodes.len() as u32);
             firsts.push(tri_base);
-            let base = nodes.len() as i32;
-            nodes.extend(b.bvh.nodes.iter().map(|&n| {
-                let mut n = n;
-                for (lo, hi) in [
-                    (&mut n.left_min, n.left_max),
-                    (&mut n.right_min, n.right_max),
-                ] {
-                    let r = lo[3].to_bits() as i32;
-                    let r = if r >= 0 {
-                        r + base
-                    } else if hi[3].to_bits() > 0 {
-                        !((!r) + tri_base as i32)
-                    } else {
-                        r
-                    };
-                    lo[3] = f32::from_bits(r as u32);
-                }
-                n
-            }));
+            nodes.extend(rebased(&b.bvh.nodes, nodes.len() as i32, tri_base));
             tri_base += b.len() as u32;
         }
         (nodes, roots, firsts)
@@ -119,20 +101,76 @@ impl TwoLevel {
             for (b, wide) in batch.iter().zip(collapsed) {
                 let base = nodes.len() as i32;
                 roots.push(base as u32);
-                nodes.par_extend(wide.nodes.into_par_iter().map(|mut n| {
-                    for i in 0..super::WIDTH {
-                        if n.count[i] > 0 {
-                            n.child[i] = !((!n.child[i]) + tri_base);
-                        } else if n.child[i] > 0 {
-                            n.child[i] += base;
-                        }
-                    }
-                    n
-                }));
+                nodes.par_extend(wide_rebased(wide.nodes, base, tri_base));
                 tri_base += b.len() as i32;
             }
         }
         nodes.shrink_to_fit();
         (nodes, roots)
     }
+
+    /// `blas`'s binary nodes in BLAS `b`'s place in [`TwoLevel::device_nodes`] (from its
+    /// root `root`, its triangles from `firsts[b]`): a refit of BLAS `b` that kept its
+    /// topology, to be written over the device's nodes in place.
+    pub fn device_blas(&self, b: usize, blas: &Blas, root: u32) -> Vec<DeviceBvhNode> {
+        rebased(&blas.bvh.nodes, root as i32, self.firsts[b]).collect()
+    }
+
+    /// The 4-wide tree of BLAS `b` as [`TwoLevel::device_wide_nodes`] collapses it, before
+    /// it is rebased (to be refitted in place after a deformation: [`WideBvh::refit`]).
+    pub fn wide_blas(&self, b: usize) -> WideBvh {
+        WideBvh::collapse_merging(&self.blases[b].bvh, self.merge)
+    }
+
+    /// `wide`, BLAS `b`'s 4-wide tree, rebased as [`TwoLevel::device_wide_nodes`] places it
+    /// from `root` on.
+    pub fn device_wide_blas(&self, b: usize, wide: &WideBvh, root: u32) -> Vec<DeviceWideNode> {
+        wide_rebased(wide.nodes.clone(), root as i32, self.firsts[b] as i32).collect()
+    }
+}
+
+/// A BLAS's binary nodes with their children moved `base` nodes on and their leaves'
+/// triangles `tri_base` on (the device's node array holds the TLAS and every BLAS, its
+/// triangle array every mesh's).
+fn rebased(
+    nodes: &[DeviceBvhNode],
+    base: i32,
+    tri_base: u32,
+) -> impl Iterator<Item = DeviceBvhNode> + '_ {
+    nodes.iter().map(move |&n| {
+        let mut n = n;
+        for (lo, hi) in [
+            (&mut n.left_min, n.left_max),
+            (&mut n.right_min, n.right_max),
+        ] {
+            let r = lo[3].to_bits() as i32;
+            let r = if r >= 0 {
+                r + base
+            } else if hi[3].to_bits() > 0 {
+                !((!r) + tri_base as i32)
+            } else {
+                r
+            };
+            lo[3] = f32::from_bits(r as u32);
+        }
+        n
+    })
+}
+
+/// [`rebased`] for a BLAS's 4-wide nodes.
+fn wide_rebased(
+    nodes: Vec<DeviceWideNode>,
+    base: i32,
+    tri_base: i32,
+) -> impl ParallelIterator<Item = DeviceWideNode> {
+    nodes.into_par_iter().map(move |mut n| {
+        for i in 0..super::WIDTH {
+            if n.count[i] > 0 {
+                n.child[i] = !((!n.child[i]) + tri_base);
+            } else if n.child[i] > 0 {
+                n.child[i] += base;
+            }
+        }
+        n
+    })
 }

@@ -140,12 +140,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         // film restarts, the seed stays).
         let mut update_ms = None;
         let mut update = None;
+        let mut update_bytes = None;
         if k > 0
             && let Some(c) = clip
         {
             let t = Instant::now();
             let applied = animate::pose(&mut prepared, c, frame.time.unwrap_or(0.0));
             let mut kinds = Vec::new();
+            let mut bytes = Vec::new();
             for renderer in &mut renderers {
                 let u = renderer.update_scene(
                     &prepared.scene,
@@ -154,9 +156,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 )?;
                 renderer.set_camera(&prepared.camera)?;
                 kinds.push(u.kind);
+                bytes.push(u.bytes);
             }
             update_ms = Some(t.elapsed().as_secs_f64() * 1e3);
             update = kinds.first().copied();
+            update_bytes = bytes.first().copied();
         }
         let output = match output.take() {
             Some(first) => first,
@@ -169,6 +173,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             "frame": frame.number,
             "scene_update_ms": update_ms,
             "scene_update": update,
+            "scene_update_bytes": update_bytes,
             "shutter": args.animation.shutter.unwrap_or(0.0),
         });
         render_frame(

@@ -158,6 +158,7 @@ impl Renderer {
             meshes,
             instances,
             device_bytes: buffers.bytes(),
+            written_bytes: buffers.bytes(),
         };
         self.scene = Some((buffers, host));
         // The SAH BLASes start once the quick scene's first image is in ([`Renderer::swap_in_sah`]),
@@ -252,6 +253,7 @@ impl Renderer {
         let (mesh_triangles, mesh_tangents) = planned.mesh_triangles();
         let mesh_colors = !planned.meshes.is_empty() && planned.colored();
         let host = &mut planned.host;
+        host.layout.mesh_tangents = mesh_tangents;
         let (nodes, wide_nodes, instances) = device_accel(host, forms);
         log::debug!(
             "device nodes: {:.0} ms",

@@ -3,6 +3,7 @@
 
 mod adaptive;
 pub mod background;
+mod blas_refit;
 pub mod camera;
 pub mod exposure;
 pub mod film;
@@ -83,6 +84,9 @@ pub struct SceneStats {
     pub instances: usize,
     /// Bytes of every scene buffer on the device (textures included).
     pub device_bytes: usize,
+    /// Bytes written to the device by the last load (all of `device_bytes`) or scene update
+    /// ([`SceneUpdate::bytes`]).
+    pub written_bytes: usize,
 }
 
 /// The path tracer on one OpenCL device.

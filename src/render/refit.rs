@@ -103,18 +103,27 @@ impl Renderer {
         }
         bytes += std::mem::size_of_val(host.materials.as_slice());
         buffers.materials.write(device, &host.materials)?;
-        self.lights = lights.to_vec();
-        self.upload_lights()?;
-        if let Some(c) = self.world_camera.clone() {
-            self.set_camera(&c)?;
-        }
-        self.reset()?;
+        self.follow_pose(lights)?;
         Ok(Ok(RefitTimes {
             flatten_ms: space_ms + flatten_ms,
             refit_ms: refit_ms + wide_ms,
             upload_ms: t.elapsed().as_secs_f64() * 1e3 - wide_ms,
             bytes,
         }))
+    }
+}
+
+impl Renderer {
+    /// The last step of a pose written in place: `lights` (in the new render space) as the
+    /// light table with the scene's emissive triangles, the camera placed in that space, and
+    /// the film reset.
+    pub(super) fn follow_pose(&mut self, lights: &[Light]) -> Result<(), ClError> {
+        self.lights = lights.to_vec();
+        self.upload_lights()?;
+        if let Some(c) = self.world_camera.clone() {
+            self.set_camera(&c)?;
+        }
+        self.reset()
     }
 }
 

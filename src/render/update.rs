@@ -6,16 +6,15 @@
 //! is refitted (`render/refit.rs`); a two-level one whose meshes deformed has their BLASes refitted
 //! and is loaded again over them (every buffer written again in place; no BLAS built).
 
+use super::blas_refit::refit_blases;
 use super::instancing::{Blases, instanced_objects, render_from_world};
 use super::refit::NoRefit;
-use super::upload::{HostScene, piece_copies};
+use super::upload::piece_copies;
 use super::{Accel, Renderer};
-use crate::bvh::{Blas, Update, WideBvh};
+use crate::bvh::WideBvh;
 use crate::cl::ClError;
 use crate::cl::types::DeviceWideNode;
-use crate::scene::{Light, Mesh, Object, Scene, distinct_meshes, is_sane};
-use rayon::prelude::*;
-use std::sync::Arc;
+use crate::scene::{Light, Scene, is_sane};
 use std::time::Instant;
 
 /// What [`Renderer::move_instances`] did.
@@ -112,24 +111,39 @@ impl Renderer {
         // Quick BLASes whose SAH trees are still to come are not refitted: the load builds
         // SAH trees, which refits then keep.
         let pending = self.sah_pending();
-        let old = self.scene.take();
         let fitting = Instant::now();
-        let refitted = old
-            .as_ref()
+        let refitted = (self.scene.as_ref())
             .filter(|_| !pending)
             .and_then(|(_, host)| refit_blases(scene, host));
         let refit_ms = fitting.elapsed().as_secs_f64() * 1e3;
+        // Deformed meshes of a two-level scene: what changed written in place where it can be.
+        let refitted = match refitted {
+            Some(r) => match self.write_refitted_blases(scene, lights, space, r)? {
+                Ok(w) => {
+                    return Ok(SceneUpdate {
+                        kind: UpdateKind::Refitted,
+                        flatten_ms: 0.0,
+                        bvh_ms: refit_ms + w.bvh_ms,
+                        upload_ms: w.upload_ms,
+                        bytes: w.bytes,
+                    });
+                }
+                Err(r) => Some(r),
+            },
+            None => None,
+        };
         let (kind, how) = match refitted {
-            Some((built, rebuilt)) => {
-                let kind = if rebuilt {
+            Some(r) => {
+                let kind = if r.rebuilt {
                     UpdateKind::Rebuilt
                 } else {
                     UpdateKind::Refitted
                 };
-                (kind, Blases::Built(built))
+                (kind, Blases::Built(r.blases))
             }
             None => (kind, Blases::Sah),
         };
+        let old = self.scene.take();
         let old = old.map(|(buffers, _)| buffers);
         let stats = self.load_with(scene, lights, space, how, old)?;
         let bvh_ms = refit_ms + stats.bvh_build_ms;
@@ -243,40 +257,4 @@ impl Renderer {
         self.reset()?;
         Ok(Some(update))
     }
-}
-
-/// Each distinct mesh with its BLAS, for [`Blases::Built`].
-type MeshBlases = Vec<(Arc<Mesh>, Blas)>;
-
-/// The BLASes of `scene`'s distinct meshes in [`super::instancing::plan`]'s order (for
-/// [`Blases::Built`]), made from those of `host`, the two-level scene on the device before the
-/// pose: each mesh's old BLAS refitted over it in its own space, the same topology (built anew
-/// past its cost bound: [`Blas::refit_over`]); with whether any was built anew. `None` when the
-/// instances place other objects or a mesh's index list changed: the scene is built again.
-fn refit_blases(scene: &Scene, host: &HostScene) -> Option<(MeshBlases, bool)> {
-    let Accel::TwoLevel(two) = &host.accel else {
-        return None;
-    };
-    let objects = instanced_objects(scene);
-    if objects != host.layout.objects || two.instances.len() != objects.len() {
-        return None;
-    }
-    let placed: Vec<&Object> = objects
-        .iter()
-        .map(|&o| &scene.objects[o as usize])
-        .collect();
-    // A mesh that deformation split from others (each deformed object gets its own copy)
-    // refits the BLAS its instance had.
-    let (meshes, _) = distinct_meshes(&placed);
-    let built: Vec<((Arc<Mesh>, Blas), Update)> = meshes
-        .par_iter()
-        .map(|&i| {
-            let mesh = &placed[i].mesh;
-            let old = two.blases.get(two.instances[i].blas as usize)?;
-            let (blas, update) = old.refit_over(mesh)?;
-            Some(((Arc::clone(mesh), blas), update))
-        })
-        .collect::<Option<_>>()?;
-    let rebuilt = built.iter().any(|(_, u)| *u == Update::Rebuilt);
-    Some((built.into_iter().map(|(b, _)| b).collect(), rebuilt))
 }

@@ -10,7 +10,7 @@ mod structs;
 mod triangles;
 
 pub use accel::{Accel, piece_copies};
-pub use host_scene::{FlatRefit, HostScene, render_middle};
+pub use host_scene::{FlatRefit, HostScene, PosedMesh, render_middle};
 pub use repose::CHUNK;
 pub(super) use structs::{f4, luminance};
 pub use structs::{gpu_camera, gpu_material, samples_textures};

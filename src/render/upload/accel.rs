@@ -2,7 +2,7 @@
 //! where the instances' parts sit there ([`InstanceLayout`]): the device instances in TLAS
 //! order and the world-space copies of small instances' triangles.
 
-use crate::bvh::{Bvh, PIECE_TRIANGLE, TwoLevel};
+use crate::bvh::{Bvh, PIECE_TRIANGLE, TwoLevel, WideBvh};
 use crate::cl::types::*;
 use glam::Vec3;
 
@@ -75,6 +75,13 @@ pub struct InstanceLayout {
     /// Each small instance's first world-space triangle copy in the device triangles (see
     /// [`piece_copies`]; `u32::MAX` for an instance that is not small).
     pub copy_bases: Vec<u32>,
+    /// Whether the device's tangents hold the meshes' (some mesh has tangents), to be
+    /// written again with a deformed mesh's triangles.
+    pub mesh_tangents: bool,
+    /// Per BLAS, the 4-wide tree on the device (before rebasing) of a mesh deformed in place,
+    /// refitted at each pose (the same nodes, so it stays in its range; collapsing the
+    /// refitted binary tree again may take more); `None` until its first deformation.
+    pub wide_blases: Vec<Option<WideBvh>>,
     /// Per BLAS, a small mesh's object-space device triangles (empty for the others): what a
     /// moved small instance's copies are made from once the triangles live on the device only.
     pub small_meshes: Vec<Vec<DeviceTriangle>>,

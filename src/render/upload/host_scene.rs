@@ -8,7 +8,7 @@ use super::structs::{gpu_material, luminance, samples_textures};
 use super::triangles::{
     FlatStructs, emissive_triangles, object_triangles, split_by, triangle_area,
 };
-use crate::bvh::{Ray, TwoLevel, WideBvh};
+use crate::bvh::{Blas, Ray, TwoLevel, WideBvh};
 use crate::cl::types::*;
 use crate::scene::{Material, Mesh, RenderFrame, Scene, WorldTriangle, robust_bounds_of};
 use glam::{DVec3, Vec3};
@@ -23,6 +23,14 @@ pub type MeshArrays<'a> = (
     &'a mut [DeviceTriUvs],
     &'a mut [DeviceTriTangents],
     &'a mut [DeviceTriColors],
+);
+
+/// One mesh's device structs in object space and BLAS order
+/// ([`HostScene::mesh_structs`]): triangles, shading data and tangents (empty without).
+pub type PosedMesh = (
+    Vec<DeviceTriangle>,
+    Vec<DeviceTriShading>,
+    Vec<DeviceTriTangents>,
 );
 
 /// An emissive triangle of the light table.
@@ -461,6 +469,49 @@ impl HostScene {
             .for_each(|((m, blas), out)| {
                 object_triangles(m, &blas.bvh.tri_indices, materials, out);
             });
+    }
+
+    /// Two levels: the device structs of `mesh` in `blas`'s order, as
+    /// [`HostScene::fill_meshes`] writes them (object space): triangles, shading data and,
+    /// when `tangents`, tangents (else none). Texture coordinates and colours are left out:
+    /// a deformation does not change them.
+    pub fn mesh_structs(
+        blas: &Blas,
+        mesh: &Mesh,
+        materials: &[Material],
+        tangents: bool,
+    ) -> PosedMesh {
+        let n = blas.len();
+        let mut tris = vec![DeviceTriangle::default(); n];
+        let mut shading = vec![DeviceTriShading::default(); n];
+        let mut tans = vec![DeviceTriTangents::default(); if tangents { n } else { 0 }];
+        let out = (
+            (&mut tris[..], &mut shading[..]),
+            (&mut [][..], &mut tans[..]),
+            &mut [][..],
+        );
+        object_triangles(mesh, &blas.bvh.tri_indices, materials, out);
+        (tris, shading, tans)
+    }
+
+    /// Two levels: every emissive triangle measured again where its instance places it now
+    /// (area, power before [`HostScene::scale_emitter_power`], centroid), as
+    /// [`HostScene::two_level`] measures them, in the same light-table order.
+    pub fn measure_emitters(&mut self, materials: &[Material]) {
+        let Accel::TwoLevel(two) = &self.accel else {
+            return;
+        };
+        for e in &mut self.emissive {
+            let v = two.hit_triangle(e.prim, e.instance);
+            let m = &materials[e.material as usize];
+            *e = emitter(e.prim, e.instance, &v, e.material, m);
+        }
+    }
+
+    /// Takes render space `space` for `scene`'s pose: the frame and the robust middle there.
+    pub fn set_space(&mut self, scene: &Scene, space: RenderFrame) {
+        self.space = space;
+        self.middle = render_middle(scene, &space);
     }
 
     /// Triangles over all placed meshes.
