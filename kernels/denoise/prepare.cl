@@ -69,52 +69,70 @@ kernel void denoise_exposure_bins(global const float4* image, global const ulong
     bins[i] = sum / (float)((y1 - y0) * (x1 - x0));
 }
 
-// The network's 9-channel input tile (`tile_w` x `tile_h`): the image's pixels from
-// (src_x, src_y) on, `w` x `h` of them, placed at (off_x, off_y) in the tile, zero elsewhere.
+// The network's 9-channel input tile (`tile_w` x `tile_h`, tile_w a multiple of DN_VEC): the
+// image's pixels from (src_x, src_y) on, `w` x `h` of them, placed at (off_x, off_y) in the tile,
+// zero elsewhere. A work item writes DN_VEC neighbouring pixels of a row: it gathers them
+// pixel by pixel, then curves the colour as one vector; global size (tile_w / DN_VEC, tile_h).
 kernel void denoise_input(global const float4* image, global const ulong4* film,
                           global const uint* state, int color_mode, float taken,
-                          global const float4* albedo, global const float4* normal, int width, int src_x, int src_y, int off_x, int off_y, int w, int h,
-                          int tile_w, int tile_h, float exposure, float pu_norm,
-                          global float* dst) {
-    const int x = get_global_id(0);
+                          global const float4* albedo, global const float4* normal, int width,
+                          int src_x, int src_y, int off_x, int off_y, int w, int h, int tile_w,
+                          int tile_h, float exposure, float pu_norm, global float* dst) {
+    const int x0 = get_global_id(0) * DN_VEC;
     const int y = get_global_id(1);
-    if (x >= tile_w || y >= tile_h)
+    if (x0 >= tile_w || y >= tile_h)
         return;
-    const int ix = x - off_x;
     const int iy = y - off_y;
-    float3 c = (float3)(0.0f), a = (float3)(0.0f), n = (float3)(0.0f);
-    if (ix >= 0 && ix < w && iy >= 0 && iy < h) {
-        const int i = (src_y + iy) * width + src_x + ix;
-        c = sanitize(color_value(image, film, state, color_mode, taken, i) * exposure, 0.0f,
-                     FLT_MAX);
-        c = (float3)(pu_forward(c.x), pu_forward(c.y), pu_forward(c.z)) * pu_norm;
-        a = sanitize(guide_value(albedo, albedo, i), 0.0f, 1.0f);
-        n = sanitize(guide_value(normal, albedo, i), -1.0f, 1.0f);
-        n = n * 0.5f + 0.5f;
+    // The 9 channels' lanes: colour (exposed, not yet curved), albedo, normal.
+    float lanes[9][DN_VEC];
+    for (int l = 0; l < DN_VEC; ++l) {
+        const int ix = x0 + l - off_x;
+        float3 c = (float3)(0.0f), a = (float3)(0.0f), n = (float3)(0.0f);
+        if (ix >= 0 && ix < w && iy >= 0 && iy < h) {
+            const int i = (src_y + iy) * width + src_x + ix;
+            c = sanitize(color_value(image, film, state, color_mode, taken, i) * exposure, 0.0f,
+                         FLT_MAX);
+            a = sanitize(guide_value(albedo, albedo, i), 0.0f, 1.0f);
+            n = sanitize(guide_value(normal, albedo, i), -1.0f, 1.0f);
+            n = n * 0.5f + 0.5f;
+        }
+        const float v[9] = {c.x, c.y, c.z, a.x, a.y, a.z, n.x, n.y, n.z};
+        for (int k = 0; k < 9; ++k)
+            lanes[k][l] = v[k];
     }
     const int plane = tensor_plane(tile_w, tile_h);
-    const int at = tensor_at(tile_w, x, y);
-    const float v[9] = {c.x, c.y, c.z, a.x, a.y, a.z, n.x, n.y, n.z};
-    for (int k = 0; k < 9; ++k)
-        dst[k * plane + at] = v[k];
+    global float* d = dst + tensor_at(tile_w, x0, y);
+    for (int k = 0; k < 3; ++k)
+        vstore_row(pu_forward(vload_row(lanes[k])) * pu_norm, d + k * plane);
+    for (int k = 3; k < 9; ++k)
+        vstore_row(vload_row(lanes[k]), d + k * plane);
 }
 
 // The image's `w` x `h` pixels from (dst_x, dst_y) on, from the network's output tile
 // (`tile_w` x `tile_h`, channels 0-2) from (src_x, src_y) on: clamped to >= 0, through the
 // inverse PU curve (`pu_max` = pu_forward(65504)) and divided by the exposure
-// (`output_scale`); .w = 1.
+// (`output_scale`); .w = 1. A work item takes DN_VEC neighbouring pixels of a row, curved as
+// one vector; global size (w / DN_VEC rounded up, h).
 kernel void denoise_output(global const float* src, int tile_w, int tile_h, int src_x,
                            int src_y, int dst_x, int dst_y, int w, int h, int width,
                            float pu_max, float output_scale, global float4* out) {
-    const int x = get_global_id(0);
+    const int x0 = get_global_id(0) * DN_VEC;
     const int y = get_global_id(1);
-    if (x >= w || y >= h)
+    if (x0 >= w || y >= h)
         return;
     const int plane = tensor_plane(tile_w, tile_h);
-    const int at = tensor_at(tile_w, src_x + x, src_y + y);
-    float3 v = sanitize((float3)(src[at], src[plane + at], src[2 * plane + at]), 0.0f, FLT_MAX);
-    v = (float3)(pu_inverse(v.x * pu_max), pu_inverse(v.y * pu_max), pu_inverse(v.z * pu_max));
-    out[(dst_y + y) * width + dst_x + x] = (float4)(v * output_scale, 1.0f);
+    global const float* s = src + tensor_at(tile_w, src_x + x0, src_y + y);
+    float lanes[3][DN_VEC];
+    for (int k = 0; k < 3; ++k) {
+        // Lanes past the region read the border or the next row (the tensor has room) and are
+        // not written.
+        const vfloat v = vload_row(s + k * plane);
+        const vfloat clean = fmax(select(v, (vfloat)(0.0f), isnan(v)), 0.0f);
+        vstore_row(pu_inverse(fmin(clean, FLT_MAX) * pu_max) * output_scale, lanes[k]);
+    }
+    global float4* o = out + (dst_y + y) * width + dst_x + x0;
+    for (int l = 0; l < DN_VEC && x0 + l < w; ++l)
+        o[l] = (float4)(lanes[0][l], lanes[1][l], lanes[2][l], 1.0f);
 }
 
 // How `denoise_planes` maps a value: as it is, into the sRGB curve, or out of it.

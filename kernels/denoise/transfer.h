@@ -4,6 +4,8 @@
 #ifndef DENOISE_TRANSFER_H
 #define DENOISE_TRANSFER_H
 
+#include "denoise/tensor.h"
+
 #define PU_A 1.41283765e+03f
 #define PU_B 1.64593172e+00f
 #define PU_C 4.31384981e-01f
@@ -16,22 +18,24 @@
 #define PU_X0 2.23151711e-03f
 #define PU_X1 3.70974749e-01f
 
-// The curve before normalisation; the kernels scale it by 1 / pu_forward(65504), which the
-// host computes once (`prepare::PU_NORM`).
-inline float pu_forward(float y) {
-    if (y <= PU_Y0)
-        return PU_A * y;
-    if (y <= PU_Y1)
-        return PU_B * pow(y, PU_C) + PU_D;
-    return PU_E * log(y + PU_F) + PU_G;
+// The curve before normalisation, on a row vector of pixels (kernels/denoise/tensor.h: 16 on
+// a CPU, where PoCL runs the vector's pow and log as vector code but calls them once per pixel
+// when each work item takes one pixel and branches); the kernels scale it by
+// 1 / pu_forward(65504), which the host computes once (`prepare::PU_NORM`). Every lane
+// computes each piece and keeps its own, so y must be finite and >= 0.
+inline vfloat pu_forward(vfloat y) {
+    const vfloat low = PU_A * y;
+    const vfloat mid = PU_B * pow(fmax(y, PU_Y0), (vfloat)(PU_C)) + PU_D;
+    const vfloat high = PU_E * log(y + PU_F) + PU_G;
+    return select(select(high, mid, y <= PU_Y1), low, y <= PU_Y0);
 }
 
-inline float pu_inverse(float x) {
-    if (x <= PU_X0)
-        return x / PU_A;
-    if (x <= PU_X1)
-        return pow((x - PU_D) / PU_B, 1.0f / PU_C);
-    return exp((x - PU_G) / PU_E) - PU_F;
+// The inverse, for x >= 0.
+inline vfloat pu_inverse(vfloat x) {
+    const vfloat low = x / PU_A;
+    const vfloat mid = pow((x - PU_D) / PU_B, (vfloat)(1.0f / PU_C));
+    const vfloat high = exp((x - PU_G) / PU_E) - PU_F;
+    return select(select(high, mid, x <= PU_X1), low, x <= PU_X0);
 }
 
 // The sRGB curve, which OIDN's albedo prefilter (`rt_alb`) works in: its input is the albedo

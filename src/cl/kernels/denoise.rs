@@ -189,15 +189,18 @@ fn launch(
 impl DenoiseKernels {
     /// Builds the denoiser's program for the device. On a CPU a work item computes 16 columns
     /// (one AVX-512 vector) of 4 rows and 4 output channels, 16 accumulator registers of 32,
-    /// and a work-group is 4 of them (PoCL runs a group as one task); on a GPU 2 columns of 4
-    /// rows and 8 channels, in groups of 64 along the row (coalesced loads).
+    /// a work-group is 4 of them (PoCL runs a group as one task), and the work-groups that run
+    /// in turn take the output-channel blocks of the same pixels (`DN_BLOCKS_FIRST`: their
+    /// input stays in cache); on a GPU 2 columns of 4 rows and 8 channels, in groups of 64
+    /// along the row (coalesced loads).
     pub fn build(device: &Device) -> Result<Self, ClError> {
-        let (ocb, vec, group_x) = if device.is_cpu() {
-            (4, 16, 4)
+        let (ocb, vec, group_x, order) = if device.is_cpu() {
+            (4, 16, 4, " -DDN_BLOCKS_FIRST")
         } else {
-            (8, 2, 64)
+            (8, 2, 64, "")
         };
-        let program = build_denoise_program(device, &format!(" -DDN_OCB={ocb} -DDN_VEC={vec}"))?;
+        let options = format!(" -DDN_OCB={ocb} -DDN_VEC={vec}{order}");
+        let program = build_denoise_program(device, &options)?;
         Ok(Self {
             conv: kernel(&program, "conv3x3")?,
             conv_up: kernel(&program, "conv3x3_up")?,
@@ -305,11 +308,16 @@ impl DenoiseKernels {
             tile.tile_h,
         ]
         .map(|v| v as i32);
+        debug_assert_eq!(
+            tile.tile_w % self.vec,
+            0,
+            "a work item takes DN_VEC columns"
+        );
         launch(
             device,
             "denoise_input",
             &self.input,
-            &[tile.tile_w, tile.tile_h],
+            &[tile.tile_w / self.vec, tile.tile_h],
             &GROUP_2D,
             |e| unsafe {
                 color.set_args(e, guides.albedo);
@@ -351,7 +359,7 @@ impl DenoiseKernels {
             device,
             "denoise_output",
             &self.output,
-            &[tile.w, tile.h],
+            &[tile.w.div_ceil(self.vec), tile.h],
             &GROUP_2D,
             |e| unsafe {
                 e.set_arg(&src.mem());
