@@ -76,26 +76,84 @@ fn adaptive_renders_average_to_the_uniform_image() {
     for kernel in KERNELS {
         let base = ["--spp", "64", "--sky", "0.3"];
         let (uniform, uniform_var, uniform_spp) = block_stats(&scene, &dir, kernel, &base);
-        // About half the pixels stop, at the minimum (32) or at the check at 48; the others
-        // go on to 64.
-        let adaptive_args = [&base[..], &["--noise-threshold", "0.1"]].concat();
-        let (adaptive, adaptive_var, adaptive_spp) =
-            block_stats(&scene, &dir, kernel, &adaptive_args);
         assert_eq!(uniform_spp, 64.0);
-        assert!(
-            (32.0..60.0).contains(&adaptive_spp),
-            "{kernel}: adaptive renders took {adaptive_spp} spp"
-        );
-        for b in 0..uniform.len() {
-            let sigma = (uniform_var[b] + adaptive_var[b]).sqrt();
-            let diff = (adaptive[b] - uniform[b]).abs();
+        // With either rule about half the pixels stop, at the minimum (32) or at the check
+        // at 48; the others go on to 64.
+        for (rule, threshold) in [("error", "0.1"), ("cost", "0.05")] {
+            let adaptive_args = [
+                &base[..],
+                &["--noise-threshold", threshold, "--adaptive-rule", rule],
+            ]
+            .concat();
+            let (adaptive, adaptive_var, adaptive_spp) =
+                block_stats(&scene, &dir, kernel, &adaptive_args);
             assert!(
-                diff <= 5.0 * sigma + 1e-4 * uniform[b].abs(),
-                "{kernel}: block {b}: adaptive mean {} vs uniform {} (σ {sigma})",
-                adaptive[b],
-                uniform[b]
+                (32.0..60.0).contains(&adaptive_spp),
+                "{kernel}, {rule}: adaptive renders took {adaptive_spp} spp"
             );
+            for b in 0..uniform.len() {
+                let sigma = (uniform_var[b] + adaptive_var[b]).sqrt();
+                let diff = (adaptive[b] - uniform[b]).abs();
+                assert!(
+                    diff <= 5.0 * sigma + 1e-4 * uniform[b].abs(),
+                    "{kernel}, {rule}: block {b}: adaptive mean {} vs uniform {} (σ {sigma})",
+                    adaptive[b],
+                    uniform[b]
+                );
+            }
         }
+    }
+}
+
+#[test]
+fn the_cost_rule_stops_pixels_whose_samples_trace_more_rays_sooner() {
+    let dir = output_dir("adaptive-cost");
+    let scene = white_sphere_under_panel(&dir, 16, 32);
+    for kernel in KERNELS {
+        let base = [
+            "--spp",
+            "256",
+            "--sky",
+            "0.3",
+            "--noise-threshold",
+            "0.05",
+            "--aovs",
+        ];
+        let mut spp = Vec::new();
+        for rule in ["error", "cost"] {
+            let out = dir.join(format!("{kernel}-{rule}.exr"));
+            let args = [&base[..], &["--adaptive-rule", rule]].concat();
+            let (summary, _) = render(&scene, &out, kernel, &args);
+            assert_eq!(summary["adaptive_rule"], rule);
+            let (_, _, channels) = penumbra::image_io::read_exr_channels(&out).unwrap();
+            let (_, samples) = channels
+                .into_iter()
+                .find(|(n, _)| n == "samples.Y")
+                .unwrap();
+            spp.push(samples);
+        }
+        // A sky pixel's samples trace one ray each: the same threshold under both rules, the
+        // minimum (48) either way. A sphere pixel's trace at least two (its light sample), so
+        // under the cost rule its threshold grows from √2 T at the minimum with its samples:
+        // the sphere, which the error rule samples past the minimum, takes fewer.
+        let (mut sphere_error, mut sphere_cost, mut sky) = (0.0, 0.0, 0);
+        for (e, c) in spp[0].iter().zip(&spp[1]) {
+            if *e == 48.0 {
+                sky += 1;
+            } else {
+                sphere_error += e;
+                sphere_cost += c;
+            }
+        }
+        assert!(
+            sky > SIZE * SIZE / 5,
+            "{kernel}: {sky} pixels at the minimum"
+        );
+        assert!(
+            sphere_cost < 0.8 * sphere_error,
+            "{kernel}: the pixels past the minimum took {sphere_cost} samples with the cost \
+             rule, {sphere_error} with the error rule"
+        );
     }
 }
 

@@ -137,7 +137,10 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     }
     if (frame.background == BACKGROUND_ENV) counted = frame.samples_in_wave;
     film[pixel] = (ulong4)(sum, pixel_film.w + counted);
-    if (frame.adaptive != 0u) half_store(halves, state, pixel, even, evens, frame.samples_in_wave);
+    if (frame.adaptive != 0u) {
+        half_store(halves, state, pixel, even, evens, frame.samples_in_wave);
+        rays[pixel] += extension_rays + shadow_rays;
+    }
 #ifdef AOVS
     aov_store(aov_albedo, aov_normal, aov_depth, pixel, aov_albedo_sum, aov_normal_sum,
               aov_depth_sum, frame.samples_in_wave);

@@ -23,6 +23,7 @@
         global const float *env_marginal, global const float *env_conditional,              \
         global const DeviceLight *lights, global const float *light_cdf, global ulong4 *film, \
         volatile global uint *counters, global float4 *halves, global uint *state,           \
+        global uint *rays,                                                                  \
         global float4 *aov_albedo, global float4 *aov_normal, global float2 *aov_depth
 
 // What shading reads of the scene, from the kernel's parameters.

@@ -52,6 +52,7 @@ typedef struct {
     float3 result[LANES];  // entry e's radiance, once its path is done
     uint escaped;          // bit e: entry e's camera ray escaped (PATH_ESCAPED)
     uint even;             // bit e: entry e's sample index is even (adaptive.h's half buffer)
+    uint rays[LANES];      // entry e's rays traced so far (adaptive.h's ray count)
     uint count;            // entries
     uint remaining;        // paths not yet done: 0 when the record is not in flight
     uint next_sample;      // one pixel a chunk: the pixel's next sample to start
@@ -69,6 +70,7 @@ typedef struct {
     uint extension_rays, shadow_rays, nonfinite;
     global float4* halves;  // adaptive sampling's film (shared/adaptive.h)
     global uint* state;
+    global uint* rays;
 } MegaWork;
 
 // The tile's pixel `i` in the order of 4×4 blocks (16 of them, row by row), or -1 outside the
@@ -88,10 +90,11 @@ inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global ulong4
         uint p = c->pixel[e];
         ulong4 f = film[p];
         ulong3 sum = f.xyz;
-        uint counted = 0u, samples = 0u;
+        uint counted = 0u, samples = 0u, traced = 0u;
         float3 even = (float3)(0.0f);
         uint evens = 0u;
         for (; e < c->count && c->pixel[e] == p; ++e, ++samples) {
+            traced += c->rays[e];
             mega_add_sample(c->result[e], ((c->escaped >> e) & 1u) != 0u, &sum, &counted,
                             &W->nonfinite);
             // The index's parity from the chunk's bit: 0 for even, 1 for odd.
@@ -99,7 +102,10 @@ inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global ulong4
         }
         uint n = frame->background == BACKGROUND_ENV ? samples : counted;
         film[p] = (ulong4)(sum, f.w + n);
-        if (frame->adaptive != 0u) half_store(W->halves, W->state, p, even, evens, samples);
+        if (frame->adaptive != 0u) {
+            half_store(W->halves, W->state, p, even, evens, samples);
+            W->rays[p] += traced;
+        }
     }
 }
 
@@ -165,6 +171,7 @@ inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const Device
     c->even = 0u;
     for (uint e = 0u; e < c->count; ++e) {
         c->even |= (uint)(((frame->first_sample + sample0[e]) & 1u) == 0u) << e;
+        c->rays[e] = 1u;  // its camera ray
     }
     c->remaining = c->count;
     uint n = c->count;
@@ -204,6 +211,7 @@ inline bool mega_chunk_start(MegaWork* W, const DeviceFrame* frame, const Device
         alive[e] = shade_vertex(frame, 0u, sc, hit[e], &s[e], &q[e]);
 #endif
         shadow[e] = q[e].valid ? -1 : 0;
+        c->rays[e] += q[e].valid;
         if (q[e].valid) packet_take_ray(&P, &R, (int)e, q[e].origin, q[e].direction, q[e].tmax);
     }
     for (uint e = n; e < (uint)LANES; ++e) shadow[e] = 0;
@@ -301,6 +309,7 @@ inline void slot_shaded(MegaSlots* S, MegaWork* W, const DeviceFrame* frame,
     alive = alive && ++S->bounce[k] <= frame->max_bounces + 1u;
     if (S->sample[k].valid) {
         ++W->shadow_rays;
+        ++W->chunk[S->chunk[k]].rays[S->entry[k]];
         S->in_shadow[k] = true;
         S->goes_on[k] = alive;
         slot_ready(S, k);
@@ -341,6 +350,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     W.extension_rays = W.shadow_rays = W.nonfinite = 0u;
     W.halves = halves;
     W.state = state;
+    W.rays = rays;
     for (int i = 0; i < MEGA_CHUNKS; ++i) {
         W.chunk[i].remaining = 0u;
         W.chunk[i].more = false;
@@ -448,6 +458,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
                 // closest hit. The path ends.
                 S.to_emitter[k] = false;
                 ++W.extension_rays;
+                ++W.chunk[S.chunk[k]].rays[S.entry[k]];
                 if (M.prim[l] < 0) {
                     shade_vertex(&frame, S.bounce[k], &sc, S.emitter[k], &S.s[k], &S.sample[k]);
                 }
@@ -473,6 +484,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
             // The vertex the extension ray found: shaded at once, or with LANES_SHADE once the
             // batch is full.
             ++W.extension_rays;
+            ++W.chunk[S.chunk[k]].rays[S.entry[k]];
 #ifdef LANES_SHADE
             shade_batch_put(&S.B, S.batch_n, &S.s[k], S.bounce[k], lanes_hit(&M, l));
             S.batch_slot[S.batch_n++] = k;

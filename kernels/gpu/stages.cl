@@ -90,7 +90,7 @@ kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const
                   global DevicePath* paths, global const uint* queue_in, global const DeviceHit* hits,
                   global uint* queue_out, global DeviceShadowRay* shadow_rays,
                   volatile global uint* counters, global float2* cones,
-                  global float4* aov_paths) {
+                  global float4* aov_paths, global uint* rays) {
     uint i = get_global_id(0);
     if (i >= counters[COUNT_IN]) return;
     uint slot = queue_in[i];
@@ -123,6 +123,9 @@ kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const
         ray.contribution = (float4)(q.contribution, q.unweight);
         shadow_rays[atomic_inc(&counters[COUNT_SHADOW])] = ray;
     }
+    // Adaptive sampling's ray count (adaptive.h): the extension ray that found this vertex
+    // and its light sample's.
+    if (frame.adaptive != 0u) atomic_add(&rays[slot % (frame.width * frame.height)], q.valid ? 2u : 1u);
 #ifdef HAS_TEXTURES
     cones[slot] = s.cone;
 #endif

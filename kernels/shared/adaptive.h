@@ -4,7 +4,9 @@
 //          .w their count: Cycles' half buffer, the second estimate the error is measured by;
 //   state: its samples taken (PIXEL_SAMPLES bits), PIXEL_UNDER when its error was under the
 //          threshold at the last check, PIXEL_CONVERGED when it and its eight neighbours were:
-//          a converged pixel takes no samples until a check wakes it again.
+//          a converged pixel takes no samples until a check wakes it again;
+//   rays:  the rays its samples traced (extension and light-sample rays): what its samples
+//          cost, which the cost-weighted rule (ADAPTIVE_COST) weighs its error by.
 // Every kernel that adds samples to the film adds them here too, in the same order, and skips
 // converged pixels; without frame.adaptive nothing here is read or written.
 #ifndef SHARED_ADAPTIVE_H
@@ -27,7 +29,8 @@ inline void half_add(float3 r, uint sample, float3* even, uint* evens) {
 }
 
 // A pixel's `n` new samples, `evens` of them even-numbered with sum `even`, into its half
-// buffer and sample count.
+// buffer and sample count. (The rays they traced go to `rays` where they are counted: the
+// megakernels add a pixel's with its samples, the wavefront's `shade` a vertex's at a time.)
 inline void half_store(global float4* halves, global uint* state, uint pixel, float3 even,
                        uint evens, uint n) {
     float4 h = halves[pixel];
@@ -47,15 +50,28 @@ inline float pixel_error(float4 film, float4 h, uint state) {
     return (d.x + d.y + d.z) / (0.0001f + sqrt(fmax(i.x + i.y + i.z, 0.0f)));
 }
 
-// The convergence check, first pass: PIXEL_UNDER set where the pixel's error is under
-// `threshold`. Pixel 0 zeroes COUNT_ACTIVE for `converge_dilate`.
+// The error a pixel may keep. ADAPTIVE_ERROR (Cycles' rule): `threshold`. ADAPTIVE_COST:
+// `threshold` · √(rays / min_samples), the rays its samples traced: the threshold at the
+// minimum for samples of one ray each, growing as the square root of the samples taken and of
+// their mean cost, so that a pixel stops near n ∝ √(variance / cost), the split of samples
+// that gives the least squared error for the time (docs/adaptive-sampling.md).
+inline float pixel_threshold(const DeviceFrame* frame, float threshold, uint traced,
+                             float min_samples) {
+    if (frame->adaptive != ADAPTIVE_COST) return threshold;
+    return threshold * sqrt((float)traced / min_samples);
+}
+
+// The convergence check, first pass: PIXEL_UNDER set where the pixel's error is under its
+// threshold (`pixel_threshold`). Pixel 0 zeroes COUNT_ACTIVE for `converge_dilate`.
 kernel void converge(DeviceFrame frame, global const ulong4* film, global const float4* halves,
-                     global uint* state, float threshold, volatile global uint* counters) {
+                     global uint* state, global const uint* rays, float threshold,
+                     float min_samples, volatile global uint* counters) {
     uint pixel = get_global_id(0);
     if (pixel == 0u) counters[COUNT_ACTIVE] = 0u;
     if (pixel >= frame.width * frame.height) return;
     uint s = state[pixel];
-    bool under = pixel_error(film_float(film[pixel]), halves[pixel], s) < threshold;
+    float limit = pixel_threshold(&frame, threshold, rays[pixel], min_samples);
+    bool under = pixel_error(film_float(film[pixel]), halves[pixel], s) < limit;
     state[pixel] = under ? s | PIXEL_UNDER : s & ~PIXEL_UNDER;
 }
 

@@ -14,7 +14,7 @@ use crate::cpu_time::process_cpu_seconds;
 use crate::date::today;
 use crate::denoise::{Denoiser, Quality};
 use crate::image_io::read_exr;
-use crate::render::{RenderSettings, Strategy, min_samples};
+use crate::render::{AdaptiveRule, RenderSettings, Strategy, min_samples};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -52,6 +52,14 @@ pub struct ConvergeArgs {
     /// (`render --noise-threshold`), as a curve of its own named "CONFIG+adaptive".
     #[arg(long, value_parser = crate::args::parse_positive)]
     pub adaptive: Option<f32>,
+    /// The adaptive curve's rule (`render --adaptive-rule`): error or cost.
+    #[arg(
+        long,
+        value_name = "RULE",
+        default_value = "error",
+        requires = "adaptive"
+    )]
+    pub adaptive_rule: AdaptiveRule,
     /// Also denoise each step's image as `render --denoise` does, as a curve of its own named
     /// "CONFIG+denoise" whose time adds that one denoising to the renders'. Both curves then
     /// render with the guide buffers on.
@@ -189,6 +197,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         // which the first adaptive curve would otherwise carry).
         renderer.set_settings(&RenderSettings {
             noise_threshold: Some(threshold),
+            adaptive_rule: args.adaptive_rule,
             ..settings.clone()
         })?;
         renderer.render(min_samples(threshold))?;
@@ -213,6 +222,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
         settings.russian_roulette = config.russian_roulette.then_some(3);
         settings.seed = base_seed.wrapping_add(ci as u32 + 1);
         settings.noise_threshold = threshold;
+        settings.adaptive_rule = args.adaptive_rule;
         renderer.set_settings(&settings)?;
         let name = match threshold {
             Some(_) => format!("{}+adaptive", config.name()),
@@ -303,6 +313,7 @@ pub fn run(args: &ConvergeArgs) -> Result<()> {
             "max_spp": max_spp,
             "max_seconds": args.max_seconds,
             "noise_threshold": args.adaptive,
+            "adaptive_rule": args.adaptive.map(|_| args.adaptive_rule.name()),
             "denoiser": args.denoise.then(|| args.denoiser.name()),
             "fit_from": args.fit_from,
             "punctual_lights": prepared.lights.len(),

@@ -233,6 +233,7 @@ impl Program {
         counters: &Buffer<u32>,
         cones: &Buffer<[f32; 2]>,
         aov_paths: &Buffer<[f32; 4]>,
+        rays: &Buffer<u32>,
         slots: usize,
     ) -> Result<Launch, ClError> {
         self.run(
@@ -258,7 +259,8 @@ impl Program {
                     .set_arg(&shadow_rays.mem())
                     .set_arg(&counters.mem())
                     .set_arg(&cones.mem())
-                    .set_arg(&aov_paths.mem());
+                    .set_arg(&aov_paths.mem())
+                    .set_arg(&rays.mem());
             },
         )
     }
@@ -346,8 +348,10 @@ impl Program {
         frame: &DeviceFrame,
         film: &AdaptiveFilm,
         threshold: f32,
+        min_samples: u32,
         counters: &Buffer<u32>,
     ) -> Result<[Launch; 2], ClError> {
+        let min_samples = min_samples as f32;
         let pixels = (frame.width * frame.height) as usize;
         let stage = Stage::Converge.name();
         let mark = self.run(device, stage, &self.converge, pixels, |e| unsafe {
@@ -355,7 +359,9 @@ impl Program {
                 .set_arg(&film.sum.mem())
                 .set_arg(&film.half.mem())
                 .set_arg(&film.state.mem())
+                .set_arg(&film.rays.mem())
                 .set_arg(&threshold)
+                .set_arg(&min_samples)
                 .set_arg(&counters.mem());
         })?;
         let dilate = self.run(device, stage, &self.converge_dilate, pixels, |e| unsafe {
@@ -538,7 +544,8 @@ impl Program {
                     .set_arg(&film.sum.mem())
                     .set_arg(&counters.mem())
                     .set_arg(&film.half.mem())
-                    .set_arg(&film.state.mem());
+                    .set_arg(&film.state.mem())
+                    .set_arg(&film.rays.mem());
                 set_aovs(e, &film.aovs);
             },
         )
@@ -556,6 +563,8 @@ pub struct AdaptiveFilm {
     pub half: Buffer<[f32; 4]>,
     /// Per pixel: the samples it took and its convergence bits (`PIXEL_*`).
     pub state: Buffer<u32>,
+    /// Per pixel: the rays its samples traced, extension and light-sample rays together.
+    pub rays: Buffer<u32>,
     /// The guide buffers (written with `AOVS` only).
     pub aovs: AovBuffers,
 }

@@ -159,6 +159,14 @@ kernel_constants! {
     /// It and its eight neighbours were under the threshold: it takes no samples.
     PIXEL_CONVERGED: u32 = 0x8000_0000;
 
+    /// `DeviceFrame::adaptive`: no adaptive sampling (its buffers untouched).
+    ADAPTIVE_OFF: u32 = 0;
+    /// Adaptive sampling, a pixel converged when its error is under the threshold (Cycles').
+    ADAPTIVE_ERROR: u32 = 1;
+    /// Adaptive sampling, the threshold weighed by the rays the pixel's samples traced
+    /// (kernels/shared/adaptive.h's `pixel_threshold`).
+    ADAPTIVE_COST: u32 = 2;
+
     /// The side of the square of pixels a work item of the megakernel with lanes
     /// (`MEGA_LANES`) renders: its sixteen lanes take them one after the other, so that a lane
     /// whose pixels sample quickly (the sky) takes more of them and none waits long for the
@@ -484,8 +492,9 @@ pub struct DeviceFrame {
     /// built for up to `SMALL_SCENE_MAX` of them so that hiding or showing an object in such a
     /// scene does not build the kernels again; 0 elsewhere.
     pub triangles: u32,
-    /// 1: adaptive sampling (kernels/shared/adaptive.h): converged pixels are skipped and the
-    /// half buffer and sample counts kept; 0: neither is read or written.
+    /// `ADAPTIVE_ERROR` or `ADAPTIVE_COST`: adaptive sampling (kernels/shared/adaptive.h) by
+    /// that rule: converged pixels are skipped and the half buffer, sample and ray counts kept;
+    /// `ADAPTIVE_OFF`: none of them is read or written.
     pub adaptive: u32,
     /// Pads the struct to the device's 16-byte alignment.
     pub pad: [u32; 3],

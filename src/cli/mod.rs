@@ -90,6 +90,16 @@ pub struct RenderArgs {
     /// (0.01 is clean, 0.1 rough); --spp is then the most a pixel takes (default: off).
     #[arg(long, allow_negative_numbers = true, value_parser = crate::args::parse_positive)]
     pub noise_threshold: Option<f32>,
+    /// How --noise-threshold judges a pixel: `error` (its relative error under the threshold,
+    /// Cycles' rule) or `cost` (under the threshold times √(rays its samples traced / the
+    /// minimum samples): expensive pixels stop sooner; docs/adaptive-sampling.md).
+    #[arg(
+        long,
+        value_name = "RULE",
+        default_value = "error",
+        requires = "noise_threshold"
+    )]
+    pub adaptive_rule: crate::render::AdaptiveRule,
     /// Stop after this many seconds of rendering, wall clock; --spp is then the most a pixel
     /// takes (default: none).
     #[arg(long, allow_negative_numbers = true, value_parser = crate::args::parse_seconds)]

@@ -42,6 +42,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut settings = args.common.settings(DEFAULT_SIZE)?;
     args.strategy.apply(&mut settings);
     settings.noise_threshold = args.noise_threshold;
+    settings.adaptive_rule = args.adaptive_rule;
     // The denoiser reads the guide buffers.
     settings.aovs = args.aovs || args.denoise;
     let spp = args.common.sampling.spp.unwrap_or(DEFAULT_SPP);
@@ -530,6 +531,10 @@ fn render_frame(
         ("samples", serde_json::json!(samples as u64)),
         ("mean_spp", serde_json::json!(mean_spp)),
         ("noise_threshold", serde_json::json!(args.noise_threshold)),
+        (
+            "adaptive_rule",
+            serde_json::json!(args.noise_threshold.map(|_| args.adaptive_rule.name())),
+        ),
         ("time_limit", serde_json::json!(args.time_limit)),
         ("aovs", serde_json::json!(args.aovs)),
         (

@@ -96,8 +96,14 @@ impl Renderer {
             return Err(ClError::Device("no scene is loaded".into()));
         };
         let frame = self.settings.gpu_frame(self.light_count);
-        let [mark, dilate] =
-            program.converge(&self.device, &frame, &f.film, threshold, &self.counters)?;
+        let [mark, dilate] = program.converge(
+            &self.device,
+            &frame,
+            &f.film,
+            threshold,
+            min_samples(threshold),
+            &self.counters,
+        )?;
         self.adaptive_checked = true;
         self.active_stale = true;
         Ok(vec![(Stage::Converge, mark), (Stage::Converge, dilate)])

@@ -29,7 +29,7 @@ pub use instancing::BvhChoice;
 pub use lights::gpu_lights;
 pub use megakernel::{Band, KernelChoice};
 pub use readback::Aovs;
-pub use settings::{RenderSettings, Strategy};
+pub use settings::{AdaptiveRule, RenderSettings, Strategy};
 pub use textures::TexturePack;
 pub use update::{InstanceUpdate, SceneUpdate, UpdateKind};
 pub use upload::{Accel, HostScene, gpu_camera, gpu_material, samples_textures};
@@ -456,6 +456,7 @@ impl Renderer {
             if self.settings.noise_threshold.is_some() {
                 f.film.half.clear(&self.device)?;
                 f.film.state.clear(&self.device)?;
+                f.film.rays.clear(&self.device)?;
             }
             if self.settings.aovs {
                 f.film.aovs.clear(&self.device)?;

@@ -1,8 +1,8 @@
 //! What the user controls about a render.
 
 use crate::cl::types::{
-    BACKGROUND_COUNT, BACKGROUND_CUTOUT, BACKGROUND_ENV, DeviceFrame, STRATEGY_BSDF,
-    STRATEGY_LIGHTS, STRATEGY_MIS,
+    ADAPTIVE_COST, ADAPTIVE_ERROR, ADAPTIVE_OFF, BACKGROUND_COUNT, BACKGROUND_CUTOUT,
+    BACKGROUND_ENV, DeviceFrame, STRATEGY_BSDF, STRATEGY_LIGHTS, STRATEGY_MIS,
 };
 
 /// Which estimator feeds direct light.
@@ -15,6 +15,39 @@ pub enum Strategy {
     Bsdf,
     /// Light sampling only (emitters hit by BSDF rays count only when seen directly).
     Lights,
+}
+
+/// When adaptive sampling stops a pixel (docs/adaptive-sampling.md, "The rule").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum AdaptiveRule {
+    /// Its relative error is under the threshold (Cycles' rule).
+    #[default]
+    Error,
+    /// Its relative error is under the threshold times √(rays its samples traced / the
+    /// minimum): expensive and well-sampled pixels stop sooner, each near n ∝ √(variance /
+    /// cost).
+    Cost,
+}
+
+impl AdaptiveRule {
+    /// The name used on the command line and in summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            AdaptiveRule::Error => "error",
+            AdaptiveRule::Cost => "cost",
+        }
+    }
+}
+
+impl std::str::FromStr for AdaptiveRule {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "error" => Ok(AdaptiveRule::Error),
+            "cost" => Ok(AdaptiveRule::Cost),
+            other => Err(format!("adaptive rule '{other}' is not 'error' or 'cost'")),
+        }
+    }
 }
 
 /// Settings of the path tracer.
@@ -53,6 +86,8 @@ pub struct RenderSettings {
     /// Adaptive sampling: pixels whose relative error is under this stop taking samples
     /// (docs/adaptive-sampling.md); `None`: every pixel takes every sample.
     pub noise_threshold: Option<f32>,
+    /// How adaptive sampling weighs a pixel's error against the threshold.
+    pub adaptive_rule: AdaptiveRule,
     /// Guide buffers for a denoiser: the film also sums each sample's albedo, normal and depth
     /// (docs/aovs.md; `Renderer::aovs`). Off, the kernels are built without them.
     pub aovs: bool,
@@ -75,6 +110,7 @@ impl Default for RenderSettings {
             cutout: false,
             count_coverage: false,
             noise_threshold: None,
+            adaptive_rule: AdaptiveRule::Error,
             aovs: false,
         }
     }
@@ -110,7 +146,11 @@ impl RenderSettings {
                 (false, false) => BACKGROUND_ENV,
             },
             triangles: 0,
-            adaptive: u32::from(self.noise_threshold.is_some()),
+            adaptive: match (self.noise_threshold, self.adaptive_rule) {
+                (None, _) => ADAPTIVE_OFF,
+                (Some(_), AdaptiveRule::Error) => ADAPTIVE_ERROR,
+                (Some(_), AdaptiveRule::Cost) => ADAPTIVE_COST,
+            },
             pad: [0; 3],
         }
     }

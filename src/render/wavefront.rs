@@ -194,6 +194,7 @@ impl Wave<'_> {
             self.counters,
             &f.cones,
             &f.aov_paths,
+            &f.film.rays,
             self.live,
         )?;
         self.push(Stage::Shade, l);
@@ -263,11 +264,13 @@ impl Renderer {
             sum: Buffer::new(device, pixels)?,
             half: Buffer::new(device, pixels)?,
             state: Buffer::new(device, pixels)?,
+            rays: Buffer::new(device, pixels)?,
             aovs: AovBuffers::new(device, if aovs { pixels } else { 1 })?,
         };
         film.sum.clear(device)?;
         film.half.clear(device)?;
         film.state.clear(device)?;
+        film.rays.clear(device)?;
         self.frame = Some(Frame {
             width: w,
             height: h,
