@@ -97,20 +97,20 @@ impl<T: Pod> Buffer<T> {
         self.len.max(1) * std::mem::size_of::<T>()
     }
 
-    /// Copies `data` to the start of the buffer (blocking).
-    pub fn write(&mut self, device: &Device, data: &[T]) -> Result<(), ClError> {
+    /// Copies `data` to the start of the buffer (blocking); the bytes written.
+    pub fn write(&mut self, device: &Device, data: &[T]) -> Result<usize, ClError> {
         self.write_at(device, 0, data)
     }
 
     /// Copies `data` into the buffer from element `at` on (blocking): an update in place, no
-    /// new allocation.
-    pub fn write_at(&mut self, device: &Device, at: usize, data: &[T]) -> Result<(), ClError> {
+    /// new allocation. The bytes written.
+    pub fn write_at(&mut self, device: &Device, at: usize, data: &[T]) -> Result<usize, ClError> {
         assert!(
             at + data.len() <= self.len.max(1),
             "write past the end of a buffer"
         );
         if data.is_empty() {
-            return Ok(());
+            return Ok(0);
         }
         let offset = at * std::mem::size_of::<T>();
         // SAFETY: the slice fits the buffer from `at` on (checked above); the write is blocking.
@@ -120,7 +120,7 @@ impl<T: Pod> Buffer<T> {
                 .enqueue_write_buffer(&mut self.inner, CL_BLOCKING, offset, data, &[])
                 .map_err(call_err("uploading a buffer"))?;
         }
-        Ok(())
+        Ok(std::mem::size_of_val(data))
     }
 
     /// Writes every element through a mapping of the whole buffer (blocking): `fill` gets the

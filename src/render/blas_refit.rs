@@ -8,6 +8,7 @@
 //! ranges, texture coordinates, colours and textures stay as they are on the device.
 
 use super::instancing::{instanced_objects, render_from_world};
+use super::update::write_tlas;
 use super::upload::{HostScene, PosedMesh, gpu_material};
 use super::{Accel, Renderer, lights};
 use crate::bvh::{Blas, Update, WideBvh};
@@ -163,29 +164,23 @@ impl Renderer {
             .collect();
         let device = &self.device;
         let mut bytes = 0;
-        let mut written = |n: usize| bytes += n;
         // The deformed meshes' ranges: nodes, triangles, shading data, tangents.
         for ((b, _, blas, nodes, wide), (tris, shading, tangents)) in made.into_iter().zip(structs)
         {
             let first = two.firsts[b] as usize;
             if forms.binary {
                 let root = layout.roots[b] as usize;
-                buffers.nodes.write_at(device, root, &nodes)?;
-                written(std::mem::size_of_val(nodes.as_slice()));
+                bytes += buffers.nodes.write_at(device, root, &nodes)?;
             }
             if let Some((nodes, wide)) = wide {
                 let root = layout.wide_roots[b] as usize;
-                buffers.wide_nodes.write_at(device, root, &nodes)?;
-                written(std::mem::size_of_val(nodes.as_slice()));
+                bytes += buffers.wide_nodes.write_at(device, root, &nodes)?;
                 layout.wide_blases[b] = Some(wide);
             }
-            buffers.triangles.write_at(device, first, &tris)?;
-            buffers.shading.write_at(device, first, &shading)?;
-            written(std::mem::size_of_val(tris.as_slice()));
-            written(std::mem::size_of_val(shading.as_slice()));
+            bytes += buffers.triangles.write_at(device, first, &tris)?;
+            bytes += buffers.shading.write_at(device, first, &shading)?;
             if layout.mesh_tangents {
-                buffers.tangents.write_at(device, first, &tangents)?;
-                written(std::mem::size_of_val(tangents.as_slice()));
+                bytes += buffers.tangents.write_at(device, first, &tangents)?;
             }
             if two.is_small(&blas) {
                 layout.small_meshes[b] = tris;
@@ -202,31 +197,16 @@ impl Renderer {
         }
         two.rebuild_tlas();
         let tlas_ms = fitting.elapsed().as_secs_f64() * 1e3;
-        if forms.binary {
-            let nodes = two.device_tlas();
-            buffers.nodes.write_at(device, 0, &nodes)?;
-            written(std::mem::size_of_val(nodes.as_slice()));
-        }
-        if forms.wide {
-            let mut wide = WideBvh::collapse(&two.tlas).nodes;
-            wide.resize(two.tlas_slots(), DeviceWideNode::default());
-            buffers.wide_nodes.write_at(device, 0, &wide)?;
-            written(std::mem::size_of_val(wide.as_slice()));
-        }
-        let instances = layout.gpu_instances(two);
-        buffers.instances.write_at(device, 0, &instances)?;
-        written(std::mem::size_of_val(instances.as_slice()));
+        bytes += write_tlas(buffers, device, two, layout)?;
         // The small instances' world-space copies follow the meshes' triangles.
         if two.has_small_meshes() {
             let first = two.blases.iter().map(|b| b.len()).sum();
             let copies = layout.piece_copies(two, first);
-            buffers.triangles.write_at(device, first, &copies)?;
-            written(std::mem::size_of_val(copies.as_slice()));
+            bytes += buffers.triangles.write_at(device, first, &copies)?;
         }
         host.set_space(scene, space);
         host.materials = materials.iter().map(gpu_material).collect();
-        buffers.materials.write(device, &host.materials)?;
-        written(std::mem::size_of_val(host.materials.as_slice()));
+        bytes += buffers.materials.write(device, &host.materials)?;
         host.measure_emitters(&materials);
         host.scale_emitter_power(&lights::emissive_texture_means(scene));
         self.follow_pose(lights)?;

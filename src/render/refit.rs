@@ -101,8 +101,7 @@ impl Renderer {
                 &dirty.tangents,
             )?;
         }
-        bytes += std::mem::size_of_val(host.materials.as_slice());
-        buffers.materials.write(device, &host.materials)?;
+        bytes += buffers.materials.write(device, &host.materials)?;
         self.follow_pose(lights)?;
         Ok(Ok(RefitTimes {
             flatten_ms: space_ms + flatten_ms,
@@ -134,11 +133,11 @@ fn replace<T: bytemuck::Pod>(
     data: &[T],
 ) -> Result<usize, ClError> {
     if buffer.len() == data.len() {
-        buffer.write(device, data)?;
+        buffer.write(device, data)
     } else {
         *buffer = Buffer::from_slice(device, data)?;
+        Ok(std::mem::size_of_val(data))
     }
-    Ok(std::mem::size_of_val(data))
 }
 
 /// Writes the chunks of `data` marked in `dirty` ([`CHUNK`] elements each) over `buffer`, a
@@ -164,8 +163,7 @@ fn write_changed<T: bytemuck::Pod>(
             c += 1;
         }
         let run = &data[first * CHUNK..(c * CHUNK).min(data.len())];
-        buffer.write_at(device, first * CHUNK, run)?;
-        bytes += std::mem::size_of_val(run);
+        bytes += buffer.write_at(device, first * CHUNK, run)?;
     }
     Ok(bytes)
 }

@@ -9,11 +9,14 @@
 use super::blas_refit::refit_blases;
 use super::instancing::{Blases, instanced_objects, render_from_world};
 use super::refit::NoRefit;
+use super::upload::InstanceLayout;
 use super::upload::piece_copies;
 use super::{Accel, Renderer};
+use crate::bvh::TwoLevel;
 use crate::bvh::WideBvh;
-use crate::cl::ClError;
+use crate::cl::kernels::SceneBuffers;
 use crate::cl::types::DeviceWideNode;
+use crate::cl::{ClError, Device};
 use crate::scene::{Light, Scene, is_sane};
 use std::time::Instant;
 
@@ -215,31 +218,15 @@ impl Renderer {
             two.hidden[i] = !visible;
         }
         two.rebuild_tlas();
-        let slots = two.tlas_slots();
-        let instances = host.layout.gpu_instances(two);
         let device = &self.device;
-        let mut bytes = std::mem::size_of_val(instances.as_slice());
-        // The TLAS in each node array the device has (`NodeForms`).
-        if buffers.forms.binary {
-            let nodes = two.device_tlas();
-            buffers.nodes.write_at(device, 0, &nodes)?;
-            bytes += std::mem::size_of_val(nodes.as_slice());
-        }
-        if buffers.forms.wide {
-            let mut wide = WideBvh::collapse(&two.tlas).nodes;
-            wide.resize(slots, DeviceWideNode::default());
-            buffers.wide_nodes.write_at(device, 0, &wide)?;
-            bytes += std::mem::size_of_val(wide.as_slice());
-        }
-        buffers.instances.write_at(device, 0, &instances)?;
+        let mut bytes = write_tlas(buffers, device, two, &host.layout)?;
         // A moved small instance's world-space triangle copies (the TLAS's pieces).
         for &(i, _, _) in &moved {
             let base = host.layout.copy_bases[i] as usize;
             if base != u32::MAX as usize {
                 let mesh = &host.layout.small_meshes[two.instances[i].blas as usize];
                 let copies = piece_copies(two, mesh, i);
-                buffers.triangles.write_at(device, base, &copies)?;
-                bytes += std::mem::size_of_val(copies.as_slice());
+                bytes += buffers.triangles.write_at(device, base, &copies)?;
             }
         }
         for &(i, _, _) in &moved {
@@ -257,4 +244,27 @@ impl Renderer {
         self.reset()?;
         Ok(Some(update))
     }
+}
+
+/// Writes `two`'s TLAS over the device's, in each node array it has (`NodeForms`), and the
+/// device instances in TLAS order (`layout`); the bytes written.
+pub(super) fn write_tlas(
+    buffers: &mut SceneBuffers,
+    device: &Device,
+    two: &TwoLevel,
+    layout: &InstanceLayout,
+) -> Result<usize, ClError> {
+    let mut bytes = 0;
+    if buffers.forms.binary {
+        bytes += buffers.nodes.write_at(device, 0, &two.device_tlas())?;
+    }
+    if buffers.forms.wide {
+        let mut wide = WideBvh::collapse(&two.tlas).nodes;
+        wide.resize(two.tlas_slots(), DeviceWideNode::default());
+        bytes += buffers.wide_nodes.write_at(device, 0, &wide)?;
+    }
+    bytes += buffers
+        .instances
+        .write_at(device, 0, &layout.gpu_instances(two))?;
+    Ok(bytes)
 }

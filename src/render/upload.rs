@@ -9,7 +9,7 @@ mod repose;
 mod structs;
 mod triangles;
 
-pub use accel::{Accel, piece_copies};
+pub use accel::{Accel, InstanceLayout, piece_copies};
 pub use host_scene::{FlatRefit, HostScene, PosedMesh, render_middle};
 pub use repose::CHUNK;
 pub(super) use structs::{f4, luminance};
