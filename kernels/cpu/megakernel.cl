@@ -139,7 +139,7 @@ kernel void megakernel(MEGAKERNEL_PARAMS) {
     film[pixel] = (ulong4)(sum, pixel_film.w + counted);
     if (frame.adaptive != 0u) {
         half_store(halves, state, pixel, even, evens, frame.samples_in_wave);
-        rays[pixel] += extension_rays + shadow_rays;
+        if (frame.adaptive == ADAPTIVE_COST) rays[pixel] += extension_rays + shadow_rays;
     }
 #ifdef AOVS
     aov_store(aov_albedo, aov_normal, aov_depth, pixel, aov_albedo_sum, aov_normal_sum,

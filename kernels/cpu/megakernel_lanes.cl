@@ -104,7 +104,7 @@ inline void mega_chunk_done(MegaWork* W, const DeviceFrame* frame, global ulong4
         film[p] = (ulong4)(sum, f.w + n);
         if (frame->adaptive != 0u) {
             half_store(W->halves, W->state, p, even, evens, samples);
-            W->rays[p] += traced;
+            if (frame->adaptive == ADAPTIVE_COST) W->rays[p] += traced;
         }
     }
 }

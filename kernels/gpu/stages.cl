@@ -123,9 +123,9 @@ kernel void shade(DeviceFrame frame, DeviceEnvironment environment, global const
         ray.contribution = (float4)(q.contribution, q.unweight);
         shadow_rays[atomic_inc(&counters[COUNT_SHADOW])] = ray;
     }
-    // Adaptive sampling's ray count (adaptive.h): the extension ray that found this vertex
-    // and its light sample's.
-    if (frame.adaptive != 0u) atomic_add(&rays[slot % (frame.width * frame.height)], q.valid ? 2u : 1u);
+    // The cost rule's ray count (adaptive.h): the extension ray that found this vertex and its
+    // light sample's. Only that rule reads it: the other modes pay no atomic here.
+    if (frame.adaptive == ADAPTIVE_COST) atomic_add(&rays[slot % (frame.width * frame.height)], q.valid ? 2u : 1u);
 #ifdef HAS_TEXTURES
     cones[slot] = s.cone;
 #endif

@@ -6,7 +6,8 @@
 //          threshold at the last check, PIXEL_CONVERGED when it and its eight neighbours were:
 //          a converged pixel takes no samples until a check wakes it again;
 //   rays:  the rays its samples traced (extension and light-sample rays): what its samples
-//          cost, which the cost-weighted rule (ADAPTIVE_COST) weighs its error by.
+//          cost, which the cost-weighted rule (ADAPTIVE_COST) weighs its error by; counted
+//          under that rule only.
 // Every kernel that adds samples to the film adds them here too, in the same order, and skips
 // converged pixels; without frame.adaptive nothing here is read or written.
 #ifndef SHARED_ADAPTIVE_H
