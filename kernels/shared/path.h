@@ -477,9 +477,13 @@ SHADE_INLINE bool shade_vertex(const DeviceFrame* frame, uint bounce, const Shad
     if (alive && bounce >= frame->rr_depth) {
         // Inside a volume of index n the throughput carries the 1/n^2 that radiance lost coming
         // in and gets back going out; the roulette judges the path without it (pbrt's eta
-        // scale), or it would cull light inside glass for a loss that is not one.
+        // scale), or it would cull light inside glass for a loss that is not one. `ng` faces
+        // `wo`, so the path goes on inside when it crosses in from the front (side < 0) or
+        // reflects off the boundary from inside (side > 0, a back face); seen from inside,
+        // `m.ior` is already the inverse (material_from_inside).
         float3 judged = throughput;
-        if (m.transmission > 0.0f && m.thickness > 0.0f && (side < 0.0f) == front) {
+        bool goes_on_inside = (side < 0.0f) == front;
+        if (m.transmission > 0.0f && m.thickness > 0.0f && goes_on_inside) {
             float n = front ? m.ior : 1.0f / m.ior;
             judged *= n * n;
         }
